@@ -1,0 +1,177 @@
+"""The ``kinelab`` command: parse, call the public API, print. User errors: one line, exit code 2.
+
+Every command that prints results takes ``--json`` for a stable machine-readable form (see README).
+Angles on the command line are radians unless ``--deg`` is given; ``--deg`` applies to revolute and
+continuous joints only (prismatic joints stay in metres).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab import catalog
+from kinelab.errors import KinelabError
+from kinelab.robot import Robot, load
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str):  # one line, exit 2, as for every user error
+        self.exit(2, f"kinelab: error: {message} (see 'kinelab {self.prog.split()[-1]} --help')\n")
+
+
+def _q_from_cli(robot: Robot, values: list[float], deg: bool, what: str = "q") -> np.ndarray:
+    q = robot.check_q(values, what=what)
+    if deg:
+        angular = np.array([k != "prismatic" for k in robot.joint_kinds])
+        q = np.where(angular, np.deg2rad(q), q)
+    return q
+
+
+def pose_dict(oMtool: pin.SE3) -> dict:
+    """The JSON form of a pose: position [m], rotation matrix, quat_wxyz, rpy [rad]."""
+    quat = pin.Quaternion(oMtool.rotation)
+    wxyz = np.array([quat.w, quat.x, quat.y, quat.z])
+    wxyz = -wxyz if wxyz[0] < 0 else wxyz  # canonical sign: w >= 0
+    return {
+        "position_m": oMtool.translation.tolist(),
+        "rotation_matrix": oMtool.rotation.tolist(),
+        "quat_wxyz": wxyz.tolist(),
+        "rpy_rad": pin.rpy.matrixToRpy(oMtool.rotation).tolist(),
+    }
+
+
+def _print_json(obj) -> None:
+    print(json.dumps(obj, indent=2))
+
+
+def cmd_robots(args) -> int:
+    rows = [
+        {"name": e.name, "source": e.source, "tool": e.tool, "description": e.description}
+        for e in catalog.ENTRIES.values()
+    ]
+    if args.json:
+        _print_json(rows)
+    else:
+        for r in rows:
+            print(f"{r['name']:<11} {r['source']:<19} {r['description']}")
+    return 0
+
+
+def _joint_row(j) -> dict:
+    row = {"name": j.name, "type": j.kind, "lower": j.lower, "upper": j.upper, "unit": j.unit}
+    if j.kind != "prismatic":
+        row["lower_deg"], row["upper_deg"] = float(np.rad2deg(j.lower)), float(np.rad2deg(j.upper))
+    return row
+
+
+def cmd_info(args) -> int:
+    robot = load(args.robot, tool=args.tool)
+    info = {
+        "robot": robot.name,
+        "urdf": str(robot.urdf_path),
+        "base": robot.base,
+        "tool": robot.tool,
+        "dof": robot.n,
+        "nq": robot.nq,
+        "nv": robot.nv,
+        "joints": [_joint_row(j) for j in robot.joints],
+        "locked": robot.locked,
+    }
+    if args.json:
+        _print_json(info)
+        return 0
+    print(f"{robot.name}: {robot.n} DOF (nq={robot.nq}, nv={robot.nv}), base {robot.base!r} -> tool {robot.tool!r}")
+    print(f"urdf: {robot.urdf_path}")
+    print(f"  {'#':>2} {'joint':<22} {'type':<11} {'lower':>12} {'upper':>12}")
+    for i, j in enumerate(robot.joints, start=1):
+        if j.kind == "prismatic":
+            lo, hi = f"{j.lower:.4f} m", f"{j.upper:.4f} m"
+        else:
+            lo, hi = f"{np.rad2deg(j.lower):.3f} deg", f"{np.rad2deg(j.upper):.3f} deg"
+        print(f"  {i:>2} {j.name:<22} {j.kind:<11} {lo:>12} {hi:>12}")
+    if robot.locked:
+        print(f"locked: {', '.join(f'{k}={v:g}' for k, v in robot.locked.items())}")
+    return 0
+
+
+def cmd_fk(args) -> int:
+    robot = load(args.robot, tool=args.tool)
+    q = _q_from_cli(robot, args.q, args.deg)
+    robot.check_q(q, limits=not args.ignore_limits)
+    oMtool = robot.fk(q)
+    out = {"robot": robot.name, "base": robot.base, "tool": robot.tool, "q": q.tolist(), **pose_dict(oMtool)}
+    if args.json:
+        _print_json(out)
+        return 0
+    print(f"{robot.name}: pose of {robot.tool!r} in {robot.base!r}")
+    print(f"  position [m]   {np.array2string(oMtool.translation, precision=6)}")
+    print(f"  quat_wxyz      {np.array2string(np.array(out['quat_wxyz']), precision=6)}")
+    print(f"  rpy [rad]      {np.array2string(np.array(out['rpy_rad']), precision=6)}")
+    print("  rotation       " + np.array2string(oMtool.rotation, precision=6, prefix="  rotation       "))
+    return 0
+
+
+def cmd_validate(args) -> int:
+    from kinelab import validate
+
+    report = validate.run(robots=args.robots, n=args.n, seed=args.seed, progress=not args.json)
+    if args.out:
+        validate.write_report(report, args.out)
+    if args.json:
+        _print_json(report.to_dict())
+    else:
+        print(validate.format_table(report))
+        if args.out:
+            print(f"report written to {args.out}")
+    return 0 if report.passed else 1
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = _Parser(prog="kinelab", description="Kinematics of serial arms, checked against Pinocchio.")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    s = sub.add_parser("robots", help="list the registered robots")
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(func=cmd_robots)
+
+    s = sub.add_parser("info", help="joints, types, limits, DOF and tool frame of a robot")
+    s.add_argument("robot", help="registered name or URDF path")
+    s.add_argument("--tool", help="tool frame (default: the robot's own)")
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(func=cmd_info)
+
+    s = sub.add_parser("fk", help="tool pose at a configuration")
+    s.add_argument("robot", help="registered name or URDF path")
+    s.add_argument("q", nargs="*", type=float, help="one number per joint (rad and m; deg with --deg)")
+    s.add_argument("--deg", action="store_true", help="angles of revolute/continuous joints in degrees")
+    s.add_argument("--tool", help="tool frame (default: the robot's own)")
+    s.add_argument("--ignore-limits", action="store_true", help="allow q outside the joint limits")
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(func=cmd_fk)
+
+    s = sub.add_parser("validate", help="check every kinelab computation against Pinocchio on the bundled robots")
+    s.add_argument("--robots", nargs="+", default=None, help="robots to check (default: the embedded set)")
+    s.add_argument("--n", type=int, default=None, help="random configurations per check")
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--out", help="write a report folder (Markdown, HTML, JSON) here")
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(func=cmd_validate)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except KinelabError as exc:
+        print(f"kinelab: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

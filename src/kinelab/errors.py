@@ -1,0 +1,69 @@
+"""kinelab's exceptions: one base class, narrow subclasses that carry what went wrong and what is valid."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+
+class KinelabError(Exception):
+    """Base class of every error kinelab raises on bad input or an impossible request."""
+
+
+def _listing(options: Iterable[str], most: int = 40) -> str:
+    names = list(options)
+    shown = ", ".join(names[:most])
+    return shown + (f", ... ({len(names)} in all)" if len(names) > most else "")
+
+
+class RobotNotFoundError(KinelabError):
+    """A robot name that is neither registered nor an existing URDF file."""
+
+    def __init__(self, name: str, valid: Iterable[str]):
+        self.name = name
+        self.valid = list(valid)
+        super().__init__(
+            f"unknown robot {name!r}: not a registered name and no such file; "
+            f"registered robots are: {_listing(self.valid)}"
+        )
+
+
+class URDFError(KinelabError):
+    """A URDF that cannot be read: missing, malformed, or not describing a usable chain."""
+
+
+class ChainError(KinelabError):
+    """The base-to-tool path is not a serial chain kinelab can use (ambiguous tool, loop, joint type)."""
+
+
+class FrameNotFoundError(KinelabError):
+    """A frame name that the robot does not have."""
+
+    def __init__(self, name: str, valid: Iterable[str], robot: str = ""):
+        self.name = name
+        self.valid = list(valid)
+        where = f" in robot {robot!r}" if robot else ""
+        super().__init__(f"unknown frame {name!r}{where}; frames are: {_listing(self.valid, 60)}")
+
+
+class JointNotFoundError(KinelabError):
+    """A joint name that is not one of the robot's chain joints."""
+
+    def __init__(self, name: str, valid: Iterable[str]):
+        self.name = name
+        self.valid = list(valid)
+        super().__init__(f"unknown joint {name!r}; joints are: {_listing(self.valid)}")
+
+
+class ConfigurationError(KinelabError):
+    """A joint vector of the wrong shape or with non-finite entries."""
+
+
+class JointLimitError(ConfigurationError):
+    """A joint value outside its limits, where the limits matter."""
+
+    def __init__(self, joint: str, value: float, lower: float, upper: float, unit: str = ""):
+        self.joint, self.value, self.lower, self.upper = joint, value, lower, upper
+        u = f" {unit}" if unit else ""
+        super().__init__(
+            f"joint {joint!r} = {value:.6g}{u} is outside its limits [{lower:.6g}, {upper:.6g}]{u}"
+        )

@@ -1,0 +1,1 @@
+"""The source papers' experiments, used by notebooks, ``kinelab validate`` and the tests."""

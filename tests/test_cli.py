@@ -1,0 +1,70 @@
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from kinelab import cli
+from kinelab.studies import stanford_seed001 as seed001
+
+
+def run(capsys, *argv):
+    code = cli.main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_robots_lists_bundled_and_arms(capsys):
+    code, out, _ = run(capsys, "robots", "--json")
+    names = [r["name"] for r in json.loads(out)]
+    assert code == 0 and names[:3] == ["stanford", "era", "youbot"] and "panda" in names
+
+
+def test_info_youbot_lists_the_papers_joints_and_limits_in_degrees(capsys):
+    code, out, _ = run(capsys, "info", "youbot")
+    assert code == 0 and "8 DOF" in out
+    rows = [line.split() for line in out.splitlines() if line.strip()[:1].isdigit()]
+    assert [r[1] for r in rows] == ["platform_x", "platform_y", "platform_yaw", "arm_joint_1",
+                                    "arm_joint_2", "arm_joint_3", "arm_joint_4", "arm_joint_5"]
+    limits = [(float(r[3]), float(r[5])) for r in rows[3:]]
+    assert limits == [(-169, 169), (-65, 90), (-151, 146), (-102.5, 102.5), (-167.5, 167.5)]
+    assert all(r[4] == "deg" for r in rows[3:])
+
+
+def test_info_json_is_stable(capsys):
+    code, out, _ = run(capsys, "info", "youbot", "--json")
+    info = json.loads(out)
+    assert code == 0 and info["dof"] == 8 and info["nq"] == 9
+    j = info["joints"][5]
+    assert j["name"] == "arm_joint_3" and j["lower_deg"] == pytest.approx(-151) and j["unit"] == "rad"
+
+
+def test_fk_stanford_matches_the_papers_rotation(capsys):
+    code, out, _ = run(capsys, "fk", "stanford", "20", "40", "0.3", "-35", "60", "-45", "--deg", "--json")
+    pose = json.loads(out)
+    assert code == 0
+    assert seed001.quat_distance_wxyz(pose["quat_wxyz"], seed001.N_REAL_WXYZ) < 1e-5
+    assert pose["quat_wxyz"][0] >= 0
+    assert pose["q"][2] == 0.3  # --deg leaves the prismatic joint in metres
+    R = np.array(pose["rotation_matrix"])
+    np.testing.assert_allclose(R @ R.T, np.eye(3), atol=1e-12)
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["info", "nosuch"], "registered robots are: stanford"),
+    (["fk", "stanford", "1", "2"], "must have 6 numbers"),
+    (["fk", "stanford", "0", "0", "nan", "0", "0", "0"], "finite"),
+    (["fk", "stanford", "0", "0", "2", "0", "0", "0"], "outside its limits"),
+    (["fk", "ur5", "0", "0", "0", "0", "0", "0", "--tool", "flange"], "unknown frame 'flange'"),
+    (["fk", "stanford", "0", "x"], "invalid float value"),
+    (["nosuchcommand"], "invalid choice"),
+])
+def test_user_errors_print_one_line_and_exit_2(argv, needle):
+    proc = subprocess.run([sys.executable, "-m", "kinelab.cli", *argv], capture_output=True, text=True,
+                          env={**os.environ, "PYTHONWARNINGS": "ignore"})
+    assert proc.returncode == 2
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("kinelab: error:") and needle in lines[0]
+    assert proc.stdout == ""
