@@ -1,3 +1,5 @@
+from pathlib import Path
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -196,3 +198,43 @@ def test_limits_are_enforced_where_they_matter_and_name_the_joint():
     robot.fk(q)  # FK itself is defined outside the limits
     with pytest.raises(kinelab.JointLimitError, match=r"joint3.*1\.5 m.*\[0, 1\] m"):
         robot.check_q(q, limits=True)
+
+
+# -- visual geometry and mesh paths ----------------------------------------------------------------
+
+def test_panda_visuals_resolve_package_uris_to_existing_meshes():
+    panda = kinelab.load("panda")
+    geom = panda.visual_model()
+    meshes = [g.meshPath for g in geom.geometryObjects if g.meshPath]
+    assert len(meshes) >= 8
+    assert all(Path(m).is_file() for m in meshes)
+    assert all(g.parentJoint < panda.model.njoints for g in geom.geometryObjects)
+
+
+def test_bundled_robots_draw_primitives_without_any_mesh():
+    for name in ("stanford", "era", "youbot"):
+        geom = kinelab.load(name).visual_model()
+        assert geom.ngeoms >= 5 and not any(g.meshPath.endswith((".dae", ".stl")) for g in geom.geometryObjects)
+
+
+def test_missing_meshes_leave_kinematics_intact_and_drop_only_those_visuals(tmp_path):
+    body = (TWO_LINK.replace('<link name="l1"/>',
+                             '<link name="l1"><visual><geometry><mesh filename="package://nowhere/m.stl"/>'
+                             '</geometry></visual><visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual>'
+                             "</link>"))
+    robot = kinelab.load(write_urdf(tmp_path, body))
+    np.testing.assert_allclose(robot.fk([0, 0]).translation, [0, 0, 1.3])
+    with pytest.warns(UserWarning, match="1 mesh.*package://nowhere/m.stl"):
+        geom = robot.visual_model()
+    assert geom.ngeoms == 1
+
+
+def test_yourdfpy_loads_real_meshes_through_the_same_resolver():
+    import yourdfpy
+
+    from kinelab.meshes import yourdfpy_filename_handler
+
+    panda = kinelab.load("panda")
+    urdf = yourdfpy.URDF.load(str(panda.urdf_path), load_meshes=True,
+                              filename_handler=yourdfpy_filename_handler(panda.urdf_path))
+    assert len(urdf.scene.geometry) >= 8

@@ -166,6 +166,7 @@ class Robot:
             nq = full.joints[jid].nq
             q_ref[full.idx_qs[jid] : full.idx_qs[jid] + nq] = _one_to_pin(kind, value)[:nq]
         lock_ids = [full.getJointId(j) for j in self.locked]
+        self._full, self._lock_ids, self._q_ref = full, lock_ids, q_ref
         self.model = pin.buildReducedModel(full, lock_ids, q_ref) if lock_ids else full
         self.data = self.model.createData()
         self.tool_frame_id = _frame_id(self.model, self.tool, self.name)
@@ -355,6 +356,20 @@ class Robot:
     def difference(self, q0, q1) -> np.ndarray:
         """q1 ⊖ q0 through ``pin.difference``: the n velocities that take q0 to q1 in 1 s."""
         return pin.difference(self.model, self.to_pin_q(q0), self.to_pin_q(q1))
+
+    def visual_model(self, package_dirs: list[str] | None = None) -> pin.GeometryModel:
+        """Visual geometry matched to ``self.model`` (locked joints folded in), meshes resolved.
+
+        ``package://`` URIs resolve under ``package_dirs`` (default: example-robot-data's); visuals
+        whose mesh cannot be found are left out with a warning.
+        """
+        from kinelab.meshes import build_visual_model
+
+        geom = build_visual_model(self._full, self.urdf_path, package_dirs)
+        if not self._lock_ids:
+            return geom
+        _, reduced = pin.buildReducedModel(self._full, geom, self._lock_ids, self._q_ref)
+        return reduced
 
     @property
     def frame_names(self) -> list[str]:
