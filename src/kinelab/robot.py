@@ -179,6 +179,16 @@ class Robot:
         self.upper = np.array([j.upper for j in self.joints])
         self.n, self.nq, self.nv = len(self.joints), self.model.nq, self.model.nv
         self.base = tree.root
+        scalar = [j for j in self.joints if j.kind != "continuous"]
+        turning = [j for j in self.joints if j.kind == "continuous"]
+        self._scalar_pos = np.array([i for i, j in enumerate(self.joints) if j.kind != "continuous"], dtype=int)
+        self._scalar_idx = np.array([j.idx_q for j in scalar], dtype=int)
+        self._cont_pos = np.array([i for i, j in enumerate(self.joints) if j.kind == "continuous"], dtype=int)
+        self._cont_idx = np.array([j.idx_q for j in turning], dtype=int)
+        self._length: float | None = None
+        continuous = np.array([k == "continuous" for k in self.joint_kinds])
+        self._lower_check = np.where(continuous, -np.inf, self.lower)
+        self._upper_check = np.where(continuous, np.inf, self.upper)
 
     # -- construction ------------------------------------------------------------------------
     @staticmethod
@@ -252,6 +262,8 @@ class Robot:
             arr = np.asarray(q, dtype=float)
         except (TypeError, ValueError):
             raise ConfigurationError(f"{what} must be {self.n} numbers, got {q!r}") from None
+        if arr.shape == (self.n,) and not limits and np.isfinite(arr).all():
+            return arr
         if arr.shape != (self.n,):
             raise ConfigurationError(
                 f"{what} must have {self.n} numbers ({', '.join(self.joint_names)}) for {self.name}, "
@@ -262,7 +274,7 @@ class Robot:
             i = int(np.flatnonzero(bad)[0])
             raise ConfigurationError(f"{what}[{i}] ({self.joint_names[i]}) is {arr[i]}: values must be finite")
         if limits:
-            outside = (arr < self.lower - LIMIT_SLACK) | (arr > self.upper + LIMIT_SLACK)
+            outside = (arr < self._lower_check - LIMIT_SLACK) | (arr > self._upper_check + LIMIT_SLACK)
             if outside.any():
                 i = int(np.flatnonzero(outside)[0])
                 j = self.joints[i]
@@ -270,17 +282,18 @@ class Robot:
         return arr
 
     def within_limits(self, q, slack: float = LIMIT_SLACK) -> bool:
-        """True when every joint value lies within its limits (plus ``slack``)."""
+        """True when every bounded joint lies within its limits (plus ``slack``); continuous joints have none."""
         arr = np.asarray(q, dtype=float)
-        return bool(np.all(arr >= self.lower - slack) and np.all(arr <= self.upper + slack))
+        return bool((arr >= self._lower_check - slack).all() and (arr <= self._upper_check + slack).all())
 
     def to_pin_q(self, q) -> np.ndarray:
         """One number per joint → Pinocchio's q (continuous joints become cos, sin)."""
         arr = self.check_q(q)
         out = np.empty(self.nq)
-        for j, value in zip(self.joints, arr, strict=True):
-            vals = _one_to_pin(j.kind, value)
-            out[j.idx_q : j.idx_q + len(vals)] = vals
+        out[self._scalar_idx] = arr[self._scalar_pos]
+        angles = arr[self._cont_pos]
+        out[self._cont_idx] = np.cos(angles)
+        out[self._cont_idx + 1] = np.sin(angles)
         return out
 
     def from_pin_q(self, q_pin) -> np.ndarray:
@@ -289,12 +302,15 @@ class Robot:
         if q_pin.shape != (self.nq,):
             raise ConfigurationError(f"Pinocchio q must have nq = {self.nq} entries, got shape {q_pin.shape}")
         out = np.empty(self.n)
-        for i, j in enumerate(self.joints):
-            if j.kind == "continuous":
-                out[i] = np.arctan2(q_pin[j.idx_q + 1], q_pin[j.idx_q])
-            else:
-                out[i] = q_pin[j.idx_q]
+        out[self._scalar_pos] = q_pin[self._scalar_idx]
+        out[self._cont_pos] = np.arctan2(q_pin[self._cont_idx + 1], q_pin[self._cont_idx])
         return out
+
+    def wrap_continuous(self, q) -> np.ndarray:
+        """q with continuous joints wrapped into (−π, π] (the same pose)."""
+        q = np.array(q, dtype=float)
+        q[self._cont_pos] = np.arctan2(np.sin(q[self._cont_pos]), np.cos(q[self._cont_pos]))
+        return q
 
     def neutral(self) -> np.ndarray:
         """Zero for every joint, moved into its limits where zero is outside them."""
@@ -319,6 +335,13 @@ class Robot:
         """oMtool: pose of the tool frame in the base frame at ``q`` (m, rad)."""
         self._forward(q)
         return pin.SE3(self.data.oMf[self.tool_frame_id])
+
+    def tool_error(self, q, oMtarget: pin.SE3) -> tuple[float, float]:
+        """(position error [m], rotation angle error [rad]) of the tool at q against oMtarget (Pinocchio FK)."""
+        pin.forwardKinematics(self.model, self.data, self.to_pin_q(q))
+        oMtool = pin.updateFramePlacement(self.model, self.data, self.tool_frame_id)
+        dp = float(np.linalg.norm(oMtool.translation - oMtarget.translation))
+        return dp, float(np.linalg.norm(pin.log3(oMtarget.rotation.T @ oMtool.rotation)))
 
     def frame_placement(self, q, frame: str) -> pin.SE3:
         """oMframe: pose of any frame of the reduced model in the base frame."""
@@ -380,6 +403,11 @@ class Robot:
 
         A length scale to weigh linear against angular quantities (IK objectives, Jacobian rank).
         """
+        if self._length is None:
+            self._length = self._mean_joint_spacing()
+        return self._length
+
+    def _mean_joint_spacing(self) -> float:
         oMi = self.joint_placements(self.neutral())
         pts = [m.translation for m in oMi.values()] + [self.fk(self.neutral()).translation]
         steps = [np.linalg.norm(b - a) for a, b in itertools.pairwise(pts)]

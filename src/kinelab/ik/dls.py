@@ -1,0 +1,55 @@
+"""The reference solver: Pinocchio damped-least-squares CLIK (log6 error, Jlog6, ``pin.integrate``).
+
+This is the baseline every other kinelab solver is compared with. One attempt from one start; the
+restarts, time budget and final check live in :func:`kinelab.solve`.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab.ik.limits import PinLimits
+from kinelab.ik.result import Attempt, Status
+from kinelab.robot import Robot
+
+
+def attempt(
+    robot: Robot,
+    oMtarget: pin.SE3,
+    q0: np.ndarray,
+    tol_pos: float,
+    tol_rot: float,
+    deadline: float,
+    *,
+    damping: float = 1e-6,
+    step: float = 1.0,
+    max_iterations: int = 100,
+) -> Attempt:
+    """Damped Gauss–Newton on the tool's log6 error in the tool frame.
+
+    Args:
+        damping: λ² added to J Jᵀ (Levenberg damping) [dimensionless, in the units of J Jᵀ].
+        step: fraction of the Gauss–Newton step taken per iteration (1 = full step).
+        max_iterations: iteration cap of this attempt.
+    """
+    model, data, fid = robot.model, robot.data, robot.tool_frame_id
+    limits = PinLimits(robot)
+    q = robot.to_pin_q(q0)
+    eye = np.eye(6)
+    for it in range(max_iterations):
+        pin.framesForwardKinematics(model, data, q)
+        oMtool = data.oMf[fid]
+        tMd = oMtool.actInv(oMtarget)
+        err = pin.log6(tMd).vector
+        if np.linalg.norm(oMtool.translation - oMtarget.translation) <= tol_pos and np.linalg.norm(err[3:]) <= tol_rot:
+            return Attempt(robot.from_pin_q(q), Status.CONVERGED, it)
+        if time.perf_counter() > deadline:
+            return Attempt(robot.from_pin_q(q), Status.TIME_BUDGET, it)
+        J = pin.computeFrameJacobian(model, data, q, fid, pin.LOCAL)
+        J = pin.Jlog6(tMd.inverse()) @ J
+        v = J.T @ np.linalg.solve(J @ J.T + damping * eye, err)
+        q = limits.project(pin.integrate(model, q, step * v))
+    return Attempt(robot.from_pin_q(q), Status.MAX_ITERATIONS, max_iterations)

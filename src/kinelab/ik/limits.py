@@ -1,0 +1,46 @@
+"""Joint-limit arithmetic shared by the solvers: wrap revolute joints by 2π into their limits, then clip."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from kinelab.robot import Robot
+
+TWO_PI = 2.0 * np.pi
+
+
+class PinLimits:
+    """Bounded scalar joints of a robot, indexed in Pinocchio's q, for fast projection inside loops."""
+
+    def __init__(self, robot: Robot):
+        bounded = [j for j in robot.joints if j.kind != "continuous"]
+        self.idx = np.array([j.idx_q for j in bounded], dtype=int)
+        self.lower = np.array([j.lower for j in bounded])
+        self.upper = np.array([j.upper for j in bounded])
+        self.revolute = np.array([j.kind == "revolute" for j in bounded], dtype=bool)
+
+    def project(self, q_pin: np.ndarray) -> np.ndarray:
+        """Wrap revolute joints by multiples of 2π towards their limits, then clip everything (in place)."""
+        if self.idx.size:
+            q_pin[self.idx] = wrap_and_clip(q_pin[self.idx], self.lower, self.upper, self.revolute)
+        return q_pin
+
+
+def wrap_and_clip(x: np.ndarray, lower: np.ndarray, upper: np.ndarray, revolute: np.ndarray) -> np.ndarray:
+    """Bring values into [lower, upper]: revolute ones first by ±2πk (same pose), then clip."""
+    x = np.array(x, dtype=float)
+    over = revolute & (x > upper)
+    x[over] -= TWO_PI * np.ceil((x[over] - upper[over]) / TWO_PI)
+    under = revolute & (x < lower)
+    x[under] += TWO_PI * np.ceil((lower[under] - x[under]) / TWO_PI)
+    return np.clip(x, lower, upper)
+
+
+def wrap_q(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """q with each out-of-limit revolute joint shifted by a multiple of 2π into its limits, where one
+    exists (the pose is unchanged); other values are returned as they are."""
+    q = np.asarray(q, dtype=float)
+    revolute = np.array([k == "revolute" for k in robot.joint_kinds])
+    outside = revolute & ((q < robot.lower) | (q > robot.upper))
+    shifted = q + TWO_PI * np.ceil((robot.lower - q) / TWO_PI)
+    return np.where(outside & (shifted <= robot.upper), shifted, q)

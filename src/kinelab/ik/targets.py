@@ -1,0 +1,55 @@
+"""Targets for IK: a ``pin.SE3`` of the tool in the robot's base frame, and helpers that build one."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab.errors import KinelabError
+
+_EYE3 = np.eye(3)
+
+
+class TargetError(KinelabError):
+    """A target that is not a valid pose."""
+
+
+def from_xyz_rpy(xyz, rpy=(0.0, 0.0, 0.0)) -> pin.SE3:
+    """oMtarget from a position [m] and roll-pitch-yaw angles [rad] (R = Rz(yaw) Ry(pitch) Rx(roll))."""
+    xyz, rpy = _finite(xyz, 3, "xyz"), _finite(rpy, 3, "rpy")
+    return pin.SE3(pin.rpy.rpyToMatrix(*rpy), xyz)
+
+
+def from_xyz_quat_wxyz(xyz, quat_wxyz) -> pin.SE3:
+    """oMtarget from a position [m] and a unit quaternion in (w, x, y, z) order."""
+    xyz, quat = _finite(xyz, 3, "xyz"), _finite(quat_wxyz, 4, "quat_wxyz")
+    norm = np.linalg.norm(quat)
+    if abs(norm - 1.0) > 1e-6:
+        raise TargetError(f"quat_wxyz must be a unit quaternion, its norm is {norm:.6g}")
+    w, x, y, z = quat / norm
+    return pin.SE3(pin.Quaternion(w, x, y, z).toRotationMatrix(), xyz)
+
+
+def as_target(target) -> pin.SE3:
+    """Check a target: a ``pin.SE3`` with finite entries and a proper rotation."""
+    if not isinstance(target, pin.SE3):
+        raise TargetError(
+            f"target must be a pin.SE3 of the tool in the base frame, got {type(target).__name__}; "
+            "build one with kinelab.target_from_xyz_rpy or kinelab.target_from_xyz_quat_wxyz"
+        )
+    H = target.homogeneous
+    if not np.isfinite(H.sum()):
+        raise TargetError("target has NaN or infinite entries")
+    R = H[:3, :3]
+    if np.abs(R.T @ R - _EYE3).max() > 1e-6 or np.linalg.det(R) < 0:
+        raise TargetError("target rotation is not a rotation matrix (RᵀR ≠ I or det R < 0)")
+    return target
+
+
+def _finite(values, size: int, what: str) -> np.ndarray:
+    arr = np.asarray(values, dtype=float)
+    if arr.shape != (size,):
+        raise TargetError(f"{what} must have {size} numbers, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise TargetError(f"{what} has NaN or infinite entries: {arr}")
+    return arr

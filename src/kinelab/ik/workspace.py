@@ -1,0 +1,34 @@
+"""A cheap, certain test that a target position is out of reach."""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from kinelab.robot import Robot
+
+
+@functools.lru_cache(maxsize=64)
+def _reach(robot: Robot) -> tuple[np.ndarray, float]:
+    q = robot.neutral()
+    oMi = list(robot.joint_placements(q).values())
+    anchor = robot.model.jointPlacements[1].translation  # where joint 1 sits, fixed in the base
+    points = [anchor] + [m.translation for m in oMi] + [robot.fk(q).translation]
+    # each distance between consecutive points is rigid, except along a prismatic joint's slide
+    rigid = sum(float(np.linalg.norm(b - a)) for a, b in zip(points, points[1:], strict=False))
+    slides = sum(
+        max(abs(j.upper - q[i]), abs(j.lower - q[i])) for i, j in enumerate(robot.joints) if j.kind == "prismatic"
+    )
+    return np.array(anchor), rigid + slides
+
+
+def reach_upper_bound(robot: Robot) -> tuple[np.ndarray, float]:
+    """(anchor [m], R [m]): every tool position lies within distance R of the anchor (joint 1's origin)."""
+    return _reach(robot)
+
+
+def out_of_reach(robot: Robot, position: np.ndarray) -> float:
+    """How far [m] a position lies beyond the reach bound (≤ 0 when it may be reachable)."""
+    anchor, radius = _reach(robot)
+    return float(np.linalg.norm(np.asarray(position) - anchor) - radius)

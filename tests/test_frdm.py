@@ -1,0 +1,265 @@
+"""FRDM: the vector model, the exact steps (against Pinocchio FK on dense grids), monotonicity, limits,
+the monitor and the kick branches, and solutions re-checked by Pinocchio."""
+
+import warnings
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from conftest import revolute, write_urdf
+
+import kinelab
+from kinelab.ik import solve
+from kinelab.ik.frdm import kernel, reference
+from kinelab.ik.frdm.solver import vector_model
+
+ROBOTS = ("stanford", "era", "youbot", "panda", "ur5", "kinova")
+
+
+def tool_objective(robot, q, oMtarget, w_p):
+    """E through Pinocchio's FK (the oracle)."""
+    oMtool = robot.fk(q)
+    return reference.objective(oMtool.translation, oMtool.rotation, oMtarget.translation, oMtarget.rotation,
+                               w_p, np.ones(3))
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_compiled_vector_model_matches_pinocchio(robots, name):
+    robot = robots.get(name) or kinelab.load(name)
+    vm = vector_model(robot)
+    for q in robot.random_qs(20, 3):
+        mine, ref = vm.vectors(q), reference.vector_model(robot, q)
+        oMtool = robot.fk(q)
+        np.testing.assert_allclose(mine["e"], ref["e"], atol=1e-12)
+        np.testing.assert_allclose(mine["N"], oMtool.translation, atol=1e-12)
+        np.testing.assert_allclose(mine["R"], oMtool.rotation, atol=1e-12)
+        revolute_rows = vm.kind != kernel.PRISMATIC
+        # the two points lie on the same axis line: their difference is parallel to e
+        diff = mine["o"] - ref["o"]
+        np.testing.assert_allclose(np.cross(diff, mine["e"])[revolute_rows], 0, atol=1e-11)
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_exact_step_is_the_minimum_of_the_true_objective_on_a_dense_grid(name):
+    robot = kinelab.load(name)
+    vm = vector_model(robot)
+    rng = np.random.default_rng(11)
+    w_p = 10 / vm.length**2
+    for _ in range(6):
+        q = robot.random_q(rng)
+        target = robot.fk(robot.random_q(rng))
+        i = int(rng.integers(robot.n))
+        joint = robot.joints[i]
+        model = reference.vector_model(robot, q)
+        if joint.kind == "continuous":
+            window = (-np.pi, np.pi)
+        else:
+            window = (joint.lower - q[i], joint.upper - q[i])
+        if joint.kind == "prismatic":
+            step = reference.prismatic_step(model["e"][i], model["p"], target.translation, w_p, window)
+        else:
+            step = reference.revolute_step(model["e"][i], model["o"][i], model["p"], model["R"],
+                                           target.translation, target.rotation, w_p, np.ones(3),
+                                           window if joint.kind == "revolute" else (-np.inf, np.inf))
+        grid = np.linspace(window[0], window[1], 20001)
+        values = []
+        for t in grid:
+            dq = np.zeros(robot.nv)
+            dq[i] = t
+            values.append(tool_objective(robot, robot.integrate(q, dq), target, w_p))
+        dq = np.zeros(robot.nv)
+        dq[i] = step
+        at_step = tool_objective(robot, robot.integrate(q, dq), target, w_p)
+        assert at_step <= min(values) + 1e-9, (name, i)
+        assert at_step <= tool_objective(robot, q, target, w_p) + 1e-12
+        spacing = grid[1] - grid[0]
+        gap = grid[int(np.argmin(values))] - step
+        if joint.kind != "prismatic":  # windows wider than 2π hold the same minimum twice
+            gap = (gap + np.pi) % (2 * np.pi) - np.pi
+        assert abs(gap) <= spacing + 1e-9
+
+
+def test_closed_form_objective_is_a_sinusoid_matching_fk(robots):
+    """E(θ) = a − 2B cos θ − 2C sin θ with B, C from the vector model, checked against Pinocchio FK."""
+    robot = robots["panda"]
+    rng = np.random.default_rng(5)
+    w_p = 1.7
+    for _ in range(10):
+        q, target = robot.random_q(rng), robot.fk(robot.random_q(rng))
+        i = int(rng.integers(robot.n))
+        m = reference.vector_model(robot, q)
+        B, C = kernel.revolute_BC(m["e"][i], m["o"][i], m["p"], m["R"], target.translation, target.rotation,
+                                  w_p, np.ones(3))
+        E0 = tool_objective(robot, q, target, w_p)
+        for theta in np.linspace(-np.pi, np.pi, 41):
+            dq = np.zeros(robot.nv)
+            dq[i] = theta
+            predicted = E0 + 2 * B - 2 * B * np.cos(theta) - 2 * C * np.sin(theta)
+            assert predicted == pytest.approx(tool_objective(robot, robot.integrate(q, dq), target, w_p), abs=1e-10)
+
+
+@pytest.mark.parametrize("base_to_tip", [True, False])
+@pytest.mark.parametrize("name", ROBOTS)
+def test_compiled_sweep_equals_the_readable_reference(name, base_to_tip):
+    robot = kinelab.load(name)
+    vm = vector_model(robot)
+    rng = np.random.default_rng(2)
+    for _ in range(5):
+        q, target = robot.random_q(rng), robot.fk(robot.random_q(rng))
+        w_p = 10 / vm.length**2
+        expected = reference.sweep(robot, q, target, w_p, base_to_tip=base_to_tip)
+        got = q.copy()
+        v = vm.vectors(q)
+        kernel.sweep(got, v["e"], v["o"], vm.kind, vm.lower, vm.upper, np.ones(robot.n, dtype=np.bool_),
+                     v["N"].copy(), v["R"].copy(), target.translation.copy(), target.rotation.copy(), w_p,
+                     np.ones(3), 1.0, base_to_tip)
+        np.testing.assert_allclose(got, expected, atol=1e-10)
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_sweeps_never_increase_the_objective_and_keep_limits(name):
+    robot = kinelab.load(name)
+    vm = vector_model(robot)
+    rng = np.random.default_rng(9)
+    w_p = 10 / vm.length**2
+    for _ in range(10):
+        q, target = robot.random_q(rng), robot.fk(robot.random_q(rng))
+        E = tool_objective(robot, q, target, w_p)
+        for k in range(15):
+            v = vm.vectors(q)
+            kernel.sweep(q, v["e"], v["o"], vm.kind, vm.lower, vm.upper, np.ones(robot.n, dtype=np.bool_),
+                         v["N"].copy(), v["R"].copy(), target.translation.copy(), target.rotation.copy(), w_p,
+                         np.ones(3), 1.0, k % 2 == 0)
+            E_next = tool_objective(robot, q, target, w_p)
+            assert E_next <= E + 1e-12
+            assert robot.within_limits(q, slack=1e-12)  # continuous joints have no limits
+            E = E_next
+
+
+def test_accelerated_runs_are_monotone_too(robots):
+    robot = robots["era"]
+    target = robot.fk(robot.random_q(4))
+    res = solve(robot, target, q0=robot.random_q(5), max_restarts=0, trace=True, time_budget=5.0)
+    trace = np.array(res.info["trace"])
+    assert len(trace) >= 2 and np.all(np.diff(trace) <= 1e-15 * trace[:-1] + 1e-300)
+
+
+# -- the monitor and the kicks on a straight planar arm ---------------------------------------------
+
+PLANAR_3R = ('<link name="base"/><link name="l1"/><link name="l2"/><link name="l3"/><link name="tool"/>'
+             + revolute("j1", "base", "l1", xyz="0 0 0") + revolute("j2", "l1", "l2", xyz="1 0 0")
+             + revolute("j3", "l2", "l3", xyz="1 0 0")
+             + '<joint name="jt" type="fixed"><parent link="l3"/><child link="tool"/><origin xyz="0.5 0 0"/></joint>')
+
+
+@pytest.fixture
+def planar(tmp_path):
+    return kinelab.load(write_urdf(tmp_path, PLANAR_3R.replace('lower="-2" upper="2"', 'lower="-3" upper="3"')))
+
+
+def test_monitor_fires_on_a_straight_arm_with_the_target_on_its_line(planar):
+    target = pin.SE3(np.eye(3), np.array([2.3, 0.0, 0.0]))
+    res = solve(planar, target, q0=np.zeros(3), mode="position", max_restarts=0, policy=())
+    assert not res.success and res.status.value == "singular"
+    first = res.singular_events[0]
+    assert first["trigger"] == "step" and first["sweep"] == 1 and first["diagnosis"] == "singular"
+    np.testing.assert_allclose(res.q, 0.0)
+
+
+def test_the_two_kick_signs_give_the_two_mirror_branches(planar):
+    target = pin.SE3(np.eye(3), np.array([2.3, 0.0, 0.0]))
+    branches = {}
+    for sign in (-1.0, 1.0):
+        res = solve(planar, target, q0=np.zeros(3), mode="position", max_restarts=0, kicks={"j2": sign * 1e-3},
+                    tol_rot=10.0, order="tip2base", time_budget=5.0)
+        assert res.success, res
+        assert [b["bypass"] for b in res.bypasses] == ["kicks"]
+        branches[sign] = res.q
+    # mirror images about the line: the elbow (j3) folds one way or the other
+    assert np.sign(branches[-1.0][2]) != np.sign(branches[1.0][2]) and abs(branches[1.0][2]) > 0.5
+    np.testing.assert_allclose(branches[-1.0], -branches[1.0], atol=1e-5)
+
+
+# -- solutions, checked by Pinocchio ----------------------------------------------------------------------
+
+@pytest.mark.parametrize("name", ("stanford", "era", "youbot", "panda", "ur5"))
+def test_frdm_solutions_are_confirmed_by_pinocchio(name):
+    robot = kinelab.load(name)
+    rng = np.random.default_rng(21)
+    solved = 0
+    for k in range(25):
+        target = robot.fk(robot.random_q(rng))
+        res = solve(robot, target, solver="frdm", seed=k, time_budget=0.2)
+        if res.success:
+            solved += 1
+            oMtool = robot.fk(res.q)  # independent re-check
+            assert np.linalg.norm(oMtool.translation - target.translation) <= 1e-6
+            assert np.linalg.norm(pin.log3(target.rotation.T @ oMtool.rotation)) <= 1e-6
+            assert robot.within_limits(res.q)
+        else:
+            assert res.status.value != "converged"
+    assert solved >= 24
+
+
+def test_position_and_orientation_modes(robots):
+    robot = robots["panda"]
+    target = robot.fk(robot.random_q(8))
+    pos = solve(robot, target, mode="position", seed=1, tol_rot=np.pi)
+    assert pos.success and np.linalg.norm(robot.fk(pos.q).translation - target.translation) <= 1e-6
+    ori = solve(robot, target, mode="orientation", seed=1, tol_pos=10.0)
+    assert ori.success and np.linalg.norm(pin.log3(target.rotation.T @ robot.fk(ori.q).rotation)) <= 1e-6
+
+
+# -- bad input -----------------------------------------------------------------------------------
+
+def test_unreachable_target_is_reported_never_success(robots):
+    robot = robots["ur5"]
+    target = pin.SE3(np.eye(3), np.array([3.0, 0.0, 0.5]))
+    res = solve(robot, target, seed=0, time_budget=0.05)
+    assert not res.success and res.status.value == "unreachable"
+    assert res.position_error > 1.5 and "beyond" in res.message
+    np.testing.assert_allclose(robot.fk(res.q).translation - target.translation,
+                               robot.fk(res.q).translation - target.translation)
+
+
+def test_start_outside_limits_is_projected_with_a_warning_or_refused(robots):
+    robot = robots["stanford"]
+    target = robot.fk(robot.random_q(1))
+    q0 = np.array([0, 0, 1.5, 0, 0, 0])
+    with pytest.warns(UserWarning, match="projected"):
+        solve(robot, target, q0=q0, seed=0)
+    with pytest.raises(kinelab.JointLimitError, match="joint3"):
+        solve(robot, target, q0=q0, start_outside_limits="refuse")
+
+
+@pytest.mark.parametrize("options, match", [
+    ({"kicks": {"nojoint": 0.1}}, "unknown joint 'nojoint'"),
+    ({"intervals": {"joint5": (0.5, 0.2)}}, "empty"),
+    ({"freeze": {"joint9": 0.0}}, "unknown joint"),
+    ({"policy": ("teleport",)}, "unknown bypass"),
+    ({"order": "sideways"}, "sweep order"),
+    ({"speed": 3}, "unknown option 'speed'"),
+])
+def test_bad_bypass_and_options_are_refused_clearly(options, match):
+    robot = kinelab.load("era")
+    with pytest.raises(kinelab.KinelabError, match=match):
+        solve(robot, robot.fk(np.zeros(7)), **options)
+
+
+def test_targets_must_be_poses():
+    robot = kinelab.load("ur5")
+    with pytest.raises(kinelab.KinelabError, match="pin.SE3"):
+        solve(robot, np.eye(4))
+    bad = pin.SE3.Identity()
+    bad.translation = np.array([np.nan, 0, 0])
+    with pytest.raises(kinelab.KinelabError, match="NaN"):
+        solve(robot, bad)
+
+
+def test_helical_or_spherical_joints_are_refused_by_name(tmp_path):
+    body = ('<link name="base"/><link name="a"/>'
+            '<joint name="ball" type="planar"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/></joint>')
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with pytest.raises(kinelab.ChainError, match="ball"):
+            kinelab.load(write_urdf(tmp_path, body))
