@@ -68,3 +68,27 @@ def test_user_errors_print_one_line_and_exit_2(argv, needle):
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("kinelab: error:") and needle in lines[0]
     assert proc.stdout == ""
+
+
+def test_ik_reaches_the_papers_stanford_target_and_reports_pinocchios_errors(capsys):
+    code, out, _ = run(capsys, "ik", "stanford", "--target-q", "20", "40", "0.3", "-35", "60", "-45",
+                       "--start-q", "-30", "15", "0.1", "36", "-90", "45", "--deg", "--json")
+    res = json.loads(out)
+    assert code == 0 and res["success"] and res["status"] == "converged"
+    assert res["position_error_m"] <= 1e-6 and res["rotation_error_rad"] <= 1e-6
+
+
+def test_ik_beyond_reach_is_unreachable_with_exit_1(capsys):
+    code, out, _ = run(capsys, "ik", "ur5", "--target-xyz", "3", "0", "0", "--json")
+    res = json.loads(out)
+    assert code == 1 and not res["success"] and res["status"] == "unreachable"
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["ik", "ur5"], "give the target"),
+    (["ik", "ur5", "--target-xyz", "0.3", "0", "0.3", "--solver", "magic"], "unknown solver 'magic'"),
+    (["ik", "stanford", "--target-q", "0", "0", "5", "0", "0", "0"], "outside its limits"),
+])
+def test_ik_user_errors(capsys, argv, needle):
+    code, _, err = run(capsys, *argv)
+    assert code == 2 and needle in err and len(err.strip().splitlines()) == 1

@@ -116,6 +116,41 @@ def cmd_fk(args) -> int:
     return 0
 
 
+def cmd_ik(args) -> int:
+    from kinelab.ik import solve, target_from_xyz_rpy
+
+    robot = load(args.robot, tool=args.tool)
+    if (args.target_q is None) == (args.target_xyz is None):
+        raise KinelabError("give the target as --target-q Q... or as --target-xyz X Y Z [--target-rpy R P Y]")
+    if args.target_q is not None:
+        target = robot.fk(robot.check_q(_q_from_cli(robot, args.target_q, args.deg, "--target-q"), limits=True,
+                                        what="--target-q"))
+    else:
+        rpy = np.array(args.target_rpy if args.target_rpy is not None else [0.0, 0.0, 0.0])
+        target = target_from_xyz_rpy(args.target_xyz, np.deg2rad(rpy) if args.deg else rpy)
+    q0 = None if args.start_q is None else _q_from_cli(robot, args.start_q, args.deg, "--start-q")
+    options = {}
+    if args.solver == "frdm" and args.polish:
+        options["polish"] = True
+    result = solve(robot, target, solver=args.solver, q0=q0, seed=args.seed, tol_pos=args.tol_pos,
+                   tol_rot=args.tol_rot, time_budget=args.time_budget, **options)
+    out = {"robot": robot.name, "target": pose_dict(target), **result.to_dict()}
+    if args.json:
+        _print_json(out)
+    else:
+        q_show = np.where([k != "prismatic" for k in robot.joint_kinds], np.rad2deg(result.q), result.q) \
+            if args.deg else result.q
+        print(f"{robot.name} {args.solver}: {result.status.value} (success: {result.success})")
+        print(f"  q{' [deg, m]' if args.deg else ' [rad, m]'}  {np.array2string(q_show, precision=6)}")
+        print(f"  position error {result.position_error:.3e} m, rotation error {result.rotation_error:.3e} rad "
+              "(Pinocchio FK)")
+        print(f"  {result.iterations} iterations, {result.restarts} restarts, {result.wall_time * 1e3:.2f} ms, "
+              f"mode {result.mode}")
+        if result.message:
+            print(f"  {result.message}")
+    return 0 if result.success else 1
+
+
 def cmd_validate(args) -> int:
     from kinelab import validate
 
@@ -153,6 +188,23 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--ignore-limits", action="store_true", help="allow q outside the joint limits")
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_fk)
+
+    s = sub.add_parser("ik", help="inverse kinematics to a target pose or configuration")
+    s.add_argument("robot", help="registered name or URDF path")
+    s.add_argument("--solver", default="frdm", help="frdm, biquat or dls (the Pinocchio reference)")
+    s.add_argument("--target-q", nargs="+", type=float, help="target as a configuration (its FK pose)")
+    s.add_argument("--target-xyz", nargs=3, type=float, help="target position [m] in the base frame")
+    s.add_argument("--target-rpy", nargs=3, type=float, help="target roll, pitch, yaw (rad; deg with --deg)")
+    s.add_argument("--start-q", nargs="+", type=float, help="first start (default: seeded random)")
+    s.add_argument("--deg", action="store_true", help="angles in degrees (revolute/continuous joints, rpy)")
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--tol-pos", type=float, default=1e-6, help="[m]")
+    s.add_argument("--tol-rot", type=float, default=1e-6, help="[rad]")
+    s.add_argument("--time-budget", type=float, default=1.0, help="[s]")
+    s.add_argument("--polish", action="store_true", help="frdm: add damped-least-squares polish steps")
+    s.add_argument("--tool", help="tool frame (default: the robot's own)")
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(func=cmd_ik)
 
     s = sub.add_parser("validate", help="check every kinelab computation against Pinocchio on the bundled robots")
     s.add_argument("--robots", nargs="+", default=None, help="robots to check (default: the embedded set)")

@@ -132,6 +132,8 @@ def solve(
     start = _start(robot, q0, rng, start_outside_limits)
     deadline = t_start + time_budget
     beyond = out_of_reach(robot, target.translation)
+    if beyond > 0:
+        max_restarts = 0  # proved out of reach: one attempt gives the best pose, restarts cannot help
 
     scale = robot.characteristic_length()
     best: tuple[float, Attempt, float, float] | None = None

@@ -55,9 +55,9 @@ class Bypass:
 
     kicks: dict[str, float] = field(default_factory=dict)
     intervals: dict[str, tuple[float, float]] = field(default_factory=dict)
-    freeze: dict[str, float] = field(default_factory=dict)
+    freeze: dict[str, float | None] = field(default_factory=dict)  # None: hold the joint where it is
     policy: tuple[str, ...] | None = None
-    kick_at_start: bool = False
+    active: tuple[str, ...] = ()  # bypasses applied before the first sweep
     auto_kick: float = 1e-2
 
     def resolved_policy(self) -> tuple[str, ...]:
@@ -76,7 +76,7 @@ class Bypass:
         for name, delta in self.kicks.items():
             if not np.isfinite(delta) or delta == 0:
                 raise KinelabError(f"kick for {name!r} must be a finite non-zero δ, got {delta}")
-        for step in self.resolved_policy():
+        for step in (*self.resolved_policy(), *self.active):
             if step not in BYPASSES:
                 raise KinelabError(f"unknown bypass {step!r} in policy; bypasses are: {', '.join(BYPASSES)}")
 
@@ -134,7 +134,7 @@ def attempt(
     intervals: dict | None = None,
     freeze: dict | None = None,
     policy: tuple[str, ...] | None = None,
-    kick_at_start: bool = False,
+    active: tuple[str, ...] = (),
     max_bypass_events: int = 3,
     polish: bool = False,
     trace: bool = False,
@@ -155,7 +155,13 @@ def attempt(
         eps_q, stall_window, stall_rel: monitor thresholds: Σ|Δq| below eps_q in a sweep, or a relative
             drop of the objective below stall_rel over stall_window sweeps (default 10 % over 15 sweeps
             accelerated, 1e-3 over 50 sweeps plain).
-        kicks, intervals, freeze, policy, kick_at_start, max_bypass_events: bypass configuration.
+        kicks: joint → signed δ (rad or m) added when the monitor fires.
+        intervals: joint → (lower, upper), a tighter window held while active.
+        freeze: joint → value (None: where the joint is) held while active.
+        policy: the order in which monitor events switch bypasses on (default: those configured, in
+            the order kicks, intervals, freeze; "auto_kick" when none is).
+        active: bypasses switched on before the first sweep (tracking holds them while passing).
+        max_bypass_events: how many monitor events the policy answers before the attempt gives up.
         polish: follow FRDM with damped-least-squares steps (reported as mode "frdm+polish").
         trace: keep the objective after every sweep in ``info["trace"]``.
     """
@@ -171,16 +177,16 @@ def attempt(
     max_sweeps = max_sweeps or (3000 if plain else 100)
     stall_window = stall_window or (50 if plain else 15)
     stall_rel = stall_rel if stall_rel is not None else (1e-3 if plain else 0.1)
-    bypass = Bypass(kicks or {}, intervals or {}, freeze or {}, policy, kick_at_start)
-    if kicks or intervals or freeze or policy:
+    bypass = Bypass(kicks or {}, intervals or {}, freeze or {}, policy, tuple(active))
+    if kicks or intervals or freeze or policy or active:
         bypass.validate(robot)
     vm = vector_model(robot)
     prob = _Problem(vm, oMtarget, mode, w_p, w_axes, use_limits, w_p_factor)
     run = _Runner(robot, vm, prob, order, relax, accel_memory if accel == "anderson" else 0,
                   eps_q, stall_window, stall_rel, trace, max_sweeps)
     q = np.array(q0, dtype=float)
-    if kick_at_start:
-        q = run.apply(bypass, "kicks", q)
+    for step in bypass.active:
+        q = run.apply(bypass, step, q)
     status = run.solve(q, tol_pos, tol_rot, deadline, bypass, max_bypass_events)
     info = {"mode": "frdm" + ("" if accel == "anderson" else " (plain)"), "sweeps": run.sweeps,
             "accelerated_sweeps": run.accepted, "order": order, "w_p": prob.w_p, "relax": relax,
@@ -268,7 +274,7 @@ class _Runner:
             self.q = self.apply(bypass, step, self.q)
             self.reset_history()
             # leaving a singularity starts slowly (the kick grows by a factor per sweep): judge it patiently
-            self.window, self.window_rel = max(self.window, 50), min(self.window_rel, 1e-3)
+            self.window, self.window_rel = max(self.window, 100), min(self.window_rel, 1e-6)
             self.max_sweeps = max(self.max_sweeps, self.sweeps + 1000)
 
     def _event(self, code: int) -> str:
@@ -307,7 +313,7 @@ class _Runner:
         elif step == "freeze":
             for name, value in bypass.freeze.items():
                 i = idx(name)
-                q[i] = value
+                q[i] = q[i] if value is None else value
                 self.prob.free[i] = False
         q = np.clip(q, self.prob.lower, self.prob.upper)
         if step in ("kicks", "auto_kick"):
