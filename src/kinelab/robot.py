@@ -13,6 +13,7 @@ Jacobians are 6 × n with rows [linear; angular] (Pinocchio's order); the method
 from __future__ import annotations
 
 import itertools
+import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -186,6 +187,7 @@ class Robot:
         self._cont_pos = np.array([i for i, j in enumerate(self.joints) if j.kind == "continuous"], dtype=int)
         self._cont_idx = np.array([j.idx_q for j in turning], dtype=int)
         self._length: float | None = None
+        self._identity_q = self.nq == self.n and bool(np.all(self._scalar_idx == np.arange(self.n)))
         continuous = np.array([k == "continuous" for k in self.joint_kinds])
         self._lower_check = np.where(continuous, -np.inf, self.lower)
         self._upper_check = np.where(continuous, np.inf, self.upper)
@@ -289,6 +291,8 @@ class Robot:
     def to_pin_q(self, q) -> np.ndarray:
         """One number per joint → Pinocchio's q (continuous joints become cos, sin)."""
         arr = self.check_q(q)
+        if self._identity_q:
+            return arr.copy()
         out = np.empty(self.nq)
         out[self._scalar_idx] = arr[self._scalar_pos]
         angles = arr[self._cont_pos]
@@ -340,8 +344,9 @@ class Robot:
         """(position error [m], rotation angle error [rad]) of the tool at q against oMtarget (Pinocchio FK)."""
         pin.forwardKinematics(self.model, self.data, self.to_pin_q(q))
         oMtool = pin.updateFramePlacement(self.model, self.data, self.tool_frame_id)
-        dp = float(np.linalg.norm(oMtool.translation - oMtarget.translation))
-        return dp, float(np.linalg.norm(pin.log3(oMtarget.rotation.T @ oMtool.rotation)))
+        err = oMtarget.actInv(oMtool)  # the tool in the target frame: |t| is the position error
+        t, w = err.translation, pin.log3(err.rotation)
+        return math.sqrt(t @ t), math.sqrt(w @ w)
 
     def frame_placement(self, q, frame: str) -> pin.SE3:
         """oMframe: pose of any frame of the reduced model in the base frame."""

@@ -137,6 +137,7 @@ def solve(
 
     scale = robot.characteristic_length()
     best: tuple[float, Attempt, float, float] | None = None
+    best_ok = False
     finals: list[tuple[Status, float]] = []
     iterations = restarts = 0
     events, bypasses = [], []
@@ -149,7 +150,7 @@ def solve(
         ok = dp <= tol_pos and dr <= tol_rot and robot.within_limits(att.q)
         score = dp / scale + dr
         if best is None or ok or score < best[0]:
-            best = (score, att, dp, dr)
+            best, best_ok = (score, att, dp, dr), ok
         finals.append((att.status, dp))
         if ok or time.perf_counter() > deadline or k == max_restarts:
             break
@@ -157,7 +158,7 @@ def solve(
         start = rng.uniform(robot.lower, robot.upper)
 
     _, att, dp, dr = best
-    success = dp <= tol_pos and dr <= tol_rot and robot.within_limits(att.q)  # the check, on the answer kept
+    success = best_ok  # Pinocchio's check of the answer kept
     status, message = _status(success, att, finals, beyond, tol_pos, time.perf_counter() > deadline)
     return IKResult(
         q=att.q, success=success, status=status, position_error=dp, rotation_error=dr,
