@@ -166,6 +166,28 @@ def cmd_validate(args) -> int:
     return 0 if report.passed else 1
 
 
+def cmd_bench(args) -> int:
+    from kinelab import bench
+
+    result = bench.run(robots=args.robots, n=args.n, seed=args.seed, solvers=args.solvers,
+                       budget=args.budget_ms / 1e3, progress=not args.json)
+    if args.scaling:
+        from kinelab import scaling
+
+        result["scaling"] = scaling.run(progress=not args.json)
+    if args.out:
+        bench.write(result, args.out)
+    if args.json:
+        _print_json(result)
+    else:
+        print(bench.markdown(result))
+        if "scaling" in result:
+            print(scaling.markdown(result["scaling"]))
+        if args.out:
+            print(f"results written to {args.out}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="kinelab", description="Kinematics of serial arms, checked against Pinocchio.")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -205,6 +227,17 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--tool", help="tool frame (default: the robot's own)")
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_ik)
+
+    s = sub.add_parser("bench", help="the IK benchmark: kinelab's solvers and the installed peers")
+    s.add_argument("--robots", nargs="+", default=None, help="robots (default: panda ur5 stanford era)")
+    s.add_argument("--n", type=int, default=200, help="targets per robot")
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--solvers", nargs="+", default=None, help="solvers to run (default: all available)")
+    s.add_argument("--budget-ms", type=float, default=5.0, help="time budget per solve [ms]")
+    s.add_argument("--scaling", action="store_true", help="also time FRDM on synthetic chains of 7-100 links")
+    s.add_argument("--out", help="write bench.json, bench.md and bench.png here")
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(func=cmd_bench)
 
     s = sub.add_parser("validate", help="check every kinelab computation against Pinocchio on the bundled robots")
     s.add_argument("--robots", nargs="+", default=None, help="robots to check (default: the embedded set)")

@@ -6,6 +6,7 @@ restarts, time budget and final check live in :func:`kinelab.solve`.
 
 from __future__ import annotations
 
+import math
 import time
 
 import numpy as np
@@ -26,7 +27,7 @@ def attempt(
     *,
     damping: float = 1e-6,
     step: float = 1.0,
-    max_iterations: int = 100,
+    max_iterations: int = 30,
 ) -> Attempt:
     """Damped Gauss–Newton on the tool's log6 error in the tool frame.
 
@@ -40,15 +41,16 @@ def attempt(
     q = robot.to_pin_q(q0)
     eye = np.eye(6)
     for it in range(max_iterations):
-        pin.framesForwardKinematics(model, data, q)
-        oMtool = data.oMf[fid]
+        pin.computeJointJacobians(model, data, q)  # FK and every joint Jacobian in one pass
+        oMtool = pin.updateFramePlacement(model, data, fid)
         tMd = oMtool.actInv(oMtarget)
         err = pin.log6(tMd).vector
-        if np.linalg.norm(oMtool.translation - oMtarget.translation) <= tol_pos and np.linalg.norm(err[3:]) <= tol_rot:
+        dp = oMtarget.actInv(oMtool).translation  # position error in the target frame (same norm)
+        if math.sqrt(dp @ dp) <= tol_pos and math.sqrt(err[3:] @ err[3:]) <= tol_rot:
             return Attempt(robot.from_pin_q(q), Status.CONVERGED, it)
         if time.perf_counter() > deadline:
             return Attempt(robot.from_pin_q(q), Status.TIME_BUDGET, it)
-        J = pin.computeFrameJacobian(model, data, q, fid, pin.LOCAL)
+        J = pin.getFrameJacobian(model, data, fid, pin.LOCAL)
         J = pin.Jlog6(tMd.inverse()) @ J
         v = J.T @ np.linalg.solve(J @ J.T + damping * eye, err)
         q = limits.project(pin.integrate(model, q, step * v))

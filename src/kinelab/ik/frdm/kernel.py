@@ -94,10 +94,14 @@ def chain_fk(PR, Pt, axis, kind, TR, Tt, q, e_out, o_out, p_out, R_out):
             t0, t1, t2 = t0 + e0 * q[i], t1 + e1 * q[i], t2 + e2 * q[i]
             Rw[:, :] = tmp
         else:
-            # Rw·Rot(a, q) = Rot(e, q)·Rw with e = Rw·a: rotate tmp's rows about the world axis
-            m = _rotm(e0, e1, e2, q[i])
-            _rotate_rows(m, tmp)
-            Rw[:, :] = tmp
+            # Rw ← tmp·Rot(a, q) about the exact unit local axis: the world axis e carries rounding, and a
+            # rotation about it would feed that back into Rw and grow along a long chain
+            m = _rotm(a[0], a[1], a[2], q[i])
+            for r in range(3):
+                x, y, z = tmp[r, 0], tmp[r, 1], tmp[r, 2]
+                Rw[r, 0] = x * m[0] + y * m[3] + z * m[6]
+                Rw[r, 1] = x * m[1] + y * m[4] + z * m[7]
+                Rw[r, 2] = x * m[2] + y * m[5] + z * m[8]
         e_out[i, 0], e_out[i, 1], e_out[i, 2] = e0, e1, e2
         o_out[i, 0], o_out[i, 1], o_out[i, 2] = t0, t1, t2
     for r in range(3):
@@ -197,6 +201,8 @@ def sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, rela
             e0 = Rg[0, 0] * e[i, 0] + Rg[0, 1] * e[i, 1] + Rg[0, 2] * e[i, 2]
             e1 = Rg[1, 0] * e[i, 0] + Rg[1, 1] * e[i, 1] + Rg[1, 2] * e[i, 2]
             e2 = Rg[2, 0] * e[i, 0] + Rg[2, 1] * e[i, 1] + Rg[2, 2] * e[i, 2]
+            norm = np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)  # keep rounding in Rg from compounding
+            e0, e1, e2 = e0 / norm, e1 / norm, e2 / norm
             o0 = Rg[0, 0] * o[i, 0] + Rg[0, 1] * o[i, 1] + Rg[0, 2] * o[i, 2] + tg[0]
             o1 = Rg[1, 0] * o[i, 0] + Rg[1, 1] * o[i, 1] + Rg[1, 2] * o[i, 2] + tg[1]
             o2 = Rg[2, 0] * o[i, 0] + Rg[2, 1] * o[i, 1] + Rg[2, 2] * o[i, 2] + tg[2]
@@ -272,8 +278,11 @@ def _anderson(X, G, count, m, x, g, out):
     trace = 0.0
     for r in range(k):
         trace += A[r, r]
+    if trace <= 0.0:  # no change in the residuals: nothing to extrapolate
+        out[:] = x + g
+        return
     for r in range(k):
-        A[r, r] += 1e-10 * trace + 1e-300
+        A[r, r] += 1e-10 * trace
     # Cholesky A = L Lᵀ in place (lower triangle), then two triangular solves
     for j in range(k):
         acc = A[j, j]
@@ -351,6 +360,12 @@ def run(
             state[0] = cnt + 1.0
             if cnt >= 1:
                 _anderson(X, G, cnt, accel_m, x_old, q - x_old, cand)
+                finite = True
+                for i in range(n):
+                    finite = finite and np.isfinite(cand[i])
+                if not finite:  # a degenerate history: drop it, keep the plain sweep
+                    state[0] = 0.0
+                    cand[:] = q
                 for i in range(n):
                     if kind[i] != CONTINUOUS:
                         cand[i] = min(max(cand[i], lower[i]), upper[i])

@@ -1,0 +1,92 @@
+"""The bench protocol: its success check must count wrong, out-of-limit and late answers as failures."""
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import kinelab
+from kinelab import bench, scaling
+from kinelab.ik.frdm.solver import vector_model
+
+
+@pytest.fixture(scope="module")
+def ur5():
+    return kinelab.load("ur5")
+
+
+def test_a_correct_answer_within_budget_counts(ur5):
+    case = bench.cases(ur5, 1, 3)[0]
+    assert bench.check_solution(ur5, case.q_target, case.oMtarget, elapsed=1e-4) == (True, "solved")
+
+
+def test_a_deliberately_wrong_answer_fails(ur5):
+    case = bench.cases(ur5, 1, 3)[0]
+    wrong = case.q_target.copy()
+    wrong[2] += 1e-5  # about 4 µm at the tool: above the 1e-6 m tolerance
+    ok, why = bench.check_solution(ur5, wrong, case.oMtarget, elapsed=1e-4)
+    assert not ok and why.startswith("pose error")
+
+
+def test_an_answer_outside_the_limits_fails_even_when_the_pose_is_right(tmp_path):
+    stanford = kinelab.load("stanford")
+    q = np.array([0.1, 0.2, 0.5, 0.3, 0.4, 0.5])
+    target = stanford.fk(q)
+    outside = q.copy()
+    outside[0] += 2 * np.pi  # same pose, but beyond joint 1's ±170°
+    assert np.linalg.norm(stanford.fk(outside).translation - target.translation) < 1e-12
+    assert bench.check_solution(stanford, outside, target, 1e-4) == (False, "outside the joint limits")
+
+
+def test_a_late_answer_fails(ur5):
+    case = bench.cases(ur5, 1, 3)[0]
+    assert bench.check_solution(ur5, case.q_target, case.oMtarget, elapsed=0.0051) == (False, "over budget")
+
+
+def test_no_answer_and_malformed_answers_fail(ur5):
+    case = bench.cases(ur5, 1, 3)[0]
+    assert not bench.check_solution(ur5, None, case.oMtarget, 1e-4)[0]
+    assert not bench.check_solution(ur5, np.full(6, np.nan), case.oMtarget, 1e-4)[0]
+    assert not bench.check_solution(ur5, np.zeros(5), case.oMtarget, 1e-4)[0]
+
+
+def test_problems_are_seeded_and_targets_are_the_fk_of_their_configurations(ur5):
+    a, b = bench.cases(ur5, 5, 11), bench.cases(ur5, 5, 11)
+    for x, y in zip(a, b, strict=True):
+        np.testing.assert_array_equal(x.q_start, y.q_start)
+        assert np.allclose(ur5.fk(x.q_target).homogeneous, x.oMtarget.homogeneous)
+
+
+def test_run_reports_rows_for_the_kinelab_solvers():
+    result = bench.run(robots=["ur5"], n=4, solvers=["frdm", "dls"], budget=0.05, progress=False)
+    rows = {r["solver"]: r for r in result["rows"]}
+    assert set(rows) == {"frdm", "dls"} and rows["frdm"]["n"] == 4
+    assert 0 <= rows["frdm"]["success_pct"] <= 100 and rows["frdm"]["median_us"] > 0
+    assert "| ur5 | frdm |" in bench.markdown(result)
+
+
+def test_unknown_solver_is_refused_with_the_available_ones():
+    with pytest.raises(kinelab.KinelabError, match="available: .*frdm"):
+        bench.run(robots=["ur5"], n=1, solvers=["nope"], progress=False)
+
+
+def test_compiled_fk_stays_exact_on_a_100_link_chain():
+    """Regression: rounding in the world axes used to compound along the chain and blow up."""
+    robot = scaling.synthetic_robot(100, seed=3)
+    vm = vector_model(robot)
+    for q in robot.random_qs(5, 1):
+        v, oMtool = vm.vectors(q), robot.fk(q)
+        np.testing.assert_allclose(v["N"], oMtool.translation, atol=1e-12)
+        np.testing.assert_allclose(v["R"], oMtool.rotation, atol=1e-12)
+
+
+def test_linear_fit_recovers_a_line_and_its_r2():
+    x = np.array([7, 15, 30, 60, 100])
+    a, b, r2 = scaling.linear_fit(x, 0.2 + 0.09 * x)
+    assert a == pytest.approx(0.2) and b == pytest.approx(0.09) and r2 == pytest.approx(1.0)
+    assert scaling.linear_fit(x, [1, 5, 2, 9, 3])[2] < 0.5
+
+
+def test_synthetic_chains_mix_joint_kinds_and_load(tmp_path):
+    robot = scaling.synthetic_robot(15)
+    assert robot.n == 15 and robot.joint_kinds.count("prismatic") == 3
+    assert isinstance(robot.fk(robot.neutral()), pin.SE3)
