@@ -92,3 +92,15 @@ def test_ik_beyond_reach_is_unreachable_with_exit_1(capsys):
 def test_ik_user_errors(capsys, argv, needle):
     code, _, err = run(capsys, *argv)
     assert code == 2 and needle in err and len(err.strip().splitlines()) == 1
+
+
+def test_ik_biquat_reproduces_seed_001_and_prints_model_time_and_M0(capsys):
+    code, out, _ = run(capsys, "ik", "stanford", "--solver", "biquat", "--target-q", "20", "40", "0.3", "-35", "60",
+                       "-45", "--start-q", "-30", "15", "0.1", "36", "-90", "45", "--deg", "--json")
+    res = json.loads(out)
+    assert code == 0 and res["success"]
+    assert res["position_error_m"] <= 1e-6 and res["rotation_error_rad"] <= 1e-6
+    assert res["info"]["model_time"] > 0 and res["info"]["M0"] == pytest.approx(-1.0, abs=1e-6)
+    code, out, _ = run(capsys, "ik", "stanford", "--solver", "biquat", "--target-q", "20", "40", "0.3", "-35", "60",
+                       "-45", "--start-q", "-30", "15", "0.1", "36", "-90", "45", "--deg")
+    assert "model time" in out and "M0 = -1.000000" in out

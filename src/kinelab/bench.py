@@ -113,8 +113,9 @@ class Row:
 
 def run_one(robot: Robot, name: str, prepare: Prepare, problems: list[Case], budget: float, seed: int) -> Row:
     solve_fn = prepare(robot, budget)
-    for case in problems[:3]:  # warm-up: compilation, caches
-        solve_fn(case, seed)
+    for case in problems[:3]:  # warm-up: compilation, caches (an error here shows again in the timed loop)
+        with contextlib.suppress(Exception):
+            solve_fn(case, seed)
     times, solved_times, iters, failures = [], [], [], {}
     solved = 0
     for case in problems:

@@ -122,16 +122,24 @@ def cmd_ik(args) -> int:
     robot = load(args.robot, tool=args.tool)
     if (args.target_q is None) == (args.target_xyz is None):
         raise KinelabError("give the target as --target-q Q... or as --target-xyz X Y Z [--target-rpy R P Y]")
+    options = {}
     if args.target_q is not None:
-        target = robot.fk(robot.check_q(_q_from_cli(robot, args.target_q, args.deg, "--target-q"), limits=True,
-                                        what="--target-q"))
+        q_target = robot.check_q(_q_from_cli(robot, args.target_q, args.deg, "--target-q"), limits=True,
+                                 what="--target-q")
+        target = robot.fk(q_target)
+        if args.solver == "biquat":
+            from kinelab import biquat_kinematics
+
+            options["target_biquaternion"] = biquat_kinematics.pose(robot, q_target)  # N with its sign
     else:
         rpy = np.array(args.target_rpy if args.target_rpy is not None else [0.0, 0.0, 0.0])
         target = target_from_xyz_rpy(args.target_xyz, np.deg2rad(rpy) if args.deg else rpy)
     q0 = None if args.start_q is None else _q_from_cli(robot, args.start_q, args.deg, "--start-q")
-    options = {}
     if args.solver == "frdm" and args.polish:
         options["polish"] = True
+    if args.solver == "biquat":
+        options.update({k: v for k, v in (("law", args.law), ("integrator", args.integrator), ("step", args.step),
+                                          ("k", args.gain)) if v is not None})
     result = solve(robot, target, solver=args.solver, q0=q0, seed=args.seed, tol_pos=args.tol_pos,
                    tol_rot=args.tol_rot, time_budget=args.time_budget, **options)
     out = {"robot": robot.name, "target": pose_dict(target), **result.to_dict()}
@@ -146,6 +154,10 @@ def cmd_ik(args) -> int:
               "(Pinocchio FK)")
         print(f"  {result.iterations} iterations, {result.restarts} restarts, {result.wall_time * 1e3:.2f} ms, "
               f"mode {result.mode}")
+        if "model_time" in result.info:
+            m0 = result.info.get("M0")
+            print(f"  model time {result.info['model_time']:.4g} s, final M0 = "
+                  + (f"{m0:+.6f}" if m0 is not None else "n/a (give --target-q for the sign of N)"))
         if result.message:
             print(f"  {result.message}")
     return 0 if result.success else 1
@@ -224,6 +236,10 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--tol-rot", type=float, default=1e-6, help="[rad]")
     s.add_argument("--time-budget", type=float, default=1.0, help="[s]")
     s.add_argument("--polish", action="store_true", help="frdm: add damped-least-squares polish steps")
+    s.add_argument("--law", choices=["simple", "regular"], help="biquat: control law (9)/(16) or (11)/(12)")
+    s.add_argument("--integrator", choices=["euler", "rk4", "adaptive"], help="biquat: integrator")
+    s.add_argument("--step", type=float, help="biquat: fixed step h [s] (the paper: 0.01; default 1/k)")
+    s.add_argument("--gain", type=float, help="biquat: gain k [1/s] (default 1)")
     s.add_argument("--tool", help="tool frame (default: the robot's own)")
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_ik)

@@ -33,3 +33,36 @@ def quat_distance_wxyz(a, b) -> float:
     """Largest component difference between unit quaternions, treating a and −a as equal."""
     a, b = np.asarray(a, float), np.asarray(b, float)
     return float(min(np.max(np.abs(a - b)), np.max(np.abs(a + b))))
+
+
+def reproduce(robot=None, law: str = "simple", integrator: str = "euler", step: float = 0.01, k: float = 1.0,
+              k0: float = 0.0, k_v: float | None = None, start_q=None, record: bool = True):
+    """The paper's run: from START_Q to the target N = Λ(TARGET_Q), K = k + s k0, step h [s].
+
+    Returns the solver's Attempt; ``info`` holds model_time [s], M0 (the scalar of N̄∘Λ at the end, the
+    chain product keeping Λ continuous) and, with ``record``, the trajectory (t, q, M*, U).
+    """
+    from kinelab import biquat_kinematics
+    from kinelab.ik import biquat
+    from kinelab.robot import load
+
+    robot = robot or load("stanford")
+    N = biquat_kinematics.pose(robot, TARGET_Q)
+    q0 = START_Q if start_q is None else np.asarray(start_q, dtype=float)
+    return biquat.attempt(robot, robot.fk(TARGET_Q), q0, 1e-6, 1e-6, np.inf, law=law, integrator=integrator,
+                          step=step, k=k, k0=k0, k_v=k_v, target_biquaternion=N, record=record)
+
+
+def part_times(trajectory: dict, eps: float = 5e-7) -> tuple[float, float]:
+    """Model times [s] at which the rotation part |m⃗| and the moment part |m0⃗| of M* first fall below eps."""
+    t, M = trajectory["t"], trajectory["M"]
+    rot, mom = np.linalg.norm(M[:, 1:4], axis=1), np.linalg.norm(M[:, 5:8], axis=1)
+    first = [t[np.argmax(x < eps)] if (x < eps).any() else float("nan") for x in (rot, mom)]
+    return float(first[0]), float(first[1])
+
+
+def near_pi_start(delta: float = 1e-2) -> np.ndarray:
+    """A start whose error rotation is π − delta: the target with q6 turned by π − delta."""
+    q = TARGET_Q.copy()
+    q[5] += np.pi - delta
+    return q

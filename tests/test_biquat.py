@@ -1,0 +1,155 @@
+"""The biquaternion kinematic-control solver: its laws on a free body (closed form), the seed-001 run,
+the singularity of law (9), and its answers re-checked by Pinocchio."""
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import kinelab
+from kinelab import biquat_kinematics as bk
+from kinelab.dualquat import DualQuat
+from kinelab.ik import biquat, solve
+from kinelab.studies import stanford_seed001 as s1
+
+
+def free_body(M0: DualQuat, law, t_end: float, h: float = 1e-3, T0=(1.0, 0.0)):
+    """Integrate 2Ṁ = M∘U(M) for a free rigid body (RK4), U from ``law``; returns times and M(t)."""
+    def f(x):
+        M = DualQuat.from_array(x[:8])
+        if law[0] == "simple":
+            w, v = biquat.simple_law(M, *law[1:])
+            Td = (0.0, 0.0)
+        else:
+            w, v, Td = biquat.regular_law(M, (x[8], x[9]), *law[1:])
+        Mdot = M * DualQuat(np.r_[0.0, w], np.r_[0.0, v])
+        return np.r_[0.5 * Mdot.as_array(), Td]
+    x = np.r_[M0.as_array(), T0]
+    ts, Ms = [0.0], [x[:8].copy()]
+    for k in range(int(round(t_end / h))):
+        a = f(x)
+        b = f(x + 0.5 * h * a)
+        c = f(x + 0.5 * h * b)
+        d = f(x + h * c)
+        x = x + h / 6 * (a + 2 * b + 2 * c + d)
+        ts.append((k + 1) * h)
+        Ms.append(x[:8].copy())
+    return np.array(ts), np.array(Ms)
+
+
+@pytest.mark.parametrize("k, k0", [(1.0, 0.0), (2.0, -1.0), (0.5, 1.0)])
+def test_simple_law_follows_its_closed_form_on_a_free_body(k, k0):
+    M0 = DualQuat.from_se3(pin.SE3(pin.exp3(np.array([0.4, -0.9, 0.3])), np.array([0.2, 0.5, -0.3])))
+    ts, Ms = free_body(M0, ("simple", k, k0), 3.0)
+    m0, d0 = M0.real_wxyz[1:], M0.dual_wxyz[1:]
+    for t, M in zip(ts[::500], Ms[::500], strict=True):
+        np.testing.assert_allclose(M[1:4], np.exp(-k * t) * m0, atol=1e-9)
+        np.testing.assert_allclose(M[5:8], np.exp(-k * t) * (d0 - k0 * t * m0), atol=1e-9)
+
+
+def test_regular_law_is_bounded_from_an_error_of_exactly_pi():
+    M0 = DualQuat(np.array([0.0, 0.0, 0.0, 1.0]), np.array([0.0, 0.1, 0.2, 0.0])).normalized()
+    with pytest.raises(kinelab.KinelabError, match="singular"):
+        biquat.simple_law(M0, 1.0)
+    ts, Ms = free_body(M0, ("regular", 1.0, 0.0), 30.0, h=1e-2)
+    assert np.linalg.norm(Ms[-1][1:4]) < 1e-5 and np.linalg.norm(Ms[-1][5:8]) < 1e-4
+
+
+# -- seed 001 on the Stanford arm ----------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def paper_run():
+    return s1.reproduce()
+
+
+def test_the_papers_run_reaches_1e6_as_checked_by_pinocchio(paper_run):
+    robot = kinelab.load("stanford")
+    assert paper_run.status.value == "converged"
+    dp, dr = robot.tool_error(paper_run.q, robot.fk(s1.TARGET_Q))
+    assert dp <= 1e-6 and dr <= 1e-6
+
+
+def test_model_time_is_the_closed_form_prediction(paper_run):
+    """K = 1, Euler h = 0.01: |m⃗| shrinks by (1 − kh) per step from |m⃗(0)| to the threshold 5e-7
+    (the continuous law would take ln(|m⃗(0)|/5e-7) = 14.46 s)."""
+    m_start = np.linalg.norm(paper_run.info["trajectory"]["M"][0][1:4])
+    h = 0.01
+    predicted = h * np.ceil(np.log(m_start / 5e-7) / -np.log(1 - h))
+    assert paper_run.info["model_time"] == pytest.approx(predicted, abs=1e-9)
+    assert 10 < paper_run.info["model_time"] < 20  # kinelab: 14.4 s; the paper reports about 40 s
+
+
+def test_final_M0_is_minus_one_as_in_the_paper(paper_run):
+    assert paper_run.info["M0"] == pytest.approx(-1.0, abs=1e-9)
+
+
+def test_separate_gains_speed_up_the_moment_part_by_their_ratio():
+    base = s1.part_times(s1.reproduce(k_v=None).info["trajectory"])
+    fast = s1.part_times(s1.reproduce(k_v=4.0).info["trajectory"])
+    assert fast[1] == pytest.approx(base[1] / 4, rel=0.1)
+    assert fast[0] == pytest.approx(base[0], rel=0.01)  # the rotation part keeps its rate
+
+
+def test_law_9_blows_up_near_pi_where_the_regular_law_converges():
+    start = s1.near_pi_start(1e-4)
+    simple = s1.reproduce(start_q=start, integrator="rk4")
+    regular = s1.reproduce(start_q=start, law="regular", integrator="rk4")
+    peak = [np.abs(r.info["trajectory"]["U"][:, :3]).max() for r in (simple, regular)]
+    assert peak[0] > 1e4  # 2k tan(φ/2) with φ = π − 1e-4
+    assert peak[1] < 2.0 and regular.status.value == "converged"
+    robot = kinelab.load("stanford")
+    dp, dr = robot.tool_error(regular.q, robot.fk(s1.TARGET_Q))
+    assert dp <= 1e-6 and dr <= 1e-6
+
+
+# -- the solver through kinelab.solve ---------------------------------------------------------------------
+
+@pytest.mark.parametrize("name", ("stanford", "ur5", "panda", "era"))
+def test_biquat_answers_are_confirmed_by_pinocchio(name):
+    robot = kinelab.load(name)
+    rng = np.random.default_rng(3)
+    solved = 0
+    for k in range(12):
+        target = robot.fk(robot.random_q(rng))
+        res = solve(robot, target, solver="biquat", seed=k, time_budget=0.2)
+        if res.success:
+            solved += 1
+            dp, dr = robot.tool_error(res.q, target)
+            assert dp <= 1e-6 and dr <= 1e-6 and robot.within_limits(res.q)
+    assert solved >= 11
+
+
+def test_redundant_chain_reports_its_damping():
+    robot = kinelab.load("panda")
+    res = solve(robot, robot.fk(robot.random_q(2)), solver="biquat", seed=0)
+    assert res.info["damping"] > 0
+
+
+def test_chain_product_target_is_used_for_the_sign():
+    robot = kinelab.load("stanford")
+    N = bk.pose(robot, s1.TARGET_Q)
+    with pytest.raises(kinelab.KinelabError, match="not the pose"):
+        solve(robot, robot.fk(s1.START_Q), solver="biquat", target_biquaternion=N)
+
+
+@pytest.mark.parametrize("options, match", [
+    ({"k": 0.0}, "positive"), ({"k": -1.0}, "positive"), ({"k_v": -2.0}, "positive"),
+    ({"law": "fast"}, "unknown law"), ({"integrator": "leapfrog"}, "unknown integrator"),
+    ({"step": 0.0}, "positive"),
+])
+def test_bad_gains_and_options_are_refused(options, match):
+    robot = kinelab.load("stanford")
+    with pytest.raises(kinelab.KinelabError, match=match):
+        solve(robot, robot.fk(s1.TARGET_Q), solver="biquat", **options)
+
+
+def test_non_unit_target_biquaternion_is_refused():
+    with pytest.raises(kinelab.KinelabError, match="not a unit"):
+        biquat.paper_unit_biquaternion([1.0, 0.2, 0, 0], [0, 0, 0, 0])
+    N = biquat.paper_unit_biquaternion(s1.N_REAL_WXYZ, s1.N_DUAL_WXYZ)  # the paper's N is unit to its digits
+    assert N.is_unit(1e-12)
+
+
+def test_unreachable_target_is_never_success():
+    robot = kinelab.load("stanford")
+    res = solve(robot, pin.SE3(np.eye(3), np.array([5.0, 0, 0])), solver="biquat", time_budget=0.05)
+    assert not res.success and res.status.value == "unreachable"
