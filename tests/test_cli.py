@@ -104,3 +104,26 @@ def test_ik_biquat_reproduces_seed_001_and_prints_model_time_and_M0(capsys):
     code, out, _ = run(capsys, "ik", "stanford", "--solver", "biquat", "--target-q", "20", "40", "0.3", "-35", "60",
                        "-45", "--start-q", "-30", "15", "0.1", "36", "-90", "45", "--deg")
     assert "model time" in out and "M0 = -1.000000" in out
+
+
+def test_singular_at_a_configuration_reports_rank_and_lost_motion(capsys):
+    code, out, _ = run(capsys, "singular", "youbot", "0", "0", "0", "30", "0", "0", "40", "10", "--deg", "--json")
+    res = json.loads(out)
+    assert code == 0 and res["rank"] == 5 and res["singular"] and len(res["lost_directions"]) == 1
+
+
+def test_singular_sweep_lists_families(capsys):
+    code, out, _ = run(capsys, "singular", "youbot", "--sweep", "3000", "--seed", "1", "--json")
+    res = json.loads(out)
+    assert code == 0 and res["families"]
+    assert any(f["relations"] == ["arm_joint_2 = 0", "arm_joint_3 = 0"] for f in res["families"])
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["singular", "youbot"], "give a configuration"),
+    (["singular", "youbot", "1", "2"], "8 numbers"),
+    (["singular", "youbot", "--sweep", "0"], "at least one sample"),
+])
+def test_singular_user_errors(capsys, argv, needle):
+    code, _, err = run(capsys, *argv)
+    assert code == 2 and needle in err

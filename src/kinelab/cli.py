@@ -163,6 +163,53 @@ def cmd_ik(args) -> int:
     return 0 if result.success else 1
 
 
+def cmd_singular(args) -> int:
+    from kinelab import singular
+
+    robot = load(args.robot, tool=args.tool)
+    if args.sweep is not None:
+        if args.q:
+            raise KinelabError("give either a configuration or --sweep N, not both")
+        result = singular.sweep(robot, samples=args.sweep, seed=args.seed, progress=not args.json)
+        out = {"robot": robot.name, **{k: v for k, v in result.items() if k not in ("families", "sigma_ratio")},
+               "families": [f.to_dict() for f in result["families"]]}
+        if args.json:
+            _print_json(out)
+            return 0
+        for note in result["notes"]:
+            print(f"note: {note}")
+        print(f"{robot.name}: {args.sweep} samples, {out['near_singular']} near-singular (σ_min/σ_max < "
+              f"{singular.NEAR_SINGULAR:g}), {out['refined']} refined, {out['singular']} singular after refinement")
+        for f in result["families"]:
+            q_show = np.round(f.representative, 4).tolist()
+            relations = " and ".join(r.text for r in f.relations) or "(no simple relation)"
+            print(f"  rank {f.rank}, {f.count:4d} found: {relations}")
+            print(f"      e.g. q = {q_show}")
+        return 0
+    if not args.q:
+        raise KinelabError("give a configuration Q1 ... Qn or --sweep N")
+    q = _q_from_cli(robot, args.q, args.deg)
+    a = singular.analyze(robot, robot.check_q(q, limits=not args.ignore_limits))
+    if args.json:
+        _print_json({"robot": robot.name, **a.to_dict()})
+        return 0
+    print(f"{robot.name}: rank {a.rank} of {a.full_rank}{' (SINGULAR)' if a.singular else ''}; "
+          f"σ = {np.array2string(a.singular_values, precision=4)} (linear rows / L = {a.length:.4g} m)")
+    print(f"  manipulability {a.manipulability:.4g}, condition {a.condition:.4g}")
+    for d in a.lost_directions:
+        parts = []
+        if "translation_axis" in d:
+            axis, share = np.round(d["translation_axis"], 3).tolist(), 100 * d["translation_share"]
+            parts.append(f"translation {axis} ({share:.0f} %)")
+        if "rotation_axis" in d:
+            axis, share = np.round(d["rotation_axis"], 3).tolist(), 100 * d["rotation_share"]
+            parts.append(f"rotation about {axis} ({share:.0f} %)")
+        print(f"  lost tool motion (base axes, at the tool): {' + '.join(parts)}")
+    for m in a.null_motions:
+        print(f"  joint motion that moves nothing: {np.round(m, 4).tolist()}")
+    return 0
+
+
 def cmd_validate(args) -> int:
     from kinelab import validate
 
@@ -243,6 +290,17 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--tool", help="tool frame (default: the robot's own)")
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_ik)
+
+    s = sub.add_parser("singular", help="rank, singular values, lost directions; or a sweep for singular families")
+    s.add_argument("robot", help="registered name or URDF path")
+    s.add_argument("q", nargs="*", type=float, help="one number per joint (rad and m; deg with --deg)")
+    s.add_argument("--deg", action="store_true")
+    s.add_argument("--sweep", type=int, help="sample N configurations within the limits and report families")
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--tool", help="tool frame (default: the robot's own)")
+    s.add_argument("--ignore-limits", action="store_true", help="allow q outside the joint limits")
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(func=cmd_singular)
 
     s = sub.add_parser("bench", help="the IK benchmark: kinelab's solvers and the installed peers")
     s.add_argument("--robots", nargs="+", default=None, help="robots (default: panda ur5 stanford era)")

@@ -83,3 +83,26 @@ def quadrant_violations(result: TrackResult, passage: Passage) -> int:
     signs = np.sign(passage.q0[2:5])
     tol = 1e-6
     return int(np.sum(np.any(result.q[:, 2:5] * signs < -tol, axis=1)))
+
+
+# The paper's three kinds of ERA singularity, by the joint whose value defines each (kinelab's frames).
+SINGULAR_KINDS = {"elbow reach": ("joint4", 0.0), "wrist gimbal lock": ("joint6", np.pi / 2),
+                  "shoulder": ("joint2", np.pi / 2)}
+
+
+def singular_examples(robot: Robot | None = None, seed: int = 0) -> dict[str, np.ndarray]:
+    """One configuration per kind: the defining joint held at its value, the others moved onto the singular
+    set (σ_min minimised). A 7R arm needs more than one condition to lose rank; the refinement finds it."""
+    from kinelab.singular import refine
+
+    robot = robot or load("era")
+    rng = np.random.default_rng(seed)
+    out = {}
+    for kind, (joint, value) in SINGULAR_KINDS.items():
+        j = robot.joint_index(joint)
+        q = 0.5 * robot.random_q(rng)
+        q[j] = value
+        lower, upper = robot.lower.copy(), robot.upper.copy()
+        lower[j] = upper[j] = value
+        out[kind] = refine(robot, q, lower, upper)
+    return out

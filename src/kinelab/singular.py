@@ -1,0 +1,256 @@
+"""Singularities of any chain: SVD rank, manipulability, lost directions, sweeps and families.
+
+Units. A tool twist mixes m/s and rad/s, so the singular values of a raw Jacobian depend on the unit of
+length. kinelab divides the linear rows by the chain's characteristic length L (the mean spacing of its
+joint origins, :meth:`Robot.characteristic_length`): the scaled Jacobian maps joint rates to
+(v/L, ω), both in 1/s, and its singular values, condition number and manipulability are
+dimensionless (for revolute chains; a prismatic column carries 1/L). The rank is the number of singular
+values above ``RANK_RTOL``·σ_max. The rank itself does not depend on L or on the frame: only the
+directions reported do.
+
+Frame. Directions are given in the base frame at the tool point (LOCAL_WORLD_ALIGNED): a lost direction
+is a tool twist (v [unit vector share], ω) that no joint motion produces; a null motion is a joint
+velocity that moves nothing.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+
+import numpy as np
+import pinocchio as pin
+from tqdm import tqdm
+
+from kinelab.errors import KinelabError
+from kinelab.robot import Robot
+
+RANK_RTOL = 1e-6  # singular values below RANK_RTOL × σ_max count as zero
+NEAR_SINGULAR = 1e-2  # σ_min/σ_max below this: worth refining onto the singular set
+RELATION_TOL = 1e-3  # [rad or m] a joint relation holds within this
+SPECIAL_VALUES = (0.0, np.pi / 2, -np.pi / 2, np.pi, -np.pi)
+FAMILY_MARGIN = 0.1  # [rad] a sample this close to every relation of a known family is explained by it
+
+
+@dataclass
+class Analysis:
+    """The singularity picture of a robot at q (see the module docstring for units and frames)."""
+
+    q: np.ndarray
+    singular_values: np.ndarray
+    rank: int
+    full_rank: int
+    manipulability: float  # Yoshikawa √det(J Jᵀ) (n ≥ 6) or √det(Jᵀ J) (n < 6), scaled J
+    condition: float  # σ_max/σ_min (inf when singular)
+    length: float  # L [m]
+    lost_directions: list[dict] = field(default_factory=list)
+    null_motions: list[np.ndarray] = field(default_factory=list)
+
+    @property
+    def singular(self) -> bool:
+        return self.rank < self.full_rank
+
+    def to_dict(self) -> dict:
+        return {
+            "q": self.q.tolist(),
+            "singular_values": self.singular_values.tolist(),
+            "rank": self.rank,
+            "full_rank": self.full_rank,
+            "singular": self.singular,
+            "manipulability": self.manipulability,
+            "condition": self.condition if np.isfinite(self.condition) else None,
+            "characteristic_length_m": self.length,
+            "lost_directions": self.lost_directions,
+            "null_motions": [m.tolist() for m in self.null_motions],
+        }
+
+
+def scaled_jacobian(robot: Robot, q, length: float | None = None) -> np.ndarray:
+    """6 × n LOCAL_WORLD_ALIGNED tool Jacobian with the linear rows divided by L."""
+    L = length or robot.characteristic_length()
+    J = robot.jacobian_local_world_aligned(q)
+    J[:3] /= L
+    return J
+
+
+def _rank(s: np.ndarray) -> int:
+    return int(np.sum(s > RANK_RTOL * s[0])) if s.size and s[0] > 0 else 0
+
+
+def describe_direction(u: np.ndarray) -> dict:
+    """A unit scaled twist (v/L, ω) as words: how much is translation, along which axis, rotation about which."""
+    lin, ang = u[:3], u[3:]
+    out = {"twist": u.tolist(), "translation_share": float(lin @ lin), "rotation_share": float(ang @ ang)}
+    for name, part in (("translation", lin), ("rotation", ang)):
+        norm = np.linalg.norm(part)
+        if norm > 1e-6:
+            out[f"{name}_axis"] = (part / norm).tolist()
+    return out
+
+
+def analyze(robot: Robot, q, length: float | None = None) -> Analysis:
+    """SVD of the scaled tool Jacobian at q: rank, σ, manipulability, condition, lost and null directions."""
+    q = robot.check_q(q)
+    L = length or robot.characteristic_length()
+    J = scaled_jacobian(robot, q, L)
+    U, s, Vt = np.linalg.svd(J)
+    full = min(6, robot.n)
+    rank = _rank(s)
+    JJ = J @ J.T if robot.n >= 6 else J.T @ J
+    manip = float(np.sqrt(max(np.linalg.det(JJ), 0.0)))
+    condition = float(s[0] / s[full - 1]) if s[full - 1] > RANK_RTOL * s[0] else float("inf")
+    lost = [describe_direction(U[:, i]) | {"sigma": float(s[i])} for i in range(rank, 6)]
+    null = [Vt[i] for i in range(rank, robot.n)]
+    return Analysis(q, s, rank, full, manip, condition, L, lost, null)
+
+
+def sigma_ratio_batch(robot: Robot, qs: np.ndarray, length: float | None = None, progress: bool = False) -> np.ndarray:
+    """σ_min/σ_max of the scaled Jacobian for each row of ``qs`` (one batched SVD)."""
+    L = length or robot.characteristic_length()
+    model, data, fid = robot.model, robot.data, robot.tool_frame_id
+    Js = np.empty((len(qs), 6, robot.nv))
+    for i, q in enumerate(tqdm(qs, desc="jacobians", disable=not progress, unit="q", leave=False)):
+        Js[i] = pin.computeFrameJacobian(model, data, robot.to_pin_q(q), fid, pin.LOCAL_WORLD_ALIGNED).reshape(6, -1)
+    Js[:, :3] /= L
+    s = np.linalg.svd(Js, compute_uv=False)
+    full = min(6, robot.n)
+    return s[:, full - 1] / s[:, 0]
+
+
+def refine(robot: Robot, q0, lower=None, upper=None, length: float | None = None) -> np.ndarray:
+    """Move q0 onto the singular set: minimise σ_min/σ_max within the joint box (L-BFGS-B)."""
+    from scipy.optimize import minimize
+
+    L = length or robot.characteristic_length()
+    lo = robot.lower if lower is None else lower
+    hi = robot.upper if upper is None else upper
+
+    def ratio(q):
+        s = np.linalg.svd(scaled_jacobian(robot, q, L), compute_uv=False)
+        return s[min(6, robot.n) - 1] / s[0]
+
+    res = minimize(ratio, np.asarray(q0, float), method="L-BFGS-B", bounds=list(zip(lo, hi, strict=True)),
+                   options={"maxiter": 300, "ftol": 1e-16, "gtol": 1e-12})
+    return res.x
+
+
+@dataclass(frozen=True)
+class Relation:
+    """Σ sign_k q[index_k] = value: a joint relation a family of singular configurations satisfies."""
+
+    index: tuple[int, ...]
+    sign: tuple[int, ...]
+    value: float
+    text: str
+
+    def residual(self, q) -> float:
+        return abs(sum(s * q[i] for i, s in zip(self.index, self.sign, strict=True)) - self.value)
+
+
+def _label(c: float) -> str:
+    return {0.0: "0", np.pi / 2: "π/2", -np.pi / 2: "−π/2", np.pi: "π", -np.pi: "−π"}[c]
+
+
+def joint_relations(robot: Robot, q, tol: float = RELATION_TOL) -> list[Relation]:
+    """Simple relations the configuration satisfies: joints at 0, ±π/2, ±π; sums and differences of two
+    joints, and sums of three consecutive angular joints, at those values (joint names in the text);
+    relations implied by single-joint ones (θ2 = 0 and θ3 = 0 imply θ2 ± θ3 = 0) are left out."""
+    names = robot.joint_names
+    angular = [i for i, k in enumerate(robot.joint_kinds) if k != "prismatic"]
+    combos = [((i,), (1,)) for i in angular]
+    combos += [((i, j), (1, s)) for i, j in itertools.combinations(angular, 2) for s in (1, -1)]
+    combos += [((a, b, d), (1, 1, 1)) for a, b, d in zip(angular, angular[1:], angular[2:], strict=False)]
+    out: list[Relation] = []
+    fixed: set[int] = set()
+    for index, sign in combos:
+        if len(index) > 1 and all(i in fixed for i in index):
+            continue
+        total = sum(s * q[i] for i, s in zip(index, sign, strict=True))
+        c = next((c for c in SPECIAL_VALUES if abs(total - c) < tol), None)
+        if c is None:
+            continue
+        lhs = names[index[0]] + "".join(f" {'+' if s > 0 else '−'} {names[i]}"
+                                        for i, s in zip(index[1:], sign[1:], strict=True))
+        out.append(Relation(index, sign, c, f"{lhs} = {_label(c)}"))
+        if len(index) == 1:
+            fixed.add(index[0])
+    return out
+
+
+def _merge_coincidences(groups: dict[tuple, list]) -> dict[tuple, list]:
+    """A relation set that strictly contains another family's carries a chance coincidence: merge it there."""
+    merged: dict[tuple, list] = {}
+    for key in sorted(groups, key=len):
+        home = next((k for k in merged if k and set(k) < set(key)), None)
+        merged.setdefault(home or key, []).extend(groups[key])
+    return merged
+
+
+@dataclass
+class Family:
+    """Singular configurations that share the same joint relations."""
+
+    relations: list[Relation]
+    count: int
+    representative: np.ndarray
+    rank: int
+    sigma_ratio: float
+
+    def to_dict(self) -> dict:
+        return {"relations": [r.text for r in self.relations], "count": self.count,
+                "representative_q": self.representative.tolist(), "rank": self.rank,
+                "sigma_min_over_max": self.sigma_ratio}
+
+
+def sweep_limits(robot: Robot) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """The box a sweep samples, and notes for joints whose range is not a finite limit."""
+    notes = []
+    for j in robot.joints:
+        if j.kind == "continuous":
+            notes.append(f"{j.name} is continuous: sampled on [−π, π]")
+    return robot.lower.copy(), robot.upper.copy(), notes
+
+
+def sweep(robot: Robot, samples: int = 5000, seed: int = 0, refine_top: int = 40, progress: bool = True) -> dict:
+    """Sample the joint box, keep near-singular configurations, refine them onto the singular set, and
+    group those that are singular into families by the joint relations they satisfy.
+
+    Returns {"families": [...], "samples", "near_singular", "refined", "singular", "notes", "sigma_ratio"}.
+    """
+    if samples < 1:
+        raise KinelabError("a sweep needs at least one sample")
+    lower, upper, notes = sweep_limits(robot)
+    rng = np.random.default_rng(seed)
+    qs = rng.uniform(lower, upper, size=(samples, robot.n))
+    L = robot.characteristic_length()
+    ratios = sigma_ratio_batch(robot, qs, L, progress)
+    order = [i for i in np.argsort(ratios) if ratios[i] < NEAR_SINGULAR]
+    groups: dict[tuple[Relation, ...], list[np.ndarray]] = {}
+    refined = singular_count = 0
+    # Refine the most singular samples that no family found so far explains. A family of lower dimension
+    # (the youBot's θ2 = θ3 = 0) is sampled far less often than one of codimension 1; leaving the
+    # explained samples out is what lets a sweep find it.
+    with tqdm(total=refine_top, desc="refine", disable=not progress, unit="q", leave=False) as bar:
+        while refined < refine_top and order:
+            known = [rel for rel in groups if rel]
+            pick = next((i for i in order if not any(all(r.residual(qs[i]) < FAMILY_MARGIN for r in rel)
+                                                     for rel in known)), None)
+            if pick is None:
+                break
+            order.remove(pick)
+            q = refine(robot, qs[pick], lower, upper, L)
+            refined += 1
+            bar.update()
+            if analyze(robot, q, L).singular:
+                singular_count += 1
+                groups.setdefault(tuple(joint_relations(robot, q)), []).append(q)
+    groups = _merge_coincidences(groups)
+    families = []
+    for rel, members in sorted(groups.items(), key=lambda kv: -len(kv[1])):
+        rep = members[0]
+        a = analyze(robot, rep, L)
+        families.append(Family(list(rel), len(members), rep, a.rank,
+                               float(a.singular_values[a.full_rank - 1] / a.singular_values[0])))
+    return {"families": families, "samples": samples, "near_singular": int(np.sum(ratios < NEAR_SINGULAR)),
+            "refined": refined, "singular": singular_count, "notes": notes,
+            "sigma_ratio": ratios}
