@@ -247,6 +247,63 @@ def cmd_bench(args) -> int:
     return 0
 
 
+def _serve(scene) -> int:
+    import time
+
+    print(f"meshcat is serving on {scene.url} (Ctrl-C to stop)", flush=True)
+    try:
+        while True:
+            time.sleep(1.0)
+    except KeyboardInterrupt:
+        return 0
+    finally:
+        scene.close()
+
+
+def cmd_view(args) -> int:
+    from kinelab import viz
+
+    robot = load(args.robot, tool=args.tool)
+    q = _q_from_cli(robot, args.q, args.deg) if args.q else robot.neutral()
+    robot.check_q(q, limits=not args.ignore_limits)
+    scene = viz.Scene(robot).show(q)
+    if args.singular:
+        scene.singular_directions(q)
+    if args.html:
+        scene.save_html(args.html)
+        scene.close()
+        print(f"wrote {args.html}")
+        return 0
+    return _serve(scene)
+
+
+def cmd_animate(args) -> int:
+    from kinelab import viz
+    from kinelab.studies import era_passages
+
+    passages = {"era-elbow": era_passages.elbow_passage}
+    if args.passage not in passages:
+        raise KinelabError(f"unknown passage {args.passage!r}; passages are: {', '.join(passages)}")
+    robot = load("era")
+    passage = passages[args.passage](robot)
+    run = era_passages.run(passage, robot)
+    result = run.without if args.without_bypass else run.with_bypass
+    scene = viz.Scene(robot, name=f"era ({'without' if args.without_bypass else 'with'} bypass)")
+    scene.animate(result.q, dt=args.dt)
+    for k, target in enumerate(passage.targets[:: max(1, len(passage.targets) // 8)]):
+        scene.frame(f"target{k}", target, 0.5 * scene.frame_length)
+    summary = result.summary()
+    print(f"{args.passage} {'without' if args.without_bypass else 'with'} bypass: {summary['reached']} of "
+          f"{summary['samples']} samples reached, largest joint step {summary['max_joint_step']:.3f} rad, "
+          f"{summary['monitor_events']} monitor events")
+    if args.html:
+        scene.save_html(args.html)
+        scene.close()
+        print(f"wrote {args.html}")
+        return 0
+    return _serve(scene)
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="kinelab", description="Kinematics of serial arms, checked against Pinocchio.")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -301,6 +358,23 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--ignore-limits", action="store_true", help="allow q outside the joint limits")
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_singular)
+
+    s = sub.add_parser("view", help="show a robot in meshcat (live on 127.0.0.1, or --html for a static page)")
+    s.add_argument("robot", help="registered name or URDF path")
+    s.add_argument("q", nargs="*", type=float, help="configuration (default: zero, moved into the limits)")
+    s.add_argument("--deg", action="store_true")
+    s.add_argument("--singular", action="store_true", help="draw the lost directions and σ_min at q")
+    s.add_argument("--html", help="write a self-contained HTML page instead of serving")
+    s.add_argument("--tool", help="tool frame (default: the robot's own)")
+    s.add_argument("--ignore-limits", action="store_true")
+    s.set_defaults(func=cmd_view)
+
+    s = sub.add_parser("animate", help="animate a solver run in meshcat (the ERA passages)")
+    s.add_argument("passage", help="era-elbow")
+    s.add_argument("--without-bypass", action="store_true", help="the run without the paper's bypass")
+    s.add_argument("--dt", type=float, default=0.1, help="seconds per path sample in the animation")
+    s.add_argument("--html", help="write a self-contained HTML page instead of serving")
+    s.set_defaults(func=cmd_animate)
 
     s = sub.add_parser("bench", help="the IK benchmark: kinelab's solvers and the installed peers")
     s.add_argument("--robots", nargs="+", default=None, help="robots (default: panda ur5 stanford era)")

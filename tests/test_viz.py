@@ -1,0 +1,81 @@
+"""meshcat scenes with a real meshcat server on loopback, static HTML, and a real browser's picture."""
+
+import os
+
+import numpy as np
+import pytest
+
+import kinelab
+from kinelab import viz
+
+BUNDLED = ("stanford", "era", "youbot")
+CHROMIUM = viz.find_chromium()
+needs_browser = pytest.mark.skipif(
+    CHROMIUM is None and not os.environ.get("CI"),
+    reason="Debian's chromium is not installed here (.ci/run installs it; in CI this test must run)",
+)
+
+
+@pytest.fixture(scope="module", params=BUNDLED)
+def scene(request):
+    robot = kinelab.load(request.param)
+    s = viz.Scene(robot).show(robot.random_q(1))
+    yield s
+    s.close()
+
+
+def test_scene_tree_holds_every_visual_of_the_robot(scene):
+    paths = viz.scene_paths(scene.static_html())
+    expected = {"/meshcat/" + p for p in scene.node_paths()}
+    assert len(expected) >= 5 and expected <= paths
+    assert any(p.startswith("/meshcat/frames/tool") for p in paths)
+    assert scene.url.startswith("http://127.0.0.1:")
+
+
+def test_static_html_is_self_contained(scene, tmp_path):
+    html = scene.save_html(tmp_path / "scene.html").read_text()
+    assert "MeshCat.Viewer" in html and "<script src=" not in html and "http" not in html.split("<script>")[0]
+
+
+def test_animation_with_tool_path_and_singular_overlay():
+    robot = kinelab.load("era")
+    s = viz.Scene(robot)
+    qs = np.linspace(np.zeros(7), [0.3, 0.5, 0.8, -1.2, 0.6, 0.2, 0.1], 12)
+    s.animate(qs, dt=0.1)
+    s.singular_directions(np.zeros(7))
+    html = s.static_html()
+    s.close()
+    paths = viz.scene_paths(html)
+    assert "/meshcat/paths/tool_path" in paths
+    assert any(p.startswith("/meshcat/singular/lost0") for p in paths) and "/meshcat/singular/sigma" in paths
+    assert html.count("data:application/octet-binary") > len(paths)  # the animation travels as a command too
+
+
+@needs_browser
+@pytest.mark.parametrize("name", BUNDLED)
+def test_a_real_browser_draws_the_robot(name, tmp_path):
+    if CHROMIUM is None:
+        pytest.fail("CI must have chromium: .ci/run installs Debian's chromium")
+    robot = kinelab.load(name)
+    s = viz.Scene(robot).show(robot.random_q(2))
+    with_robot = s.save_html(tmp_path / "robot.html")
+    (tmp_path / "empty.html").write_text(viz.without_robot_html(s))
+    shot_robot = viz.screenshot(with_robot, tmp_path / "robot.png")
+    shot_empty = viz.screenshot(tmp_path / "empty.html", tmp_path / "empty.png")
+    share = viz.changed_share(shot_robot, shot_empty)
+    live_share = viz.changed_share(viz.screenshot(s.url, tmp_path / "live.png"), shot_empty)
+    s.close()
+    assert share > 0.003, f"the robot covers only {share:.2%} of the picture"
+    assert live_share > 0.003, f"the live viewer shows only {live_share:.2%} of changed pixels"
+
+
+@needs_browser
+def test_the_empty_reference_really_is_empty_of_the_robot(tmp_path):
+    robot = kinelab.load("era")
+    s = viz.Scene(robot)
+    (tmp_path / "a.html").write_text(viz.without_robot_html(s))
+    (tmp_path / "b.html").write_text(viz.without_robot_html(s))
+    s.close()
+    share = viz.changed_share(viz.screenshot(tmp_path / "a.html", tmp_path / "a.png"),
+                              viz.screenshot(tmp_path / "b.html", tmp_path / "b.png"))
+    assert share < 0.001  # two renders of the same page agree: the comparison measures the robot
