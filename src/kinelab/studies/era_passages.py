@@ -106,3 +106,24 @@ def singular_examples(robot: Robot | None = None, seed: int = 0) -> dict[str, np
         lower[j] = upper[j] = value
         out[kind] = refine(robot, q, lower, upper)
     return out
+
+
+def dls_tracking(passage: Passage, robot: Robot | None = None) -> dict[str, np.ndarray]:
+    """The Pinocchio DLS reference along the same path, warm-started from the previous sample, no restarts."""
+    import time
+
+    from kinelab.ik import solve
+
+    robot = robot or load("era")
+    q = passage.q0
+    rows, times, perr, rerr = [], [], [], []
+    for target in passage.targets:
+        t0 = time.perf_counter()
+        res = solve(robot, target, solver="dls", q0=q, max_restarts=0, time_budget=1.0)
+        times.append(time.perf_counter() - t0)
+        q = res.q
+        rows.append(q)
+        perr.append(res.position_error)
+        rerr.append(res.rotation_error)
+    return {"q": np.array(rows), "wall_time": np.array(times), "position_error": np.array(perr),
+            "rotation_error": np.array(rerr)}

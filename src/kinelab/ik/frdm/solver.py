@@ -49,6 +49,20 @@ def vector_model(robot: Robot) -> VectorModel:
     return cached[1]
 
 
+_COMPILED = False
+
+
+def prepare(robot: Robot) -> None:
+    """Build the vector model and compile (or load) the kernel: done before a solve's clock starts."""
+    global _COMPILED
+    vm = vector_model(robot)
+    if not _COMPILED:
+        target = pin.SE3.Identity()
+        prob = _Problem(vm, target, "pose", None, (1.0, 1.0, 1.0), True)
+        _Runner(robot, vm, prob, "base2tip", 1.0, 5, 1e-10, 15, 0.1, False, 2)._kernel(robot.neutral(), 2, 1e-6, 1e-6)
+        _COMPILED = True
+
+
 @dataclass
 class Bypass:
     """The bypass configuration (all optional). Joint names are the robot's; values rad or m."""
