@@ -12,7 +12,8 @@ def test_validate_passes_on_two_robots_and_writes_the_report(tmp_path, capsys):
     assert report["passed"] and {c["robot"] for c in report["checks"]} == {"stanford", "ur5"}
     assert any("seed 001" in c["name"] for c in report["checks"])
     assert any(c["name"].startswith("frdm:") for c in report["checks"])
-    assert (out / "seed001_convergence.png").stat().st_size > 1000 and "data:image/png" in (out / "report.html").read_text()
+    assert (out / "seed001_convergence.png").stat().st_size > 1000
+    assert "data:image/png" in (out / "report.html").read_text()
     assert (out / "report.md").read_text().count("PASS") == len(report["checks"])
     assert "<table" in (out / "report.html").read_text()
 
