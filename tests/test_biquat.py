@@ -153,3 +153,14 @@ def test_unreachable_target_is_never_success():
     robot = kinelab.load("stanford")
     res = solve(robot, pin.SE3(np.eye(3), np.array([5.0, 0, 0])), solver="biquat", time_budget=0.05)
     assert not res.success and res.status.value == "unreachable"
+
+
+def test_a_unit_biquaternion_is_a_valid_target_and_a_non_unit_one_is_not():
+    robot = kinelab.load("stanford")
+    N = bk.pose(robot, s1.TARGET_Q)
+    res = solve(robot, N, solver="frdm", seed=0)
+    assert res.success and robot.tool_error(res.q, robot.fk(s1.TARGET_Q))[0] <= 1e-6
+    with pytest.raises(kinelab.KinelabError, match="not a unit"):
+        solve(robot, DualQuat(2 * N.real_wxyz, N.dual_wxyz))
+    with pytest.raises(kinelab.KinelabError, match="NaN"):
+        solve(robot, DualQuat(np.array([np.nan, 0, 0, 0]), np.zeros(4)))

@@ -142,3 +142,13 @@ def test_era_has_the_papers_three_kinds_of_singularity():
 def test_bad_configurations(youbot, bad, match):
     with pytest.raises(kinelab.ConfigurationError, match=match):
         singular.analyze(youbot, bad)
+
+
+def test_grid_sweep_on_a_6r_arm_finds_the_wrist_and_elbow_families():
+    ur5 = kinelab.load("ur5")
+    res = singular.sweep(ur5, samples=4096, method="grid", progress=False)
+    assert res["samples"] == 4 ** 6
+    texts = [" and ".join(r.text for r in f.relations) for f in res["families"]]
+    assert any("wrist_2_joint" in t for t in texts) and any("elbow_joint" in t for t in texts)
+    for f in res["families"]:
+        assert independent_rank(ur5, f.representative) < 6

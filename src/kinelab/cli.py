@@ -170,7 +170,8 @@ def cmd_singular(args) -> int:
     if args.sweep is not None:
         if args.q:
             raise KinelabError("give either a configuration or --sweep N, not both")
-        result = singular.sweep(robot, samples=args.sweep, seed=args.seed, progress=not args.json)
+        result = singular.sweep(robot, samples=args.sweep, seed=args.seed, progress=not args.json,
+                                method="grid" if args.grid else "random")
         out = {"robot": robot.name, **{k: v for k, v in result.items() if k not in ("families", "sigma_ratio")},
                "families": [f.to_dict() for f in result["families"]]}
         if args.json:
@@ -353,6 +354,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("q", nargs="*", type=float, help="one number per joint (rad and m; deg with --deg)")
     s.add_argument("--deg", action="store_true")
     s.add_argument("--sweep", type=int, help="sample N configurations within the limits and report families")
+    s.add_argument("--grid", action="store_true", help="sweep a stratified grid instead of uniform samples")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--tool", help="tool frame (default: the robot's own)")
     s.add_argument("--ignore-limits", action="store_true", help="allow q outside the joint limits")

@@ -211,17 +211,31 @@ def sweep_limits(robot: Robot) -> tuple[np.ndarray, np.ndarray, list[str]]:
     return robot.lower.copy(), robot.upper.copy(), notes
 
 
-def sweep(robot: Robot, samples: int = 5000, seed: int = 0, refine_top: int = 40, progress: bool = True) -> dict:
-    """Sample the joint box, keep near-singular configurations, refine them onto the singular set, and
-    group those that are singular into families by the joint relations they satisfy.
+def grid(robot: Robot, samples: int, rng: np.random.Generator) -> np.ndarray:
+    """A stratified grid over the joint box: k cells per joint (k^n ≤ samples, k ≥ 2), one sample per cell,
+    jittered within it. (A plain grid puts joints on 0 and ±π/2 together, where every relation holds.)"""
+    k = max(2, int(np.floor(samples ** (1.0 / robot.n) + 1e-9)))
+    cells = np.array(np.meshgrid(*[np.arange(k)] * robot.n, indexing="ij")).reshape(robot.n, -1).T
+    width = (robot.upper - robot.lower) / k
+    return robot.lower + (cells + rng.uniform(size=cells.shape)) * width
+
+
+def sweep(robot: Robot, samples: int = 5000, seed: int = 0, refine_top: int = 40, progress: bool = True,
+          method: str = "random") -> dict:
+    """Sample the joint box (seeded uniform samples, or a full grid), keep near-singular configurations,
+    refine them onto the singular set, and group those that are singular into families by the joint
+    relations they satisfy (relations that hold there; for a redundant arm one relation can be a necessary
+    condition only, the refinement supplies the rest).
 
     Returns {"families": [...], "samples", "near_singular", "refined", "singular", "notes", "sigma_ratio"}.
     """
     if samples < 1:
         raise KinelabError("a sweep needs at least one sample")
     lower, upper, notes = sweep_limits(robot)
+    if method not in ("random", "grid"):
+        raise KinelabError(f"unknown sweep method {method!r}; use 'random' or 'grid'")
     rng = np.random.default_rng(seed)
-    qs = rng.uniform(lower, upper, size=(samples, robot.n))
+    qs = rng.uniform(lower, upper, size=(samples, robot.n)) if method == "random" else grid(robot, samples, rng)
     L = robot.characteristic_length()
     ratios = sigma_ratio_batch(robot, qs, L, progress)
     order = [i for i in np.argsort(ratios) if ratios[i] < NEAR_SINGULAR]
@@ -251,6 +265,6 @@ def sweep(robot: Robot, samples: int = 5000, seed: int = 0, refine_top: int = 40
         a = analyze(robot, rep, L)
         families.append(Family(list(rel), len(members), rep, a.rank,
                                float(a.singular_values[a.full_rank - 1] / a.singular_values[0])))
-    return {"families": families, "samples": samples, "near_singular": int(np.sum(ratios < NEAR_SINGULAR)),
+    return {"families": families, "samples": len(qs), "near_singular": int(np.sum(ratios < NEAR_SINGULAR)),
             "refined": refined, "singular": singular_count, "notes": notes,
             "sigma_ratio": ratios}

@@ -31,10 +31,15 @@ def from_xyz_quat_wxyz(xyz, quat_wxyz) -> pin.SE3:
 
 
 def as_target(target) -> pin.SE3:
-    """Check a target: a ``pin.SE3`` with finite entries and a proper rotation."""
+    """Check a target: a ``pin.SE3`` with finite entries and a proper rotation, or a unit biquaternion."""
+    from kinelab.dualquat import DualQuat
+
+    if isinstance(target, DualQuat):
+        return target.require_unit("the target biquaternion").to_se3()
     if not isinstance(target, pin.SE3):
         raise TargetError(
-            f"target must be a pin.SE3 of the tool in the base frame, got {type(target).__name__}; "
+            f"target must be a pin.SE3 (or a unit DualQuat) of the tool in the base frame, "
+            f"got {type(target).__name__}; "
             "build one with kinelab.target_from_xyz_rpy or kinelab.target_from_xyz_quat_wxyz"
         )
     H = target.homogeneous
