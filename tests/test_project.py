@@ -37,5 +37,6 @@ def test_the_readme_python_example_runs():
     block = re.search(r"```python\n(.*?)```", (ROOT / "README.md").read_text(), re.S).group(1)
     namespace: dict = {}
     exec(compile(block, "README.md", "exec"), namespace)  # noqa: S102 - the README's own example
-    assert namespace["res"].success and namespace["a"].rank == 5
+    assert namespace["res"].success
+    assert namespace["a"].rank == 4  # youBot at zero: θ2 = θ3 = 0 and the gripper vertical, two losses
     namespace["scene"].close()
