@@ -305,6 +305,17 @@ def cmd_animate(args) -> int:
     return _serve(scene)
 
 
+def _robot_arguments(s: argparse.ArgumentParser, q_help: str | None = None, limits: bool = True) -> None:
+    """The arguments every per-robot command shares: ROBOT [Q...] [--deg] [--tool] [--ignore-limits]."""
+    s.add_argument("robot", help="registered name or URDF path")
+    if q_help:
+        s.add_argument("q", nargs="*", type=float, help=q_help)
+        s.add_argument("--deg", action="store_true", help="angles of revolute/continuous joints in degrees")
+    s.add_argument("--tool", help="tool frame (default: the robot's own)")
+    if limits:
+        s.add_argument("--ignore-limits", action="store_true", help="allow q outside the joint limits")
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="kinelab", description="Kinematics of serial arms, checked against Pinocchio.")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -314,17 +325,12 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_robots)
 
     s = sub.add_parser("info", help="joints, types, limits, DOF and tool frame of a robot")
-    s.add_argument("robot", help="registered name or URDF path")
-    s.add_argument("--tool", help="tool frame (default: the robot's own)")
+    _robot_arguments(s, limits=False)
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_info)
 
     s = sub.add_parser("fk", help="tool pose at a configuration")
-    s.add_argument("robot", help="registered name or URDF path")
-    s.add_argument("q", nargs="*", type=float, help="one number per joint (rad and m; deg with --deg)")
-    s.add_argument("--deg", action="store_true", help="angles of revolute/continuous joints in degrees")
-    s.add_argument("--tool", help="tool frame (default: the robot's own)")
-    s.add_argument("--ignore-limits", action="store_true", help="allow q outside the joint limits")
+    _robot_arguments(s, "one number per joint (rad and m; deg with --deg)")
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_fk)
 
@@ -350,25 +356,17 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_ik)
 
     s = sub.add_parser("singular", help="rank, singular values, lost directions; or a sweep for singular families")
-    s.add_argument("robot", help="registered name or URDF path")
-    s.add_argument("q", nargs="*", type=float, help="one number per joint (rad and m; deg with --deg)")
-    s.add_argument("--deg", action="store_true")
+    _robot_arguments(s, "one number per joint (rad and m; deg with --deg)")
     s.add_argument("--sweep", type=int, help="sample N configurations within the limits and report families")
     s.add_argument("--grid", action="store_true", help="sweep a stratified grid instead of uniform samples")
     s.add_argument("--seed", type=int, default=0)
-    s.add_argument("--tool", help="tool frame (default: the robot's own)")
-    s.add_argument("--ignore-limits", action="store_true", help="allow q outside the joint limits")
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_singular)
 
     s = sub.add_parser("view", help="show a robot in meshcat (live on 127.0.0.1, or --html for a static page)")
-    s.add_argument("robot", help="registered name or URDF path")
-    s.add_argument("q", nargs="*", type=float, help="configuration (default: zero, moved into the limits)")
-    s.add_argument("--deg", action="store_true")
+    _robot_arguments(s, "configuration (default: zero, moved into the limits)")
     s.add_argument("--singular", action="store_true", help="draw the lost directions and σ_min at q")
     s.add_argument("--html", help="write a self-contained HTML page instead of serving")
-    s.add_argument("--tool", help="tool frame (default: the robot's own)")
-    s.add_argument("--ignore-limits", action="store_true")
     s.set_defaults(func=cmd_view)
 
     s = sub.add_parser("animate", help="animate a solver run in meshcat (the ERA passages)")
