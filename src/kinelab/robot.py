@@ -313,7 +313,8 @@ class Robot:
     def wrap_continuous(self, q) -> np.ndarray:
         """q with continuous joints wrapped into (−π, π] (the same pose)."""
         q = np.array(q, dtype=float)
-        q[self._cont_pos] = np.arctan2(np.sin(q[self._cont_pos]), np.cos(q[self._cont_pos]))
+        if self._cont_pos.size:
+            q[self._cont_pos] = np.arctan2(np.sin(q[self._cont_pos]), np.cos(q[self._cont_pos]))
         return q
 
     def neutral(self) -> np.ndarray:

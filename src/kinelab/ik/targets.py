@@ -46,7 +46,9 @@ def as_target(target) -> pin.SE3:
     if not np.isfinite(H.sum()):
         raise TargetError("target has NaN or infinite entries")
     R = H[:3, :3]
-    if np.abs(R.T @ R - _EYE3).max() > 1e-6 or np.linalg.det(R) < 0:
+    (a, b, c), (d, e, f), (g, h, i) = R.tolist()
+    det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)  # np.linalg.det costs 10 µs here
+    if np.abs(R.T @ R - _EYE3).max() > 1e-6 or det < 0:
         raise TargetError("target rotation is not a rotation matrix (RᵀR ≠ I or det R < 0)")
     return target
 

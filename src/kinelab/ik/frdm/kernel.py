@@ -384,3 +384,64 @@ def run(
             state[2] = E1
             state[3] = state[1]
     return BUDGET, max_sweeps
+
+
+@njit(cache=True)
+def _xorshift(state):
+    """xorshift64*: a small seeded generator for restarts inside the kernel; returns a float in [0, 1)."""
+    x = state[0]
+    x ^= x >> np.uint64(12)
+    x ^= x << np.uint64(25)
+    x ^= x >> np.uint64(27)
+    state[0] = x
+    return float((x * np.uint64(2685821657736338717)) >> np.uint64(11)) / 9007199254740992.0
+
+
+@njit(cache=True)
+def multistart(
+    q, PR, Pt, axis, kind, TR, Tt, lower, upper, free, pstar, Rstar, w_p, w_ax, relax, order,
+    tol_pos, tol_rot, check_pos, check_rot, max_sweeps, eps_q, window, window_rel, accel_m,
+    rng_state, max_attempts, sweep_budget, best_q, stats,
+):
+    """Attempts from q, then from seeded uniform starts, until one converges, ``max_attempts`` have run or
+    ``sweep_budget`` sweeps are spent. A stall ends an attempt (a restart, not a bypass).
+
+    On return q holds the converged configuration (or the last start), best_q the lowest-objective one;
+    stats = [attempts, sweeps, stalls, accepted accelerations, best objective]. Returns a run() code.
+    """
+    n = q.shape[0]
+    X = np.zeros((accel_m + 1, n))
+    G = np.zeros((accel_m + 1, n))
+    state = np.zeros(7)
+    trace = np.zeros(0)
+    best = np.inf
+    for a in range(max_attempts):
+        if a > 0:
+            for i in range(n):
+                if kind[i] == CONTINUOUS:
+                    q[i] = -np.pi + 2.0 * np.pi * _xorshift(rng_state)
+                else:
+                    q[i] = lower[i] + (upper[i] - lower[i]) * _xorshift(rng_state)
+        for k in range(7):
+            state[k] = 0.0
+        budget = min(max_sweeps, int(sweep_budget - stats[1]))
+        code, s = run(q, PR, Pt, axis, kind, TR, Tt, lower, upper, free, pstar, Rstar, w_p, w_ax, relax, order,
+                      tol_pos, tol_rot, check_pos, check_rot, budget, eps_q, window, window_rel, accel_m, X, G,
+                      state, trace)
+        stats[0] += 1.0
+        stats[1] += s
+        stats[3] += state[4]
+        if state[5] < best:
+            best = state[5]
+            best_q[:] = q
+        if code == CONVERGED:
+            best_q[:] = q
+            stats[4] = state[5]
+            return CONVERGED
+        if code == STALL_STEP or code == STALL_WINDOW:  # noqa: SIM109 - plain comparisons for numba
+            stats[2] += 1.0
+        if stats[1] >= sweep_budget:
+            stats[4] = best
+            return BUDGET
+    stats[4] = best
+    return code

@@ -123,6 +123,17 @@ def _scaled_sigma_min(robot: Robot, q: np.ndarray, length: float) -> float:
     return float(np.linalg.svd(J, compute_uv=False)[-1])
 
 
+def _validate(mode: str, order: str, accel: str, relax: float) -> None:
+    if mode not in MODES:
+        raise KinelabError(f"unknown FRDM mode {mode!r}; modes are: {', '.join(MODES)}")
+    if order not in ORDERS:
+        raise KinelabError(f"unknown sweep order {order!r}; orders are: {', '.join(ORDERS)}")
+    if accel not in ("anderson", "none"):
+        raise KinelabError(f"unknown acceleration {accel!r}; use 'anderson' or 'none'")
+    if not 0.0 < relax < 2.0:
+        raise KinelabError(f"relax must lie in (0, 2), got {relax}")
+
+
 def attempt(
     robot: Robot,
     oMtarget: pin.SE3,
@@ -179,14 +190,7 @@ def attempt(
         polish: follow FRDM with damped-least-squares steps (reported as mode "frdm+polish").
         trace: keep the objective after every sweep in ``info["trace"]``.
     """
-    if mode not in MODES:
-        raise KinelabError(f"unknown FRDM mode {mode!r}; modes are: {', '.join(MODES)}")
-    if order not in ORDERS:
-        raise KinelabError(f"unknown sweep order {order!r}; orders are: {', '.join(ORDERS)}")
-    if accel not in ("anderson", "none"):
-        raise KinelabError(f"unknown acceleration {accel!r}; use 'anderson' or 'none'")
-    if not 0.0 < relax < 2.0:
-        raise KinelabError(f"relax must lie in (0, 2), got {relax}")
+    _validate(mode, order, accel, relax)
     plain = accel == "none"
     max_sweeps = max_sweeps or (3000 if plain else 100)
     stall_window = stall_window or (50 if plain else 15)
@@ -334,3 +338,74 @@ class _Runner:
             self.state[6] = 1.0  # the joints nearest the base act first on the kicked chain
         self.bypass_log.append({"sweep": self.sweeps, "bypass": step, "q": q.tolist()})
         return q
+
+
+def _seed_state(seed: int | None) -> int:
+    """A non-zero 64-bit state for the kernel's generator from a seed (splitmix64; None: fresh entropy)."""
+    mask = (1 << 64) - 1
+    x = (int(np.random.SeedSequence().entropy) if seed is None else int(seed)) & mask
+    x = (x + 0x9E3779B97F4A7C15) & mask
+    x = ((x ^ (x >> 30)) * 0xBF58476D1CE4E5B9) & mask
+    x = ((x ^ (x >> 27)) * 0x94D049BB133111EB) & mask
+    return (x ^ (x >> 31)) | 1
+
+
+FAST_PATH_BLOCKERS = ("kicks", "intervals", "freeze", "policy", "active", "polish", "trace")
+
+
+def fast_path_allowed(options: dict) -> bool:
+    """The compiled multistart serves a solve that names no bypass, policy, polish or trace (naming one,
+    even empty, asks for the monitor's diagnosis and log, which the Python loop keeps)."""
+    return not any(name in options for name in FAST_PATH_BLOCKERS)
+
+
+def multistart(
+    robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol_rot: float, deadline: float,
+    seed: int | None, max_restarts: int, **options,
+) -> tuple[Attempt, int]:
+    """FRDM from q0 and then from seeded random starts, all inside the compiled kernel (a stall is answered
+    by a restart: with no bypass configured that is what the monitor's policy does for a local minimum).
+    Returns the attempt kept and the number of restarts. The caller checks the answer with Pinocchio."""
+    mode = options.get("mode", "pose")
+    accel = options.get("accel", "anderson")
+    _validate(mode, options.get("order", "base2tip"), accel, float(options.get("relax", 1.0)))
+    plain = accel == "none"
+    vm = vector_model(robot)
+    prob = _Problem(vm, oMtarget, mode, options.get("w_p"), options.get("w_axes", (1.0, 1.0, 1.0)),
+                    options.get("use_limits", True), options.get("w_p_factor", 10.0))
+    max_sweeps = options.get("max_sweeps") or (3000 if plain else 100)
+    window = options.get("stall_window") or (50 if plain else 15)
+    window_rel = options.get("stall_rel")
+    window_rel = (1e-3 if plain else 0.1) if window_rel is None else window_rel
+    accel_m = 0 if plain else int(options.get("accel_memory", 5))
+    rng_state = np.array([_seed_state(seed)], dtype=np.uint64)
+    q = np.array(q0, dtype=float)
+    best_q = q.copy()
+    stats = np.zeros(5)
+    attempts_left = max_restarts + 1
+    code = kernel.BUDGET
+    while attempts_left > 0:
+        before = stats[0]
+        code = kernel.multistart(
+            q, vm.placement_R, vm.placement_t, vm.axis_local, vm.kind, vm.tool_R, vm.tool_t, prob.lower, prob.upper,
+            prob.free, prob.pstar, prob.Rstar, prob.w_p, prob.w_ax, float(options.get("relax", 1.0)),
+            ORDERS[options.get("order", "base2tip")], tol_pos, tol_rot, prob.check_pos, prob.check_rot, max_sweeps,
+            float(options.get("eps_q", 1e-10)), window, window_rel, accel_m, rng_state, attempts_left,
+            stats[1] + CHUNK * 32, best_q, stats,
+        )
+        attempts_left -= int(stats[0] - before)
+        if code == kernel.CONVERGED or time.perf_counter() > deadline:
+            break
+        q = best_q.copy() if attempts_left > 0 and stats[0] == before else q
+    if code == kernel.CONVERGED:
+        status = Status.CONVERGED
+    elif time.perf_counter() > deadline:
+        status = Status.TIME_BUDGET
+    else:
+        status = Status.STALLED if stats[2] > 0 else Status.MAX_ITERATIONS
+    info = {"mode": "frdm" + ("" if not plain else " (plain)"), "sweeps": int(stats[1]),
+            "accelerated_sweeps": int(stats[3]), "order": options.get("order", "base2tip"), "w_p": prob.w_p,
+            "objective": float(stats[4]), "attempts": int(stats[0]), "stalls": int(stats[2]), "path": "compiled"}
+    events = [{"trigger": "stall", "diagnosis": "not diagnosed (compiled multistart: restarted)",
+               "count": int(stats[2])}] if stats[2] else []
+    return Attempt(robot.wrap_continuous(best_q), status, int(stats[1]), events, [], info), max(0, int(stats[0]) - 1)
