@@ -263,3 +263,17 @@ def test_helical_or_spherical_joints_are_refused_by_name(tmp_path):
         warnings.simplefilter("ignore")
         with pytest.raises(kinelab.ChainError, match="ball"):
             kinelab.load(write_urdf(tmp_path, body))
+
+
+def test_compiled_multistart_is_seeded_and_checked_by_pinocchio(robots):
+    robot = robots["panda"]
+    rng = np.random.default_rng(44)
+    for k in range(10):
+        target = robot.fk(robot.random_q(rng))
+        a = solve(robot, target, seed=k, time_budget=1.0)
+        b = solve(robot, target, seed=k, time_budget=1.0)
+        assert a.info["path"] == "compiled" and a.success
+        np.testing.assert_array_equal(a.q, b.q)
+        assert robot.tool_error(a.q, target)[0] <= 1e-6 and robot.within_limits(a.q)
+    loop = solve(robot, target, seed=0, policy=("auto_kick",))
+    assert "path" not in loop.info and loop.success
