@@ -35,8 +35,8 @@ def test_stanford_dual_part_is_ten_times_the_printed_one():
 
 def test_papers_start_and_target_are_within_the_stanford_limits():
     robot = kinelab.load("stanford")
-    robot.check_q(seed001.TARGET_Q, limits=True)
-    robot.check_q(seed001.START_Q, limits=True)
+    assert robot.within_limits(seed001.TARGET_Q) and robot.within_limits(seed001.START_Q)
+    assert seed001.START_Q[4] == pytest.approx(robot.lower[4])  # the paper starts q5 on its −90° stop
 
 
 def test_youbot_vendor_mapping_sends_vendor_limits_to_the_papers_limits():

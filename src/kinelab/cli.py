@@ -248,6 +248,16 @@ def cmd_bench(args) -> int:
     return 0
 
 
+def _publish(scene, html: str | None) -> int:
+    """Write the scene as a static page, or serve it live until interrupted."""
+    if html:
+        scene.save_html(html)
+        scene.close()
+        print(f"wrote {html}")
+        return 0
+    return _serve(scene)
+
+
 def _serve(scene) -> int:
     import time
 
@@ -270,12 +280,7 @@ def cmd_view(args) -> int:
     scene = viz.Scene(robot).show(q)
     if args.singular:
         scene.singular_directions(q)
-    if args.html:
-        scene.save_html(args.html)
-        scene.close()
-        print(f"wrote {args.html}")
-        return 0
-    return _serve(scene)
+    return _publish(scene, args.html)
 
 
 def cmd_animate(args) -> int:
@@ -297,12 +302,7 @@ def cmd_animate(args) -> int:
     print(f"{args.passage} {'without' if args.without_bypass else 'with'} bypass: {summary['reached']} of "
           f"{summary['samples']} samples reached, largest joint step {summary['max_joint_step']:.3f} rad, "
           f"{summary['monitor_events']} monitor events")
-    if args.html:
-        scene.save_html(args.html)
-        scene.close()
-        print(f"wrote {args.html}")
-        return 0
-    return _serve(scene)
+    return _publish(scene, args.html)
 
 
 def _robot_arguments(s: argparse.ArgumentParser, q_help: str | None = None, limits: bool = True) -> None:
