@@ -99,4 +99,16 @@ for ax, theta2 in zip(axes, [0.0, 0.6]):
 axes[0].legend(loc="lower right")
 plt.tight_layout()
 """),
+("md", """
+## In the browser
+
+`kinelab.viz.Scene` draws a robot with meshcat (its server listens on 127.0.0.1 only). Here the youBot at
+a random configuration; under CI the page is embedded as static HTML.
+"""),
+("code", """
+import os
+from kinelab import viz
+scene = viz.Scene(youbot).show(youbot.random_q(rng))
+scene.viewer.render_static() if os.environ.get("CI") else scene.viewer.jupyter_cell()
+"""),
 ]
