@@ -18,15 +18,16 @@ def test_validate_passes_on_two_robots_and_writes_the_report(tmp_path, capsys):
     assert "<table" in (out / "report.html").read_text()
 
 
-def test_a_failing_check_makes_validate_exit_non_zero(monkeypatch, capsys):
+def test_a_failing_check_makes_validate_exit_non_zero(monkeypatch, capsys, tmp_path):
     def with_a_failure(robot, n, seed):
         rows = validate.model_checks(robot, n, seed)
         return rows + [validate.Check(robot.name, "deliberately failing", 1.0, 0.5, "m")]
 
     monkeypatch.setattr(validate, "GENERAL_CHECKS", [with_a_failure])
-    code = cli.main(["validate", "--robots", "ur5", "--n", "10"])
+    code = cli.main(["validate", "--robots", "ur5", "--n", "10", "--out", str(tmp_path)])
     assert code == 1
     assert "FAIL" in capsys.readouterr().out
+    assert (tmp_path / "report.md").read_text().count("FAIL") == 1
 
 
 def test_validate_refuses_an_unknown_robot_before_working(capsys):

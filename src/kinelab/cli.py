@@ -391,7 +391,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--robots", nargs="+", default=None, help="robots to check (default: the embedded set)")
     s.add_argument("--n", type=int, default=None, help="random configurations per check")
     s.add_argument("--seed", type=int, default=0)
-    s.add_argument("--out", help="write a report folder (Markdown, HTML, JSON) here")
+    s.add_argument("--out", default="kinelab-report",
+                   help="the report folder (Markdown, HTML with the figures, JSON); default ./kinelab-report")
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_validate)
     return p
