@@ -143,12 +143,10 @@ def solve(
     if beyond > 0:
         max_restarts = 0  # proved out of reach: one attempt gives the best pose, restarts cannot help
 
-    if solver == "frdm" and beyond <= 0:
-        from kinelab.ik.frdm import solver as frdm_solver
-
-        if frdm_solver.fast_path_allowed(solver_options):
-            return _fast_frdm(robot, target, start, tol_pos, tol_rot, deadline, seed, max_restarts, solver_options,
-                              t_start)
+    compiled = _compiled_multistart(solver, solver_options) if beyond <= 0 else None
+    if compiled is not None:
+        return _fast(compiled, solver, robot, target, start, tol_pos, tol_rot, deadline, seed, max_restarts,
+                     solver_options, t_start)
     scale = robot.characteristic_length()
     best: tuple[float, Attempt, float, float] | None = None
     best_ok = False
@@ -182,12 +180,17 @@ def solve(
     )
 
 
-def _fast_frdm(robot, target, start, tol_pos, tol_rot, deadline, seed, max_restarts, options, t_start) -> IKResult:
-    """FRDM with its restarts inside the compiled kernel; the answer is then checked by Pinocchio."""
-    from kinelab.ik.frdm import solver as frdm_solver
+def _compiled_multistart(solver: str, options: dict):
+    """The solver's compiled multistart when the options ask for nothing it leaves out, else None."""
+    module = importlib.import_module(SOLVERS[solver].__module__)
+    allowed = getattr(module, "fast_path_allowed", None)
+    return module.multistart if allowed is not None and allowed(options) else None
 
-    att, restarts = frdm_solver.multistart(robot, target, start, tol_pos, tol_rot, deadline, seed, max_restarts,
-                                           **options)
+
+def _fast(multistart, solver, robot, target, start, tol_pos, tol_rot, deadline, seed, max_restarts, options,
+          t_start) -> IKResult:
+    """Restarts inside the solver's compiled kernel; the answer is then checked by Pinocchio."""
+    att, restarts = multistart(robot, target, start, tol_pos, tol_rot, deadline, seed, max_restarts, **options)
     dp, dr = robot.tool_error(att.q, target)
     success = dp <= tol_pos and dr <= tol_rot and robot.within_limits(att.q)
     status, message = att.status, ""
@@ -197,7 +200,7 @@ def _fast_frdm(robot, target, start, tol_pos, tol_rot, deadline, seed, max_resta
         status, message = Status.STALLED, "the solver converged but its answer failed Pinocchio's check"
     return IKResult(
         q=att.q, success=success, status=status, position_error=dp, rotation_error=dr, iterations=att.iterations,
-        restarts=restarts, wall_time=time.perf_counter() - t_start, solver="frdm", mode=att.info["mode"],
+        restarts=restarts, wall_time=time.perf_counter() - t_start, solver=solver, mode=att.info["mode"],
         singular_events=att.events, message=message, info=att.info,
     )
 

@@ -334,3 +334,70 @@ def paper_unit_biquaternion(real_wxyz, dual_wxyz) -> DualQuat:
 
 
 __all__ = ["attempt", "canonical", "error_biquaternion", "qconj", "qmul", "regular_law", "simple_law"]
+
+
+FAST_OPTIONS = {"law": "simple", "integrator": "euler", "step": None, "k0": 0.0, "k_v": None, "max_step": None,
+                "max_steps": None, "clamp": None, "target_biquaternion": None, "record": False}
+
+
+def fast_path_allowed(options: dict) -> bool:
+    """The compiled preset serves law (9), newton Euler, k0 = 0, no trajectory and no given N."""
+    return all(options.get(key, default) == default for key, default in FAST_OPTIONS.items()
+               if key in options)
+
+
+def multistart(
+    robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol_rot: float, deadline: float,
+    seed: int | None, max_restarts: int, **options,
+) -> tuple[Attempt, int]:
+    """The default preset (law (9), Euler, h = 1/k, steps capped at 0.5 rad, 30 steps per attempt) with
+    its seeded restarts inside the compiled kernel; answers outside the joint limits are restarted."""
+    from kinelab.ik import biquat_kernel
+    from kinelab.ik.frdm.solver import CHUNK, _seed_state, vector_model
+
+    k = 1.0 if options.get("k") is None else float(options["k"])
+    if not (k > 0 and np.isfinite(k)):
+        raise KinelabError(f"gains must be positive and finite, got k = {k}")
+    damping = (0.0 if robot.n == 6 else 1e-4) if options.get("damping") is None else float(options["damping"])
+    max_time = options.get("max_time")
+    vm = vector_model(robot)
+    rng_state = np.array([_seed_state(seed)], dtype=np.uint64)
+    q = np.array(q0, dtype=float)
+    stats = np.zeros(5)
+    attempts_left = max_restarts + 1
+    code = biquat_kernel.BUDGET
+    pstar, Rstar = np.array(oMtarget.translation), np.array(oMtarget.rotation)
+    max_steps = 30 if max_time is None else max(1, int(np.ceil(float(max_time) * k)))
+    while attempts_left > 0:
+        before = stats[0]
+        code = biquat_kernel.multistart(
+            q, vm.placement_R, vm.placement_t, vm.axis_local, vm.kind, vm.tool_R, vm.tool_t, vm.lower, vm.upper,
+            pstar, Rstar, k, 1.0 / k, 0.5, max_steps, 0.5 * tol_rot, 0.5 * tol_pos, damping, rng_state,
+            attempts_left, stats[1] + CHUNK * 4, stats)
+        attempts_left -= int(stats[0] - before)
+        if code == biquat_kernel.CONVERGED or time.perf_counter() > deadline:
+            break
+    if code == biquat_kernel.CONVERGED:
+        status = Status.CONVERGED
+    elif time.perf_counter() > deadline:
+        status = Status.TIME_BUDGET
+    else:
+        status = Status.SINGULAR if code == biquat_kernel.SINGULAR else Status.MAX_ITERATIONS
+    info = {"mode": f"biquat (simple, newton euler, h={1.0 / k:g}, k={k:g}, compiled)", "model_time": float(stats[2]),
+            "steps": int(stats[1]), "M0": None, "damping": damping, "law": "simple", "integrator": "euler",
+            "attempts": int(stats[0]), "outside_limits": int(stats[3]), "path": "compiled"}
+    return Attempt(q, status, int(stats[1]), info=info), max(0, int(stats[0]) - 1)
+
+
+_COMPILED = False
+
+
+def prepare(robot: Robot) -> None:
+    """Compile (or load) the kernels before a solve's clock starts (once per process)."""
+    global _COMPILED
+    from kinelab.ik.frdm.solver import prepare as frdm_prepare
+
+    frdm_prepare(robot)
+    if not _COMPILED:
+        multistart(robot, pin.SE3.Identity(), robot.neutral(), 1e-6, 1e-6, np.inf, 0, 0)
+        _COMPILED = True
