@@ -229,12 +229,15 @@ def cmd_validate(args) -> int:
 def cmd_bench(args) -> int:
     from kinelab import bench
 
-    result = bench.run(robots=args.robots, n=args.n, seed=args.seed, solvers=args.solvers,
-                       budget=args.budget_ms / 1e3, progress=not args.json)
-    if args.scaling:
+    scaled = None
+    if args.scaling:  # first: the peers' solver threads and caches would disturb this timing afterwards
         from kinelab import scaling
 
-        result["scaling"] = scaling.run(progress=not args.json)
+        scaled = scaling.run(progress=not args.json)
+    result = bench.run(robots=args.robots, n=args.n, seed=args.seed, solvers=args.solvers,
+                       budget=args.budget_ms / 1e3, progress=not args.json)
+    if scaled is not None:
+        result["scaling"] = scaled
     if args.out:
         bench.write(result, args.out)
     if args.json:
