@@ -192,11 +192,6 @@ def same_pose(a: DualQuat, b: DualQuat, tol: float = 1e-12) -> bool:
     return bool(min(np.max(np.abs(x - y)), np.max(np.abs(x + y))) <= tol)
 
 
-def dual_mul_scalar(k: tuple[float, float], v: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """(k + s k0)(v + s v0) = k v + s(k v0 + k0 v) for a dual scalar and a dual vector."""
-    return k[0] * v[0], k[0] * v[1] + k[1] * v[0]
-
-
 def dual_div(a: tuple[float, float], b: tuple[float, float]) -> tuple[float, float]:
     """(a + s a0)/(b + s b0) = a/b + s(a0 b − a b0)/b²."""
     if b[0] == 0:

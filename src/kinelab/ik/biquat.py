@@ -23,7 +23,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab import biquat_kinematics
-from kinelab.dualquat import DualQuat, qconj, qmul, same_pose
+from kinelab.dualquat import DualQuat, same_pose
 from kinelab.errors import KinelabError
 from kinelab.ik.limits import PinLimits, wrap_q
 from kinelab.ik.result import Attempt, Status
@@ -333,9 +333,6 @@ def paper_unit_biquaternion(real_wxyz, dual_wxyz) -> DualQuat:
     return lam.require_unit("the target biquaternion", tol=1e-5).normalized()
 
 
-__all__ = ["attempt", "canonical", "error_biquaternion", "qconj", "qmul", "regular_law", "simple_law"]
-
-
 FAST_OPTIONS = {"law": "simple", "integrator": "euler", "step": None, "k0": 0.0, "k_v": None, "max_step": None,
                 "max_steps": None, "clamp": None, "target_biquaternion": None, "record": False}
 
@@ -352,8 +349,8 @@ def multistart(
 ) -> tuple[Attempt, int]:
     """The default preset (law (9), Euler, h = 1/k, steps capped at 0.5 rad, 30 steps per attempt) with
     its seeded restarts inside the compiled kernel; answers outside the joint limits are restarted."""
-    from kinelab.ik import biquat_kernel
-    from kinelab.ik.frdm.solver import CHUNK, _seed_state, vector_model
+    from kinelab.ik import biquat_kernel, restarts
+    from kinelab.ik.frdm.solver import CHUNK, vector_model
 
     k = 1.0 if options.get("k") is None else float(options["k"])
     if not (k > 0 and np.isfinite(k)):
@@ -361,22 +358,19 @@ def multistart(
     damping = (0.0 if robot.n == 6 else 1e-4) if options.get("damping") is None else float(options["damping"])
     max_time = options.get("max_time")
     vm = vector_model(robot)
-    rng_state = np.array([_seed_state(seed)], dtype=np.uint64)
+    rng_state = restarts.seed_state(seed)
     q = np.array(q0, dtype=float)
     stats = np.zeros(5)
-    attempts_left = max_restarts + 1
-    code = biquat_kernel.BUDGET
     pstar, Rstar = np.array(oMtarget.translation), np.array(oMtarget.rotation)
     max_steps = 30 if max_time is None else max(1, int(np.ceil(float(max_time) * k)))
-    while attempts_left > 0:
-        before = stats[0]
-        code = biquat_kernel.multistart(
+
+    def chunk(attempts_left: int) -> int:
+        return biquat_kernel.multistart(
             q, vm.placement_R, vm.placement_t, vm.axis_local, vm.kind, vm.tool_R, vm.tool_t, vm.lower, vm.upper,
             pstar, Rstar, k, 1.0 / k, 0.5, max_steps, 0.5 * tol_rot, 0.5 * tol_pos, damping, rng_state,
             attempts_left, stats[1] + CHUNK * 4, stats)
-        attempts_left -= int(stats[0] - before)
-        if code == biquat_kernel.CONVERGED or time.perf_counter() > deadline:
-            break
+
+    code = restarts.run_in_chunks(chunk, max_restarts + 1, stats, deadline, biquat_kernel.CONVERGED)
     if code == biquat_kernel.CONVERGED:
         status = Status.CONVERGED
     elif time.perf_counter() > deadline:

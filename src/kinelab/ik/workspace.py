@@ -23,11 +23,6 @@ def _reach(robot: Robot) -> tuple[np.ndarray, float]:
     return np.array(anchor), rigid + slides
 
 
-def reach_upper_bound(robot: Robot) -> tuple[np.ndarray, float]:
-    """(anchor [m], R [m]): every tool position lies within distance R of the anchor (joint 1's origin)."""
-    return _reach(robot)
-
-
 def out_of_reach(robot: Robot, position: np.ndarray) -> float:
     """How far [m] a position lies beyond the reach bound (≤ 0 when it may be reachable)."""
     anchor, radius = _reach(robot)

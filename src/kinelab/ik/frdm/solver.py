@@ -26,6 +26,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.errors import KinelabError
+from kinelab.ik import restarts
 from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm.model import VectorModel, build
 from kinelab.ik.result import Attempt, Status
@@ -340,16 +341,6 @@ class _Runner:
         return q
 
 
-def _seed_state(seed: int | None) -> int:
-    """A non-zero 64-bit state for the kernel's generator from a seed (splitmix64; None: fresh entropy)."""
-    mask = (1 << 64) - 1
-    x = (int(np.random.SeedSequence().entropy) if seed is None else int(seed)) & mask
-    x = (x + 0x9E3779B97F4A7C15) & mask
-    x = ((x ^ (x >> 30)) * 0xBF58476D1CE4E5B9) & mask
-    x = ((x ^ (x >> 27)) * 0x94D049BB133111EB) & mask
-    return (x ^ (x >> 31)) | 1
-
-
 FAST_PATH_BLOCKERS = ("kicks", "intervals", "freeze", "policy", "active", "polish", "trace")
 
 
@@ -378,25 +369,21 @@ def multistart(
     window_rel = options.get("stall_rel")
     window_rel = (1e-3 if plain else 0.1) if window_rel is None else window_rel
     accel_m = 0 if plain else int(options.get("accel_memory", 5))
-    rng_state = np.array([_seed_state(seed)], dtype=np.uint64)
+    rng_state = restarts.seed_state(seed)
     q = np.array(q0, dtype=float)
     best_q = q.copy()
     stats = np.zeros(5)
-    attempts_left = max_restarts + 1
-    code = kernel.BUDGET
-    while attempts_left > 0:
-        before = stats[0]
-        code = kernel.multistart(
+
+    def chunk(attempts_left: int) -> int:
+        return kernel.multistart(
             q, vm.placement_R, vm.placement_t, vm.axis_local, vm.kind, vm.tool_R, vm.tool_t, prob.lower, prob.upper,
             prob.free, prob.pstar, prob.Rstar, prob.w_p, prob.w_ax, float(options.get("relax", 1.0)),
             ORDERS[options.get("order", "base2tip")], tol_pos, tol_rot, prob.check_pos, prob.check_rot, max_sweeps,
             float(options.get("eps_q", 1e-10)), window, window_rel, accel_m, rng_state, attempts_left,
             stats[1] + CHUNK * 32, best_q, stats,
         )
-        attempts_left -= int(stats[0] - before)
-        if code == kernel.CONVERGED or time.perf_counter() > deadline:
-            break
-        q = best_q.copy() if attempts_left > 0 and stats[0] == before else q
+
+    code = restarts.run_in_chunks(chunk, max_restarts + 1, stats, deadline, kernel.CONVERGED)
     if code == kernel.CONVERGED:
         status = Status.CONVERGED
     elif time.perf_counter() > deadline:
