@@ -3,6 +3,9 @@
 import numpy as np
 import pytest
 
+from kinelab.errors import KinelabError
+from kinelab.ik.frdm.tracking import track
+from kinelab.robot import load
 from kinelab.studies import era_passages as ep
 
 STEP_BOUND = 0.25  # [rad] largest joint change between samples allowed with the bypass
@@ -40,3 +43,97 @@ def test_without_bypass_the_monitor_fires_and_the_arm_fails_the_paper_way(elbow)
     assert res.reached[reachable].sum() < 0.7 * reachable.sum()
     assert res.position_error[reachable].max() > 0.5  # the tool left behind by the target
     assert res.max_joint_step > 4 * STEP_BOUND  # and the jump when it finally folds
+
+
+# Passages 2 and 3: closed paths inside the two gimbal locks (see the module docstring).
+CLOSURE_TOL = 1e-5  # [rad] a lap that ends where it started
+
+
+@pytest.fixture(scope="module")
+def wrist():
+    passage = ep.wrist_passage()
+    return passage, ep.run(passage)
+
+
+@pytest.fixture(scope="module")
+def shoulder():
+    passage = ep.shoulder_passage()
+    return passage, ep.run(passage)
+
+
+def _every_sample_reached(res):
+    assert res.reached.all()
+    assert res.position_error.max() <= 1e-6 and res.rotation_error.max() <= 1e-6
+
+
+def test_wrist_path_sits_in_the_gimbal_lock(wrist):
+    passage, run = wrist
+    era = load("era")
+    oMtool = era.fk(passage.q0)
+    x5 = era.joint_placements(passage.q0)["joint5"].rotation[:, 0]  # J5 turns about its local x
+    assert abs(abs(oMtool.rotation[:, 2] @ x5) - 1.0) < 1e-12  # tool roll axis J7 ∥ J5
+    np.testing.assert_allclose(run.without.q[:, 5], np.pi / 2, atol=1e-6)  # and FRDM keeps q6 there
+    assert passage.samples == 4 * passage.lap + 1
+
+
+def test_wrist_with_intervals_closes_every_lap_smoothly(wrist):
+    passage, run = wrist
+    res = run.with_bypass
+    _every_sample_reached(res)
+    assert res.max_joint_step < 0.05
+    assert res.q[:, 4].max() <= ep.WRIST_LIMIT + 1e-12 and res.q[:, 5].max() <= ep.WRIST_LIMIT + 1e-12
+    laps = ep.lap_changes(res, passage)
+    assert np.abs(laps[1:]).max() < CLOSURE_TOL  # after the first lap settles, the joint path is closed
+
+
+def test_wrist_without_bypass_sums_angles_in_q5_and_q7(wrist):
+    passage, run = wrist
+    res = run.without
+    _every_sample_reached(res)  # the tool is fine: the failure is in joint space
+    laps = np.rad2deg(ep.lap_changes(res, passage))
+    assert (laps[:, 4] < -5).all() and (laps[:, 6] > 5).all()  # q5 down, q7 up, every lap
+    assert abs(laps[:, 4].sum()) > 35  # summed over four laps
+    np.testing.assert_allclose(laps[:, 4] + laps[:, 6], 0.0, atol=2.0)  # the wrist group turns as one
+
+
+def test_wrist_freezing_q1_does_not_help_on_this_model(wrist):
+    passage, _ = wrist
+    res = track(load("era"), passage.targets, passage.q0, freeze={"joint1": None}, restrict=("freeze",))
+    laps = np.rad2deg(ep.lap_changes(res, passage))
+    assert (laps[:, 4] < -5).all()  # q1 takes no part in the spin, so the drift stays
+
+
+def test_shoulder_with_q1_frozen_closes_every_lap(shoulder):
+    passage, run = shoulder
+    res = run.with_bypass
+    _every_sample_reached(res)
+    assert res.max_joint_step < 0.05
+    assert np.ptp(res.q[:, 0]) == 0.0
+    assert np.abs(ep.lap_changes(res, passage)).max() < CLOSURE_TOL
+
+
+def test_shoulder_with_q7_frozen_closes_every_lap_too():
+    passage = ep.shoulder_passage(frozen="joint7")
+    res = ep.run(passage).with_bypass
+    _every_sample_reached(res)
+    assert res.max_joint_step < 0.05 and np.abs(ep.lap_changes(res, passage)).max() < CLOSURE_TOL
+
+
+def test_shoulder_without_bypass_q1_and_q7_climb_together_until_the_stop(shoulder):
+    passage, run = shoulder
+    res = run.without
+    _every_sample_reached(res)
+    laps = np.rad2deg(ep.lap_changes(res, passage))
+    assert (laps[:2, 0] > 60).all()  # the arm turns with the tool, lap after lap
+    np.testing.assert_allclose(laps[:, 0], laps[:, 6], atol=1e-6)  # q1 and q7 in phase
+    assert res.max_joint_step > 6.0  # at the ±180° stop q1 swings back a whole turn in one sample
+    assert any(e["trigger"] == "jump" for e in res.events)
+
+
+def test_restrict_needs_its_table():
+    era = load("era")
+    passage = ep.shoulder_passage(era, laps=1)
+    with pytest.raises(KinelabError, match="no freeze table"):
+        track(era, passage.targets, passage.q0, restrict=("freeze",))
+    with pytest.raises(KinelabError, match="restrict takes"):
+        track(era, passage.targets, passage.q0, restrict=("kicks",))

@@ -10,6 +10,26 @@ down. Straight, with the target on its own line, every FRDM step is zero (Σ|Δq
 fires. Without bypass the arm stays straight while the target moves away, and then folds whichever
 way rounding lets it; with the paper's bypass, a small δq on the central joint with a minus sign,
 the elbow folds back the way it came and q3, q4, q5 stay each in its own quadrant.
+
+Passages 2 and 3 happen at the arm's two gimbal locks, where a roll axis lines up with another joint
+axis. The ERA is redundant (7R), so neither lock costs it a tool direction on its own; what the lock
+creates is a spin of a link group that leaves the tool where it is (a null motion). FRDM, warm-started
+sample after sample, drifts along that spin as the tool moves, and the angles add up: the paper's
+"summing of angles" (Fig. 10) and "linear increase of the angles in opposite joints" (Fig. 13). A
+single straight pass through either lock is smooth on this model (the wrist is not spherical: J5 and
+J7 are 0.34 m apart), so kinelab moves the tool round a closed path inside the lock, lap after lap,
+where the drift shows as a joint path that does not close.
+
+Passage 2, wrist gimbal lock (Fig. 9–11): q6 = 90° puts the tool roll axis J7 parallel to J5 (and to
+J3, J4): the wrist circles in the arm's vertical plane (bottom-up and back each lap), tool orientation
+fixed. Without bypass q5 and q7 wind in opposite senses lap after lap; with the paper's intervals
+q5, q6 < 80° held along the path the joint path closes after the first lap. (The paper's other option,
+q1 frozen, does nothing here: q1 takes no part in this spin.)
+
+Passage 3, shoulder (Fig. 12–14): the tool, pointing down, circles the vertical roll axis J1 with the
+wrist above the base, so J7 lines up with J1. Without bypass the whole arm turns with the tool: q1 and
+q7 climb together, about 81° per lap, until q1 meets its ±180° stop and the arm swings back a full
+turn in one sample. With q1 (or q7) frozen the joint path closes every lap.
 """
 
 from __future__ import annotations
@@ -19,6 +39,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from kinelab.ik.frdm import solver
 from kinelab.ik.frdm.tracking import TrackResult, track
 from kinelab.robot import Robot, load
 
@@ -26,6 +47,9 @@ FULL_REACH = 1.228 + 0.340 + 4.072 + 4.072 + 0.340 + 1.228  # [m] joint 1 to the
 ELBOW_FOLD = np.deg2rad(40.0)  # start: q3 = a, q4 = −2a, q5 = a keeps the tool on the vertical axis
 OVERSHOOT = 0.05  # [m] the top of passage 1 lies this far past full reach: the arm ends exactly straight
 KICK = 1e-2  # [rad] the paper's δq (> ε) on the central (elbow) joint
+WRIST_LOCK = np.deg2rad([0.0, 0.0, 30.0, 60.0, 0.0, 90.0, 0.0])  # q6 = 90°: J7 ∥ J5 ∥ J4 ∥ J3
+WRIST_LIMIT = np.deg2rad(80.0)  # the paper's bypass: q5, q6 < 80°
+SHOULDER_LOCK = np.deg2rad([0.0, 0.0, -55.0, 110.0, 125.0, 0.0, 0.0])  # tool down on the J1 axis: J7 ∥ J1
 
 
 @dataclass
@@ -38,6 +62,8 @@ class Passage:
     q0: np.ndarray
     bypass: dict = field(default_factory=dict)
     unreachable: np.ndarray | None = None  # samples that lie beyond reach by design
+    lap: int | None = None  # samples per lap of a closed path (sample k·lap is the start pose again)
+    q0_bypass: np.ndarray | None = None  # the start under the bypass's restrictions, when q0 breaks them
 
     @property
     def samples(self) -> int:
@@ -70,12 +96,68 @@ def elbow_passage(robot: Robot | None = None, samples: int = 40) -> Passage:
     )
 
 
+def _circle(oMcentre_start: pin.SE3, radius: float, plane: tuple, samples: int, laps: int) -> list[pin.SE3]:
+    """Tool poses round a circle that starts at oMcentre_start's point, orientation fixed [m]."""
+    u, v = (np.asarray(a, float) for a in plane)
+    phi = np.linspace(0.0, 2 * np.pi * laps, samples * laps + 1)
+    centre = oMcentre_start.translation - radius * u
+    return [pin.SE3(oMcentre_start.rotation, centre + radius * (np.cos(p) * u + np.sin(p) * v)) for p in phi]
+
+
+def wrist_passage(robot: Robot | None = None, radius: float = 0.35, samples: int = 60, laps: int = 4) -> Passage:
+    """Passage 2: at q6 = 90° the wrist circles in the arm's vertical plane (y, z), tool orientation fixed."""
+    robot = robot or load("era")
+    targets = _circle(robot.fk(WRIST_LOCK), radius, ((0, 1, 0), (0, 0, 1)), samples, laps)
+    j5, j6 = robot.joint_index("joint5"), robot.joint_index("joint6")
+    intervals = {"joint5": (robot.lower[j5], WRIST_LIMIT), "joint6": (robot.lower[j6], WRIST_LIMIT)}
+    start = solver.attempt(robot, targets[0], WRIST_LOCK, 1e-9, 1e-9, np.inf, intervals=intervals,
+                           active=("intervals",), max_sweeps=3000, stall_window=200, stall_rel=1e-9)
+    return Passage(
+        name="wrist",
+        description=f"wrist in the gimbal lock (q6 = 90°) on a {radius} m circle in the arm plane, {laps} laps",
+        targets=targets,
+        q0=WRIST_LOCK.copy(),
+        bypass={"intervals": intervals, "restrict": ("intervals",)},
+        lap=samples,
+        q0_bypass=start.q,
+    )
+
+
+def shoulder_passage(robot: Robot | None = None, radius: float = 0.5, samples: int = 72, laps: int = 3,
+                     frozen: str = "joint1") -> Passage:
+    """Passage 3: the tool, pointing down, circles the vertical roll axis J1 (J7 ∥ J1), orientation fixed."""
+    robot = robot or load("era")
+    oMlock = robot.fk(SHOULDER_LOCK)
+    oMstart = pin.SE3(oMlock.rotation, oMlock.translation + np.array([radius, 0.0, 0.0]))
+    targets = _circle(oMstart, radius, ((1, 0, 0), (0, 1, 0)), samples, laps)
+    start = solver.attempt(robot, targets[0], SHOULDER_LOCK, 1e-9, 1e-9, np.inf, max_sweeps=3000,
+                           stall_window=200, stall_rel=1e-9)
+    return Passage(
+        name="shoulder",
+        description=f"tool on a {radius} m circle round the vertical axis J1, {laps} laps, {frozen} frozen",
+        targets=targets,
+        q0=start.q,
+        bypass={"freeze": {frozen: None}, "restrict": ("freeze",)},
+        lap=samples,
+    )
+
+
+PASSAGES = {"elbow": elbow_passage, "wrist": wrist_passage, "shoulder": shoulder_passage}
+
+
 def run(passage: Passage, robot: Robot | None = None, **options) -> PassageRun:
     """Track the passage without bypass and with the paper's bypass (FRDM, warm-started, no restarts)."""
     robot = robot or load("era")
     without = track(robot, passage.targets, passage.q0, policy=(), **options)
-    with_bypass = track(robot, passage.targets, passage.q0, **passage.bypass, **options)
+    q0 = passage.q0 if passage.q0_bypass is None else passage.q0_bypass
+    with_bypass = track(robot, passage.targets, q0, **passage.bypass, **options)
     return PassageRun(passage, without, with_bypass)
+
+
+def lap_changes(result: TrackResult, passage: Passage) -> np.ndarray:
+    """q at the end of each lap minus q at its start, one row per lap [rad]: zero rows = a closed path."""
+    ends = result.q[:: passage.lap]
+    return np.diff(ends, axis=0)
 
 
 def quadrant_violations(result: TrackResult, passage: Passage) -> int:

@@ -5,7 +5,9 @@ monitors watch each sample: FRDM's own (Σ|Δq| = 0 short of the target, see
 :mod:`kinelab.ik.frdm.solver`), and a jump monitor (a joint moving more than ``jump_limit`` between
 consecutive samples: the links spinning through a singularity). When a monitor fires and the policy
 has a restriction (``intervals`` or ``freeze``), the sample is solved again with it switched on, and it
-stays on for ``hold`` samples before it is released.
+stays on for ``hold`` samples before it is released. A restriction named in ``restrict`` is on for the
+whole path instead: the paper's constraints set as parameters for a path that stays near a singular
+point (the ERA wrist and shoulder passages), where no monitor fires before the damage is done.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from kinelab.errors import KinelabError
 from kinelab.ik.frdm import solver
 from kinelab.ik.result import Status
 from kinelab.robot import Robot
@@ -74,6 +77,7 @@ def track(
     intervals: dict | None = None,
     freeze: dict | None = None,
     policy: tuple[str, ...] | None = (),
+    restrict: tuple[str, ...] = (),
     hold: int = 10,
     stall_window: int = 100,
     stall_rel: float = 1e-6,
@@ -88,20 +92,28 @@ def track(
         jump_limit: largest joint change per sample [rad or m] before the jump monitor fires (None: off).
         kicks, intervals, freeze, policy: the bypass configuration (see ``solver.attempt``); the
             default ``policy=()`` is FRDM without bypass.
+        restrict: restrictions ("intervals", "freeze") held on every sample of the path.
         hold: samples a restriction stays on after the monitor switched it on.
         stall_window, stall_rel: the monitor's patience; a path sample starts close to its answer, so a
             slow start is an escape from a singularity, not a local minimum to abandon.
         frdm_options: passed to ``solver.attempt`` (order, w_p, accel, ...).
     """
     q_prev = robot.check_q(q0, limits=True, what="q0")
+    unknown = [s for s in restrict if s not in ("intervals", "freeze")]
+    if unknown:
+        raise KinelabError(f"restrict takes 'intervals' and 'freeze', not {unknown}")
+    for name, table in (("intervals", intervals), ("freeze", freeze)):
+        if name in restrict and not table:
+            raise KinelabError(f"restrict names {name!r} but no {name} table was given")
     restrictions = [s for s in (policy or ()) if s in ("intervals", "freeze")]
     reactive = tuple(s for s in (policy or ()) if s not in ("intervals", "freeze"))
     frdm_options = {"stall_window": stall_window, "stall_rel": stall_rel, **frdm_options}
     held: dict[str, int] = {}
-    rows, perr, rerr, status, sweeps, times, events, bypasses = [], [], [], [], [], [], [], []
+    rows, perr, rerr, status, sweeps, times, events = [], [], [], [], [], [], []
+    bypasses: list[dict] = [{"sample": 0, "bypass": s, "hold": "path"} for s in restrict]
     for k, target in enumerate(targets):
         t0 = time.perf_counter()
-        active = tuple(s for s, left in held.items() if left > 0)
+        active = (*restrict, *(s for s, left in held.items() if left > 0 and s not in restrict))
         att = _solve(robot, target, q_prev, tol_pos, tol_rot, max_sweeps, kicks, intervals, freeze,
                      reactive, active, frdm_options)
         jumped = jump_limit is not None and np.max(np.abs(att.q - q_prev)) > jump_limit
