@@ -1,6 +1,7 @@
 """Seed 000: the ERA elbow passage with and without the paper's bypass (FRDM tracking)."""
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
 from kinelab.errors import KinelabError
@@ -137,3 +138,15 @@ def test_restrict_needs_its_table():
         track(era, passage.targets, passage.q0, restrict=("freeze",))
     with pytest.raises(KinelabError, match="restrict takes"):
         track(era, passage.targets, passage.q0, restrict=("kicks",))
+
+
+def test_a_single_straight_pass_through_the_wrist_lock_is_smooth_on_this_model():
+    """Why passage 2 is a closed path: the paper's one bottom-up pass shows nothing here (J5, J7 0.34 m apart)."""
+    era = load("era")
+    oMlock = era.fk(ep.WRIST_LOCK)
+    targets = [pin.SE3(oMlock.rotation, oMlock.translation + np.array([x, 0.0, 0.0])) for x in np.linspace(-1, 1, 41)]
+    start = ep.solver.attempt(era, targets[0], ep.WRIST_LOCK, 1e-9, 1e-9, np.inf, max_sweeps=3000)
+    res = track(era, targets, start.q)
+    _every_sample_reached(res)
+    assert res.q[:, 5].min() < np.deg2rad(85) and res.q[:, 5].max() > np.deg2rad(95)  # q6 crosses 90°
+    assert res.max_joint_step < 0.05 and not res.events
