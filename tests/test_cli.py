@@ -60,6 +60,7 @@ def test_fk_stanford_matches_the_papers_rotation(capsys):
     (["fk", "ur5", "0", "0", "0", "0", "0", "0", "--tool", "flange"], "unknown frame 'flange'"),
     (["fk", "stanford", "0", "x"], "invalid float value"),
     (["nosuchcommand"], "invalid choice"),
+    (["animate", "era-knee"], "passages are: era-elbow, era-wrist, era-shoulder"),
 ])
 def test_user_errors_print_one_line_and_exit_2(argv, needle):
     proc = subprocess.run([sys.executable, "-m", "kinelab.cli", *argv], capture_output=True, text=True,
@@ -127,3 +128,10 @@ def test_singular_sweep_lists_families(capsys):
 def test_singular_user_errors(capsys, argv, needle):
     code, _, err = run(capsys, *argv)
     assert code == 2 and needle in err
+
+
+def test_animate_the_shoulder_passage_writes_html_and_reports_the_jump(capsys, tmp_path):
+    code, out, _ = run(capsys, "animate", "era-shoulder", "--without-bypass", "--html", str(tmp_path / "s.html"))
+    assert code == 0 and (tmp_path / "s.html").stat().st_size > 10_000
+    assert "217 of 217 samples reached" in out
+    assert float(out.split("largest joint step ")[1].split()[0]) > 6.0  # q1 swinging back a whole turn

@@ -33,3 +33,14 @@ def test_a_failing_check_makes_validate_exit_non_zero(monkeypatch, capsys, tmp_p
 def test_validate_refuses_an_unknown_robot_before_working(capsys):
     assert cli.main(["validate", "--robots", "nosuch"]) == 2
     assert "registered robots" in capsys.readouterr().err
+
+
+def test_era_checks_cover_the_three_passages_and_print_tolerances_exactly():
+    checks = validate.era_checks(validate.load("era"), 0, 0)
+    names = " ".join(c.name for c in checks)
+    for passage in ("elbow", "wrist", "shoulder"):
+        assert f"seed 000 {passage}" in names
+    assert all(c.passed for c in checks), [c for c in checks if not c.passed]
+    table = validate.format_table(validate.Report(robots=["era"], checks=checks))
+    step_row = next(line for line in table.splitlines() if "elbow, bypass: largest joint step" in line)
+    assert " 0.25 rad" in step_row  # a 0.25 rad bound printed as such, not rounded to "2e-01"

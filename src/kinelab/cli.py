@@ -290,7 +290,7 @@ def cmd_animate(args) -> int:
     from kinelab import viz
     from kinelab.studies import era_passages
 
-    passages = {"era-elbow": era_passages.elbow_passage}
+    passages = {f"era-{name}": build for name, build in era_passages.PASSAGES.items()}
     if args.passage not in passages:
         raise KinelabError(f"unknown passage {args.passage!r}; passages are: {', '.join(passages)}")
     robot = load("era")
@@ -299,7 +299,8 @@ def cmd_animate(args) -> int:
     result = run.without if args.without_bypass else run.with_bypass
     scene = viz.Scene(robot, name=f"era ({'without' if args.without_bypass else 'with'} bypass)")
     scene.animate(result.q, dt=args.dt)
-    for k, target in enumerate(passage.targets[:: max(1, len(passage.targets) // 8)]):
+    one_lap = passage.targets[: (passage.lap or passage.samples) + 1]
+    for k, target in enumerate(one_lap[:: max(1, len(one_lap) // 8)]):
         scene.frame(f"target{k}", target, 0.5 * scene.frame_length)
     summary = result.summary()
     print(f"{args.passage} {'without' if args.without_bypass else 'with'} bypass: {summary['reached']} of "
@@ -373,7 +374,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_view)
 
     s = sub.add_parser("animate", help="animate a solver run in meshcat (the ERA passages)")
-    s.add_argument("passage", help="era-elbow")
+    s.add_argument("passage", help="era-elbow, era-wrist or era-shoulder (seed paper 000)")
     s.add_argument("--without-bypass", action="store_true", help="the run without the paper's bypass")
     s.add_argument("--dt", type=float, default=0.1, help="seconds per path sample in the animation")
     s.add_argument("--html", help="write a self-contained HTML page instead of serving")

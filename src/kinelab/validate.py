@@ -170,9 +170,13 @@ def youbot_checks(robot: Robot, n: int, seed: int) -> list[Check]:
 
 
 def era_checks(robot: Robot, n: int, seed: int) -> list[Check]:
-    """Seed 000: the elbow passage with and without the paper's bypass."""
+    """Seed 000: the three ERA passages with and without the paper's bypass."""
     from kinelab.studies import era_passages as ep
 
+    return _elbow_checks(robot, ep) + _lock_checks(robot, ep)
+
+
+def _elbow_checks(robot: Robot, ep) -> list[Check]:
     passage = ep.elbow_passage(robot)
     run = ep.run(passage, robot)
     reach = ~passage.unreachable
@@ -187,6 +191,34 @@ def era_checks(robot: Robot, n: int, seed: int) -> list[Check]:
         Check(robot.name, "seed 000 elbow, bypass: samples leaving the fold's quadrants",
               ep.quadrant_violations(w, passage), 0, ""),
     ]
+
+
+def _lock_checks(robot: Robot, ep) -> list[Check]:
+    """Passages 2 and 3: with the bypass the joint path closes every lap; without, the paper's drift."""
+    checks = []
+    for name, joints, bypass in (("wrist", (4, 6), "q5, q6 < 80°"), ("shoulder", (0, 6), "q1 frozen")):
+        passage = ep.PASSAGES[name](robot)
+        run = ep.run(passage, robot)
+        w, wo = run.with_bypass, run.without
+        laps_w = ep.lap_changes(w, passage)
+        laps_wo = np.rad2deg(ep.lap_changes(wo, passage))
+        a, b = joints
+        drift = ", ".join(f"θ{j + 1} {np.array2string(laps_wo[:, j], precision=1)}°" for j in joints)
+        if name == "wrist":  # q5 down and q7 up by the same amount, every lap
+            shown = bool((laps_wo[:, a] < -5).all() and (laps_wo[:, b] > 5).all())
+        else:  # q1 and q7 climbing together
+            shown = bool((laps_wo[:2, a] > 60).all() and np.allclose(laps_wo[:, a], laps_wo[:, b], atol=1e-3))
+        checks += [
+            Check(robot.name, f"seed 000 {name}, {bypass}: largest joint step", w.max_joint_step, 0.05, "rad",
+                  f"without bypass {wo.max_joint_step:.3f} rad"),
+            Check(robot.name, f"seed 000 {name}, {bypass}: joint change over a lap (after the 1st)",
+                  float(np.abs(laps_w[1:]).max()), 1e-5, "rad"),
+            Check(robot.name, f"seed 000 {name}, {bypass}: worst tool error", float(w.position_error.max()), 1e-6,
+                  "m", f"reached {w.reached.sum()}/{passage.samples}"),
+            Check(robot.name, f"seed 000 {name}, without: paper's drift absent (0 = shown)", 0.0 if shown else 1.0,
+                  0.0, "", f"per-lap change {drift}"),
+        ]
+    return checks
 
 
 PAPER_CHECKS: dict[str, list[Callable[[Robot, int, int], list[Check]]]] = {
@@ -213,15 +245,31 @@ def format_table(report: Report) -> str:
     lines = [f"{'robot':<10} {'check':<56} {'measured':>10} {'tolerance':>10}  result"]
     for c in report.checks:
         unit = f" {c.unit}" if c.unit else ""
-        lines.append(f"{c.robot:<10} {c.name:<56} {c.value:>10.2e} {c.tolerance:>10.0e}{unit:<4} "
+        lines.append(f"{c.robot:<10} {c.name:<56} {c.value:>10.2e} {c.tolerance:>10.3g}{unit:<4} "
                      f"{'PASS' if c.passed else 'FAIL'}")
     failed = sum(not c.passed for c in report.checks)
     lines.append(f"{len(report.checks) - failed} passed, {failed} failed")
     return "\n".join(lines)
 
 
+def _passage_figure(plt, run, name: str, joints, folder: Path) -> str:
+    fig, axes = plt.subplots(1, 2, figsize=(10, 3.2), sharey=True)
+    for ax, res, title in ((axes[0], run.without, f"ERA {name}, without bypass"),
+                           (axes[1], run.with_bypass, f"ERA {name}, with bypass")):
+        for j in joints:
+            ax.plot(np.rad2deg(res.q[:, j]), "--" if j == 6 else "-", label=f"θ{j + 1}")
+        ax.set_title(title)
+        ax.set_xlabel("path sample")
+    axes[0].set_ylabel("deg")
+    axes[1].legend()
+    fig.tight_layout()
+    fig.savefig(folder / f"era_{name}.png", dpi=100)
+    plt.close(fig)
+    return f"era_{name}.png"
+
+
 def plots(report: Report, folder: Path) -> list[str]:
-    """The report's figures as PNG files in ``folder`` (ERA elbow passage, seed-001 convergence)."""
+    """The report's figures as PNG files in ``folder`` (the ERA passages, seed-001 convergence)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -231,20 +279,9 @@ def plots(report: Report, folder: Path) -> list[str]:
 
     names = []
     if "era" in report.robots:
-        run = ep.run(ep.elbow_passage())
-        fig, axes = plt.subplots(1, 2, figsize=(10, 3.2), sharey=True)
-        for ax, res, title in ((axes[0], run.without, "ERA elbow, without bypass"),
-                               (axes[1], run.with_bypass, "ERA elbow, with bypass")):
-            for j in (2, 3, 4):
-                ax.plot(np.rad2deg(res.q[:, j]), label=f"θ{j + 1}")
-            ax.set_title(title)
-            ax.set_xlabel("path sample")
-        axes[0].set_ylabel("deg")
-        axes[1].legend()
-        fig.tight_layout()
-        fig.savefig(folder / "era_elbow.png", dpi=100)
-        plt.close(fig)
-        names.append("era_elbow.png")
+        for name, joints in (("elbow", (2, 3, 4)), ("wrist", (4, 6)), ("shoulder", (0, 6))):
+            passage = ep.PASSAGES[name]()
+            names.append(_passage_figure(plt, ep.run(passage), name, joints, folder))
     if "stanford" in report.robots:
         traj = seed001.reproduce().info["trajectory"]
         fig, ax = plt.subplots(figsize=(5, 3.2))
@@ -268,13 +305,13 @@ def write_report(report: Report, out: str | Path) -> Path:
     (folder / "report.json").write_text(json.dumps(report.to_dict(), indent=2))
     md = ["# kinelab validate", "", f"Robots: {', '.join(report.robots)}; n = {report.n}; seed = {report.seed}.", "",
           "| robot | check | measured | tolerance | result |", "|---|---|---|---|---|"]
-    md += [f"| {c.robot} | {c.name} | {c.value:.2e} {c.unit} | {c.tolerance:.0e} | {'PASS' if c.passed else 'FAIL'} |"
+    md += [f"| {c.robot} | {c.name} | {c.value:.2e} {c.unit} | {c.tolerance:.3g} | {'PASS' if c.passed else 'FAIL'} |"
            for c in report.checks]
     md += [""] + [f"![{name}]({name})" for name in figures]
     (folder / "report.md").write_text("\n".join(md) + "\n")
     rows = "".join(
         f"<tr><td>{html.escape(c.robot)}</td><td>{html.escape(c.name)}</td><td>{c.value:.2e} {c.unit}</td>"
-        f"<td>{c.tolerance:.0e}</td><td>{'PASS' if c.passed else 'FAIL'}</td></tr>"
+        f"<td>{c.tolerance:.3g}</td><td>{'PASS' if c.passed else 'FAIL'}</td></tr>"
         for c in report.checks
     )
     (folder / "report.html").write_text(
