@@ -249,24 +249,23 @@ def sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, rela
 
 
 @njit(cache=True)
-def _anderson(X, G, count, m, x, g, out):
+def _anderson(X, G, count, m, x, g, out, dG, dX, A, rhs, gamma):
     """Type-II Anderson mixing of the last ``count`` (x, g = F(x) − x) pairs; result in ``out``.
 
     Solves the small least-squares problem min ‖g − ΔG γ‖ by a regularised Cholesky factorisation.
+    dG, dX (n × m), A (m × m), rhs, gamma (m): work arrays, allocated once per run (allocation inside
+    the sweep loop cost more than the arithmetic).
     """
     k = min(count, m)
     n = x.shape[0]
-    dG = np.empty((n, k))
-    dX = np.empty((n, k))
     for c in range(k):
         a = (count - k + c) % (m + 1)
         b = (count - k + c + 1) % (m + 1)
         for i in range(n):
             dG[i, c] = G[b, i] - G[a, i]
             dX[i, c] = X[b, i] - X[a, i]
-    A = np.zeros((k, k))
-    rhs = np.zeros(k)
     for r in range(k):
+        rhs[r] = 0.0
         for i in range(n):
             rhs[r] += dG[i, r] * g[i]
         for c in range(r + 1):
@@ -294,7 +293,8 @@ def _anderson(X, G, count, m, x, g, out):
             for t in range(j):
                 acc -= A[r, t] * A[j, t]
             A[r, j] = acc / A[j, j]
-    gamma = rhs.copy()
+    for r in range(k):
+        gamma[r] = rhs[r]
     for r in range(k):
         for t in range(r):
             gamma[r] -= A[r, t] * gamma[t]
@@ -332,8 +332,15 @@ def run(
     Rc = np.empty((3, 3))
     x_old = np.empty(n)
     cand = np.empty(n)
+    g = np.empty(n)
+    m = max(accel_m, 1)
+    dG, dX, A = np.empty((n, m)), np.empty((n, m)), np.empty((m, m))
+    rhs, gamma = np.empty(m), np.empty(m)
+    fresh = False  # e, o, p, R already hold the FK at q (an accepted extrapolation computed it)
     for s in range(max_sweeps):
-        chain_fk(PR, Pt, axis, kind, TR, Tt, q, e, o, p, R)
+        if not fresh:
+            chain_fk(PR, Pt, axis, kind, TR, Tt, q, e, o, p, R)
+        fresh = False
         E0 = objective(p, R, pstar, Rstar, w_p, w_ax)
         if state[1] == 0.0:
             state[2] = E0
@@ -355,11 +362,13 @@ def run(
         if accel_m > 0:
             cnt = int(state[0])
             slot = cnt % (accel_m + 1)
-            X[slot] = x_old
-            G[slot] = q - x_old
+            for i in range(n):
+                g[i] = q[i] - x_old[i]
+                X[slot, i] = x_old[i]
+                G[slot, i] = g[i]
             state[0] = cnt + 1.0
             if cnt >= 1:
-                _anderson(X, G, cnt, accel_m, x_old, q - x_old, cand)
+                _anderson(X, G, cnt, accel_m, x_old, g, cand, dG, dX, A, rhs, gamma)
                 finite = True
                 for i in range(n):
                     finite = finite and np.isfinite(cand[i])
@@ -375,6 +384,9 @@ def run(
                 Ec = objective(pc, Rc, pstar, Rstar, w_p, w_ax)
                 if Ec < E1:
                     q[:] = cand
+                    p[:] = pc
+                    R[:, :] = Rc
+                    fresh = True
                     E1 = Ec
                     state[4] += 1.0
         state[5] = E1
