@@ -61,9 +61,13 @@ def _options_of(fn: AttemptFn) -> tuple[str, ...]:
     return tuple(p for p, spec in params.items() if spec.kind == inspect.Parameter.KEYWORD_ONLY)
 
 
+@functools.cache
+def _module_of(fn: AttemptFn):
+    return importlib.import_module(fn.__module__)
+
+
 def _prepare(name: str, robot: Robot) -> None:
-    module = importlib.import_module(SOLVERS[name].__module__)
-    prep = getattr(module, "prepare", None)
+    prep = getattr(_module_of(SOLVERS[name]), "prepare", None)
     if prep is not None:
         prep(robot)
 
@@ -182,7 +186,7 @@ def solve(
 
 def _compiled_multistart(solver: str, options: dict):
     """The solver's compiled multistart when the options ask for nothing it leaves out, else None."""
-    module = importlib.import_module(SOLVERS[solver].__module__)
+    module = _module_of(SOLVERS[solver])
     allowed = getattr(module, "fast_path_allowed", None)
     return module.multistart if allowed is not None and allowed(options) else None
 

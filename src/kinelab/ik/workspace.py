@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import math
 
 import numpy as np
 
@@ -10,7 +11,7 @@ from kinelab.robot import Robot
 
 
 @functools.lru_cache(maxsize=64)
-def _reach(robot: Robot) -> tuple[np.ndarray, float]:
+def _reach(robot: Robot) -> tuple[tuple[float, float, float], float]:
     q = robot.neutral()
     oMi = list(robot.joint_placements(q).values())
     anchor = robot.model.jointPlacements[1].translation  # where joint 1 sits, fixed in the base
@@ -20,10 +21,10 @@ def _reach(robot: Robot) -> tuple[np.ndarray, float]:
     slides = sum(
         max(abs(j.upper - q[i]), abs(j.lower - q[i])) for i, j in enumerate(robot.joints) if j.kind == "prismatic"
     )
-    return np.array(anchor), rigid + slides
+    return tuple(np.asarray(anchor, dtype=float).tolist()), rigid + slides
 
 
 def out_of_reach(robot: Robot, position: np.ndarray) -> float:
     """How far [m] a position lies beyond the reach bound (≤ 0 when it may be reachable)."""
     anchor, radius = _reach(robot)
-    return float(np.linalg.norm(np.asarray(position) - anchor) - radius)
+    return math.dist(np.asarray(position, dtype=float).tolist(), anchor) - radius
