@@ -1,5 +1,7 @@
 """The bench protocol: its success check must count wrong, out-of-limit and late answers as failures."""
 
+import time
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -62,6 +64,37 @@ def test_run_reports_rows_for_the_kinelab_solvers():
     assert set(rows) == {"frdm", "dls"} and rows["frdm"]["n"] == 4
     assert 0 <= rows["frdm"]["success_pct"] <= 100 and rows["frdm"]["median_us"] > 0
     assert "| ur5 | frdm |" in bench.markdown(result)
+
+
+def test_each_problem_keeps_its_fastest_round_with_that_rounds_verdict():
+    ur5 = kinelab.load("ur5")
+    problems = bench.cases(ur5, 2, 0)
+    clock = iter([0.004, 0.001, 0.006, 0.002])  # problem 0: 4 ms then 6 ms; problem 1: 1 ms then 2 ms
+
+    def prepare(robot, budget):
+        def solve(case, seed):
+            time.sleep(next(clock))
+            return (case.q_target if case.index == 0 else None), 1
+        return solve
+
+    def warm(robot, budget):  # the warm-up calls must not eat the clock above
+        inner = prepare(robot, budget)
+        calls = {"n": 0}
+
+        def solve(case, seed):
+            calls["n"] += 1
+            return inner(case, seed) if calls["n"] > 2 else (None, 0)
+        return solve
+
+    [row] = bench.run_robot(ur5, {"fake": warm}, problems, budget=0.005, seed=0, missing={}, repeats=2)
+    assert row.n == 2 and row.solved == 1 and row.failures == {"no answer": 1}
+    assert 4000 <= row.median_solved_us < 5000  # problem 0 counts its 4 ms round, not the 6 ms one (over budget)
+
+
+def test_bench_refuses_empty_protocols():
+    for kwargs in ({"n": 0}, {"repeats": 0}, {"budget": 0.0}):
+        with pytest.raises(kinelab.KinelabError, match="bench needs"):
+            bench.run(robots=["ur5"], progress=False, **kwargs)
 
 
 def test_unknown_solver_is_refused_with_the_available_ones():

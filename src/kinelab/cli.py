@@ -235,7 +235,7 @@ def cmd_bench(args) -> int:
 
         scaled = scaling.run(progress=not args.json)
     result = bench.run(robots=args.robots, n=args.n, seed=args.seed, solvers=args.solvers,
-                       budget=args.budget_ms / 1e3, progress=not args.json)
+                       budget=args.budget_ms / 1e3, progress=not args.json, repeats=args.repeats)
     if scaled is not None:
         result["scaling"] = scaled
     if args.out:
@@ -386,6 +386,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--solvers", nargs="+", default=None, help="solvers to run (default: all available)")
     s.add_argument("--budget-ms", type=float, default=5.0, help="time budget per solve [ms]")
+    s.add_argument("--repeats", type=int, default=3, help="rounds over the set; per problem the fastest counts")
     s.add_argument("--scaling", action="store_true", help="also time FRDM on synthetic chains of 7-100 links")
     s.add_argument("--out", help="write bench.json, bench.md and bench.png here")
     s.add_argument("--json", action="store_true")
