@@ -277,3 +277,29 @@ def test_compiled_multistart_is_seeded_and_checked_by_pinocchio(robots):
         assert robot.tool_error(a.q, target)[0] <= 1e-6 and robot.within_limits(a.q)
     loop = solve(robot, target, seed=0, policy=("auto_kick",))
     assert "path" not in loop.info and loop.success
+
+
+def test_mixed_order_restarts_turn_the_sweep_direction(robots):
+    """order="mixed": attempt 1 sweeps base → tip, the restart tip → base, from the same seeded start."""
+    from kinelab.ik.frdm import solver as frdm
+    from kinelab.ik.restarts import seed_state
+
+    robot = robots["stanford"]
+    vm = vector_model(robot)
+    rng = np.random.default_rng(3)
+    for _ in range(20):  # find a start whose first attempt, either way, does not converge
+        target, q0 = robot.fk(robot.random_q(rng)), robot.random_q(rng)
+        last = {}
+        for name in ("mixed", "base2tip", "tip2base"):
+            q, best, stats = q0.copy(), q0.copy(), np.zeros(5)
+            code = kernel.multistart(
+                q, vm.placement_R, vm.placement_t, vm.axis_local, vm.kind, vm.tool_R, vm.tool_t, vm.lower,
+                vm.upper, np.ones(vm.n, dtype=np.bool_), target.translation, target.rotation, 3.0 / vm.length**2,
+                np.ones(3), 1.0, frdm.ORDERS[name], 1e-6, 1e-6, True, True, 100, 1e-10, 10, 0.1, 5, seed_state(7),
+                2, 1e9, best, stats)
+            last[name] = (q, stats[0], code)
+        if last["mixed"][1] == 2 and last["base2tip"][1] == 2 and last["tip2base"][1] == 2:
+            np.testing.assert_array_equal(last["mixed"][0], last["tip2base"][0])  # the restart ran tip → base
+            assert not np.array_equal(last["mixed"][0], last["base2tip"][0])
+            return
+    pytest.fail("no start found whose first attempt fails both ways")

@@ -18,6 +18,8 @@ from numba import njit
 REVOLUTE, PRISMATIC, CONTINUOUS = 0, 1, 2
 TWO_PI = 2.0 * np.pi
 
+MIXED = 3  # multistart order code: alternate the sweep direction from one attempt to the next
+
 # run() return codes
 CONVERGED, STALL_STEP, STALL_WINDOW, BUDGET = 0, 1, 2, 3
 
@@ -437,7 +439,10 @@ def multistart(
         for k in range(7):
             state[k] = 0.0
         budget = min(max_sweeps, int(sweep_budget - stats[1]))
-        code, s = run(q, PR, Pt, axis, kind, TR, Tt, lower, upper, free, pstar, Rstar, w_p, w_ax, relax, order,
+        attempt_order = order
+        if order == MIXED:  # base → tip on the first attempt and every other restart, tip → base between
+            attempt_order = 1 if int(stats[0]) % 2 == 0 else 0
+        code, s = run(q, PR, Pt, axis, kind, TR, Tt, lower, upper, free, pstar, Rstar, w_p, w_ax, relax, attempt_order,
                       tol_pos, tol_rot, check_pos, check_rot, budget, eps_q, window, window_rel, accel_m, X, G,
                       state, trace)
         stats[0] += 1.0
