@@ -268,7 +268,7 @@ class Robot:
             arr = np.asarray(q, dtype=float)
         except (TypeError, ValueError):
             raise ConfigurationError(f"{what} must be {self.n} numbers, got {q!r}") from None
-        if arr.shape == (self.n,) and not limits and math.isfinite(arr.sum()):  # NaN and ±inf poison the sum
+        if arr.shape == (self.n,) and not limits and math.isfinite(sum(arr.tolist())):  # NaN, ±inf poison it
             return arr
         if arr.shape != (self.n,):
             raise ConfigurationError(

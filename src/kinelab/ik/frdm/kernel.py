@@ -18,6 +18,7 @@ from numba import njit
 REVOLUTE, PRISMATIC, CONTINUOUS = 0, 1, 2
 TWO_PI = 2.0 * np.pi
 
+REFRESH_SWEEPS = 8  # sweeps carried incrementally before the chain FK is recomputed
 MIXED = 3  # multistart order code: alternate the sweep direction from one attempt to the next
 
 # run() return codes
@@ -136,6 +137,13 @@ def rotation_angle(R, Rstar):
 
 
 @njit(cache=True, inline="always")
+def _within(p, R, pstar, Rstar, tol_pos, tol_rot, check_pos, check_rot):
+    """Both tolerances met (those checked): position [m] and rotation angle [rad]."""
+    dp = np.sqrt((p[0] - pstar[0]) ** 2 + (p[1] - pstar[1]) ** 2 + (p[2] - pstar[2]) ** 2)
+    return (not check_pos or dp <= tol_pos) and (not check_rot or rotation_angle(R, Rstar) <= tol_rot)
+
+
+@njit(cache=True, inline="always")
 def _bc(e0, e1, e2, o0, o1, o2, p, R, pstar, Rstar, w_p, w_ax):
     """B, C of E(θ) = a − 2B cos θ − 2C sin θ for a rotation θ about the line (e, o)."""
     r0, r1, r2 = p[0] - o0, p[1] - o1, p[2] - o2
@@ -188,7 +196,8 @@ def sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, rela
 
     ``e``, ``o`` must hold the axes at the sweep's starting q (from ``chain_fk``). Tip → base needs
     nothing more (a joint never moves the joints upstream of it); base → tip carries the rigid motion
-    (Rg, tg) of the joints already stepped to the downstream axes. Returns Σ|Δq_i|.
+    (Rg, tg) of the joints already stepped to the downstream axes, and leaves e, o at the new q (tip →
+    base leaves them stale). Returns Σ|Δq_i|.
     """
     n = q.shape[0]
     total = 0.0
@@ -197,8 +206,6 @@ def sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, rela
     moved_any = False
     for k in range(n):
         i = k if base_to_tip else n - 1 - k
-        if not free[i]:
-            continue
         if moved_any:
             e0 = Rg[0, 0] * e[i, 0] + Rg[0, 1] * e[i, 1] + Rg[0, 2] * e[i, 2]
             e1 = Rg[1, 0] * e[i, 0] + Rg[1, 1] * e[i, 1] + Rg[1, 2] * e[i, 2]
@@ -208,9 +215,15 @@ def sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, rela
             o0 = Rg[0, 0] * o[i, 0] + Rg[0, 1] * o[i, 1] + Rg[0, 2] * o[i, 2] + tg[0]
             o1 = Rg[1, 0] * o[i, 0] + Rg[1, 1] * o[i, 1] + Rg[1, 2] * o[i, 2] + tg[1]
             o2 = Rg[2, 0] * o[i, 0] + Rg[2, 1] * o[i, 1] + Rg[2, 2] * o[i, 2] + tg[2]
+            # base → tip, no later step moves joint i's axis: written back, e and o hold the axes at the
+            # new q when the sweep ends, and the next sweep needs no chain FK
+            e[i, 0], e[i, 1], e[i, 2] = e0, e1, e2
+            o[i, 0], o[i, 1], o[i, 2] = o0, o1, o2
         else:
             e0, e1, e2 = e[i, 0], e[i, 1], e[i, 2]
             o0, o1, o2 = o[i, 0], o[i, 1], o[i, 2]
+        if not free[i]:
+            continue
         lo = lower[i] - q[i]
         hi = upper[i] - q[i]
         if kind[i] == PRISMATIC:
@@ -335,25 +348,33 @@ def run(
     x_old = np.empty(n)
     cand = np.empty(n)
     g = np.empty(n)
+    ec = np.empty((n, 3))
+    oc = np.empty((n, 3))
     m = max(accel_m, 1)
     dG, dX, A = np.empty((n, m)), np.empty((n, m)), np.empty((m, m))
     rhs, gamma = np.empty(m), np.empty(m)
-    fresh = False  # e, o, p, R already hold the FK at q (an accepted extrapolation computed it)
+    fresh = False  # e, o, p, R hold the state at q (carried by the last sweep or an accepted extrapolation)
+    since_fk = 0  # sweeps since p, R came from a chain FK (incremental updates carry rounding)
     for s in range(max_sweeps):
-        if not fresh:
+        if not fresh or since_fk >= REFRESH_SWEEPS:
             chain_fk(PR, Pt, axis, kind, TR, Tt, q, e, o, p, R)
-        fresh = False
+            since_fk = 0
         E0 = objective(p, R, pstar, Rstar, w_p, w_ax)
         if state[1] == 0.0:
             state[2] = E0
-        dp = np.sqrt((p[0] - pstar[0]) ** 2 + (p[1] - pstar[1]) ** 2 + (p[2] - pstar[2]) ** 2)
-        if (not check_pos or dp <= tol_pos) and (not check_rot or rotation_angle(R, Rstar) <= tol_rot):
+        if _within(p, R, pstar, Rstar, tol_pos, tol_rot, check_pos, check_rot) and since_fk > 0:
+            chain_fk(PR, Pt, axis, kind, TR, Tt, q, e, o, p, R)  # converged only on an exact FK
+            since_fk = 0
+            E0 = objective(p, R, pstar, Rstar, w_p, w_ax)
+        if _within(p, R, pstar, Rstar, tol_pos, tol_rot, check_pos, check_rot):
             state[5] = E0
             return CONVERGED, s
         x_old[:] = q
         base_to_tip = order == 1 or (order == 2 and int(state[1]) % 2 == 1) or state[6] != 0.0
         state[6] = 0.0
         moved = sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, relax, base_to_tip)
+        fresh = base_to_tip
+        since_fk += 1
         E1 = objective(p, R, pstar, Rstar, w_p, w_ax)
         state[1] += 1.0
         if int(state[1]) - 1 < trace.shape[0]:
@@ -382,13 +403,16 @@ def run(
                         cand[i] = min(max(cand[i], lower[i]), upper[i])
                     if not free[i]:
                         cand[i] = q[i]
-                chain_fk(PR, Pt, axis, kind, TR, Tt, cand, e, o, pc, Rc)
+                chain_fk(PR, Pt, axis, kind, TR, Tt, cand, ec, oc, pc, Rc)
                 Ec = objective(pc, Rc, pstar, Rstar, w_p, w_ax)
                 if Ec < E1:
                     q[:] = cand
-                    p[:] = pc
-                    R[:, :] = Rc
+                    e, ec = ec, e
+                    o, oc = oc, o
+                    p, pc = pc, p
+                    R, Rc = Rc, R
                     fresh = True
+                    since_fk = 0
                     E1 = Ec
                     state[4] += 1.0
         state[5] = E1
