@@ -162,3 +162,15 @@ def test_the_drift_grows_with_the_position_weight():
              for w in (1.0, 3.0, 10.0)]
     assert turns[0] < turns[1] < turns[2]
     assert turns[0] > np.deg2rad(5)  # present even at the lightest weight
+
+
+def test_tracking_bench_reports_both_solvers_on_every_passage():
+    result = ep.tracking_bench(repeats=1)
+    rows = {(r["passage"], r["solver"]): r for r in result["rows"]}
+    assert set(rows) == {(p, s) for p in ("elbow", "wrist", "shoulder") for s in ("frdm+bypass", "dls")}
+    for (passage, solver), r in rows.items():
+        assert r["reached"] == r["reachable"] and r["max_position_error_m"] <= 1e-6, (passage, solver)
+        assert r["median_us"] > 0
+    assert rows[("shoulder", "frdm+bypass")]["max_lap_change"] < CLOSURE_TOL
+    assert rows[("elbow", "dls")]["max_lap_change"] is None  # not a closed path
+    assert "| shoulder | dls |" in ep.tracking_markdown(result)

@@ -85,9 +85,9 @@ dls = ep.dls_tracking(passage, era)
 reach = ~passage.unreachable
 print(f"FRDM: median {np.median(run.with_bypass.wall_time) * 1e6:6.0f} µs per sample, "
       f"max error {run.with_bypass.position_error[reach].max():.1e} m on reachable samples")
-print(f"DLS : median {np.median(dls['wall_time']) * 1e6:6.0f} µs per sample, "
-      f"max error {dls['position_error'][reach].max():.1e} m on reachable samples, "
-      f"largest joint step {np.abs(np.diff(dls['q'], axis=0)).max():.3f} rad")
+print(f"DLS : median {np.median(dls.wall_time) * 1e6:6.0f} µs per sample, "
+      f"max error {dls.position_error[reach].max():.1e} m on reachable samples, "
+      f"largest joint step {dls.max_joint_step:.3f} rad")
 """),
 ("md", """
 ## The three kinds of ERA singularity, by SVD
@@ -174,8 +174,8 @@ the largest joint step.
 for name, p, r in (("wrist", wrist, wrist_run), ("shoulder", shoulder, shoulder_run)):
     d = ep.dls_tracking(p, era)
     print(f"{name:8s} FRDM with bypass: {np.median(r.with_bypass.wall_time) * 1e6:5.0f} µs/sample, "
-          f"step {r.with_bypass.max_joint_step:.3f} rad | DLS: {np.median(d['wall_time']) * 1e6:5.0f} µs/sample, "
-          f"step {np.abs(np.diff(d['q'], axis=0)).max():.3f} rad, per-lap change "
-          f"{np.abs(np.diff(d['q'][::p.lap], axis=0)).max():.1e} rad, worst error {d['position_error'].max():.1e} m")
+          f"step {r.with_bypass.max_joint_step:.3f} rad | DLS: {np.median(d.wall_time) * 1e6:5.0f} µs/sample, "
+          f"step {d.max_joint_step:.3f} rad, per-lap change {np.abs(ep.lap_changes(d, p)).max():.1e} rad, "
+          f"worst error {d.position_error.max():.1e} m")
 """),
 ]

@@ -252,7 +252,16 @@ def write(result: dict, out: str | Path) -> Path:
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "bench.json").write_text(json.dumps(result, indent=2))
-    (folder / "bench.md").write_text(markdown(result) + "\n")
+    sections = [markdown(result)]
+    if "scaling" in result:
+        from kinelab import scaling
+
+        sections.append(scaling.markdown(result["scaling"]))
+    if "tracking" in result:
+        from kinelab.studies import era_passages
+
+        sections.append(era_passages.tracking_markdown(result["tracking"]))
+    (folder / "bench.md").write_text("\n\n".join(sections) + "\n")
     with contextlib.suppress(ImportError):
         plot(result, folder / "bench.png")
     return folder

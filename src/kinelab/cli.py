@@ -238,6 +238,10 @@ def cmd_bench(args) -> int:
                        budget=args.budget_ms / 1e3, progress=not args.json, repeats=args.repeats)
     if scaled is not None:
         result["scaling"] = scaled
+    if args.tracking:
+        from kinelab.studies import era_passages
+
+        result["tracking"] = era_passages.tracking_bench(repeats=args.repeats)
     if args.out:
         bench.write(result, args.out)
     if args.json:
@@ -246,6 +250,8 @@ def cmd_bench(args) -> int:
         print(bench.markdown(result))
         if "scaling" in result:
             print(scaling.markdown(result["scaling"]))
+        if "tracking" in result:
+            print(era_passages.tracking_markdown(result["tracking"]))
         if args.out:
             print(f"results written to {args.out}")
     return 0
@@ -388,6 +394,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--budget-ms", type=float, default=5.0, help="time budget per solve [ms]")
     s.add_argument("--repeats", type=int, default=3, help="rounds over the set; per problem the fastest counts")
     s.add_argument("--scaling", action="store_true", help="also time FRDM on synthetic chains of 7-100 links")
+    s.add_argument("--tracking", action="store_true", help="also time tracking along the ERA passages (FRDM, DLS)")
     s.add_argument("--out", help="write bench.json, bench.md and bench.png here")
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_bench)

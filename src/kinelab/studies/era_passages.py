@@ -199,7 +199,7 @@ def singular_examples(robot: Robot | None = None, seed: int = 0) -> dict[str, np
     return out
 
 
-def dls_tracking(passage: Passage, robot: Robot | None = None) -> dict[str, np.ndarray]:
+def dls_tracking(passage: Passage, robot: Robot | None = None) -> TrackResult:
     """The Pinocchio DLS reference along the same path, warm-started from the previous sample, no restarts."""
     import time
 
@@ -207,7 +207,7 @@ def dls_tracking(passage: Passage, robot: Robot | None = None) -> dict[str, np.n
 
     robot = robot or load("era")
     q = passage.q0
-    rows, times, perr, rerr = [], [], [], []
+    rows, times, perr, rerr, status, iters = [], [], [], [], [], []
     for target in passage.targets:
         t0 = time.perf_counter()
         res = solve(robot, target, solver="dls", q0=q, max_restarts=0, time_budget=1.0)
@@ -216,5 +216,46 @@ def dls_tracking(passage: Passage, robot: Robot | None = None) -> dict[str, np.n
         rows.append(q)
         perr.append(res.position_error)
         rerr.append(res.rotation_error)
-    return {"q": np.array(rows), "wall_time": np.array(times), "position_error": np.array(perr),
-            "rotation_error": np.array(rerr)}
+        status.append(res.status.value)
+        iters.append(res.iterations)
+    return TrackResult(np.array(rows), np.array(perr), np.array(rerr), status, np.array(iters), np.array(times))
+
+
+def tracking_bench(repeats: int = 3, robot: Robot | None = None) -> dict:
+    """Per-sample cost along the three passages: FRDM with the paper's bypass against the Pinocchio DLS
+    reference, both warm-started from the previous sample with no restarts. Each run is repeated and
+    every sample keeps its fastest time (the runs are deterministic, so the work is the same).
+
+    Returns {"rows": [{"passage", "solver", "samples", "reached", "median_us", "p95_us",
+    "max_position_error_m" (reachable samples), "max_joint_step", "max_lap_change"}]}."""
+    robot = robot or load("era")
+    rows = []
+    for name, build in PASSAGES.items():
+        passage = build(robot)
+        reach = np.ones(passage.samples, bool) if passage.unreachable is None else ~passage.unreachable
+        frdm_runs = [run(passage, robot).with_bypass for _ in range(repeats)]
+        dls_runs = [dls_tracking(passage, robot) for _ in range(repeats)]
+        for label, runs in (("frdm+bypass", frdm_runs), ("dls", dls_runs)):
+            last = runs[-1]
+            times = np.min([r.wall_time for r in runs], axis=0) * 1e6
+            laps = lap_changes(last, passage)[1:] if passage.lap else np.zeros((0, 1))
+            reached = (last.position_error <= 1e-6) & (last.rotation_error <= 1e-6) & reach
+            rows.append({
+                "passage": name, "solver": label, "samples": passage.samples, "reached": int(reached.sum()),
+                "reachable": int(reach.sum()),
+                "median_us": float(np.median(times)), "p95_us": float(np.percentile(times, 95)),
+                "max_position_error_m": float(last.position_error[reach].max()),
+                "max_joint_step": last.max_joint_step,
+                "max_lap_change": float(np.abs(laps).max()) if laps.size else None,
+            })
+    return {"rows": rows}
+
+
+def tracking_markdown(result: dict) -> str:
+    lines = ["| ERA passage | solver | reached | median per sample | p95 | worst error | largest joint step | "
+             "lap change (after the 1st) |", "|---|---|---|---|---|---|---|---|"]
+    for r in result["rows"]:
+        lap = "—" if r["max_lap_change"] is None else f"{r['max_lap_change']:.1e} rad"
+        lines.append(f"| {r['passage']} | {r['solver']} | {r['reached']}/{r['reachable']} | {r['median_us']:.0f} µs | "
+                     f"{r['p95_us']:.0f} µs | {r['max_position_error_m']:.1e} m | {r['max_joint_step']:.3f} | {lap} |")
+    return "\n".join(lines)
