@@ -72,6 +72,11 @@ def _prepare(name: str, robot: Robot) -> None:
         prep(robot)
 
 
+@functools.cache
+def _fast_path_test(fn: AttemptFn):
+    return getattr(_module_of(fn), "fast_path_allowed", None)
+
+
 def _check_options(name: str, fn: AttemptFn, options: dict) -> None:
     valid = _options_of(fn)
     unknown = [k for k in options if k not in valid]
@@ -134,7 +139,8 @@ def solve(
     fn = _solver(solver)
     _prepare(solver, robot)  # compilation and model building are not the solve's time
     t_start = time.perf_counter()
-    _check_options(solver, fn, solver_options)
+    if solver_options:
+        _check_options(solver, fn, solver_options)
     target = as_target(target)
     if not (tol_pos > 0 and tol_rot > 0 and time_budget > 0 and max_restarts >= 0):
         raise KinelabError("tol_pos, tol_rot and time_budget must be positive and max_restarts ≥ 0")
@@ -186,9 +192,8 @@ def solve(
 
 def _compiled_multistart(solver: str, options: dict):
     """The solver's compiled multistart when the options ask for nothing it leaves out, else None."""
-    module = _module_of(SOLVERS[solver])
-    allowed = getattr(module, "fast_path_allowed", None)
-    return module.multistart if allowed is not None and allowed(options) else None
+    allowed = _fast_path_test(SOLVERS[solver])
+    return _module_of(SOLVERS[solver]).multistart if allowed is not None and allowed(options) else None
 
 
 def _fast(multistart, solver, robot, target, start, tol_pos, tol_rot, deadline, seed, max_restarts, options,
