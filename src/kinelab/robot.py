@@ -296,10 +296,15 @@ class Robot:
         return bool((arr >= self._lower_check - slack).all() and (arr <= self._upper_check + slack).all())
 
     def to_pin_q(self, q) -> np.ndarray:
-        """One number per joint → Pinocchio's q (continuous joints become cos, sin)."""
+        """One number per joint → Pinocchio's q (continuous joints become cos, sin); a new array."""
+        pin_q = self._pin_q(q)
+        return pin_q.copy() if pin_q is q else pin_q
+
+    def _pin_q(self, q) -> np.ndarray:
+        """Pinocchio's q for reading only: q itself when the two orders coincide (no copy)."""
         arr = self.check_q(q)
         if self._identity_q:
-            return arr.copy()
+            return arr
         out = np.empty(self.nq)
         out[self._scalar_idx] = arr[self._scalar_pos]
         angles = arr[self._cont_pos]
@@ -340,7 +345,7 @@ class Robot:
 
     # -- kinematics ----------------------------------------------------------------------------
     def _forward(self, q) -> None:
-        pin.forwardKinematics(self.model, self.data, self.to_pin_q(q))
+        pin.forwardKinematics(self.model, self.data, self._pin_q(q))
         pin.updateFramePlacements(self.model, self.data)
 
     def fk(self, q) -> pin.SE3:
@@ -350,11 +355,11 @@ class Robot:
 
     def tool_error(self, q, oMtarget: pin.SE3) -> tuple[float, float]:
         """(position error [m], rotation angle error [rad]) of the tool at q against oMtarget (Pinocchio FK)."""
-        pin.forwardKinematics(self.model, self.data, self.to_pin_q(q))
+        pin.forwardKinematics(self.model, self.data, self._pin_q(q))
         oMtool = pin.updateFramePlacement(self.model, self.data, self.tool_frame_id)
         err = oMtarget.actInv(oMtool)  # the tool in the target frame: |t| is the position error
-        t, w = err.translation, pin.log3(err.rotation)
-        return math.sqrt(t @ t), math.sqrt(w @ w)
+        # hypot over Python floats: a solve ends with this check, and numpy's calls cost more than the maths
+        return math.hypot(*err.translation.tolist()), math.hypot(*pin.log3(err.rotation).tolist())
 
     def frame_placement(self, q, frame: str) -> pin.SE3:
         """oMframe: pose of any frame of the reduced model in the base frame."""

@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pinocchio as pin
 
+from kinelab.dualquat import DualQuat
 from kinelab.errors import KinelabError
 
 
@@ -32,8 +33,6 @@ def from_xyz_quat_wxyz(xyz, quat_wxyz) -> pin.SE3:
 
 def as_target(target) -> pin.SE3:
     """Check a target: a ``pin.SE3`` with finite entries and a proper rotation, or a unit biquaternion."""
-    from kinelab.dualquat import DualQuat
-
     if isinstance(target, DualQuat):
         return target.require_unit("the target biquaternion").to_se3()
     if not isinstance(target, pin.SE3):
