@@ -254,6 +254,28 @@ def test_targets_must_be_poses():
     bad.translation = np.array([np.nan, 0, 0])
     with pytest.raises(kinelab.KinelabError, match="NaN"):
         solve(robot, bad)
+    skew = pin.SE3.Identity()
+    skew.rotation = np.diag([1.0, 1.0, 1.001])
+    with pytest.raises(kinelab.KinelabError, match="not a rotation"):
+        solve(robot, skew)
+    mirror = pin.SE3.Identity()
+    mirror.rotation = np.diag([1.0, 1.0, -1.0])
+    with pytest.raises(kinelab.KinelabError, match="det R < 0"):
+        solve(robot, mirror)
+
+
+def test_huge_finite_inputs_are_judged_exactly_not_as_overflow():
+    """The fast finiteness tests sum the entries; a sum that overflows must fall back to the exact test."""
+    robot = kinelab.load("ur5")
+    far = pin.SE3.Identity()
+    far.translation = np.array([1e308, 1e308, 0.0])  # finite, its sum is not
+    res = solve(robot, far)
+    assert not res.success and res.status.value == "unreachable"
+    q = np.zeros(robot.n)
+    q[:2] = 1e308
+    with pytest.raises(kinelab.KinelabError, match="outside its limits"):
+        robot.check_q(q, limits=True)
+    assert robot.check_q(q).shape == (robot.n,)  # finite: accepted when limits are not asked for
 
 
 def test_helical_or_spherical_joints_are_refused_by_name(tmp_path):
