@@ -6,6 +6,7 @@ import sys
 import numpy as np
 import pytest
 
+import kinelab
 from kinelab import cli
 from kinelab.studies import stanford_seed001 as seed001
 
@@ -89,6 +90,12 @@ def test_ik_beyond_reach_is_unreachable_with_exit_1(capsys):
     (["ik", "ur5"], "give the target"),
     (["ik", "ur5", "--target-xyz", "0.3", "0", "0.3", "--solver", "magic"], "unknown solver 'magic'"),
     (["ik", "stanford", "--target-q", "0", "0", "5", "0", "0", "0"], "outside its limits"),
+    (["ik", "era", "--target-xyz", "4", "2", "6", "--kick", "joint9=-0.01"], "joints are: joint1"),
+    (["ik", "era", "--target-xyz", "4", "2", "6", "--kick", "joint4"], "--kick wants JOINT=DELTA"),
+    (["ik", "era", "--target-xyz", "4", "2", "6", "--interval", "joint5=80"], "wants JOINT=LOWER:UPPER"),
+    (["ik", "era", "--target-xyz", "4", "2", "6", "--interval", "joint5=1:-1"], "is empty"),
+    (["ik", "era", "--target-xyz", "4", "2", "6", "--freeze", "joint1=x"], "is not a number"),
+    (["ik", "era", "--solver", "dls", "--target-xyz", "4", "2", "6", "--freeze", "joint1"], "FRDM's bypasses"),
 ])
 def test_ik_user_errors(capsys, argv, needle):
     code, _, err = run(capsys, *argv)
@@ -135,3 +142,18 @@ def test_animate_the_shoulder_passage_writes_html_and_reports_the_jump(capsys, t
     assert code == 0 and (tmp_path / "s.html").stat().st_size > 10_000
     assert "217 of 217 samples reached" in out
     assert float(out.split("largest joint step ")[1].split()[0]) > 6.0  # q1 swinging back a whole turn
+
+
+def test_ik_bypass_flags_reach_the_solver_in_radians(capsys):
+    era = kinelab.load("era")
+    target_q = np.deg2rad([10, 20, 30, -60, 30, 10, 5])
+    code, out, _ = run(capsys, "ik", "era", "--target-q", *map(str, np.rad2deg(target_q)), "--deg",
+                       "--start-q", "0", "0", "0", "0", "0", "0", "0", "--kick", "joint4=-1", "--json")
+    res = json.loads(out)
+    assert code == 0 and res["success"]
+    assert era.tool_error(np.array(res["q"]), era.fk(target_q))[0] <= 1e-6
+    assert any(b["bypass"] == "kicks" for b in res["bypasses"])
+    from kinelab.ik import solve
+
+    same = solve(era, era.fk(target_q), q0=np.zeros(7), seed=0, kicks={"joint4": -np.deg2rad(1.0)})
+    np.testing.assert_allclose(res["q"], same.q, atol=1e-12)  # −1 with --deg is −1° in radians

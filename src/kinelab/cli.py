@@ -116,6 +116,42 @@ def cmd_fk(args) -> int:
     return 0
 
 
+def _bypass_value(robot, joint: str, text: str, deg: bool, flag: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise KinelabError(f"{flag} {joint}: {text!r} is not a number") from None
+    kind = robot.joint_kinds[robot.joint_index(joint)]
+    return float(np.deg2rad(value)) if deg and kind != "prismatic" else value
+
+
+def _bypass_options(robot, args) -> dict:
+    """FRDM's bypasses from --kick J=D, --interval J=LO:HI and --freeze J[=V] (rad, m; deg with --deg)."""
+    specs = {"kicks": args.kick or [], "intervals": args.interval or [], "freeze": args.freeze or []}
+    if not any(specs.values()):
+        return {}
+    if args.solver != "frdm":
+        raise KinelabError("--kick, --interval and --freeze are FRDM's bypasses; use --solver frdm")
+    out: dict[str, dict] = {}
+    for spec in specs["kicks"]:
+        joint, sep, value = spec.partition("=")
+        if not sep:
+            raise KinelabError(f"--kick wants JOINT=DELTA, got {spec!r}")
+        out.setdefault("kicks", {})[joint] = _bypass_value(robot, joint, value, args.deg, "--kick")
+    for spec in specs["intervals"]:
+        joint, sep, bounds = spec.partition("=")
+        lo, colon, hi = bounds.partition(":")
+        if not (sep and colon):
+            raise KinelabError(f"--interval wants JOINT=LOWER:UPPER, got {spec!r}")
+        out.setdefault("intervals", {})[joint] = (_bypass_value(robot, joint, lo, args.deg, "--interval"),
+                                                  _bypass_value(robot, joint, hi, args.deg, "--interval"))
+    for spec in specs["freeze"]:
+        joint, sep, value = spec.partition("=")
+        robot.joint_index(joint)  # an unknown joint is named with the valid ones
+        out.setdefault("freeze", {})[joint] = _bypass_value(robot, joint, value, args.deg, "--freeze") if sep else None
+    return out
+
+
 def cmd_ik(args) -> int:
     from kinelab.ik import solve, target_from_xyz_rpy
 
@@ -137,6 +173,7 @@ def cmd_ik(args) -> int:
     q0 = None if args.start_q is None else _q_from_cli(robot, args.start_q, args.deg, "--start-q")
     if args.solver == "frdm" and args.polish:
         options["polish"] = True
+    options.update(_bypass_options(robot, args))
     if args.solver == "biquat":
         options.update({k: v for k, v in (("law", args.law), ("integrator", args.integrator), ("step", args.step),
                                           ("k", args.gain)) if v is not None})
@@ -357,6 +394,12 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--tol-rot", type=float, default=1e-6, help="[rad]")
     s.add_argument("--time-budget", type=float, default=1.0, help="[s]")
     s.add_argument("--polish", action="store_true", help="frdm: add damped-least-squares polish steps")
+    s.add_argument("--kick", action="append", metavar="JOINT=DELTA",
+                   help="frdm bypass: signed step added when the monitor fires (repeatable)")
+    s.add_argument("--interval", action="append", metavar="JOINT=LO:HI",
+                   help="frdm bypass: tighter window switched on when the monitor fires (repeatable)")
+    s.add_argument("--freeze", action="append", metavar="JOINT[=VALUE]",
+                   help="frdm bypass: joint held (where it is, or at VALUE) when the monitor fires (repeatable)")
     s.add_argument("--law", choices=["simple", "regular"], help="biquat: control law (9)/(16) or (11)/(12)")
     s.add_argument("--integrator", choices=["euler", "rk4", "adaptive"], help="biquat: integrator")
     s.add_argument("--step", type=float, help="biquat: fixed step h [s] (the paper: 0.01; default 1/k)")
