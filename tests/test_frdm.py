@@ -325,3 +325,22 @@ def test_mixed_order_restarts_turn_the_sweep_direction(robots):
             assert not np.array_equal(last["mixed"][0], last["base2tip"][0])
             return
     pytest.fail("no start found whose first attempt fails both ways")
+
+
+def test_a_cold_first_solve_compiles_before_its_clock_starts(tmp_path):
+    """With an empty numba cache every kernel a solve uses is compiled by prepare(), outside the budget."""
+    import os
+    import subprocess
+    import sys
+
+    code = (
+        "import numpy as np, kinelab\n"
+        "from kinelab.ik import solve\n"
+        "r = kinelab.load('ur5'); T = r.fk(r.random_q(np.random.default_rng(0)))\n"
+        "res = solve(r, T, seed=0, time_budget=0.05)\n"
+        "print(res.success, res.wall_time)\n"
+    )
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path), "PYTHONWARNINGS": "ignore"}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=600)
+    success, wall_time = out.stdout.split()
+    assert success == "True" and float(wall_time) < 0.05, out.stdout + out.stderr
