@@ -129,9 +129,9 @@ class _Problem:
 
 @functools.cache
 def _all_free(n: int) -> np.ndarray:
-    free = np.ones(n, dtype=np.bool_)
-    free.flags.writeable = False
-    return free
+    """Shared by every compiled solve; the kernel never writes it (left writeable: a read-only array is
+    a second numba signature, 5 s more compiling on a cold cache)."""
+    return np.ones(n, dtype=np.bool_)
 
 
 def _scaled_sigma_min(robot: Robot, q: np.ndarray, length: float) -> float:
@@ -398,7 +398,6 @@ def _settings(items: tuple) -> _Settings:
     plain = accel == "none"
     window_rel = options.get("stall_rel")
     w_ax = np.zeros(3) if mode == "position" else np.array(options.get("w_axes", (1.0, 1.0, 1.0)), dtype=float)
-    w_ax.flags.writeable = False
     return _Settings(
         mode, plain, order, relax, options.get("max_sweeps") or (3000 if plain else 100),
         options.get("stall_window") or (PLAIN_STALL_WINDOW if plain else STALL_WINDOW),
