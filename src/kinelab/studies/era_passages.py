@@ -101,12 +101,13 @@ def elbow_passage(robot: Robot | None = None, samples: int = 40) -> Passage:
     )
 
 
-def _circle(oMcentre_start: pin.SE3, radius: float, plane: tuple, samples: int, laps: int) -> list[pin.SE3]:
-    """Tool poses round a circle that starts at oMcentre_start's point, orientation fixed [m]."""
+def _circle(oMstart: pin.SE3, radius: float, plane: tuple, samples: int, laps: int) -> list[pin.SE3]:
+    """Tool poses round a circle of ``radius`` [m] in the plane (u, v) that starts at oMstart, orientation
+    fixed; ``samples`` per lap, the last pose closing the last lap."""
     u, v = (np.asarray(a, float) for a in plane)
     phi = np.linspace(0.0, 2 * np.pi * laps, samples * laps + 1)
-    centre = oMcentre_start.translation - radius * u
-    return [pin.SE3(oMcentre_start.rotation, centre + radius * (np.cos(p) * u + np.sin(p) * v)) for p in phi]
+    centre = oMstart.translation - radius * u
+    return [pin.SE3(oMstart.rotation, centre + radius * (np.cos(p) * u + np.sin(p) * v)) for p in phi]
 
 
 def wrist_passage(robot: Robot | None = None, radius: float = 0.35, samples: int = 60, laps: int = 4) -> Passage:
