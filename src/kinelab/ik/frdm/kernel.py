@@ -359,15 +359,15 @@ def run(
         if not fresh or since_fk >= REFRESH_SWEEPS:
             chain_fk(PR, Pt, axis, kind, TR, Tt, q, e, o, p, R)
             since_fk = 0
-        E0 = objective(p, R, pstar, Rstar, w_p, w_ax)
         if state[1] == 0.0:
-            state[2] = E0
-        if _within(p, R, pstar, Rstar, tol_pos, tol_rot, check_pos, check_rot) and since_fk > 0:
-            chain_fk(PR, Pt, axis, kind, TR, Tt, q, e, o, p, R)  # converged only on an exact FK
+            state[2] = objective(p, R, pstar, Rstar, w_p, w_ax)
+        converged = _within(p, R, pstar, Rstar, tol_pos, tol_rot, check_pos, check_rot)
+        if converged and since_fk > 0:  # converged only on an exact FK
+            chain_fk(PR, Pt, axis, kind, TR, Tt, q, e, o, p, R)
             since_fk = 0
-            E0 = objective(p, R, pstar, Rstar, w_p, w_ax)
-        if _within(p, R, pstar, Rstar, tol_pos, tol_rot, check_pos, check_rot):
-            state[5] = E0
+            converged = _within(p, R, pstar, Rstar, tol_pos, tol_rot, check_pos, check_rot)
+        if converged:
+            state[5] = objective(p, R, pstar, Rstar, w_p, w_ax)
             return CONVERGED, s
         x_old[:] = q
         base_to_tip = order == 1 or (order == 2 and int(state[1]) % 2 == 1) or state[6] != 0.0
