@@ -113,18 +113,31 @@ class _Problem:
         self.vm = vm
         self.pstar = oMtarget.translation  # pinocchio hands out a fresh array on every access
         self.Rstar = oMtarget.rotation
-        w_p = w_p_factor / vm.length**2 if w_p is None else float(w_p)
-        w_ax = np.array(w_axes, dtype=float)
-        if mode == "position":
-            w_ax = np.zeros(3)
-        elif mode == "orientation":
-            w_p = 0.0
-        self.w_p, self.w_ax = w_p, w_ax
+        self.w_p = _position_weight(vm, mode, w_p, w_p_factor)
+        self.w_ax = _axis_weights(mode, w_axes)
         self.check_pos, self.check_rot = mode != "orientation", mode != "position"
         self.lower = vm.lower.copy() if use_limits else np.full(vm.n, -np.inf)
         self.upper = vm.upper.copy() if use_limits else np.full(vm.n, np.inf)
         self.base_lower, self.base_upper = self.lower.copy(), self.upper.copy()
         self.free = np.ones(vm.n, dtype=np.bool_)
+
+
+def _position_weight(vm: VectorModel, mode: str, w_p: float | None, w_p_factor: float) -> float:
+    """w_p [1/m²]: given, or w_p_factor/L² (L the chain's characteristic length); 0 in orientation mode."""
+    if mode == "orientation":
+        return 0.0
+    return w_p_factor / vm.length**2 if w_p is None else float(w_p)
+
+
+def _axis_weights(mode: str, w_axes) -> np.ndarray:
+    """Weights of the tool x, y, z axes; 0 in position mode."""
+    return np.zeros(3) if mode == "position" else np.array(w_axes, dtype=float)
+
+
+def _monitor_defaults(plain: bool, max_sweeps, stall_window, stall_rel) -> tuple[int, int, float]:
+    """Sweep cap and stall window of an attempt: 100 sweeps, 10 % over 10 accelerated; 3000, 1e-3 over 50 plain."""
+    return (max_sweeps or (3000 if plain else 100), stall_window or (PLAIN_STALL_WINDOW if plain else STALL_WINDOW),
+            (1e-3 if plain else 0.1) if stall_rel is None else float(stall_rel))
 
 
 @functools.cache
@@ -212,9 +225,7 @@ def attempt(
     """
     _validate(mode, order, accel, relax)
     plain = accel == "none"
-    max_sweeps = max_sweeps or (3000 if plain else 100)
-    stall_window = stall_window or (PLAIN_STALL_WINDOW if plain else STALL_WINDOW)
-    stall_rel = stall_rel if stall_rel is not None else (1e-3 if plain else 0.1)
+    max_sweeps, stall_window, stall_rel = _monitor_defaults(plain, max_sweeps, stall_window, stall_rel)
     bypass = Bypass(kicks or {}, intervals or {}, freeze or {}, policy, tuple(active))
     if kicks or intervals or freeze or policy or active:
         bypass.validate(robot)
@@ -396,15 +407,14 @@ def _settings(items: tuple) -> _Settings:
     order, relax = options.get("order", "mixed"), float(options.get("relax", 1.0))
     _validate(mode, order, accel, relax)
     plain = accel == "none"
-    window_rel = options.get("stall_rel")
-    w_ax = np.zeros(3) if mode == "position" else np.array(options.get("w_axes", (1.0, 1.0, 1.0)), dtype=float)
+    max_sweeps, window, window_rel = _monitor_defaults(
+        plain, options.get("max_sweeps"), options.get("stall_window"), options.get("stall_rel"))
     return _Settings(
-        mode, plain, order, relax, options.get("max_sweeps") or (3000 if plain else 100),
-        options.get("stall_window") or (PLAIN_STALL_WINDOW if plain else STALL_WINDOW),
-        (1e-3 if plain else 0.1) if window_rel is None else float(window_rel),
+        mode, plain, order, relax, max_sweeps, window, window_rel,
         0 if plain else int(options.get("accel_memory", 5)), float(options.get("eps_q", 1e-10)),
-        None if options.get("w_p") is None else float(options["w_p"]), float(options.get("w_p_factor", W_P_FACTOR)),
-        w_ax, mode != "orientation", mode != "position", bool(options.get("use_limits", True)),
+        options.get("w_p"), float(options.get("w_p_factor", W_P_FACTOR)),
+        _axis_weights(mode, options.get("w_axes", (1.0, 1.0, 1.0))), mode != "orientation", mode != "position",
+        bool(options.get("use_limits", True)),
     )
 
 
@@ -424,7 +434,7 @@ def multistart(
     Returns the attempt kept and the number of restarts. The caller checks the answer with Pinocchio."""
     st = _parsed(options)
     vm = vector_model(robot)
-    w_p = 0.0 if st.mode == "orientation" else (st.w_p_factor / vm.length**2 if st.w_p is None else st.w_p)
+    w_p = _position_weight(vm, st.mode, st.w_p, st.w_p_factor)
     if st.use_limits:
         lower, upper = vm.lower, vm.upper
     else:
