@@ -7,8 +7,9 @@ import pinocchio as pin
 import pytest
 
 import kinelab
-from kinelab import bench, scaling
-from kinelab.ik.frdm.solver import vector_model
+from kinelab.ik.chain import chain_model as vector_model
+from kinelab.report import render
+from kinelab.report.bench import protocol, runner, scaling
 
 
 @pytest.fixture(scope="module")
@@ -17,15 +18,15 @@ def ur5():
 
 
 def test_a_correct_answer_within_budget_counts(ur5):
-    case = bench.cases(ur5, 1, 3)[0]
-    assert bench.check_solution(ur5, case.q_target, case.oMtarget, elapsed=1e-4) == (True, "solved")
+    case = protocol.cases(ur5, 1, 3)[0]
+    assert protocol.check_solution(ur5, case.q_target, case.oMtarget, elapsed=1e-4) == (True, "solved")
 
 
 def test_a_deliberately_wrong_answer_fails(ur5):
-    case = bench.cases(ur5, 1, 3)[0]
+    case = protocol.cases(ur5, 1, 3)[0]
     wrong = case.q_target.copy()
     wrong[2] += 1e-5  # about 4 µm at the tool: above the 1e-6 m tolerance
-    ok, why = bench.check_solution(ur5, wrong, case.oMtarget, elapsed=1e-4)
+    ok, why = protocol.check_solution(ur5, wrong, case.oMtarget, elapsed=1e-4)
     assert not ok and why.startswith("pose error")
 
 
@@ -36,39 +37,39 @@ def test_an_answer_outside_the_limits_fails_even_when_the_pose_is_right(tmp_path
     outside = q.copy()
     outside[0] += 2 * np.pi  # same pose, but beyond joint 1's ±170°
     assert np.linalg.norm(stanford.fk(outside).translation - target.translation) < 1e-12
-    assert bench.check_solution(stanford, outside, target, 1e-4) == (False, "outside the joint limits")
+    assert protocol.check_solution(stanford, outside, target, 1e-4) == (False, "outside the joint limits")
 
 
 def test_a_late_answer_fails(ur5):
-    case = bench.cases(ur5, 1, 3)[0]
-    assert bench.check_solution(ur5, case.q_target, case.oMtarget, elapsed=0.0051) == (False, "over budget")
+    case = protocol.cases(ur5, 1, 3)[0]
+    assert protocol.check_solution(ur5, case.q_target, case.oMtarget, elapsed=0.0051) == (False, "over budget")
 
 
 def test_no_answer_and_malformed_answers_fail(ur5):
-    case = bench.cases(ur5, 1, 3)[0]
-    assert not bench.check_solution(ur5, None, case.oMtarget, 1e-4)[0]
-    assert not bench.check_solution(ur5, np.full(6, np.nan), case.oMtarget, 1e-4)[0]
-    assert not bench.check_solution(ur5, np.zeros(5), case.oMtarget, 1e-4)[0]
+    case = protocol.cases(ur5, 1, 3)[0]
+    assert not protocol.check_solution(ur5, None, case.oMtarget, 1e-4)[0]
+    assert not protocol.check_solution(ur5, np.full(6, np.nan), case.oMtarget, 1e-4)[0]
+    assert not protocol.check_solution(ur5, np.zeros(5), case.oMtarget, 1e-4)[0]
 
 
 def test_problems_are_seeded_and_targets_are_the_fk_of_their_configurations(ur5):
-    a, b = bench.cases(ur5, 5, 11), bench.cases(ur5, 5, 11)
+    a, b = protocol.cases(ur5, 5, 11), protocol.cases(ur5, 5, 11)
     for x, y in zip(a, b, strict=True):
         np.testing.assert_array_equal(x.q_start, y.q_start)
         assert np.allclose(ur5.fk(x.q_target).homogeneous, x.oMtarget.homogeneous)
 
 
 def test_run_reports_rows_for_the_kinelab_solvers():
-    result = bench.run(robots=["ur5"], n=4, solvers=["frdm", "dls"], budget=0.05, progress=False)
+    result = runner.run(robots=["ur5"], n=4, solvers=["frdm", "dls"], budget=0.05, progress=False)
     rows = {r["solver"]: r for r in result["rows"]}
     assert set(rows) == {"frdm", "dls"} and rows["frdm"]["n"] == 4
     assert 0 <= rows["frdm"]["success_pct"] <= 100 and rows["frdm"]["median_us"] > 0
-    assert "| ur5 | frdm |" in bench.markdown(result)
+    assert "| ur5 | frdm |" in render.bench_markdown(result)
 
 
 def test_each_problem_keeps_its_fastest_round_with_that_rounds_verdict():
     ur5 = kinelab.load("ur5")
-    problems = bench.cases(ur5, 2, 0)
+    problems = protocol.cases(ur5, 2, 0)
     clock = iter([0.02, 0.001, 0.08, 0.002])  # problem 0: 20 ms then 80 ms (over the 50 ms budget)
 
     def prepare(robot, budget):
@@ -86,7 +87,7 @@ def test_each_problem_keeps_its_fastest_round_with_that_rounds_verdict():
             return inner(case, seed) if calls["n"] > 2 else (None, 0)
         return solve
 
-    [row] = bench.run_robot(ur5, {"fake": warm}, problems, budget=0.05, seed=0, missing={}, repeats=2)
+    [row] = runner.run_robot(ur5, {"fake": warm}, problems, budget=0.05, seed=0, missing={}, repeats=2)
     assert row.n == 2 and row.solved == 1 and row.failures == {"no answer": 1}
     assert 20_000 <= row.median_solved_us < 50_000  # problem 0 counts its 20 ms round, not the 80 ms one
 
@@ -94,12 +95,12 @@ def test_each_problem_keeps_its_fastest_round_with_that_rounds_verdict():
 def test_bench_refuses_empty_protocols():
     for kwargs in ({"n": 0}, {"repeats": 0}, {"budget": 0.0}):
         with pytest.raises(kinelab.KinelabError, match="bench needs"):
-            bench.run(robots=["ur5"], progress=False, **kwargs)
+            runner.run(robots=["ur5"], progress=False, **kwargs)
 
 
 def test_unknown_solver_is_refused_with_the_available_ones():
     with pytest.raises(kinelab.KinelabError, match="available: .*frdm"):
-        bench.run(robots=["ur5"], n=1, solvers=["nope"], progress=False)
+        runner.run(robots=["ur5"], n=1, solvers=["nope"], progress=False)
 
 
 def test_compiled_fk_stays_exact_on_a_100_link_chain():

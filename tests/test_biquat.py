@@ -6,10 +6,11 @@ import pinocchio as pin
 import pytest
 
 import kinelab
-from kinelab import biquat_kinematics as bk
-from kinelab.dualquat import DualQuat
-from kinelab.ik import biquat, solve
-from kinelab.studies import stanford_seed001 as s1
+from kinelab.dq import kinematics as bk
+from kinelab.dq.algebra import DualQuat
+from kinelab.ik import solve
+from kinelab.ik.biquat import solver as biquat
+from kinelab.studies import paper001_stanford as s1
 
 
 def free_body(M0: DualQuat, law, t_end: float, h: float = 1e-3, T0=(1.0, 0.0)):
@@ -169,8 +170,8 @@ def test_a_unit_biquaternion_is_a_valid_target_and_a_non_unit_one_is_not():
 @pytest.mark.parametrize("name", ("stanford", "panda", "youbot"))
 def test_compiled_preset_takes_the_same_steps_as_the_python_integrator(name):
     """Law (9), Euler h = 1/k, 0.5 rad cap: the numba kernel against the readable Python integrator."""
-    from kinelab.ik import biquat_kernel
-    from kinelab.ik.frdm.solver import vector_model
+    from kinelab.ik.biquat import kernel as biquat_kernel
+    from kinelab.ik.chain import chain_model as vector_model
 
     robot = kinelab.load(name)
     vm = vector_model(robot)
@@ -180,9 +181,9 @@ def test_compiled_preset_takes_the_same_steps_as_the_python_integrator(name):
         ref = biquat.attempt(robot, target, q0, 1e-6, 1e-6, np.inf, max_steps=30)
         q = q0.copy()
         damping = 0.0 if robot.n == 6 else 1e-4
-        code, steps, t = biquat_kernel.integrate(
-            q, vm.placement_R, vm.placement_t, vm.axis_local, vm.kind, vm.tool_R, vm.tool_t,
-            target.translation.copy(), target.rotation.copy(), 1.0, 1.0, 0.5, 30, 5e-7, 5e-7, damping)
+        problem = biquat_kernel.Problem(target.translation.copy(), target.rotation.copy(), 1.0, 1.0, 0.5, 30, 5e-7,
+                                        5e-7, damping)
+        code, steps, t = biquat_kernel.integrate(q, vm.chain, problem, 30)
         assert steps == ref.iterations and t == pytest.approx(ref.info["model_time"], abs=1e-9)
         if code == biquat_kernel.CONVERGED:
             assert ref.status.value == "converged"

@@ -5,9 +5,9 @@ import pytest
 from conftest import BUNDLED
 
 import kinelab
-from kinelab import biquat_kinematics as bk
-from kinelab import catalog
-from kinelab.dualquat import DualQuat, same_pose
+from kinelab.dq import kinematics as bk
+from kinelab.dq.algebra import DualQuat, same_pose
+from kinelab.robot import catalog
 
 ARMS = tuple(e.name for e in catalog.ERD_ARMS)
 

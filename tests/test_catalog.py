@@ -3,7 +3,7 @@ from pathlib import Path
 import pytest
 
 import kinelab
-from kinelab import catalog
+from kinelab.robot import catalog
 
 
 def test_registered_names_cover_bundled_and_example_robot_data_arms():

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from conftest import BUNDLED, ERD_ARMS
 
-from kinelab import checks
+from kinelab.analysis import oracles as checks
 
 FK_TOL = 1e-9  # m and rad
 JAC_TOL = 1e-6  # max abs entry; central differences with eps = 1e-6
@@ -26,7 +26,7 @@ def test_pinocchio_jacobians_match_finite_differences(robots, name):
 def test_the_cross_check_detects_a_wrong_model(robots, monkeypatch):
     """A one-millimetre change in the tool offset must show up: the check can fail."""
     robot = robots["ur5"]
-    from kinelab.yourdfpy_fk import YourdfpyFK
+    from kinelab.analysis.oracles import YourdfpyFK
 
     original = YourdfpyFK.fk
 

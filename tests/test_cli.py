@@ -8,7 +8,7 @@ import pytest
 
 import kinelab
 from kinelab import cli
-from kinelab.studies import stanford_seed001 as seed001
+from kinelab.studies import paper001_stanford as seed001
 
 
 def run(capsys, *argv):

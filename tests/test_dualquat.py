@@ -4,7 +4,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from kinelab.dualquat import BiquaternionError, DualQuat, dual_div, same_pose
+from kinelab.dq.algebra import BiquaternionError, DualQuat, dual_div, same_pose
 
 
 def random_dq(rng, unit=True) -> DualQuat:

@@ -10,8 +10,8 @@ from conftest import revolute, write_urdf
 
 import kinelab
 from kinelab.ik import solve
+from kinelab.ik.chain import chain_model as vector_model
 from kinelab.ik.frdm import kernel, reference
-from kinelab.ik.frdm.solver import vector_model
 
 ROBOTS = ("stanford", "era", "youbot", "panda", "ur5", "kinova")
 
@@ -303,8 +303,8 @@ def test_compiled_multistart_is_seeded_and_checked_by_pinocchio(robots):
 
 def test_mixed_order_restarts_turn_the_sweep_direction(robots):
     """order="mixed": attempt 1 sweeps base → tip, the restart tip → base, from the same seeded start."""
-    from kinelab.ik.frdm import solver as frdm
-    from kinelab.ik.restarts import seed_state
+    from kinelab.ik.frdm.options import ORDERS
+    from kinelab.ik.multistart import seed_state
 
     robot = robots["stanford"]
     vm = vector_model(robot)
@@ -314,11 +314,11 @@ def test_mixed_order_restarts_turn_the_sweep_direction(robots):
         last = {}
         for name in ("mixed", "base2tip", "tip2base"):
             q, best, stats = q0.copy(), q0.copy(), np.zeros(5)
-            code = kernel.multistart(
-                q, vm.placement_R, vm.placement_t, vm.axis_local, vm.kind, vm.tool_R, vm.tool_t, vm.lower,
-                vm.upper, np.ones(vm.n, dtype=np.bool_), target.translation, target.rotation, 3.0 / vm.length**2,
-                np.ones(3), 1.0, frdm.ORDERS[name], 1e-6, 1e-6, True, True, 100, 1e-10, 10, 0.1, 5, seed_state(7),
-                2, 1e9, best, stats)
+            problem = kernel.Problem(vm.lower, vm.upper, np.ones(vm.n, dtype=np.bool_), target.translation,
+                                     target.rotation, 3.0 / vm.length**2, np.ones(3), 1e-6, 1e-6, True, True)
+            settings = kernel.Settings(1.0, 1e-10, 10, 0.1, 5)
+            code = kernel.multistart(q, vm.chain, problem, settings, ORDERS[name], 100, seed_state(7), 2, 1e9, best,
+                                     stats)
             last[name] = (q, stats[0], code)
         if last["mixed"][1] == 2 and last["base2tip"][1] == 2 and last["tip2base"][1] == 2:
             np.testing.assert_array_equal(last["mixed"][0], last["tip2base"][0])  # the restart ran tip → base

@@ -6,7 +6,7 @@ import pytest
 from conftest import revolute, write_urdf
 
 import kinelab
-from kinelab.checks import pose_error
+from kinelab.analysis.oracles import pose_error
 
 TWO_LINK = (
     '<link name="base"/><link name="l1"/><link name="l2"/><link name="tool"/>'
@@ -232,7 +232,7 @@ def test_missing_meshes_leave_kinematics_intact_and_drop_only_those_visuals(tmp_
 def test_yourdfpy_loads_real_meshes_through_the_same_resolver():
     import yourdfpy
 
-    from kinelab.meshes import yourdfpy_filename_handler
+    from kinelab.robot.meshes import yourdfpy_filename_handler
 
     panda = kinelab.load("panda")
     urdf = yourdfpy.URDF.load(str(panda.urdf_path), load_meshes=True,

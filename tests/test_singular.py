@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 import kinelab
-from kinelab import singular
-from kinelab.studies import youbot as yb
+from kinelab.analysis import families, singular
+from kinelab.studies import paper003_youbot as yb
 
 
 @pytest.fixture(scope="module")
@@ -15,7 +15,7 @@ def youbot():
 
 def independent_rank(robot, q, rtol=1e-6):
     """Rank from numpy's SVD of Pinocchio's WORLD Jacobian, scaled by its own length (a different frame and
-    code path from kinelab.singular)."""
+    code path from kinelab.analysis.singular)."""
     J = robot.jacobian_world(q)
     J[:3] /= 0.1
     s = np.linalg.svd(J, compute_uv=False)
@@ -109,7 +109,7 @@ def test_theta4_zero_special_case_E_cannot_move_vertically(youbot):
 
 @pytest.fixture(scope="module")
 def youbot_sweep(youbot):
-    return singular.sweep(youbot, samples=4000, seed=0, progress=False)
+    return families.sweep(youbot, samples=4000, seed=0, progress=False)
 
 
 def test_sweep_finds_the_papers_family_and_the_vertical_gripper_families(youbot_sweep):
@@ -122,11 +122,11 @@ def test_sweep_finds_the_papers_family_and_the_vertical_gripper_families(youbot_
 def test_every_family_is_confirmed_by_an_independent_svd(youbot, youbot_sweep):
     for f in youbot_sweep["families"]:
         assert independent_rank(youbot, f.representative) < 6
-        assert all(r.residual(f.representative) < singular.RELATION_TOL for r in f.relations)
+        assert all(r.residual(f.representative) < families.RELATION_TOL for r in f.relations)
 
 
 def test_era_has_the_papers_three_kinds_of_singularity():
-    from kinelab.studies import era_passages as ep
+    from kinelab.studies import paper000_era as ep
 
     era = kinelab.load("era")
     for kind, q in ep.singular_examples(era).items():
@@ -146,7 +146,7 @@ def test_bad_configurations(youbot, bad, match):
 
 def test_grid_sweep_on_a_6r_arm_finds_the_wrist_and_elbow_families():
     ur5 = kinelab.load("ur5")
-    res = singular.sweep(ur5, samples=4096, method="grid", progress=False)
+    res = families.sweep(ur5, samples=4096, method="grid", progress=False)
     assert res["samples"] == 4 ** 6
     texts = [" and ".join(r.text for r in f.relations) for f in res["families"]]
     assert any("wrist_2_joint" in t for t in texts) and any("elbow_joint" in t for t in texts)

@@ -3,8 +3,8 @@ import pinocchio as pin
 import pytest
 
 import kinelab
-from kinelab.studies import stanford_seed001 as seed001
-from kinelab.studies import youbot
+from kinelab.studies import paper001_stanford as seed001
+from kinelab.studies import paper003_youbot as youbot
 
 
 def _dq_wxyz(oMtool):

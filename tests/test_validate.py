@@ -1,6 +1,7 @@
 import json
 
-from kinelab import cli, validate
+from kinelab import cli
+from kinelab.report import render, validate
 
 
 def test_validate_passes_on_two_robots_and_writes_the_report(tmp_path, capsys):
@@ -41,6 +42,6 @@ def test_era_checks_cover_the_three_passages_and_print_tolerances_exactly():
     for passage in ("elbow", "wrist", "shoulder"):
         assert f"seed 000 {passage}" in names
     assert all(c.passed for c in checks), [c for c in checks if not c.passed]
-    table = validate.format_table(validate.Report(robots=["era"], checks=checks))
+    table = render.validate_table(validate.Report(robots=["era"], checks=checks))
     step_row = next(line for line in table.splitlines() if "elbow, bypass: largest joint step" in line)
     assert " 0.25 rad" in step_row  # a 0.25 rad bound printed as such, not rounded to "2e-01"

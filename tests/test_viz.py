@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import kinelab
-from kinelab import viz
+from kinelab.view import scene as viz
 
 BUNDLED = ("stanford", "era", "youbot")
 CHROMIUM = viz.find_chromium()

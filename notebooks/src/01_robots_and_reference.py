@@ -15,8 +15,8 @@ import pinocchio as pin
 import matplotlib
 import matplotlib.pyplot as plt
 import kinelab
-from kinelab import checks
-from kinelab.yourdfpy_fk import YourdfpyFK
+from kinelab.analysis import oracles as checks
+from kinelab.analysis.oracles import YourdfpyFK
 
 print(kinelab.robots())
 """),
@@ -102,12 +102,12 @@ plt.tight_layout()
 ("md", """
 ## In the browser
 
-`kinelab.viz.Scene` draws a robot with meshcat (its server listens on 127.0.0.1 only). Here the youBot at
+`kinelab.view.scene.Scene` draws a robot with meshcat (its server listens on 127.0.0.1 only). Here the youBot at
 a random configuration; under CI the page is embedded as static HTML.
 """),
 ("code", """
 import os
-from kinelab import viz
+from kinelab.view import scene as viz
 scene = viz.Scene(youbot).show(youbot.random_q(rng))
 scene.viewer.render_static() if os.environ.get("CI") else scene.viewer.jupyter_cell()
 """),

@@ -17,8 +17,8 @@ import pinocchio as pin
 import matplotlib.pyplot as plt
 import kinelab
 from kinelab.ik import solve
-from kinelab.ik.frdm.solver import vector_model
-from kinelab.studies import era_passages as ep
+from kinelab.ik.chain import chain_model as vector_model
+from kinelab.studies import paper000_era as ep
 
 era = kinelab.load("era")
 vm = vector_model(era)
@@ -96,7 +96,7 @@ The same analysis as `kinelab singular`: a configuration of each kind, its rank,
 cannot make.
 """),
 ("code", """
-from kinelab import singular
+from kinelab.analysis import singular
 for kind, q in ep.singular_examples(era).items():
     a = singular.analyze(era, q)
     d = a.lost_directions[0]

@@ -13,8 +13,8 @@ the start q = (−30°, 15°, 0.1 m, 36°, −90°, 45°), gain K = 1, fixed ste
 import numpy as np
 import matplotlib.pyplot as plt
 import kinelab
-from kinelab import biquat_kinematics as bk
-from kinelab.studies import stanford_seed001 as s1
+from kinelab.dq import kinematics as bk
+from kinelab.studies import paper001_stanford as s1
 
 robot = kinelab.load("stanford")
 N = bk.pose(robot, s1.TARGET_Q)

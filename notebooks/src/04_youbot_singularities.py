@@ -14,8 +14,8 @@ SVD of Pinocchio's geometric Jacobian of `youbot.urdf`, whose coordinates are th
 import numpy as np
 import matplotlib.pyplot as plt
 import kinelab
-from kinelab import singular
-from kinelab.studies import youbot as yb
+from kinelab.analysis import families, singular
+from kinelab.studies import paper003_youbot as yb
 
 robot = kinelab.load("youbot")
 print(robot.joint_names)
@@ -46,7 +46,7 @@ moves each onto the singular set (minimising σ_min/σ_max) and groups the resul
 they satisfy.
 """),
 ("code", """
-result = singular.sweep(robot, samples=5000, seed=0, progress=False)
+result = families.sweep(robot, samples=5000, seed=0, progress=False)
 print(result["notes"])
 for f in result["families"]:
     print(f"rank {f.rank}  x{f.count:3d}  " + " and ".join(r.text for r in f.relations))
@@ -94,7 +94,7 @@ t2 = np.linspace(np.deg2rad(-65), np.deg2rad(90), 121)
 t3 = np.linspace(np.deg2rad(-151), np.deg2rad(146), 121)
 base = robot.neutral(); base[3], base[6], base[7] = 0.4, 0.6, 0.2
 grid = np.array([[*base[:4], a, b, *base[6:]] for b in t3 for a in t2])
-ratio = singular.sigma_ratio_batch(robot, grid).reshape(len(t3), len(t2))
+ratio = families.sigma_ratio_batch(robot, grid).reshape(len(t3), len(t2))
 plt.figure(figsize=(6, 4.5))
 plt.pcolormesh(np.rad2deg(t2), np.rad2deg(t3), np.log10(ratio), shading="auto")
 plt.colorbar(label="log10 σ_min/σ_max")

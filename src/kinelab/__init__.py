@@ -1,31 +1,64 @@
-"""kinelab: kinematics of serial arms and mobile manipulators, checked against Pinocchio."""
+"""kinelab: kinematics of serial arms and mobile manipulators, checked against Pinocchio.
 
-from kinelab.catalog import names as robots
+The public API: :func:`load` a robot, :func:`solve` IK for a target (built with
+:func:`target_from_xyz_rpy` or :func:`target_from_xyz_quat_wxyz`), :func:`track` a path, and the
+errors every call raises on bad input (all :class:`KinelabError`).
+"""
+
+from importlib.metadata import PackageNotFoundError, version
+
 from kinelab.errors import (
+    BiquaternionError,
     ChainError,
     ConfigurationError,
     FrameNotFoundError,
     JointLimitError,
     JointNotFoundError,
     KinelabError,
+    OptionError,
     RobotNotFoundError,
+    SolverNotFoundError,
+    TargetError,
     URDFError,
 )
+from kinelab.ik.frdm.options import FRDMOptions
+from kinelab.ik.frdm.tracking import TrackResult, track
+from kinelab.ik.result import IKResult, Status
+from kinelab.ik.solve import solve
+from kinelab.ik.targets import from_xyz_quat_wxyz as target_from_xyz_quat_wxyz
+from kinelab.ik.targets import from_xyz_rpy as target_from_xyz_rpy
 from kinelab.robot import Joint, Robot, load
+from kinelab.robot.catalog import names as robots
 
-__version__ = "0.1.0"
+try:
+    __version__ = version("kinelab")
+except PackageNotFoundError:  # a source tree that was never installed
+    __version__ = "0+unknown"
 
 __all__ = [
+    "BiquaternionError",
     "ChainError",
     "ConfigurationError",
+    "FRDMOptions",
     "FrameNotFoundError",
+    "IKResult",
     "Joint",
     "JointLimitError",
     "JointNotFoundError",
     "KinelabError",
+    "OptionError",
     "Robot",
     "RobotNotFoundError",
+    "SolverNotFoundError",
+    "Status",
+    "TargetError",
+    "TrackResult",
     "URDFError",
+    "__version__",
     "load",
     "robots",
+    "solve",
+    "target_from_xyz_quat_wxyz",
+    "target_from_xyz_rpy",
+    "track",
 ]

@@ -67,3 +67,28 @@ class JointLimitError(ConfigurationError):
         super().__init__(
             f"joint {joint!r} = {value:.6g}{u} is outside its limits [{lower:.6g}, {upper:.6g}]{u}"
         )
+
+
+class TargetError(KinelabError):
+    """A target that is not a valid pose (shape, NaN/inf, not a rotation, not a unit quaternion)."""
+
+
+class BiquaternionError(KinelabError):
+    """A biquaternion that is not what an operation needs (non-finite, not unit, wrong shape)."""
+
+
+class OptionError(KinelabError):
+    """A solver or command option with a value outside what it accepts; names the option and the valid values."""
+
+    def __init__(self, option: str, value: object, valid: str, message: str | None = None):
+        self.option, self.value, self.valid = option, value, valid
+        super().__init__(message or f"option {option}={value!r} is not valid: {valid}")
+
+
+class SolverNotFoundError(KinelabError):
+    """A solver name that is not registered."""
+
+    def __init__(self, name: str, valid: Iterable[str]):
+        self.name = name
+        self.valid = sorted(valid)
+        super().__init__(f"unknown solver {name!r}; solvers are: {', '.join(self.valid)}")

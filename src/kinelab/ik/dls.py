@@ -8,13 +8,47 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
+from kinelab.errors import OptionError
+from kinelab.ik import options as opt
 from kinelab.ik.limits import PinLimits
 from kinelab.ik.result import Attempt, Status
 from kinelab.robot import Robot
+
+
+@dataclass(frozen=True)
+class DLSOptions:
+    """Options of the damped-least-squares reference.
+
+    Attributes:
+        damping: λ² added to J Jᵀ (Levenberg damping) [in the units of J Jᵀ], ≥ 0.
+        step: fraction of the Gauss–Newton step taken per iteration (1 = full step), in (0, 2).
+        max_iterations: iteration cap of one attempt.
+    """
+
+    damping: float = 1e-6
+    step: float = 1.0
+    max_iterations: int = 30
+
+    def __post_init__(self) -> None:
+        opt.positive("damping", self.damping, zero=True)
+        opt.positive("max_iterations", self.max_iterations, integer=True)
+        opt.positive("step", self.step)
+        if not float(self.step) < 2.0:
+            raise OptionError("step", self.step, "a number in (0, 2)")
+
+    @classmethod
+    def of(cls, options: DLSOptions | None = None, **kwargs: Any) -> DLSOptions:
+        """``options`` as given, or built from keyword arguments."""
+        return options if options is not None else opt.from_kwargs(cls, "dls", kwargs)
+
+
+Options = DLSOptions
 
 
 def attempt(
@@ -24,18 +58,22 @@ def attempt(
     tol_pos: float,
     tol_rot: float,
     deadline: float,
-    *,
-    damping: float = 1e-6,
-    step: float = 1.0,
-    max_iterations: int = 30,
+    options: DLSOptions | None = None,
+    **kwargs: Any,
 ) -> Attempt:
-    """Damped Gauss–Newton on the tool's log6 error in the tool frame.
+    """Damped Gauss–Newton on the tool's log6 error in the tool frame, from ``q0``.
 
     Args:
-        damping: λ² added to J Jᵀ (Levenberg damping) [dimensionless, in the units of J Jᵀ].
-        step: fraction of the Gauss–Newton step taken per iteration (1 = full step).
-        max_iterations: iteration cap of this attempt.
+        robot: the robot; oMtarget: the wanted tool pose in the base frame; q0: the start [rad or m].
+        tol_pos: position tolerance [m]; tol_rot: rotation tolerance [rad].
+        deadline: ``time.perf_counter()`` value after which the attempt stops.
+        options: a :class:`DLSOptions`, or its fields as keyword arguments.
+
+    Returns:
+        The attempt, before kinelab's Pinocchio check.
     """
+    opts = DLSOptions.of(options, **kwargs)
+    damping, step, max_iterations = opts.damping, opts.step, opts.max_iterations
     model, data, fid = robot.model, robot.data, robot.tool_frame_id
     limits = PinLimits(robot)
     q = robot.to_pin_q(q0)

@@ -7,12 +7,8 @@ import math
 import numpy as np
 import pinocchio as pin
 
-from kinelab.dualquat import DualQuat
-from kinelab.errors import KinelabError
-
-
-class TargetError(KinelabError):
-    """A target that is not a valid pose."""
+from kinelab.dq.algebra import DualQuat
+from kinelab.errors import TargetError
 
 
 def from_xyz_rpy(xyz, rpy=(0.0, 0.0, 0.0)) -> pin.SE3:

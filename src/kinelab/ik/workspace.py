@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
@@ -10,7 +9,6 @@ import numpy as np
 from kinelab.robot import Robot
 
 
-@functools.lru_cache(maxsize=64)
 def _reach(robot: Robot) -> tuple[tuple[float, float, float], float]:
     q = robot.neutral()
     oMi = list(robot.joint_placements(q).values())
@@ -26,5 +24,5 @@ def _reach(robot: Robot) -> tuple[tuple[float, float, float], float]:
 
 def out_of_reach(robot: Robot, position: np.ndarray) -> float:
     """How far [m] a position lies beyond the reach bound (≤ 0 when it may be reachable)."""
-    anchor, radius = _reach(robot)
+    anchor, radius = robot.derived("reach_bound", _reach)
     return math.dist(np.asarray(position, dtype=float).tolist(), anchor) - radius

@@ -1,115 +1,90 @@
-"""The compiled FRDM inner loop (numba): chain FK, the exact per-joint steps, sweeps, acceleration.
+"""The compiled FRDM inner loop (numba): the exact per-joint steps, sweeps, acceleration, restarts.
 
-Everything here works on plain arrays of the vector model (:mod:`kinelab.ik.frdm.model`); the
-readable reference of the same mathematics is :mod:`kinelab.ik.frdm.reference`, and the tests hold
-the two together. Notation (methods.md §1): e, o = joint axis and a point on it (base frame), p = tool
+Everything here works on the arrays of the chain model (:mod:`kinelab.ik.chain`); the readable
+reference of the same mathematics is :mod:`kinelab.ik.frdm.reference`, and the tests hold the two
+together. Notation (docs/methods.md §1): e, o = joint axis and a point on it (base frame), p = tool
 point, R = tool rotation (columns u_x, u_y, u_z), starred = target. Objective
 
     E = w_p ‖p − p*‖² + Σ_j w_j ‖u_j − u*_j‖².
 
-Joint kinds: 0 revolute with limits, 1 prismatic, 2 continuous (revolute without limits).
+Inputs travel as typed tuples: :class:`~kinelab.ik.chain.Chain` (the robot), :class:`Problem` (the
+target, weights, tolerances and windows of one solve), :class:`Settings` (the sweep and monitor
+settings) and :class:`Memory` (work arrays the caller keeps between calls). State and statistics are
+float arrays whose slots have names (``S_*``, ``T_*``).
 """
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
 
-REVOLUTE, PRISMATIC, CONTINUOUS = 0, 1, 2
-TWO_PI = 2.0 * np.pi
+from kinelab.ik.chain import (
+    CONTINUOUS,
+    PRISMATIC,
+    TWO_PI,
+    chain_fk,
+    random_configuration,
+    rotate_about,
+    rotate_rows,
+    rotation_angle,
+    rotm,
+)
 
 REFRESH_SWEEPS = 8  # sweeps carried incrementally before the chain FK is recomputed
-MIXED = 3  # multistart order code: alternate the sweep direction from one attempt to the next
+TIP_TO_BASE, BASE_TO_TIP, ALTERNATE, MIXED = 0, 1, 2, 3  # sweep order codes (MIXED: per restart, in turn)
 
 # run() return codes
 CONVERGED, STALL_STEP, STALL_WINDOW, BUDGET = 0, 1, 2, 3
 
-
-@njit(cache=True, inline="always")
-def _rotm(x, y, z, angle):
-    """Rodrigues' rotation by ``angle`` [rad] about the unit vector (x, y, z), as 9 scalars row by row."""
-    c, s = np.cos(angle), np.sin(angle)
-    C = 1.0 - c
-    return (c + x * x * C, x * y * C - z * s, x * z * C + y * s,
-            y * x * C + z * s, c + y * y * C, y * z * C - x * s,
-            z * x * C - y * s, z * y * C + x * s, c + z * z * C)
+# slots of an attempt's state array
+S_HISTORY, S_SWEEPS, S_E_WINDOW, S_WINDOW_START, S_ACCEPTED, S_E, S_KICKED = range(7)
+STATE_SIZE = 7
+# slots of a multistart's statistics array
+T_ATTEMPTS, T_SWEEPS, T_STALLS, T_ACCEPTED, T_BEST_E = range(5)
+STATS_SIZE = 5
 
 
-@njit(cache=True)
-def rot(axis, angle):
-    """Rotation matrix by ``angle`` [rad] about the unit vector ``axis``."""
-    m = _rotm(axis[0], axis[1], axis[2], angle)
-    R = np.empty((3, 3))
-    for k in range(9):
-        R[k // 3, k % 3] = m[k]
-    return R
+class Problem(NamedTuple):
+    """One solve: target, weights, tolerances, and the joint windows the bypasses may tighten."""
+
+    lower: np.ndarray  # (n,) [rad or m]; −inf where unbounded
+    upper: np.ndarray  # (n,)
+    free: np.ndarray  # (n,) bool; False: the joint is frozen
+    pstar: np.ndarray  # (3,) target point [m], base frame
+    Rstar: np.ndarray  # (3, 3) target rotation
+    w_p: float  # position weight [1/m²]
+    w_ax: np.ndarray  # (3,) weights of the tool x, y, z axes
+    tol_pos: float  # [m]
+    tol_rot: float  # [rad]
+    check_pos: bool
+    check_rot: bool
 
 
-@njit(cache=True, inline="always")
-def _mm_into(A, B, out):
-    """out = A @ B for 3 × 3 matrices (loops: numba's @ calls BLAS, far slower at this size)."""
-    for r in range(3):
-        a0, a1, a2 = A[r, 0], A[r, 1], A[r, 2]
-        for c in range(3):
-            out[r, c] = a0 * B[0, c] + a1 * B[1, c] + a2 * B[2, c]
+class Settings(NamedTuple):
+    """Sweep and monitor settings (docs/methods.md §1.5–1.6)."""
+
+    relax: float  # step = relax × the exact optimum, 0 < relax < 2
+    eps_q: float  # a sweep moving less than this in Σ|Δq| is a stall [rad or m]
+    window: int  # sweeps over which the objective must fall by window_rel
+    window_rel: float
+    accel_m: int  # Anderson memory (0: plain FRDM)
 
 
-@njit(cache=True, inline="always")
-def _rotate_rows(m, R):
-    """R ← M R in place, M given as 9 scalars."""
-    for c in range(3):
-        x, y, z = R[0, c], R[1, c], R[2, c]
-        R[0, c] = m[0] * x + m[1] * y + m[2] * z
-        R[1, c] = m[3] * x + m[4] * y + m[5] * z
-        R[2, c] = m[6] * x + m[7] * y + m[8] * z
+class Memory(NamedTuple):
+    """Work arrays kept by the caller between kernel calls of one attempt."""
+
+    X: np.ndarray  # (accel_m + 1, n) ring of iterates
+    G: np.ndarray  # (accel_m + 1, n) ring of sweep residuals F(x) − x
+    state: np.ndarray  # (STATE_SIZE,) slots S_*
+    trace: np.ndarray  # per-sweep objective (length 0: not recorded)
 
 
-@njit(cache=True, inline="always")
-def _rotate_about(m, ox, oy, oz, v):
-    """v ← o + M (v − o) in place."""
-    x, y, z = v[0] - ox, v[1] - oy, v[2] - oz
-    v[0] = ox + m[0] * x + m[1] * y + m[2] * z
-    v[1] = oy + m[3] * x + m[4] * y + m[5] * z
-    v[2] = oz + m[6] * x + m[7] * y + m[8] * z
-
-
-@njit(cache=True)
-def chain_fk(PR, Pt, axis, kind, TR, Tt, q, e_out, o_out, p_out, R_out):
-    """FK of the chain at q: joint axes ``e_out`` and origins ``o_out`` and the tool pose (p, R), base frame.
-
-    PR, Pt: placement of each joint frame in its parent's at q = 0; axis: local joint axes;
-    TR, Tt: tool frame in the last joint's frame.
-    """
-    Rw = np.eye(3)
-    tmp = np.empty((3, 3))
-    t0 = t1 = t2 = 0.0
-    for i in range(q.shape[0]):
-        P = Pt[i]
-        t0, t1, t2 = (t0 + Rw[0, 0] * P[0] + Rw[0, 1] * P[1] + Rw[0, 2] * P[2],
-                      t1 + Rw[1, 0] * P[0] + Rw[1, 1] * P[1] + Rw[1, 2] * P[2],
-                      t2 + Rw[2, 0] * P[0] + Rw[2, 1] * P[1] + Rw[2, 2] * P[2])
-        _mm_into(Rw, PR[i], tmp)
-        a = axis[i]
-        e0 = tmp[0, 0] * a[0] + tmp[0, 1] * a[1] + tmp[0, 2] * a[2]
-        e1 = tmp[1, 0] * a[0] + tmp[1, 1] * a[1] + tmp[1, 2] * a[2]
-        e2 = tmp[2, 0] * a[0] + tmp[2, 1] * a[1] + tmp[2, 2] * a[2]
-        if kind[i] == PRISMATIC:
-            t0, t1, t2 = t0 + e0 * q[i], t1 + e1 * q[i], t2 + e2 * q[i]
-            Rw[:, :] = tmp
-        else:
-            # Rw ← tmp·Rot(a, q) about the exact unit local axis: the world axis e carries rounding, and a
-            # rotation about it would feed that back into Rw and grow along a long chain
-            m = _rotm(a[0], a[1], a[2], q[i])
-            for r in range(3):
-                x, y, z = tmp[r, 0], tmp[r, 1], tmp[r, 2]
-                Rw[r, 0] = x * m[0] + y * m[3] + z * m[6]
-                Rw[r, 1] = x * m[1] + y * m[4] + z * m[7]
-                Rw[r, 2] = x * m[2] + y * m[5] + z * m[8]
-        e_out[i, 0], e_out[i, 1], e_out[i, 2] = e0, e1, e2
-        o_out[i, 0], o_out[i, 1], o_out[i, 2] = t0, t1, t2
-    for r in range(3):
-        p_out[r] = (t0, t1, t2)[r] + Rw[r, 0] * Tt[0] + Rw[r, 1] * Tt[1] + Rw[r, 2] * Tt[2]
-    _mm_into(Rw, TR, R_out)
+def new_memory(n: int, accel_m: int, trace_length: int = 0) -> Memory:
+    """Zeroed work arrays for an attempt on an n-joint chain."""
+    return Memory(np.zeros((accel_m + 1, n)), np.zeros((accel_m + 1, n)), np.zeros(STATE_SIZE),
+                  np.full(trace_length, -1.0))
 
 
 @njit(cache=True)
@@ -122,18 +97,6 @@ def objective(p, R, pstar, Rstar, w_p, w_ax):
         u2 = R[2, j] - Rstar[2, j]
         E += w_ax[j] * (u0 * u0 + u1 * u1 + u2 * u2)
     return E
-
-
-@njit(cache=True)
-def rotation_angle(R, Rstar):
-    """Angle [rad] of R*ᵀR, accurate near 0 and near π (atan2 of the sine and cosine parts)."""
-    M = np.empty((3, 3))
-    _mm_into(Rstar.T, R, M)
-    sx = 0.5 * (M[2, 1] - M[1, 2])
-    sy = 0.5 * (M[0, 2] - M[2, 0])
-    sz = 0.5 * (M[1, 0] - M[0, 1])
-    c = 0.5 * (M[0, 0] + M[1, 1] + M[2, 2] - 1.0)
-    return np.arctan2(np.sqrt(sx * sx + sy * sy + sz * sz), c)
 
 
 @njit(cache=True, inline="always")
@@ -250,12 +213,12 @@ def sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, rela
                     theta = min(max(theta, lo), hi)
             if theta == 0.0:
                 continue
-            m = _rotm(e0, e1, e2, theta)
-            _rotate_about(m, o0, o1, o2, p)
-            _rotate_rows(m, R)
+            m = rotm(e0, e1, e2, theta)
+            rotate_about(m, o0, o1, o2, p)
+            rotate_rows(m, R)
             if base_to_tip:
-                _rotate_rows(m, Rg)
-                _rotate_about(m, o0, o1, o2, tg)
+                rotate_rows(m, Rg)
+                rotate_about(m, o0, o1, o2, tg)
             step = theta
         moved_any = base_to_tip
         q[i] += step
@@ -279,6 +242,25 @@ def _anderson(X, G, count, m, x, g, out, dG, dX, A, rhs, gamma):
         for i in range(n):
             dG[i, c] = G[b, i] - G[a, i]
             dX[i, c] = X[b, i] - X[a, i]
+    trace = _normal_equations(dG, g, k, A, rhs)
+    if trace <= 0.0:  # no change in the residuals: nothing to extrapolate
+        out[:] = x + g
+        return
+    for r in range(k):
+        A[r, r] += 1e-10 * trace
+    _cholesky_solve(A, rhs, gamma, k)
+    for i in range(n):
+        acc = x[i] + g[i]
+        for c in range(k):
+            acc -= (dX[i, c] + dG[i, c]) * gamma[c]
+        out[i] = acc
+
+
+@njit(cache=True, inline="always")
+def _normal_equations(dG, g, k, A, rhs):
+    """A = ΔGᵀΔG, rhs = ΔGᵀg over the first k columns; returns trace(A)."""
+    n = g.shape[0]
+    trace = 0.0
     for r in range(k):
         rhs[r] = 0.0
         for i in range(n):
@@ -289,15 +271,13 @@ def _anderson(X, G, count, m, x, g, out, dG, dX, A, rhs, gamma):
                 acc += dG[i, r] * dG[i, c]
             A[r, c] = acc
             A[c, r] = acc
-    trace = 0.0
-    for r in range(k):
         trace += A[r, r]
-    if trace <= 0.0:  # no change in the residuals: nothing to extrapolate
-        out[:] = x + g
-        return
-    for r in range(k):
-        A[r, r] += 1e-10 * trace
-    # Cholesky A = L Lᵀ in place (lower triangle), then two triangular solves
+    return trace
+
+
+@njit(cache=True, inline="always")
+def _cholesky_solve(A, rhs, gamma, k):
+    """gamma = A⁻¹ rhs for the symmetric positive definite leading k × k block (A is overwritten)."""
     for j in range(k):
         acc = A[j, j]
         for t in range(j):
@@ -310,7 +290,6 @@ def _anderson(X, G, count, m, x, g, out, dG, dX, A, rhs, gamma):
             A[r, j] = acc / A[j, j]
     for r in range(k):
         gamma[r] = rhs[r]
-    for r in range(k):
         for t in range(r):
             gamma[r] -= A[r, t] * gamma[t]
         gamma[r] /= A[r, r]
@@ -318,171 +297,191 @@ def _anderson(X, G, count, m, x, g, out, dG, dX, A, rhs, gamma):
         for t in range(r + 1, k):
             gamma[r] -= A[t, r] * gamma[t]
         gamma[r] /= A[r, r]
-    for i in range(n):
-        acc = x[i] + g[i]
-        for c in range(k):
-            acc -= (dX[i, c] + dG[i, c]) * gamma[c]
-        out[i] = acc
+
+
+class _Work(NamedTuple):
+    """Arrays of one run() call (allocated once per call, never inside the sweep loop)."""
+
+    e: np.ndarray
+    o: np.ndarray
+    p: np.ndarray
+    R: np.ndarray
+    ec: np.ndarray
+    oc: np.ndarray
+    pc: np.ndarray
+    Rc: np.ndarray
+    x_old: np.ndarray
+    cand: np.ndarray
+    g: np.ndarray
+    dG: np.ndarray
+    dX: np.ndarray
+    A: np.ndarray
+    rhs: np.ndarray
+    gamma: np.ndarray
 
 
 @njit(cache=True)
-def run(
-    q, PR, Pt, axis, kind, TR, Tt, lower, upper, free, pstar, Rstar, w_p, w_ax, relax, order,
-    tol_pos, tol_rot, check_pos, check_rot, max_sweeps, eps_q, window, window_rel,
-    accel_m, X, G, state, trace,
-):
-    """Sweep until converged, stalled or ``max_sweeps`` sweeps; q is updated in place.
+def _work(n, accel_m):
+    m = max(accel_m, 1)
+    return _Work(np.empty((n, 3)), np.empty((n, 3)), np.empty(3), np.empty((3, 3)),
+                 np.empty((n, 3)), np.empty((n, 3)), np.empty(3), np.empty((3, 3)),
+                 np.empty(n), np.empty(n), np.empty(n),
+                 np.empty((n, m)), np.empty((n, m)), np.empty((m, m)), np.empty(m), np.empty(m))
 
-    order: 0 tip → base, 1 base → tip, 2 alternating. accel_m: Anderson memory (0 = plain FRDM).
-    X, G: (accel_m + 1) × n history rings; state: [history count, sweeps done, E at window start,
-    sweep at window start, accepted accelerations, E, next sweep base → tip (after a kick)];
-    trace: per-sweep objective (−1 where unused). Returns (code, sweeps in this call).
+
+@njit(cache=True)
+def _extrapolate(q, ch, pb, st, mem, w, E1):
+    """Record the sweep in the history and try the Anderson extrapolation; keep it only if it lowers E.
+
+    Returns (objective after this step, accepted). When accepted, q and the candidate FK arrays (w.ec,
+    w.oc, w.pc, w.Rc) hold the new state, and the caller swaps them with its own.
     """
     n = q.shape[0]
-    e = np.empty((n, 3))
-    o = np.empty((n, 3))
-    p = np.empty(3)
-    R = np.empty((3, 3))
-    pc = np.empty(3)
-    Rc = np.empty((3, 3))
-    x_old = np.empty(n)
-    cand = np.empty(n)
-    g = np.empty(n)
-    ec = np.empty((n, 3))
-    oc = np.empty((n, 3))
-    m = max(accel_m, 1)
-    dG, dX, A = np.empty((n, m)), np.empty((n, m)), np.empty((m, m))
-    rhs, gamma = np.empty(m), np.empty(m)
+    state = mem.state
+    cnt = int(state[S_HISTORY])
+    slot = cnt % (st.accel_m + 1)
+    for i in range(n):
+        w.g[i] = q[i] - w.x_old[i]
+        mem.X[slot, i] = w.x_old[i]
+        mem.G[slot, i] = w.g[i]
+    state[S_HISTORY] = cnt + 1.0
+    if cnt < 1:
+        return E1, False
+    _anderson(mem.X, mem.G, cnt, st.accel_m, w.x_old, w.g, w.cand, w.dG, w.dX, w.A, w.rhs, w.gamma)
+    finite = True
+    for i in range(n):
+        finite = finite and np.isfinite(w.cand[i])
+    if not finite:  # a degenerate history: drop it, keep the plain sweep
+        state[S_HISTORY] = 0.0
+        w.cand[:] = q
+    for i in range(n):
+        if ch.kind[i] != CONTINUOUS:
+            w.cand[i] = min(max(w.cand[i], pb.lower[i]), pb.upper[i])
+        if not pb.free[i]:
+            w.cand[i] = q[i]
+    chain_fk(ch, w.cand, w.ec, w.oc, w.pc, w.Rc)
+    Ec = objective(w.pc, w.Rc, pb.pstar, pb.Rstar, pb.w_p, pb.w_ax)
+    if Ec < E1:
+        q[:] = w.cand
+        state[S_ACCEPTED] += 1.0
+        return Ec, True
+    return E1, False
+
+
+@njit(cache=True)
+def _fk_converged(q, ch, pb, e, o, p, R, since_fk):
+    """Recompute the FK if the state was carried incrementally, then test both tolerances."""
+    if since_fk > 0:
+        chain_fk(ch, q, e, o, p, R)
+    return _within(p, R, pb.pstar, pb.Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot)
+
+
+@njit(cache=True)
+def _window_stalled(state, st, E1):
+    """The monitor's window test: True when E fell by less than window_rel over the last window."""
+    if state[S_SWEEPS] - state[S_WINDOW_START] >= st.window:
+        if state[S_E_WINDOW] - E1 <= st.window_rel * state[S_E_WINDOW]:
+            return True
+        state[S_E_WINDOW] = E1
+        state[S_WINDOW_START] = state[S_SWEEPS]
+    return False
+
+
+@njit(cache=True)
+def run(q, ch, pb, st, order, max_sweeps, mem):
+    """Sweep until converged, stalled or ``max_sweeps`` sweeps; q is updated in place.
+
+    Args:
+        q: start, one number per joint [rad or m]; holds the result on return.
+        ch, pb, st, mem: :class:`~kinelab.ik.chain.Chain`, :class:`Problem`, :class:`Settings`, :class:`Memory`.
+        order: TIP_TO_BASE, BASE_TO_TIP or ALTERNATE.
+        max_sweeps: sweeps allowed in this call.
+
+    Returns:
+        (code, sweeps in this call); the state slots S_* carry the rest.
+    """
+    state = mem.state
+    w = _work(q.shape[0], st.accel_m)
+    e, o, p, R = w.e, w.o, w.p, w.R
+    ec, oc, pc, Rc = w.ec, w.oc, w.pc, w.Rc
     fresh = False  # e, o, p, R hold the state at q (carried by the last sweep or an accepted extrapolation)
     since_fk = 0  # sweeps since p, R came from a chain FK (incremental updates carry rounding)
     for s in range(max_sweeps):
         if not fresh or since_fk >= REFRESH_SWEEPS:
-            chain_fk(PR, Pt, axis, kind, TR, Tt, q, e, o, p, R)
+            chain_fk(ch, q, e, o, p, R)
             since_fk = 0
-        if state[1] == 0.0:
-            state[2] = objective(p, R, pstar, Rstar, w_p, w_ax)
-        converged = _within(p, R, pstar, Rstar, tol_pos, tol_rot, check_pos, check_rot)
-        if converged and since_fk > 0:  # converged only on an exact FK
-            chain_fk(PR, Pt, axis, kind, TR, Tt, q, e, o, p, R)
-            since_fk = 0
-            converged = _within(p, R, pstar, Rstar, tol_pos, tol_rot, check_pos, check_rot)
-        if converged:
-            state[5] = objective(p, R, pstar, Rstar, w_p, w_ax)
+        if state[S_SWEEPS] == 0.0:
+            state[S_E_WINDOW] = objective(p, R, pb.pstar, pb.Rstar, pb.w_p, pb.w_ax)
+        if _within(p, R, pb.pstar, pb.Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot) and \
+                _fk_converged(q, ch, pb, e, o, p, R, since_fk):  # converged only on an exact FK
+            state[S_E] = objective(p, R, pb.pstar, pb.Rstar, pb.w_p, pb.w_ax)
             return CONVERGED, s
-        x_old[:] = q
-        base_to_tip = order == 1 or (order == 2 and int(state[1]) % 2 == 1) or state[6] != 0.0
-        state[6] = 0.0
-        moved = sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, relax, base_to_tip)
+        w.x_old[:] = q
+        base_to_tip = order == BASE_TO_TIP or (order == ALTERNATE and int(state[S_SWEEPS]) % 2 == 1) \
+            or state[S_KICKED] != 0.0
+        state[S_KICKED] = 0.0
+        moved = sweep(q, e, o, ch.kind, pb.lower, pb.upper, pb.free, p, R, pb.pstar, pb.Rstar, pb.w_p, pb.w_ax,
+                      st.relax, base_to_tip)
         fresh = base_to_tip
         since_fk += 1
-        E1 = objective(p, R, pstar, Rstar, w_p, w_ax)
-        state[1] += 1.0
-        if int(state[1]) - 1 < trace.shape[0]:
-            trace[int(state[1]) - 1] = E1
-        if moved < eps_q:
-            state[5] = E1
+        E1 = objective(p, R, pb.pstar, pb.Rstar, pb.w_p, pb.w_ax)
+        state[S_SWEEPS] += 1.0
+        if int(state[S_SWEEPS]) - 1 < mem.trace.shape[0]:
+            mem.trace[int(state[S_SWEEPS]) - 1] = E1
+        if moved < st.eps_q:
+            state[S_E] = E1
             return STALL_STEP, s + 1
-        if accel_m > 0:
-            cnt = int(state[0])
-            slot = cnt % (accel_m + 1)
-            for i in range(n):
-                g[i] = q[i] - x_old[i]
-                X[slot, i] = x_old[i]
-                G[slot, i] = g[i]
-            state[0] = cnt + 1.0
-            if cnt >= 1:
-                _anderson(X, G, cnt, accel_m, x_old, g, cand, dG, dX, A, rhs, gamma)
-                finite = True
-                for i in range(n):
-                    finite = finite and np.isfinite(cand[i])
-                if not finite:  # a degenerate history: drop it, keep the plain sweep
-                    state[0] = 0.0
-                    cand[:] = q
-                for i in range(n):
-                    if kind[i] != CONTINUOUS:
-                        cand[i] = min(max(cand[i], lower[i]), upper[i])
-                    if not free[i]:
-                        cand[i] = q[i]
-                chain_fk(PR, Pt, axis, kind, TR, Tt, cand, ec, oc, pc, Rc)
-                Ec = objective(pc, Rc, pstar, Rstar, w_p, w_ax)
-                if Ec < E1:
-                    q[:] = cand
-                    e, ec = ec, e
-                    o, oc = oc, o
-                    p, pc = pc, p
-                    R, Rc = Rc, R
-                    fresh = True
-                    since_fk = 0
-                    E1 = Ec
-                    state[4] += 1.0
-        state[5] = E1
-        if state[1] - state[3] >= window:
-            if state[2] - E1 <= window_rel * state[2]:
-                return STALL_WINDOW, s + 1
-            state[2] = E1
-            state[3] = state[1]
+        if st.accel_m > 0:
+            E1, accepted = _extrapolate(q, ch, pb, st, mem, w, E1)
+            if accepted:
+                e, ec = ec, e
+                o, oc = oc, o
+                p, pc = pc, p
+                R, Rc = Rc, R
+                w = _Work(e, o, p, R, ec, oc, pc, Rc, w.x_old, w.cand, w.g, w.dG, w.dX, w.A, w.rhs, w.gamma)
+                fresh = True
+                since_fk = 0
+        state[S_E] = E1
+        if _window_stalled(state, st, E1):
+            return STALL_WINDOW, s + 1
     return BUDGET, max_sweeps
 
 
 @njit(cache=True)
-def _xorshift(state):
-    """xorshift64*: a small seeded generator for restarts inside the kernel; returns a float in [0, 1)."""
-    x = state[0]
-    x ^= x >> np.uint64(12)
-    x ^= x << np.uint64(25)
-    x ^= x >> np.uint64(27)
-    state[0] = x
-    return float((x * np.uint64(2685821657736338717)) >> np.uint64(11)) / 9007199254740992.0
-
-
-@njit(cache=True)
-def multistart(
-    q, PR, Pt, axis, kind, TR, Tt, lower, upper, free, pstar, Rstar, w_p, w_ax, relax, order,
-    tol_pos, tol_rot, check_pos, check_rot, max_sweeps, eps_q, window, window_rel, accel_m,
-    rng_state, max_attempts, sweep_budget, best_q, stats,
-):
+def multistart(q, ch, pb, st, order, max_sweeps, rng_state, max_attempts, sweep_budget, best_q, stats):
     """Attempts from q, then from seeded uniform starts, until one converges, ``max_attempts`` have run or
     ``sweep_budget`` sweeps are spent. A stall ends an attempt (a restart, not a bypass).
 
     On return q holds the converged configuration (or the last start), best_q the lowest-objective one;
-    stats = [attempts, sweeps, stalls, accepted accelerations, best objective]. Returns a run() code.
+    stats has the slots T_*. Returns a run() code.
     """
     n = q.shape[0]
-    X = np.zeros((accel_m + 1, n))
-    G = np.zeros((accel_m + 1, n))
-    state = np.zeros(7)
-    trace = np.zeros(0)
+    mem = Memory(np.zeros((st.accel_m + 1, n)), np.zeros((st.accel_m + 1, n)), np.zeros(STATE_SIZE), np.zeros(0))
     best = np.inf
+    code = BUDGET
     for a in range(max_attempts):
         if a > 0:
-            for i in range(n):
-                if kind[i] == CONTINUOUS:
-                    q[i] = -np.pi + 2.0 * np.pi * _xorshift(rng_state)
-                else:
-                    q[i] = lower[i] + (upper[i] - lower[i]) * _xorshift(rng_state)
-        for k in range(7):
-            state[k] = 0.0
-        budget = min(max_sweeps, int(sweep_budget - stats[1]))
+            random_configuration(q, ch.kind, pb.lower, pb.upper, rng_state)
+        mem.state[:] = 0.0
+        budget = min(max_sweeps, int(sweep_budget - stats[T_SWEEPS]))
         attempt_order = order
         if order == MIXED:  # base → tip on the first attempt and every other restart, tip → base between
-            attempt_order = 1 if int(stats[0]) % 2 == 0 else 0
-        code, s = run(q, PR, Pt, axis, kind, TR, Tt, lower, upper, free, pstar, Rstar, w_p, w_ax, relax, attempt_order,
-                      tol_pos, tol_rot, check_pos, check_rot, budget, eps_q, window, window_rel, accel_m, X, G,
-                      state, trace)
-        stats[0] += 1.0
-        stats[1] += s
-        stats[3] += state[4]
-        if state[5] < best:
-            best = state[5]
+            attempt_order = BASE_TO_TIP if int(stats[T_ATTEMPTS]) % 2 == 0 else TIP_TO_BASE
+        code, s = run(q, ch, pb, st, attempt_order, budget, mem)
+        stats[T_ATTEMPTS] += 1.0
+        stats[T_SWEEPS] += s
+        stats[T_ACCEPTED] += mem.state[S_ACCEPTED]
+        if mem.state[S_E] < best:
+            best = mem.state[S_E]
             best_q[:] = q
         if code == CONVERGED:
             best_q[:] = q
-            stats[4] = state[5]
+            stats[T_BEST_E] = mem.state[S_E]
             return CONVERGED
         if code == STALL_STEP or code == STALL_WINDOW:  # noqa: SIM109 - plain comparisons for numba
-            stats[2] += 1.0
-        if stats[1] >= sweep_budget:
-            stats[4] = best
+            stats[T_STALLS] += 1.0
+        if stats[T_SWEEPS] >= sweep_budget:
+            stats[T_BEST_E] = best
             return BUDGET
-    stats[4] = best
+    stats[T_BEST_E] = best
     return code

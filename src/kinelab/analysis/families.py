@@ -1,0 +1,187 @@
+"""Singular families of a chain: batched σ sweeps, refinement onto the singular set, joint relations.
+
+See :mod:`kinelab.analysis.singular` for units and frames (the scaled Jacobian, the rank threshold).
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+from tqdm import tqdm
+
+from kinelab.analysis.singular import NEAR_SINGULAR, analyze, scaled_jacobian
+from kinelab.errors import KinelabError
+from kinelab.robot import Robot
+
+RELATION_TOL = 1e-3  # [rad or m] a joint relation holds within this
+SPECIAL_VALUES = (0.0, np.pi / 2, -np.pi / 2, np.pi, -np.pi)
+FAMILY_MARGIN = 0.1  # [rad] a sample this close to every relation of a known family is explained by it
+
+
+def sigma_ratio_batch(robot: Robot, qs: np.ndarray, length: float | None = None, progress: bool = False) -> np.ndarray:
+    """σ_min/σ_max of the scaled Jacobian for each row of ``qs`` (one batched SVD)."""
+    L = length or robot.characteristic_length()
+    model, data, fid = robot.model, robot.data, robot.tool_frame_id
+    Js = np.empty((len(qs), 6, robot.nv))
+    for i, q in enumerate(tqdm(qs, desc="jacobians", disable=not progress, unit="q", leave=False)):
+        Js[i] = pin.computeFrameJacobian(model, data, robot.to_pin_q(q), fid, pin.LOCAL_WORLD_ALIGNED).reshape(6, -1)
+    Js[:, :3] /= L
+    s = np.linalg.svd(Js, compute_uv=False)
+    full = min(6, robot.n)
+    return s[:, full - 1] / s[:, 0]
+
+
+def refine(robot: Robot, q0, lower=None, upper=None, length: float | None = None) -> np.ndarray:
+    """Move q0 onto the singular set: minimise σ_min/σ_max within the joint box (L-BFGS-B)."""
+    from scipy.optimize import minimize
+
+    L = length or robot.characteristic_length()
+    lo = robot.lower if lower is None else lower
+    hi = robot.upper if upper is None else upper
+
+    def ratio(q):
+        s = np.linalg.svd(scaled_jacobian(robot, q, L), compute_uv=False)
+        return s[min(6, robot.n) - 1] / s[0]
+
+    res = minimize(ratio, np.asarray(q0, float), method="L-BFGS-B", bounds=list(zip(lo, hi, strict=True)),
+                   options={"maxiter": 300, "ftol": 1e-16, "gtol": 1e-12})
+    return res.x
+
+
+@dataclass(frozen=True)
+class Relation:
+    """Σ sign_k q[index_k] = value: a joint relation a family of singular configurations satisfies."""
+
+    index: tuple[int, ...]
+    sign: tuple[int, ...]
+    value: float
+    text: str
+
+    def residual(self, q) -> float:
+        return abs(sum(s * q[i] for i, s in zip(self.index, self.sign, strict=True)) - self.value)
+
+
+def _label(c: float) -> str:
+    return {0.0: "0", np.pi / 2: "π/2", -np.pi / 2: "−π/2", np.pi: "π", -np.pi: "−π"}[c]
+
+
+def joint_relations(robot: Robot, q, tol: float = RELATION_TOL) -> list[Relation]:
+    """Simple relations the configuration satisfies: joints at 0, ±π/2, ±π; sums and differences of two
+    joints, and sums of three consecutive angular joints, at those values (joint names in the text);
+    relations implied by single-joint ones (θ2 = 0 and θ3 = 0 imply θ2 ± θ3 = 0) are left out."""
+    names = robot.joint_names
+    angular = [i for i, k in enumerate(robot.joint_kinds) if k != "prismatic"]
+    combos = [((i,), (1,)) for i in angular]
+    combos += [((i, j), (1, s)) for i, j in itertools.combinations(angular, 2) for s in (1, -1)]
+    combos += [((a, b, d), (1, 1, 1)) for a, b, d in zip(angular, angular[1:], angular[2:], strict=False)]
+    out: list[Relation] = []
+    fixed: set[int] = set()
+    for index, sign in combos:
+        if len(index) > 1 and all(i in fixed for i in index):
+            continue
+        total = sum(s * q[i] for i, s in zip(index, sign, strict=True))
+        c = next((c for c in SPECIAL_VALUES if abs(total - c) < tol), None)
+        if c is None:
+            continue
+        lhs = names[index[0]] + "".join(f" {'+' if s > 0 else '−'} {names[i]}"
+                                        for i, s in zip(index[1:], sign[1:], strict=True))
+        out.append(Relation(index, sign, c, f"{lhs} = {_label(c)}"))
+        if len(index) == 1:
+            fixed.add(index[0])
+    return out
+
+
+def _merge_coincidences(groups: dict[tuple, list]) -> dict[tuple, list]:
+    """A relation set that strictly contains another family's carries a chance coincidence: merge it there."""
+    merged: dict[tuple, list] = {}
+    for key in sorted(groups, key=len):
+        home = next((k for k in merged if k and set(k) < set(key)), None)
+        merged.setdefault(home or key, []).extend(groups[key])
+    return merged
+
+
+@dataclass
+class Family:
+    """Singular configurations that share the same joint relations."""
+
+    relations: list[Relation]
+    count: int
+    representative: np.ndarray
+    rank: int
+    sigma_ratio: float
+
+    def to_dict(self) -> dict:
+        return {"relations": [r.text for r in self.relations], "count": self.count,
+                "representative_q": self.representative.tolist(), "rank": self.rank,
+                "sigma_min_over_max": self.sigma_ratio}
+
+
+def sweep_limits(robot: Robot) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """The box a sweep samples, and notes for joints whose range is not a finite limit."""
+    notes = []
+    for j in robot.joints:
+        if j.kind == "continuous":
+            notes.append(f"{j.name} is continuous: sampled on [−π, π]")
+    return robot.lower.copy(), robot.upper.copy(), notes
+
+
+def grid(robot: Robot, samples: int, rng: np.random.Generator) -> np.ndarray:
+    """A stratified grid over the joint box: k cells per joint (k^n ≤ samples, k ≥ 2), one sample per cell,
+    jittered within it. (A plain grid puts joints on 0 and ±π/2 together, where every relation holds.)"""
+    k = max(2, int(np.floor(samples ** (1.0 / robot.n) + 1e-9)))
+    cells = np.array(np.meshgrid(*[np.arange(k)] * robot.n, indexing="ij")).reshape(robot.n, -1).T
+    width = (robot.upper - robot.lower) / k
+    return robot.lower + (cells + rng.uniform(size=cells.shape)) * width
+
+
+def sweep(robot: Robot, samples: int = 5000, seed: int = 0, refine_top: int = 40, progress: bool = False,
+          method: str = "random") -> dict:
+    """Sample the joint box (seeded uniform samples, or a full grid), keep near-singular configurations,
+    refine them onto the singular set, and group those that are singular into families by the joint
+    relations they satisfy (relations that hold there; for a redundant arm one relation can be a necessary
+    condition only, the refinement supplies the rest).
+
+    Returns {"families": [...], "samples", "near_singular", "refined", "singular", "notes", "sigma_ratio"}.
+    """
+    if samples < 1:
+        raise KinelabError("a sweep needs at least one sample")
+    lower, upper, notes = sweep_limits(robot)
+    if method not in ("random", "grid"):
+        raise KinelabError(f"unknown sweep method {method!r}; use 'random' or 'grid'")
+    rng = np.random.default_rng(seed)
+    qs = rng.uniform(lower, upper, size=(samples, robot.n)) if method == "random" else grid(robot, samples, rng)
+    L = robot.characteristic_length()
+    ratios = sigma_ratio_batch(robot, qs, L, progress)
+    order = [i for i in np.argsort(ratios) if ratios[i] < NEAR_SINGULAR]
+    groups: dict[tuple[Relation, ...], list[np.ndarray]] = {}
+    refined = singular_count = 0
+    # Refine the most singular samples that no family found so far explains. A family of lower dimension
+    # (the youBot's θ2 = θ3 = 0) is sampled far less often than one of codimension 1; leaving the
+    # explained samples out is what lets a sweep find it.
+    with tqdm(total=refine_top, desc="refine", disable=not progress, unit="q", leave=False) as bar:
+        while refined < refine_top and order:
+            known = [rel for rel in groups if rel]
+            pick = next((i for i in order if not any(all(r.residual(qs[i]) < FAMILY_MARGIN for r in rel)
+                                                     for rel in known)), None)
+            if pick is None:
+                break
+            order.remove(pick)
+            q = refine(robot, qs[pick], lower, upper, L)
+            refined += 1
+            bar.update()
+            if analyze(robot, q, L).singular:
+                singular_count += 1
+                groups.setdefault(tuple(joint_relations(robot, q)), []).append(q)
+    groups = _merge_coincidences(groups)
+    families = []
+    for rel, members in sorted(groups.items(), key=lambda kv: -len(kv[1])):
+        rep = members[0]
+        a = analyze(robot, rep, L)
+        families.append(Family(list(rel), len(members), rep, a.rank,
+                               float(a.singular_values[a.full_rank - 1] / a.singular_values[0])))
+    return {"families": families, "samples": len(qs), "near_singular": int(np.sum(ratios < NEAR_SINGULAR)),
+            "refined": refined, "singular": singular_count, "notes": notes,
+            "sigma_ratio": ratios}

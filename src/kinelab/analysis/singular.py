@@ -1,0 +1,97 @@
+"""Singularities of any chain: SVD rank, manipulability, lost directions, sweeps and families.
+
+Units. A tool twist mixes m/s and rad/s, so the singular values of a raw Jacobian depend on the unit of
+length. kinelab divides the linear rows by the chain's characteristic length L (the mean spacing of its
+joint origins, :meth:`Robot.characteristic_length`): the scaled Jacobian maps joint rates to
+(v/L, ω), both in 1/s, and its singular values, condition number and manipulability are
+dimensionless (for revolute chains; a prismatic column carries 1/L). The rank is the number of singular
+values above ``RANK_RTOL``·σ_max. The rank itself does not depend on L or on the frame: only the
+directions reported do.
+
+Frame. Directions are given in the base frame at the tool point (LOCAL_WORLD_ALIGNED): a lost direction
+is a tool twist (v [unit vector share], ω) that no joint motion produces; a null motion is a joint
+velocity that moves nothing.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from kinelab.robot import Robot
+
+RANK_RTOL = 1e-6  # singular values below RANK_RTOL × σ_max count as zero
+NEAR_SINGULAR = 1e-2  # σ_min/σ_max below this: worth refining onto the singular set
+
+
+@dataclass
+class Analysis:
+    """The singularity picture of a robot at q (see the module docstring for units and frames)."""
+
+    q: np.ndarray
+    singular_values: np.ndarray
+    rank: int
+    full_rank: int
+    manipulability: float  # Yoshikawa √det(J Jᵀ) (n ≥ 6) or √det(Jᵀ J) (n < 6), scaled J
+    condition: float  # σ_max/σ_min (inf when singular)
+    length: float  # L [m]
+    lost_directions: list[dict] = field(default_factory=list)
+    null_motions: list[np.ndarray] = field(default_factory=list)
+
+    @property
+    def singular(self) -> bool:
+        return self.rank < self.full_rank
+
+    def to_dict(self) -> dict:
+        return {
+            "q": self.q.tolist(),
+            "singular_values": self.singular_values.tolist(),
+            "rank": self.rank,
+            "full_rank": self.full_rank,
+            "singular": self.singular,
+            "manipulability": self.manipulability,
+            "condition": self.condition if np.isfinite(self.condition) else None,
+            "characteristic_length_m": self.length,
+            "lost_directions": self.lost_directions,
+            "null_motions": [m.tolist() for m in self.null_motions],
+        }
+
+
+def scaled_jacobian(robot: Robot, q, length: float | None = None) -> np.ndarray:
+    """6 × n LOCAL_WORLD_ALIGNED tool Jacobian with the linear rows divided by L."""
+    L = length or robot.characteristic_length()
+    J = robot.jacobian_local_world_aligned(q)
+    J[:3] /= L
+    return J
+
+
+def _rank(s: np.ndarray) -> int:
+    return int(np.sum(s > RANK_RTOL * s[0])) if s.size and s[0] > 0 else 0
+
+
+def describe_direction(u: np.ndarray) -> dict:
+    """A unit scaled twist (v/L, ω) as words: how much is translation, along which axis, rotation about which."""
+    lin, ang = u[:3], u[3:]
+    out = {"twist": u.tolist(), "translation_share": float(lin @ lin), "rotation_share": float(ang @ ang)}
+    for name, part in (("translation", lin), ("rotation", ang)):
+        norm = np.linalg.norm(part)
+        if norm > 1e-6:
+            out[f"{name}_axis"] = (part / norm).tolist()
+    return out
+
+
+def analyze(robot: Robot, q, length: float | None = None) -> Analysis:
+    """SVD of the scaled tool Jacobian at q: rank, σ, manipulability, condition, lost and null directions."""
+    q = robot.check_q(q)
+    L = length or robot.characteristic_length()
+    J = scaled_jacobian(robot, q, L)
+    U, s, Vt = np.linalg.svd(J)
+    full = min(6, robot.n)
+    rank = _rank(s)
+    JJ = J @ J.T if robot.n >= 6 else J.T @ J
+    manip = float(np.sqrt(max(np.linalg.det(JJ), 0.0)))
+    condition = float(s[0] / s[full - 1]) if s[full - 1] > RANK_RTOL * s[0] else float("inf")
+    lost = [describe_direction(U[:, i]) | {"sigma": float(s[i])} for i in range(rank, 6)]
+    null = [Vt[i] for i in range(rank, robot.n)]
+    return Analysis(q, s, rank, full, manip, condition, L, lost, null)

@@ -1,0 +1,466 @@
+"""The ``kinelab`` command: parse, call the public API, print. User errors: one line, exit code 2.
+
+Every command that prints results takes ``--json`` for a stable machine-readable form (see README).
+Angles on the command line are radians unless ``--deg`` is given; ``--deg`` applies to revolute and
+continuous joints only (prismatic joints stay in metres).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab.errors import KinelabError
+from kinelab.robot import Robot, catalog, load
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str):  # one line, exit 2, as for every user error
+        self.exit(2, f"kinelab: error: {message} (see 'kinelab {self.prog.split()[-1]} --help')\n")
+
+
+def _q_from_cli(robot: Robot, values: list[float], deg: bool, what: str = "q") -> np.ndarray:
+    q = robot.check_q(values, what=what)
+    if deg:
+        angular = np.array([k != "prismatic" for k in robot.joint_kinds])
+        q = np.where(angular, np.deg2rad(q), q)
+    return q
+
+
+def pose_dict(oMtool: pin.SE3) -> dict:
+    """The JSON form of a pose: position [m], rotation matrix, quat_wxyz, rpy [rad]."""
+    quat = pin.Quaternion(oMtool.rotation)
+    wxyz = np.array([quat.w, quat.x, quat.y, quat.z])
+    wxyz = -wxyz if wxyz[0] < 0 else wxyz  # canonical sign: w >= 0
+    return {
+        "position_m": oMtool.translation.tolist(),
+        "rotation_matrix": oMtool.rotation.tolist(),
+        "quat_wxyz": wxyz.tolist(),
+        "rpy_rad": pin.rpy.matrixToRpy(oMtool.rotation).tolist(),
+    }
+
+
+def _print_json(obj) -> None:
+    print(json.dumps(obj, indent=2))
+
+
+def cmd_robots(args) -> int:
+    rows = [
+        {"name": e.name, "source": e.source, "tool": e.tool, "description": e.description}
+        for e in catalog.ENTRIES.values()
+    ]
+    if args.json:
+        _print_json(rows)
+    else:
+        for r in rows:
+            print(f"{r['name']:<11} {r['source']:<19} {r['description']}")
+    return 0
+
+
+def _joint_row(j) -> dict:
+    row = {"name": j.name, "type": j.kind, "lower": j.lower, "upper": j.upper, "unit": j.unit}
+    if j.kind != "prismatic":
+        row["lower_deg"], row["upper_deg"] = float(np.rad2deg(j.lower)), float(np.rad2deg(j.upper))
+    return row
+
+
+def cmd_info(args) -> int:
+    robot = load(args.robot, tool=args.tool)
+    info = {
+        "robot": robot.name,
+        "urdf": str(robot.urdf_path),
+        "base": robot.base,
+        "tool": robot.tool,
+        "dof": robot.n,
+        "nq": robot.nq,
+        "nv": robot.nv,
+        "joints": [_joint_row(j) for j in robot.joints],
+        "locked": robot.locked,
+    }
+    if args.json:
+        _print_json(info)
+        return 0
+    print(f"{robot.name}: {robot.n} DOF (nq={robot.nq}, nv={robot.nv}), base {robot.base!r} -> tool {robot.tool!r}")
+    print(f"urdf: {robot.urdf_path}")
+    print(f"  {'#':>2} {'joint':<22} {'type':<11} {'lower':>12} {'upper':>12}")
+    for i, j in enumerate(robot.joints, start=1):
+        if j.kind == "prismatic":
+            lo, hi = f"{j.lower:.4f} m", f"{j.upper:.4f} m"
+        else:
+            lo, hi = f"{np.rad2deg(j.lower):.3f} deg", f"{np.rad2deg(j.upper):.3f} deg"
+        print(f"  {i:>2} {j.name:<22} {j.kind:<11} {lo:>12} {hi:>12}")
+    if robot.locked:
+        print(f"locked: {', '.join(f'{k}={v:g}' for k, v in robot.locked.items())}")
+    return 0
+
+
+def cmd_fk(args) -> int:
+    robot = load(args.robot, tool=args.tool)
+    q = _q_from_cli(robot, args.q, args.deg)
+    robot.check_q(q, limits=not args.ignore_limits)
+    oMtool = robot.fk(q)
+    out = {"robot": robot.name, "base": robot.base, "tool": robot.tool, "q": q.tolist(), **pose_dict(oMtool)}
+    if args.json:
+        _print_json(out)
+        return 0
+    print(f"{robot.name}: pose of {robot.tool!r} in {robot.base!r}")
+    print(f"  position [m]   {np.array2string(oMtool.translation, precision=6)}")
+    print(f"  quat_wxyz      {np.array2string(np.array(out['quat_wxyz']), precision=6)}")
+    print(f"  rpy [rad]      {np.array2string(np.array(out['rpy_rad']), precision=6)}")
+    print("  rotation       " + np.array2string(oMtool.rotation, precision=6, prefix="  rotation       "))
+    return 0
+
+
+def _bypass_value(robot, joint: str, text: str, deg: bool, flag: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise KinelabError(f"{flag} {joint}: {text!r} is not a number") from None
+    kind = robot.joint_kinds[robot.joint_index(joint)]
+    return float(np.deg2rad(value)) if deg and kind != "prismatic" else value
+
+
+def _bypass_options(robot, args) -> dict:
+    """FRDM's bypasses from --kick J=D, --interval J=LO:HI and --freeze J[=V] (rad, m; deg with --deg)."""
+    specs = {"kicks": args.kick or [], "intervals": args.interval or [], "freeze": args.freeze or []}
+    if not any(specs.values()):
+        return {}
+    if args.solver != "frdm":
+        raise KinelabError("--kick, --interval and --freeze are FRDM's bypasses; use --solver frdm")
+    out: dict[str, dict] = {}
+    for spec in specs["kicks"]:
+        joint, sep, value = spec.partition("=")
+        if not sep:
+            raise KinelabError(f"--kick wants JOINT=DELTA, got {spec!r}")
+        out.setdefault("kicks", {})[joint] = _bypass_value(robot, joint, value, args.deg, "--kick")
+    for spec in specs["intervals"]:
+        joint, sep, bounds = spec.partition("=")
+        lo, colon, hi = bounds.partition(":")
+        if not (sep and colon):
+            raise KinelabError(f"--interval wants JOINT=LOWER:UPPER, got {spec!r}")
+        out.setdefault("intervals", {})[joint] = (_bypass_value(robot, joint, lo, args.deg, "--interval"),
+                                                  _bypass_value(robot, joint, hi, args.deg, "--interval"))
+    for spec in specs["freeze"]:
+        joint, sep, value = spec.partition("=")
+        robot.joint_index(joint)  # an unknown joint is named with the valid ones
+        out.setdefault("freeze", {})[joint] = _bypass_value(robot, joint, value, args.deg, "--freeze") if sep else None
+    return out
+
+
+def cmd_ik(args) -> int:
+    from kinelab.ik import solve, target_from_xyz_rpy
+
+    robot = load(args.robot, tool=args.tool)
+    if (args.target_q is None) == (args.target_xyz is None):
+        raise KinelabError("give the target as --target-q Q... or as --target-xyz X Y Z [--target-rpy R P Y]")
+    options = {}
+    if args.target_q is not None:
+        q_target = robot.check_q(_q_from_cli(robot, args.target_q, args.deg, "--target-q"), limits=True,
+                                 what="--target-q")
+        target = robot.fk(q_target)
+        if args.solver == "biquat":
+            from kinelab.dq import kinematics as biquat_kinematics
+
+            options["target_biquaternion"] = biquat_kinematics.pose(robot, q_target)  # N with its sign
+    else:
+        rpy = np.array(args.target_rpy if args.target_rpy is not None else [0.0, 0.0, 0.0])
+        target = target_from_xyz_rpy(args.target_xyz, np.deg2rad(rpy) if args.deg else rpy)
+    q0 = None if args.start_q is None else _q_from_cli(robot, args.start_q, args.deg, "--start-q")
+    if args.solver == "frdm" and args.polish:
+        options["polish"] = True
+    options.update(_bypass_options(robot, args))
+    if args.solver == "biquat":
+        options.update({k: v for k, v in (("law", args.law), ("integrator", args.integrator), ("step", args.step),
+                                          ("k", args.gain)) if v is not None})
+    result = solve(robot, target, solver=args.solver, q0=q0, seed=args.seed, tol_pos=args.tol_pos,
+                   tol_rot=args.tol_rot, time_budget=args.time_budget, **options)
+    out = {"robot": robot.name, "target": pose_dict(target), **result.to_dict()}
+    if args.json:
+        _print_json(out)
+    else:
+        q_show = np.where([k != "prismatic" for k in robot.joint_kinds], np.rad2deg(result.q), result.q) \
+            if args.deg else result.q
+        print(f"{robot.name} {args.solver}: {result.status.value} (success: {result.success})")
+        print(f"  q{' [deg, m]' if args.deg else ' [rad, m]'}  {np.array2string(q_show, precision=6)}")
+        print(f"  position error {result.position_error:.3e} m, rotation error {result.rotation_error:.3e} rad "
+              "(Pinocchio FK)")
+        print(f"  {result.iterations} iterations, {result.restarts} restarts, {result.wall_time * 1e3:.2f} ms, "
+              f"mode {result.mode}")
+        if "model_time" in result.info:
+            m0 = result.info.get("M0")
+            print(f"  model time {result.info['model_time']:.4g} s, final M0 = "
+                  + (f"{m0:+.6f}" if m0 is not None else "n/a (give --target-q for the sign of N)"))
+        if result.message:
+            print(f"  {result.message}")
+    return 0 if result.success else 1
+
+
+def cmd_singular(args) -> int:
+    from kinelab.analysis import families, singular
+
+    robot = load(args.robot, tool=args.tool)
+    if args.sweep is not None:
+        if args.q:
+            raise KinelabError("give either a configuration or --sweep N, not both")
+        result = families.sweep(robot, samples=args.sweep, seed=args.seed, progress=not args.json,
+                                method="grid" if args.grid else "random")
+        out = {"robot": robot.name, **{k: v for k, v in result.items() if k not in ("families", "sigma_ratio")},
+               "families": [f.to_dict() for f in result["families"]]}
+        if args.json:
+            _print_json(out)
+            return 0
+        for note in result["notes"]:
+            print(f"note: {note}")
+        print(f"{robot.name}: {args.sweep} samples, {out['near_singular']} near-singular (σ_min/σ_max < "
+              f"{singular.NEAR_SINGULAR:g}), {out['refined']} refined, {out['singular']} singular after refinement")
+        for f in result["families"]:
+            q_show = np.round(f.representative, 4).tolist()
+            relations = " and ".join(r.text for r in f.relations) or "(no simple relation)"
+            print(f"  rank {f.rank}, {f.count:4d} found: {relations}")
+            print(f"      e.g. q = {q_show}")
+        return 0
+    if not args.q:
+        raise KinelabError("give a configuration Q1 ... Qn or --sweep N")
+    q = _q_from_cli(robot, args.q, args.deg)
+    a = singular.analyze(robot, robot.check_q(q, limits=not args.ignore_limits))
+    if args.json:
+        _print_json({"robot": robot.name, **a.to_dict()})
+        return 0
+    print(f"{robot.name}: rank {a.rank} of {a.full_rank}{' (SINGULAR)' if a.singular else ''}; "
+          f"σ = {np.array2string(a.singular_values, precision=4)} (linear rows / L = {a.length:.4g} m)")
+    print(f"  manipulability {a.manipulability:.4g}, condition {a.condition:.4g}")
+    for d in a.lost_directions:
+        parts = []
+        if "translation_axis" in d:
+            axis, share = np.round(d["translation_axis"], 3).tolist(), 100 * d["translation_share"]
+            parts.append(f"translation {axis} ({share:.0f} %)")
+        if "rotation_axis" in d:
+            axis, share = np.round(d["rotation_axis"], 3).tolist(), 100 * d["rotation_share"]
+            parts.append(f"rotation about {axis} ({share:.0f} %)")
+        print(f"  lost tool motion (base axes, at the tool): {' + '.join(parts)}")
+    for m in a.null_motions:
+        print(f"  joint motion that moves nothing: {np.round(m, 4).tolist()}")
+    return 0
+
+
+def cmd_validate(args) -> int:
+    from kinelab.report import render, validate
+
+    report = validate.run(robots=args.robots, n=args.n, seed=args.seed, progress=not args.json)
+    if args.out:
+        render.write_validate_report(report, args.out)
+    if args.json:
+        _print_json(report.to_dict())
+    else:
+        print(render.validate_table(report))
+        if args.out:
+            print(f"report written to {args.out}")
+    return 0 if report.passed else 1
+
+
+def cmd_bench(args) -> int:
+    from kinelab.report import render
+    from kinelab.report.bench import runner as bench
+
+    scaled = None
+    if args.scaling:  # first: the peers' solver threads and caches would disturb this timing afterwards
+        from kinelab.report.bench import scaling
+
+        scaled = scaling.run(progress=not args.json)
+    result = bench.run(robots=args.robots, n=args.n, seed=args.seed, solvers=args.solvers,
+                       budget=args.budget_ms / 1e3, progress=not args.json, repeats=args.repeats)
+    if scaled is not None:
+        result["scaling"] = scaled
+    if args.tracking:
+        from kinelab.studies import paper000_era
+
+        result["tracking"] = paper000_era.tracking_bench(repeats=args.repeats)
+    if args.out:
+        render.write_bench(result, args.out)
+    if args.json:
+        _print_json(result)
+    else:
+        print(render.bench_markdown(result))
+        if "scaling" in result:
+            print(scaling.markdown(result["scaling"]))
+        if "tracking" in result:
+            print(paper000_era.tracking_markdown(result["tracking"]))
+        if args.out:
+            print(f"results written to {args.out}")
+    return 0
+
+
+def _publish(scene, html: str | None) -> int:
+    """Write the scene as a static page, or serve it live until interrupted."""
+    if html:
+        scene.save_html(html)
+        scene.close()
+        print(f"wrote {html}")
+        return 0
+    return _serve(scene)
+
+
+def _serve(scene) -> int:
+    import time
+
+    print(f"meshcat is serving on {scene.url} (Ctrl-C to stop)", flush=True)
+    try:
+        while True:
+            time.sleep(1.0)
+    except KeyboardInterrupt:
+        return 0
+    finally:
+        scene.close()
+
+
+def cmd_view(args) -> int:
+    from kinelab.view import scene as viz
+
+    robot = load(args.robot, tool=args.tool)
+    q = _q_from_cli(robot, args.q, args.deg) if args.q else robot.neutral()
+    robot.check_q(q, limits=not args.ignore_limits)
+    scene = viz.Scene(robot).show(q)
+    if args.singular:
+        scene.singular_directions(q)
+    return _publish(scene, args.html)
+
+
+def cmd_animate(args) -> int:
+    from kinelab.studies import paper000_era
+    from kinelab.view import scene as viz
+
+    passages = {f"era-{name}": build for name, build in paper000_era.PASSAGES.items()}
+    if args.passage not in passages:
+        raise KinelabError(f"unknown passage {args.passage!r}; passages are: {', '.join(passages)}")
+    robot = load("era")
+    passage = passages[args.passage](robot)
+    run = paper000_era.run(passage, robot)
+    result = run.without if args.without_bypass else run.with_bypass
+    scene = viz.Scene(robot, name=f"era ({'without' if args.without_bypass else 'with'} bypass)")
+    scene.animate(result.q, dt=args.dt)
+    one_lap = passage.targets[: (passage.lap or passage.samples) + 1]
+    for k, target in enumerate(one_lap[:: max(1, len(one_lap) // 8)]):
+        scene.frame(f"target{k}", target, 0.5 * scene.frame_length)
+    summary = result.summary()
+    print(f"{args.passage} {'without' if args.without_bypass else 'with'} bypass: {summary['reached']} of "
+          f"{summary['samples']} samples reached, largest joint step {summary['max_joint_step']:.3f} rad, "
+          f"{summary['monitor_events']} monitor events")
+    return _publish(scene, args.html)
+
+
+def _robot_arguments(s: argparse.ArgumentParser, q_help: str | None = None, limits: bool = True) -> None:
+    """The arguments every per-robot command shares: ROBOT [Q...] [--deg] [--tool] [--ignore-limits]."""
+    s.add_argument("robot", help="registered name or URDF path")
+    if q_help:
+        s.add_argument("q", nargs="*", type=float, help=q_help)
+        s.add_argument("--deg", action="store_true", help="angles of revolute/continuous joints in degrees")
+    s.add_argument("--tool", help="tool frame (default: the robot's own)")
+    if limits:
+        s.add_argument("--ignore-limits", action="store_true", help="allow q outside the joint limits")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = _Parser(prog="kinelab", description="Kinematics of serial arms, checked against Pinocchio.")
+    sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    s = sub.add_parser("robots", help="list the registered robots")
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(func=cmd_robots)
+
+    s = sub.add_parser("info", help="joints, types, limits, DOF and tool frame of a robot")
+    _robot_arguments(s, limits=False)
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(func=cmd_info)
+
+    s = sub.add_parser("fk", help="tool pose at a configuration")
+    _robot_arguments(s, "one number per joint (rad and m; deg with --deg)")
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(func=cmd_fk)
+
+    s = sub.add_parser("ik", help="inverse kinematics to a target pose or configuration")
+    s.add_argument("robot", help="registered name or URDF path")
+    s.add_argument("--solver", default="frdm", help="frdm, biquat or dls (the Pinocchio reference)")
+    s.add_argument("--target-q", nargs="+", type=float, help="target as a configuration (its FK pose)")
+    s.add_argument("--target-xyz", nargs=3, type=float, help="target position [m] in the base frame")
+    s.add_argument("--target-rpy", nargs=3, type=float, help="target roll, pitch, yaw (rad; deg with --deg)")
+    s.add_argument("--start-q", nargs="+", type=float, help="first start (default: seeded random)")
+    s.add_argument("--deg", action="store_true", help="angles in degrees (revolute/continuous joints, rpy)")
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--tol-pos", type=float, default=1e-6, help="[m]")
+    s.add_argument("--tol-rot", type=float, default=1e-6, help="[rad]")
+    s.add_argument("--time-budget", type=float, default=1.0, help="[s]")
+    s.add_argument("--polish", action="store_true", help="frdm: add damped-least-squares polish steps")
+    s.add_argument("--kick", action="append", metavar="JOINT=DELTA",
+                   help="frdm bypass: signed step added when the monitor fires (repeatable)")
+    s.add_argument("--interval", action="append", metavar="JOINT=LO:HI",
+                   help="frdm bypass: tighter window switched on when the monitor fires (repeatable)")
+    s.add_argument("--freeze", action="append", metavar="JOINT[=VALUE]",
+                   help="frdm bypass: joint held (where it is, or at VALUE) when the monitor fires (repeatable)")
+    s.add_argument("--law", choices=["simple", "regular"], help="biquat: control law (9)/(16) or (11)/(12)")
+    s.add_argument("--integrator", choices=["euler", "rk4", "adaptive"], help="biquat: integrator")
+    s.add_argument("--step", type=float, help="biquat: fixed step h [s] (the paper: 0.01; default 1/k)")
+    s.add_argument("--gain", type=float, help="biquat: gain k [1/s] (default 1)")
+    s.add_argument("--tool", help="tool frame (default: the robot's own)")
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(func=cmd_ik)
+
+    s = sub.add_parser("singular", help="rank, singular values, lost directions; or a sweep for singular families")
+    _robot_arguments(s, "one number per joint (rad and m; deg with --deg)")
+    s.add_argument("--sweep", type=int, help="sample N configurations within the limits and report families")
+    s.add_argument("--grid", action="store_true", help="sweep a stratified grid instead of uniform samples")
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(func=cmd_singular)
+
+    s = sub.add_parser("view", help="show a robot in meshcat (live on 127.0.0.1, or --html for a static page)")
+    _robot_arguments(s, "configuration (default: zero, moved into the limits)")
+    s.add_argument("--singular", action="store_true", help="draw the lost directions and σ_min at q")
+    s.add_argument("--html", help="write a self-contained HTML page instead of serving")
+    s.set_defaults(func=cmd_view)
+
+    s = sub.add_parser("animate", help="animate a solver run in meshcat (the ERA passages)")
+    s.add_argument("passage", help="era-elbow, era-wrist or era-shoulder (seed paper 000)")
+    s.add_argument("--without-bypass", action="store_true", help="the run without the paper's bypass")
+    s.add_argument("--dt", type=float, default=0.1, help="seconds per path sample in the animation")
+    s.add_argument("--html", help="write a self-contained HTML page instead of serving")
+    s.set_defaults(func=cmd_animate)
+
+    s = sub.add_parser("bench", help="the IK benchmark: kinelab's solvers and the installed peers")
+    s.add_argument("--robots", nargs="+", default=None, help="robots (default: panda ur5 stanford era)")
+    s.add_argument("--n", type=int, default=200, help="targets per robot")
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--solvers", nargs="+", default=None, help="solvers to run (default: all available)")
+    s.add_argument("--budget-ms", type=float, default=5.0, help="time budget per solve [ms]")
+    s.add_argument("--repeats", type=int, default=3, help="rounds over the set; per problem the fastest counts")
+    s.add_argument("--scaling", action="store_true", help="also time FRDM on synthetic chains of 7-100 links")
+    s.add_argument("--tracking", action="store_true", help="also time tracking along the ERA passages (FRDM, DLS)")
+    s.add_argument("--out", help="write bench.json, bench.md and bench.png here")
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(func=cmd_bench)
+
+    s = sub.add_parser("validate", help="check every kinelab computation against Pinocchio on the bundled robots")
+    s.add_argument("--robots", nargs="+", default=None, help="robots to check (default: the embedded set)")
+    s.add_argument("--n", type=int, default=None, help="random configurations per check")
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--out", default="kinelab-report",
+                   help="the report folder (Markdown, HTML with the figures, JSON); default ./kinelab-report")
+    s.add_argument("--json", action="store_true")
+    s.set_defaults(func=cmd_validate)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except KinelabError as exc:
+        print(f"kinelab: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

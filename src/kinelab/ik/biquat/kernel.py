@@ -1,0 +1,94 @@
+"""The biquaternion solver's default preset compiled (numba): law (9), Euler with h·k = 1 and a joint-step
+cap, the Cauchy problem q̇ = A⁻¹U integrated on the shared chain FK, with seeded restarts.
+
+The Python integrators (:mod:`kinelab.ik.biquat.integrators`) are the reference and call the same laws
+(:mod:`kinelab.ik.biquat.laws`); tests hold the two paths equal.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit
+
+from kinelab.ik.biquat.laws import converged, error_biquaternion, joint_rates, simple_law
+from kinelab.ik.chain import chain_fk, jacobian_local, random_configuration, wrap_into_limits
+
+CONVERGED, SINGULAR, MAX_STEPS, OUTSIDE_LIMITS, BUDGET = 0, 1, 2, 3, 4
+# slots of a multistart's statistics array
+T_ATTEMPTS, T_STEPS, T_MODEL_TIME, T_OUTSIDE, T_SINGULAR = range(5)
+STATS_SIZE = 5
+
+
+class Problem(NamedTuple):
+    """The target and the preset's settings."""
+
+    pstar: np.ndarray  # (3,) target point [m], base frame
+    Rstar: np.ndarray  # (3, 3) target rotation
+    k: float  # gain [1/s]
+    h: float  # step [s]
+    max_step: float  # largest joint change per step [rad or m]
+    max_steps: int  # steps per attempt
+    eps_rot: float  # stop when |m⃗| < eps_rot (half the rotation tolerance)
+    eps_dual: float  # and |m0⃗| < eps_dual (half the position tolerance) [m]
+    damping: float  # λ of the damped pseudo-inverse (0: exact solve when n = 6)
+
+
+@njit(cache=True)
+def integrate(q, ch, pb, max_steps):
+    """Euler steps of q̇ = A⁻¹U(M*) with law (9) (k0 = 0) from q, in place. Returns (code, steps, model time)."""
+    n = q.shape[0]
+    e = np.empty((n, 3))
+    o = np.empty((n, 3))
+    p = np.empty(3)
+    R = np.empty((3, 3))
+    twist = np.empty(6)
+    t = 0.0
+    for step in range(max_steps + 1):
+        chain_fk(ch, q, e, o, p, R)
+        M = error_biquaternion(p, R, pb.pstar, pb.Rstar)
+        if converged(M, pb.eps_rot, pb.eps_dual):
+            return CONVERGED, step, t
+        if M[0] == 0.0:
+            return SINGULAR, step, t
+        if step == max_steps:
+            return MAX_STEPS, step, t
+        simple_law(M, pb.k, 0.0, pb.k, twist)
+        qd = joint_rates(jacobian_local(e, o, ch.kind, p, R), twist, pb.damping)
+        fastest = 0.0
+        for i in range(n):
+            if not np.isfinite(qd[i]):
+                return SINGULAR, step, t
+            fastest = max(fastest, abs(qd[i]))
+        dt = pb.h if fastest * pb.h <= pb.max_step else pb.max_step / fastest
+        for i in range(n):
+            q[i] += dt * qd[i]
+        t += dt
+    return MAX_STEPS, max_steps, t
+
+
+@njit(cache=True)
+def multistart(q, ch, lower, upper, pb, rng_state, max_attempts, step_budget, stats):
+    """Attempts from q, then from seeded uniform starts, until one converges inside the joint limits.
+    stats has the slots T_*. Returns an integrate() code, or OUTSIDE_LIMITS, or BUDGET."""
+    start = q.copy()
+    code = BUDGET
+    for a in range(max_attempts):
+        if a > 0:
+            random_configuration(start, ch.kind, lower, upper, rng_state)
+            q[:] = start
+        code, steps, t = integrate(q, ch, pb, min(pb.max_steps, int(step_budget - stats[T_STEPS])))
+        stats[T_ATTEMPTS] += 1.0
+        stats[T_STEPS] += steps
+        if code == CONVERGED:
+            if wrap_into_limits(q, ch.kind, lower, upper):
+                stats[T_MODEL_TIME] = t
+                return CONVERGED
+            stats[T_OUTSIDE] += 1.0
+            code = OUTSIDE_LIMITS
+        elif code == SINGULAR:
+            stats[T_SINGULAR] += 1.0
+        if stats[T_STEPS] >= step_budget:
+            return BUDGET
+    return code

@@ -1,0 +1,187 @@
+"""FRDM's options: every default written once, every value checked once (docs/methods.md §1.5–1.6)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from kinelab.errors import OptionError
+from kinelab.ik import options as opt
+from kinelab.ik.frdm import kernel
+
+ORDERS = {"tip2base": kernel.TIP_TO_BASE, "base2tip": kernel.BASE_TO_TIP, "alternate": kernel.ALTERNATE,
+          "mixed": kernel.MIXED}
+MODES = ("pose", "position", "orientation")
+ACCELERATIONS = ("anderson", "none")
+BYPASSES = ("kicks", "intervals", "freeze", "auto_kick")
+# Defaults measured on panda, ur5, stanford and era (docs/bench): w_p = 3/L², a 10-sweep stall window.
+W_P_FACTOR = 3.0
+STALL_WINDOW = 10
+PLAIN_STALL_WINDOW = 50
+
+
+@dataclass(frozen=True)
+class FRDMOptions:
+    """Options of one FRDM solve.
+
+    Attributes:
+        mode: "pose", "position" (tool point only) or "orientation" (tool axes only).
+        w_p: position weight [1/m²]; None: ``w_p_factor``/L² with L the chain's characteristic length
+            (scale-aware: the same factor serves a 0.3 m arm and the 11 m ERA).
+        w_p_factor: the dimensionless factor of the default w_p.
+        w_axes: weights of the tool x, y, z axes (≥ 0, three numbers).
+        order: "tip2base", "base2tip", "alternate" (each way in turn) or "mixed" (base → tip here; in the
+            compiled multistart, base → tip and tip → base on alternate restarts: the two directions fall
+            into different local minima).
+        relax: step = relax × the exact optimum, 0 < relax < 2 (still never increases the objective).
+        accel: "anderson" (safeguarded extrapolation of the sweep map) or "none" (plain FRDM).
+        accel_memory: Anderson memory (sweeps), ≥ 1.
+        max_sweeps: sweep cap of one attempt; None: 100 accelerated, 3000 plain.
+        eps_q: Σ|Δq| over a sweep below this is a stall [rad or m].
+        stall_window: sweeps over which the objective must fall by ``stall_rel``; None: 10 accelerated,
+            50 plain.
+        stall_rel: relative fall required over the window; None: 0.1 accelerated, 1e-3 plain.
+        use_limits: keep every step within the joint limits.
+        kicks: joint → signed δ [rad or m] added when the monitor fires.
+        intervals: joint → (lower, upper), a tighter window held while active.
+        freeze: joint → value (None: where the joint is) held while active.
+        policy: the order in which monitor events switch bypasses on (None: those configured, in the
+            order kicks, intervals, freeze; "auto_kick" when none is).
+        active: bypasses switched on before the first sweep.
+        max_bypass_events: how many monitor events the policy answers before the attempt gives up.
+        polish: follow FRDM with damped-least-squares steps (reported as mode "frdm+polish").
+        trace: keep the objective after every sweep in ``info["trace"]``.
+    """
+
+    mode: str = "pose"
+    w_p: float | None = None
+    w_p_factor: float = W_P_FACTOR
+    w_axes: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    order: str = "mixed"
+    relax: float = 1.0
+    accel: str = "anderson"
+    accel_memory: int = 5
+    max_sweeps: int | None = None
+    eps_q: float = 1e-10
+    stall_window: int | None = None
+    stall_rel: float | None = None
+    use_limits: bool = True
+    kicks: dict[str, float] | None = None
+    intervals: dict[str, tuple[float, float]] | None = None
+    freeze: dict[str, float | None] | None = None
+    policy: tuple[str, ...] | None = None
+    active: tuple[str, ...] | None = None
+    max_bypass_events: int = 3
+    polish: bool = False
+    trace: bool = False
+
+    def __post_init__(self) -> None:
+        opt.choice("mode", self.mode, MODES, what="FRDM mode")
+        opt.choice("order", self.order, tuple(ORDERS), what="sweep order")
+        opt.choice("accel", self.accel, ACCELERATIONS, what="acceleration")
+        opt.positive("w_p", self.w_p, allow_none=True)
+        opt.positive("w_p_factor", self.w_p_factor)
+        opt.positive("eps_q", self.eps_q)
+        opt.positive("accel_memory", self.accel_memory, integer=True)
+        opt.positive("max_sweeps", self.max_sweeps, allow_none=True, integer=True)
+        opt.positive("stall_window", self.stall_window, allow_none=True, integer=True)
+        opt.positive("stall_rel", self.stall_rel, allow_none=True)
+        opt.positive("max_bypass_events", self.max_bypass_events, integer=True, zero=True)
+        for name in ("use_limits", "polish", "trace"):
+            opt.flag(name, getattr(self, name))
+        if not (isinstance(self.relax, (int, float)) and 0.0 < float(self.relax) < 2.0):
+            raise OptionError("relax", self.relax, "a number in (0, 2)")
+        self._check_weights()
+        self._check_bypass_tables()
+
+    def _check_weights(self) -> None:
+        try:
+            w = np.asarray(self.w_axes, dtype=float)
+        except (TypeError, ValueError):
+            w = np.full(1, np.nan)
+        if w.shape != (3,) or not np.all(np.isfinite(w)) or np.any(w < 0):
+            raise OptionError("w_axes", self.w_axes, "three finite weights ≥ 0 (tool x, y, z axes)")
+        object.__setattr__(self, "w_axes", tuple(float(x) for x in w))
+
+    def _check_bypass_tables(self) -> None:
+        for name in ("kicks", "intervals", "freeze"):
+            table = getattr(self, name)
+            if table is not None and not isinstance(table, dict):
+                raise OptionError(name, table, "a dict joint name → value")
+        for name, delta in (self.kicks or {}).items():
+            if not isinstance(delta, (int, float)) or not math.isfinite(delta) or delta == 0:
+                raise OptionError("kicks", {name: delta}, "a finite non-zero δ per joint [rad or m]")
+        for name, window in (self.intervals or {}).items():
+            if not (isinstance(window, (tuple, list)) and len(window) == 2 and float(window[0]) < float(window[1])):
+                raise OptionError("intervals", {name: window}, "a non-empty (lower, upper) per joint",
+                                  f"bypass interval for {name!r} is empty or malformed: {window!r}")
+        for name in ("policy", "active"):
+            steps = getattr(self, name)
+            if steps is None:
+                continue
+            bad = [steps] if isinstance(steps, str) else [s for s in steps if s not in BYPASSES]
+            if bad:
+                raise OptionError(name, steps, ", ".join(BYPASSES),
+                                  f"unknown bypass {bad[0]!r} in {name}; bypasses are: {', '.join(BYPASSES)}")
+            object.__setattr__(self, name, tuple(steps))
+
+    @classmethod
+    def of(cls, options: FRDMOptions | None = None, **kwargs: Any) -> FRDMOptions:
+        """``options`` as given, or built from keyword arguments (cached for hashable ones)."""
+        if options is not None:
+            if kwargs:
+                raise OptionError(next(iter(kwargs)), kwargs[next(iter(kwargs))],
+                                  "give either options=FRDMOptions(...) or keyword options, not both")
+            return options
+        return opt.from_kwargs(cls, "frdm", kwargs)
+
+    # -- resolved values --------------------------------------------------------------------
+    @property
+    def plain(self) -> bool:
+        """No acceleration: every change is an exact FRDM step."""
+        return self.accel == "none"
+
+    @property
+    def sweep_cap(self) -> int:
+        """Sweeps allowed in one attempt."""
+        return self.max_sweeps or (3000 if self.plain else 100)
+
+    @property
+    def window(self) -> int:
+        """The monitor's stall window [sweeps]."""
+        return self.stall_window or (PLAIN_STALL_WINDOW if self.plain else STALL_WINDOW)
+
+    @property
+    def window_rel(self) -> float:
+        """Relative fall of the objective required over the window."""
+        return (1e-3 if self.plain else 0.1) if self.stall_rel is None else float(self.stall_rel)
+
+    @property
+    def accel_m(self) -> int:
+        """Anderson memory used by the kernel (0: plain)."""
+        return 0 if self.plain else int(self.accel_memory)
+
+    @property
+    def compiled(self) -> bool:
+        """True when the compiled multistart can serve these options: no bypass, policy, polish or trace
+        named (naming one, even empty, asks for the monitor's diagnosis and log, kept by the Python loop)."""
+        return (self.kicks is None and self.intervals is None and self.freeze is None and self.policy is None
+                and self.active is None and not self.polish and not self.trace)
+
+    def settings(self) -> kernel.Settings:
+        """The kernel's sweep and monitor settings."""
+        return kernel.Settings(float(self.relax), float(self.eps_q), int(self.window), float(self.window_rel),
+                               self.accel_m)
+
+    def position_weight(self, length: float) -> float:
+        """w_p [1/m²] for a chain of characteristic length ``length`` [m]; 0 in orientation mode."""
+        if self.mode == "orientation":
+            return 0.0
+        return self.w_p_factor / length**2 if self.w_p is None else float(self.w_p)
+
+    def axis_weights(self) -> np.ndarray:
+        """Weights of the tool x, y, z axes; 0 in position mode."""
+        return np.zeros(3) if self.mode == "position" else np.array(self.w_axes, dtype=float)

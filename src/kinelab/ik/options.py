@@ -1,0 +1,85 @@
+"""What every solver's options object shares: construction from keyword arguments, validation helpers.
+
+Each solver has one frozen options dataclass (``FRDMOptions``, ``BiquatOptions``, ``DLSOptions``) with
+every default written once and every value checked once, on construction. ``solve(..., **options)``
+builds it; a caller that solves many targets with the same options can build it once and pass it as
+``options=``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+import numbers
+from typing import Any, TypeVar
+
+from kinelab.errors import OptionError
+
+T = TypeVar("T")
+
+
+def from_kwargs(cls: type[T], solver: str, kwargs: dict[str, Any]) -> T:
+    """``cls(**kwargs)``, an unknown name refused with the valid ones listed.
+
+    Hashable keyword sets are cached: the options of a solve in a loop are built and checked once.
+
+    Raises:
+        OptionError: an unknown option, or a value outside what the option accepts.
+    """
+    try:
+        key = tuple(sorted(kwargs.items()))
+        hash(key)
+    except TypeError:  # an unhashable value (a dict of kicks, a list of weights): build without the cache
+        return _build(cls, solver, kwargs)
+    return _cached(cls, solver, key)  # type: ignore[no-any-return]
+
+
+@functools.lru_cache(maxsize=256)
+def _cached(cls: type, solver: str, key: tuple) -> Any:
+    return _build(cls, solver, dict(key))
+
+
+def _build(cls: type[T], solver: str, kwargs: dict[str, Any]) -> T:
+    names = [f.name for f in dataclasses.fields(cls)]  # type: ignore[arg-type]
+    unknown = [k for k in kwargs if k not in names]
+    if unknown:
+        valid = ", ".join(names)
+        raise OptionError(unknown[0], kwargs[unknown[0]], valid,
+                          f"unknown option {unknown[0]!r} for solver {solver!r}; its options are: {valid}")
+    return cls(**kwargs)
+
+
+def choice(name: str, value: object, valid: tuple[str, ...], what: str | None = None) -> None:
+    """Refuse ``value`` unless it is one of ``valid`` (``what`` names the kind in the message)."""
+    if not isinstance(value, str) or value not in valid:
+        label = what or name
+        raise OptionError(name, value, ", ".join(valid),
+                          f"unknown {label} {value!r} (option {name}); valid: {', '.join(valid)}")
+
+
+def positive(name: str, value: object, *, allow_none: bool = False, integer: bool = False,
+             zero: bool = False) -> None:
+    """Refuse anything but a finite number > 0 (≥ 0 with ``zero``; an int with ``integer``)."""
+    if value is None and allow_none:
+        return
+    kind = "an integer" if integer else "a finite number"
+    bound = "≥ 0" if zero else "> 0 (positive)"
+    ok_type = isinstance(value, numbers.Integral if integer else numbers.Real)
+    if isinstance(value, bool) or not ok_type:
+        raise OptionError(name, value, f"{kind} {bound}" + (" or None" if allow_none else ""))
+    number = float(value)  # type: ignore[arg-type]
+    if not math.isfinite(number) or number < 0 or (number == 0 and not zero):
+        raise OptionError(name, value, f"{kind} {bound}" + (" or None" if allow_none else ""))
+
+
+def finite(name: str, value: object) -> None:
+    """Refuse anything but a finite real number."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(float(value)):
+        raise OptionError(name, value, "a finite number")
+
+
+def flag(name: str, value: object, *, allow_none: bool = False) -> None:
+    """Refuse anything but True or False (or None with ``allow_none``)."""
+    if not (isinstance(value, bool) or (value is None and allow_none)):
+        raise OptionError(name, value, "True or False" + (" or None" if allow_none else ""))

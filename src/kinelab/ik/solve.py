@@ -1,0 +1,233 @@
+"""Inverse kinematics: one entry point, :func:`solve`, for every kinelab solver.
+
+``solve`` validates the input, runs the chosen solver from a start and then from seeded random starts
+until one succeeds or the time budget or restart count runs out, and re-checks the answer with
+Pinocchio's FK: ``success`` means the returned q is within the joint limits and its tool pose is within
+``tol_pos`` [m] and ``tol_rot`` [rad] of the target.
+"""
+
+from __future__ import annotations
+
+import importlib
+import time
+import warnings
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab.errors import KinelabError, SolverNotFoundError
+from kinelab.ik.limits import wrap_q
+from kinelab.ik.result import Attempt, IKResult, Status
+from kinelab.ik.targets import as_target
+from kinelab.ik.workspace import out_of_reach
+from kinelab.robot import Robot
+
+
+class SolverModule(Protocol):
+    """What a solver provides: an options class with ``of(**kwargs)``, and ``attempt``; optionally
+    ``prepare(robot)`` (compilation, outside the timed region) and a compiled ``multistart``."""
+
+    Options: Any
+
+    def attempt(self, robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol_rot: float,
+                deadline: float, options: Any = None) -> Attempt: ...
+
+
+BUILTIN = {"frdm": "kinelab.ik.frdm.solver", "biquat": "kinelab.ik.biquat.solver", "dls": "kinelab.ik.dls"}
+SOLVERS: dict[str, Any] = {}
+
+
+def register(name: str, module: Any) -> None:
+    """Make a solver module (see :class:`SolverModule`) available as ``solve(..., solver=name)``."""
+    SOLVERS[name] = module
+
+
+def solver_module(name: str) -> Any:
+    """The module of solver ``name``, imported on first use.
+
+    Raises:
+        SolverNotFoundError: an unknown name.
+    """
+    if name not in SOLVERS:
+        if not isinstance(name, str) or name not in BUILTIN:
+            raise SolverNotFoundError(str(name), [*BUILTIN, *SOLVERS])
+        SOLVERS[name] = importlib.import_module(BUILTIN[name])
+    return SOLVERS[name]
+
+
+class _LazyRng:
+    """A seeded generator made on first use (making one costs more than most solves)."""
+
+    def __init__(self, seed: int | None):
+        self.seed = seed
+        self._rng: np.random.Generator | None = None
+
+    def uniform(self, low: np.ndarray, high: np.ndarray, size: int | None = None) -> np.ndarray:
+        if self._rng is None:
+            self._rng = np.random.default_rng(self.seed)
+        return self._rng.uniform(low, high, size)
+
+
+def _start(robot: Robot, q0: Any, rng: _LazyRng, on_limits: str) -> np.ndarray:
+    if q0 is None:
+        return rng.uniform(robot.lower, robot.upper)
+    q0 = robot.check_q(q0, what="q0")
+    if robot.within_limits(q0):
+        return q0
+    if on_limits == "refuse":
+        robot.check_q(q0, limits=True, what="q0")
+    projected = np.clip(wrap_q(robot, q0), robot.lower, robot.upper)
+    warnings.warn(f"q0 is outside the joint limits of {robot.name}; projected into them", stacklevel=3)
+    return projected
+
+
+def solve(
+    robot: Robot,
+    target: pin.SE3,
+    solver: str = "frdm",
+    q0: Any = None,
+    seed: int | None = None,
+    tol_pos: float = 1e-6,
+    tol_rot: float = 1e-6,
+    time_budget: float = 1.0,
+    max_restarts: int = 1000,
+    start_outside_limits: str = "project",
+    options: Any = None,
+    **solver_options: Any,
+) -> IKResult:
+    """Solve IK for the tool pose ``target`` (``pin.SE3`` in the robot's base frame).
+
+    Args:
+        robot: the robot (:func:`kinelab.load`).
+        target: oMtarget, the wanted tool pose in the base frame.
+        solver: "frdm", "biquat" or "dls" (the Pinocchio reference).
+        q0: first start (one number per joint, rad or m); default a seeded random configuration.
+        seed: seed of the random starts (restarts always draw from it, so runs repeat exactly).
+        tol_pos: position tolerance [m].
+        tol_rot: rotation tolerance [rad] (angle of R*ᵀR).
+        time_budget: wall-clock budget [s] for all attempts together.
+        max_restarts: random restarts after the first attempt.
+        start_outside_limits: "project" (default: move q0 into the limits, with a warning) or "refuse".
+        options: the solver's options object (``FRDMOptions``, ``BiquatOptions``, ``DLSOptions``).
+        solver_options: or its fields as keyword arguments.
+
+    Returns:
+        The result, checked by Pinocchio.
+
+    Raises:
+        SolverNotFoundError, OptionError, TargetError, ConfigurationError: bad input, named.
+    """
+    module = solver_module(solver)
+    opts = module.Options.of(options, **solver_options)
+    prepare = getattr(module, "prepare", None)
+    if prepare is not None:
+        prepare(robot)  # compilation and model building are not the solve's time
+    t_start = time.perf_counter()
+    target = as_target(target)
+    if not (tol_pos > 0 and tol_rot > 0 and time_budget > 0 and max_restarts >= 0):
+        raise KinelabError("tol_pos, tol_rot and time_budget must be positive and max_restarts ≥ 0")
+    if start_outside_limits not in ("project", "refuse"):
+        raise KinelabError("start_outside_limits must be 'project' or 'refuse'")
+    rng = _LazyRng(seed)
+    problem = _Problem(robot, target, solver, tol_pos, tol_rot, t_start, t_start + time_budget, seed)
+    start = _start(robot, q0, rng, start_outside_limits)
+    beyond = out_of_reach(robot, target.translation)
+    if beyond > 0:
+        max_restarts = 0  # proved out of reach: one attempt gives the best pose, restarts cannot help
+    elif getattr(opts, "compiled", False) and hasattr(module, "multistart"):
+        return _fast(module, problem, start, max_restarts, opts)
+    return _loop(module, problem, start, max_restarts, opts, rng, beyond)
+
+
+@dataclass
+class _Problem:
+    """What one solve is asked, handed between solve's helpers."""
+
+    robot: Robot
+    target: pin.SE3
+    solver: str
+    tol_pos: float
+    tol_rot: float
+    t_start: float
+    deadline: float
+    seed: int | None
+    finals: list[tuple[Status, float]] = field(default_factory=list)
+
+    def judge(self, q: np.ndarray) -> tuple[bool, float, float]:
+        """Pinocchio's verdict on q: (success, position error [m], rotation error [rad])."""
+        dp, dr = self.robot.tool_error(q, self.target)
+        return dp <= self.tol_pos and dr <= self.tol_rot and self.robot.within_limits(q), dp, dr
+
+
+def _loop(module: Any, pb: _Problem, start: np.ndarray, max_restarts: int, opts: Any, rng: _LazyRng,
+          beyond: float) -> IKResult:
+    """Attempts from the start, then from seeded random starts, each judged by Pinocchio."""
+    robot = pb.robot
+    scale = robot.characteristic_length()
+    best: tuple[float, Attempt, float, float] | None = None
+    best_ok = False
+    iterations = restarts = 0
+    events: list[dict] = []
+    bypasses: list[dict] = []
+    for k in range(max_restarts + 1):
+        att = module.attempt(robot, pb.target, start, pb.tol_pos, pb.tol_rot, pb.deadline, opts)
+        iterations += att.iterations
+        events += att.events
+        bypasses += att.bypasses
+        ok, dp, dr = pb.judge(att.q)
+        score = dp / scale + dr
+        if best is None or ok or score < best[0]:
+            best, best_ok = (score, att, dp, dr), ok
+        pb.finals.append((att.status, dp))
+        if ok or time.perf_counter() > pb.deadline or k == max_restarts:
+            break
+        restarts += 1
+        start = rng.uniform(robot.lower, robot.upper)
+    assert best is not None
+    _, att, dp, dr = best
+    status, message = _status(best_ok, att, pb.finals, beyond, pb.tol_pos, time.perf_counter() > pb.deadline)
+    return IKResult(
+        q=att.q, success=best_ok, status=status, position_error=dp, rotation_error=dr,
+        iterations=iterations, restarts=restarts, wall_time=time.perf_counter() - pb.t_start, solver=pb.solver,
+        mode=att.info.get("mode", pb.solver), singular_events=events, bypasses=bypasses, message=message,
+        info=att.info,
+    )
+
+
+def _fast(module: Any, pb: _Problem, start: np.ndarray, max_restarts: int, opts: Any) -> IKResult:
+    """Restarts inside the solver's compiled kernel; the answer is then checked by Pinocchio."""
+    att, restarts = module.multistart(pb.robot, pb.target, start, pb.tol_pos, pb.tol_rot, pb.deadline, pb.seed,
+                                      max_restarts, opts)
+    success, dp, dr = pb.judge(att.q)
+    status, message = att.status, ""
+    if success:
+        status = Status.CONVERGED
+    elif status == Status.CONVERGED:
+        status, message = Status.STALLED, "the solver converged but its answer failed Pinocchio's check"
+    return IKResult(
+        q=att.q, success=success, status=status, position_error=dp, rotation_error=dr, iterations=att.iterations,
+        restarts=restarts, wall_time=time.perf_counter() - pb.t_start, solver=pb.solver, mode=att.info["mode"],
+        singular_events=att.events, message=message, info=att.info,
+    )
+
+
+def _status(success: bool, att: Attempt, finals: list[tuple[Status, float]], beyond: float, tol_pos: float,
+            out_of_time: bool) -> tuple[Status, str]:
+    if success:
+        return Status.CONVERGED, ""
+    if beyond > 0:
+        return Status.UNREACHABLE, f"the target position is at least {beyond:.4g} m beyond the robot's reach"
+    stationary = [dp for st, dp in finals if st in (Status.STALLED, Status.SINGULAR)]
+    agree = len(stationary) >= 3 and len(stationary) == len(finals) and min(stationary) > tol_pos
+    if agree and max(stationary) - min(stationary) <= 1e-3 * min(stationary) + 1e-9:
+        return Status.UNREACHABLE, (
+            f"every one of {len(finals)} starts stopped at a stationary point {min(stationary):.4g} m from the "
+            "target: it is very likely out of the workspace"
+        )
+    if att.status == Status.CONVERGED:  # the solver's own test passed but Pinocchio's or the limits did not
+        return Status.STALLED, "the solver converged but its answer failed Pinocchio's check or the joint limits"
+    if out_of_time and att.status != Status.TIME_BUDGET:
+        return Status.TIME_BUDGET, f"best attempt ended {att.status.value}; then the time budget ran out"
+    return att.status, ""

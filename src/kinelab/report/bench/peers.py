@@ -1,0 +1,143 @@
+"""Peer IK libraries for ``kinelab bench`` (the optional ``bench`` extra): each solves the same problems.
+
+Every peer reads the same URDF, stripped to its kinematics (no meshes to resolve), with the same joint
+limits; its answer is re-checked by :func:`kinelab.report.bench.protocol.check_solution` like kinelab's own.
+
+- roboticstoolbox-python ``ik_LM`` (its C++ Levenberg–Marquardt, with its own restarts);
+- TRAC-IK through ``pytracik`` (KDL Newton + SQP in parallel; limits set explicitly, ε = 5e-7);
+- ikpy (scipy optimisation);
+- pink (Pinocchio differential IK, a QP per step with the DAQP solver).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import tempfile
+import time
+import warnings
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+
+from kinelab.report.bench.protocol import TOL_POS, TOL_ROT, Case, Prepare, SolveFn
+from kinelab.robot import Robot
+
+PEERS = {"rtb-ik_LM": "roboticstoolbox", "trac-ik": "pytracik", "ikpy": "ikpy", "pink": "pink"}
+
+
+def kinematic_urdf(robot: Robot) -> Path:
+    """A copy of the robot's URDF without visual, collision, inertial, gazebo or transmission elements."""
+    tree = ET.parse(robot.urdf_path)
+    root = tree.getroot()
+    for link in root.iter("link"):
+        for tag in ("visual", "collision", "inertial"):
+            for el in list(link.findall(tag)):
+                link.remove(el)
+    for tag in ("gazebo", "transmission"):
+        for el in list(root.findall(tag)):
+            root.remove(el)
+    out = Path(tempfile.mkdtemp(prefix="kinelab-bench-")) / f"{robot.name}.urdf"
+    tree.write(out)
+    return out
+
+
+def tool_link(robot: Robot) -> str:
+    from kinelab.analysis.oracles import tool_link as _tool_link
+
+    return _tool_link(robot)
+
+
+def _rtb(robot: Robot, budget: float) -> SolveFn:
+    import roboticstoolbox as rtb
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ets = rtb.Robot.URDF(str(kinematic_urdf(robot))).ets(end=tool_link(robot))
+    if ets.n != robot.n:
+        raise ValueError(f"roboticstoolbox sees {ets.n} joints, kinelab {robot.n}")
+
+    def run(case: Case, seed: int):
+        # tol bounds E = ½ eᵀe (e in m and rad): 5e-13 keeps both parts below 1e-6
+        sol = ets.ik_LM(case.oMtarget.homogeneous, q0=case.q_start, tol=5e-13, joint_limits=True)
+        return np.asarray(sol.q, dtype=float), int(sol.iterations)
+
+    return run
+
+
+def _tracik(robot: Robot, budget: float) -> SolveFn:
+    from trac_ik.trac_ik import TracIK
+
+    solver = TracIK(robot.base, tool_link(robot), str(kinematic_urdf(robot)), timeout=budget, epsilon=5e-7)
+    if solver.dof != robot.n:
+        raise ValueError(f"TRAC-IK sees {solver.dof} joints, kinelab {robot.n}")
+    solver.joint_limits = (list(robot.lower), list(robot.upper))
+
+    def run(case: Case, seed: int):
+        q = solver.ik(case.oMtarget.translation, case.oMtarget.rotation, case.q_start)
+        return (None if q is None else np.asarray(q, dtype=float)), -1
+
+    return run
+
+
+def _ikpy(robot: Robot, budget: float) -> SolveFn:
+    from ikpy.chain import Chain
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        chain = Chain.from_urdf_file(str(kinematic_urdf(robot)), base_elements=[robot.base],
+                                     last_link_vector=None)
+    names = [link.name for link in chain.links]
+    active = [names.index(j) for j in robot.joint_names if j in names]
+    if len(active) != robot.n:
+        raise ValueError(f"ikpy's chain lacks some of {robot.joint_names}")
+    mask = [i in active for i in range(len(names))]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        chain = Chain.from_urdf_file(str(kinematic_urdf(robot)), base_elements=[robot.base], active_links_mask=mask)
+
+    def run(case: Case, seed: int):
+        start = np.zeros(len(names))
+        start[active] = case.q_start
+        full = chain.inverse_kinematics_frame(case.oMtarget.homogeneous, initial_position=start,
+                                              orientation_mode="all")
+        return np.asarray(full)[active], -1
+
+    return run
+
+
+def _pink(robot: Robot, budget: float) -> SolveFn:
+    import pink
+    from pink.tasks import FrameTask
+
+    task = FrameTask(robot.tool, position_cost=1.0, orientation_cost=1.0)
+
+    def run(case: Case, seed: int):
+        deadline = time.perf_counter() + budget
+        conf = pink.Configuration(robot.model, robot.model.createData(), robot.to_pin_q(case.q_start))
+        task.set_target(case.oMtarget)
+        it = 0
+        while time.perf_counter() < deadline:
+            err = task.compute_error(conf)
+            if np.linalg.norm(err[:3]) < TOL_POS and np.linalg.norm(err[3:]) < TOL_ROT:
+                break
+            velocity = pink.solve_ik(conf, [task], dt=1.0, solver="daqp", damping=1e-12)
+            conf.integrate_inplace(velocity, 1.0)
+            it += 1
+        return robot.from_pin_q(conf.q), it
+
+    return run
+
+
+ADAPTERS: dict[str, Prepare] = {"rtb-ik_LM": _rtb, "trac-ik": _tracik, "ikpy": _ikpy, "pink": _pink}
+
+
+def available() -> tuple[dict[str, Prepare], dict[str, str]]:
+    """The installed peers, and for the others the install hint."""
+    found, missing = {}, {}
+    for name, module in PEERS.items():
+        if importlib.util.find_spec(module) is None:
+            missing[name] = "not installed: pip install -e '.[bench]'"
+        else:
+            found[name] = ADAPTERS[name]
+    return found, missing

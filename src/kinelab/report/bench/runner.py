@@ -1,0 +1,156 @@
+"""``kinelab bench``: the runner, kinelab's solvers against the peer libraries (see protocol.py).
+
+Protocol (per robot): ``n`` seeded random configurations within the limits give the targets (their
+Pinocchio FK); every solver starts from the same seeded random configuration per target. A result
+counts as solved only when, checked here with Pinocchio's FK, the position error is below 1e-6 m and
+the rotation error below 1e-6 rad, q is within the joint limits, and the call returned within the
+budget (5 ms by default; restarts inside it are the solver's business). The solvers take turns over
+the whole set ``repeats`` times (3 by default) and per problem the fastest run counts, with its own
+verdict: the machines are shared and noisy, and a slow spell should not decide a comparison. Speed
+targets live here, never in timed tests.
+"""
+from __future__ import annotations
+
+import contextlib
+import importlib.metadata as md
+import platform
+import time
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+from tqdm import tqdm
+
+from kinelab.errors import KinelabError
+from kinelab.report.bench import peers
+from kinelab.report.bench.adapters import KINELAB_SOLVERS
+from kinelab.report.bench.protocol import (
+    BUDGET,
+    DEFAULT_ROBOTS,
+    REPEATS,
+    TOL_POS,
+    TOL_ROT,
+    Case,
+    Prepare,
+    SolveFn,
+    cases,
+    check_solution,
+)
+from kinelab.robot import Robot, load
+
+
+@dataclass
+class Row:
+    """Figures of one (robot, solver) pair."""
+
+    robot: str
+    solver: str
+    n: int
+    solved: int
+    success_pct: float
+    median_us: float  # over all problems, failures included
+    p95_us: float
+    median_solved_us: float
+    median_iterations: float
+    failures: dict[str, int] = field(default_factory=dict)
+
+
+class _Tally:
+    """Per-problem (time, verdict, iterations) of one (robot, solver) pair, the fastest of its repeats kept."""
+
+    def __init__(self, robot: Robot, name: str, solve_fn: SolveFn, n: int):
+        self.robot, self.name, self.solve_fn = robot, name, solve_fn
+        self.best: list[tuple[float, bool, str, int] | None] = [None] * n
+
+    def attempt(self, k: int, case: Case, budget: float, seed: int) -> None:
+        t0 = time.perf_counter()
+        try:
+            q, it = self.solve_fn(case, seed + case.index)
+        except Exception:  # noqa: BLE001 - a solver that raises on a problem has failed that problem
+            q, it = None, -1
+        elapsed = time.perf_counter() - t0
+        ok, why = check_solution(self.robot, q, case.oMtarget, elapsed, budget)
+        if self.best[k] is None or elapsed < self.best[k][0]:
+            self.best[k] = (elapsed, ok, why, it)
+
+    def row(self) -> Row:
+        times = np.array([b[0] for b in self.best]) * 1e6
+        solved = [b[0] * 1e6 for b in self.best if b[1]]
+        failures: dict[str, int] = {}
+        for _, ok, why, _ in self.best:
+            if not ok:
+                key = why.split(" ")[0] if why.startswith("pose") else why
+                failures[key] = failures.get(key, 0) + 1
+        n = len(self.best)
+        return Row(self.robot.name, self.name, n, len(solved), 100.0 * len(solved) / n, float(np.median(times)),
+                   float(np.percentile(times, 95)), float(np.median(solved)) if solved else float("nan"),
+                   float(np.median([b[3] for b in self.best])), failures)
+
+
+def run_robot(robot: Robot, solvers: dict[str, Prepare], problems: list[Case], budget: float, seed: int,
+              missing: dict[str, str], repeats: int = REPEATS) -> list[Row]:
+    """Every solver on every problem of one robot, ``repeats`` times over, the solvers taking turns (the
+    order rotating each round); per problem the fastest run counts, with its verdict. A slow spell of a
+    shared machine then costs no solver its figures, and each runs its problems back to back, warm."""
+    tallies = []
+    for name, prepare in solvers.items():
+        try:
+            solve_fn = prepare(robot, budget)
+            for case in problems[:3]:  # warm-up: compilation, caches (an error here shows in the timed loop)
+                with contextlib.suppress(Exception):
+                    solve_fn(case, seed)
+        except Exception as exc:  # noqa: BLE001 - a peer that cannot load this robot is reported, not fatal
+            missing[f"{name} on {robot.name}"] = f"{type(exc).__name__}: {exc}"[:200]
+            continue
+        tallies.append(_Tally(robot, name, solve_fn, len(problems)))
+    for r in range(repeats):
+        k = r % max(1, len(tallies))
+        for tally in tallies[k:] + tallies[:k]:
+            for i, case in enumerate(problems):
+                tally.attempt(i, case, budget, seed)
+    return [t.row() for t in tallies]
+
+
+def available_solvers() -> tuple[dict[str, Prepare], dict[str, str]]:
+    """kinelab's solvers and the peers that are installed; the second dict says why a peer is absent."""
+    solvers: dict[str, Prepare] = dict(KINELAB_SOLVERS)
+    found, missing = peers.available()
+    solvers.update(found)
+    return solvers, missing
+
+
+def run(robots: list[str] | None = None, n: int = 200, seed: int = 0, solvers: list[str] | None = None,
+        budget: float = BUDGET, progress: bool = False, repeats: int = REPEATS) -> dict[str, Any]:
+    """Run the protocol; returns a JSON-ready dict with the rows, the machine and the versions."""
+    if n < 1 or repeats < 1 or not budget > 0:
+        raise KinelabError(f"bench needs n ≥ 1, repeats ≥ 1 and a positive budget (got {n}, {repeats}, {budget} s)")
+    names = list(robots or DEFAULT_ROBOTS)
+    loaded = [load(name) for name in names]
+    table, missing = available_solvers()
+    if solvers:
+        unknown = [s for s in solvers if s not in table]
+        if unknown:
+                raise KinelabError(f"unknown or unavailable solver {unknown[0]!r}; available: {', '.join(table)}"
+                               + (f"; not installed: {', '.join(missing)}" if missing else ""))
+        table = {k: table[k] for k in solvers}
+    rows = []
+    for robot in tqdm(loaded, desc="bench", disable=not progress, unit="robot"):
+        rows += run_robot(robot, table, cases(robot, n, seed), budget, seed, missing, repeats)
+    return {
+        "date": time.strftime("%Y-%m-%d %H:%M:%S"),
+        "machine": {"platform": platform.platform(), "processor": platform.processor() or platform.machine(),
+                    "python": platform.python_version()},
+        "versions": _versions(),
+        "protocol": {"n": n, "seed": seed, "repeats": repeats, "budget_s": budget, "tol_pos_m": TOL_POS,
+                     "tol_rot_rad": TOL_ROT},
+        "rows": [asdict(r) for r in rows],
+        "not_run": missing,
+    }
+
+
+def _versions() -> dict[str, str]:
+    out = {}
+    for dist in ("kinelab", "pin", "numpy", "numba", "roboticstoolbox-python", "pytracik", "ikpy", "pin-pink"):
+        with contextlib.suppress(md.PackageNotFoundError):
+            out[dist] = md.version(dist)
+    return out

@@ -1,0 +1,114 @@
+"""FRDM cost against chain length: synthetic serial chains of 7 to 100 links, revolute and prismatic mixed.
+
+Time per sweep is measured on the compiled kernel alone (plain sweeps, a fixed count, a target it
+cannot reach so that it never stops early); time per solve through :func:`kinelab.solve`. A straight
+line is fitted to time per sweep against the number of links and its R² reported.
+"""
+
+from __future__ import annotations
+
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+from tqdm import tqdm
+
+from kinelab.ik.chain import chain_model
+from kinelab.ik.frdm import kernel
+from kinelab.robot import Robot
+
+LENGTHS = (7, 15, 30, 60, 100)
+
+
+def synthetic_urdf(n: int, seed: int = 0, link: float | None = None) -> str:
+    """A serial chain of ``n`` joints (every fourth prismatic) with random axes and offsets, total length ≈ 2 m."""
+    rng = np.random.default_rng(seed)
+    link = link or 2.0 / n
+    parts = ['<?xml version="1.0"?>', f'<robot name="chain{n}">', '<link name="base"/>']
+    for i in range(n):
+        parts.append(f'<link name="l{i}"/>')
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        offset = rng.normal(scale=0.3 * link, size=3) + np.array([0, 0, link])
+        parent = "base" if i == 0 else f"l{i - 1}"
+        kind, lo, hi = ("prismatic", -0.5 * link, 0.5 * link) if i % 4 == 3 else ("revolute", -2.5, 2.5)
+        parts.append(
+            f'<joint name="j{i}" type="{kind}"><parent link="{parent}"/><child link="l{i}"/>'
+            f'<origin xyz="{offset[0]:.6f} {offset[1]:.6f} {offset[2]:.6f}"/>'
+            f'<axis xyz="{axis[0]:.6f} {axis[1]:.6f} {axis[2]:.6f}"/>'
+            f'<limit lower="{lo:.6f}" upper="{hi:.6f}" effort="1" velocity="1"/></joint>'
+        )
+    parts += ['<link name="tool"/>', f'<joint name="jt" type="fixed"><parent link="l{n - 1}"/><child link="tool"/>'
+              f'<origin xyz="0 0 {link:.6f}"/></joint>', "</robot>"]
+    return "\n".join(parts)
+
+
+def synthetic_robot(n: int, seed: int = 0) -> Robot:
+    path = Path(tempfile.mkdtemp(prefix="kinelab-chain-")) / f"chain{n}.urdf"
+    path.write_text(synthetic_urdf(n, seed))
+    return Robot(path, name=f"chain{n}")
+
+
+def time_per_sweep(robot: Robot, sweeps: int = 500, repeats: int = 30) -> float:
+    """Seconds per plain FRDM sweep (kernel only, FK resync included), best of ``repeats`` (the minimum
+    is what the code costs; a shared machine only ever adds to it)."""
+    cm = chain_model(robot)
+    far = pin.SE3(np.eye(3), np.array([100.0, 0.0, 0.0]))  # unreachable: the kernel never stops early
+    problem = kernel.Problem(cm.lower, cm.upper, np.ones(cm.n, dtype=np.bool_), far.translation.copy(),
+                             far.rotation.copy(), 1.0 / cm.length**2, np.ones(3), 1e-300, 1e-300, True, True)
+    settings = kernel.Settings(1.0, -1.0, sweeps + 1, -1.0, 0)
+    best = np.inf
+    for _ in range(repeats + 1):
+        q = robot.neutral()
+        mem = kernel.new_memory(cm.n, 0)
+        mem.state[kernel.S_E_WINDOW] = np.inf
+        t0 = time.perf_counter()
+        kernel.run(q, cm.chain, problem, settings, kernel.BASE_TO_TIP, sweeps, mem)
+        best = min(best, (time.perf_counter() - t0) / sweeps)
+    return best
+
+
+def time_per_solve(robot: Robot, count: int = 20, seed: int = 0) -> tuple[float, float]:
+    """(median seconds per solve, success rate) of :func:`kinelab.solve` on reachable random targets."""
+    from kinelab.ik import solve
+
+    rng = np.random.default_rng(seed)
+    times, ok = [], 0
+    for k in range(count):
+        target = robot.fk(robot.random_q(rng))
+        res = solve(robot, target, q0=robot.random_q(rng), seed=k, time_budget=0.5)
+        times.append(res.wall_time)
+        ok += res.success
+    return float(np.median(times)), ok / count
+
+
+def linear_fit(x, y) -> tuple[float, float, float]:
+    """(intercept, slope, R²) of the least-squares line y = a + b x."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    b, a = np.polyfit(x, y, 1)
+    residual = y - (a + b * x)
+    r2 = 1.0 - residual @ residual / ((y - y.mean()) @ (y - y.mean()))
+    return float(a), float(b), float(r2)
+
+
+def run(lengths: tuple[int, ...] = LENGTHS, seed: int = 0, progress: bool = False, solves: int = 20) -> dict:
+    rows = []
+    for n in tqdm(lengths, desc="scaling", disable=not progress, unit="chain"):
+        robot = synthetic_robot(n, seed)
+        sweep_s = time_per_sweep(robot)
+        solve_s, rate = time_per_solve(robot, solves, seed) if solves else (float("nan"), float("nan"))
+        rows.append({"links": n, "us_per_sweep": sweep_s * 1e6, "us_per_solve": solve_s * 1e6, "solved": rate})
+    a, b, r2 = linear_fit([r["links"] for r in rows], [r["us_per_sweep"] for r in rows])
+    return {"rows": rows, "fit_us_per_sweep": {"intercept": a, "slope_per_link": b, "r2": r2}}
+
+
+def markdown(result: dict) -> str:
+    fit = result["fit_us_per_sweep"]
+    lines = ["| links | µs per sweep | µs per solve (median) | solved |", "|---|---|---|---|"]
+    lines += [f"| {r['links']} | {r['us_per_sweep']:.2f} | {r['us_per_solve']:.0f} | {100 * r['solved']:.0f} % |"
+              for r in result["rows"]]
+    lines.append(f"\nTime per sweep ≈ {fit['intercept']:.2f} + {fit['slope_per_link']:.3f} µs × links, "
+                 f"R² = {fit['r2']:.4f}.")
+    return "\n".join(lines)

@@ -1,0 +1,155 @@
+"""Every table and figure kinelab writes: the validate report and the bench figures.
+
+Figures are drawn on ``matplotlib.figure.Figure`` objects, which need no pyplot state and no backend
+choice, so rendering never changes the caller's matplotlib settings.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from kinelab.report.bench import scaling
+from kinelab.report.validate import Report
+from kinelab.studies import paper000_era as ep
+from kinelab.studies import paper001_stanford as seed001
+
+
+def validate_table(report: Report) -> str:
+    """The checks as an aligned text table with a closing 'N passed, M failed' line."""
+    lines = [f"{'robot':<10} {'check':<56} {'measured':>10} {'tolerance':>10}  result"]
+    for c in report.checks:
+        unit = f" {c.unit}" if c.unit else ""
+        lines.append(f"{c.robot:<10} {c.name:<56} {c.value:>10.2e} {c.tolerance:>10.3g}{unit:<4} "
+                     f"{'PASS' if c.passed else 'FAIL'}")
+    failed = sum(not c.passed for c in report.checks)
+    lines.append(f"{len(report.checks) - failed} passed, {failed} failed")
+    return "\n".join(lines)
+
+
+def _passage_figure(run: Any, name: str, joints: tuple[int, ...], folder: Path) -> str:
+    fig = Figure(figsize=(10, 3.2))
+    axes = fig.subplots(1, 2, sharey=True)
+    for ax, res, title in ((axes[0], run.without, f"ERA {name}, without bypass"),
+                           (axes[1], run.with_bypass, f"ERA {name}, with bypass")):
+        for j in joints:
+            ax.plot(np.rad2deg(res.q[:, j]), "--" if j == 6 else "-", label=f"θ{j + 1}")
+        ax.set_title(title)
+        ax.set_xlabel("path sample")
+    axes[0].set_ylabel("deg")
+    axes[1].legend()
+    fig.tight_layout()
+    fig.savefig(folder / f"era_{name}.png", dpi=100)
+    return f"era_{name}.png"
+
+
+def validate_figures(report: Report, folder: Path) -> list[str]:
+    """The report's figures as PNG files in ``folder`` (the ERA passages, seed-001 convergence)."""
+    names = []
+    if "era" in report.robots:
+        for name, joints in (("elbow", (2, 3, 4)), ("wrist", (4, 6)), ("shoulder", (0, 6))):
+            passage = ep.PASSAGES[name]()
+            names.append(_passage_figure(ep.run(passage), name, joints, folder))
+    if "stanford" in report.robots:
+        traj = seed001.reproduce().info["trajectory"]
+        fig = Figure(figsize=(5, 3.2))
+        ax = fig.subplots()
+        ax.semilogy(traj["t"], np.linalg.norm(traj["M"][:, 1:4], axis=1), label="|m⃗| (rotation part)")
+        ax.semilogy(traj["t"], np.linalg.norm(traj["M"][:, 5:8], axis=1), label="|m0⃗| (moment part)")
+        ax.set_xlabel("model time [s]")
+        ax.set_title("seed 001: error biquaternion, K = 1")
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(folder / "seed001_convergence.png", dpi=100)
+        names.append("seed001_convergence.png")
+    return names
+
+
+def write_validate_report(report: Report, out: str | Path) -> Path:
+    """Write report.json, report.md, report.html and the figures into the folder ``out``."""
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    figures = validate_figures(report, folder)
+    (folder / "report.json").write_text(json.dumps(report.to_dict(), indent=2))
+    md = ["# kinelab validate", "", f"Robots: {', '.join(report.robots)}; n = {report.n}; seed = {report.seed}.", "",
+          "| robot | check | measured | tolerance | result |", "|---|---|---|---|---|"]
+    md += [f"| {c.robot} | {c.name} | {c.value:.2e} {c.unit} | {c.tolerance:.3g} | {'PASS' if c.passed else 'FAIL'} |"
+           for c in report.checks]
+    md += [""] + [f"![{name}]({name})" for name in figures]
+    (folder / "report.md").write_text("\n".join(md) + "\n")
+    rows = "".join(
+        f"<tr><td>{html.escape(c.robot)}</td><td>{html.escape(c.name)}</td><td>{c.value:.2e} {c.unit}</td>"
+        f"<td>{c.tolerance:.3g}</td><td>{'PASS' if c.passed else 'FAIL'}</td></tr>"
+        for c in report.checks
+    )
+    (folder / "report.html").write_text(
+        "<!doctype html><meta charset='utf-8'><title>kinelab validate</title>"
+        f"<h1>kinelab validate: {'PASS' if report.passed else 'FAIL'}</h1>"
+        "<table border=1><tr><th>robot</th><th>check</th><th>measured</th><th>tolerance</th><th>result</th></tr>"
+        f"{rows}</table>"
+        + "".join(f"<p><img alt='{name}' src='data:image/png;base64,"
+                  f"{base64.b64encode((folder / name).read_bytes()).decode()}'></p>" for name in figures)
+    )
+    return folder
+
+
+def bench_markdown(result: dict[str, Any]) -> str:
+    """The bench rows as a Markdown table."""
+    p = result["protocol"]
+    lines = [f"Bench {result['date']}, {result['machine']['processor']}, Python {result['machine']['python']}; "
+             f"n = {p['n']} targets per robot, seed {p['seed']}, best of {p.get('repeats', 1)} rounds per target, "
+             f"budget {p['budget_s'] * 1e3:g} ms, "
+             f"tolerances {p['tol_pos_m']:g} m / {p['tol_rot_rad']:g} rad (Pinocchio-checked).", "",
+             "| robot | solver | success | median | p95 | median (solved) | iterations |",
+             "|---|---|---|---|---|---|---|"]
+    for r in result["rows"]:
+        lines.append(f"| {r['robot']} | {r['solver']} | {r['success_pct']:.1f} % | {r['median_us']:.0f} µs | "
+                     f"{r['p95_us']:.0f} µs | {r['median_solved_us']:.0f} µs | {r['median_iterations']:.0f} |")
+    if result.get("not_run"):
+        lines += ["", "Not run: " + "; ".join(f"{k} ({v})" for k, v in result["not_run"].items())]
+    return "\n".join(lines)
+
+
+def write_bench(result: dict[str, Any], out: str | Path) -> Path:
+    """bench.json, bench.md and (with matplotlib) bench.png in the folder ``out``."""
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "bench.json").write_text(json.dumps(result, indent=2))
+    sections = [bench_markdown(result)]
+    if "scaling" in result:
+        sections.append(scaling.markdown(result["scaling"]))
+    if "tracking" in result:
+        sections.append(ep.tracking_markdown(result["tracking"]))
+    (folder / "bench.md").write_text("\n\n".join(sections) + "\n")
+    bench_figure(result, folder / "bench.png")
+    return folder
+
+
+def bench_figure(result: dict[str, Any], path: str | Path) -> None:
+    """Success rate and median time per solver and robot, as a PNG."""
+    rows = result["rows"]
+    robots = list(dict.fromkeys(r["robot"] for r in rows))
+    solvers = list(dict.fromkeys(r["solver"] for r in rows))
+    fig = Figure(figsize=(11, 4))
+    ax1, ax2 = fig.subplots(1, 2)
+    width = 0.8 / max(len(solvers), 1)
+    for k, s in enumerate(solvers):
+        xs = [i + k * width for i, rb in enumerate(robots)]
+        by = {r["robot"]: r for r in rows if r["solver"] == s}
+        ax1.bar(xs, [by.get(rb, {}).get("success_pct", 0) for rb in robots], width, label=s)
+        ax2.bar(xs, [by.get(rb, {}).get("median_us", 0) for rb in robots], width, label=s)
+    for ax, title in ((ax1, "success [%]"), (ax2, "median time [µs]")):
+        ax.set_xticks([i + 0.4 - width / 2 for i in range(len(robots))], robots)
+        ax.set_title(title)
+    ax2.set_yscale("log")
+    ax1.set_ylim(0, 105)
+    handles, labels = ax1.get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=len(solvers), fontsize=8)
+    fig.tight_layout(rect=(0, 0.08, 1, 1))
+    fig.savefig(path, dpi=110)

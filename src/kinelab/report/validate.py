@@ -1,0 +1,237 @@
+"""``kinelab validate``: every kinelab computation against Pinocchio (and yourdfpy), on the bundled robots.
+
+Each check measures a figure, compares it with a stated tolerance and records pass/fail. The report
+is a list of :class:`Check` rows, printed as a table, written as Markdown/HTML/JSON with ``--out``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+import pinocchio as pin
+from tqdm import tqdm
+
+from kinelab.analysis import oracles as checks
+from kinelab.robot import Robot, load
+from kinelab.studies import paper001_stanford as seed001
+
+DEFAULT_ROBOTS = ("stanford", "era", "youbot", "panda", "ur5")
+DEFAULT_N = 200
+
+
+@dataclass(frozen=True)
+class Check:
+    """One validated figure: ``value`` must be ≤ ``tolerance`` (both in ``unit``)."""
+
+    robot: str
+    name: str
+    value: float
+    tolerance: float
+    unit: str
+    detail: str = ""
+
+    @property
+    def passed(self) -> bool:
+        return bool(np.isfinite(self.value) and self.value <= self.tolerance)
+
+
+@dataclass
+class Report:
+    checks: list[Check] = field(default_factory=list)
+    robots: list[str] = field(default_factory=list)
+    n: int = DEFAULT_N
+    seed: int = 0
+
+    @property
+    def passed(self) -> bool:
+        return all(c.passed for c in self.checks)
+
+    def to_dict(self) -> dict:
+        return {
+            "passed": self.passed,
+            "robots": self.robots,
+            "n": self.n,
+            "seed": self.seed,
+            "versions": {"pinocchio": pin.__version__, "numpy": np.__version__},
+            "checks": [{**asdict(c), "passed": c.passed} for c in self.checks],
+        }
+
+
+def model_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+    """yourdfpy vs Pinocchio FK at n configurations; Pinocchio's Jacobians vs finite differences."""
+    fk = checks.fk_vs_yourdfpy(robot, n, seed)
+    jac = checks.jacobians_vs_fd(robot, max(10, n // 10), seed)
+    return [
+        Check(robot.name, "FK position: yourdfpy vs Pinocchio", fk.max_position, 1e-9, "m", f"{n} random q"),
+        Check(robot.name, "FK rotation: yourdfpy vs Pinocchio", fk.max_rotation, 1e-9, "rad", f"{n} random q"),
+        Check(robot.name, "Jacobians (3 frames) vs central differences", jac.max_rotation, 1e-6, "",
+              f"{jac.count} random q, max abs entry"),
+    ]
+
+
+def stanford_paper_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+    """Seed 001: the tool rotation at the paper's target against the printed N (6 digits)."""
+    oMtool = robot.fk(seed001.TARGET_Q)
+    quat = pin.Quaternion(oMtool.rotation)
+    d = seed001.quat_distance_wxyz([quat.w, quat.x, quat.y, quat.z], seed001.N_REAL_WXYZ)
+    return [Check(robot.name, "seed 001: rotation at the paper's target vs printed N", d,
+                  seed001.PRINTED_DIGITS_TOL, "", "quaternion components, up to sign")]
+
+
+def biquaternion_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+    """Λ(q) by the chain product and A(q) by screw transforms against Pinocchio."""
+    from kinelab.dq import kinematics as bk
+    from kinelab.dq.algebra import DualQuat
+
+    worst_pose = worst_A = 0.0
+    for q in robot.random_qs(max(10, n // 10), seed + 1):
+        lam, ref = bk.pose(robot, q).as_array(), DualQuat.from_se3(robot.fk(q)).as_array()
+        worst_pose = max(worst_pose, min(np.abs(lam - ref).max(), np.abs(lam + ref).max()))
+        J = robot.jacobian_local(q)
+        worst_A = max(worst_A, float(np.abs(bk.a_matrix(robot, q) - np.vstack([J[3:], J[:3]])).max()))
+    count = max(10, n // 10)
+    return [Check(robot.name, "biquaternion Λ(q) vs Pinocchio FK (up to ±)", worst_pose, 1e-12, "", f"{count} q"),
+            Check(robot.name, "biquaternion A(q) vs Pinocchio LOCAL Jacobian", worst_A, 1e-10, "", f"{count} q")]
+
+
+def solver_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+    """FRDM and the biquaternion solver on seeded reachable targets, every answer checked by Pinocchio."""
+    from kinelab.ik import solve
+
+    count = max(10, n // 4)
+    rows = []
+    for solver, allowed in (("frdm", 0.02), ("biquat", 0.05)):
+        rng = np.random.default_rng(seed + 2)
+        failures, times, iters, worst = 0, [], [], 0.0
+        for k in range(count):
+            target = robot.fk(robot.random_q(rng))
+            res = solve(robot, target, solver=solver, seed=k, time_budget=0.2)
+            dp, dr = robot.tool_error(res.q, target)  # the check, independent of the solver's own
+            ok = res.success and dp <= 1e-6 and dr <= 1e-6 and robot.within_limits(res.q)
+            failures += not ok
+            times.append(res.wall_time)
+            iters.append(res.iterations)
+            worst = max(worst, dp if ok else 0.0)
+        rows.append(Check(robot.name, f"{solver}: share of targets not solved (Pinocchio-checked)", failures / count,
+                          allowed, "", f"{count} targets, median {np.median(times) * 1e3:.2f} ms, median "
+                          f"{np.median(iters):.0f} iterations, worst solved error {worst:.1e} m"))
+    return rows
+
+
+def seed001_run_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+    """Seed 001's run: from the paper's start to its target with K = 1, h = 0.01 s."""
+    run = seed001.reproduce(robot, record=True)
+    dp, dr = robot.tool_error(run.q, robot.fk(seed001.TARGET_Q))
+    m_start = float(np.linalg.norm(run.info["trajectory"]["M"][0][1:4]))
+    predicted = 0.01 * np.ceil(np.log(m_start / 5e-7) / -np.log(1 - 0.01))
+    return [
+        Check(robot.name, "seed 001: the paper's run reaches 1e-6 (position)", dp, 1e-6, "m",
+              f"model time {run.info['model_time']:.2f} s at K = 1 (paper: about 40 s)"),
+        Check(robot.name, "seed 001: the paper's run reaches 1e-6 (rotation)", dr, 1e-6, "rad"),
+        Check(robot.name, "seed 001: final M0 = -1 as in the paper", abs(run.info["M0"] + 1.0), 1e-9, ""),
+        Check(robot.name, "seed 001: model time vs closed-form prediction", abs(run.info["model_time"] - predicted),
+              1e-9, "s", f"{predicted:.2f} s predicted"),
+    ]
+
+
+def youbot_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+    """Seed 003: the paper's J and Pinocchio's rank at θ2 = θ3 = 0, the box, and the families of a sweep."""
+    from kinelab.analysis import families, singular
+    from kinelab.studies import paper003_youbot as yb
+
+    rng = np.random.default_rng(seed + 3)
+    count = max(20, n // 5)
+    sing = [yb.singular_configuration(rng) for _ in range(count)]
+    off_paper = sum(yb.paper_rank(q) != 5 for q in sing)
+    off_pin = sum(singular.analyze(robot, q).rank != 5 for q in sing)
+    box = sum(yb.paper_rank(robot.random_q(rng)) != 6 for _ in range(count))
+    J_fd = 0.0
+    for _ in range(10):
+        Q = robot.random_q(rng)
+        fd = np.array([(yb.paper_location(Q + 1e-6 * e) - yb.paper_location(Q - 1e-6 * e)) / 2e-6 for e in np.eye(8)]).T
+        J_fd = max(J_fd, float(np.abs(fd - yb.paper_jacobian(Q)).max()))
+    sweep = families.sweep(robot, samples=max(2000, 10 * n), seed=seed, progress=False)
+    texts = [" and ".join(r.text for r in f.relations) for f in sweep["families"]]
+    found = "arm_joint_2 = 0 and arm_joint_3 = 0" in texts
+    return [
+        Check(robot.name, "seed 003: paper's J vs finite differences of X(Q)", J_fd, 1e-6, ""),
+        Check(robot.name, "seed 003: paper's J rank ≠ 5 at θ2 = θ3 = 0 (count)", off_paper, 0, "", f"{count} Q"),
+        Check(robot.name, "seed 003: Pinocchio SVD rank ≠ 5 at θ2 = θ3 = 0 (count)", off_pin, 0, "", f"{count} Q"),
+        Check(robot.name, "seed 003: paper's J rank ≠ 6 over the limit box (count)", box, 0, "", f"{count} Q"),
+        Check(robot.name, "seed 003: sweep finds θ2 = θ3 = 0 (0 = found)", 0.0 if found else 1.0, 0.0, "",
+              "families: " + "; ".join(texts)),
+    ]
+
+
+def era_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+    """Seed 000: the three ERA passages with and without the paper's bypass."""
+    from kinelab.studies import paper000_era as ep
+
+    return _elbow_checks(robot, ep) + _lock_checks(robot, ep)
+
+
+def _elbow_checks(robot: Robot, ep) -> list[Check]:
+    passage = ep.elbow_passage(robot)
+    run = ep.run(passage, robot)
+    reach = ~passage.unreachable
+    w, wo = run.with_bypass, run.without
+    return [
+        Check(robot.name, "seed 000 elbow, bypass: largest joint step between samples", w.max_joint_step, 0.25,
+              "rad", f"without bypass {wo.max_joint_step:.3f} rad, {len(wo.events)} monitor events"),
+        Check(robot.name, "seed 000 elbow, bypass: worst error on reachable samples",
+              float(w.position_error[reach].max()), 1e-6, "m",
+              f"without bypass {wo.position_error[reach].max():.2f} m, "
+              f"reached {wo.reached[reach].sum()}/{reach.sum()}"),
+        Check(robot.name, "seed 000 elbow, bypass: samples leaving the fold's quadrants",
+              ep.quadrant_violations(w, passage), 0, ""),
+    ]
+
+
+def _lock_checks(robot: Robot, ep) -> list[Check]:
+    """Passages 2 and 3: with the bypass the joint path closes every lap; without, the paper's drift."""
+    checks = []
+    for name, joints, bypass in (("wrist", (4, 6), "q5, q6 < 80°"), ("shoulder", (0, 6), "q1 frozen")):
+        passage = ep.PASSAGES[name](robot)
+        run = ep.run(passage, robot)
+        w, wo = run.with_bypass, run.without
+        laps_w = ep.lap_changes(w, passage)
+        laps_wo = np.rad2deg(ep.lap_changes(wo, passage))
+        a, b = joints
+        drift = ", ".join(f"θ{j + 1} {np.array2string(laps_wo[:, j], precision=1)}°" for j in joints)
+        if name == "wrist":  # q5 down and q7 up by the same amount, every lap
+            shown = bool((laps_wo[:, a] < -5).all() and (laps_wo[:, b] > 5).all())
+        else:  # q1 and q7 climbing together
+            shown = bool((laps_wo[:2, a] > 60).all() and np.allclose(laps_wo[:, a], laps_wo[:, b], atol=1e-3))
+        checks += [
+            Check(robot.name, f"seed 000 {name}, {bypass}: largest joint step", w.max_joint_step, 0.05, "rad",
+                  f"without bypass {wo.max_joint_step:.3f} rad"),
+            Check(robot.name, f"seed 000 {name}, {bypass}: joint change over a lap (after the 1st)",
+                  float(np.abs(laps_w[1:]).max()), 1e-5, "rad"),
+            Check(robot.name, f"seed 000 {name}, {bypass}: worst tool error", float(w.position_error.max()), 1e-6,
+                  "m", f"reached {w.reached.sum()}/{passage.samples}"),
+            Check(robot.name, f"seed 000 {name}, without: paper's drift absent (0 = shown)", 0.0 if shown else 1.0,
+                  0.0, "", f"per-lap change {drift}"),
+        ]
+    return checks
+
+
+PAPER_CHECKS: dict[str, list[Callable[[Robot, int, int], list[Check]]]] = {
+    "stanford": [stanford_paper_checks, seed001_run_checks],
+    "youbot": [youbot_checks],
+    "era": [era_checks],
+}
+GENERAL_CHECKS = [model_checks, biquaternion_checks, solver_checks]
+
+
+def run(robots: list[str] | None = None, n: int | None = None, seed: int = 0, progress: bool = False) -> Report:
+    """Run every check on ``robots`` (default: stanford, era, youbot, panda, ur5)."""
+    names = list(robots or DEFAULT_ROBOTS)
+    n = n or DEFAULT_N
+    loaded = [load(name) for name in names]  # fail early, before any work, on a bad name
+    report = Report(robots=names, n=n, seed=seed)
+    steps = [(robot, fn) for robot in loaded for fn in [*GENERAL_CHECKS, *PAPER_CHECKS.get(robot.name, [])]]
+    for robot, fn in tqdm(steps, desc="validate", disable=not progress, unit="check"):
+        report.checks.extend(fn(robot, n, seed))
+    return report

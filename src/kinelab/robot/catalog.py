@@ -1,0 +1,114 @@
+"""Registered robot names: the URDFs bundled in ``urdf/`` and the serial arms of example-robot-data.
+
+example-robot-data 6 ships its URDFs and meshes as data files (under ``share/example-robot-data``)
+but no Python loader, so the ``robots/`` directory is found from the installed package's file list.
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib.metadata
+from dataclasses import dataclass
+from pathlib import Path
+
+from kinelab.errors import RobotNotFoundError
+
+
+@dataclass(frozen=True)
+class Entry:
+    """One registered robot: where its URDF is and which frame is its tool."""
+
+    name: str
+    source: str  # "kinelab" (bundled) or "example-robot-data"
+    relpath: str  # below the bundled urdf/ directory or the example-robot-data robots/ directory
+    tool: str
+    description: str
+
+
+BUNDLED = (
+    Entry("stanford", "kinelab", "stanford.urdf", "tool",
+          "Stanford arm RRPRRR, frames of Lomovtseva & Chelnokov (seed 001)"),
+    Entry("era", "kinelab", "era.urdf", "tool",
+          "European Robotic Arm, 7R symmetric, approximate geometry (seed 000)"),
+    Entry("youbot", "kinelab", "youbot.urdf", "tool",
+          "KUKA youBot arm on its planar base, Q = (X_C, Y_C, theta, theta1..theta5) (seed 003)"),
+)
+
+ERD_ARMS = (
+    Entry("panda", "example-robot-data", "panda_description/urdf/panda.urdf", "panda_hand_tcp",
+          "Franka Emika Panda, 7R, fingers locked"),
+    Entry("ur3", "example-robot-data", "ur_description/urdf/ur3_robot.urdf", "tool0", "Universal Robots UR3, 6R"),
+    Entry("ur5", "example-robot-data", "ur_description/urdf/ur5_robot.urdf", "tool0", "Universal Robots UR5, 6R"),
+    Entry("ur10", "example-robot-data", "ur_description/urdf/ur10_robot.urdf", "tool0", "Universal Robots UR10, 6R"),
+    Entry("kinova", "example-robot-data", "kinova_description/robots/kinova.urdf", "j2s6s200_end_effector",
+          "Kinova Jaco j2s6s200, 6R with three continuous joints, fingers locked"),
+    Entry("xarm7", "example-robot-data", "xarm_description/urdf/xarm7.urdf", "link_eef", "UFACTORY xArm7, 7R"),
+    Entry("z1", "example-robot-data", "z1_description/urdf/z1.urdf", "gripperStator",
+          "Unitree Z1, 6R, gripper locked"),
+    Entry("so101", "example-robot-data", "so_arm_description/urdf/so101.urdf", "gripper_frame_link",
+          "SO-101 arm, 5R, gripper locked"),
+    Entry("finger_edu", "example-robot-data", "finger_edu_description/robots/finger_edu.urdf", "finger_tip_link",
+          "TriFinger EDU finger, 3R"),
+)
+
+ENTRIES = {e.name: e for e in BUNDLED + ERD_ARMS}
+
+
+def bundled_urdf_dir() -> Path:
+    """The directory holding kinelab's own URDFs (inside the wheel, or ``urdf/`` of a checkout)."""
+    package = Path(__file__).resolve().parents[1]  # src/kinelab (a checkout) or site-packages/kinelab
+    for candidate in (package / "urdf", package.parents[1] / "urdf"):
+        if (candidate / "stanford.urdf").is_file():
+            return candidate
+    raise FileNotFoundError(f"kinelab's bundled URDFs are missing (looked in {package / 'urdf'})")
+
+
+@functools.cache
+def erd_share_dir() -> Path | None:
+    """``.../share`` that holds ``example-robot-data/robots``, or None if the package is absent."""
+    try:
+        files = importlib.metadata.files("example-robot-data") or []
+    except importlib.metadata.PackageNotFoundError:
+        return None
+    for f in files:
+        parts = Path(str(f)).parts
+        if "example-robot-data" in parts and "robots" in parts:
+            full = Path(f.locate()).resolve()
+            i = len(full.parts) - 1 - full.parts[::-1].index("example-robot-data")
+            return Path(*full.parts[:i])
+    return None
+
+
+def erd_robots_dir() -> Path | None:
+    """The example-robot-data ``robots/`` directory, or None if the package is not installed."""
+    share = erd_share_dir()
+    return share / "example-robot-data" / "robots" if share else None
+
+
+def package_dirs() -> list[str]:
+    """Directories under which ``package://NAME/...`` mesh paths resolve (for Pinocchio and yourdfpy)."""
+    dirs = []
+    share = erd_share_dir()
+    if share:
+        dirs += [str(share), str(share / "example-robot-data" / "robots")]
+    return dirs
+
+
+def names() -> list[str]:
+    """All registered robot names, bundled ones first."""
+    return list(ENTRIES)
+
+
+def resolve(name_or_path: str | Path) -> tuple[Path, Entry | None]:
+    """Turn a registered name or a URDF path into (urdf path, catalogue entry or None)."""
+    key = str(name_or_path)
+    entry = ENTRIES.get(key)
+    if entry is not None:
+        root = bundled_urdf_dir() if entry.source == "kinelab" else erd_robots_dir()
+        if root is None:
+            raise RobotNotFoundError(key + " (example-robot-data is not installed)", names())
+        return root / entry.relpath, entry
+    path = Path(key)
+    if path.suffix.lower() in {".urdf", ".xml"} or path.exists() or "/" in key:
+        return path, None
+    raise RobotNotFoundError(key, names())

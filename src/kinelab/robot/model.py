@@ -1,0 +1,477 @@
+"""Robot: a URDF loaded into Pinocchio, reduced to the serial chain from the base to a tool frame.
+
+Coordinates. kinelab speaks "one number per joint" (``q``, length ``robot.n``): an angle in rad for
+revolute and continuous joints, a displacement in m for prismatic ones, in chain order base → tool.
+Pinocchio stores a continuous joint as (cos, sin), so its configuration ``q_pin`` has ``robot.nq``
+entries; ``to_pin_q``/``from_pin_q`` convert. Velocities and Jacobian columns need no conversion:
+``nv == n`` for every joint kinelab accepts.
+
+Frames. Poses are ``pin.SE3`` of a frame in the robot's base (root link) frame, named ``oM<frame>``.
+Jacobians are 6 × n with rows [linear; angular] (Pinocchio's order); the method name states the frame.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import xml.etree.ElementTree as ET
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, TypeVar
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab.errors import (
+    ChainError,
+    ConfigurationError,
+    FrameNotFoundError,
+    JointLimitError,
+    JointNotFoundError,
+    URDFError,
+)
+from kinelab.robot import catalog
+
+_REVOLUTE = {"JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned"}
+_PRISMATIC = {"JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned"}
+_CONTINUOUS = {"JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "JointModelRevoluteUnboundedUnaligned"}
+T = TypeVar("T")
+LIMIT_SLACK = 1e-9  # joint values this far past a limit still count as within it (rad or m)
+
+
+@dataclass(frozen=True)
+class Joint:
+    """One chain joint: ``kind`` is revolute, prismatic or continuous; limits in rad or m."""
+
+    name: str
+    kind: str
+    lower: float
+    upper: float
+    idx_q: int  # first index in Pinocchio's q
+    idx_v: int  # index in Pinocchio's v (and Jacobian column)
+    axis_local: tuple[float, float, float]
+
+    @property
+    def unit(self) -> str:
+        return "m" if self.kind == "prismatic" else "rad"
+
+
+@dataclass(frozen=True)
+class _UrdfTree:
+    """The joint/link graph of a URDF, read with the standard library so errors can be specific."""
+
+    root: str
+    parent_of: dict[str, str]  # child link -> parent link
+    joint_of: dict[str, str]  # child link -> joint name
+    mimic: dict[str, str]  # joint -> the joint it mimics
+    links: list[str]
+    leaves: list[str]
+
+
+def _read_tree(path: Path) -> _UrdfTree:
+    if not path.is_file():
+        raise URDFError(f"URDF file not found: {path}")
+    try:
+        xml = ET.parse(path).getroot()
+    except ET.ParseError as exc:
+        raise URDFError(f"malformed URDF {path}: {exc}") from None
+    if xml.tag != "robot":
+        raise URDFError(f"malformed URDF {path}: the root element is <{xml.tag}>, expected <robot>")
+    links = [link.get("name", "") for link in xml.findall("link")]
+    parent_of: dict[str, str] = {}
+    joint_of: dict[str, str] = {}
+    mimic: dict[str, str] = {}
+    for joint in xml.findall("joint"):
+        name = joint.get("name", "?")
+        parent, child = joint.find("parent"), joint.find("child")
+        if parent is None or child is None:
+            raise URDFError(f"malformed URDF {path}: joint {name!r} lacks <parent> or <child>")
+        c = child.get("link", "")
+        if c in joint_of:
+            raise ChainError(
+                f"{path.name} has a closed loop: link {c!r} is the child of both joint "
+                f"{joint_of[c]!r} and joint {name!r}; kinelab handles serial chains and trees only"
+            )
+        parent_of[c], joint_of[c] = parent.get("link", ""), name
+        m = joint.find("mimic")
+        if m is not None:
+            mimic[name] = m.get("joint", "")
+    roots = [link for link in links if link not in parent_of]
+    if len(roots) != 1:
+        raise URDFError(f"malformed URDF {path}: expected one root link, found {roots}")
+    parents = set(parent_of.values())
+    leaves = [link for link in links if link not in parents]
+    return _UrdfTree(roots[0], parent_of, joint_of, mimic, links, leaves)
+
+
+def _build_full_model(path: Path) -> pin.Model:
+    try:
+        return pin.buildModelFromUrdf(str(path))
+    except (RuntimeError, ValueError) as exc:
+        raise URDFError(f"Pinocchio cannot read {path}: {exc}") from None
+
+
+def _frame_id(model: pin.Model, name: str, robot: str) -> int:
+    """Id of frame ``name``, preferring the link (BODY) frame where a joint shares the name."""
+    body = [i for i, f in enumerate(model.frames) if f.name == name and f.type == pin.FrameType.BODY]
+    if body:
+        return body[0]
+    ids = [i for i, f in enumerate(model.frames) if f.name == name]
+    if not ids:
+        raise FrameNotFoundError(name, [f.name for f in model.frames], robot)
+    return ids[0]
+
+
+def _kind(joint_model: pin.JointModel) -> str | None:
+    short = joint_model.shortname()
+    if short in _REVOLUTE:
+        return "revolute"
+    if short in _PRISMATIC:
+        return "prismatic"
+    if short in _CONTINUOUS:
+        return "continuous"
+    return None
+
+
+def _read_only(arr: np.ndarray) -> np.ndarray:
+    arr.flags.writeable = False  # the checks derived from the limits would not see an edit
+    return arr
+
+
+def _one_to_pin(kind: str, value: float) -> list[float]:
+    return [np.cos(value), np.sin(value)] if kind == "continuous" else [value]
+
+
+class Robot:
+    """A serial chain base → tool, with Pinocchio as the kinematic reference.
+
+    Build with :func:`kinelab.load`. Joints off the base → tool path (fingers, other branches) are
+    locked; ``locked`` locks chain joints too. Attributes: ``name``, ``urdf_path``, ``model``,
+    ``data``, ``tool`` (frame name), ``tool_frame_id``, ``joints``, ``joint_names``, ``lower``,
+    ``upper`` (one number per joint, rad or m), ``n``, ``nq``, ``nv``, ``locked``.
+    """
+
+    def __init__(
+        self,
+        urdf_path: str | Path,
+        tool: str | None = None,
+        locked: dict[str, float] | None = None,
+        name: str | None = None,
+    ):
+        self.urdf_path = Path(urdf_path)
+        tree = _read_tree(self.urdf_path)
+        full = _build_full_model(self.urdf_path)
+        self.name = name or full.name or self.urdf_path.stem
+        self.tool = tool or self._default_tool(tree, full)
+        tool_id = _frame_id(full, self.tool, self.name)
+        chain = [j for j in full.supports[full.frames[tool_id].parentJoint] if j != 0]
+        self._check_chain(full, chain, tree)
+        self.locked = self._locked_values(full, chain, locked or {})
+        q_ref = pin.neutral(full)
+        for jname, value in self.locked.items():
+            jid = full.getJointId(jname)
+            kind = _kind(full.joints[jid]) or "revolute"
+            nq = full.joints[jid].nq
+            q_ref[full.idx_qs[jid] : full.idx_qs[jid] + nq] = _one_to_pin(kind, value)[:nq]
+        lock_ids = [full.getJointId(j) for j in self.locked]
+        self._full, self._lock_ids, self._q_ref = full, lock_ids, q_ref
+        self.model = pin.buildReducedModel(full, lock_ids, q_ref) if lock_ids else full
+        self.data = self.model.createData()
+        self.tool_frame_id = _frame_id(self.model, self.tool, self.name)
+        self.joints = self._joint_table()
+        if not self.joints:
+            raise ChainError(f"{self.name}: no movable joint between the base and frame {self.tool!r}")
+        self.joint_names = [j.name for j in self.joints]
+        self.joint_kinds = [j.kind for j in self.joints]
+        self.lower = _read_only(np.array([j.lower for j in self.joints]))
+        self.upper = _read_only(np.array([j.upper for j in self.joints]))
+        self.n, self.nq, self.nv = len(self.joints), self.model.nq, self.model.nv
+        self.base = tree.root
+        scalar = [j for j in self.joints if j.kind != "continuous"]
+        turning = [j for j in self.joints if j.kind == "continuous"]
+        self._scalar_pos = np.array([i for i, j in enumerate(self.joints) if j.kind != "continuous"], dtype=int)
+        self._scalar_idx = np.array([j.idx_q for j in scalar], dtype=int)
+        self._cont_pos = np.array([i for i, j in enumerate(self.joints) if j.kind == "continuous"], dtype=int)
+        self._cont_idx = np.array([j.idx_q for j in turning], dtype=int)
+        self._length: float | None = None
+        self._derived: dict[str, Any] = {}
+        self._identity_q = self.nq == self.n and bool(np.all(self._scalar_idx == np.arange(self.n)))
+        continuous = np.array([k == "continuous" for k in self.joint_kinds])
+        self._lower_check = np.where(continuous, -np.inf, self.lower)
+        self._upper_check = np.where(continuous, np.inf, self.upper)
+        # the same bounds with the default slack, as Python floats: a solve checks limits twice, and a
+        # loop over seven floats costs a fifth of the numpy expression
+        self._limit_pairs = list(zip((self._lower_check - LIMIT_SLACK).tolist(),
+                                     (self._upper_check + LIMIT_SLACK).tolist(), strict=True))
+
+    def derived(self, key: str, build: Callable[[Robot], T]) -> T:
+        """Data derived from this robot (a solver's chain arrays, say), built on first use and kept here,
+        so it lives exactly as long as the Robot."""
+        if key not in self._derived:
+            self._derived[key] = build(self)
+        return self._derived[key]  # type: ignore[no-any-return]
+
+    # -- construction ------------------------------------------------------------------------
+    @staticmethod
+    def _default_tool(tree: _UrdfTree, full: pin.Model) -> str:
+        if any(f.name == "tool" for f in full.frames):
+            return "tool"
+        if len(tree.leaves) == 1:
+            return tree.leaves[0]
+        raise ChainError(
+            f"the tool frame is ambiguous: {tree.root!r} branches into {len(tree.leaves)} leaf links "
+            f"({', '.join(tree.leaves[:12])}{', ...' if len(tree.leaves) > 12 else ''}); pass tool=NAME"
+        )
+
+    @staticmethod
+    def _check_chain(full: pin.Model, chain: list[int], tree: _UrdfTree) -> None:
+        for jid in chain:
+            jname = full.names[jid]
+            if jname in tree.mimic:
+                raise ChainError(
+                    f"joint {jname!r} mimics {tree.mimic[jname]!r}; mimic joints on the base-tool chain "
+                    "are not supported (lock it or choose another tool frame)"
+                )
+            if _kind(full.joints[jid]) is None:
+                raise ChainError(
+                    f"joint {jname!r} is a {full.joints[jid].shortname()}: kinelab chains take revolute, "
+                    "continuous and prismatic joints only"
+                )
+
+    @staticmethod
+    def _locked_values(full: pin.Model, chain: list[int], user: dict[str, float]) -> dict[str, float]:
+        chain_names = [full.names[j] for j in chain]
+        for jname in user:
+            if jname not in chain_names:
+                raise JointNotFoundError(jname, chain_names)
+        locked = {}
+        for jid in range(1, full.njoints):
+            jname = full.names[jid]
+            if jname in user:
+                locked[jname] = float(user[jname])
+            elif jid not in chain:
+                iq = full.idx_qs[jid]
+                lo, hi = full.lowerPositionLimit[iq], full.upperPositionLimit[iq]
+                locked[jname] = float(np.clip(0.0, lo, hi)) if full.joints[jid].nq == 1 else 0.0
+        return locked
+
+    def _joint_table(self) -> list[Joint]:
+        m = self.model
+        table = []
+        for jid in range(1, m.njoints):
+            jm = m.joints[jid]
+            kind = _kind(jm)
+            iq, iv = jm.idx_q, jm.idx_v
+            if kind == "continuous":
+                lo, hi = -np.pi, np.pi
+            else:
+                lo, hi = float(m.lowerPositionLimit[iq]), float(m.upperPositionLimit[iq])
+            axis = tuple(float(a) for a in _local_axis(m, jid))
+            table.append(Joint(m.names[jid], kind, lo, hi, iq, iv, axis))
+        return table
+
+    # -- coordinates ---------------------------------------------------------------------------
+    def joint_index(self, name: str) -> int:
+        """Position of joint ``name`` in kinelab's q (raises JointNotFoundError with the valid names)."""
+        if name not in self.joint_names:
+            raise JointNotFoundError(name, self.joint_names)
+        return self.joint_names.index(name)
+
+    def check_q(self, q, *, limits: bool = False, what: str = "q") -> np.ndarray:
+        """``q`` as a float array of length n, refusing wrong shapes, NaN/inf and (if asked) limits."""
+        try:
+            arr = np.asarray(q, dtype=float)
+        except (TypeError, ValueError):
+            raise ConfigurationError(f"{what} must be {self.n} numbers, got {q!r}") from None
+        if arr.shape == (self.n,) and not limits and math.isfinite(sum(arr.tolist())):  # NaN, ±inf poison it
+            return arr
+        if arr.shape != (self.n,):
+            raise ConfigurationError(
+                f"{what} must have {self.n} numbers ({', '.join(self.joint_names)}) for {self.name}, "
+                f"got shape {arr.shape}"
+            )
+        bad = ~np.isfinite(arr)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise ConfigurationError(f"{what}[{i}] ({self.joint_names[i]}) is {arr[i]}: values must be finite")
+        if limits:
+            outside = (arr < self._lower_check - LIMIT_SLACK) | (arr > self._upper_check + LIMIT_SLACK)
+            if outside.any():
+                i = int(np.flatnonzero(outside)[0])
+                j = self.joints[i]
+                raise JointLimitError(j.name, arr[i], j.lower, j.upper, j.unit)
+        return arr
+
+    def within_limits(self, q, slack: float = LIMIT_SLACK) -> bool:
+        """True when every bounded joint lies within its limits (plus ``slack``); continuous joints have none."""
+        if slack == LIMIT_SLACK:
+            return all(lo <= x <= hi for x, (lo, hi) in zip(np.asarray(q, dtype=float).tolist(), self._limit_pairs,
+                                                               strict=True))
+        arr = np.asarray(q, dtype=float)
+        return bool((arr >= self._lower_check - slack).all() and (arr <= self._upper_check + slack).all())
+
+    def to_pin_q(self, q) -> np.ndarray:
+        """One number per joint → Pinocchio's q (continuous joints become cos, sin); a new array."""
+        pin_q = self._pin_q(q)
+        return pin_q.copy() if pin_q is q else pin_q
+
+    def _pin_q(self, q) -> np.ndarray:
+        """Pinocchio's q for reading only: q itself when the two orders coincide (no copy)."""
+        arr = self.check_q(q)
+        if self._identity_q:
+            return arr
+        out = np.empty(self.nq)
+        out[self._scalar_idx] = arr[self._scalar_pos]
+        angles = arr[self._cont_pos]
+        out[self._cont_idx] = np.cos(angles)
+        out[self._cont_idx + 1] = np.sin(angles)
+        return out
+
+    def from_pin_q(self, q_pin) -> np.ndarray:
+        """Pinocchio's q → one number per joint (continuous joints as atan2(sin, cos) in (−π, π])."""
+        q_pin = np.asarray(q_pin, dtype=float)
+        if q_pin.shape != (self.nq,):
+            raise ConfigurationError(f"Pinocchio q must have nq = {self.nq} entries, got shape {q_pin.shape}")
+        out = np.empty(self.n)
+        out[self._scalar_pos] = q_pin[self._scalar_idx]
+        out[self._cont_pos] = np.arctan2(q_pin[self._cont_idx + 1], q_pin[self._cont_idx])
+        return out
+
+    def wrap_continuous(self, q) -> np.ndarray:
+        """q with continuous joints wrapped into (−π, π] (the same pose)."""
+        q = np.array(q, dtype=float)
+        if self._cont_pos.size:
+            q[self._cont_pos] = np.arctan2(np.sin(q[self._cont_pos]), np.cos(q[self._cont_pos]))
+        return q
+
+    def neutral(self) -> np.ndarray:
+        """Zero for every joint, moved into its limits where zero is outside them."""
+        return np.clip(np.zeros(self.n), self.lower, self.upper)
+
+    def random_q(self, rng: np.random.Generator | int | None = None) -> np.ndarray:
+        """A configuration drawn uniformly within the limits (continuous joints on [−π, π])."""
+        rng = np.random.default_rng(rng)
+        return rng.uniform(self.lower, self.upper)
+
+    def random_qs(self, count: int, rng: np.random.Generator | int | None = None) -> np.ndarray:
+        """``count`` configurations (rows) drawn uniformly within the limits."""
+        rng = np.random.default_rng(rng)
+        return rng.uniform(self.lower, self.upper, size=(count, self.n))
+
+    # -- kinematics ----------------------------------------------------------------------------
+    def _forward(self, q) -> None:
+        pin.forwardKinematics(self.model, self.data, self._pin_q(q))
+        pin.updateFramePlacements(self.model, self.data)
+
+    def fk(self, q) -> pin.SE3:
+        """oMtool: pose of the tool frame in the base frame at ``q`` (m, rad)."""
+        self._forward(q)
+        return pin.SE3(self.data.oMf[self.tool_frame_id])
+
+    def tool_error(self, q, oMtarget: pin.SE3) -> tuple[float, float]:
+        """(position error [m], rotation angle error [rad]) of the tool at q against oMtarget (Pinocchio FK)."""
+        pin.forwardKinematics(self.model, self.data, self._pin_q(q))
+        oMtool = pin.updateFramePlacement(self.model, self.data, self.tool_frame_id)
+        err = oMtarget.actInv(oMtool)  # the tool in the target frame: |t| is the position error
+        # hypot over Python floats: a solve ends with this check, and numpy's calls cost more than the maths
+        return math.hypot(*err.translation.tolist()), math.hypot(*pin.log3(err.rotation).tolist())
+
+    def frame_placement(self, q, frame: str) -> pin.SE3:
+        """oMframe: pose of any frame of the reduced model in the base frame."""
+        fid = _frame_id(self.model, frame, self.name)
+        self._forward(q)
+        return pin.SE3(self.data.oMf[fid])
+
+    def joint_placements(self, q) -> dict[str, pin.SE3]:
+        """oMjoint for every chain joint: the joint frame (after its motion) in the base frame."""
+        self._forward(q)
+        return {j.name: pin.SE3(self.data.oMi[i + 1]) for i, j in enumerate(self.joints)}
+
+    def _jacobian(self, q, frame: pin.ReferenceFrame) -> np.ndarray:
+        q_pin = self.to_pin_q(q)
+        J = pin.computeFrameJacobian(self.model, self.data, q_pin, self.tool_frame_id, frame)
+        return np.array(J).reshape(6, self.nv)  # a 1-DoF chain comes back as a flat 6-vector
+
+    def jacobian_local(self, q) -> np.ndarray:
+        """6 × n tool Jacobian in the tool frame (LOCAL): twist [v; ω] of the tool in its own axes."""
+        return self._jacobian(q, pin.LOCAL)
+
+    def jacobian_world(self, q) -> np.ndarray:
+        """6 × n tool Jacobian in the base frame (WORLD): spatial twist, v at the base origin."""
+        return self._jacobian(q, pin.WORLD)
+
+    def jacobian_local_world_aligned(self, q) -> np.ndarray:
+        """6 × n tool Jacobian with base axes at the tool origin (LOCAL_WORLD_ALIGNED)."""
+        return self._jacobian(q, pin.LOCAL_WORLD_ALIGNED)
+
+    def integrate(self, q, dq) -> np.ndarray:
+        """q ⊕ dq through ``pin.integrate`` (dq: n velocities × 1 s), back in one-number-per-joint form."""
+        dq = np.asarray(dq, dtype=float)
+        return self.from_pin_q(pin.integrate(self.model, self.to_pin_q(q), dq))
+
+    def difference(self, q0, q1) -> np.ndarray:
+        """q1 ⊖ q0 through ``pin.difference``: the n velocities that take q0 to q1 in 1 s."""
+        return pin.difference(self.model, self.to_pin_q(q0), self.to_pin_q(q1))
+
+    def visual_model(self, package_dirs: list[str] | None = None) -> pin.GeometryModel:
+        """Visual geometry matched to ``self.model`` (locked joints folded in), meshes resolved.
+
+        ``package://`` URIs resolve under ``package_dirs`` (default: example-robot-data's); visuals
+        whose mesh cannot be found are left out with a warning.
+        """
+        from kinelab.robot.meshes import build_visual_model
+
+        geom = build_visual_model(self._full, self.urdf_path, package_dirs)
+        if not self._lock_ids:
+            return geom
+        _, reduced = pin.buildReducedModel(self._full, geom, self._lock_ids, self._q_ref)
+        return reduced
+
+    @property
+    def frame_names(self) -> list[str]:
+        return [f.name for f in self.model.frames]
+
+    def characteristic_length(self) -> float:
+        """Mean distance between consecutive joint origins and the tool at the neutral pose [m].
+
+        A length scale to weigh linear against angular quantities (IK objectives, Jacobian rank).
+        """
+        if self._length is None:
+            self._length = self._mean_joint_spacing()
+        return self._length
+
+    def _mean_joint_spacing(self) -> float:
+        oMi = self.joint_placements(self.neutral())
+        pts = [m.translation for m in oMi.values()] + [self.fk(self.neutral()).translation]
+        steps = [np.linalg.norm(b - a) for a, b in itertools.pairwise(pts)]
+        positive = [s for s in steps if s > 1e-9]
+        return float(np.mean(positive)) if positive else 1.0
+
+    def __repr__(self) -> str:
+        return f"Robot({self.name!r}, n={self.n}, tool={self.tool!r}, urdf={str(self.urdf_path)!r})"
+
+
+def _local_axis(model: pin.Model, jid: int) -> np.ndarray:
+    """Unit axis of a 1-DoF joint in its own frame, read from its motion subspace."""
+    data = model.createData()
+    pin.computeJointJacobians(model, data, pin.neutral(model))
+    J = np.asarray(pin.getJointJacobian(model, data, jid, pin.LOCAL)).reshape(6, model.nv)
+    col = J[:, model.joints[jid].idx_v]
+    lin, ang = col[:3], col[3:]
+    return ang if np.linalg.norm(ang) > 0.5 else lin
+
+
+def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, float] | None = None) -> Robot:
+    """Load a registered robot (``kinelab.robots()``) or a URDF file as a :class:`Robot`.
+
+    Args:
+        name_or_path: a registered name such as ``"era"`` or ``"panda"``, or a path to a URDF.
+        tool: the tool frame; default: the registered tool, else a frame named ``tool``, else the
+            single leaf link (an error lists the leaves when there are several).
+        locked: chain joints to hold fixed, name → value (rad or m).
+    """
+    path, entry = catalog.resolve(name_or_path)
+    if entry is not None:
+        return Robot(path, tool=tool or entry.tool, locked=locked, name=entry.name)
+    return Robot(path, tool=tool, locked=locked)

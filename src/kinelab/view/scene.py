@@ -1,0 +1,261 @@
+"""meshcat scenes: a robot at q, tool and target frames, joint-trajectory animations with the tool path,
+singularity overlays, and self-contained static HTML.
+
+A :class:`Scene` owns a meshcat viewer (its zmq and web servers listen on 127.0.0.1 only) and draws
+through Pinocchio's MeshcatVisualizer, so meshes resolve with the loader's ``package://`` logic and the
+bundled robots draw their primitive shapes. Nothing opens a browser unless asked (``open=False``).
+"""
+
+from __future__ import annotations
+
+import base64
+import contextlib
+import io
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab.robot import Robot
+
+AXIS_COLORS = (0xE6194B, 0x3CB44B, 0x4363D8)  # x red, y green, z blue
+
+
+class Scene:
+    """A meshcat scene for one robot. ``scene.url`` is the live viewer; ``save_html`` writes a static copy."""
+
+    def __init__(self, robot: Robot, viewer=None, open: bool = False, name: str | None = None,
+                 frame_length: float | None = None):
+        import meshcat
+        from pinocchio.visualize import MeshcatVisualizer
+
+        self.robot = robot
+        with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL; we expose it as .url
+            self.viewer = viewer if viewer is not None else meshcat.Visualizer()
+        self.geom = robot.visual_model()
+        self.pinviz = MeshcatVisualizer(robot.model, pin.GeometryModel(), self.geom)
+        self.pinviz.initViewer(viewer=self.viewer)
+        self.root = name or robot.name
+        self.pinviz.loadViewerModel(rootNodeName=self.root)
+        self.frame_length = frame_length or 0.5 * robot.characteristic_length()
+        self._reach = self._arm_reach()
+        self.show(robot.neutral())
+        if open:
+            self.viewer.open()
+
+    @property
+    def url(self) -> str:
+        return self.viewer.url()
+
+    def node_paths(self) -> list[str]:
+        """The meshcat paths of the robot's visual geometries (one per URDF visual)."""
+        return [self.pinviz.getViewerNodeName(g, pin.GeometryType.VISUAL) for g in self.geom.geometryObjects]
+
+    def _arm_reach(self) -> float:
+        q = self.robot.neutral()
+        points = [m.translation for m in self.robot.joint_placements(q).values()] + [self.robot.fk(q).translation]
+        reach = sum(float(np.linalg.norm(b - a)) for a, b in zip(points, points[1:], strict=False))
+        # an arm's slide adds its stroke; a mobile base's long rails (over 2 m) would only shrink the arm
+        reach += sum(j.upper - j.lower for j in self.robot.joints if j.kind == "prismatic" and j.upper - j.lower < 2)
+        return max(reach, 0.3)
+
+    def look_at_robot(self, q=None) -> Scene:
+        """Aim the camera at the robot as it stands at q, far enough to see the arm stretched any way."""
+        q = self.robot.neutral() if q is None else q
+        points = np.array([m.translation for m in self.robot.joint_placements(q).values()])
+        reach = self._reach
+        # meshcat's orbit controls always look at the world origin: bring the robot to it instead, the
+        # point a little above its first joint at the origin, the grid moving with it
+        center = points[1:].mean(axis=0) if len(points) > 1 else points[0]
+        shift = pin.SE3(np.eye(3), -np.array([center[0], center[1], points[0][2] + 0.4 * reach]))
+        self.viewer.set_transform(shift.homogeneous)
+        self.viewer["/Grid"].set_transform(shift.homogeneous)
+        # the camera's position is in three.js axes (y up)
+        self.viewer["/Cameras/default/rotated/<object>"].set_property("position", [0.85 * reach, 0.3 * reach,
+                                                                                  0.65 * reach])
+        return self
+
+    # -- static scene ---------------------------------------------------------------------------
+    def show(self, q) -> Scene:
+        """Draw the robot at q (one number per joint) with its tool frame."""
+        q = self.robot.check_q(q)
+        self.pinviz.display(self.robot.to_pin_q(q))
+        self.frame("tool", self.robot.fk(q))
+        return self.look_at_robot(q)
+
+    def frame(self, name: str, oMframe: pin.SE3, length: float | None = None) -> Scene:
+        """A triad (x red, y green, z blue) at a pose in the base frame, under ``frames/<name>``."""
+        import meshcat.geometry as g
+
+        length = length or self.frame_length
+        for axis, color in enumerate(AXIS_COLORS):
+            end = np.zeros((3, 2))
+            end[axis, 1] = length
+            self.viewer["frames"][name][f"axis{axis}"].set_object(
+                g.Line(g.PointsGeometry(end), g.MeshBasicMaterial(color=color, linewidth=4)))
+        self.viewer["frames"][name].set_transform(oMframe.homogeneous)
+        return self
+
+    def target(self, oMtarget: pin.SE3) -> Scene:
+        """The target frame of an IK problem."""
+        return self.frame("target", oMtarget, 1.3 * self.frame_length)
+
+    def path(self, points: np.ndarray, name: str = "tool_path", color: int = 0xF58231) -> Scene:
+        """A polyline through points (rows, base frame) — e.g. the tool path of a trajectory."""
+        import meshcat.geometry as g
+
+        pts = np.asarray(points, dtype=float).T
+        self.viewer["paths"][name].set_object(g.Line(g.PointsGeometry(pts), g.MeshBasicMaterial(color=color)))
+        return self
+
+    # -- animation ------------------------------------------------------------------------------
+    def animate(self, qs, dt: float = 0.05, draw_path: bool = True, play: bool = True) -> Scene:
+        """An animation of a joint trajectory (rows of q) with the tool path drawn as a line."""
+        from meshcat.animation import Animation
+
+        qs = np.asarray(qs, dtype=float)
+        anim = Animation(default_framerate=max(1, int(round(1.0 / dt))))
+        model, data = self.robot.model, self.robot.model.createData()
+        gdata = pin.GeometryData(self.geom)
+        tool_points = []
+        for k, q in enumerate(qs):
+            q_pin = self.robot.to_pin_q(q)
+            pin.forwardKinematics(model, data, q_pin)
+            pin.updateGeometryPlacements(model, data, self.geom, gdata)
+            with anim.at_frame(self.viewer, k) as frame:
+                for obj, path in zip(self.geom.geometryObjects, self.node_paths(), strict=True):
+                    T = gdata.oMg[self.geom.getGeometryId(obj.name)].homogeneous.copy()
+                    T[:3, :3] = T[:3, :3] * np.asarray(obj.meshScale)
+                    frame[path].set_transform(T)
+                oMtool = self.robot.fk(q)
+                frame["frames"]["tool"].set_transform(oMtool.homogeneous)
+            tool_points.append(oMtool.translation)
+        if draw_path:
+            self.path(np.array(tool_points))
+        self.viewer.set_animation(anim, play=play)
+        return self
+
+    # -- singularities --------------------------------------------------------------------------
+    def singular_directions(self, q, scale: float | None = None) -> Scene:
+        """At q: the lost tool directions as arrows from the tool (translation magenta, rotation axis cyan)
+        and a sphere at the tool coloured by σ_min/σ_max (red: singular, green: far from it)."""
+        import meshcat.geometry as g
+
+        from kinelab.analysis.singular import analyze
+
+        a = analyze(self.robot, q)
+        oMtool = self.robot.fk(q)
+        scale = scale or 2 * self.frame_length
+        self.viewer["singular"].delete()
+        for k, d in enumerate(a.lost_directions):
+            for kind, color in (("translation", 0xF032E6), ("rotation", 0x42D4F4)):
+                axis = d.get(f"{kind}_axis")
+                share = d[f"{kind}_share"]
+                if axis is None or share < 1e-3:
+                    continue
+                seg = np.column_stack([oMtool.translation, oMtool.translation + scale * share * np.array(axis)])
+                self.viewer["singular"][f"lost{k}_{kind}"].set_object(
+                    g.Line(g.PointsGeometry(seg), g.MeshBasicMaterial(color=color, linewidth=6)))
+        ratio = float(a.singular_values[a.full_rank - 1] / a.singular_values[0])
+        level = min(1.0, max(0.0, (np.log10(max(ratio, 1e-12)) + 6) / 5))  # 1e-6 → red, 0.1 → green
+        color = int(255 * (1 - level)) << 16 | int(255 * level) << 8
+        self.viewer["singular"]["sigma"].set_object(g.Sphere(0.15 * self.frame_length),
+                                                    g.MeshLambertMaterial(color=color))
+        self.viewer["singular"]["sigma"].set_transform(pin.SE3(np.eye(3), oMtool.translation).homogeneous)
+        return self
+
+    # -- export ---------------------------------------------------------------------------------
+    def static_html(self) -> str:
+        """The whole scene (and its animation) as one self-contained HTML page (works offline)."""
+        return self.viewer.static_html()
+
+    def save_html(self, path: str | Path) -> Path:
+        path = Path(path)
+        path.write_text(self.static_html(), encoding="utf-8")
+        return path
+
+    def close(self) -> None:
+        with contextlib.suppress(Exception):
+            self.viewer.window.server_proc.kill()
+
+
+def empty_scene_html(viewer=None) -> str:
+    """A static page of an empty meshcat scene (the reference a robot's picture is compared with)."""
+    import meshcat
+
+    with contextlib.redirect_stdout(io.StringIO()):
+        vis = viewer if viewer is not None else meshcat.Visualizer()
+    html = vis.static_html()
+    if viewer is None:
+        with contextlib.suppress(Exception):
+            vis.window.server_proc.kill()
+    return html
+
+
+def scene_paths(html: str) -> set[str]:
+    """The meshcat node paths a static page sets objects on (decoded from its embedded commands)."""
+    import re
+
+    import umsgpack
+
+    paths = set()
+    for blob in re.findall(r"data:application/octet-binary;base64,([A-Za-z0-9+/=]+)", html):
+        cmd = umsgpack.unpackb(base64.b64decode(blob))
+        if isinstance(cmd, dict) and cmd.get("type") == "set_object":
+            paths.add(cmd.get("path", ""))
+    return paths
+
+
+def find_chromium() -> str | None:
+    """Path of a Chromium executable on PATH (Debian's ``chromium``), or None."""
+    import shutil
+
+    for name in ("chromium", "chromium-browser", "google-chrome"):
+        path = shutil.which(name)
+        if path:
+            return path
+    return None
+
+
+def screenshot(url_or_path: str | Path, png: str | Path, size: tuple[int, int] = (640, 480),
+               wait_ms: int = 8000, chromium: str | None = None) -> Path:
+    """Render a page in headless Chromium (software WebGL, no network but loopback) and save a PNG."""
+    import subprocess
+    import tempfile
+
+    chromium = chromium or find_chromium()
+    if chromium is None:
+        raise FileNotFoundError("no chromium on PATH (Debian: apt-get install chromium)")
+    target = str(url_or_path)
+    if "://" not in target:
+        target = Path(target).resolve().as_uri()
+    png = Path(png).resolve()
+    with tempfile.TemporaryDirectory(prefix="kinelab-chromium-") as profile:
+        cmd = [chromium, "--headless", "--no-sandbox", "--disable-gpu", "--use-angle=swiftshader",
+               "--enable-unsafe-swiftshader", "--disable-background-networking", "--disable-component-update",
+               "--disable-sync", "--disable-quic", "--no-first-run", f"--user-data-dir={profile}",
+               f"--window-size={size[0]},{size[1]}", f"--virtual-time-budget={wait_ms}", f"--screenshot={png}",
+               target]
+        subprocess.run(cmd, capture_output=True, timeout=120, check=False)
+    if not png.exists():
+        raise RuntimeError(f"chromium wrote no screenshot of {target}")
+    return png
+
+
+def changed_share(png_a: str | Path, png_b: str | Path, threshold: int = 24) -> float:
+    """Share of pixels whose colour differs by more than ``threshold`` (0–255, any channel) between two PNGs."""
+    from PIL import Image
+
+    a = np.asarray(Image.open(png_a).convert("RGB"), dtype=int)
+    b = np.asarray(Image.open(png_b).convert("RGB"), dtype=int)
+    if a.shape != b.shape:
+        raise ValueError(f"screenshots differ in size: {a.shape} and {b.shape}")
+    return float(np.mean(np.max(np.abs(a - b), axis=2) > threshold))
+
+
+def without_robot_html(scene: Scene) -> str:
+    """The same page (camera, frames, grid) with the robot's geometry removed: the reference picture."""
+    scene.viewer[scene.root].delete()
+    html = scene.static_html()
+    scene.pinviz.loadViewerModel(rootNodeName=scene.root)
+    return html
