@@ -2,6 +2,7 @@
 
 import os
 
+import browser
 import numpy as np
 import pytest
 
@@ -9,7 +10,7 @@ import kinelab
 from kinelab.view import scene as viz
 
 BUNDLED = ("stanford", "era", "youbot")
-CHROMIUM = viz.find_chromium()
+CHROMIUM = browser.find_chromium()
 needs_browser = pytest.mark.skipif(
     CHROMIUM is None and not os.environ.get("CI"),
     reason="Debian's chromium is not installed here (.ci/run installs it; in CI this test must run)",
@@ -25,7 +26,7 @@ def scene(request):
 
 
 def test_scene_tree_holds_every_visual_of_the_robot(scene):
-    paths = viz.scene_paths(scene.static_html())
+    paths = browser.scene_paths(scene.static_html())
     expected = {"/meshcat/" + p for p in scene.node_paths()}
     assert len(expected) >= 5 and expected <= paths
     assert any(p.startswith("/meshcat/frames/tool") for p in paths)
@@ -45,7 +46,7 @@ def test_animation_with_tool_path_and_singular_overlay():
     s.singular_directions(np.zeros(7))
     html = s.static_html()
     s.close()
-    paths = viz.scene_paths(html)
+    paths = browser.scene_paths(html)
     assert "/meshcat/paths/tool_path" in paths
     assert any(p.startswith("/meshcat/singular/lost0") for p in paths) and "/meshcat/singular/sigma" in paths
     assert html.count("data:application/octet-binary") > len(paths)  # the animation travels as a command too
@@ -59,11 +60,11 @@ def test_a_real_browser_draws_the_robot(name, tmp_path):
     robot = kinelab.load(name)
     s = viz.Scene(robot).show(robot.random_q(2))
     with_robot = s.save_html(tmp_path / "robot.html")
-    (tmp_path / "empty.html").write_text(viz.without_robot_html(s))
-    shot_robot = viz.screenshot(with_robot, tmp_path / "robot.png")
-    shot_empty = viz.screenshot(tmp_path / "empty.html", tmp_path / "empty.png")
-    share = viz.changed_share(shot_robot, shot_empty)
-    live_share = viz.changed_share(viz.screenshot(s.url, tmp_path / "live.png"), shot_empty)
+    (tmp_path / "empty.html").write_text(browser.without_robot_html(s))
+    shot_robot = browser.screenshot(with_robot, tmp_path / "robot.png")
+    shot_empty = browser.screenshot(tmp_path / "empty.html", tmp_path / "empty.png")
+    share = browser.changed_share(shot_robot, shot_empty)
+    live_share = browser.changed_share(browser.screenshot(s.url, tmp_path / "live.png"), shot_empty)
     s.close()
     assert share > 0.003, f"the robot covers only {share:.2%} of the picture"
     assert live_share > 0.003, f"the live viewer shows only {live_share:.2%} of changed pixels"
@@ -73,9 +74,9 @@ def test_a_real_browser_draws_the_robot(name, tmp_path):
 def test_the_empty_reference_really_is_empty_of_the_robot(tmp_path):
     robot = kinelab.load("era")
     s = viz.Scene(robot)
-    (tmp_path / "a.html").write_text(viz.without_robot_html(s))
-    (tmp_path / "b.html").write_text(viz.without_robot_html(s))
+    (tmp_path / "a.html").write_text(browser.without_robot_html(s))
+    (tmp_path / "b.html").write_text(browser.without_robot_html(s))
     s.close()
-    share = viz.changed_share(viz.screenshot(tmp_path / "a.html", tmp_path / "a.png"),
-                              viz.screenshot(tmp_path / "b.html", tmp_path / "b.png"))
+    share = browser.changed_share(browser.screenshot(tmp_path / "a.html", tmp_path / "a.png"),
+                              browser.screenshot(tmp_path / "b.html", tmp_path / "b.png"))
     assert share < 0.001  # two renders of the same page agree: the comparison measures the robot

@@ -74,7 +74,7 @@ def joint_relations(robot: Robot, q, tol: float = RELATION_TOL) -> list[Relation
     relations implied by single-joint ones (θ2 = 0 and θ3 = 0 imply θ2 ± θ3 = 0) are left out."""
     names = robot.joint_names
     angular = [i for i, k in enumerate(robot.joint_kinds) if k != "prismatic"]
-    combos = [((i,), (1,)) for i in angular]
+    combos: list[tuple[tuple[int, ...], tuple[int, ...]]] = [((i,), (1,)) for i in angular]
     combos += [((i, j), (1, s)) for i, j in itertools.combinations(angular, 2) for s in (1, -1)]
     combos += [((a, b, d), (1, 1, 1)) for a, b, d in zip(angular, angular[1:], angular[2:], strict=False)]
     out: list[Relation] = []

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -157,7 +158,7 @@ def cmd_ik(args) -> int:
     robot = load(args.robot, tool=args.tool)
     if (args.target_q is None) == (args.target_xyz is None):
         raise KinelabError("give the target as --target-q Q... or as --target-xyz X Y Z [--target-rpy R P Y]")
-    options = {}
+    options: dict[str, Any] = {}
     if args.target_q is not None:
         q_target = robot.check_q(_q_from_cli(robot, args.target_q, args.deg, "--target-q"), limits=True,
                                  what="--target-q")

@@ -11,7 +11,8 @@ import numpy as np
 def seed_state(seed: int | None) -> np.ndarray:
     """A non-zero 64-bit state for a kernel's xorshift generator (splitmix64 of the seed; None: fresh entropy)."""
     mask = (1 << 64) - 1
-    x = (int(np.random.SeedSequence().entropy) if seed is None else int(seed)) & mask
+    entropy = np.random.SeedSequence().entropy if seed is None else seed
+    x = int(entropy) & mask  # type: ignore[arg-type]
     x = (x + 0x9E3779B97F4A7C15) & mask
     x = ((x ^ (x >> 30)) * 0xBF58476D1CE4E5B9) & mask
     x = ((x ^ (x >> 27)) * 0x94D049BB133111EB) & mask

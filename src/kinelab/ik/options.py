@@ -32,7 +32,7 @@ def from_kwargs(cls: type[T], solver: str, kwargs: dict[str, Any]) -> T:
         hash(key)
     except TypeError:  # an unhashable value (a dict of kicks, a list of weights): build without the cache
         return _build(cls, solver, kwargs)
-    return _cached(cls, solver, key)  # type: ignore[no-any-return]
+    return _cached(cls, solver, key)  # type: ignore[arg-type]
 
 
 @functools.lru_cache(maxsize=256)

@@ -210,7 +210,7 @@ class Robot:
         so it lives exactly as long as the Robot."""
         if key not in self._derived:
             self._derived[key] = build(self)
-        return self._derived[key]  # type: ignore[no-any-return]
+        return self._derived[key]
 
     # -- construction ------------------------------------------------------------------------
     @staticmethod
@@ -267,8 +267,8 @@ class Robot:
                 lo, hi = -np.pi, np.pi
             else:
                 lo, hi = float(m.lowerPositionLimit[iq]), float(m.upperPositionLimit[iq])
-            axis = tuple(float(a) for a in _local_axis(m, jid))
-            table.append(Joint(m.names[jid], kind, lo, hi, iq, iv, axis))
+            ax, ay, az = (float(a) for a in _local_axis(m, jid))
+            table.append(Joint(m.names[jid], kind or "revolute", lo, hi, iq, iv, (ax, ay, az)))
         return table
 
     # -- coordinates ---------------------------------------------------------------------------

@@ -34,6 +34,7 @@ turn in one sample. With q1 (or q7) frozen the joint path closes every lap.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -148,7 +149,8 @@ def shoulder_passage(robot: Robot | None = None, radius: float = 0.5, samples: i
     )
 
 
-PASSAGES = {"elbow": elbow_passage, "wrist": wrist_passage, "shoulder": shoulder_passage}
+PASSAGES: dict[str, Callable[..., Passage]] = {"elbow": elbow_passage, "wrist": wrist_passage,
+                                               "shoulder": shoulder_passage}
 
 
 def run(passage: Passage, robot: Robot | None = None, **options) -> PassageRun:

@@ -2,7 +2,7 @@
 
 The paper's biquaternion N = n + s n0 is printed to six digits, scalar first (``_wxyz``). Its rotation
 part is reproduced by ``urdf/stanford.urdf`` at the paper's target q; its dual part equals
-n0 = ½ r∘n of that model divided by 10 (see the header of stanford.urdf and robot-models.md §4).
+n0 = ½ r∘n of that model divided by 10 (see the header of stanford.urdf and docs/robot-models.md §4).
 """
 
 from __future__ import annotations

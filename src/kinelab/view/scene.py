@@ -8,7 +8,6 @@ bundled robots draw their primitive shapes. Nothing opens a browser unless asked
 
 from __future__ import annotations
 
-import base64
 import contextlib
 import io
 from pathlib import Path
@@ -177,85 +176,3 @@ class Scene:
     def close(self) -> None:
         with contextlib.suppress(Exception):
             self.viewer.window.server_proc.kill()
-
-
-def empty_scene_html(viewer=None) -> str:
-    """A static page of an empty meshcat scene (the reference a robot's picture is compared with)."""
-    import meshcat
-
-    with contextlib.redirect_stdout(io.StringIO()):
-        vis = viewer if viewer is not None else meshcat.Visualizer()
-    html = vis.static_html()
-    if viewer is None:
-        with contextlib.suppress(Exception):
-            vis.window.server_proc.kill()
-    return html
-
-
-def scene_paths(html: str) -> set[str]:
-    """The meshcat node paths a static page sets objects on (decoded from its embedded commands)."""
-    import re
-
-    import umsgpack
-
-    paths = set()
-    for blob in re.findall(r"data:application/octet-binary;base64,([A-Za-z0-9+/=]+)", html):
-        cmd = umsgpack.unpackb(base64.b64decode(blob))
-        if isinstance(cmd, dict) and cmd.get("type") == "set_object":
-            paths.add(cmd.get("path", ""))
-    return paths
-
-
-def find_chromium() -> str | None:
-    """Path of a Chromium executable on PATH (Debian's ``chromium``), or None."""
-    import shutil
-
-    for name in ("chromium", "chromium-browser", "google-chrome"):
-        path = shutil.which(name)
-        if path:
-            return path
-    return None
-
-
-def screenshot(url_or_path: str | Path, png: str | Path, size: tuple[int, int] = (640, 480),
-               wait_ms: int = 8000, chromium: str | None = None) -> Path:
-    """Render a page in headless Chromium (software WebGL, no network but loopback) and save a PNG."""
-    import subprocess
-    import tempfile
-
-    chromium = chromium or find_chromium()
-    if chromium is None:
-        raise FileNotFoundError("no chromium on PATH (Debian: apt-get install chromium)")
-    target = str(url_or_path)
-    if "://" not in target:
-        target = Path(target).resolve().as_uri()
-    png = Path(png).resolve()
-    with tempfile.TemporaryDirectory(prefix="kinelab-chromium-") as profile:
-        cmd = [chromium, "--headless", "--no-sandbox", "--disable-gpu", "--use-angle=swiftshader",
-               "--enable-unsafe-swiftshader", "--disable-background-networking", "--disable-component-update",
-               "--disable-sync", "--disable-quic", "--no-first-run", f"--user-data-dir={profile}",
-               f"--window-size={size[0]},{size[1]}", f"--virtual-time-budget={wait_ms}", f"--screenshot={png}",
-               target]
-        subprocess.run(cmd, capture_output=True, timeout=120, check=False)
-    if not png.exists():
-        raise RuntimeError(f"chromium wrote no screenshot of {target}")
-    return png
-
-
-def changed_share(png_a: str | Path, png_b: str | Path, threshold: int = 24) -> float:
-    """Share of pixels whose colour differs by more than ``threshold`` (0–255, any channel) between two PNGs."""
-    from PIL import Image
-
-    a = np.asarray(Image.open(png_a).convert("RGB"), dtype=int)
-    b = np.asarray(Image.open(png_b).convert("RGB"), dtype=int)
-    if a.shape != b.shape:
-        raise ValueError(f"screenshots differ in size: {a.shape} and {b.shape}")
-    return float(np.mean(np.max(np.abs(a - b), axis=2) > threshold))
-
-
-def without_robot_html(scene: Scene) -> str:
-    """The same page (camera, frames, grid) with the robot's geometry removed: the reference picture."""
-    scene.viewer[scene.root].delete()
-    html = scene.static_html()
-    scene.pinviz.loadViewerModel(rootNodeName=scene.root)
-    return html

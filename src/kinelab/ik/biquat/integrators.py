@@ -178,7 +178,7 @@ def adaptive(system: System, q_pin: np.ndarray, stop: Stop, traj: Trajectory | N
         M = system.error(q)
         return max(np.linalg.norm(M[1:4]) / eps_rot, np.linalg.norm(M[5:8]) / eps_dual) - 1.0
 
-    converged.terminal = True
+    converged.terminal = True  # type: ignore[attr-defined]
     sol = solve_ivp(rhs, (0.0, stop.max_time), np.r_[np.zeros(nv), 1.0, 0.0], events=converged, rtol=1e-8,
                     atol=1e-10, first_step=min(stop.h, 0.1))
     q_end, _ = unpack(sol.y[:, -1])

@@ -31,7 +31,7 @@ def error_biquaternion(p, R, pstar, Rstar):
 
 
 @njit(cache=True)
-def simple_law(M, k, k0, k_v, twist):
+def simple_law(M: np.ndarray, k: float, k0: float, k_v: float, twist: np.ndarray) -> bool:
     """Law (9)/(16): U = −2K vect(M)/scal(M) with K = k + s k0 [1/s]; ``k_v`` a separate moment gain.
 
     ω = −2k m⃗/m^0 and v = −2[k_v (m^0 m0⃗ − m0^0 m⃗) + k0 m^0 m⃗]/(m^0)². With k_v = k this is the dual gain
@@ -50,7 +50,8 @@ def simple_law(M, k, k0, k_v, twist):
 
 
 @njit(cache=True)
-def regular_law(M, tau, tau0, k, k0, twist):
+def regular_law(M: np.ndarray, tau: float, tau0: float, k: float, k0: float,
+                twist: np.ndarray) -> tuple[float, float]:
     """Law (11)/(12): U = −K T⁻¹ vect(M), 2Ṫ = K(scal(M) − T), T = τ + s τ0 (T(t0) = 1).
 
     Returns:

@@ -83,8 +83,8 @@ def attempt(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol
         The attempt, before kinelab's Pinocchio check.
 
     Raises:
-        OptionError: an option outside what it accepts; BiquaternionError: a target biquaternion that is
-        not unit or not the target's pose.
+        OptionError: an option outside what it accepts.
+        BiquaternionError: a target biquaternion that is not unit or not the target's pose.
     """
     opts = BiquatOptions.of(options, **kwargs)
     N = _target_biquaternion(opts, oMtarget)

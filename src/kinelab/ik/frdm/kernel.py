@@ -24,6 +24,7 @@ from kinelab.ik.chain import (
     CONTINUOUS,
     PRISMATIC,
     TWO_PI,
+    Chain,
     chain_fk,
     random_configuration,
     rotate_about,
@@ -320,7 +321,7 @@ class _Work(NamedTuple):
     gamma: np.ndarray
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _work(n, accel_m):
     m = max(accel_m, 1)
     return _Work(np.empty((n, 3)), np.empty((n, 3)), np.empty(3), np.empty((3, 3)),
@@ -329,7 +330,7 @@ def _work(n, accel_m):
                  np.empty((n, m)), np.empty((n, m)), np.empty((m, m)), np.empty(m), np.empty(m))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _extrapolate(q, ch, pb, st, mem, w, E1):
     """Record the sweep in the history and try the Anderson extrapolation; keep it only if it lowers E.
 
@@ -368,7 +369,7 @@ def _extrapolate(q, ch, pb, st, mem, w, E1):
     return E1, False
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _fk_converged(q, ch, pb, e, o, p, R, since_fk):
     """Recompute the FK if the state was carried incrementally, then test both tolerances."""
     if since_fk > 0:
@@ -376,7 +377,7 @@ def _fk_converged(q, ch, pb, e, o, p, R, since_fk):
     return _within(p, R, pb.pstar, pb.Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _window_stalled(state, st, E1):
     """The monitor's window test: True when E fell by less than window_rel over the last window."""
     if state[S_SWEEPS] - state[S_WINDOW_START] >= st.window:
@@ -388,14 +389,18 @@ def _window_stalled(state, st, E1):
 
 
 @njit(cache=True)
-def run(q, ch, pb, st, order, max_sweeps, mem):
+def run(q: np.ndarray, ch: Chain, pb: Problem, st: Settings, order: int, max_sweeps: int,
+        mem: Memory) -> tuple[int, int]:
     """Sweep until converged, stalled or ``max_sweeps`` sweeps; q is updated in place.
 
     Args:
-        q: start, one number per joint [rad or m]; holds the result on return.
-        ch, pb, st, mem: :class:`~kinelab.ik.chain.Chain`, :class:`Problem`, :class:`Settings`, :class:`Memory`.
-        order: TIP_TO_BASE, BASE_TO_TIP or ALTERNATE.
-        max_sweeps: sweeps allowed in this call.
+        q (np.ndarray): start, one number per joint [rad or m]; holds the result on return.
+        ch (Chain): the chain.
+        pb (Problem): the target, weights, tolerances and windows.
+        st (Settings): sweep and monitor settings.
+        order (int): TIP_TO_BASE, BASE_TO_TIP or ALTERNATE.
+        max_sweeps (int): sweeps allowed in this call.
+        mem (Memory): work arrays kept between calls.
 
     Returns:
         (code, sweeps in this call); the state slots S_* carry the rest.

@@ -8,6 +8,7 @@ polish or trace (``FRDMOptions.compiled``). Both return before kinelab's Pinocch
 
 from __future__ import annotations
 
+import functools
 import time
 from typing import Any
 
@@ -16,7 +17,7 @@ import pinocchio as pin
 
 from kinelab.ik import dls
 from kinelab.ik import multistart as restarts
-from kinelab.ik.chain import chain_model
+from kinelab.ik.chain import ChainModel, chain_model
 from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm.monitor import CHUNK, Bypass, Problem, Runner
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
@@ -91,7 +92,7 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, 
     """
     opts = options or FRDMOptions()
     cm = chain_model(robot)
-    prob = Problem(cm, oMtarget, opts, tol_pos, tol_rot).tuple()
+    prob = _compiled_problem(cm, oMtarget, opts, tol_pos, tol_rot)
     rng_state = restarts.seed_state(seed)
     q = np.array(q0, dtype=float)
     best_q = q.copy()
@@ -120,3 +121,27 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, 
     attempts = int(stats[kernel.T_ATTEMPTS])
     return Attempt(robot.wrap_continuous(best_q), status, int(stats[kernel.T_SWEEPS]), events, [], info), \
         max(0, attempts - 1)
+
+
+def _compiled_problem(cm: ChainModel, oMtarget: pin.SE3, opts: FRDMOptions, tol_pos: float,
+                      tol_rot: float) -> kernel.Problem:
+    """The kernel's problem for the multistart: no bypass ever changes its windows, so the chain's own
+    limit arrays and one shared all-free mask serve (no copies: the per-call cost is what a loop pays)."""
+    if opts.use_limits:
+        lower, upper = cm.lower, cm.upper
+    else:
+        lower, upper = _unbounded(cm.n), _unbounded(cm.n, 1.0)
+    return kernel.Problem(lower, upper, _all_free(cm.n), oMtarget.translation, oMtarget.rotation,
+                          opts.position_weight(cm.length), opts.axis_weights(), float(tol_pos), float(tol_rot),
+                          opts.mode != "orientation", opts.mode != "position")
+
+
+@functools.cache
+def _all_free(n: int) -> np.ndarray:
+    """Shared by every compiled solve; the kernel never writes it."""
+    return np.ones(n, dtype=np.bool_)
+
+
+@functools.cache
+def _unbounded(n: int, sign: float = -1.0) -> np.ndarray:
+    return np.full(n, sign * np.inf)

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -67,7 +68,7 @@ class TrackResult:
 def track(
     robot: Robot,
     targets: list[pin.SE3],
-    q0,
+    q0: np.ndarray,
     *,
     tol_pos: float = 1e-6,
     tol_rot: float = 1e-6,
@@ -81,22 +82,35 @@ def track(
     hold: int = 10,
     stall_window: int = 100,
     stall_rel: float = 1e-6,
-    **frdm_options,
+    **frdm_options: Any,
 ) -> TrackResult:
     """Solve each target in turn, warm-started from the previous answer.
 
     Args:
+        robot: the robot.
         targets: oMtarget per sample (base frame).
-        q0: the configuration at the start of the path.
+        q0: the configuration at the start of the path [rad or m].
+        tol_pos: position tolerance per sample [m].
+        tol_rot: rotation tolerance per sample [rad].
         max_sweeps: sweep cap per sample.
         jump_limit: largest joint change per sample [rad or m] before the jump monitor fires (None: off).
-        kicks, intervals, freeze, policy: the bypass configuration (see ``solver.attempt``); the
-            default ``policy=()`` is FRDM without bypass.
+        kicks: the bypass kicks (see :class:`~kinelab.ik.frdm.options.FRDMOptions`).
+        intervals: the bypass intervals.
+        freeze: the joints to freeze.
+        policy: the bypass policy; the default ``()`` is FRDM without bypass.
         restrict: restrictions ("intervals", "freeze") held on every sample of the path.
         hold: samples a restriction stays on after the monitor switched it on.
-        stall_window, stall_rel: the monitor's patience; a path sample starts close to its answer, so a
-            slow start is an escape from a singularity, not a local minimum to abandon.
-        frdm_options: passed to ``solver.attempt`` (order, w_p, accel, ...).
+        stall_window: the monitor's window [sweeps]; a path sample starts close to its answer, so a slow
+            start is an escape from a singularity, not a local minimum to abandon.
+        stall_rel: the relative fall required over the window.
+        **frdm_options: other :class:`~kinelab.ik.frdm.options.FRDMOptions` fields (order, w_p, accel, ...).
+
+    Returns:
+        One row of q per sample with its Pinocchio-measured errors, statuses and the monitor log.
+
+    Raises:
+        ConfigurationError: q0 of the wrong shape or outside the limits.
+        KinelabError: a restriction named without its table.
     """
     q_prev = robot.check_q(q0, limits=True, what="q0")
     unknown = [s for s in restrict if s not in ("intervals", "freeze")]

@@ -70,21 +70,23 @@ class _Tally:
             q, it = None, -1
         elapsed = time.perf_counter() - t0
         ok, why = check_solution(self.robot, q, case.oMtarget, elapsed, budget)
-        if self.best[k] is None or elapsed < self.best[k][0]:
+        kept = self.best[k]
+        if kept is None or elapsed < kept[0]:
             self.best[k] = (elapsed, ok, why, it)
 
     def row(self) -> Row:
-        times = np.array([b[0] for b in self.best]) * 1e6
-        solved = [b[0] * 1e6 for b in self.best if b[1]]
+        best = [b for b in self.best if b is not None]
+        times = np.array([b[0] for b in best]) * 1e6
+        solved = [b[0] * 1e6 for b in best if b[1]]
         failures: dict[str, int] = {}
-        for _, ok, why, _ in self.best:
+        for _, ok, why, _ in best:
             if not ok:
                 key = why.split(" ")[0] if why.startswith("pose") else why
                 failures[key] = failures.get(key, 0) + 1
-        n = len(self.best)
+        n = len(best)
         return Row(self.robot.name, self.name, n, len(solved), 100.0 * len(solved) / n, float(np.median(times)),
                    float(np.percentile(times, 95)), float(np.median(solved)) if solved else float("nan"),
-                   float(np.median([b[3] for b in self.best])), failures)
+                   float(np.median([b[3] for b in best])), failures)
 
 
 def run_robot(robot: Robot, solvers: dict[str, Prepare], problems: list[Case], budget: float, seed: int,
