@@ -300,17 +300,9 @@ def _cholesky_solve(A, rhs, gamma, k):
         gamma[r] /= A[r, r]
 
 
-class _Work(NamedTuple):
-    """Arrays of one run() call (allocated once per call, never inside the sweep loop)."""
+class _Scratch(NamedTuple):
+    """Work arrays of the acceleration step (allocated once per run() call, never inside the sweep loop)."""
 
-    e: np.ndarray
-    o: np.ndarray
-    p: np.ndarray
-    R: np.ndarray
-    ec: np.ndarray
-    oc: np.ndarray
-    pc: np.ndarray
-    Rc: np.ndarray
     x_old: np.ndarray
     cand: np.ndarray
     g: np.ndarray
@@ -322,20 +314,18 @@ class _Work(NamedTuple):
 
 
 @njit(cache=True, inline="always")
-def _work(n, accel_m):
+def _scratch(n, accel_m):
     m = max(accel_m, 1)
-    return _Work(np.empty((n, 3)), np.empty((n, 3)), np.empty(3), np.empty((3, 3)),
-                 np.empty((n, 3)), np.empty((n, 3)), np.empty(3), np.empty((3, 3)),
-                 np.empty(n), np.empty(n), np.empty(n),
-                 np.empty((n, m)), np.empty((n, m)), np.empty((m, m)), np.empty(m), np.empty(m))
+    return _Scratch(np.empty(n), np.empty(n), np.empty(n), np.empty((n, m)), np.empty((n, m)), np.empty((m, m)),
+                    np.empty(m), np.empty(m))
 
 
 @njit(cache=True, inline="always")
-def _extrapolate(q, ch, pb, st, mem, w, E1):
+def _extrapolate(q, ch, pb, st, mem, w, ec, oc, pc, Rc, E1):
     """Record the sweep in the history and try the Anderson extrapolation; keep it only if it lowers E.
 
-    Returns (objective after this step, accepted). When accepted, q and the candidate FK arrays (w.ec,
-    w.oc, w.pc, w.Rc) hold the new state, and the caller swaps them with its own.
+    Returns (objective after this step, accepted). When accepted, q and the candidate FK arrays (ec, oc,
+    pc, Rc) hold the new state, and the caller swaps them with its own.
     """
     n = q.shape[0]
     state = mem.state
@@ -360,8 +350,8 @@ def _extrapolate(q, ch, pb, st, mem, w, E1):
             w.cand[i] = min(max(w.cand[i], pb.lower[i]), pb.upper[i])
         if not pb.free[i]:
             w.cand[i] = q[i]
-    chain_fk(ch, w.cand, w.ec, w.oc, w.pc, w.Rc)
-    Ec = objective(w.pc, w.Rc, pb.pstar, pb.Rstar, pb.w_p, pb.w_ax)
+    chain_fk(ch, w.cand, ec, oc, pc, Rc)
+    Ec = objective(pc, Rc, pb.pstar, pb.Rstar, pb.w_p, pb.w_ax)
     if Ec < E1:
         q[:] = w.cand
         state[S_ACCEPTED] += 1.0
@@ -406,9 +396,10 @@ def run(q: np.ndarray, ch: Chain, pb: Problem, st: Settings, order: int, max_swe
         (code, sweeps in this call); the state slots S_* carry the rest.
     """
     state = mem.state
-    w = _work(q.shape[0], st.accel_m)
-    e, o, p, R = w.e, w.o, w.p, w.R
-    ec, oc, pc, Rc = w.ec, w.oc, w.pc, w.Rc
+    n = q.shape[0]
+    w = _scratch(n, st.accel_m)
+    e, o, p, R = np.empty((n, 3)), np.empty((n, 3)), np.empty(3), np.empty((3, 3))
+    ec, oc, pc, Rc = np.empty((n, 3)), np.empty((n, 3)), np.empty(3), np.empty((3, 3))
     fresh = False  # e, o, p, R hold the state at q (carried by the last sweep or an accepted extrapolation)
     since_fk = 0  # sweeps since p, R came from a chain FK (incremental updates carry rounding)
     for s in range(max_sweeps):
@@ -437,13 +428,12 @@ def run(q: np.ndarray, ch: Chain, pb: Problem, st: Settings, order: int, max_swe
             state[S_E] = E1
             return STALL_STEP, s + 1
         if st.accel_m > 0:
-            E1, accepted = _extrapolate(q, ch, pb, st, mem, w, E1)
+            E1, accepted = _extrapolate(q, ch, pb, st, mem, w, ec, oc, pc, Rc, E1)
             if accepted:
                 e, ec = ec, e
                 o, oc = oc, o
                 p, pc = pc, p
                 R, Rc = Rc, R
-                w = _Work(e, o, p, R, ec, oc, pc, Rc, w.x_old, w.cand, w.g, w.dG, w.dX, w.A, w.rhs, w.gamma)
                 fresh = True
                 since_fk = 0
         state[S_E] = E1
