@@ -344,3 +344,40 @@ def test_a_cold_first_solve_compiles_before_its_clock_starts(tmp_path):
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=600)
     success, wall_time = out.stdout.split()
     assert success == "True" and float(wall_time) < 0.05, out.stdout + out.stderr
+
+
+def test_the_typed_entry_point_gives_the_dispatchers_answer(robots):
+    """solve() calls the compiled multistart through TypedKernel; numba's own dispatch must agree bit for bit."""
+    from kinelab.ik.frdm import kernel
+    from kinelab.ik.frdm import solver as frdm_solver
+    from kinelab.ik.multistart import seed_state
+
+    robot = robots["panda"]
+    cm = vector_model(robot)
+    opts = kinelab.FRDMOptions()
+    rng = np.random.default_rng(21)
+    solve(robot, robot.fk(robot.random_q(rng)))  # the typed entry point exists from here on
+    for k in range(20):
+        target, q0 = robot.fk(robot.random_q(rng)), robot.random_q(rng)
+        problem = frdm_solver._compiled_problem(cm, target, opts, 1e-6, 1e-6)
+        out = []
+        for call in (frdm_solver._MULTISTART, kernel.multistart):
+            q, best, stats = q0.copy(), q0.copy(), np.zeros(kernel.STATS_SIZE)
+            code = call(q, cm.chain, problem, opts.settings(), 3, 100, seed_state(k), 5, 1e9, best, stats)
+            out.append((code, best, stats))
+        assert out[0][0] == out[1][0]
+        np.testing.assert_array_equal(out[0][1], out[1][1])
+        np.testing.assert_array_equal(out[0][2], out[1][2])
+
+
+def test_numpy_scalars_as_arguments_give_the_same_answer_as_python_ones(robots):
+    """Every scalar reaching a compiled kernel is made a Python int, float or bool first (one signature)."""
+    robot = robots["ur5"]
+    rng = np.random.default_rng(5)
+    for _ in range(5):
+        target, q0 = robot.fk(robot.random_q(rng)), robot.random_q(rng)
+        plain = solve(robot, target, q0=q0, seed=3, max_restarts=20, max_sweeps=100, w_p=30.0, relax=1.0)
+        numpy = solve(robot, target, q0=q0, seed=np.int64(3), max_restarts=np.int32(20), max_sweeps=np.int16(100),
+                      w_p=np.float64(30.0), relax=np.float32(1.0), tol_pos=np.float64(1e-6))
+        np.testing.assert_array_equal(plain.q, numpy.q)
+        assert plain.status == numpy.status and plain.iterations == numpy.iterations

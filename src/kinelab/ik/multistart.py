@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from typing import Any
 
+import numba
 import numpy as np
 
 
@@ -24,6 +26,7 @@ def run_in_chunks(chunk: Callable[[int], int], attempts: int, stats: np.ndarray,
     """Call ``chunk(attempts_left)`` (a kernel run that adds its attempts to stats[0]) until it returns
     ``converged``, the attempts are spent or the deadline passes; returns the last code."""
     code = -1
+    attempts = int(attempts)
     while attempts > 0:
         before = stats[0]
         code = chunk(attempts)
@@ -31,3 +34,27 @@ def run_in_chunks(chunk: Callable[[int], int], attempts: int, stats: np.ndarray,
         if code == converged or time.perf_counter() > deadline:
             break
     return code
+
+
+class TypedKernel:
+    """A numba kernel called through the compiled entry point of the argument types it first saw.
+
+    numba types every argument on every call, and a NamedTuple argument is typed in Python: 2–3 µs per
+    call for kinelab's kernel tuples, as much as a converged solve costs. kinelab builds every argument
+    of its kernels itself, with fixed dtypes, layouts and scalar types (``float``, ``int``, ``bool``), so
+    after the first call (which compiles or loads the kernel through the dispatcher, with numba's own
+    type check) the same compiled function serves every later call. A call whose argument types could
+    differ must go through the dispatcher (``kernel.py_dispatcher``) instead.
+    """
+
+    def __init__(self, dispatcher: Any):
+        self.py_dispatcher = dispatcher
+        self._entry: Callable[..., Any] | None = None
+
+    def __call__(self, *args: Any) -> Any:
+        if self._entry is not None:
+            return self._entry(*args)
+        result = self.py_dispatcher(*args)
+        signature = tuple(numba.typeof(a) for a in args)
+        self._entry = self.py_dispatcher.overloads[signature].entry_point
+        return result

@@ -141,7 +141,7 @@ def solve(
     return _loop(module, problem, start, max_restarts, opts, rng, beyond)
 
 
-@dataclass
+@dataclass(slots=True)
 class _Problem:
     """What one solve is asked, handed between solve's helpers."""
 

@@ -24,11 +24,13 @@ from kinelab.ik.biquat.integrators import Stop, System, Trajectory, adaptive, fi
 from kinelab.ik.biquat.options import BiquatOptions
 from kinelab.ik.chain import chain_model
 from kinelab.ik.limits import wrap_q
+from kinelab.ik.multistart import TypedKernel
 from kinelab.ik.result import Attempt, Status
 from kinelab.robot import Robot
 
 Options = BiquatOptions
 CHUNK_STEPS = 256  # steps between two looks at the clock in the compiled preset
+_MULTISTART = TypedKernel(kernel.multistart)
 
 
 def error_biquaternion(N: DualQuat, Lam: DualQuat) -> DualQuat:
@@ -136,15 +138,15 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, 
     damping = opts.damping_for(robot.n)
     cm = chain_model(robot)
     max_steps = 30 if opts.max_time is None else max(1, int(np.ceil(float(opts.max_time) * k)))
-    prob = kernel.Problem(np.array(oMtarget.translation), np.array(oMtarget.rotation), k, 1.0 / k, 0.5, max_steps,
-                          0.5 * tol_rot, 0.5 * tol_pos, damping)
+    prob = kernel.Problem(np.array(oMtarget.translation), np.ascontiguousarray(oMtarget.rotation), float(k), 1.0 / k,
+                          0.5, int(max_steps), 0.5 * float(tol_rot), 0.5 * float(tol_pos), float(damping))
     rng_state = restarts.seed_state(seed)
     q = np.array(q0, dtype=float)
     stats = np.zeros(kernel.STATS_SIZE)
 
     def chunk(attempts_left: int) -> int:
-        return kernel.multistart(q, cm.chain, cm.lower, cm.upper, prob, rng_state, attempts_left,
-                                 stats[kernel.T_STEPS] + CHUNK_STEPS, stats)
+        return _MULTISTART(q, cm.chain, cm.lower, cm.upper, prob, rng_state, attempts_left,
+                           float(stats[kernel.T_STEPS] + CHUNK_STEPS), stats)
 
     code = restarts.run_in_chunks(chunk, max_restarts + 1, stats, deadline, kernel.CONVERGED)
     if code == kernel.CONVERGED:

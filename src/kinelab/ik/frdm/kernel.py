@@ -327,33 +327,36 @@ def _extrapolate(q, ch, pb, st, mem, w, ec, oc, pc, Rc, E1):
     Returns (objective after this step, accepted). When accepted, q and the candidate FK arrays (ec, oc,
     pc, Rc) hold the new state, and the caller swaps them with its own.
     """
+    # tuple fields read once into locals: a field read inside a loop costs a reference-count pair
+    X, G, state = mem.X, mem.G, mem.state
+    x_old, cand, g = w.x_old, w.cand, w.g
+    lower, upper, free, kind = pb.lower, pb.upper, pb.free, ch.kind
     n = q.shape[0]
-    state = mem.state
     cnt = int(state[S_HISTORY])
     slot = cnt % (st.accel_m + 1)
     for i in range(n):
-        w.g[i] = q[i] - w.x_old[i]
-        mem.X[slot, i] = w.x_old[i]
-        mem.G[slot, i] = w.g[i]
+        g[i] = q[i] - x_old[i]
+        X[slot, i] = x_old[i]
+        G[slot, i] = g[i]
     state[S_HISTORY] = cnt + 1.0
     if cnt < 1:
         return E1, False
-    _anderson(mem.X, mem.G, cnt, st.accel_m, w.x_old, w.g, w.cand, w.dG, w.dX, w.A, w.rhs, w.gamma)
+    _anderson(X, G, cnt, st.accel_m, x_old, g, cand, w.dG, w.dX, w.A, w.rhs, w.gamma)
     finite = True
     for i in range(n):
-        finite = finite and np.isfinite(w.cand[i])
+        finite = finite and np.isfinite(cand[i])
     if not finite:  # a degenerate history: drop it, keep the plain sweep
         state[S_HISTORY] = 0.0
-        w.cand[:] = q
+        cand[:] = q
     for i in range(n):
-        if ch.kind[i] != CONTINUOUS:
-            w.cand[i] = min(max(w.cand[i], pb.lower[i]), pb.upper[i])
-        if not pb.free[i]:
-            w.cand[i] = q[i]
-    chain_fk(ch, w.cand, ec, oc, pc, Rc)
+        if kind[i] != CONTINUOUS:
+            cand[i] = min(max(cand[i], lower[i]), upper[i])
+        if not free[i]:
+            cand[i] = q[i]
+    chain_fk(ch, cand, ec, oc, pc, Rc)
     Ec = objective(pc, Rc, pb.pstar, pb.Rstar, pb.w_p, pb.w_ax)
     if Ec < E1:
-        q[:] = w.cand
+        q[:] = cand
         state[S_ACCEPTED] += 1.0
         return Ec, True
     return E1, False
@@ -395,9 +398,12 @@ def run(q: np.ndarray, ch: Chain, pb: Problem, st: Settings, order: int, max_swe
     Returns:
         (code, sweeps in this call); the state slots S_* carry the rest.
     """
-    state = mem.state
+    state, trace = mem.state, mem.trace
+    lower, upper, free, pstar, Rstar, w_p, w_ax = pb.lower, pb.upper, pb.free, pb.pstar, pb.Rstar, pb.w_p, pb.w_ax
+    kind = ch.kind
     n = q.shape[0]
     w = _scratch(n, st.accel_m)
+    x_old = w.x_old
     e, o, p, R = np.empty((n, 3)), np.empty((n, 3)), np.empty(3), np.empty((3, 3))
     ec, oc, pc, Rc = np.empty((n, 3)), np.empty((n, 3)), np.empty(3), np.empty((3, 3))
     fresh = False  # e, o, p, R hold the state at q (carried by the last sweep or an accepted extrapolation)
@@ -407,23 +413,22 @@ def run(q: np.ndarray, ch: Chain, pb: Problem, st: Settings, order: int, max_swe
             chain_fk(ch, q, e, o, p, R)
             since_fk = 0
         if state[S_SWEEPS] == 0.0:
-            state[S_E_WINDOW] = objective(p, R, pb.pstar, pb.Rstar, pb.w_p, pb.w_ax)
-        if _within(p, R, pb.pstar, pb.Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot) and \
+            state[S_E_WINDOW] = objective(p, R, pstar, Rstar, w_p, w_ax)
+        if _within(p, R, pstar, Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot) and \
                 _fk_converged(q, ch, pb, e, o, p, R, since_fk):  # converged only on an exact FK
-            state[S_E] = objective(p, R, pb.pstar, pb.Rstar, pb.w_p, pb.w_ax)
+            state[S_E] = objective(p, R, pstar, Rstar, w_p, w_ax)
             return CONVERGED, s
-        w.x_old[:] = q
+        x_old[:] = q
         base_to_tip = order == BASE_TO_TIP or (order == ALTERNATE and int(state[S_SWEEPS]) % 2 == 1) \
             or state[S_KICKED] != 0.0
         state[S_KICKED] = 0.0
-        moved = sweep(q, e, o, ch.kind, pb.lower, pb.upper, pb.free, p, R, pb.pstar, pb.Rstar, pb.w_p, pb.w_ax,
-                      st.relax, base_to_tip)
+        moved = sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, st.relax, base_to_tip)
         fresh = base_to_tip
         since_fk += 1
-        E1 = objective(p, R, pb.pstar, pb.Rstar, pb.w_p, pb.w_ax)
+        E1 = objective(p, R, pstar, Rstar, w_p, w_ax)
         state[S_SWEEPS] += 1.0
-        if int(state[S_SWEEPS]) - 1 < mem.trace.shape[0]:
-            mem.trace[int(state[S_SWEEPS]) - 1] = E1
+        if int(state[S_SWEEPS]) - 1 < trace.shape[0]:
+            trace[int(state[S_SWEEPS]) - 1] = E1
         if moved < st.eps_q:
             state[S_E] = E1
             return STALL_STEP, s + 1

@@ -29,11 +29,13 @@ from kinelab.errors import KinelabError
 from kinelab.ik.chain import PRISMATIC, ChainModel
 from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm.options import BYPASSES, ORDERS, FRDMOptions
+from kinelab.ik.multistart import TypedKernel
 from kinelab.ik.result import Status
 from kinelab.robot import Robot
 
 SINGULAR_SIGMA = 1e-4  # σ_min of the scaled Jacobian below this: a kinematic singularity
 CHUNK = 64  # sweeps between two looks at the clock
+_RUN = TypedKernel(kernel.run)
 
 
 @dataclass
@@ -73,7 +75,7 @@ class Problem:
 
     def __init__(self, cm: ChainModel, oMtarget: pin.SE3, options: FRDMOptions, tol_pos: float, tol_rot: float):
         self.pstar = oMtarget.translation  # pinocchio hands out a fresh array on every access
-        self.Rstar = oMtarget.rotation
+        self.Rstar = np.ascontiguousarray(oMtarget.rotation)  # one layout: one compiled signature
         self.w_p = options.position_weight(cm.length)
         self.w_ax = options.axis_weights()
         self.check_pos, self.check_rot = options.mode != "orientation", options.mode != "position"
@@ -135,7 +137,7 @@ class Runner:
 
     def kernel_run(self, q: np.ndarray, budget: int) -> tuple[int, int]:
         """Up to ``budget`` sweeps of the compiled kernel from q (in place)."""
-        return kernel.run(q, self.vm.chain, self.prob.tuple(), self.settings, self.order, budget, self.mem)
+        return _RUN(q, self.vm.chain, self.prob.tuple(), self.settings, self.order, int(budget), self.mem)
 
     def solve(self, q: np.ndarray, deadline: float, bypass: Bypass, max_events: int) -> Status:
         """Run until converged, out of sweeps or time, or the policy has no answer to a monitor event."""

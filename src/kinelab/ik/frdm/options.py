@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import functools
 import math
+import numbers
 from dataclasses import dataclass
 from typing import Any
 
@@ -92,7 +94,8 @@ class FRDMOptions:
         opt.positive("max_bypass_events", self.max_bypass_events, integer=True, zero=True)
         for name in ("use_limits", "polish", "trace"):
             opt.flag(name, getattr(self, name))
-        if not (isinstance(self.relax, (int, float)) and 0.0 < float(self.relax) < 2.0):
+        opt.positive("relax", self.relax)
+        if not float(self.relax) < 2.0:
             raise OptionError("relax", self.relax, "a number in (0, 2)")
         self._check_weights()
         self._check_bypass_tables()
@@ -112,7 +115,7 @@ class FRDMOptions:
             if table is not None and not isinstance(table, dict):
                 raise OptionError(name, table, "a dict joint name → value")
         for name, delta in (self.kicks or {}).items():
-            if not isinstance(delta, (int, float)) or not math.isfinite(delta) or delta == 0:
+            if isinstance(delta, bool) or not isinstance(delta, numbers.Real) or not math.isfinite(delta) or delta == 0:
                 raise OptionError("kicks", {name: delta}, "a finite non-zero δ per joint [rad or m]")
         for name, window in (self.intervals or {}).items():
             if not (isinstance(window, (tuple, list)) and len(window) == 2 and float(window[0]) < float(window[1])):
@@ -136,7 +139,7 @@ class FRDMOptions:
                 raise OptionError(next(iter(kwargs)), kwargs[next(iter(kwargs))],
                                   "give either options=FRDMOptions(...) or keyword options, not both")
             return options
-        return opt.from_kwargs(cls, "frdm", kwargs)
+        return opt.from_kwargs(cls, "frdm", kwargs) if kwargs else _DEFAULT
 
     # -- resolved values --------------------------------------------------------------------
     @property
@@ -147,12 +150,12 @@ class FRDMOptions:
     @property
     def sweep_cap(self) -> int:
         """Sweeps allowed in one attempt."""
-        return self.max_sweeps or (3000 if self.plain else 100)
+        return int(self.max_sweeps or (3000 if self.plain else 100))
 
     @property
     def window(self) -> int:
         """The monitor's stall window [sweeps]."""
-        return self.stall_window or (PLAIN_STALL_WINDOW if self.plain else STALL_WINDOW)
+        return int(self.stall_window or (PLAIN_STALL_WINDOW if self.plain else STALL_WINDOW))
 
     @property
     def window_rel(self) -> float:
@@ -171,17 +174,30 @@ class FRDMOptions:
         return (self.kicks is None and self.intervals is None and self.freeze is None and self.policy is None
                 and self.active is None and not self.polish and not self.trace)
 
-    def settings(self) -> kernel.Settings:
-        """The kernel's sweep and monitor settings."""
+    @functools.cached_property
+    def _settings(self) -> kernel.Settings:
         return kernel.Settings(float(self.relax), float(self.eps_q), int(self.window), float(self.window_rel),
-                               self.accel_m)
+                               int(self.accel_m))
+
+    def settings(self) -> kernel.Settings:
+        """The kernel's sweep and monitor settings (an immutable tuple, built once)."""
+        return self._settings
 
     def position_weight(self, length: float) -> float:
         """w_p [1/m²] for a chain of characteristic length ``length`` [m]; 0 in orientation mode."""
         if self.mode == "orientation":
             return 0.0
-        return self.w_p_factor / length**2 if self.w_p is None else float(self.w_p)
+        return float(self.w_p_factor) / float(length) ** 2 if self.w_p is None else float(self.w_p)
 
     def axis_weights(self) -> np.ndarray:
-        """Weights of the tool x, y, z axes; 0 in position mode."""
-        return np.zeros(3) if self.mode == "position" else np.array(self.w_axes, dtype=float)
+        """Weights of the tool x, y, z axes; 0 in position mode (a shared read-only array)."""
+        return self._axis_weights
+
+    @functools.cached_property
+    def _axis_weights(self) -> np.ndarray:
+        w = np.zeros(3) if self.mode == "position" else np.array(self.w_axes, dtype=float)
+        w.flags.writeable = False
+        return w
+
+
+_DEFAULT = FRDMOptions()

@@ -21,10 +21,12 @@ from kinelab.ik.chain import ChainModel, chain_model
 from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm.monitor import CHUNK, Bypass, Problem, Runner
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
+from kinelab.ik.multistart import TypedKernel
 from kinelab.ik.result import Attempt, Status
 from kinelab.robot import Robot
 
 Options = FRDMOptions
+_MULTISTART = TypedKernel(kernel.multistart)
 
 
 def prepare(robot: Robot) -> None:
@@ -101,8 +103,8 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, 
     order = ORDERS[opts.order]
 
     def chunk(attempts_left: int) -> int:
-        return kernel.multistart(q, cm.chain, prob, settings, order, opts.sweep_cap, rng_state, attempts_left,
-                                 stats[kernel.T_SWEEPS] + CHUNK * 32, best_q, stats)
+        return _MULTISTART(q, cm.chain, prob, settings, order, opts.sweep_cap, rng_state, attempts_left,
+                           float(stats[kernel.T_SWEEPS] + CHUNK * 32), best_q, stats)
 
     code = restarts.run_in_chunks(chunk, max_restarts + 1, stats, deadline, kernel.CONVERGED)
     if code == kernel.CONVERGED:
@@ -131,7 +133,7 @@ def _compiled_problem(cm: ChainModel, oMtarget: pin.SE3, opts: FRDMOptions, tol_
         lower, upper = cm.lower, cm.upper
     else:
         lower, upper = _unbounded(cm.n), _unbounded(cm.n, 1.0)
-    return kernel.Problem(lower, upper, _all_free(cm.n), oMtarget.translation, oMtarget.rotation,
+    return kernel.Problem(lower, upper, _all_free(cm.n), oMtarget.translation, np.ascontiguousarray(oMtarget.rotation),
                           opts.position_weight(cm.length), opts.axis_weights(), float(tol_pos), float(tol_rot),
                           opts.mode != "orientation", opts.mode != "position")
 
