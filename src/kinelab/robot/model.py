@@ -163,11 +163,19 @@ class Robot:
         tree = _read_tree(self.urdf_path)
         full = _build_full_model(self.urdf_path)
         self.name = name or full.name or self.urdf_path.stem
+        self.base = tree.root
         self.tool = tool or self._default_tool(tree, full)
         tool_id = _frame_id(full, self.tool, self.name)
         chain = [j for j in full.supports[full.frames[tool_id].parentJoint] if j != 0]
         self._check_chain(full, chain, tree)
         self.locked = self._locked_values(full, chain, locked or {})
+        self._reduce(full)
+        self._index_joints()
+        self._length: float | None = None
+        self._derived: dict[str, Any] = {}
+
+    def _reduce(self, full: pin.Model) -> None:
+        """The model with every locked joint folded in at its value, and its joint table."""
         q_ref = pin.neutral(full)
         for jname, value in self.locked.items():
             jid = full.getJointId(jname)
@@ -182,22 +190,21 @@ class Robot:
         self.joints = self._joint_table()
         if not self.joints:
             raise ChainError(f"{self.name}: no movable joint between the base and frame {self.tool!r}")
+
+    def _index_joints(self) -> None:
+        """Names, kinds, limits and the index maps between kinelab's q and Pinocchio's."""
         self.joint_names = [j.name for j in self.joints]
         self.joint_kinds = [j.kind for j in self.joints]
         self.lower = _read_only(np.array([j.lower for j in self.joints]))
         self.upper = _read_only(np.array([j.upper for j in self.joints]))
         self.n, self.nq, self.nv = len(self.joints), self.model.nq, self.model.nv
-        self.base = tree.root
-        scalar = [j for j in self.joints if j.kind != "continuous"]
-        turning = [j for j in self.joints if j.kind == "continuous"]
-        self._scalar_pos = np.array([i for i, j in enumerate(self.joints) if j.kind != "continuous"], dtype=int)
-        self._scalar_idx = np.array([j.idx_q for j in scalar], dtype=int)
-        self._cont_pos = np.array([i for i, j in enumerate(self.joints) if j.kind == "continuous"], dtype=int)
-        self._cont_idx = np.array([j.idx_q for j in turning], dtype=int)
-        self._length: float | None = None
-        self._derived: dict[str, Any] = {}
+        continuous = np.array([k == "continuous" for k in self.joint_kinds], dtype=bool)
+        idx_q = np.array([j.idx_q for j in self.joints], dtype=int)
+        self._scalar_pos = np.flatnonzero(~continuous)
+        self._scalar_idx = idx_q[~continuous]
+        self._cont_pos = np.flatnonzero(continuous)
+        self._cont_idx = idx_q[continuous]
         self._identity_q = self.nq == self.n and bool(np.all(self._scalar_idx == np.arange(self.n)))
-        continuous = np.array([k == "continuous" for k in self.joint_kinds])
         self._lower_check = np.where(continuous, -np.inf, self.lower)
         self._upper_check = np.where(continuous, np.inf, self.upper)
         # the same bounds with the default slack, as Python floats: a solve checks limits twice, and a

@@ -115,21 +115,16 @@ class FRDMOptions:
             if table is not None and not isinstance(table, dict):
                 raise OptionError(name, table, "a dict joint name → value")
         for name, delta in (self.kicks or {}).items():
-            if isinstance(delta, bool) or not isinstance(delta, numbers.Real) or not math.isfinite(delta) or delta == 0:
+            if not _nonzero_finite(delta):
                 raise OptionError("kicks", {name: delta}, "a finite non-zero δ per joint [rad or m]")
         for name, window in (self.intervals or {}).items():
-            if not (isinstance(window, (tuple, list)) and len(window) == 2 and float(window[0]) < float(window[1])):
+            if not _interval(window):
                 raise OptionError("intervals", {name: window}, "a non-empty (lower, upper) per joint",
                                   f"bypass interval for {name!r} is empty or malformed: {window!r}")
         for name in ("policy", "active"):
             steps = getattr(self, name)
-            if steps is None:
-                continue
-            bad = [steps] if isinstance(steps, str) else [s for s in steps if s not in BYPASSES]
-            if bad:
-                raise OptionError(name, steps, ", ".join(BYPASSES),
-                                  f"unknown bypass {bad[0]!r} in {name}; bypasses are: {', '.join(BYPASSES)}")
-            object.__setattr__(self, name, tuple(steps))
+            if steps is not None:
+                object.__setattr__(self, name, _bypass_steps(name, steps))
 
     @classmethod
     def of(cls, options: FRDMOptions | None = None, **kwargs: Any) -> FRDMOptions:
@@ -201,3 +196,25 @@ class FRDMOptions:
 
 
 _DEFAULT = FRDMOptions()
+
+
+def _nonzero_finite(value: object) -> bool:
+    return (not isinstance(value, bool) and isinstance(value, numbers.Real) and math.isfinite(value)
+            and value != 0)
+
+
+def _interval(window: object) -> bool:
+    if not (isinstance(window, (tuple, list)) and len(window) == 2):
+        return False
+    lo, hi = window
+    return isinstance(lo, numbers.Real) and isinstance(hi, numbers.Real) and float(lo) < float(hi)
+
+
+def _bypass_steps(name: str, steps: object) -> tuple[str, ...]:
+    """``steps`` as a tuple of known bypass names, or OptionError naming the first unknown one."""
+    bad = [steps] if isinstance(steps, str) or not isinstance(steps, (tuple, list)) else [
+        s for s in steps if s not in BYPASSES]
+    if bad:
+        raise OptionError(name, steps, ", ".join(BYPASSES),
+                          f"unknown bypass {bad[0]!r} in {name}; bypasses are: {', '.join(BYPASSES)}")
+    return tuple(steps)  # type: ignore[arg-type]

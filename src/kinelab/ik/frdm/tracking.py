@@ -21,7 +21,7 @@ import pinocchio as pin
 
 from kinelab.errors import KinelabError
 from kinelab.ik.frdm import solver
-from kinelab.ik.result import Status
+from kinelab.ik.result import Attempt, Status
 from kinelab.robot import Robot
 
 
@@ -113,53 +113,70 @@ def track(
         KinelabError: a restriction named without its table.
     """
     q_prev = robot.check_q(q0, limits=True, what="q0")
-    unknown = [s for s in restrict if s not in ("intervals", "freeze")]
+    _check_restrict(restrict, intervals, freeze)
+    options = {"max_sweeps": max_sweeps, "kicks": kicks, "intervals": intervals, "freeze": freeze,
+               "policy": tuple(s for s in (policy or ()) if s not in RESTRICTIONS),
+               "stall_window": stall_window, "stall_rel": stall_rel, **frdm_options}
+    path = _Path(robot, tol_pos, tol_rot, options, restrict,
+                 [s for s in (policy or ()) if s in RESTRICTIONS], jump_limit, hold)
+    for k, target in enumerate(targets):
+        q_prev = path.sample(k, target, q_prev)
+    return path.result()
+
+
+RESTRICTIONS = ("intervals", "freeze")
+
+
+def _check_restrict(restrict: tuple[str, ...], intervals: dict | None, freeze: dict | None) -> None:
+    unknown = [s for s in restrict if s not in RESTRICTIONS]
     if unknown:
         raise KinelabError(f"restrict takes 'intervals' and 'freeze', not {unknown}")
     for name, table in (("intervals", intervals), ("freeze", freeze)):
         if name in restrict and not table:
             raise KinelabError(f"restrict names {name!r} but no {name} table was given")
-    restrictions = [s for s in (policy or ()) if s in ("intervals", "freeze")]
-    reactive = tuple(s for s in (policy or ()) if s not in ("intervals", "freeze"))
-    frdm_options = {"stall_window": stall_window, "stall_rel": stall_rel, **frdm_options}
-    held: dict[str, int] = {}
-    rows, perr, rerr, status, sweeps, times, events = [], [], [], [], [], [], []
-    bypasses: list[dict] = [{"sample": 0, "bypass": s, "hold": "path"} for s in restrict]
-    for k, target in enumerate(targets):
+
+
+class _Path:
+    """The samples solved so far, the restrictions held and the monitor log of one tracked path."""
+
+    def __init__(self, robot: Robot, tol_pos: float, tol_rot: float, options: dict[str, Any],
+                 restrict: tuple[str, ...], restrictions: list[str], jump_limit: float | None, hold: int):
+        self.robot, self.tol_pos, self.tol_rot, self.options = robot, tol_pos, tol_rot, options
+        self.restrict, self.restrictions, self.jump_limit, self.hold = restrict, restrictions, jump_limit, hold
+        self.held: dict[str, int] = {}
+        self.rows: list[np.ndarray] = []
+        self.figures: list[tuple[float, float, str, int, float]] = []
+        self.events: list[dict] = []
+        self.bypasses: list[dict] = [{"sample": 0, "bypass": s, "hold": "path"} for s in restrict]
+
+    def _solve(self, target: pin.SE3, q_start: np.ndarray, active: tuple[str, ...]) -> Attempt:
+        return solver.attempt(self.robot, target, q_start, self.tol_pos, self.tol_rot, np.inf, active=active,
+                              **self.options)
+
+    def sample(self, k: int, target: pin.SE3, q_prev: np.ndarray) -> np.ndarray:
+        """Solve sample k warm-started from q_prev, switching a restriction on if a monitor fires."""
         t0 = time.perf_counter()
-        active = (*restrict, *(s for s, left in held.items() if left > 0 and s not in restrict))
-        att = _solve(robot, target, q_prev, tol_pos, tol_rot, max_sweeps, kicks, intervals, freeze,
-                     reactive, active, frdm_options)
-        jumped = jump_limit is not None and np.max(np.abs(att.q - q_prev)) > jump_limit
-        fired = att.events or jumped
-        for ev in att.events:
-            events.append({**ev, "sample": k})
+        active = (*self.restrict, *(s for s, left in self.held.items() if left > 0 and s not in self.restrict))
+        att = self._solve(target, q_prev, active)
+        step = float(np.max(np.abs(att.q - q_prev)))
+        jumped = self.jump_limit is not None and step > self.jump_limit
+        self.events += [{**ev, "sample": k} for ev in att.events]
         if jumped:
-            events.append({"sample": k, "trigger": "jump", "max_joint_step": float(np.max(np.abs(att.q - q_prev)))})
-        pending = [s for s in restrictions if s not in active]
-        if fired and (att.status != Status.CONVERGED or jumped) and pending:
-            step = pending[0]
-            held[step] = hold
-            bypasses.append({"sample": k, "bypass": step, "hold": hold})
-            active = (*active, step)
-            att = _solve(robot, target, q_prev, tol_pos, tol_rot, max_sweeps, kicks, intervals, freeze,
-                         reactive, active, frdm_options)
-        bypasses += [{**b, "sample": k} for b in att.bypasses if b["bypass"] not in ("intervals", "freeze")]
-        held = {s: left - 1 for s, left in held.items() if left > 1}
-        dp, dr = robot.tool_error(att.q, target)
-        rows.append(att.q)
-        perr.append(dp)
-        rerr.append(dr)
-        status.append(att.status.value)
-        sweeps.append(att.iterations)
-        times.append(time.perf_counter() - t0)
-        q_prev = att.q
-    return TrackResult(np.array(rows), np.array(perr), np.array(rerr), status, np.array(sweeps), np.array(times),
-                       events, bypasses)
+            self.events.append({"sample": k, "trigger": "jump", "max_joint_step": step})
+        pending = [s for s in self.restrictions if s not in active]
+        if (att.events or jumped) and (att.status != Status.CONVERGED or jumped) and pending:
+            self.held[pending[0]] = self.hold
+            self.bypasses.append({"sample": k, "bypass": pending[0], "hold": self.hold})
+            att = self._solve(target, q_prev, (*active, pending[0]))
+        self.bypasses += [{**b, "sample": k} for b in att.bypasses if b["bypass"] not in RESTRICTIONS]
+        self.held = {s: left - 1 for s, left in self.held.items() if left > 1}
+        dp, dr = self.robot.tool_error(att.q, target)
+        self.rows.append(att.q)
+        self.figures.append((dp, dr, att.status.value, att.iterations, time.perf_counter() - t0))
+        return att.q
 
-
-def _solve(robot, target, q_start, tol_pos, tol_rot, max_sweeps, kicks, intervals, freeze, reactive, active, options):
-    return solver.attempt(
-        robot, target, q_start, tol_pos, tol_rot, np.inf, max_sweeps=max_sweeps, kicks=kicks, intervals=intervals,
-        freeze=freeze, policy=reactive, **{"active": active, **options},
-    )
+    def result(self) -> TrackResult:
+        """The path's TrackResult."""
+        dp, dr, status, sweeps, times = zip(*self.figures, strict=True) if self.figures else ([],) * 5
+        return TrackResult(np.array(self.rows), np.array(dp), np.array(dr), list(status), np.array(sweeps),
+                           np.array(times), self.events, self.bypasses)
