@@ -113,7 +113,7 @@ for kind, q in ep.singular_examples(era).items():
     a = singular.analyze(era, q)
     d = a.lost_directions[0]
     print(f"{kind:18s} rank {a.rank}, σ_min/σ_max = {a.singular_values[-1] / a.singular_values[0]:.1e}, "
-          f"lost: {100 * d['translation_share']:.0f} % translation, {100 * d['rotation_share']:.0f} % rotation")
+          f"lost: {100 * d.translation_share:.0f} % translation, {100 * d.rotation_share:.0f} % rotation")
 
 # %% [markdown]
 # ## Passages 2 and 3: the two gimbal locks

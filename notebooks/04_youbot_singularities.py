@@ -61,8 +61,8 @@ print("at θ2 = θ3 = 0 (200 random others): paper", {yb.paper_rank(q) for q in 
 
 # %%
 result = families.sweep(robot, samples=5000, seed=0, progress=False)
-print(result["notes"])
-for f in result["families"]:
+print(result.notes)
+for f in result.families:
     print(f"rank {f.rank}  x{f.count:3d}  " + " and ".join(r.text for r in f.relations))
 
 # %% [markdown]
@@ -77,7 +77,7 @@ for f in result["families"]:
 Qv = robot.random_q(rng); Qv[4], Qv[5] = 0.5, 0.7; Qv[6] = -1.2
 a = singular.analyze(robot, Qv)
 print("gripper vertical: paper rank", yb.paper_rank(Qv), "| Pinocchio rank", a.rank)
-print("lost twist (v/L, ω), base axes at E:", np.round(a.lost_directions[0]["twist"], 3))
+print("lost twist (v/L, ω), base axes at E:", np.round(a.lost_directions[0].twist, 3))
 yaw = Qv[2] + Qv[3]
 print("x1 axis of the arm plane:              ", np.round([np.cos(yaw), np.sin(yaw), 0], 3))
 
@@ -98,7 +98,7 @@ for th4 in [0.9, -0.4, 0.0]:
         print(f"θ4 = {th4:+.1f}: w = {np.round(w, 4)}, |w_ω|/|w_z| = {np.linalg.norm(w[3:]) / abs(w[2]):.4f}, "
               f"c|sin θ4| = {yb.PARAMS['c'] * abs(np.sin(th4)):.4f}")
     else:
-        lost = np.array([d["twist"] for d in a.lost_directions])
+        lost = np.array([d.twist for d in a.lost_directions])
         print(f"θ4 = {th4:+.1f}: rank {a.rank} (the gripper is vertical too); share of vertical translation "
               f"in the lost space = {np.linalg.norm(lost @ [0, 0, 1, 0, 0, 0]):.3f}")
 

@@ -162,7 +162,7 @@ def test_monitor_fires_on_a_straight_arm_with_the_target_on_its_line(planar):
     res = solve(planar, target, q0=np.zeros(3), mode="position", max_restarts=0, policy=())
     assert not res.success and res.status.value == "singular"
     first = res.singular_events[0]
-    assert first["trigger"] == "step" and first["sweep"] == 1 and first["diagnosis"] == "singular"
+    assert first.trigger == "step" and first.sweep == 1 and first.diagnosis == "singular"
     np.testing.assert_allclose(res.q, 0.0)
 
 
@@ -173,7 +173,7 @@ def test_the_two_kick_signs_give_the_two_mirror_branches(planar):
         res = solve(planar, target, q0=np.zeros(3), mode="position", max_restarts=0, kicks={"j2": sign * 1e-3},
                     tol_rot=10.0, order="tip2base", time_budget=5.0)
         assert res.success, res
-        assert [b["bypass"] for b in res.bypasses] == ["kicks"]
+        assert [b.bypass for b in res.bypasses] == ["kicks"]
         branches[sign] = res.q
     # mirror images about the line: the elbow (j3) folds one way or the other
     assert np.sign(branches[-1.0][2]) != np.sign(branches[1.0][2]) and abs(branches[1.0][2]) > 0.5

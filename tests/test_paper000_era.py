@@ -32,14 +32,14 @@ def test_with_the_bypass_every_reachable_sample_is_reached_smoothly(elbow):
     assert res.position_error[reachable].max() <= 1e-6 and res.rotation_error[reachable].max() <= 1e-6
     assert res.max_joint_step < STEP_BOUND
     assert ep.quadrant_violations(res, passage) == 0
-    assert any(b["bypass"] == "kicks" for b in res.bypasses)
+    assert any(b.bypass == "kicks" for b in res.bypasses)
     np.testing.assert_allclose(res.q[-1], passage.q0, atol=1e-5)  # back where it started, same fold
 
 
 def test_without_bypass_the_monitor_fires_and_the_arm_fails_the_paper_way(elbow):
     passage, run = elbow
     res, reachable = run.without, ~passage.unreachable
-    singular = [e for e in res.events if e.get("diagnosis") == "singular" and e["trigger"] == "step"]
+    singular = [e for e in res.events if e.diagnosis == "singular" and e.trigger == "step"]
     assert len(singular) >= 10  # Σ|Δq| = 0 sample after sample while the arm is straight
     assert res.reached[reachable].sum() < 0.7 * reachable.sum()
     assert res.position_error[reachable].max() > 0.5  # the tool left behind by the target
@@ -129,7 +129,7 @@ def test_shoulder_without_bypass_q1_and_q7_climb_together_until_the_stop(shoulde
     assert (laps[:2, 0] > 60).all()  # the arm turns with the tool, lap after lap
     np.testing.assert_allclose(laps[:, 0], laps[:, 6], atol=1e-6)  # q1 and q7 in phase
     assert res.max_joint_step > 6.0  # at the ±180° stop q1 swings back a whole turn in one sample
-    assert any(e["trigger"] == "jump" for e in res.events)
+    assert any(e.trigger == "jump" for e in res.events)
 
 
 def test_restrict_needs_its_table():

@@ -75,7 +75,7 @@ def test_tool_axis_vertical_is_a_family_pinocchio_sees_and_the_papers_J_does_not
         assert yb.paper_rank(Q) == 6
         a = singular.analyze(youbot, Q)
         assert a.rank == 5 and independent_rank(youbot, Q) == 5
-        lost = np.array(a.lost_directions[0]["twist"])
+        lost = np.array(a.lost_directions[0].twist)
         yaw = Q[2] + Q[3]
         x1 = np.array([np.cos(yaw), np.sin(yaw), 0.0])
         assert abs(abs(lost[3:] @ x1) - np.linalg.norm(lost)) < 1e-6  # pure rotation about x1
@@ -102,7 +102,7 @@ def test_theta4_zero_special_case_E_cannot_move_vertically(youbot):
     Q = yb.singular_configuration(np.random.default_rng(7), theta4=0.0)
     a = singular.analyze(youbot, Q)
     assert a.rank == 4  # θ2 = θ3 = θ4 = 0 also puts the gripper axis vertical: both families meet
-    lost = np.array([d["twist"] for d in a.lost_directions])
+    lost = np.array([d.twist for d in a.lost_directions])
     e_z = np.r_[0, 0, 1.0, 0, 0, 0]
     assert np.linalg.norm(lost @ e_z) == pytest.approx(1.0, abs=1e-9)  # vertical translation is lost
 
@@ -113,14 +113,14 @@ def youbot_sweep(youbot):
 
 
 def test_sweep_finds_the_papers_family_and_the_vertical_gripper_families(youbot_sweep):
-    texts = {tuple(r.text for r in f.relations) for f in youbot_sweep["families"]}
+    texts = {tuple(r.text for r in f.relations) for f in youbot_sweep.families}
     assert ("arm_joint_2 = 0", "arm_joint_3 = 0") in texts
     assert ("arm_joint_2 + arm_joint_3 + arm_joint_4 = 0",) in texts
-    assert "platform_yaw is continuous: sampled on [−π, π]" in youbot_sweep["notes"]
+    assert "platform_yaw is continuous: sampled on [−π, π]" in youbot_sweep.notes
 
 
 def test_every_family_is_confirmed_by_an_independent_svd(youbot, youbot_sweep):
-    for f in youbot_sweep["families"]:
+    for f in youbot_sweep.families:
         assert independent_rank(youbot, f.representative) < 6
         assert all(r.residual(f.representative) < families.RELATION_TOL for r in f.relations)
 
@@ -147,8 +147,8 @@ def test_bad_configurations(youbot, bad, match):
 def test_grid_sweep_on_a_6r_arm_finds_the_wrist_and_elbow_families():
     ur5 = kinelab.load("ur5")
     res = families.sweep(ur5, samples=4096, method="grid", progress=False)
-    assert res["samples"] == 4 ** 6
-    texts = [" and ".join(r.text for r in f.relations) for f in res["families"]]
+    assert res.samples == 4 ** 6
+    texts = [" and ".join(r.text for r in f.relations) for f in res.families]
     assert any("wrist_2_joint" in t for t in texts) and any("elbow_joint" in t for t in texts)
-    for f in res["families"]:
+    for f in res.families:
         assert independent_rank(ur5, f.representative) < 6

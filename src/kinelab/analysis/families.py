@@ -137,14 +137,41 @@ def grid(robot: Robot, samples: int, rng: np.random.Generator) -> np.ndarray:
     return robot.lower + (cells + rng.uniform(size=cells.shape)) * width
 
 
+@dataclass(frozen=True)
+class SweepResult:
+    """What a sweep found.
+
+    Attributes:
+        families: the singular families, largest first.
+        samples: configurations sampled; near_singular: how many had σ_min/σ_max < NEAR_SINGULAR.
+        refined: samples moved onto the singular set; singular: how many of those were singular.
+        notes: how the joint box was sampled (continuous joints, unbounded slides).
+        sigma_ratio: σ_min/σ_max of every sample (not in the JSON form).
+    """
+
+    families: list[Family]
+    samples: int
+    near_singular: int
+    refined: int
+    singular: int
+    notes: list[str]
+    sigma_ratio: np.ndarray
+
+    def to_dict(self) -> dict:
+        """The JSON form of ``kinelab singular --sweep``."""
+        return {"samples": self.samples, "near_singular": self.near_singular, "refined": self.refined,
+                "singular": self.singular, "notes": self.notes, "families": [f.to_dict() for f in self.families]}
+
+
 def sweep(robot: Robot, samples: int = 5000, seed: int = 0, refine_top: int = 40, progress: bool = False,
-          method: str = "random") -> dict:
+          method: str = "random") -> SweepResult:
     """Sample the joint box (seeded uniform samples, or a full grid), keep near-singular configurations,
     refine them onto the singular set, and group those that are singular into families by the joint
     relations they satisfy (relations that hold there; for a redundant arm one relation can be a necessary
     condition only, the refinement supplies the rest).
 
-    Returns {"families": [...], "samples", "near_singular", "refined", "singular", "notes", "sigma_ratio"}.
+    Raises:
+        KinelabError: no sample asked for, or an unknown method.
     """
     if samples < 1:
         raise KinelabError("a sweep needs at least one sample")
@@ -156,11 +183,25 @@ def sweep(robot: Robot, samples: int = 5000, seed: int = 0, refine_top: int = 40
     L = robot.characteristic_length()
     ratios = sigma_ratio_batch(robot, qs, L, progress)
     order = [i for i in np.argsort(ratios) if ratios[i] < NEAR_SINGULAR]
+    groups, refined, singular_count = _refine_samples(robot, qs, order, lower, upper, L, refine_top, progress)
+    families = []
+    for rel, members in sorted(_merge_coincidences(groups).items(), key=lambda kv: -len(kv[1])):
+        a = analyze(robot, members[0], L)
+        families.append(Family(list(rel), len(members), members[0], a.rank,
+                               float(a.singular_values[a.full_rank - 1] / a.singular_values[0])))
+    return SweepResult(families, len(qs), int(np.sum(ratios < NEAR_SINGULAR)), refined, singular_count, notes,
+                       ratios)
+
+
+def _refine_samples(robot: Robot, qs: np.ndarray, order: list[int], lower: np.ndarray, upper: np.ndarray,
+                    L: float, refine_top: int, progress: bool) -> tuple[dict, int, int]:
+    """Refine the most singular samples that no family found so far explains; group the singular ones.
+
+    A family of lower dimension (the youBot's θ2 = θ3 = 0) is sampled far less often than one of
+    codimension 1; leaving the explained samples out is what lets a sweep find it.
+    """
     groups: dict[tuple[Relation, ...], list[np.ndarray]] = {}
     refined = singular_count = 0
-    # Refine the most singular samples that no family found so far explains. A family of lower dimension
-    # (the youBot's θ2 = θ3 = 0) is sampled far less often than one of codimension 1; leaving the
-    # explained samples out is what lets a sweep find it.
     with tqdm(total=refine_top, desc="refine", disable=not progress, unit="q", leave=False) as bar:
         while refined < refine_top and order:
             known = [rel for rel in groups if rel]
@@ -175,13 +216,4 @@ def sweep(robot: Robot, samples: int = 5000, seed: int = 0, refine_top: int = 40
             if analyze(robot, q, L).singular:
                 singular_count += 1
                 groups.setdefault(tuple(joint_relations(robot, q)), []).append(q)
-    groups = _merge_coincidences(groups)
-    families = []
-    for rel, members in sorted(groups.items(), key=lambda kv: -len(kv[1])):
-        rep = members[0]
-        a = analyze(robot, rep, L)
-        families.append(Family(list(rel), len(members), rep, a.rank,
-                               float(a.singular_values[a.full_rank - 1] / a.singular_values[0])))
-    return {"families": families, "samples": len(qs), "near_singular": int(np.sum(ratios < NEAR_SINGULAR)),
-            "refined": refined, "singular": singular_count, "notes": notes,
-            "sigma_ratio": ratios}
+    return groups, refined, singular_count

@@ -13,14 +13,8 @@ import pinocchio as pin
 import yourdfpy
 
 from kinelab.errors import ChainError
+from kinelab.geometry import pose_error
 from kinelab.robot import Robot
-
-
-def pose_error(oMa: pin.SE3, oMb: pin.SE3) -> tuple[float, float]:
-    """(position error [m], rotation angle error [rad]) between two poses of the same frame."""
-    dp = float(np.linalg.norm(oMa.translation - oMb.translation))
-    dr = float(np.linalg.norm(pin.log3(oMa.rotation.T @ oMb.rotation)))
-    return dp, dr
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,7 @@ velocity that moves nothing.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
@@ -36,7 +36,7 @@ class Analysis:
     manipulability: float  # Yoshikawa √det(J Jᵀ) (n ≥ 6) or √det(Jᵀ J) (n < 6), scaled J
     condition: float  # σ_max/σ_min (inf when singular)
     length: float  # L [m]
-    lost_directions: list[dict] = field(default_factory=list)
+    lost_directions: list[LostDirection] = field(default_factory=list)
     null_motions: list[np.ndarray] = field(default_factory=list)
 
     @property
@@ -53,7 +53,7 @@ class Analysis:
             "manipulability": self.manipulability,
             "condition": self.condition if np.isfinite(self.condition) else None,
             "characteristic_length_m": self.length,
-            "lost_directions": self.lost_directions,
+            "lost_directions": [d.to_dict() for d in self.lost_directions],
             "null_motions": [m.tolist() for m in self.null_motions],
         }
 
@@ -70,15 +70,38 @@ def _rank(s: np.ndarray) -> int:
     return int(np.sum(s > RANK_RTOL * s[0])) if s.size and s[0] > 0 else 0
 
 
-def describe_direction(u: np.ndarray) -> dict:
-    """A unit scaled twist (v/L, ω) as words: how much is translation, along which axis, rotation about which."""
+@dataclass(frozen=True)
+class LostDirection:
+    """A tool twist no joint motion produces (base axes at the tool point, scaled: (v/L, ω)).
+
+    Attributes:
+        twist: the unit scaled twist (6 numbers).
+        translation_share: |v/L|² (0..1); rotation_share: |ω|² (the two add up to 1).
+        translation_axis: unit direction of the translation part, if it is not negligible.
+        rotation_axis: unit axis of the rotation part, if it is not negligible.
+        sigma: the singular value of the direction (0 at an exact singularity).
+    """
+
+    twist: tuple[float, ...]
+    translation_share: float
+    rotation_share: float
+    translation_axis: tuple[float, float, float] | None = None
+    rotation_axis: tuple[float, float, float] | None = None
+    sigma: float | None = None
+
+    def to_dict(self) -> dict:
+        """The JSON form (the documented fields; the axes only where present)."""
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self).items() if v is not None}
+
+
+def describe_direction(u: np.ndarray, sigma: float | None = None) -> LostDirection:
+    """A unit scaled twist (v/L, ω) in words: how much is translation, along which axis, rotation about which."""
     lin, ang = u[:3], u[3:]
-    out = {"twist": u.tolist(), "translation_share": float(lin @ lin), "rotation_share": float(ang @ ang)}
-    for name, part in (("translation", lin), ("rotation", ang)):
+    axes: list[tuple[float, float, float] | None] = []
+    for part in (lin, ang):
         norm = np.linalg.norm(part)
-        if norm > 1e-6:
-            out[f"{name}_axis"] = (part / norm).tolist()
-    return out
+        axes.append(tuple((part / norm).tolist()) if norm > 1e-6 else None)
+    return LostDirection(tuple(u.tolist()), float(lin @ lin), float(ang @ ang), axes[0], axes[1], sigma)
 
 
 def analyze(robot: Robot, q, length: float | None = None) -> Analysis:
@@ -92,6 +115,6 @@ def analyze(robot: Robot, q, length: float | None = None) -> Analysis:
     JJ = J @ J.T if robot.n >= 6 else J.T @ J
     manip = float(np.sqrt(max(np.linalg.det(JJ), 0.0)))
     condition = float(s[0] / s[full - 1]) if s[full - 1] > RANK_RTOL * s[0] else float("inf")
-    lost = [describe_direction(U[:, i]) | {"sigma": float(s[i])} for i in range(rank, 6)]
+    lost = [describe_direction(U[:, i], float(s[i])) for i in range(rank, 6)]
     null = [Vt[i] for i in range(rank, robot.n)]
     return Analysis(q, s, rank, full, manip, condition, L, lost, null)

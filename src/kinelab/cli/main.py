@@ -16,6 +16,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.errors import KinelabError
+from kinelab.geometry import quat_wxyz_from_matrix
 from kinelab.robot import Robot, catalog, load
 
 
@@ -34,13 +35,10 @@ def _q_from_cli(robot: Robot, values: list[float], deg: bool, what: str = "q") -
 
 def pose_dict(oMtool: pin.SE3) -> dict:
     """The JSON form of a pose: position [m], rotation matrix, quat_wxyz, rpy [rad]."""
-    quat = pin.Quaternion(oMtool.rotation)
-    wxyz = np.array([quat.w, quat.x, quat.y, quat.z])
-    wxyz = -wxyz if wxyz[0] < 0 else wxyz  # canonical sign: w >= 0
     return {
         "position_m": oMtool.translation.tolist(),
         "rotation_matrix": oMtool.rotation.tolist(),
-        "quat_wxyz": wxyz.tolist(),
+        "quat_wxyz": quat_wxyz_from_matrix(oMtool.rotation).tolist(),
         "rpy_rad": pin.rpy.matrixToRpy(oMtool.rotation).tolist(),
     }
 
@@ -209,16 +207,15 @@ def cmd_singular(args) -> int:
             raise KinelabError("give either a configuration or --sweep N, not both")
         result = families.sweep(robot, samples=args.sweep, seed=args.seed, progress=not args.json,
                                 method="grid" if args.grid else "random")
-        out = {"robot": robot.name, **{k: v for k, v in result.items() if k not in ("families", "sigma_ratio")},
-               "families": [f.to_dict() for f in result["families"]]}
+        out = {"robot": robot.name, **result.to_dict()}
         if args.json:
             _print_json(out)
             return 0
-        for note in result["notes"]:
+        for note in result.notes:
             print(f"note: {note}")
         print(f"{robot.name}: {args.sweep} samples, {out['near_singular']} near-singular (σ_min/σ_max < "
               f"{singular.NEAR_SINGULAR:g}), {out['refined']} refined, {out['singular']} singular after refinement")
-        for f in result["families"]:
+        for f in result.families:
             q_show = np.round(f.representative, 4).tolist()
             relations = " and ".join(r.text for r in f.relations) or "(no simple relation)"
             print(f"  rank {f.rank}, {f.count:4d} found: {relations}")
@@ -236,11 +233,11 @@ def cmd_singular(args) -> int:
     print(f"  manipulability {a.manipulability:.4g}, condition {a.condition:.4g}")
     for d in a.lost_directions:
         parts = []
-        if "translation_axis" in d:
-            axis, share = np.round(d["translation_axis"], 3).tolist(), 100 * d["translation_share"]
+        if d.translation_axis is not None:
+            axis, share = np.round(d.translation_axis, 3).tolist(), 100 * d.translation_share
             parts.append(f"translation {axis} ({share:.0f} %)")
-        if "rotation_axis" in d:
-            axis, share = np.round(d["rotation_axis"], 3).tolist(), 100 * d["rotation_share"]
+        if d.rotation_axis is not None:
+            axis, share = np.round(d.rotation_axis, 3).tolist(), 100 * d.rotation_share
             parts.append(f"rotation about {axis} ({share:.0f} %)")
         print(f"  lost tool motion (base axes, at the tool): {' + '.join(parts)}")
     for m in a.null_motions:

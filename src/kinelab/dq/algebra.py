@@ -17,6 +17,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.errors import BiquaternionError
+from kinelab.geometry import matrix_from_quat_wxyz, quat_wxyz_from_matrix
 
 
 def qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -33,18 +34,6 @@ def qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def qconj(a: np.ndarray) -> np.ndarray:
     return np.array([a[0], -a[1], -a[2], -a[3]])
-
-
-def quat_wxyz_from_matrix(R: np.ndarray) -> np.ndarray:
-    """Unit quaternion (w, x, y, z) of a rotation matrix, sign chosen with w ≥ 0."""
-    q = pin.Quaternion(np.asarray(R, dtype=float))
-    wxyz = np.array([q.w, q.x, q.y, q.z])
-    return -wxyz if wxyz[0] < 0 else wxyz
-
-
-def matrix_from_quat_wxyz(wxyz: np.ndarray) -> np.ndarray:
-    w, x, y, z = np.asarray(wxyz, dtype=float) / np.linalg.norm(wxyz)
-    return pin.Quaternion(w, x, y, z).toRotationMatrix()
 
 
 @dataclass(frozen=True)

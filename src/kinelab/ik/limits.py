@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from kinelab.geometry import TWO_PI, turns_into
 from kinelab.robot import Robot
-
-TWO_PI = 2.0 * np.pi
 
 
 class PinLimits:
@@ -29,10 +28,7 @@ class PinLimits:
 def wrap_and_clip(x: np.ndarray, lower: np.ndarray, upper: np.ndarray, revolute: np.ndarray) -> np.ndarray:
     """Bring values into [lower, upper]: revolute ones first by ±2πk (same pose), then clip."""
     x = np.array(x, dtype=float)
-    over = revolute & (x > upper)
-    x[over] -= TWO_PI * np.ceil((x[over] - upper[over]) / TWO_PI)
-    under = revolute & (x < lower)
-    x[under] += TWO_PI * np.ceil((lower[under] - x[under]) / TWO_PI)
+    x[revolute] = turns_into(x[revolute], lower[revolute], upper[revolute])
     return np.clip(x, lower, upper)
 
 
@@ -42,5 +38,5 @@ def wrap_q(robot: Robot, q: np.ndarray) -> np.ndarray:
     q = np.asarray(q, dtype=float)
     revolute = np.array([k == "revolute" for k in robot.joint_kinds])
     outside = revolute & ((q < robot.lower) | (q > robot.upper))
-    shifted = q + TWO_PI * np.ceil((robot.lower - q) / TWO_PI)
-    return np.where(outside & (shifted <= robot.upper), shifted, q)
+    lowest = q + TWO_PI * np.ceil((robot.lower - q) / TWO_PI)  # the first turn of q at or above the lower limit
+    return np.where(outside & (lowest <= robot.upper), lowest, q)

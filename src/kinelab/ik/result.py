@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from enum import Enum
+from typing import Any
 
 import numpy as np
 
@@ -17,6 +18,64 @@ class Status(str, Enum):
     STALLED = "stalled"  # stopped at a stationary point (local minimum, joint limit) short of the target
     MAX_ITERATIONS = "max_iterations"
     TIME_BUDGET = "time_budget"
+
+
+@dataclass(frozen=True)
+class SingularEvent:
+    """One firing of a monitor (FRDM's Σ|Δq| or window test, the compiled multistart's stalls, or the
+    tracking jump monitor), with its diagnosis.
+
+    Attributes:
+        trigger: "step" (Σ|Δq| below eps_q), "window" (the objective stopped falling), "stall" (the
+            compiled multistart, which restarts instead of diagnosing) or "jump" (tracking).
+        diagnosis: "singular" (σ_min of the scaled Jacobian below 1e-4), "stationary", or a note.
+        sweep: the sweep at which it fired; sample: the path sample (tracking); count: how many stalls.
+        sigma_min: σ_min of the scaled Jacobian; position_error [m], rotation_error [rad] at that point.
+        q: the configuration [rad or m]; max_joint_step: the jump [rad or m] (tracking).
+    """
+
+    trigger: str
+    diagnosis: str | None = None
+    sweep: int | None = None
+    sample: int | None = None
+    count: int | None = None
+    sigma_min: float | None = None
+    position_error: float | None = None
+    rotation_error: float | None = None
+    q: tuple[float, ...] | None = None
+    max_joint_step: float | None = None
+
+    def at_sample(self, k: int) -> SingularEvent:
+        """The same event, located at path sample k."""
+        return replace(self, sample=k)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form: the fields that are set."""
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self).items() if v is not None}
+
+
+@dataclass(frozen=True)
+class BypassRecord:
+    """One bypass switched on: ``bypass`` is "kicks", "intervals", "freeze" or "auto_kick".
+
+    Attributes:
+        sweep: the sweep at which it was applied (a solve); sample: the path sample (tracking).
+        q: the configuration after it was applied [rad or m]; hold: samples it stays on, or "path".
+    """
+
+    bypass: str
+    sweep: int | None = None
+    sample: int | None = None
+    q: tuple[float, ...] | None = None
+    hold: int | str | None = None
+
+    def at_sample(self, k: int) -> BypassRecord:
+        """The same record, located at path sample k."""
+        return replace(self, sample=k)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form: the fields that are set."""
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self).items() if v is not None}
 
 
 @dataclass
@@ -38,8 +97,8 @@ class IKResult:
     wall_time: float  # [s]
     solver: str
     mode: str = ""  # which variant produced the figures, e.g. "frdm (anderson)", "frdm+polish"
-    singular_events: list[dict] = field(default_factory=list)
-    bypasses: list[dict] = field(default_factory=list)
+    singular_events: list[SingularEvent] = field(default_factory=list)
+    bypasses: list[BypassRecord] = field(default_factory=list)
     message: str = ""
     info: dict = field(default_factory=dict)
 
@@ -55,8 +114,8 @@ class IKResult:
             "wall_time_s": self.wall_time,
             "solver": self.solver,
             "mode": self.mode,
-            "singular_events": self.singular_events,
-            "bypasses": self.bypasses,
+            "singular_events": [e.to_dict() for e in self.singular_events],
+            "bypasses": [b.to_dict() for b in self.bypasses],
             "message": self.message,
             "info": {k: v for k, v in self.info.items() if _jsonable(v)},
         }
@@ -73,6 +132,6 @@ class Attempt:
     q: np.ndarray
     status: Status
     iterations: int
-    events: list[dict] = field(default_factory=list)
-    bypasses: list[dict] = field(default_factory=list)
+    events: list[SingularEvent] = field(default_factory=list)
+    bypasses: list[BypassRecord] = field(default_factory=list)
     info: dict = field(default_factory=dict)

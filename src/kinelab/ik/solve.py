@@ -19,7 +19,7 @@ import pinocchio as pin
 
 from kinelab.errors import KinelabError, SolverNotFoundError
 from kinelab.ik.limits import wrap_q
-from kinelab.ik.result import Attempt, IKResult, Status
+from kinelab.ik.result import Attempt, BypassRecord, IKResult, SingularEvent, Status
 from kinelab.ik.targets import as_target
 from kinelab.ik.workspace import out_of_reach
 from kinelab.robot import Robot
@@ -169,8 +169,8 @@ def _loop(module: Any, pb: _Problem, start: np.ndarray, max_restarts: int, opts:
     best: tuple[float, Attempt, float, float] | None = None
     best_ok = False
     iterations = restarts = 0
-    events: list[dict] = []
-    bypasses: list[dict] = []
+    events: list[SingularEvent] = []
+    bypasses: list[BypassRecord] = []
     for k in range(max_restarts + 1):
         att = module.attempt(robot, pb.target, start, pb.tol_pos, pb.tol_rot, pb.deadline, opts)
         iterations += att.iterations

@@ -14,6 +14,7 @@ import pinocchio as pin
 from tqdm import tqdm
 
 from kinelab.analysis import oracles as checks
+from kinelab.geometry import quat_wxyz_from_matrix
 from kinelab.robot import Robot, load
 from kinelab.studies import paper001_stanford as seed001
 
@@ -74,8 +75,7 @@ def model_checks(robot: Robot, n: int, seed: int) -> list[Check]:
 def stanford_paper_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     """Seed 001: the tool rotation at the paper's target against the printed N (6 digits)."""
     oMtool = robot.fk(seed001.TARGET_Q)
-    quat = pin.Quaternion(oMtool.rotation)
-    d = seed001.quat_distance_wxyz([quat.w, quat.x, quat.y, quat.z], seed001.N_REAL_WXYZ)
+    d = seed001.quat_distance_wxyz(quat_wxyz_from_matrix(oMtool.rotation), seed001.N_REAL_WXYZ)
     return [Check(robot.name, "seed 001: rotation at the paper's target vs printed N", d,
                   seed001.PRINTED_DIGITS_TOL, "", "quaternion components, up to sign")]
 
@@ -153,7 +153,7 @@ def youbot_checks(robot: Robot, n: int, seed: int) -> list[Check]:
         fd = np.array([(yb.paper_location(Q + 1e-6 * e) - yb.paper_location(Q - 1e-6 * e)) / 2e-6 for e in np.eye(8)]).T
         J_fd = max(J_fd, float(np.abs(fd - yb.paper_jacobian(Q)).max()))
     sweep = families.sweep(robot, samples=max(2000, 10 * n), seed=seed, progress=False)
-    texts = [" and ".join(r.text for r in f.relations) for f in sweep["families"]]
+    texts = [" and ".join(r.text for r in f.relations) for f in sweep.families]
     found = "arm_joint_2 = 0 and arm_joint_3 = 0" in texts
     return [
         Check(robot.name, "seed 003: paper's J vs finite differences of X(Q)", J_fd, 1e-6, ""),

@@ -31,6 +31,7 @@ from kinelab.errors import (
     JointNotFoundError,
     URDFError,
 )
+from kinelab.geometry import pose_error, wrap_to_pi
 from kinelab.robot import catalog
 
 _REVOLUTE = {"JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned"}
@@ -349,7 +350,7 @@ class Robot:
         """q with continuous joints wrapped into (−π, π] (the same pose)."""
         q = np.array(q, dtype=float)
         if self._cont_pos.size:
-            q[self._cont_pos] = np.arctan2(np.sin(q[self._cont_pos]), np.cos(q[self._cont_pos]))
+            q[self._cont_pos] = wrap_to_pi(q[self._cont_pos])
         return q
 
     def neutral(self) -> np.ndarray:
@@ -380,9 +381,7 @@ class Robot:
         """(position error [m], rotation angle error [rad]) of the tool at q against oMtarget (Pinocchio FK)."""
         pin.forwardKinematics(self.model, self.data, self._pin_q(q))
         oMtool = pin.updateFramePlacement(self.model, self.data, self.tool_frame_id)
-        err = oMtarget.actInv(oMtool)  # the tool in the target frame: |t| is the position error
-        # hypot over Python floats: a solve ends with this check, and numpy's calls cost more than the maths
-        return math.hypot(*err.translation.tolist()), math.hypot(*pin.log3(err.rotation).tolist())
+        return pose_error(oMtarget, oMtool)
 
     def frame_placement(self, q, frame: str) -> pin.SE3:
         """oMframe: pose of any frame of the reduced model in the base frame."""

@@ -97,6 +97,6 @@ def lost_constraint(robot, Q) -> np.ndarray:
     a = analyze(robot, Q)
     if not a.lost_directions:
         raise ValueError("the configuration is not singular")
-    u = np.array(a.lost_directions[0]["twist"])
+    u = np.array(a.lost_directions[0].twist)
     w = np.r_[u[:3] / a.length, u[3:]]
     return w / np.linalg.norm(w)

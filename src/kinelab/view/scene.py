@@ -147,9 +147,8 @@ class Scene:
         scale = scale or 2 * self.frame_length
         self.viewer["singular"].delete()
         for k, d in enumerate(a.lost_directions):
-            for kind, color in (("translation", 0xF032E6), ("rotation", 0x42D4F4)):
-                axis = d.get(f"{kind}_axis")
-                share = d[f"{kind}_share"]
+            for kind, axis, share, color in (("translation", d.translation_axis, d.translation_share, 0xF032E6),
+                                             ("rotation", d.rotation_axis, d.rotation_share, 0x42D4F4)):
                 if axis is None or share < 1e-3:
                     continue
                 seg = np.column_stack([oMtool.translation, oMtool.translation + scale * share * np.array(axis)])

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Any
 
@@ -117,7 +118,7 @@ class BiquatOptions:
         """λ of the pseudo-inverse for an n-joint chain."""
         return (0.0 if n == 6 else 1e-4) if self.damping is None else float(self.damping)
 
-    @property
+    @functools.cached_property
     def compiled(self) -> bool:
         """True when the compiled preset serves these options: law (9), newton Euler, k0 = 0, no
         moment gain, step caps and clamp at their defaults, no trajectory and no given N."""

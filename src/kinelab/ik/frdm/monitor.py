@@ -30,7 +30,7 @@ from kinelab.ik.chain import PRISMATIC, ChainModel
 from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm.options import BYPASSES, ORDERS, FRDMOptions
 from kinelab.ik.multistart import TypedKernel
-from kinelab.ik.result import Status
+from kinelab.ik.result import BypassRecord, SingularEvent, Status
 from kinelab.robot import Robot
 
 SINGULAR_SIGMA = 1e-4  # σ_min of the scaled Jacobian below this: a kinematic singularity
@@ -107,8 +107,8 @@ class Runner:
         self.max_sweeps = options.sweep_cap
         self.mem = kernel.new_memory(cm.n, options.accel_m, self.max_sweeps if options.trace else 0)
         self.state = self.mem.state
-        self.events: list[dict] = []
-        self.bypass_log: list[dict] = []
+        self.events: list[SingularEvent] = []
+        self.bypass_log: list[BypassRecord] = []
         self.q = np.zeros(cm.n)
         self.next_bypass = 0
 
@@ -171,16 +171,16 @@ class Runner:
     def _event(self, code: int) -> str:
         sigma = _scaled_sigma_min(self.robot, self.q, self.vm.length)
         diagnosis = "singular" if sigma < SINGULAR_SIGMA else "stationary"
-        oMtool = self.robot.fk(self.q)
-        self.events.append({
-            "sweep": self.sweeps,
-            "trigger": "step" if code == kernel.STALL_STEP else "window",
-            "diagnosis": diagnosis,
-            "sigma_min": sigma,
-            "position_error": float(np.linalg.norm(oMtool.translation - self.prob.pstar)),
-            "rotation_error": float(np.linalg.norm(pin.log3(self.prob.Rstar.T @ oMtool.rotation))),
-            "q": self.q.tolist(),
-        })
+        dp, dr = self.robot.tool_error(self.q, pin.SE3(self.prob.Rstar, self.prob.pstar))
+        self.events.append(SingularEvent(
+            trigger="step" if code == kernel.STALL_STEP else "window",
+            diagnosis=diagnosis,
+            sweep=self.sweeps,
+            sigma_min=sigma,
+            position_error=dp,
+            rotation_error=dr,
+            q=tuple(self.q.tolist()),
+        ))
         return diagnosis
 
     def apply(self, bypass: Bypass, step: str, q: np.ndarray) -> np.ndarray:
@@ -209,7 +209,7 @@ class Runner:
         q = np.clip(q, self.prob.lower, self.prob.upper)
         if step in ("kicks", "auto_kick"):
             self.state[kernel.S_KICKED] = 1.0  # the joints nearest the base act first on the kicked chain
-        self.bypass_log.append({"sweep": self.sweeps, "bypass": step, "q": q.tolist()})
+        self.bypass_log.append(BypassRecord(step, sweep=self.sweeps, q=tuple(q.tolist())))
         return q
 
 

@@ -162,7 +162,7 @@ class FRDMOptions:
         """Anderson memory used by the kernel (0: plain)."""
         return 0 if self.plain else int(self.accel_memory)
 
-    @property
+    @functools.cached_property
     def compiled(self) -> bool:
         """True when the compiled multistart can serve these options: no bypass, policy, polish or trace
         named (naming one, even empty, asks for the monitor's diagnosis and log, kept by the Python loop)."""

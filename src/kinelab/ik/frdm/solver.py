@@ -22,7 +22,7 @@ from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm.monitor import CHUNK, Bypass, Problem, Runner
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.multistart import TypedKernel
-from kinelab.ik.result import Attempt, Status
+from kinelab.ik.result import Attempt, SingularEvent, Status
 from kinelab.robot import Robot
 
 Options = FRDMOptions
@@ -118,8 +118,7 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, 
             "accelerated_sweeps": int(stats[kernel.T_ACCEPTED]), "order": opts.order, "w_p": prob.w_p,
             "objective": float(stats[kernel.T_BEST_E]), "attempts": int(stats[kernel.T_ATTEMPTS]),
             "stalls": stalls, "path": "compiled"}
-    events = [{"trigger": "stall", "diagnosis": "not diagnosed (compiled multistart: restarted)",
-               "count": stalls}] if stalls else []
+    events = [SingularEvent("stall", "not diagnosed (compiled multistart: restarted)", count=stalls)] if stalls else []
     attempts = int(stats[kernel.T_ATTEMPTS])
     return Attempt(robot.wrap_continuous(best_q), status, int(stats[kernel.T_SWEEPS]), events, [], info), \
         max(0, attempts - 1)

@@ -21,7 +21,7 @@ import pinocchio as pin
 
 from kinelab.errors import KinelabError
 from kinelab.ik.frdm import solver
-from kinelab.ik.result import Attempt, Status
+from kinelab.ik.result import Attempt, BypassRecord, SingularEvent, Status
 from kinelab.robot import Robot
 
 
@@ -35,8 +35,8 @@ class TrackResult:
     status: list[str]
     sweeps: np.ndarray
     wall_time: np.ndarray  # [s] per sample
-    events: list[dict] = field(default_factory=list)
-    bypasses: list[dict] = field(default_factory=list)
+    events: list[SingularEvent] = field(default_factory=list)
+    bypasses: list[BypassRecord] = field(default_factory=list)
 
     @property
     def joint_steps(self) -> np.ndarray:
@@ -146,8 +146,8 @@ class _Path:
         self.held: dict[str, int] = {}
         self.rows: list[np.ndarray] = []
         self.figures: list[tuple[float, float, str, int, float]] = []
-        self.events: list[dict] = []
-        self.bypasses: list[dict] = [{"sample": 0, "bypass": s, "hold": "path"} for s in restrict]
+        self.events: list[SingularEvent] = []
+        self.bypasses: list[BypassRecord] = [BypassRecord(s, sample=0, hold="path") for s in restrict]
 
     def _solve(self, target: pin.SE3, q_start: np.ndarray, active: tuple[str, ...]) -> Attempt:
         return solver.attempt(self.robot, target, q_start, self.tol_pos, self.tol_rot, np.inf, active=active,
@@ -160,15 +160,15 @@ class _Path:
         att = self._solve(target, q_prev, active)
         step = float(np.max(np.abs(att.q - q_prev)))
         jumped = self.jump_limit is not None and step > self.jump_limit
-        self.events += [{**ev, "sample": k} for ev in att.events]
+        self.events += [ev.at_sample(k) for ev in att.events]
         if jumped:
-            self.events.append({"sample": k, "trigger": "jump", "max_joint_step": step})
+            self.events.append(SingularEvent("jump", sample=k, max_joint_step=step))
         pending = [s for s in self.restrictions if s not in active]
         if (att.events or jumped) and (att.status != Status.CONVERGED or jumped) and pending:
             self.held[pending[0]] = self.hold
-            self.bypasses.append({"sample": k, "bypass": pending[0], "hold": self.hold})
+            self.bypasses.append(BypassRecord(pending[0], sample=k, hold=self.hold))
             att = self._solve(target, q_prev, (*active, pending[0]))
-        self.bypasses += [{**b, "sample": k} for b in att.bypasses if b["bypass"] not in RESTRICTIONS]
+        self.bypasses += [b.at_sample(k) for b in att.bypasses if b.bypass not in RESTRICTIONS]
         self.held = {s: left - 1 for s, left in self.held.items() if left > 1}
         dp, dr = self.robot.tool_error(att.q, target)
         self.rows.append(att.q)

@@ -1,0 +1,54 @@
+"""The small geometry every layer shares, written once: quaternions (w ≥ 0), pose error, 2π wrapping.
+
+Conventions: rotations are 3 × 3 matrices, poses ``pin.SE3``, quaternions (w, x, y, z) with the sign
+chosen so that w ≥ 0 (q and −q are the same rotation).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pinocchio as pin
+
+TWO_PI = 2.0 * np.pi
+
+
+def quat_wxyz_from_matrix(R: np.ndarray) -> np.ndarray:
+    """The unit quaternion (w, x, y, z) of a rotation matrix, with w ≥ 0."""
+    q = pin.Quaternion(np.asarray(R, dtype=float))
+    wxyz = np.array([q.w, q.x, q.y, q.z])
+    return -wxyz if wxyz[0] < 0 else wxyz
+
+
+def matrix_from_quat_wxyz(wxyz: np.ndarray) -> np.ndarray:
+    """The rotation matrix of a quaternion (w, x, y, z), normalised first."""
+    w, x, y, z = np.asarray(wxyz, dtype=float) / np.linalg.norm(wxyz)
+    return pin.Quaternion(w, x, y, z).toRotationMatrix()
+
+
+def pose_error(oMa: pin.SE3, oMb: pin.SE3) -> tuple[float, float]:
+    """(position error [m], rotation angle error [rad]) between two poses of the same frame.
+
+    The position error is |t_a − t_b|; the rotation error is the angle of R_aᵀR_b (in [0, π]).
+    """
+    err = oMa.actInv(oMb)  # b in a's frame: |t| is the distance, log3 the relative rotation
+    return math.hypot(*err.translation.tolist()), math.hypot(*pin.log3(err.rotation).tolist())
+
+
+def wrap_to_pi(angles: np.ndarray) -> np.ndarray:
+    """Angles [rad] wrapped into (−π, π] (the same rotations)."""
+    angles = np.asarray(angles, dtype=float)
+    return np.arctan2(np.sin(angles), np.cos(angles))
+
+
+def turns_into(x: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+    """x moved by whole turns (2πk, the same rotation) towards [lower, upper]: values above the upper
+    bound come down, values below the lower one go up; a value no turn brings inside stays outside by less
+    than a turn (clip it if it must be inside)."""
+    x = np.array(x, dtype=float)
+    over = x > upper
+    x[over] -= TWO_PI * np.ceil((x[over] - upper[over]) / TWO_PI)
+    under = x < lower
+    x[under] += TWO_PI * np.ceil((lower[under] - x[under]) / TWO_PI)
+    return x
