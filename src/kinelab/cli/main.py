@@ -362,23 +362,36 @@ def _robot_arguments(s: argparse.ArgumentParser, q_help: str | None = None, limi
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``kinelab`` command line: one subparser per command."""
     p = _Parser(prog="kinelab", description="Kinematics of serial arms, checked against Pinocchio.")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    for add in (_add_robots, _add_info, _add_fk, _add_ik, _add_singular, _add_view, _add_animate, _add_bench,
+                _add_validate):
+        add(sub)
+    return p
 
+
+def _add_robots(sub: Any) -> None:
     s = sub.add_parser("robots", help="list the registered robots")
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_robots)
 
+
+def _add_info(sub: Any) -> None:
     s = sub.add_parser("info", help="joints, types, limits, DOF and tool frame of a robot")
     _robot_arguments(s, limits=False)
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_info)
 
+
+def _add_fk(sub: Any) -> None:
     s = sub.add_parser("fk", help="tool pose at a configuration")
     _robot_arguments(s, "one number per joint (rad and m; deg with --deg)")
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_fk)
 
+
+def _add_ik(sub: Any) -> None:
     s = sub.add_parser("ik", help="inverse kinematics to a target pose or configuration")
     s.add_argument("robot", help="registered name or URDF path")
     s.add_argument("--solver", default="frdm", help="frdm, biquat or dls (the Pinocchio reference)")
@@ -406,6 +419,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_ik)
 
+
+def _add_singular(sub: Any) -> None:
     s = sub.add_parser("singular", help="rank, singular values, lost directions; or a sweep for singular families")
     _robot_arguments(s, "one number per joint (rad and m; deg with --deg)")
     s.add_argument("--sweep", type=int, help="sample N configurations within the limits and report families")
@@ -414,12 +429,16 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_singular)
 
+
+def _add_view(sub: Any) -> None:
     s = sub.add_parser("view", help="show a robot in meshcat (live on 127.0.0.1, or --html for a static page)")
     _robot_arguments(s, "configuration (default: zero, moved into the limits)")
     s.add_argument("--singular", action="store_true", help="draw the lost directions and σ_min at q")
     s.add_argument("--html", help="write a self-contained HTML page instead of serving")
     s.set_defaults(func=cmd_view)
 
+
+def _add_animate(sub: Any) -> None:
     s = sub.add_parser("animate", help="animate a solver run in meshcat (the ERA passages)")
     s.add_argument("passage", help="era-elbow, era-wrist or era-shoulder (seed paper 000)")
     s.add_argument("--without-bypass", action="store_true", help="the run without the paper's bypass")
@@ -427,6 +446,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--html", help="write a self-contained HTML page instead of serving")
     s.set_defaults(func=cmd_animate)
 
+
+def _add_bench(sub: Any) -> None:
     s = sub.add_parser("bench", help="the IK benchmark: kinelab's solvers and the installed peers")
     s.add_argument("--robots", nargs="+", default=None, help="robots (default: panda ur5 stanford era)")
     s.add_argument("--n", type=int, default=200, help="targets per robot")
@@ -440,6 +461,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_bench)
 
+
+def _add_validate(sub: Any) -> None:
     s = sub.add_parser("validate", help="check every kinelab computation against Pinocchio on the bundled robots")
     s.add_argument("--robots", nargs="+", default=None, help="robots to check (default: the embedded set)")
     s.add_argument("--n", type=int, default=None, help="random configurations per check")
@@ -448,7 +471,6 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the report folder (Markdown, HTML with the figures, JSON); default ./kinelab-report")
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_validate)
-    return p
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -154,6 +154,24 @@ def revolute_angle(B, C, lo, hi, continuous):
     return lo if np.cos(lo - t) >= np.cos(hi - t) else hi
 
 
+@njit(cache=True, inline="always")
+def _carry_axis(Rg, tg, e, o, i):
+    """Move joint i's axis (e_i, o_i) by the rigid motion (Rg, tg) of the joints stepped before it, in place.
+
+    Base → tip, no later step moves joint i's axis: written back, e and o hold the axes at the new q when
+    the sweep ends, and the next sweep needs no chain FK.
+    """
+    e0 = Rg[0, 0] * e[i, 0] + Rg[0, 1] * e[i, 1] + Rg[0, 2] * e[i, 2]
+    e1 = Rg[1, 0] * e[i, 0] + Rg[1, 1] * e[i, 1] + Rg[1, 2] * e[i, 2]
+    e2 = Rg[2, 0] * e[i, 0] + Rg[2, 1] * e[i, 1] + Rg[2, 2] * e[i, 2]
+    norm = np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)  # keep rounding in Rg from compounding
+    o0 = Rg[0, 0] * o[i, 0] + Rg[0, 1] * o[i, 1] + Rg[0, 2] * o[i, 2] + tg[0]
+    o1 = Rg[1, 0] * o[i, 0] + Rg[1, 1] * o[i, 1] + Rg[1, 2] * o[i, 2] + tg[1]
+    o2 = Rg[2, 0] * o[i, 0] + Rg[2, 1] * o[i, 1] + Rg[2, 2] * o[i, 2] + tg[2]
+    e[i, 0], e[i, 1], e[i, 2] = e0 / norm, e1 / norm, e2 / norm
+    o[i, 0], o[i, 1], o[i, 2] = o0, o1, o2
+
+
 @njit(cache=True)
 def sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, relax, base_to_tip):
     """One sweep over the free joints, tip → base or base → tip; updates q, p, R in place.
@@ -171,21 +189,9 @@ def sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, rela
     for k in range(n):
         i = k if base_to_tip else n - 1 - k
         if moved_any:
-            e0 = Rg[0, 0] * e[i, 0] + Rg[0, 1] * e[i, 1] + Rg[0, 2] * e[i, 2]
-            e1 = Rg[1, 0] * e[i, 0] + Rg[1, 1] * e[i, 1] + Rg[1, 2] * e[i, 2]
-            e2 = Rg[2, 0] * e[i, 0] + Rg[2, 1] * e[i, 1] + Rg[2, 2] * e[i, 2]
-            norm = np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)  # keep rounding in Rg from compounding
-            e0, e1, e2 = e0 / norm, e1 / norm, e2 / norm
-            o0 = Rg[0, 0] * o[i, 0] + Rg[0, 1] * o[i, 1] + Rg[0, 2] * o[i, 2] + tg[0]
-            o1 = Rg[1, 0] * o[i, 0] + Rg[1, 1] * o[i, 1] + Rg[1, 2] * o[i, 2] + tg[1]
-            o2 = Rg[2, 0] * o[i, 0] + Rg[2, 1] * o[i, 1] + Rg[2, 2] * o[i, 2] + tg[2]
-            # base → tip, no later step moves joint i's axis: written back, e and o hold the axes at the
-            # new q when the sweep ends, and the next sweep needs no chain FK
-            e[i, 0], e[i, 1], e[i, 2] = e0, e1, e2
-            o[i, 0], o[i, 1], o[i, 2] = o0, o1, o2
-        else:
-            e0, e1, e2 = e[i, 0], e[i, 1], e[i, 2]
-            o0, o1, o2 = o[i, 0], o[i, 1], o[i, 2]
+            _carry_axis(Rg, tg, e, o, i)
+        e0, e1, e2 = e[i, 0], e[i, 1], e[i, 2]
+        o0, o1, o2 = o[i, 0], o[i, 1], o[i, 2]
         if not free[i]:
             continue
         lo = lower[i] - q[i]
@@ -384,7 +390,8 @@ def _window_stalled(state, st, E1):
 @njit(cache=True)
 def run(q: np.ndarray, ch: Chain, pb: Problem, st: Settings, order: int, max_sweeps: int,
         mem: Memory) -> tuple[int, int]:
-    """Sweep until converged, stalled or ``max_sweeps`` sweeps; q is updated in place.
+    """Sweep until converged, stalled or ``max_sweeps`` sweeps; q is updated in place. Returns (code,
+    sweeps in this call); the state slots S_* carry the rest.
 
     Args:
         q (np.ndarray): start, one number per joint [rad or m]; holds the result on return.
@@ -394,14 +401,10 @@ def run(q: np.ndarray, ch: Chain, pb: Problem, st: Settings, order: int, max_swe
         order (int): TIP_TO_BASE, BASE_TO_TIP or ALTERNATE.
         max_sweeps (int): sweeps allowed in this call.
         mem (Memory): work arrays kept between calls.
-
-    Returns:
-        (code, sweeps in this call); the state slots S_* carry the rest.
     """
     state, trace = mem.state, mem.trace
     lower, upper, free, pstar, Rstar, w_p, w_ax = pb.lower, pb.upper, pb.free, pb.pstar, pb.Rstar, pb.w_p, pb.w_ax
-    kind = ch.kind
-    n = q.shape[0]
+    kind, n = ch.kind, q.shape[0]
     w = _scratch(n, st.accel_m)
     x_old = w.x_old
     e, o, p, R = np.empty((n, 3)), np.empty((n, 3)), np.empty(3), np.empty((3, 3))
