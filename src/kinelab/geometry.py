@@ -42,13 +42,13 @@ def wrap_to_pi(angles: np.ndarray) -> np.ndarray:
     return np.arctan2(np.sin(angles), np.cos(angles))
 
 
-def turns_into(x: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+def turns_into(x: np.ndarray, lower: np.ndarray, upper: np.ndarray, where: np.ndarray | None = None) -> np.ndarray:
     """x moved by whole turns (2πk, the same rotation) towards [lower, upper]: values above the upper
     bound come down, values below the lower one go up; a value no turn brings inside stays outside by less
-    than a turn (clip it if it must be inside)."""
+    than a turn (clip it if it must be inside). ``where``: only these entries (the angles) move."""
     x = np.array(x, dtype=float)
-    over = x > upper
+    over = x > upper if where is None else where & (x > upper)
     x[over] -= TWO_PI * np.ceil((x[over] - upper[over]) / TWO_PI)
-    under = x < lower
+    under = x < lower if where is None else where & (x < lower)
     x[under] += TWO_PI * np.ceil((lower[under] - x[under]) / TWO_PI)
     return x

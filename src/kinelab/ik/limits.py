@@ -27,9 +27,7 @@ class PinLimits:
 
 def wrap_and_clip(x: np.ndarray, lower: np.ndarray, upper: np.ndarray, revolute: np.ndarray) -> np.ndarray:
     """Bring values into [lower, upper]: revolute ones first by ±2πk (same pose), then clip."""
-    x = np.array(x, dtype=float)
-    x[revolute] = turns_into(x[revolute], lower[revolute], upper[revolute])
-    return np.clip(x, lower, upper)
+    return np.clip(turns_into(x, lower, upper, where=revolute), lower, upper)
 
 
 def wrap_q(robot: Robot, q: np.ndarray) -> np.ndarray:
