@@ -88,7 +88,7 @@ def new_memory(n: int, accel_m: int, trace_length: int = 0) -> Memory:
                   np.full(trace_length, -1.0))
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def objective(p, R, pstar, Rstar, w_p, w_ax):
     d0, d1, d2 = p[0] - pstar[0], p[1] - pstar[1], p[2] - pstar[2]
     E = w_p * (d0 * d0 + d1 * d1 + d2 * d2)
@@ -134,7 +134,7 @@ def revolute_BC(e, o, p, R, pstar, Rstar, w_p, w_ax):
     return _bc(e[0], e[1], e[2], o[0], o[1], o[2], p, R, pstar, Rstar, w_p, w_ax)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def revolute_angle(B, C, lo, hi, continuous):
     """The exact minimiser of E(θ) over the window [lo, hi] ∋ 0 (methods.md §1.5)."""
     if B == 0.0 and C == 0.0:
@@ -172,7 +172,7 @@ def _carry_axis(Rg, tg, e, o, i):
     o[i, 0], o[i, 1], o[i, 2] = o0, o1, o2
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, relax, base_to_tip):
     """One sweep over the free joints, tip → base or base → tip; updates q, p, R in place.
 
