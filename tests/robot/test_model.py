@@ -3,7 +3,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import revolute, write_urdf
+from helpers import revolute, write_urdf
 
 import kinelab
 from kinelab.analysis.oracles import pose_error

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from conftest import BUNDLED, ERD_ARMS
+from helpers import BUNDLED, ERD_ARMS
 
 from kinelab.analysis import oracles as checks
 

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from conftest import BUNDLED
+from helpers import BUNDLED
 
 import kinelab
 from kinelab.dq import kinematics as bk

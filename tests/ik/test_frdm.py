@@ -6,7 +6,7 @@ import warnings
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest import revolute, write_urdf
+from helpers import revolute, write_urdf
 
 import kinelab
 from kinelab.ik import solve
