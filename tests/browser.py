@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import base64
-import contextlib
-import io
 import re
 import shutil
 import subprocess
@@ -16,19 +14,6 @@ import umsgpack
 from PIL import Image
 
 from kinelab.view import Scene
-
-
-def empty_scene_html(viewer=None) -> str:
-    import meshcat
-
-    """A static page of an empty meshcat scene (the reference a robot's picture is compared with)."""
-    with contextlib.redirect_stdout(io.StringIO()):
-        vis = viewer if viewer is not None else meshcat.Visualizer()
-    html = vis.static_html()
-    if viewer is None:
-        with contextlib.suppress(Exception):
-            vis.window.server_proc.kill()
-    return html
 
 
 def scene_paths(html: str) -> set[str]:

@@ -303,8 +303,10 @@ def _publish(scene, html: str | None) -> int:
 
 
 def _serve(scene) -> int:
+    import signal
     import time
 
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))  # so that the finally below stops the server
     print(f"meshcat is serving on {scene.url} (Ctrl-C to stop)", flush=True)
     try:
         while True:

@@ -16,6 +16,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.robot import Robot
+from kinelab.view.server import Server
 
 AXIS_COLORS = (0xE6194B, 0x3CB44B, 0x4363D8)  # x red, y green, z blue
 
@@ -29,8 +30,11 @@ class Scene:
         from pinocchio.visualize import MeshcatVisualizer
 
         self.robot = robot
+        self.server: Server | None = None
+        if viewer is None:
+            self.server = Server()  # meshcat's bridge on 127.0.0.1 only, ending with this process
         with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL; we expose it as .url
-            self.viewer = viewer if viewer is not None else meshcat.Visualizer()
+            self.viewer = viewer if viewer is not None else meshcat.Visualizer(zmq_url=self.server.zmq_url)
         self.geom = robot.visual_model()
         self.pinviz = MeshcatVisualizer(robot.model, pin.GeometryModel(), self.geom)
         self.pinviz.initViewer(viewer=self.viewer)
@@ -173,5 +177,6 @@ class Scene:
         return path
 
     def close(self) -> None:
-        with contextlib.suppress(Exception):
-            self.viewer.window.server_proc.kill()
+        """Stop the server this scene started (a viewer passed in is left alone)."""
+        if self.server is not None:
+            self.server.stop()
