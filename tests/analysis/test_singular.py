@@ -152,3 +152,18 @@ def test_grid_sweep_on_a_6r_arm_finds_the_wrist_and_elbow_families():
     assert any("wrist_2_joint" in t for t in texts) and any("elbow_joint" in t for t in texts)
     for f in res.families:
         assert independent_rank(ur5, f.representative) < 6
+
+
+@pytest.mark.parametrize("name", ["so101", "finger_edu"])
+def test_arms_with_fewer_than_six_joints_report_the_twists_they_cannot_make(name):
+    """A 5- or 3-joint arm: full rank n at a generic q, and 6 − n lost twists, each orthogonal to every
+    column of the scaled Jacobian (checked against Pinocchio's Jacobian)."""
+    robot = kinelab.load(name)
+    for q in robot.random_qs(10, 4):
+        a = singular.analyze(robot, q)
+        assert a.full_rank == robot.n and a.rank == robot.n and not a.singular
+        assert len(a.lost_directions) == 6 - robot.n
+        J = singular.scaled_jacobian(robot, q)
+        for d in a.lost_directions:
+            assert d.sigma == 0.0
+            assert np.max(np.abs(np.array(d.twist) @ J)) < 1e-9

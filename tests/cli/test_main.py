@@ -157,3 +157,10 @@ def test_ik_bypass_flags_reach_the_solver_in_radians(capsys):
 
     same = solve(era, era.fk(target_q), q0=np.zeros(7), seed=0, kicks={"joint4": -np.deg2rad(1.0)})
     np.testing.assert_allclose(res["q"], same.q, atol=1e-12)  # −1 with --deg is −1° in radians
+
+
+def test_singular_on_an_arm_with_fewer_than_six_joints(capsys):
+    """Regression: a 5-joint arm used to end in an IndexError traceback."""
+    code, out, _ = run(capsys, "singular", "so101", "0.1", "0.2", "0.3", "0.4", "0.5", "--json")
+    res = json.loads(out)
+    assert code == 0 and res["rank"] == 5 and res["full_rank"] == 5 and len(res["lost_directions"]) == 1

@@ -203,3 +203,13 @@ def test_compiled_multistart_is_seeded_and_checked():
         assert a.info["path"] == "compiled" and a.success and robot.within_limits(a.q)
         np.testing.assert_array_equal(a.q, b.q)
         assert robot.tool_error(a.q, target)[0] <= 1e-6
+
+
+def test_the_adaptive_integrator_keeps_the_time_budget():
+    """Regression: scipy's integrator has no deadline; this start used to run for more than 10 minutes."""
+    robot = kinelab.load("panda")
+    target = robot.fk(np.array([-1.579979, -0.646037, 1.723114, -1.041683, -0.630977, 1.237209, 0.569660]))
+    start = np.array([1.615679, -1.155520, 1.237569, -0.819294, -1.905791, 3.382756, -2.075733])
+    res = solve(robot, target, solver="biquat", integrator="adaptive", time_budget=0.3, q0=start, seed=0)
+    assert res.wall_time < 0.3 * 1.05 + 0.05  # generous: one rhs evaluation past the deadline at most
+    assert res.status.value in ("time_budget", "converged")

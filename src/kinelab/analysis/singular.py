@@ -115,6 +115,7 @@ def analyze(robot: Robot, q, length: float | None = None) -> Analysis:
     JJ = J @ J.T if robot.n >= 6 else J.T @ J
     manip = float(np.sqrt(max(np.linalg.det(JJ), 0.0)))
     condition = float(s[0] / s[full - 1]) if s[full - 1] > RANK_RTOL * s[0] else float("inf")
-    lost = [describe_direction(U[:, i], float(s[i])) for i in range(rank, 6)]
+    # an arm with fewer than six joints has 6 − n directions it can never produce (σ = 0 by construction)
+    lost = [describe_direction(U[:, i], float(s[i]) if i < s.size else 0.0) for i in range(rank, 6)]
     null = [Vt[i] for i in range(rank, robot.n)]
     return Analysis(q, s, rank, full, manip, condition, L, lost, null)

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import itertools
 import math
-import xml.etree.ElementTree as ET
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -33,6 +32,7 @@ from kinelab.errors import (
 )
 from kinelab.geometry import pose_error, wrap_to_pi
 from kinelab.robot import catalog
+from kinelab.robot.urdf import UrdfTree, read_tree
 
 _REVOLUTE = {"JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned"}
 _PRISMATIC = {"JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned"}
@@ -58,58 +58,10 @@ class Joint:
         return "m" if self.kind == "prismatic" else "rad"
 
 
-@dataclass(frozen=True)
-class _UrdfTree:
-    """The joint/link graph of a URDF, read with the standard library so errors can be specific."""
-
-    root: str
-    parent_of: dict[str, str]  # child link -> parent link
-    joint_of: dict[str, str]  # child link -> joint name
-    mimic: dict[str, str]  # joint -> the joint it mimics
-    links: list[str]
-    leaves: list[str]
-
-
-def _read_tree(path: Path) -> _UrdfTree:
-    if not path.is_file():
-        raise URDFError(f"URDF file not found: {path}")
-    try:
-        xml = ET.parse(path).getroot()
-    except ET.ParseError as exc:
-        raise URDFError(f"malformed URDF {path}: {exc}") from None
-    if xml.tag != "robot":
-        raise URDFError(f"malformed URDF {path}: the root element is <{xml.tag}>, expected <robot>")
-    links = [link.get("name", "") for link in xml.findall("link")]
-    parent_of: dict[str, str] = {}
-    joint_of: dict[str, str] = {}
-    mimic: dict[str, str] = {}
-    for joint in xml.findall("joint"):
-        name = joint.get("name", "?")
-        parent, child = joint.find("parent"), joint.find("child")
-        if parent is None or child is None:
-            raise URDFError(f"malformed URDF {path}: joint {name!r} lacks <parent> or <child>")
-        c = child.get("link", "")
-        if c in joint_of:
-            raise ChainError(
-                f"{path.name} has a closed loop: link {c!r} is the child of both joint "
-                f"{joint_of[c]!r} and joint {name!r}; kinelab handles serial chains and trees only"
-            )
-        parent_of[c], joint_of[c] = parent.get("link", ""), name
-        m = joint.find("mimic")
-        if m is not None:
-            mimic[name] = m.get("joint", "")
-    roots = [link for link in links if link not in parent_of]
-    if len(roots) != 1:
-        raise URDFError(f"malformed URDF {path}: expected one root link, found {roots}")
-    parents = set(parent_of.values())
-    leaves = [link for link in links if link not in parents]
-    return _UrdfTree(roots[0], parent_of, joint_of, mimic, links, leaves)
-
-
 def _build_full_model(path: Path) -> pin.Model:
     try:
         return pin.buildModelFromUrdf(str(path))
-    except (RuntimeError, ValueError) as exc:
+    except (RuntimeError, ValueError, UnicodeDecodeError) as exc:
         raise URDFError(f"Pinocchio cannot read {path}: {exc}") from None
 
 
@@ -133,6 +85,23 @@ def _kind(joint_model: pin.JointModel) -> str | None:
     if short in _CONTINUOUS:
         return "continuous"
     return None
+
+
+def _locked_value(full: pin.Model, jid: int, value: object) -> float:
+    """A user's locked value for joint jid: a finite number within the joint's limits."""
+    name = full.names[jid]
+    try:
+        number = float(value)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise ConfigurationError(f"locked[{name!r}] must be a number, got {value!r}") from None
+    if not math.isfinite(number):
+        raise ConfigurationError(f"locked[{name!r}] is {number}: locked values must be finite")
+    iq = full.idx_qs[jid]
+    if full.joints[jid].nq == 1:
+        lo, hi = float(full.lowerPositionLimit[iq]), float(full.upperPositionLimit[iq])
+        if not lo - LIMIT_SLACK <= number <= hi + LIMIT_SLACK:
+            raise JointLimitError(name, number, lo, hi)
+    return number
 
 
 def _read_only(arr: np.ndarray) -> np.ndarray:
@@ -161,7 +130,7 @@ class Robot:
         name: str | None = None,
     ):
         self.urdf_path = Path(urdf_path)
-        tree = _read_tree(self.urdf_path)
+        tree = read_tree(self.urdf_path)
         full = _build_full_model(self.urdf_path)
         self.name = name or full.name or self.urdf_path.stem
         self.base = tree.root
@@ -222,7 +191,7 @@ class Robot:
 
     # -- construction ------------------------------------------------------------------------
     @staticmethod
-    def _default_tool(tree: _UrdfTree, full: pin.Model) -> str:
+    def _default_tool(tree: UrdfTree, full: pin.Model) -> str:
         if any(f.name == "tool" for f in full.frames):
             return "tool"
         if len(tree.leaves) == 1:
@@ -233,7 +202,7 @@ class Robot:
         )
 
     @staticmethod
-    def _check_chain(full: pin.Model, chain: list[int], tree: _UrdfTree) -> None:
+    def _check_chain(full: pin.Model, chain: list[int], tree: UrdfTree) -> None:
         for jid in chain:
             jname = full.names[jid]
             if jname in tree.mimic:
@@ -257,7 +226,7 @@ class Robot:
         for jid in range(1, full.njoints):
             jname = full.names[jid]
             if jname in user:
-                locked[jname] = float(user[jname])
+                locked[jname] = _locked_value(full, jid, user[jname])
             elif jid not in chain:
                 iq = full.idx_qs[jid]
                 lo, hi = full.lowerPositionLimit[iq], full.upperPositionLimit[iq]

@@ -33,8 +33,9 @@ class Scene:
         self.server: Server | None = None
         if viewer is None:
             self.server = Server()  # meshcat's bridge on 127.0.0.1 only, ending with this process
+            viewer_url = self.server.zmq_url
         with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL; we expose it as .url
-            self.viewer = viewer if viewer is not None else meshcat.Visualizer(zmq_url=self.server.zmq_url)
+            self.viewer = viewer if viewer is not None else meshcat.Visualizer(zmq_url=viewer_url)
         self.geom = robot.visual_model()
         self.pinviz = MeshcatVisualizer(robot.model, pin.GeometryModel(), self.geom)
         self.pinviz.initViewer(viewer=self.viewer)

@@ -82,7 +82,7 @@ def _die_with_parent() -> None:
 def _loopback_bridge() -> Any:
     from meshcat.servers import zmqserver
 
-    class LoopbackBridge(zmqserver.ZMQWebSocketBridge):  # type: ignore[misc]
+    class LoopbackBridge(zmqserver.ZMQWebSocketBridge):
         """meshcat's bridge with its web server listening on 127.0.0.1 only."""
 
         def make_app(self) -> Any:

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 import pinocchio as pin
@@ -164,8 +164,13 @@ def adaptive(system: System, q_pin: np.ndarray, stop: Stop, traj: Trajectory | N
     def unpack(y):
         return pin.integrate(model, q_base, y[:nv]), y[nv:]
 
+    last: dict[str, Any] = {"q": q_pin, "t": 0.0, "nfev": 0}  # where a run stopped by the clock ends
+
     def rhs(t, y):
+        if time.perf_counter() > stop.deadline:
+            raise _OutOfTimeError
         q, T = unpack(y)
+        last.update(q=q, t=t, nfev=last["nfev"] + 1)
         qd, Td, M, U = system.rates(q, T)
         if traj is not None:
             traj.append(t, system.robot.from_pin_q(q), M, U)
@@ -179,10 +184,17 @@ def adaptive(system: System, q_pin: np.ndarray, stop: Stop, traj: Trajectory | N
         return max(np.linalg.norm(M[1:4]) / eps_rot, np.linalg.norm(M[5:8]) / eps_dual) - 1.0
 
     converged.terminal = True  # type: ignore[attr-defined]
-    sol = solve_ivp(rhs, (0.0, stop.max_time), np.r_[np.zeros(nv), 1.0, 0.0], events=converged, rtol=1e-8,
-                    atol=1e-10, first_step=min(stop.h, 0.1))
+    try:
+        sol = solve_ivp(rhs, (0.0, stop.max_time), np.r_[np.zeros(nv), 1.0, 0.0], events=converged, rtol=1e-8,
+                        atol=1e-10, first_step=min(stop.h, 0.1))
+    except _OutOfTimeError:
+        return last["q"], float(last["t"]), int(last["nfev"]), Status.TIME_BUDGET, system.error(last["q"])
     q_end, _ = unpack(sol.y[:, -1])
     M = system.error(q_end)
     status = Status.CONVERGED if done(M, eps_rot * 1.0001, eps_dual * 1.0001) else (
         Status.MAX_ITERATIONS if sol.status == 0 else Status.SINGULAR)
     return q_end, float(sol.t[-1]), int(sol.nfev), status, M
+
+
+class _OutOfTimeError(Exception):
+    """Raised inside scipy's integrator when the solve's deadline has passed (scipy has no deadline)."""

@@ -1,0 +1,120 @@
+"""A URDF read with the standard library before Pinocchio sees it: the joint/link graph, and the rules a
+file must meet to be a model (so that errors name the file, the element and the rule).
+
+Rules: one root link; no link that is its own parent; every joint has a parent and a child; origins are
+finite and within ``MAX_OFFSET`` of their parent; axes are finite and not zero; limits are finite with
+lower ≤ upper; a mimic joint names a joint that exists; the text decodes in the encoding the XML
+declares (UTF-8 when it declares none).
+"""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+from kinelab.errors import ChainError, URDFError
+
+MAX_OFFSET = 1e4  # [m] the largest joint or link offset a model may have (no robot is 10 km long)
+
+
+@dataclass(frozen=True)
+class UrdfTree:
+    """The joint/link graph of a URDF."""
+
+    root: str
+    parent_of: dict[str, str]  # child link -> parent link
+    joint_of: dict[str, str]  # child link -> joint name
+    mimic: dict[str, str]  # joint -> the joint it mimics
+    links: list[str]
+    leaves: list[str]
+
+
+def read_tree(path: Path) -> UrdfTree:
+    """The graph of the URDF at ``path``, its elements checked against the rules above.
+
+    Raises:
+        URDFError: a missing or malformed file, or an element that breaks a rule (named with the rule).
+        ChainError: a closed loop.
+    """
+    xml = _parse(path)
+    links = [link.get("name", "") for link in xml.findall("link")]
+    parent_of: dict[str, str] = {}
+    joint_of: dict[str, str] = {}
+    mimic: dict[str, str] = {}
+    for joint in xml.findall("joint"):
+        name = joint.get("name", "?")
+        parent, child = _check_joint(path, joint)
+        if child in joint_of:
+            raise ChainError(
+                f"{path.name} has a closed loop: link {child!r} is the child of both joint "
+                f"{joint_of[child]!r} and joint {name!r}; kinelab handles serial chains and trees only"
+            )
+        parent_of[child], joint_of[child] = parent, name
+        m = joint.find("mimic")
+        if m is not None:
+            mimic[name] = m.get("joint", "")
+    joint_names = {j.get("name", "?") for j in xml.findall("joint")}
+    for name, leader in mimic.items():
+        if leader not in joint_names:
+            raise URDFError(f"{path}: joint {name!r} mimics {leader!r}, which is not a joint of this file")
+    roots = [link for link in links if link not in parent_of]
+    if len(roots) != 1:
+        raise URDFError(f"malformed URDF {path}: expected one root link, found {roots}")
+    parents = set(parent_of.values())
+    return UrdfTree(roots[0], parent_of, joint_of, mimic, links, [link for link in links if link not in parents])
+
+
+def _parse(path: Path) -> ET.Element:
+    if not path.is_file():
+        raise URDFError(f"URDF file not found: {path}")
+    try:
+        xml = ET.parse(path).getroot()
+    except ET.ParseError as exc:
+        raise URDFError(f"malformed URDF {path}: {exc} (the text must be UTF-8 or declare its encoding)") from None
+    except (UnicodeDecodeError, LookupError) as exc:
+        raise URDFError(f"URDF {path} cannot be decoded: {exc}") from None
+    if xml.tag != "robot":
+        raise URDFError(f"malformed URDF {path}: the root element is <{xml.tag}>, expected <robot>")
+    return xml
+
+
+def _check_joint(path: Path, joint: ET.Element) -> tuple[str, str]:
+    """(parent link, child link) of a joint whose origin, axis and limits meet the rules."""
+    name = joint.get("name", "?")
+    parent, child = joint.find("parent"), joint.find("child")
+    if parent is None or child is None:
+        raise URDFError(f"malformed URDF {path}: joint {name!r} lacks <parent> or <child>")
+    p, c = parent.get("link", ""), child.get("link", "")
+    if p == c:
+        raise URDFError(f"{path}: joint {name!r} connects link {p!r} to itself")
+    where = f"{path}: joint {name!r}"
+    origin = joint.find("origin")
+    if origin is not None:
+        xyz = _numbers(where, "origin xyz", origin.get("xyz", "0 0 0"), 3)
+        _numbers(where, "origin rpy", origin.get("rpy", "0 0 0"), 3)
+        if max(abs(v) for v in xyz) > MAX_OFFSET:
+            raise URDFError(f"{where}: origin xyz {xyz} is more than {MAX_OFFSET:g} m from its parent")
+    axis = joint.find("axis")
+    if axis is not None and joint.get("type") not in ("fixed", "floating"):
+        a = _numbers(where, "axis xyz", axis.get("xyz", "1 0 0"), 3)
+        if math.hypot(*a) < 1e-12:
+            raise URDFError(f"{where}: the axis is zero; an axis must be a non-zero direction")
+    limit = joint.find("limit")
+    if limit is not None and joint.get("type") in ("revolute", "prismatic"):
+        lo = _numbers(where, "limit lower", limit.get("lower", "0"), 1)[0]
+        hi = _numbers(where, "limit upper", limit.get("upper", "0"), 1)[0]
+        if lo > hi:
+            raise URDFError(f"{where}: limit lower {lo:g} > upper {hi:g}")
+    return p, c
+
+
+def _numbers(where: str, what: str, text: str, count: int) -> list[float]:
+    try:
+        values = [float(v) for v in text.split()]
+    except ValueError:
+        values = []
+    if len(values) != count or not all(math.isfinite(v) for v in values):
+        raise URDFError(f"{where}: {what} must be {count} finite number{'s' if count > 1 else ''}, got {text!r}")
+    return values

@@ -1,0 +1,79 @@
+"""Nonsense models are refused at load, each refusal naming the file, the element and the rule."""
+
+import numpy as np
+import pytest
+from helpers import revolute, write_urdf
+
+import kinelab
+
+LINKS = '<link name="a"/><link name="b"/><link name="c"/>'
+
+
+def _chain(j1: str, j2: str | None = None) -> str:
+    return LINKS + j1 + (j2 or revolute("j2", "b", "c"))
+
+
+@pytest.mark.parametrize("joint, rule", [
+    (revolute("j1", "a", "b", axis="0 0 0"), "axis is zero"),
+    (revolute("j1", "a", "b", axis="0 nan 1"), "axis xyz must be 3 finite numbers"),
+    (revolute("j1", "a", "b", xyz="1e308 0 0.1"), "more than 10000 m"),
+    (revolute("j1", "a", "b", xyz="inf 0 0"), "origin xyz must be 3 finite numbers"),
+    (revolute("j1", "a", "b", xyz="0 0"), "origin xyz must be 3 finite numbers"),
+    ('<joint name="j1" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>'
+     '<limit lower="1" upper="-1" effort="1" velocity="1"/></joint>', "limit lower 1 > upper -1"),
+    ('<joint name="j1" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>'
+     '<limit lower="nan" upper="1" effort="1" velocity="1"/></joint>', "limit lower must be 1 finite number"),
+])
+def test_joint_rules(tmp_path, joint, rule):
+    path = write_urdf(tmp_path, _chain(joint))
+    with pytest.raises(kinelab.URDFError, match=rule) as err:
+        kinelab.load(path)
+    assert "r.urdf" in str(err.value) and "'j1'" in str(err.value)
+
+
+def test_a_link_that_is_its_own_parent(tmp_path):
+    path = write_urdf(tmp_path, LINKS + revolute("j1", "a", "a") + revolute("j2", "a", "b") + revolute("j3", "b", "c"))
+    with pytest.raises(kinelab.URDFError, match="joint 'j1' connects link 'a' to itself"):
+        kinelab.load(path)
+
+
+def test_a_mimic_joint_naming_a_missing_joint(tmp_path):
+    j2 = revolute("j2", "b", "c", extra='<mimic joint="nosuch"/>')
+    path = write_urdf(tmp_path, _chain(revolute("j1", "a", "b"), j2))
+    with pytest.raises(kinelab.URDFError, match="'j2' mimics 'nosuch', which is not a joint"):
+        kinelab.load(path)
+
+
+def test_a_file_in_another_encoding_without_a_declaration(tmp_path):
+    path = tmp_path / "latin.urdf"
+    text = '<?xml version="1.0"?>\n<robot name="t"><!-- café -->' + _chain(revolute("j1", "a", "b")) + "</robot>\n"
+    path.write_bytes(text.encode("latin-1"))
+    with pytest.raises(kinelab.URDFError, match="latin.urdf"):
+        kinelab.load(str(path))
+
+
+def test_a_file_that_declares_its_encoding_loads(tmp_path):
+    path = tmp_path / "latin.urdf"
+    text = ('<?xml version="1.0" encoding="ISO-8859-1"?>\n<robot name="t"><!-- café -->'
+            + _chain(revolute("j1", "a", "b")) + "</robot>\n")
+    path.write_bytes(text.encode("latin-1"))
+    assert kinelab.load(str(path)).n == 2
+
+
+@pytest.mark.parametrize("value, error, words", [
+    (float("nan"), kinelab.ConfigurationError, "must be finite"),
+    (float("inf"), kinelab.ConfigurationError, "must be finite"),
+    (5.0, kinelab.JointLimitError, "outside its limits"),
+    ("a lot", kinelab.ConfigurationError, "must be a number"),
+])
+def test_locked_values_must_be_finite_and_within_limits(tmp_path, value, error, words):
+    path = write_urdf(tmp_path, _chain(revolute("j1", "a", "b")))
+    with pytest.raises(error, match=words):
+        kinelab.load(path, locked={"j2": value})
+
+
+def test_a_sensible_locked_value_is_kept(tmp_path):
+    path = write_urdf(tmp_path, _chain(revolute("j1", "a", "b")))
+    robot = kinelab.load(path, locked={"j2": 1.5})
+    assert robot.n == 1 and robot.locked["j2"] == 1.5
+    np.testing.assert_allclose(robot.fk([0.0]).translation, [0.0, 0.0, 1.0], atol=1e-12)
