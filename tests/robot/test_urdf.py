@@ -77,3 +77,32 @@ def test_a_sensible_locked_value_is_kept(tmp_path):
     robot = kinelab.load(path, locked={"j2": 1.5})
     assert robot.n == 1 and robot.locked["j2"] == 1.5
     np.testing.assert_allclose(robot.fk([0.0]).translation, [0.0, 0.0, 1.0], atol=1e-12)
+
+
+def test_a_chain_too_long_for_pinocchio_is_refused_at_once_with_the_estimate(tmp_path):
+    """Pinocchio's Data grows as nv³ (8 GB at 500 joints): kinelab refuses before allocating it."""
+    import time
+
+    from kinelab.report.bench import scaling
+    from kinelab.robot.model import max_joints
+
+    path = tmp_path / "long.urdf"
+    path.write_text(scaling.synthetic_urdf(max_joints() + 200))
+    t0 = time.perf_counter()
+    with pytest.raises(kinelab.ChainError, match=r"would take about \d+\.\d GiB"):
+        kinelab.load(str(path))
+    assert time.perf_counter() - t0 < 10  # refused before any large allocation
+
+
+def test_loading_is_linear_in_the_chain_below_the_data_bound(tmp_path):
+    """The load's own work is linear: a 150-link chain loads (its Data is 0.2 GB)."""
+    from kinelab.report.bench import scaling
+
+    path = tmp_path / "c150.urdf"
+    path.write_text(scaling.synthetic_urdf(150))
+    robot = kinelab.load(str(path))
+    assert robot.n == 150 and robot.joint_kinds.count("prismatic") == 150 // 4
+    from kinelab.ik.chain import chain_model
+
+    for q in robot.random_qs(3, 0):  # the axes read from the joint models give Pinocchio's FK
+        np.testing.assert_allclose(chain_model(robot).vectors(q)["N"], robot.fk(q).translation, atol=1e-9)

@@ -38,6 +38,7 @@ _REVOLUTE = {"JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevolute
 _PRISMATIC = {"JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned"}
 _CONTINUOUS = {"JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "JointModelRevoluteUnboundedUnaligned"}
 T = TypeVar("T")
+MAX_DATA_BYTES = 2**31  # 2 GiB for one Pinocchio Data (see data_bytes)
 LIMIT_SLACK = 1e-9  # joint values this far past a limit still count as within it (rad or m)
 
 
@@ -104,6 +105,30 @@ def _locked_value(full: pin.Model, jid: int, value: object) -> float:
     return number
 
 
+def data_bytes(nv: int) -> int:
+    """Bytes a Pinocchio Data takes for nv velocities: it allocates nv × nv × nv tensors (second-order
+    derivatives) and a 6 × nv × nv one, whatever the algorithms used, so its size grows as nv³."""
+    return 8 * (8 * nv**3 + 6 * nv**2 + 64 * nv)  # measured: 513 MB at nv = 200, 1.7 GB at nv = 300
+
+
+def _check_data_size(model: pin.Model, name: str) -> None:
+    need = data_bytes(model.nv)
+    if need > MAX_DATA_BYTES:
+        raise ChainError(
+            f"{name}: the chain has {model.nv} joints, and a Pinocchio Data for it would take about "
+            f"{need / 2**30:.1f} GiB (Pinocchio allocates nv³-sized tensors); kinelab loads chains whose Data "
+            f"fits in {MAX_DATA_BYTES / 2**30:g} GiB (about {max_joints()} joints)"
+        )
+
+
+def max_joints() -> int:
+    """The longest chain whose Pinocchio Data fits in MAX_DATA_BYTES."""
+    nv = 1
+    while data_bytes(nv + 1) <= MAX_DATA_BYTES:
+        nv += 1
+    return nv
+
+
 def _read_only(arr: np.ndarray) -> np.ndarray:
     arr.flags.writeable = False  # the checks derived from the limits would not see an edit
     return arr
@@ -155,6 +180,7 @@ class Robot:
         lock_ids = [full.getJointId(j) for j in self.locked]
         self._full, self._lock_ids, self._q_ref = full, lock_ids, q_ref
         self.model = pin.buildReducedModel(full, lock_ids, q_ref) if lock_ids else full
+        _check_data_size(self.model, self.name)
         self.data = self.model.createData()
         self.tool_frame_id = _frame_id(self.model, self.tool, self.name)
         self.joints = self._joint_table()
@@ -235,6 +261,7 @@ class Robot:
 
     def _joint_table(self) -> list[Joint]:
         m = self.model
+        axes = _local_axes(m)
         table = []
         for jid in range(1, m.njoints):
             jm = m.joints[jid]
@@ -244,7 +271,7 @@ class Robot:
                 lo, hi = -np.pi, np.pi
             else:
                 lo, hi = float(m.lowerPositionLimit[iq]), float(m.upperPositionLimit[iq])
-            ax, ay, az = (float(a) for a in _local_axis(m, jid))
+            ax, ay, az = (float(a) for a in axes[jid - 1])
             table.append(Joint(m.names[jid], kind or "revolute", lo, hi, iq, iv, (ax, ay, az)))
         return table
 
@@ -427,14 +454,20 @@ class Robot:
         return f"Robot({self.name!r}, n={self.n}, tool={self.tool!r}, urdf={str(self.urdf_path)!r})"
 
 
-def _local_axis(model: pin.Model, jid: int) -> np.ndarray:
-    """Unit axis of a 1-DoF joint in its own frame, read from its motion subspace."""
-    data = model.createData()
-    pin.computeJointJacobians(model, data, pin.neutral(model))
-    J = np.asarray(pin.getJointJacobian(model, data, jid, pin.LOCAL)).reshape(6, model.nv)
-    col = J[:, model.joints[jid].idx_v]
-    lin, ang = col[:3], col[3:]
-    return ang if np.linalg.norm(ang) > 0.5 else lin
+_AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
+
+
+def _local_axes(model: pin.Model) -> list[np.ndarray]:
+    """Unit axis of every 1-DoF joint in its own frame, from the joint models themselves (no Data: a
+    Pinocchio Data holds nv³-sized tensors, so building one per joint made a load cubic in size)."""
+    axes = []
+    for jid in range(1, model.njoints):
+        joint = model.joints[jid]
+        axis = getattr(joint.extract(), "axis", None)
+        if axis is None:  # an aligned joint: JointModelRX, PY, RUBZ, ...
+            axis = _AXES[joint.shortname()[-1]]
+        axes.append(np.asarray(axis, dtype=float))
+    return axes
 
 
 def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, float] | None = None) -> Robot:
