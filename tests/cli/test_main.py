@@ -164,3 +164,54 @@ def test_singular_on_an_arm_with_fewer_than_six_joints(capsys):
     code, out, _ = run(capsys, "singular", "so101", "0.1", "0.2", "0.3", "0.4", "0.5", "--json")
     res = json.loads(out)
     assert code == 0 and res["rank"] == 5 and res["full_rank"] == 5 and len(res["lost_directions"]) == 1
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["validate", "--out", "/proc/kinelab-report"], "not a writable folder"),
+    (["validate", "--n", "0"], "n ≥ 1"),
+    (["validate", "--n", "-1"], "n ≥ 1"),
+    (["animate", "era-elbow", "--dt", "0"], "--dt 0.0 is not valid"),
+    (["animate", "era-elbow", "--dt", "nan"], "--dt nan is not valid"),
+    (["animate", "era-elbow", "--dt", "1e-300"], "is not valid"),
+    (["singular", "ur5", "--sweep", "100000000"], "needs about"),
+    (["singular", "ur5", "--sweep", "0"], "at least one sample"),
+    (["ik", "ur5", "--target-xyz", "0.3", "0.2", "0.4", "--seed", "-1"], "seed"),
+    (["bench", "--out", "/proc/kinelab-bench", "--n", "1"], "not a writable folder"),
+])
+def test_bad_values_end_in_one_line_and_exit_2_before_any_work(argv, needle):
+    proc = subprocess.run([sys.executable, "-m", "kinelab.cli", *argv], capture_output=True, text=True,
+                          env={**os.environ, "PYTHONWARNINGS": "ignore"}, timeout=300)
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and len(lines) == 1 and needle in lines[0], proc.stderr
+    assert proc.stdout == ""
+
+
+def test_ctrl_c_stops_a_long_command_with_one_line_and_130():
+    import signal
+    import time
+
+    proc = subprocess.Popen([sys.executable, "-m", "kinelab.cli", "singular", "ur5", "--sweep", "1000000", "--json"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            env={**os.environ, "PYTHONWARNINGS": "ignore"})
+    time.sleep(4.0)  # well inside the sweep's Jacobians
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=30)
+    assert proc.returncode == 130 and err.strip().splitlines() == ["kinelab: interrupted"] and out == ""
+
+
+def test_a_failed_report_leaves_the_previous_one_whole(tmp_path, monkeypatch):
+    from kinelab.report import render, validate
+
+    out = tmp_path / "report"
+    out.mkdir()
+    (out / "report.json").write_text("previous")
+
+    def half_written(report, folder):
+        (folder / "report.json").write_text("partial")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(render, "_write_validate_files", half_written)
+    with pytest.raises(KeyboardInterrupt):
+        render.write_validate_report(validate.Report(robots=[], n=1, seed=0), out)
+    assert (out / "report.json").read_text() == "previous"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]  # no temporary folder left behind

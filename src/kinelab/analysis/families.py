@@ -137,6 +137,28 @@ def grid(robot: Robot, samples: int, rng: np.random.Generator) -> np.ndarray:
     return robot.lower + (cells + rng.uniform(size=cells.shape)) * width
 
 
+MAX_SWEEP_BYTES = 2**30  # [bytes] the largest sweep that runs without force=True
+
+
+def sweep_bytes(robot: Robot, samples: int) -> int:
+    """Memory a sweep of ``samples`` configurations needs: the samples, their 6 × n Jacobians and σ."""
+    return 8 * samples * (robot.n + 6 * robot.n + min(6, robot.n) + 1)
+
+
+def check_sweep_size(robot: Robot, samples: int, force: bool = False) -> None:
+    """Refuse a sweep whose memory estimate passes MAX_SWEEP_BYTES (unless ``force``), or a count < 1.
+
+    Raises:
+        KinelabError: with the estimate and how to run it anyway.
+    """
+    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
+        raise KinelabError(f"a sweep needs at least one sample (an integer ≥ 1), got {samples!r}")
+    need = sweep_bytes(robot, samples)
+    if need > MAX_SWEEP_BYTES and not force:
+        raise KinelabError(f"a sweep of {samples} samples of {robot.name} needs about {need / 2**30:.1f} GiB; the "
+                           f"limit is {MAX_SWEEP_BYTES / 2**30:g} GiB (--force, or force=True, runs it anyway)")
+
+
 @dataclass(frozen=True)
 class SweepResult:
     """What a sweep found.

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
+import os
 import sys
 from typing import Any
 
@@ -205,6 +207,7 @@ def cmd_singular(args) -> int:
     if args.sweep is not None:
         if args.q:
             raise KinelabError("give either a configuration or --sweep N, not both")
+        families.check_sweep_size(robot, args.sweep, force=args.force)
         result = families.sweep(robot, samples=args.sweep, seed=args.seed, progress=not args.json,
                                 method="grid" if args.grid else "random")
         out = {"robot": robot.name, **result.to_dict()}
@@ -248,6 +251,8 @@ def cmd_singular(args) -> int:
 def cmd_validate(args) -> int:
     from kinelab.report import render, validate
 
+    if args.out:
+        render.check_output_folder(args.out)  # before the work, not after it
     report = validate.run(robots=args.robots, n=args.n, seed=args.seed, progress=not args.json)
     if args.out:
         render.write_validate_report(report, args.out)
@@ -264,6 +269,8 @@ def cmd_bench(args) -> int:
     from kinelab.report import render
     from kinelab.report.bench import runner as bench
 
+    if args.out:
+        render.check_output_folder(args.out)
     scaled = None
     if args.scaling:  # first: the peers' solver threads and caches would disturb this timing afterwards
         from kinelab.report.bench import scaling
@@ -336,6 +343,8 @@ def cmd_animate(args) -> int:
     passages = {f"era-{name}": build for name, build in paper000_era.PASSAGES.items()}
     if args.passage not in passages:
         raise KinelabError(f"unknown passage {args.passage!r}; passages are: {', '.join(passages)}")
+    if not (math.isfinite(args.dt) and MIN_DT <= args.dt <= MAX_DT):
+        raise KinelabError(f"--dt {args.dt} is not valid: seconds per sample, between {MIN_DT:g} and {MAX_DT:g}")
     robot = load("era")
     passage = passages[args.passage](robot)
     run = paper000_era.run(passage, robot)
@@ -350,6 +359,9 @@ def cmd_animate(args) -> int:
           f"{summary['samples']} samples reached, largest joint step {summary['max_joint_step']:.3f} rad, "
           f"{summary['monitor_events']} monitor events")
     return _publish(scene, args.html)
+
+
+MIN_DT, MAX_DT = 1e-3, 60.0  # [s] per animation sample
 
 
 def _robot_arguments(s: argparse.ArgumentParser, q_help: str | None = None, limits: bool = True) -> None:
@@ -427,6 +439,7 @@ def _add_singular(sub: Any) -> None:
     _robot_arguments(s, "one number per joint (rad and m; deg with --deg)")
     s.add_argument("--sweep", type=int, help="sample N configurations within the limits and report families")
     s.add_argument("--grid", action="store_true", help="sweep a stratified grid instead of uniform samples")
+    s.add_argument("--force", action="store_true", help="run a sweep even when its memory estimate is over the limit")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--json", action="store_true")
     s.set_defaults(func=cmd_singular)
@@ -476,12 +489,20 @@ def _add_validate(sub: Any) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run one command; a user error prints one line and returns 2, Ctrl-C returns 130."""
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
     except KinelabError as exc:
         print(f"kinelab: error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("kinelab: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:  # the reader went away (| head): say nothing more
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 1
 
 
 if __name__ == "__main__":

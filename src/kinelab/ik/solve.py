@@ -9,6 +9,8 @@ Pinocchio's FK: ``success`` means the returned q is within the joint limits and 
 from __future__ import annotations
 
 import importlib
+import math
+import numbers
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -17,7 +19,7 @@ from typing import Any, Protocol
 import numpy as np
 import pinocchio as pin
 
-from kinelab.errors import KinelabError, SolverNotFoundError
+from kinelab.errors import OptionError, SolverNotFoundError
 from kinelab.ik.limits import wrap_q
 from kinelab.ik.result import Attempt, BypassRecord, IKResult, SingularEvent, Status
 from kinelab.ik.targets import as_target
@@ -126,10 +128,7 @@ def solve(
         prepare(robot)  # compilation and model building are not the solve's time
     t_start = time.perf_counter()
     target = as_target(target)
-    if not (tol_pos > 0 and tol_rot > 0 and time_budget > 0 and max_restarts >= 0):
-        raise KinelabError("tol_pos, tol_rot and time_budget must be positive and max_restarts ≥ 0")
-    if start_outside_limits not in ("project", "refuse"):
-        raise KinelabError("start_outside_limits must be 'project' or 'refuse'")
+    _check_arguments(tol_pos, tol_rot, time_budget, max_restarts, seed, start_outside_limits)
     rng = _LazyRng(seed)
     problem = _Problem(robot, target, solver, tol_pos, tol_rot, t_start, t_start + time_budget, seed)
     start = _start(robot, q0, rng, start_outside_limits)
@@ -139,6 +138,20 @@ def solve(
     elif getattr(opts, "compiled", False) and hasattr(module, "multistart"):
         return _fast(module, problem, start, max_restarts, opts)
     return _loop(module, problem, start, max_restarts, opts, rng, beyond)
+
+
+def _check_arguments(tol_pos: float, tol_rot: float, time_budget: float, max_restarts: int, seed: int | None,
+                     start_outside_limits: str) -> None:
+    """Refuse what solve() cannot honour, naming the argument, the value and what is valid."""
+    for name, value in (("tol_pos", tol_pos), ("tol_rot", tol_rot), ("time_budget", time_budget)):
+        if isinstance(value, bool) or not isinstance(value, numbers.Real) or not 0 < value < math.inf:
+            raise OptionError(name, value, "a finite number > 0")
+    if isinstance(max_restarts, bool) or not isinstance(max_restarts, numbers.Integral) or max_restarts < 0:
+        raise OptionError("max_restarts", max_restarts, "an integer ≥ 0")
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0):
+        raise OptionError("seed", seed, "an integer ≥ 0, or None for fresh entropy")
+    if start_outside_limits not in ("project", "refuse"):
+        raise OptionError("start_outside_limits", start_outside_limits, "'project' or 'refuse'")
 
 
 @dataclass(slots=True)

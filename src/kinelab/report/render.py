@@ -7,18 +7,66 @@ choice, so rendering never changes the caller's matplotlib settings.
 from __future__ import annotations
 
 import base64
+import contextlib
 import html
 import json
+import os
+import shutil
+import tempfile
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from matplotlib.figure import Figure
 
+from kinelab.errors import KinelabError
 from kinelab.report.bench import scaling
 from kinelab.report.validate import Report
 from kinelab.studies import paper000_era as ep
 from kinelab.studies import paper001_stanford as seed001
+
+
+def check_output_folder(out: str | Path) -> Path:
+    """Make sure a report can be written to the folder ``out`` before any work is done.
+
+    Raises:
+        KinelabError: ``out`` is a file, or no folder can be created or written there.
+    """
+    final = Path(out)
+    if final.exists() and not final.is_dir():
+        raise KinelabError(f"cannot write the report to {out}: it is a file, not a folder")
+    existing = final.parent.resolve()
+    while not existing.exists():
+        existing = existing.parent
+    try:  # a real probe: permission bits say nothing to root, nor about read-only or special filesystems
+        shutil.rmtree(tempfile.mkdtemp(prefix=".kinelab-probe-", dir=existing))
+    except OSError:
+        raise KinelabError(f"cannot write the report to {out}: {existing} is not a writable folder") from None
+    return final
+
+
+@contextlib.contextmanager
+def atomic_folder(out: str | Path) -> Iterator[Path]:
+    """A temporary folder beside ``out`` that replaces ``out`` only when the block ends normally: an
+    interrupted or failed report leaves the previous one (or nothing) in place, never a mixture."""
+    final = check_output_folder(out)
+    final.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{final.name}.", dir=final.parent))
+    try:
+        yield tmp
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    umask = os.umask(0)
+    os.umask(umask)
+    tmp.chmod(0o777 & ~umask)
+    old = final.with_name(f".{final.name}.old-{os.getpid()}") if final.exists() else None
+    if old is not None:
+        final.rename(old)
+    tmp.rename(final)
+    if old is not None:
+        shutil.rmtree(old, ignore_errors=True)
 
 
 def validate_table(report: Report) -> str:
@@ -72,9 +120,13 @@ def validate_figures(report: Report, folder: Path) -> list[str]:
 
 
 def write_validate_report(report: Report, out: str | Path) -> Path:
-    """Write report.json, report.md, report.html and the figures into the folder ``out``."""
-    folder = Path(out)
-    folder.mkdir(parents=True, exist_ok=True)
+    """Write report.json, report.md, report.html and the figures into the folder ``out`` (all or nothing)."""
+    with atomic_folder(out) as folder:
+        _write_validate_files(report, folder)
+    return Path(out)
+
+
+def _write_validate_files(report: Report, folder: Path) -> None:
     figures = validate_figures(report, folder)
     (folder / "report.json").write_text(json.dumps(report.to_dict(), indent=2))
     md = ["# kinelab validate", "", f"Robots: {', '.join(report.robots)}; n = {report.n}; seed = {report.seed}.", "",
@@ -96,7 +148,6 @@ def write_validate_report(report: Report, out: str | Path) -> Path:
         + "".join(f"<p><img alt='{name}' src='data:image/png;base64,"
                   f"{base64.b64encode((folder / name).read_bytes()).decode()}'></p>" for name in figures)
     )
-    return folder
 
 
 def bench_markdown(result: dict[str, Any]) -> str:
@@ -117,9 +168,13 @@ def bench_markdown(result: dict[str, Any]) -> str:
 
 
 def write_bench(result: dict[str, Any], out: str | Path) -> Path:
-    """bench.json, bench.md and (with matplotlib) bench.png in the folder ``out``."""
-    folder = Path(out)
-    folder.mkdir(parents=True, exist_ok=True)
+    """bench.json, bench.md and bench.png in the folder ``out`` (all or nothing)."""
+    with atomic_folder(out) as folder:
+        _write_bench_files(result, folder)
+    return Path(out)
+
+
+def _write_bench_files(result: dict[str, Any], folder: Path) -> None:
     (folder / "bench.json").write_text(json.dumps(result, indent=2))
     sections = [bench_markdown(result)]
     if "scaling" in result:
@@ -128,7 +183,6 @@ def write_bench(result: dict[str, Any], out: str | Path) -> Path:
         sections.append(ep.tracking_markdown(result["tracking"]))
     (folder / "bench.md").write_text("\n\n".join(sections) + "\n")
     bench_figure(result, folder / "bench.png")
-    return folder
 
 
 def bench_figure(result: dict[str, Any], path: str | Path) -> None:

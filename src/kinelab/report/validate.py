@@ -14,6 +14,7 @@ import pinocchio as pin
 from tqdm import tqdm
 
 from kinelab.analysis import oracles as checks
+from kinelab.errors import KinelabError
 from kinelab.geometry import quat_wxyz_from_matrix
 from kinelab.robot import Robot, load
 from kinelab.studies import paper001_stanford as seed001
@@ -228,7 +229,9 @@ GENERAL_CHECKS = [model_checks, biquaternion_checks, solver_checks]
 def run(robots: list[str] | None = None, n: int | None = None, seed: int = 0, progress: bool = False) -> Report:
     """Run every check on ``robots`` (default: stanford, era, youbot, panda, ur5)."""
     names = list(robots or DEFAULT_ROBOTS)
-    n = n or DEFAULT_N
+    n = DEFAULT_N if n is None else n
+    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        raise KinelabError(f"validate needs n ≥ 1 configurations per check, got {n!r}")
     loaded = [load(name) for name in names]  # fail early, before any work, on a bad name
     report = Report(robots=names, n=n, seed=seed)
     steps = [(robot, fn) for robot in loaded for fn in [*GENERAL_CHECKS, *PAPER_CHECKS.get(robot.name, [])]]

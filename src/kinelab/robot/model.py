@@ -285,9 +285,12 @@ class Robot:
     def check_q(self, q, *, limits: bool = False, what: str = "q") -> np.ndarray:
         """``q`` as a float array of length n, refusing wrong shapes, NaN/inf and (if asked) limits."""
         try:
-            arr = np.asarray(q, dtype=float)
+            raw = np.asarray(q)
+            if raw.dtype.kind not in "fiu":  # complex, bool, text and objects are not joint values
+                raise TypeError
+            arr = raw.astype(float, copy=False)
         except (TypeError, ValueError):
-            raise ConfigurationError(f"{what} must be {self.n} numbers, got {q!r}") from None
+            raise ConfigurationError(f"{what} must be {self.n} numbers (real), got {q!r}") from None
         if arr.shape == (self.n,) and not limits and math.isfinite(sum(arr.tolist())):  # NaN, ±inf poison it
             return arr
         if arr.shape != (self.n,):
