@@ -44,3 +44,20 @@ def test_numpy_integers_are_fine_as_seed_and_restarts(ur5):
     a = kinelab.solve(ur5, target, seed=np.uint32(7), max_restarts=np.int64(10))
     b = kinelab.solve(ur5, target, seed=7, max_restarts=10)
     np.testing.assert_array_equal(a.q, b.q)
+
+
+@pytest.mark.parametrize("solver", ["frdm", "biquat", "dls"])
+@pytest.mark.parametrize("links", [6, 150])
+def test_an_unattainable_tolerance_ends_at_the_budget(solver, links):
+    """A tolerance no solver reaches: the answer comes back once the budget is spent, not much later (the
+    compiled kernels look at the clock after a fixed amount of joint work, whatever the chain's length)."""
+    from kinelab.report.bench import scaling
+
+    robot = kinelab.load("ur5") if links == 6 else scaling.synthetic_robot(links, seed=1)
+    target = robot.fk(robot.random_q(2))
+    kinelab.solve(robot, target, solver=solver, time_budget=0.01)  # compile outside the measurement
+    budget = 0.02
+    res = kinelab.solve(robot, target, solver=solver, q0=robot.random_q(3), seed=0, tol_pos=1e-300,
+                        tol_rot=1e-300, time_budget=budget)
+    assert not res.success and res.status.value == "time_budget"
+    assert budget <= res.wall_time < budget + 0.01  # generous for a shared machine; the bench measures the p99

@@ -36,6 +36,12 @@ def run_in_chunks(chunk: Callable[[int], int], attempts: int, stats: np.ndarray,
     return code
 
 
+def clock_chunk(joint_steps: int, n: int) -> int:
+    """Iterations of an n-joint kernel between two looks at the clock: the work of ``joint_steps`` single-joint
+    steps, so that a budget is overrun by about the same time whatever the chain's length (at least 4)."""
+    return max(4, joint_steps // max(1, n))
+
+
 class TypedKernel:
     """A numba kernel called through the compiled entry point of the argument types it first saw.
 

@@ -17,8 +17,8 @@ from kinelab.ik.chain import chain_fk, jacobian_local, random_configuration, wra
 
 CONVERGED, SINGULAR, MAX_STEPS, OUTSIDE_LIMITS, BUDGET = 0, 1, 2, 3, 4
 # slots of a multistart's statistics array
-T_ATTEMPTS, T_STEPS, T_MODEL_TIME, T_OUTSIDE, T_SINGULAR = range(5)
-STATS_SIZE = 5
+T_ATTEMPTS, T_STEPS, T_MODEL_TIME, T_OUTSIDE, T_SINGULAR, T_CUT, T_ATTEMPT_STEPS, T_ATTEMPT_TIME = range(8)
+STATS_SIZE = 8
 
 
 class Problem(NamedTuple):
@@ -71,19 +71,32 @@ def integrate(q, ch, pb, max_steps):
 @njit(cache=True)
 def multistart(q, ch, lower, upper, pb, rng_state, max_attempts, step_budget, stats):
     """Attempts from q, then from seeded uniform starts, until one converges inside the joint limits.
-    stats has the slots T_*. Returns an integrate() code, or OUTSIDE_LIMITS, or BUDGET."""
-    start = q.copy()
+
+    Called in chunks: an attempt that ``step_budget`` (a total) cuts is resumed by the next call from the
+    same q with the steps it has left, so the answer does not depend on where the chunks end. stats has the
+    slots T_*. Returns an integrate() code, or OUTSIDE_LIMITS, or BUDGET.
+    """
     code = BUDGET
-    for a in range(max_attempts):
-        if a > 0:
-            random_configuration(start, ch.kind, lower, upper, rng_state)
-            q[:] = start
-        code, steps, t = integrate(q, ch, pb, min(pb.max_steps, int(step_budget - stats[T_STEPS])))
-        stats[T_ATTEMPTS] += 1.0
+    for _ in range(max_attempts):
+        if stats[T_CUT] == 0.0:
+            if stats[T_ATTEMPTS] > 0.0:
+                random_configuration(q, ch.kind, lower, upper, rng_state)
+            stats[T_ATTEMPT_STEPS] = 0.0
+            stats[T_ATTEMPT_TIME] = 0.0
+        stats[T_CUT] = 0.0
+        left = pb.max_steps - int(stats[T_ATTEMPT_STEPS])
+        budget = min(left, int(step_budget - stats[T_STEPS]))
+        code, steps, t = integrate(q, ch, pb, budget)
         stats[T_STEPS] += steps
+        stats[T_ATTEMPT_STEPS] += steps
+        stats[T_ATTEMPT_TIME] += t
+        if code == MAX_STEPS and budget < left:  # cut by the chunk: the next call resumes this attempt
+            stats[T_CUT] = 1.0
+            return BUDGET
+        stats[T_ATTEMPTS] += 1.0
         if code == CONVERGED:
             if wrap_into_limits(q, ch.kind, lower, upper):
-                stats[T_MODEL_TIME] = t
+                stats[T_MODEL_TIME] = stats[T_ATTEMPT_TIME]
                 return CONVERGED
             stats[T_OUTSIDE] += 1.0
             code = OUTSIDE_LIMITS

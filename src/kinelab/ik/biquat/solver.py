@@ -21,15 +21,15 @@ from kinelab.errors import BiquaternionError, KinelabError
 from kinelab.ik import multistart as restarts
 from kinelab.ik.biquat import kernel, laws
 from kinelab.ik.biquat.integrators import Stop, System, Trajectory, adaptive, fixed
-from kinelab.ik.biquat.options import BiquatOptions
+from kinelab.ik.biquat.options import LAWS, BiquatOptions
 from kinelab.ik.chain import chain_model
 from kinelab.ik.limits import wrap_q
-from kinelab.ik.multistart import TypedKernel
+from kinelab.ik.multistart import TypedKernel, clock_chunk
 from kinelab.ik.result import Attempt, Status
 from kinelab.robot import Robot
 
 Options = BiquatOptions
-CHUNK_STEPS = 256  # steps between two looks at the clock in the compiled preset
+JOINT_STEPS_PER_LOOK = 128  # integration steps × joints between two looks at the clock (≈ 0.1–0.2 ms of work)
 _MULTISTART = TypedKernel(kernel.multistart)
 
 
@@ -143,10 +143,11 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, 
     rng_state = restarts.seed_state(seed)
     q = np.array(q0, dtype=float)
     stats = np.zeros(kernel.STATS_SIZE)
+    chunk_steps = clock_chunk(JOINT_STEPS_PER_LOOK, cm.n)
 
     def chunk(attempts_left: int) -> int:
         return _MULTISTART(q, cm.chain, cm.lower, cm.upper, prob, rng_state, attempts_left,
-                           float(stats[kernel.T_STEPS] + CHUNK_STEPS), stats)
+                           float(stats[kernel.T_STEPS] + chunk_steps), stats)
 
     code = restarts.run_in_chunks(chunk, max_restarts + 1, stats, deadline, kernel.CONVERGED)
     if code == kernel.CONVERGED:
@@ -169,5 +170,8 @@ def prepare(robot: Robot) -> None:
     """Compile (or load) the kernels before a solve's clock starts (once per process)."""
     chain_model(robot)
     if not _COMPILED:
-        multistart(robot, pin.SE3.Identity(), robot.neutral(), 1e-6, 1e-6, np.inf, 0, 0)
+        target = pin.SE3.Identity()
+        multistart(robot, target, robot.neutral(), 1e-6, 1e-6, np.inf, 0, 0)
+        for law in LAWS:  # the laws the Python integrators call are compiled too, outside any budget
+            attempt(robot, target, robot.neutral(), 1e-6, 1e-6, np.inf, law=law, step=0.01, max_steps=1)
         _COMPILED.append(True)

@@ -19,14 +19,17 @@ from kinelab.ik import dls
 from kinelab.ik import multistart as restarts
 from kinelab.ik.chain import ChainModel, chain_model
 from kinelab.ik.frdm import kernel
-from kinelab.ik.frdm.monitor import CHUNK, Bypass, Problem, Runner
+from kinelab.ik.frdm.monitor import Bypass, Problem, Runner
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
-from kinelab.ik.multistart import TypedKernel
+from kinelab.ik.multistart import TypedKernel, clock_chunk
 from kinelab.ik.result import Attempt, SingularEvent, Status
 from kinelab.robot import Robot
 
 Options = FRDMOptions
 _MULTISTART = TypedKernel(kernel.multistart)
+# joint steps between two looks at the clock (≈ 0.2 ms of work at 0.07 µs per joint step): a budget is then
+# overrun by at most that much
+JOINT_SWEEPS_PER_LOOK = 2048
 
 
 def prepare(robot: Robot) -> None:
@@ -98,15 +101,20 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, 
     rng_state = restarts.seed_state(seed)
     q = np.array(q0, dtype=float)
     best_q = q.copy()
-    stats = np.zeros(kernel.STATS_SIZE)
+    stats = kernel.new_stats()
+    mem = kernel.new_memory(cm.n, opts.accel_m)
     settings = opts.settings()
     order = ORDERS[opts.order]
+    chunk_sweeps = clock_chunk(JOINT_SWEEPS_PER_LOOK, cm.n)
 
     def chunk(attempts_left: int) -> int:
         return _MULTISTART(q, cm.chain, prob, settings, order, opts.sweep_cap, rng_state, attempts_left,
-                           float(stats[kernel.T_SWEEPS] + CHUNK * 32), best_q, stats)
+                           float(stats[kernel.T_SWEEPS] + chunk_sweeps), best_q, stats, mem)
 
     code = restarts.run_in_chunks(chunk, max_restarts + 1, stats, deadline, kernel.CONVERGED)
+    if stats[kernel.T_CUT] and mem.state[kernel.S_E] < stats[kernel.T_BEST_E]:  # the clock stopped an attempt
+        best_q[:] = q
+        stats[kernel.T_BEST_E] = mem.state[kernel.S_E]
     if code == kernel.CONVERGED:
         status = Status.CONVERGED
     elif time.perf_counter() > deadline:
