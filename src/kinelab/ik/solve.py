@@ -143,6 +143,11 @@ def solve(
 def _check_arguments(tol_pos: float, tol_rot: float, time_budget: float, max_restarts: int, seed: int | None,
                      start_outside_limits: str) -> None:
     """Refuse what solve() cannot honour, naming the argument, the value and what is valid."""
+    if (type(tol_pos) is float and type(tol_rot) is float and type(time_budget) is float  # the common case,
+            and 0.0 < tol_pos < math.inf and 0.0 < tol_rot < math.inf and 0.0 < time_budget < math.inf  # fast
+            and type(max_restarts) is int and max_restarts >= 0 and (seed is None or (type(seed) is int and seed >= 0))
+            and start_outside_limits in ("project", "refuse")):
+        return
     for name, value in (("tol_pos", tol_pos), ("tol_rot", tol_rot), ("time_budget", time_budget)):
         if isinstance(value, bool) or not isinstance(value, numbers.Real) or not 0 < value < math.inf:
             raise OptionError(name, value, "a finite number > 0")

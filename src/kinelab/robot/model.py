@@ -285,10 +285,10 @@ class Robot:
     def check_q(self, q, *, limits: bool = False, what: str = "q") -> np.ndarray:
         """``q`` as a float array of length n, refusing wrong shapes, NaN/inf and (if asked) limits."""
         try:
-            raw = np.asarray(q)
+            raw = q if type(q) is np.ndarray else np.asarray(q)
             if raw.dtype.kind not in "fiu":  # complex, bool, text and objects are not joint values
                 raise TypeError
-            arr = raw.astype(float, copy=False)
+            arr = raw if raw.dtype == np.float64 else raw.astype(float)
         except (TypeError, ValueError):
             raise ConfigurationError(f"{what} must be {self.n} numbers (real), got {q!r}") from None
         if arr.shape == (self.n,) and not limits and math.isfinite(sum(arr.tolist())):  # NaN, ±inf poison it

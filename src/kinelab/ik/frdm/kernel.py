@@ -43,8 +43,8 @@ CONVERGED, STALL_STEP, STALL_WINDOW, BUDGET = 0, 1, 2, 3
 S_HISTORY, S_SWEEPS, S_E_WINDOW, S_WINDOW_START, S_ACCEPTED, S_E, S_KICKED = range(7)
 STATE_SIZE = 7
 # slots of a multistart's statistics array
-T_ATTEMPTS, T_SWEEPS, T_STALLS, T_ACCEPTED, T_BEST_E, T_CUT = range(6)
-STATS_SIZE = 6
+T_ATTEMPTS, T_SWEEPS, T_STALLS, T_ACCEPTED, T_BEST_E = range(5)
+STATS_SIZE = 5
 
 
 class Problem(NamedTuple):
@@ -80,13 +80,6 @@ class Memory(NamedTuple):
     G: np.ndarray  # (accel_m + 1, n) ring of sweep residuals F(x) − x
     state: np.ndarray  # (STATE_SIZE,) slots S_*
     trace: np.ndarray  # per-sweep objective (length 0: not recorded)
-
-
-def new_stats() -> np.ndarray:
-    """A multistart's statistics, zeroed, with the best objective at +inf."""
-    stats = np.zeros(STATS_SIZE)
-    stats[T_BEST_E] = np.inf
-    return stats
 
 
 def new_memory(n: int, accel_m: int, trace_length: int = 0) -> Memory:
@@ -458,43 +451,40 @@ def run(q: np.ndarray, ch: Chain, pb: Problem, st: Settings, order: int, max_swe
 
 
 @njit(cache=True)
-def multistart(q, ch, pb, st, order, max_sweeps, rng_state, max_attempts, sweep_budget, best_q, stats, mem):
+def multistart(q, ch, pb, st, order, max_sweeps, rng_state, max_attempts, sweep_budget, best_q, stats):
     """Attempts from q, then from seeded uniform starts, until one converges, ``max_attempts`` have run or
-    ``sweep_budget`` (a total) sweeps are spent. A stall ends an attempt (a restart, not a bypass).
+    ``sweep_budget`` sweeps are spent. A stall ends an attempt (a restart, not a bypass).
 
-    Called in chunks (the caller looks at the clock between them): an attempt the sweep budget cuts is
-    resumed by the next call, from the same q and the same ``mem`` (a :class:`Memory`), so the answer
-    does not depend on where the chunks end. stats has the slots T_* (T_BEST_E starts at +inf); on return
-    q holds the converged configuration (or where the search is), best_q the lowest-objective one.
-    Returns a run() code (BUDGET when the chunk's budget ran out).
+    On return q holds the converged configuration (or the last start), best_q the lowest-objective one;
+    stats has the slots T_*. Returns a run() code.
     """
+    n = q.shape[0]
+    mem = Memory(np.zeros((st.accel_m + 1, n)), np.zeros((st.accel_m + 1, n)), np.zeros(STATE_SIZE), np.zeros(0))
+    best = np.inf
     code = BUDGET
-    for _ in range(max_attempts):
-        resuming = stats[T_CUT] != 0.0
-        stats[T_CUT] = 0.0
-        if not resuming:
-            if stats[T_ATTEMPTS] > 0.0:
-                random_configuration(q, ch.kind, pb.lower, pb.upper, rng_state)
-            mem.state[:] = 0.0
+    for a in range(max_attempts):
+        if a > 0:
+            random_configuration(q, ch.kind, pb.lower, pb.upper, rng_state)
+        mem.state[:] = 0.0
+        budget = min(max_sweeps, int(sweep_budget - stats[T_SWEEPS]))
         attempt_order = order
         if order == MIXED:  # base → tip on the first attempt and every other restart, tip → base between
             attempt_order = BASE_TO_TIP if int(stats[T_ATTEMPTS]) % 2 == 0 else TIP_TO_BASE
-        left = max_sweeps - int(mem.state[S_SWEEPS])
-        budget = min(left, int(sweep_budget - stats[T_SWEEPS]))
         code, s = run(q, ch, pb, st, attempt_order, budget, mem)
-        stats[T_SWEEPS] += s
-        if code == BUDGET and budget < left:  # cut by the chunk: the next call resumes this attempt
-            stats[T_CUT] = 1.0
-            return BUDGET
         stats[T_ATTEMPTS] += 1.0
+        stats[T_SWEEPS] += s
         stats[T_ACCEPTED] += mem.state[S_ACCEPTED]
-        if code == CONVERGED or mem.state[S_E] < stats[T_BEST_E]:
-            stats[T_BEST_E] = mem.state[S_E]
+        if mem.state[S_E] < best:
+            best = mem.state[S_E]
             best_q[:] = q
         if code == CONVERGED:
+            best_q[:] = q
+            stats[T_BEST_E] = mem.state[S_E]
             return CONVERGED
         if code == STALL_STEP or code == STALL_WINDOW:  # noqa: SIM109 - plain comparisons for numba
             stats[T_STALLS] += 1.0
         if stats[T_SWEEPS] >= sweep_budget:
+            stats[T_BEST_E] = best
             return BUDGET
+    stats[T_BEST_E] = best
     return code

@@ -28,7 +28,7 @@ from kinelab.robot import Robot
 Options = FRDMOptions
 _MULTISTART = TypedKernel(kernel.multistart)
 # joint steps between two looks at the clock (≈ 0.2 ms of work at 0.07 µs per joint step): a budget is then
-# overrun by at most that much
+# overrun by about that much whatever the chain's length
 JOINT_SWEEPS_PER_LOOK = 2048
 
 
@@ -101,20 +101,16 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, 
     rng_state = restarts.seed_state(seed)
     q = np.array(q0, dtype=float)
     best_q = q.copy()
-    stats = kernel.new_stats()
-    mem = kernel.new_memory(cm.n, opts.accel_m)
+    stats = np.zeros(kernel.STATS_SIZE)
     settings = opts.settings()
     order = ORDERS[opts.order]
     chunk_sweeps = clock_chunk(JOINT_SWEEPS_PER_LOOK, cm.n)
 
     def chunk(attempts_left: int) -> int:
         return _MULTISTART(q, cm.chain, prob, settings, order, opts.sweep_cap, rng_state, attempts_left,
-                           float(stats[kernel.T_SWEEPS] + chunk_sweeps), best_q, stats, mem)
+                           float(stats[kernel.T_SWEEPS] + chunk_sweeps), best_q, stats)
 
     code = restarts.run_in_chunks(chunk, max_restarts + 1, stats, deadline, kernel.CONVERGED)
-    if stats[kernel.T_CUT] and mem.state[kernel.S_E] < stats[kernel.T_BEST_E]:  # the clock stopped an attempt
-        best_q[:] = q
-        stats[kernel.T_BEST_E] = mem.state[kernel.S_E]
     if code == kernel.CONVERGED:
         status = Status.CONVERGED
     elif time.perf_counter() > deadline:
