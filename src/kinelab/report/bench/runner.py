@@ -1,14 +1,8 @@
-"""``kinelab bench``: the runner, kinelab's solvers against the peer libraries (see protocol.py).
-
-Protocol (per robot): ``n`` seeded random configurations within the limits give the targets (their
-Pinocchio FK); every solver starts from the same seeded random configuration per target. A result
-counts as solved only when, checked here with Pinocchio's FK, the position error is below 1e-6 m and
-the rotation error below 1e-6 rad, q is within the joint limits, and the call returned within the
-budget (5 ms by default; restarts inside it are the solver's business). The solvers take turns over
-the whole set ``repeats`` times (3 by default) and per problem the fastest run counts, with its own
-verdict: the machines are shared and noisy, and a slow spell should not decide a comparison. Speed
-targets live here, never in timed tests.
+"""``kinelab bench``: the runner. It runs kinelab's solvers and the installed peers over the problems of
+:mod:`kinelab.report.bench.protocol` (which states the protocol), the solvers taking turns, rounds
+rotating their order, and keeps per problem the fastest run with its own verdict.
 """
+
 from __future__ import annotations
 
 import contextlib
