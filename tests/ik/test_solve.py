@@ -61,3 +61,20 @@ def test_an_unattainable_tolerance_ends_at_the_budget(solver, links):
                         tol_rot=1e-300, time_budget=budget)
     assert not res.success and res.status.value == "time_budget"
     assert budget <= res.wall_time < budget + 0.01  # generous for a shared machine; the bench measures the p99
+
+
+def test_the_same_seed_gives_the_same_answer_in_another_process():
+    """Determinism as the README states it: with a budget that does not run out, a seed fixes the answer
+    bit for bit, whichever process computes it (no clock, address or thread count enters the search)."""
+    import subprocess
+    import sys
+
+    code = ("import numpy as np, kinelab\n"
+            "for name, solver in (('panda', 'frdm'), ('stanford', 'frdm'), ('ur5', 'biquat'), ('ur5', 'dls')):\n"
+            "    r = kinelab.load(name); rng = np.random.default_rng(11)\n"
+            "    for _ in range(15):\n"
+            "        res = kinelab.solve(r, r.fk(r.random_q(rng)), solver=solver, seed=5, time_budget=30.0)\n"
+            "        print(res.status.value, res.restarts, res.iterations, res.q.tobytes().hex())\n")
+    runs = [subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600).stdout
+            for _ in range(2)]
+    assert runs[0] and runs[0] == runs[1]

@@ -106,7 +106,8 @@ def solve(
         target: oMtarget, the wanted tool pose in the base frame.
         solver: "frdm", "biquat" or "dls" (the Pinocchio reference).
         q0: first start (one number per joint, rad or m); default a seeded random configuration.
-        seed: seed of the random starts (restarts always draw from it, so runs repeat exactly).
+        seed: seed of the random starts, an int ≥ 0 (None: fresh entropy). A solve that does not run out of
+            budget returns the same answer for the same seed in any process; one that does depends on speed.
         tol_pos: position tolerance [m].
         tol_rot: rotation tolerance [rad] (angle of R*ᵀR).
         time_budget: wall-clock budget [s] for all attempts together.
