@@ -106,3 +106,28 @@ def test_loading_is_linear_in_the_chain_below_the_data_bound(tmp_path):
 
     for q in robot.random_qs(3, 0):  # the axes read from the joint models give Pinocchio's FK
         np.testing.assert_allclose(chain_model(robot).vectors(q)["N"], robot.fk(q).translation, atol=1e-9)
+
+
+def test_a_joint_naming_a_link_that_does_not_exist(tmp_path):
+    j2 = revolute("j2", "b", "nowhere")
+    path = write_urdf(tmp_path, LINKS + revolute("j1", "a", "b") + j2)
+    with pytest.raises(kinelab.URDFError, match="names link 'nowhere', which the file does not define"):
+        kinelab.load(path)
+
+
+def test_the_cli_says_one_line_even_when_pinocchios_parser_complains(tmp_path):
+    """urdfdom writes its complaints to the process's stderr; kinelab folds them into its one line."""
+    import os
+    import subprocess
+    import sys
+
+    bad_visual = '<link name="b"><visual><geometry><box size="x"/></geometry></visual></link>'
+    body = _chain(revolute("j1", "a", "b")).replace('<link name="b"/>', bad_visual)
+    path = write_urdf(tmp_path, body)
+    proc = subprocess.run([sys.executable, "-m", "kinelab.cli", "info", path], capture_output=True, text=True,
+                          env={**os.environ, "PYTHONWARNINGS": "ignore"}, timeout=120)
+    assert proc.returncode in (0, 2)
+    if proc.returncode == 2:
+        assert len(proc.stderr.strip().splitlines()) == 1
+    else:
+        assert "Error" not in proc.stderr

@@ -12,9 +12,14 @@ Jacobians are 6 × n with rows [linear; angular] (Pinocchio's order); the method
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import math
-from collections.abc import Callable
+import os
+import sys
+import tempfile
+import warnings
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TypeVar
@@ -60,10 +65,32 @@ class Joint:
 
 
 def _build_full_model(path: Path) -> pin.Model:
+    said: list[str] = []
     try:
-        return pin.buildModelFromUrdf(str(path))
+        with _c_stderr_captured(said):  # urdfdom prints its complaints on the process's stderr
+            model = pin.buildModelFromUrdf(str(path))
     except (RuntimeError, ValueError, UnicodeDecodeError) as exc:
-        raise URDFError(f"Pinocchio cannot read {path}: {exc}") from None
+        detail = " ".join([str(exc), *said]).strip()
+        raise URDFError(f"Pinocchio cannot read {path}: {detail}") from None
+    if said:
+        warnings.warn(f"Pinocchio's URDF parser on {path.name}: {' '.join(said)}", stacklevel=3)
+    return model
+
+
+@contextlib.contextmanager
+def _c_stderr_captured(said: list[str]) -> Iterator[None]:
+    """File descriptor 2 redirected to a temporary file for the block; its lines appended to ``said``."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile(mode="w+b") as sink:
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            sink.seek(0)
+            said.extend(line.strip() for line in sink.read().decode("utf-8", "replace").splitlines() if line.strip())
 
 
 def _frame_id(model: pin.Model, name: str, robot: str) -> int:

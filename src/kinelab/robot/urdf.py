@@ -55,6 +55,12 @@ def read_tree(path: Path) -> UrdfTree:
         m = joint.find("mimic")
         if m is not None:
             mimic[name] = m.get("joint", "")
+    known = set(links)
+    for child, parent in parent_of.items():
+        for link in (parent, child):
+            if link not in known:
+                raise URDFError(f"{path}: joint {joint_of[child]!r} names link {link!r}, "
+                                "which the file does not define")
     joint_names = {j.get("name", "?") for j in xml.findall("joint")}
     for name, leader in mimic.items():
         if leader not in joint_names:

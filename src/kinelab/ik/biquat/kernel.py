@@ -55,6 +55,9 @@ def integrate(q, ch, pb, max_steps):
         if step == max_steps:
             return MAX_STEPS, step, t
         simple_law(M, pb.k, 0.0, pb.k, twist)
+        if not (np.isfinite(twist[0]) and np.isfinite(twist[1]) and np.isfinite(twist[2]) and np.isfinite(twist[3])
+                and np.isfinite(twist[4]) and np.isfinite(twist[5])):
+            return SINGULAR, step, t  # the law overflowed (m^0 tiny against the gain)
         qd = joint_rates(jacobian_local(e, o, ch.kind, p, R), twist, pb.damping)
         fastest = 0.0
         for i in range(n):

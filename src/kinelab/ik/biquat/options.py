@@ -14,6 +14,8 @@ LAWS = ("simple", "regular")
 INTEGRATORS = ("euler", "rk4", "adaptive")
 MAX_STEPS = 20000  # step cap of the paper's fixed-step runs
 NEWTON_MAX_STEPS = 30  # a converging newton-preset run takes 10–25 steps; a longer one crawls past a singularity
+MAX_MODEL_TIME = 1e6  # [s] of model time; the paper's run takes about 14 s
+MAX_GAIN = 1e6  # [1/s] larger gains only make the step h = 1/k vanish (and the law overflow)
 NEWTON_MAX_STEP = 0.5  # [rad or m] joint-step cap of the newton preset
 
 
@@ -59,8 +61,14 @@ class BiquatOptions:
         opt.positive("k", self.k, allow_none=True)
         opt.finite("k0", self.k0)
         opt.positive("k_v", self.k_v, allow_none=True)
+        for name in ("k", "k0", "k_v"):
+            value = getattr(self, name)
+            if value is not None and abs(float(value)) > MAX_GAIN:
+                raise OptionError(name, value, f"a gain of at most {MAX_GAIN:g} 1/s in size")
         opt.positive("step", self.step, allow_none=True)
         opt.positive("max_time", self.max_time, allow_none=True)
+        if self.max_time is not None and float(self.max_time) > MAX_MODEL_TIME:
+            raise OptionError("max_time", self.max_time, f"a model time of at most {MAX_MODEL_TIME:g} s")
         opt.positive("damping", self.damping, allow_none=True, zero=True)
         opt.positive("max_step", self.max_step, allow_none=True)
         opt.positive("max_steps", self.max_steps, allow_none=True, integer=True)
