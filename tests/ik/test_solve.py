@@ -78,3 +78,13 @@ def test_the_same_seed_gives_the_same_answer_in_another_process():
     runs = [subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600).stdout
             for _ in range(2)]
     assert runs[0] and runs[0] == runs[1]
+
+
+@pytest.mark.parametrize("solver, options", [("frdm", kinelab.FRDMOptions()), ("dls", None), ("biquat", None)])
+def test_an_options_object_and_keyword_options_together_are_refused(ur5, solver, options):
+    from kinelab.ik.solve import solver_module
+
+    opts = options or solver_module(solver).Options()
+    with pytest.raises(kinelab.OptionError, match="not both"):
+        kinelab.solve(ur5, ur5.fk(ur5.random_q(0)), solver=solver, options=opts, max_restarts=1, **{
+            "frdm": {"relax": 1.0}, "dls": {"damping": 1e-6}, "biquat": {"k": 1.0}}[solver])

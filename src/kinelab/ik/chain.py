@@ -19,10 +19,10 @@ import numpy as np
 from numba import njit
 
 from kinelab.errors import ChainError
+from kinelab.geometry import TWO_PI
 from kinelab.robot import Robot
 
 REVOLUTE, PRISMATIC, CONTINUOUS = 0, 1, 2
-TWO_PI = 2.0 * np.pi
 KIND_CODES = {"revolute": REVOLUTE, "prismatic": PRISMATIC, "continuous": CONTINUOUS}
 
 

@@ -44,8 +44,8 @@ class DLSOptions:
 
     @classmethod
     def of(cls, options: DLSOptions | None = None, **kwargs: Any) -> DLSOptions:
-        """``options`` as given, or built from keyword arguments."""
-        return options if options is not None else opt.from_kwargs(cls, "dls", kwargs)
+        """``options`` as given, or built from keyword arguments (cached for hashable ones)."""
+        return opt.resolve(cls, "dls", options, kwargs)
 
 
 Options = DLSOptions

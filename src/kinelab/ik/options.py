@@ -19,6 +19,26 @@ from kinelab.errors import OptionError
 T = TypeVar("T")
 
 
+def resolve(cls: type[T], solver: str, options: T | None, kwargs: dict[str, Any]) -> T:
+    """A solver's options: ``options`` as given, the defaults, or ``cls(**kwargs)`` (cached).
+
+    Raises:
+        OptionError: both an options object and keyword options, an unknown option, or a bad value.
+    """
+    if options is not None:
+        if kwargs:
+            name = next(iter(kwargs))
+            raise OptionError(name, kwargs[name], f"give either options={cls.__name__}(...) or keyword options, "
+                                                  "not both")
+        return options
+    return from_kwargs(cls, solver, kwargs) if kwargs else _defaults(cls)  # type: ignore[arg-type]
+
+
+@functools.cache
+def _defaults(cls: type[T]) -> T:
+    return cls()
+
+
 def from_kwargs(cls: type[T], solver: str, kwargs: dict[str, Any]) -> T:
     """``cls(**kwargs)``, an unknown name refused with the valid ones listed.
 

@@ -80,12 +80,7 @@ class BiquatOptions:
     @classmethod
     def of(cls, options: BiquatOptions | None = None, **kwargs: Any) -> BiquatOptions:
         """``options`` as given, or built from keyword arguments (cached for hashable ones)."""
-        if options is not None:
-            if kwargs:
-                name = next(iter(kwargs))
-                raise OptionError(name, kwargs[name], "give either options=BiquatOptions(...) or keywords, not both")
-            return options
-        return opt.from_kwargs(cls, "biquat", kwargs)
+        return opt.resolve(cls, "biquat", options, kwargs)
 
     # -- resolved values --------------------------------------------------------------------
     @property

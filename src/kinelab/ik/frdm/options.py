@@ -129,12 +129,7 @@ class FRDMOptions:
     @classmethod
     def of(cls, options: FRDMOptions | None = None, **kwargs: Any) -> FRDMOptions:
         """``options`` as given, or built from keyword arguments (cached for hashable ones)."""
-        if options is not None:
-            if kwargs:
-                raise OptionError(next(iter(kwargs)), kwargs[next(iter(kwargs))],
-                                  "give either options=FRDMOptions(...) or keyword options, not both")
-            return options
-        return opt.from_kwargs(cls, "frdm", kwargs) if kwargs else _DEFAULT
+        return opt.resolve(cls, "frdm", options, kwargs)
 
     # -- resolved values --------------------------------------------------------------------
     @property
@@ -193,9 +188,6 @@ class FRDMOptions:
         w = np.zeros(3) if self.mode == "position" else np.array(self.w_axes, dtype=float)
         w.flags.writeable = False
         return w
-
-
-_DEFAULT = FRDMOptions()
 
 
 def _nonzero_finite(value: object) -> bool:
