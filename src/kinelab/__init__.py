@@ -21,6 +21,7 @@ from kinelab.errors import (
     TargetError,
     URDFError,
 )
+from kinelab.ik.batch import BatchIKResult, solve_batch
 from kinelab.ik.frdm.options import FRDMOptions
 from kinelab.ik.frdm.tracking import TrackResult, track
 from kinelab.ik.result import IKResult, Status
@@ -36,6 +37,7 @@ except PackageNotFoundError:  # a source tree that was never installed
     __version__ = "0+unknown"
 
 __all__ = [
+    "BatchIKResult",
     "BiquaternionError",
     "ChainError",
     "ConfigurationError",
@@ -58,6 +60,7 @@ __all__ = [
     "load",
     "robots",
     "solve",
+    "solve_batch",
     "target_from_xyz_quat_wxyz",
     "target_from_xyz_rpy",
     "track",

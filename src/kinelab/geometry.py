@@ -36,6 +36,17 @@ def pose_error(oMa: pin.SE3, oMb: pin.SE3) -> tuple[float, float]:
     return math.hypot(*err.translation.tolist()), math.hypot(*pin.log3(err.rotation).tolist())
 
 
+def pose_errors(H_a: np.ndarray, H_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`pose_error` for (B, 4, 4) stacks of homogeneous matrices: (position errors [m], rotation
+    angles [rad]), the angle as atan2(|vee(M − Mᵀ)|/2, (tr M − 1)/2) with M = R_aᵀR_b (accurate near 0 and π).
+    """
+    dp = np.linalg.norm(H_a[:, :3, 3] - H_b[:, :3, 3], axis=1)
+    M = np.einsum("bki,bkj->bij", H_a[:, :3, :3], H_b[:, :3, :3])
+    vee = np.stack([M[:, 2, 1] - M[:, 1, 2], M[:, 0, 2] - M[:, 2, 0], M[:, 1, 0] - M[:, 0, 1]], axis=1)
+    cos = (M[:, 0, 0] + M[:, 1, 1] + M[:, 2, 2] - 1.0) / 2.0
+    return dp, np.arctan2(np.linalg.norm(vee, axis=1) / 2.0, cos)
+
+
 def wrap_to_pi(angles: np.ndarray) -> np.ndarray:
     """Angles [rad] wrapped into (−π, π] (the same rotations)."""
     angles = np.asarray(angles, dtype=float)

@@ -1,6 +1,7 @@
 """FRDM: the vector model, the exact steps (against Pinocchio FK on dense grids), monotonicity, limits,
 the monitor and the kick branches, and solutions re-checked by Pinocchio."""
 
+import functools
 import warnings
 
 import numpy as np
@@ -112,8 +113,45 @@ def test_compiled_sweep_equals_the_readable_reference(name, base_to_tip):
         v = vm.vectors(q)
         kernel.sweep(got, v["e"], v["o"], vm.kind, vm.lower, vm.upper, np.ones(robot.n, dtype=np.bool_),
                      v["N"].copy(), v["R"].copy(), target.translation.copy(), target.rotation.copy(), w_p,
-                     np.ones(3), 1.0, base_to_tip)
+                     np.ones(3), 1.0, base_to_tip, np.zeros(robot.n), 0.0)
         np.testing.assert_allclose(got, expected, atol=1e-10)
+
+
+def _objective_with_rest(robot, q, i, target, rest, w_p, w_rest, x):
+    """E + rest term with joint i at x, E from Pinocchio's FK."""
+    qq = q.copy()
+    qq[i] = x
+    M = robot.fk(qq)
+    d = x - rest[i]
+    rest_term = d * d if robot.joints[i].kind == "prismatic" else 2 * (1 - np.cos(d))
+    return (w_p * np.sum((M.translation - target.translation) ** 2)
+            + np.sum((M.rotation - target.rotation) ** 2) + w_rest * rest_term)
+
+
+@pytest.mark.parametrize("name", ["panda", "stanford"])
+def test_a_step_with_the_rest_term_is_the_exact_minimiser_by_pinocchio(name):
+    """One joint free: the kernel's step must minimise E + w_rest·2(1 − cos(q_i − r_i)) (revolute) or
+    w_rest (q_i − r_i)² (prismatic), E evaluated with Pinocchio's FK on a fine grid over the window."""
+    robot = kinelab.load(name)
+    vm = vector_model(robot)
+    rng = np.random.default_rng(5)
+    w_p, w_rest = 10 / vm.length**2, 0.3
+    for _ in range(4):
+        q, target, rest = robot.random_q(rng), robot.fk(robot.random_q(rng)), robot.random_q(rng)
+        i = int(rng.integers(robot.n))
+        free = np.zeros(robot.n, dtype=np.bool_)
+        free[i] = True
+        got = q.copy()
+        v = vm.vectors(q)
+        kernel.sweep(got, v["e"], v["o"], vm.kind, vm.lower, vm.upper, free, v["N"].copy(), v["R"].copy(),
+                     target.translation.copy(), target.rotation.copy(), w_p, np.ones(3), 1.0, True, rest, w_rest)
+
+        total = functools.partial(_objective_with_rest, robot, q, i, target, rest, w_p, w_rest)
+        grid = np.linspace(robot.lower[i], robot.upper[i], 4001)
+        best = grid[np.argmin([total(x) for x in grid])]
+        step = (robot.upper[i] - robot.lower[i]) / 4000
+        assert total(got[i]) <= total(best) + 1e-12
+        assert abs(got[i] - best) <= step or total(got[i]) <= min(total(best - step), total(best + step))
 
 
 @pytest.mark.parametrize("name", ROBOTS)
@@ -129,7 +167,7 @@ def test_sweeps_never_increase_the_objective_and_keep_limits(name):
             v = vm.vectors(q)
             kernel.sweep(q, v["e"], v["o"], vm.kind, vm.lower, vm.upper, np.ones(robot.n, dtype=np.bool_),
                          v["N"].copy(), v["R"].copy(), target.translation.copy(), target.rotation.copy(), w_p,
-                         np.ones(3), 1.0, k % 2 == 0)
+                         np.ones(3), 1.0, k % 2 == 0, np.zeros(robot.n), 0.0)
             E_next = tool_objective(robot, q, target, w_p)
             assert E_next <= E + 1e-12
             assert robot.within_limits(q, slack=1e-12)  # continuous joints have no limits
@@ -315,7 +353,8 @@ def test_mixed_order_restarts_turn_the_sweep_direction(robots):
         for name in ("mixed", "base2tip", "tip2base"):
             q, best, stats = q0.copy(), q0.copy(), np.zeros(5)
             problem = kernel.Problem(vm.lower, vm.upper, np.ones(vm.n, dtype=np.bool_), target.translation,
-                                     target.rotation, 3.0 / vm.length**2, np.ones(3), 1e-6, 1e-6, True, True)
+                                     target.rotation, 3.0 / vm.length**2, np.ones(3), 1e-6, 1e-6, True, True,
+                                     np.zeros(vm.n), 0.0)
             settings = kernel.Settings(1.0, 1e-10, 10, 0.1, 5)
             code = kernel.multistart(q, vm.chain, problem, settings, ORDERS[name], 100, seed_state(7), 2, 1e9, best,
                                      stats)

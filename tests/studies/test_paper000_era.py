@@ -147,7 +147,7 @@ def test_a_single_straight_pass_through_the_wrist_lock_is_smooth_on_this_model()
     oMlock = era.fk(ep.WRIST_LOCK)
     targets = [pin.SE3(oMlock.rotation, oMlock.translation + np.array([x, 0.0, 0.0])) for x in np.linspace(-1, 1, 41)]
     start = ep.solver.attempt(era, targets[0], ep.WRIST_LOCK, 1e-9, 1e-9, np.inf, max_sweeps=3000)
-    res = track(era, targets, start.q, **ep.TRACK_OPTIONS)
+    res = track(era, targets, start.q, policy=(), **ep.TRACK_OPTIONS)
     _every_sample_reached(res)
     assert res.q[:, 5].min() < np.deg2rad(85) and res.q[:, 5].max() > np.deg2rad(95)  # q6 crosses 90°
     assert res.max_joint_step < 0.05 and not res.events
@@ -158,7 +158,7 @@ def test_the_drift_grows_with_the_position_weight():
     and FRDM turns the arm further per lap (shoulder, first lap)."""
     era = load("era")
     passage = ep.shoulder_passage(era, laps=1)
-    turns = [abs(ep.lap_changes(track(era, passage.targets, passage.q0, w_p_factor=w), passage)[0, 0])
+    turns = [abs(ep.lap_changes(track(era, passage.targets, passage.q0, policy=(), w_p_factor=w), passage)[0, 0])
              for w in (1.0, 3.0, 10.0)]
     assert turns[0] < turns[1] < turns[2]
     assert turns[0] > np.deg2rad(5)  # present even at the lightest weight

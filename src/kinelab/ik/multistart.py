@@ -9,6 +9,8 @@ from typing import Any
 import numba
 import numpy as np
 
+from kinelab.ik.chain import random_configuration
+
 
 def seed_state(seed: int | None) -> np.ndarray:
     """A non-zero 64-bit state for a kernel's xorshift generator (splitmix64 of the seed; None: fresh entropy)."""
@@ -19,6 +21,28 @@ def seed_state(seed: int | None) -> np.ndarray:
     x = ((x ^ (x >> 30)) * 0xBF58476D1CE4E5B9) & mask
     x = ((x ^ (x >> 27)) * 0x94D049BB133111EB) & mask
     return np.array([(x ^ (x >> 31)) | 1], dtype=np.uint64)
+
+
+def seed_states(seed: int, count: int) -> np.ndarray:
+    """(count, 1) generator states, row b's equal to ``seed_state(seed + b)`` (splitmix64, vectorised)."""
+    with np.errstate(over="ignore"):
+        x = np.arange(count, dtype=np.uint64) + np.uint64(seed % (1 << 64))
+        x = x + np.uint64(0x9E3779B97F4A7C15)
+        x = (x ^ (x >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+        x = (x ^ (x >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+        x = (x ^ (x >> np.uint64(31))) | np.uint64(1)
+    return x.reshape(count, 1)
+
+
+def first_start(q0: np.ndarray | None, kind: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+                rng_state: np.ndarray) -> np.ndarray:
+    """A kernel's first start: a copy of q0, or (q0 None) a configuration drawn from the kernel's generator,
+    so that a solve without q0 and a batch row with the same seed start alike."""
+    if q0 is not None:
+        return np.array(q0, dtype=float)
+    q = np.empty(kind.shape[0])
+    random_configuration(q, kind, lower, upper, rng_state)
+    return q
 
 
 def run_in_chunks(chunk: Callable[[int], int], attempts: int, stats: np.ndarray, deadline: float,

@@ -135,3 +135,51 @@ class Attempt:
     events: list[SingularEvent] = field(default_factory=list)
     bypasses: list[BypassRecord] = field(default_factory=list)
     info: dict = field(default_factory=dict)
+
+
+@dataclass
+class TrackResult:
+    """One q per path sample (rows, rad/m) with its Pinocchio-measured errors and the monitor log."""
+
+    q: np.ndarray
+    position_error: np.ndarray  # [m]
+    rotation_error: np.ndarray  # [rad]
+    status: list[str]
+    sweeps: np.ndarray
+    wall_time: np.ndarray  # [s] per sample
+    events: list[SingularEvent] = field(default_factory=list)
+    bypasses: list[BypassRecord] = field(default_factory=list)
+    mode: str = "frdm (monitored)"
+
+    @property
+    def joint_steps(self) -> np.ndarray:
+        """|q_k − q_(k−1)| per sample and joint (first row zero) [rad or m]."""
+        return np.vstack([np.zeros(self.q.shape[1]), np.abs(np.diff(self.q, axis=0))])
+
+    @property
+    def max_joint_step(self) -> float:
+        """The largest joint change between two consecutive samples [rad or m]."""
+        return float(self.joint_steps.max())
+
+    @property
+    def reached(self) -> np.ndarray:
+        """Per sample: True when Pinocchio confirms the tolerances within the limits."""
+        return np.array([s == Status.CONVERGED.value for s in self.status])
+
+    @property
+    def success(self) -> np.ndarray:
+        """The same as :attr:`reached` (the name :class:`~kinelab.ik.result.IKResult` uses)."""
+        return self.reached
+
+    def summary(self) -> dict:
+        return {
+            "samples": len(self.status),
+            "reached": int(self.reached.sum()),
+            "max_position_error_m": float(self.position_error.max()),
+            "max_rotation_error_rad": float(self.rotation_error.max()),
+            "max_joint_step": self.max_joint_step,
+            "monitor_events": len(self.events),
+            "bypasses": len(self.bypasses),
+            "median_time_per_sample_s": float(np.median(self.wall_time)),
+            "mode": self.mode,
+        }

@@ -129,19 +129,19 @@ def solve(
         prepare(robot)  # compilation and model building are not the solve's time
     t_start = time.perf_counter()
     target = as_target(target)
-    _check_arguments(tol_pos, tol_rot, time_budget, max_restarts, seed, start_outside_limits)
+    check_arguments(tol_pos, tol_rot, time_budget, max_restarts, seed, start_outside_limits)
     rng = _LazyRng(seed)
     problem = _Problem(robot, target, solver, tol_pos, tol_rot, t_start, t_start + time_budget, seed)
-    start = _start(robot, q0, rng, start_outside_limits)
     beyond = out_of_reach(robot, target.translation)
     if beyond > 0:
         max_restarts = 0  # proved out of reach: one attempt gives the best pose, restarts cannot help
     elif getattr(opts, "compiled", False) and hasattr(module, "multistart"):
+        start = None if q0 is None else _start(robot, q0, rng, start_outside_limits)  # None: the kernel draws it
         return _fast(module, problem, start, max_restarts, opts)
-    return _loop(module, problem, start, max_restarts, opts, rng, beyond)
+    return _loop(module, problem, _start(robot, q0, rng, start_outside_limits), max_restarts, opts, rng, beyond)
 
 
-def _check_arguments(tol_pos: float, tol_rot: float, time_budget: float, max_restarts: int, seed: int | None,
+def check_arguments(tol_pos: float, tol_rot: float, time_budget: float, max_restarts: int, seed: int | None,
                      start_outside_limits: str) -> None:
     """Refuse what solve() cannot honour, naming the argument, the value and what is valid."""
     if (type(tol_pos) is float and type(tol_rot) is float and type(time_budget) is float  # the common case,
@@ -215,7 +215,7 @@ def _loop(module: Any, pb: _Problem, start: np.ndarray, max_restarts: int, opts:
     )
 
 
-def _fast(module: Any, pb: _Problem, start: np.ndarray, max_restarts: int, opts: Any) -> IKResult:
+def _fast(module: Any, pb: _Problem, start: np.ndarray | None, max_restarts: int, opts: Any) -> IKResult:
     """Restarts inside the solver's compiled kernel; the answer is then checked by Pinocchio."""
     att, restarts = module.multistart(pb.robot, pb.target, start, pb.tol_pos, pb.tol_rot, pb.deadline, pb.seed,
                                       max_restarts, opts)

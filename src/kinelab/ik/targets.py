@@ -58,3 +58,36 @@ def _finite(values, size: int, what: str) -> np.ndarray:
     if not np.all(np.isfinite(arr)):
         raise TargetError(f"{what} has NaN or infinite entries: {arr}")
     return arr
+
+
+def as_target_arrays(targets) -> tuple[np.ndarray, np.ndarray]:
+    """Check a sequence of targets; returns (points (N, 3) [m], rotations (N, 3, 3)), base frame.
+
+    ``targets`` is a sequence of ``pin.SE3`` (or unit biquaternions), or an (N, 4, 4) array of
+    homogeneous matrices. A bad target is named by its index.
+
+    Raises:
+        TargetError: an empty sequence, a wrong shape or a bad target (its index named).
+    """
+    if isinstance(targets, np.ndarray) and targets.dtype.kind in "fiu" and targets.ndim == 3:
+        if targets.shape[1:] != (4, 4):
+            raise TargetError(f"targets as an array must have shape (N, 4, 4), got {targets.shape}")
+        targets = [pin.SE3(np.asarray(h, dtype=float)) if np.all(np.isfinite(h)) else np.asarray(h)
+                   for h in targets]
+    try:
+        count = len(targets)
+    except TypeError:
+        raise TargetError(f"targets must be a sequence of pin.SE3, got {type(targets).__name__}") from None
+    if count == 0:
+        raise TargetError("targets is empty: give at least one pin.SE3")
+    points, rotations = np.empty((count, 3)), np.empty((count, 3, 3))
+    for k, target in enumerate(targets):
+        try:
+            if isinstance(target, np.ndarray):
+                raise TargetError("has NaN or infinite entries")
+            checked = as_target(target)
+        except TargetError as err:
+            raise TargetError(f"targets[{k}]: {err}") from None
+        points[k] = checked.translation
+        rotations[k] = checked.rotation
+    return points, rotations

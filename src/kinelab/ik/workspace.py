@@ -22,6 +22,11 @@ def _reach(robot: Robot) -> tuple[tuple[float, float, float], float]:
     return tuple(np.asarray(anchor, dtype=float).tolist()), rigid + slides
 
 
+def reach_bound(robot: Robot) -> tuple[tuple[float, float, float], float]:
+    """(anchor [m], radius [m]): every reachable tool position lies within the radius of the anchor."""
+    return robot.derived("reach_bound", _reach)
+
+
 def out_of_reach(robot: Robot, position: np.ndarray) -> float:
     """How far [m] a position lies beyond the reach bound (≤ 0 when it may be reachable)."""
     anchor, radius = robot.derived("reach_bound", _reach)

@@ -33,6 +33,7 @@ from kinelab.errors import (
     FrameNotFoundError,
     JointLimitError,
     JointNotFoundError,
+    OptionError,
     URDFError,
 )
 from kinelab.geometry import pose_error, wrap_to_pi
@@ -402,6 +403,50 @@ class Robot:
         """oMtool: pose of the tool frame in the base frame at ``q`` (m, rad)."""
         self._forward(q)
         return pin.SE3(self.data.oMf[self.tool_frame_id])
+
+    def fk_batch(self, Q: np.ndarray) -> np.ndarray:
+        """oMtool for every row of Q (B × n, rad or m): a (B, 4, 4) stack of homogeneous matrices (Pinocchio FK).
+
+        Raises:
+            ConfigurationError: Q not (B, n) finite numbers (the first bad row named).
+        """
+        Q = self.check_qs(Q)
+        out = np.empty((Q.shape[0], 4, 4))
+        model, data, fid = self.model, self.data, self.tool_frame_id
+        for b in range(Q.shape[0]):
+            pin.forwardKinematics(model, data, self._pin_q(Q[b]))
+            out[b] = pin.updateFramePlacement(model, data, fid).homogeneous
+        return out
+
+    def jacobian_batch(self, Q: np.ndarray, frame: str = "local") -> np.ndarray:
+        """The 6 × n tool Jacobian for every row of Q: (B, 6, n), rows [v; ω].
+
+        Args:
+            Q: (B, n) configurations [rad or m].
+            frame: "local" (tool frame), "world" (base frame, v at the base origin) or
+                "local_world_aligned" (base axes at the tool origin).
+
+        Raises:
+            ConfigurationError: Q not (B, n) finite numbers; OptionError: an unknown frame.
+        """
+        frames = {"local": pin.LOCAL, "world": pin.WORLD, "local_world_aligned": pin.LOCAL_WORLD_ALIGNED}
+        if frame not in frames:
+            raise OptionError("frame", frame, f"one of {sorted(frames)}")
+        Q = self.check_qs(Q)
+        return np.stack([self._jacobian(q, frames[frame]) for q in Q]) if Q.shape[0] else np.empty((0, 6, self.n))
+
+    def check_qs(self, Q: np.ndarray, what: str = "Q") -> np.ndarray:
+        """Q as a (B, n) float array of finite numbers, refusing other shapes and naming the first bad row."""
+        arr = np.asarray(Q) if not isinstance(Q, np.ndarray) else Q
+        if arr.dtype.kind not in "fiu" or arr.ndim != 2 or arr.shape[1] != self.n:
+            raise ConfigurationError(f"{what} must be a (B, {self.n}) array of numbers for {self.name}, "
+                                     f"got {getattr(arr, 'shape', '?')} of {arr.dtype}")
+        arr = np.asarray(arr, dtype=float)
+        bad = ~np.isfinite(arr).all(axis=1)
+        if bad.any():
+            b = int(np.flatnonzero(bad)[0])
+            self.check_q(arr[b], what=f"{what}[{b}]")
+        return arr
 
     def tool_error(self, q, oMtarget: pin.SE3) -> tuple[float, float]:
         """(position error [m], rotation angle error [rad]) of the tool at q against oMtarget (Pinocchio FK)."""

@@ -129,7 +129,7 @@ def paper_unit_biquaternion(real_wxyz: Any, dual_wxyz: Any) -> DualQuat:
     return lam.require_unit("the target biquaternion", tol=1e-5).normalized()
 
 
-def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol_rot: float, deadline: float,
+def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: float, tol_rot: float, deadline: float,
                seed: int | None, max_restarts: int, options: BiquatOptions | None = None) -> tuple[Attempt, int]:
     """The default preset (law (9), Euler, h = 1/k, steps capped at 0.5 rad, 30 steps per attempt) with
     its seeded restarts inside the compiled kernel; answers outside the joint limits are restarted."""
@@ -141,7 +141,7 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, 
     prob = kernel.Problem(np.array(oMtarget.translation), np.ascontiguousarray(oMtarget.rotation), float(k), 1.0 / k,
                           0.5, int(max_steps), 0.5 * float(tol_rot), 0.5 * float(tol_pos), float(damping))
     rng_state = restarts.seed_state(seed)
-    q = np.array(q0, dtype=float)
+    q = restarts.first_start(q0, cm.kind, cm.lower, cm.upper, rng_state)
     stats = np.zeros(kernel.STATS_SIZE)
     chunk_steps = clock_chunk(JOINT_STEPS_PER_LOOK, cm.n)
 

@@ -15,6 +15,7 @@ float arrays whose slots have names (``S_*``, ``T_*``).
 
 from __future__ import annotations
 
+import functools
 from typing import NamedTuple
 
 import numpy as np
@@ -61,6 +62,8 @@ class Problem(NamedTuple):
     tol_rot: float  # [rad]
     check_pos: bool
     check_rot: bool
+    q_rest: np.ndarray  # (n,) rest configuration [rad or m] the rest term pulls towards
+    w_rest: float  # weight of the rest term (0: none, the paper's objective)
 
 
 class Settings(NamedTuple):
@@ -98,6 +101,24 @@ def objective(p, R, pstar, Rstar, w_p, w_ax):
         u2 = R[2, j] - Rstar[2, j]
         E += w_ax[j] * (u0 * u0 + u1 * u1 + u2 * u2)
     return E
+
+
+@njit(cache=True, inline="always")
+def rest_term(q, kind, q_rest, w_rest):
+    """w_rest Σ 2(1 − cos(q_i − r_i)) over revolute joints + w_rest Σ (q_i − r_i)² over prismatic ones."""
+    if w_rest == 0.0:
+        return 0.0
+    acc = 0.0
+    for i in range(q.shape[0]):
+        d = q[i] - q_rest[i]
+        acc += d * d if kind[i] == PRISMATIC else 2.0 * (1.0 - np.cos(d))
+    return w_rest * acc
+
+
+@njit(cache=True, inline="always")
+def total_objective(q, kind, p, R, pb):
+    """The objective E plus the rest term of the problem."""
+    return objective(p, R, pb.pstar, pb.Rstar, pb.w_p, pb.w_ax) + rest_term(q, kind, pb.q_rest, pb.w_rest)
 
 
 @njit(cache=True, inline="always")
@@ -173,13 +194,15 @@ def _carry_axis(Rg, tg, e, o, i):
 
 
 @njit(cache=True, inline="always")
-def sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, relax, base_to_tip):
+def sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, relax, base_to_tip, q_rest, w_rest):
     """One sweep over the free joints, tip → base or base → tip; updates q, p, R in place.
 
     ``e``, ``o`` must hold the axes at the sweep's starting q (from ``chain_fk``). Tip → base needs
     nothing more (a joint never moves the joints upstream of it); base → tip carries the rigid motion
     (Rg, tg) of the joints already stepped to the downstream axes, and leaves e, o at the new q (tip →
-    base leaves them stale). Returns Σ|Δq_i|.
+    base leaves them stale). With ``w_rest`` > 0 each step is the exact minimiser of E plus the rest term
+    (the term keeps the closed form: it adds w_rest cos φ to B and −w_rest sin φ to C, φ = q_i − r_i).
+    Returns Σ|Δq_i|.
     """
     n = q.shape[0]
     total = 0.0
@@ -198,8 +221,9 @@ def sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, rela
         hi = upper[i] - q[i]
         if kind[i] == PRISMATIC:
             s = 0.0
-            if w_p > 0.0:
-                s = relax * (e0 * (pstar[0] - p[0]) + e1 * (pstar[1] - p[1]) + e2 * (pstar[2] - p[2]))
+            if w_p > 0.0 or w_rest > 0.0:
+                along = e0 * (pstar[0] - p[0]) + e1 * (pstar[1] - p[1]) + e2 * (pstar[2] - p[2])
+                s = relax * (w_p * along - w_rest * (q[i] - q_rest[i])) / (w_p + w_rest)
             s = min(max(s, lo), hi)
             if s == 0.0:
                 continue
@@ -213,6 +237,9 @@ def sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, rela
             step = s
         else:
             B, C = _bc(e0, e1, e2, o0, o1, o2, p, R, pstar, Rstar, w_p, w_ax)
+            if w_rest != 0.0:
+                B += w_rest * np.cos(q[i] - q_rest[i])
+                C -= w_rest * np.sin(q[i] - q_rest[i])
             theta = revolute_angle(B, C, lo, hi, kind[i] == CONTINUOUS)
             if relax != 1.0:
                 theta = relax * theta
@@ -360,7 +387,7 @@ def _extrapolate(q, ch, pb, st, mem, w, ec, oc, pc, Rc, E1):
         if not free[i]:
             cand[i] = q[i]
     chain_fk(ch, cand, ec, oc, pc, Rc)
-    Ec = objective(pc, Rc, pb.pstar, pb.Rstar, pb.w_p, pb.w_ax)
+    Ec = total_objective(cand, kind, pc, Rc, pb)
     if Ec < E1:
         q[:] = cand
         state[S_ACCEPTED] += 1.0
@@ -416,19 +443,20 @@ def run(q: np.ndarray, ch: Chain, pb: Problem, st: Settings, order: int, max_swe
             chain_fk(ch, q, e, o, p, R)
             since_fk = 0
         if state[S_SWEEPS] == 0.0:
-            state[S_E_WINDOW] = objective(p, R, pstar, Rstar, w_p, w_ax)
+            state[S_E_WINDOW] = total_objective(q, kind, p, R, pb)
         if _within(p, R, pstar, Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot) and \
                 _fk_converged(q, ch, pb, e, o, p, R, since_fk):  # converged only on an exact FK
-            state[S_E] = objective(p, R, pstar, Rstar, w_p, w_ax)
+            state[S_E] = total_objective(q, kind, p, R, pb)
             return CONVERGED, s
         x_old[:] = q
         base_to_tip = order == BASE_TO_TIP or (order == ALTERNATE and int(state[S_SWEEPS]) % 2 == 1) \
             or state[S_KICKED] != 0.0
         state[S_KICKED] = 0.0
-        moved = sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, st.relax, base_to_tip)
+        moved = sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, st.relax, base_to_tip,
+                      pb.q_rest, pb.w_rest)
         fresh = base_to_tip
         since_fk += 1
-        E1 = objective(p, R, pstar, Rstar, w_p, w_ax)
+        E1 = total_objective(q, kind, p, R, pb)
         state[S_SWEEPS] += 1.0
         if int(state[S_SWEEPS]) - 1 < trace.shape[0]:
             trace[int(state[S_SWEEPS]) - 1] = E1
@@ -488,3 +516,9 @@ def multistart(q, ch, pb, st, order, max_sweeps, rng_state, max_attempts, sweep_
             return BUDGET
     stats[T_BEST_E] = best
     return code
+
+
+@functools.cache
+def no_rest(n: int) -> np.ndarray:
+    """A shared rest configuration for problems whose rest weight is 0 (the kernel never reads it then)."""
+    return np.zeros(n)

@@ -28,6 +28,7 @@ import pinocchio as pin
 from kinelab.errors import KinelabError
 from kinelab.ik.chain import PRISMATIC, ChainModel
 from kinelab.ik.frdm import kernel
+from kinelab.ik.frdm.kernel import no_rest
 from kinelab.ik.frdm.options import BYPASSES, ORDERS, FRDMOptions
 from kinelab.ik.multistart import TypedKernel
 from kinelab.ik.result import BypassRecord, SingularEvent, Status
@@ -88,7 +89,7 @@ class Problem:
     def tuple(self) -> kernel.Problem:
         """The kernel's view of the problem (arrays shared, so bypasses show through)."""
         return kernel.Problem(self.lower, self.upper, self.free, self.pstar, self.Rstar, self.w_p, self.w_ax,
-                              self.tol_pos, self.tol_rot, self.check_pos, self.check_rot)
+                              self.tol_pos, self.tol_rot, self.check_pos, self.check_rot, no_rest(len(self.free)), 0.0)
 
 
 def _scaled_sigma_min(robot: Robot, q: np.ndarray, length: float) -> float:

@@ -19,6 +19,7 @@ from kinelab.ik import dls
 from kinelab.ik import multistart as restarts
 from kinelab.ik.chain import ChainModel, chain_model
 from kinelab.ik.frdm import kernel
+from kinelab.ik.frdm.kernel import no_rest
 from kinelab.ik.frdm.monitor import Bypass, Problem, Runner
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.multistart import TypedKernel, clock_chunk
@@ -87,19 +88,20 @@ def attempt(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol
     return att
 
 
-def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol_rot: float, deadline: float,
+def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: float, tol_rot: float, deadline: float,
                seed: int | None, max_restarts: int, options: FRDMOptions | None = None) -> tuple[Attempt, int]:
     """FRDM from q0 and then from seeded random starts, all inside the compiled kernel.
 
     A stall is answered by a restart: with no bypass configured that is what the monitor's policy does
-    for a local minimum. Returns the attempt kept and the number of restarts; the caller checks the
+    for a local minimum. ``q0`` None: the first start is drawn from the seeded generator too (as
+    :func:`kinelab.solve_batch` does). Returns the attempt kept and the number of restarts; the caller checks the
     answer with Pinocchio.
     """
     opts = options or FRDMOptions()
     cm = chain_model(robot)
     prob = _compiled_problem(cm, oMtarget, opts, tol_pos, tol_rot)
     rng_state = restarts.seed_state(seed)
-    q = np.array(q0, dtype=float)
+    q = restarts.first_start(q0, cm.kind, cm.lower, cm.upper, rng_state)
     best_q = q.copy()
     stats = np.zeros(kernel.STATS_SIZE)
     settings = opts.settings()
@@ -138,7 +140,8 @@ def _compiled_problem(cm: ChainModel, oMtarget: pin.SE3, opts: FRDMOptions, tol_
         lower, upper = _unbounded(cm.n), _unbounded(cm.n, 1.0)
     return kernel.Problem(lower, upper, _all_free(cm.n), oMtarget.translation, np.ascontiguousarray(oMtarget.rotation),
                           opts.position_weight(cm.length), opts.axis_weights(), float(tol_pos), float(tol_rot),
-                          opts.mode != "orientation", opts.mode != "position")
+                          opts.mode != "orientation", opts.mode != "position",
+                          no_rest(cm.n), 0.0)
 
 
 @functools.cache

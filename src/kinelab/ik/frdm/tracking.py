@@ -1,7 +1,11 @@
 """Tracking: follow a Cartesian path in small steps, each FRDM solve warm-started from the last answer.
 
-This is FRDM's direct-control use (Danilov 2019): no restarts, so every jump or stall is visible. Two
-monitors watch each sample: FRDM's own (Σ|Δq| = 0 short of the target, see
+This is FRDM's direct-control use (Danilov 2019): no restarts, so every jump or stall is visible. With
+no bypass named, the whole path runs in the compiled follower (:mod:`kinelab.ik.frdm.path_kernel`),
+which on an arm with more joints than the task constrains prefers, among the answers, the one nearest
+the previous sample (a rest term, then plain FRDM to the tolerance). With a bypass, a policy or a
+restriction named, the monitored loop below runs instead. Two monitors watch each of its samples:
+FRDM's own (Σ|Δq| = 0 short of the target, see
 :mod:`kinelab.ik.frdm.solver`), and a jump monitor (a joint moving more than ``jump_limit`` between
 consecutive samples: the links spinning through a singularity). When a monitor fires and the policy
 has a restriction (``intervals`` or ``freeze``), the sample is solved again with it switched on, and it
@@ -13,7 +17,6 @@ point (the ERA wrist and shoulder passages), where no monitor fires before the d
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -21,48 +24,10 @@ import pinocchio as pin
 
 from kinelab.errors import KinelabError
 from kinelab.ik.frdm import solver
-from kinelab.ik.result import Attempt, BypassRecord, SingularEvent, Status
+from kinelab.ik.frdm.follower import follow
+from kinelab.ik.frdm.options import FRDMOptions
+from kinelab.ik.result import Attempt, BypassRecord, SingularEvent, Status, TrackResult
 from kinelab.robot import Robot
-
-
-@dataclass
-class TrackResult:
-    """One q per path sample (rows, rad/m) with its Pinocchio-measured errors and the monitor log."""
-
-    q: np.ndarray
-    position_error: np.ndarray  # [m]
-    rotation_error: np.ndarray  # [rad]
-    status: list[str]
-    sweeps: np.ndarray
-    wall_time: np.ndarray  # [s] per sample
-    events: list[SingularEvent] = field(default_factory=list)
-    bypasses: list[BypassRecord] = field(default_factory=list)
-
-    @property
-    def joint_steps(self) -> np.ndarray:
-        """|q_k − q_(k−1)| per sample and joint (first row zero) [rad or m]."""
-        return np.vstack([np.zeros(self.q.shape[1]), np.abs(np.diff(self.q, axis=0))])
-
-    @property
-    def max_joint_step(self) -> float:
-        """The largest joint change between two consecutive samples [rad or m]."""
-        return float(self.joint_steps.max())
-
-    @property
-    def reached(self) -> np.ndarray:
-        return np.array([s == Status.CONVERGED.value for s in self.status])
-
-    def summary(self) -> dict:
-        return {
-            "samples": len(self.status),
-            "reached": int(self.reached.sum()),
-            "max_position_error_m": float(self.position_error.max()),
-            "max_rotation_error_rad": float(self.rotation_error.max()),
-            "max_joint_step": self.max_joint_step,
-            "monitor_events": len(self.events),
-            "bypasses": len(self.bypasses),
-            "median_time_per_sample_s": float(np.median(self.wall_time)),
-        }
 
 
 def track(
@@ -77,11 +42,12 @@ def track(
     kicks: dict | None = None,
     intervals: dict | None = None,
     freeze: dict | None = None,
-    policy: tuple[str, ...] | None = (),
+    policy: tuple[str, ...] | None = None,
     restrict: tuple[str, ...] = (),
     hold: int = 10,
     stall_window: int = 100,
     stall_rel: float = 1e-6,
+    rest_weight: float | None = None,
     **frdm_options: Any,
 ) -> TrackResult:
     """Solve each target in turn, warm-started from the previous answer.
@@ -97,12 +63,15 @@ def track(
         kicks: the bypass kicks (see :class:`~kinelab.ik.frdm.options.FRDMOptions`).
         intervals: the bypass intervals.
         freeze: the joints to freeze.
-        policy: the bypass policy; the default ``()`` is FRDM without bypass.
+        policy: the bypass policy; None (default) with no bypass table runs the compiled follower, ``()``
+            the monitored loop without bypass (every monitor event logged).
         restrict: restrictions ("intervals", "freeze") held on every sample of the path.
         hold: samples a restriction stays on after the monitor switched it on.
         stall_window: the monitor's window [sweeps]; a path sample starts close to its answer, so a slow
             start is an escape from a singularity, not a local minimum to abandon.
         stall_rel: the relative fall required over the window.
+        rest_weight: compiled follower only: weight of the rest term that keeps each answer near the
+            previous one; None: 0.01 on arms with more than six joints, 0 (plain FRDM) otherwise.
         **frdm_options: other :class:`~kinelab.ik.frdm.options.FRDMOptions` fields (order, w_p, accel, ...).
 
     Returns:
@@ -114,6 +83,9 @@ def track(
     """
     q_prev = robot.check_q(q0, limits=True, what="q0")
     _check_restrict(restrict, intervals, freeze)
+    if policy is None and not (kicks or intervals or freeze or restrict):
+        return follow(robot, targets, q_prev, tol_pos, tol_rot, max_sweeps, rest_weight,
+                      FRDMOptions(stall_window=stall_window, stall_rel=stall_rel, **frdm_options))
     options = {"max_sweeps": max_sweeps, "kicks": kicks, "intervals": intervals, "freeze": freeze,
                "policy": tuple(s for s in (policy or ()) if s not in RESTRICTIONS),
                "stall_window": stall_window, "stall_rel": stall_rel, **frdm_options}

@@ -1,0 +1,148 @@
+"""FRDM on a batch of targets: one compiled call, the targets spread over every core (numba ``prange``).
+
+Target b is solved exactly as :func:`kinelab.solve` solves it alone with ``seed = seed + b`` and the
+same start: its own generator state, the same restarts, and the same chunks of sweeps (the points at
+which the single solve looks at the clock), so the answer does not depend on the thread count or on
+the other targets.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+from numba import njit, prange
+
+from kinelab.geometry import wrap_to_pi
+from kinelab.ik.chain import CONTINUOUS, chain_model, random_configuration
+from kinelab.ik.frdm import solver
+from kinelab.ik.frdm.kernel import CONVERGED, STATS_SIZE, T_ATTEMPTS, T_STALLS, T_SWEEPS, Problem, multistart
+from kinelab.ik.frdm.options import ORDERS, FRDMOptions
+from kinelab.ik.multistart import clock_chunk
+from kinelab.ik.result import Status
+from kinelab.robot import Robot
+
+ROWS_PER_LOOK = 256  # rows per thread between two looks at the clock
+
+
+@dataclass
+class Rows:
+    """Raw batch answers before Pinocchio's verdict: q (B, n), status strings, iterations, restarts."""
+
+    Q: np.ndarray
+    status: np.ndarray
+    iterations: np.ndarray
+    restarts: np.ndarray
+
+    @classmethod
+    def unsolved(cls, count: int, n: int) -> Rows:
+        """Rows not reached by the budget: NaN q, status time_budget."""
+        return cls(np.full((count, n), np.nan), np.full(count, Status.TIME_BUDGET.value, dtype="<U14"),
+                   np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64))
+
+
+def prepare(robot: Robot) -> None:
+    """Compile (or load) the single-solve and the batch kernels: outside the batch's clock."""
+    solver.prepare(robot)
+    if not _COMPILED:
+        one = np.ones(1, dtype=np.int64)
+        run(robot, np.zeros((1, 3)), np.eye(3)[None], None, np.ones((1, 1), dtype=np.uint64), one, 1e-6, 1e-6,
+            np.inf, FRDMOptions())
+        _COMPILED.append(True)
+
+
+_COMPILED: list[bool] = []
+
+
+def run(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts: np.ndarray | None, rng_states: np.ndarray,
+        attempts: np.ndarray, tol_pos: float, tol_rot: float, deadline: float, opts: FRDMOptions) -> Rows:
+    """Solve the rows in slices of ROWS_PER_LOOK per thread, looking at the clock between slices.
+
+    Args:
+        robot: the robot.
+        points: (B, 3) target points [m] (base frame).
+        rotations: (B, 3, 3) target rotations.
+        starts: (B, n) starts, or None (each row draws its start from its generator).
+        rng_states: (B, 1) generator states.
+        attempts: (B,) attempts per row.
+        tol_pos: [m].
+        tol_rot: [rad].
+        deadline: a ``time.perf_counter()`` value.
+        opts: compiled FRDM options.
+
+    Returns:
+        Rows with the kernel's status (converged, stalled, max_iterations; time_budget where not started).
+    """
+    cm = chain_model(robot)
+    count = points.shape[0]
+    rows = Rows.unsolved(count, cm.n)
+    Q = np.zeros((count, cm.n)) if starts is None else np.array(starts, dtype=float)
+    codes, stats = np.zeros(count, dtype=np.int64), np.zeros((count, STATS_SIZE))
+    lower, upper = (cm.lower, cm.upper) if opts.use_limits else (np.full(cm.n, -np.inf), np.full(cm.n, np.inf))
+    step = ROWS_PER_LOOK * numba.get_num_threads()
+    for a in range(0, count, step):
+        if time.perf_counter() > deadline:
+            break
+        z = slice(a, min(a + step, count))
+        solve_rows(Q[z], starts is None, cm.chain, lower, upper, np.ones(cm.n, dtype=np.bool_), points[z],
+                   rotations[z], opts.position_weight(cm.length), opts.axis_weights(), float(tol_pos), float(tol_rot),
+                   opts.mode != "orientation", opts.mode != "position", opts.settings(), ORDERS[opts.order],
+                   opts.sweep_cap, rng_states[z], attempts[z], float(clock_chunk(solver.JOINT_SWEEPS_PER_LOOK, cm.n)),
+                   codes[z], stats[z])
+        rows.Q[z] = Q[z]
+        rows.status[z] = np.where(codes[z] == CONVERGED, Status.CONVERGED.value,
+                                  np.where(stats[z, T_STALLS] > 0, Status.STALLED.value, Status.MAX_ITERATIONS.value))
+        rows.iterations[z] = stats[z, T_SWEEPS]
+        rows.restarts[z] = np.maximum(0, stats[z, T_ATTEMPTS] - 1)
+    continuous = cm.kind == CONTINUOUS
+    if continuous.any():
+        rows.Q[:, continuous] = wrap_to_pi(rows.Q[:, continuous])
+    return rows
+
+
+@njit(cache=True)
+def chunked(q, ch, pb, st, order, max_sweeps, rng_state, attempts, chunk_sweeps, best_q, stats):
+    """The kernel's multistart in chunks of ``chunk_sweeps`` sweeps, as the timed single solve runs it
+    (:func:`kinelab.ik.multistart.run_in_chunks`) but without the clock. Returns the last code."""
+    code = -1
+    while attempts > 0:
+        before = stats[T_ATTEMPTS]
+        code = multistart(q, ch, pb, st, order, max_sweeps, rng_state, attempts, stats[T_SWEEPS] + chunk_sweeps,
+                          best_q, stats)
+        attempts -= int(stats[T_ATTEMPTS] - before)
+        if code == CONVERGED:
+            break
+    return code
+
+
+@njit(cache=True, parallel=True)
+def solve_rows(Q, draw_start, ch, lower, upper, free, pstars, Rstars, w_p, w_ax, tol_pos, tol_rot, check_pos,
+               check_rot, st, order, max_sweeps, rng_states, attempts, chunk_sweeps, codes, stats):
+    """Solve rows [0, B) in parallel; row b's start is Q[b] (drawn from its generator when draw_start).
+
+    Inputs, in order:
+        Q (np.ndarray): (B, n) starts; on return the answers [rad or m].
+        draw_start (bool): draw every start from its row's generator (the single solve's ``q0=None``).
+        ch, lower, upper, free: the chain, its windows and free mask (shared).
+        pstars (np.ndarray): (B, 3) target points [m]; Rstars: (B, 3, 3) target rotations.
+        w_p, w_ax, tol_pos, tol_rot, check_pos, check_rot, st, order, max_sweeps: as the single solve.
+        rng_states (np.ndarray): (B, 1) uint64 generator state per row.
+        attempts (np.ndarray): (B,) attempts allowed per row (1 for a target proved out of reach).
+        chunk_sweeps (float): sweeps per chunk (the single solve's clock chunk).
+        codes (np.ndarray): (B,) run() code per row; stats: (B, STATS_SIZE) the slots T_* per row.
+    """
+    rest = np.zeros(Q.shape[1])
+    for b in prange(Q.shape[0]):
+        q = Q[b].copy()
+        if draw_start:
+            random_configuration(q, ch.kind, lower, upper, rng_states[b])
+        pb = Problem(lower, upper, free, pstars[b], Rstars[b], w_p, w_ax, tol_pos, tol_rot, check_pos, check_rot,
+                     rest, 0.0)
+        best_q = q.copy()
+        row_stats = np.zeros(STATS_SIZE)
+        codes[b] = chunked(q, ch, pb, st, order, max_sweeps, rng_states[b], attempts[b], chunk_sweeps, best_q,
+                           row_stats)
+        Q[b] = best_q
+        stats[b] = row_stats

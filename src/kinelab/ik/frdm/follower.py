@@ -1,0 +1,75 @@
+"""The compiled path follower's Python side: checks, the kernel call, Pinocchio's verdict per sample."""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab.ik.chain import chain_model
+from kinelab.ik.frdm import kernel, path_kernel
+from kinelab.ik.frdm.options import ORDERS, FRDMOptions
+from kinelab.ik.result import SingularEvent, Status, TrackResult
+from kinelab.ik.targets import as_target_arrays
+from kinelab.robot import Robot
+
+REST_WEIGHT = 0.01  # objective units (the weighted pose error is ~1 at a chain length's distance)
+REST_SWEEPS = 10  # sweeps of the first phase of a sample
+LM_ITERATIONS = 20  # Levenberg–Marquardt steps of the polish (mode "frdm+lm")
+CENTRE_PULL = 0.1  # share of the way from the previous answer to mid-range taken as the rest configuration
+# any other code (a kernel's converged that Pinocchio does not confirm, the polish's −1): max_iterations
+_STATUS = {kernel.STALL_STEP: Status.STALLED, kernel.STALL_WINDOW: Status.STALLED, kernel.BUDGET: Status.MAX_ITERATIONS}
+
+
+def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: float, max_sweeps: int,
+           rest_weight: float | None, opts: FRDMOptions) -> TrackResult:
+    """Solve every sample of a path in the compiled follower; each answer judged by Pinocchio.
+
+    Args:
+        robot: the robot.
+        targets: oMtarget per sample (see :func:`~kinelab.ik.targets.as_target_arrays`).
+        q0: checked start configuration [rad or m].
+        tol_pos: per-sample position tolerance [m].
+        tol_rot: per-sample rotation tolerance [rad].
+        max_sweeps: sweep cap of each phase of a sample.
+        rest_weight: weight of the rest term (None: :data:`REST_WEIGHT` on arms with more than six joints).
+        opts: FRDM options (order, weights, stall window).
+
+    Returns:
+        A :class:`~kinelab.ik.frdm.tracking.TrackResult` with mode "frdm (compiled follower)".
+    """
+    if rest_weight is None:
+        rest_weight = REST_WEIGHT if robot.n > 6 else 0.0
+    points, rotations = as_target_arrays(targets)
+    cm = chain_model(robot)
+    count = points.shape[0]
+    Q, codes, sweeps = np.empty((count, robot.n)), np.empty(count, dtype=np.int64), np.empty(count, dtype=np.int64)
+    order = ORDERS[opts.order if opts.order != "mixed" else "tip2base"]
+    bounded = np.isfinite(cm.lower) & np.isfinite(cm.upper)
+    centre = np.where(bounded, (np.where(bounded, cm.lower, 0.0) + np.where(bounded, cm.upper, 0.0)) / 2, q0)
+    lower, upper = (cm.lower, cm.upper) if opts.use_limits else (np.full(cm.n, -np.inf), np.full(cm.n, np.inf))
+    t0 = time.perf_counter()
+    path_kernel.follow(Q, np.array(q0, dtype=float), cm.chain, lower, upper, np.ones(cm.n, dtype=np.bool_), points,
+                       rotations, opts.position_weight(cm.length), opts.axis_weights(), float(tol_pos),
+                       float(tol_rot), opts.mode != "orientation", opts.mode != "position", opts.settings(), order,
+                       int(max_sweeps), float(rest_weight), REST_SWEEPS, centre, CENTRE_PULL,
+                       LM_ITERATIONS if opts.polish else 0, codes, sweeps)
+    dp, dr, status = np.empty(count), np.empty(count), []
+    for k in range(count):
+        Q[k] = robot.wrap_continuous(Q[k])
+        dp[k], dr[k] = robot.tool_error(Q[k], _pose(points[k], rotations[k]))
+        ok = dp[k] <= tol_pos and dr[k] <= tol_rot and robot.within_limits(Q[k])
+        code = int(codes[k])
+        status.append(Status.CONVERGED.value if ok else
+                      _STATUS.get(code, Status.MAX_ITERATIONS).value)
+    per_sample = (time.perf_counter() - t0) / count  # the kernel and Pinocchio's check of every answer
+    events = [SingularEvent("stall", "not diagnosed (compiled follower)", sample=k)
+              for k in range(count) if codes[k] in (kernel.STALL_STEP, kernel.STALL_WINDOW)]
+    return TrackResult(Q, dp, dr, status, sweeps, np.full(count, per_sample), events, [],
+                       mode="frdm+lm (compiled follower)" if opts.polish else "frdm (compiled follower)")
+
+
+def _pose(point: np.ndarray, rotation: np.ndarray) -> pin.SE3:
+    return pin.SE3(rotation, point)

@@ -1,0 +1,120 @@
+"""The compiled path follower: every sample of a path solved inside one kernel call, warm-started from
+the sample before (FRDM's direct-control use, Danilov 2019).
+
+Each sample runs in two phases. The first minimises E plus a rest term pulling towards the previous
+sample's answer (``w_rest`` Σ 2(1 − cos Δq)): among the configurations that reach the target it
+prefers the nearest one, which on a redundant arm keeps the self-motion from drifting into a joint
+limit or a branch jump. The second, run only when the first has not met the tolerances, is plain
+FRDM from where the first stopped, so the rest term never costs accuracy. Near a singular point FRDM
+crawls (its rate tends to 1); with ``lm_iterations`` > 0 a sample it leaves short of the tolerances
+gets damped Gauss–Newton steps (Levenberg–Marquardt): not an FRDM step, so the follower reports that
+mode under its own name.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from kinelab.ik.chain import PRISMATIC, chain_fk
+from kinelab.ik.frdm.kernel import CONVERGED, STATE_SIZE, Memory, Problem, _within, run
+
+
+@njit(cache=True)
+def follow(Q, q0, ch, lower, upper, free, pstars, Rstars, w_p, w_ax, tol_pos, tol_rot, check_pos, check_rot,
+           st, order, max_sweeps, w_rest, rest_sweeps, centre, pull, lm_iterations, codes, sweeps):
+    """Solve sample k of the path (pstars[k], Rstars[k]) from the answer to sample k − 1 (q0 for the first).
+
+    Inputs, in order:
+        Q (np.ndarray): (N, n) output, one configuration per sample [rad or m].
+        q0 (np.ndarray): (n,) configuration before the first sample.
+        ch (Chain): the chain.
+        lower, upper, free (np.ndarray): joint windows and free mask, shared by every sample.
+        pstars (np.ndarray): (N, 3) target points [m]; Rstars: (N, 3, 3) target rotations (base frame).
+        w_p (float), w_ax (np.ndarray): objective weights; tol_pos [m], tol_rot [rad], check_pos, check_rot.
+        st (Settings), order (int): sweep settings and order code.
+        max_sweeps (int): sweep cap of each phase.
+        w_rest (float): weight of the rest term in the first phase (0: one plain phase).
+        rest_sweeps (int): sweep cap of the first phase.
+        centre (np.ndarray), pull (float): the rest configuration is q_prev + pull (centre − q_prev).
+        lm_iterations (int): Levenberg–Marquardt steps after FRDM for a sample still short (0: none).
+        codes, sweeps (np.ndarray): (N,) outputs: run() code and sweeps spent per sample.
+    """
+    n = q0.shape[0]
+    mem = Memory(np.zeros((st.accel_m + 1, n)), np.zeros((st.accel_m + 1, n)), np.zeros(STATE_SIZE), np.zeros(0))
+    q = q0.copy()
+    q_prev = q0.copy()
+    rest = q0.copy()
+    for k in range(Q.shape[0]):
+        spent = 0
+        code = -1
+        if w_rest > 0.0:
+            for i in range(n):
+                rest[i] = q_prev[i] + pull * (centre[i] - q_prev[i])
+            pb = Problem(lower, upper, free, pstars[k], Rstars[k], w_p, w_ax, tol_pos, tol_rot, check_pos, check_rot,
+                         rest, w_rest)
+            mem.state[:] = 0.0
+            code, spent = run(q, ch, pb, st, order, rest_sweeps, mem)
+        if code != CONVERGED:
+            pb = Problem(lower, upper, free, pstars[k], Rstars[k], w_p, w_ax, tol_pos, tol_rot, check_pos, check_rot,
+                         q_prev, 0.0)
+            mem.state[:] = 0.0
+            code, more = run(q, ch, pb, st, order, max_sweeps, mem)
+            spent += more
+        if code != CONVERGED and lm_iterations > 0:
+            code, more = lm_polish(q, ch, pb, lm_iterations)
+            spent += more
+        Q[k] = q
+        q_prev[:] = q
+        codes[k] = code
+        sweeps[k] = spent
+
+
+@njit(cache=True)
+def lm_polish(q, ch, pb, iterations):
+    """Levenberg–Marquardt on the world-frame error [p* − p; log(R* Rᵀ)], steps kept in the windows.
+
+    Returns (CONVERGED or −1, iterations spent); q is updated in place.
+    """
+    n = q.shape[0]
+    e, o, p, R = np.empty((n, 3)), np.empty((n, 3)), np.empty(3), np.empty((3, 3))
+    J = np.empty((6, n))
+    err = np.empty(6)
+    for it in range(iterations):
+        chain_fk(ch, q, e, o, p, R)
+        if _within(p, R, pb.pstar, pb.Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot):
+            return CONVERGED, it
+        _world_error(p, R, pb, err)
+        for i in range(n):
+            if ch.kind[i] == PRISMATIC:
+                J[0:3, i] = e[i]
+                J[3:6, i] = 0.0
+            else:
+                J[0:3, i] = np.cross(e[i], p - o[i])
+                J[3:6, i] = e[i]
+        A = J.T @ J
+        damping = 1e-9 + 1e-3 * (err @ err)
+        for i in range(n):
+            A[i, i] += damping
+        dq = np.linalg.solve(A, J.T @ err)
+        for i in range(n):
+            q[i] = min(max(q[i] + dq[i], pb.lower[i]), pb.upper[i])
+    chain_fk(ch, q, e, o, p, R)
+    if _within(p, R, pb.pstar, pb.Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot):
+        return CONVERGED, iterations
+    return -1, iterations
+
+
+@njit(cache=True)
+def _world_error(p, R, pb, err):
+    """err = [w·(p* − p); log(R* Rᵀ)] with the constrained components only (w = √w_p: the objective's scale
+    is irrelevant to a Gauss–Newton step, but an unchecked component must not pull)."""
+    for k in range(3):
+        err[k] = pb.pstar[k] - p[k] if pb.check_pos else 0.0
+    M = pb.Rstar @ R.T
+    cos_a = min(1.0, max(-1.0, (M[0, 0] + M[1, 1] + M[2, 2] - 1.0) / 2.0))
+    angle = np.arccos(cos_a)
+    scale = 0.5 if angle < 1e-8 else angle / (2.0 * np.sin(angle))
+    w = (M[2, 1] - M[1, 2], M[0, 2] - M[2, 0], M[1, 0] - M[0, 1])
+    for k in range(3):
+        err[3 + k] = scale * w[k] if pb.check_rot else 0.0
