@@ -176,7 +176,7 @@ class _Problem:
 
     def judge(self, q: np.ndarray) -> tuple[bool, float, float]:
         """Pinocchio's verdict on q: (success, position error [m], rotation error [rad])."""
-        dp, dr = self.robot.tool_error(q, self.target)
+        dp, dr = self.robot.tool_error_of_float_q(q, self.target)
         return dp <= self.tol_pos and dr <= self.tol_rot and self.robot.within_limits(q), dp, dr
 
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 import contextlib
 import itertools
 import math
+import operator
 import os
 import sys
 import tempfile
@@ -233,8 +234,8 @@ class Robot:
         self._upper_check = np.where(continuous, np.inf, self.upper)
         # the same bounds with the default slack, as Python floats: a solve checks limits twice, and a
         # loop over seven floats costs a fifth of the numpy expression
-        self._limit_pairs = list(zip((self._lower_check - LIMIT_SLACK).tolist(),
-                                     (self._upper_check + LIMIT_SLACK).tolist(), strict=True))
+        self._lower_list = (self._lower_check - LIMIT_SLACK).tolist()
+        self._upper_list = (self._upper_check + LIMIT_SLACK).tolist()
 
     def derived(self, key: str, build: Callable[[Robot], T]) -> T:
         """Data derived from this robot (a solver's chain arrays, say), built on first use and kept here,
@@ -341,8 +342,9 @@ class Robot:
     def within_limits(self, q, slack: float = LIMIT_SLACK) -> bool:
         """True when every bounded joint lies within its limits (plus ``slack``); continuous joints have none."""
         if slack == LIMIT_SLACK:
-            return all(lo <= x <= hi for x, (lo, hi) in zip(np.asarray(q, dtype=float).tolist(), self._limit_pairs,
-                                                               strict=True))
+            values = (q if type(q) is np.ndarray else np.asarray(q, dtype=float)).tolist()
+            return len(values) == self.n and all(map(operator.le, self._lower_list, values)) and \
+                all(map(operator.le, values, self._upper_list))
         arr = np.asarray(q, dtype=float)
         return bool((arr >= self._lower_check - slack).all() and (arr <= self._upper_check + slack).all())
 
@@ -450,7 +452,11 @@ class Robot:
 
     def tool_error(self, q, oMtarget: pin.SE3) -> tuple[float, float]:
         """(position error [m], rotation angle error [rad]) of the tool at q against oMtarget (Pinocchio FK)."""
-        pin.forwardKinematics(self.model, self.data, self._pin_q(q))
+        return self.tool_error_of_float_q(self.check_q(q), oMtarget)
+
+    def tool_error_of_float_q(self, q: np.ndarray, oMtarget: pin.SE3) -> tuple[float, float]:
+        """:meth:`tool_error` for a q known to be n finite floats (a solver's answer): no check repeated."""
+        pin.forwardKinematics(self.model, self.data, q if self._identity_q else self._pin_q(q))
         oMtool = pin.updateFramePlacement(self.model, self.data, self.tool_frame_id)
         return pose_error(oMtarget, oMtool)
 

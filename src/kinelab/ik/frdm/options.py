@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 import numbers
@@ -79,6 +80,13 @@ class FRDMOptions:
     max_bypass_events: int = 3
     polish: bool = False
     trace: bool = False
+
+    def __hash__(self) -> int:  # computed once: solve() looks its compiled context up by these options
+        cached = self.__dict__.get("_hash")
+        if cached is None:
+            cached = hash(tuple(getattr(self, f.name) for f in dataclasses.fields(self)))
+            object.__setattr__(self, "_hash", cached)
+        return cached
 
     def __post_init__(self) -> None:
         opt.choice("mode", self.mode, MODES, what="FRDM mode")

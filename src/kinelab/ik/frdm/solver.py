@@ -17,7 +17,7 @@ import pinocchio as pin
 
 from kinelab.ik import dls
 from kinelab.ik import multistart as restarts
-from kinelab.ik.chain import ChainModel, chain_model
+from kinelab.ik.chain import CONTINUOUS, ChainModel, chain_model
 from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm.kernel import no_rest
 from kinelab.ik.frdm.monitor import Bypass, Problem, Runner
@@ -94,40 +94,89 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: 
 
     A stall is answered by a restart: with no bypass configured that is what the monitor's policy does
     for a local minimum. ``q0`` None: the first start is drawn from the seeded generator too (as
-    :func:`kinelab.solve_batch` does). Returns the attempt kept and the number of restarts; the caller checks the
-    answer with Pinocchio.
+    :func:`kinelab.solve_batch` does). Returns the attempt kept and the number of restarts; the caller
+    checks the answer with Pinocchio.
     """
     opts = options or FRDMOptions()
-    cm = chain_model(robot)
-    prob = _compiled_problem(cm, oMtarget, opts, tol_pos, tol_rot)
-    rng_state = restarts.seed_state(seed)
-    q = restarts.first_start(q0, cm.kind, cm.lower, cm.upper, rng_state)
-    best_q = q.copy()
-    stats = np.zeros(kernel.STATS_SIZE)
-    settings = opts.settings()
-    order = ORDERS[opts.order]
-    chunk_sweeps = clock_chunk(JOINT_SWEEPS_PER_LOOK, cm.n)
-
-    def chunk(attempts_left: int) -> int:
-        return _MULTISTART(q, cm.chain, prob, settings, order, opts.sweep_cap, rng_state, attempts_left,
-                           float(stats[kernel.T_SWEEPS] + chunk_sweeps), best_q, stats)
-
-    code = restarts.run_in_chunks(chunk, max_restarts + 1, stats, deadline, kernel.CONVERGED)
+    ctx = _context(robot, opts, float(tol_pos), float(tol_rot))
+    code, q, stats = ctx.run(oMtarget, q0, seed, max_restarts + 1, deadline)
     if code == kernel.CONVERGED:
         status = Status.CONVERGED
     elif time.perf_counter() > deadline:
         status = Status.TIME_BUDGET
     else:
         status = Status.STALLED if stats[kernel.T_STALLS] > 0 else Status.MAX_ITERATIONS
-    stalls = int(stats[kernel.T_STALLS])
-    info = {"mode": "frdm" + (" (plain)" if opts.plain else ""), "sweeps": int(stats[kernel.T_SWEEPS]),
-            "accelerated_sweeps": int(stats[kernel.T_ACCEPTED]), "order": opts.order, "w_p": prob.w_p,
-            "objective": float(stats[kernel.T_BEST_E]), "attempts": int(stats[kernel.T_ATTEMPTS]),
-            "stalls": stalls, "path": "compiled"}
+    sweeps, stalls, attempts = int(stats[kernel.T_SWEEPS]), int(stats[kernel.T_STALLS]), int(stats[kernel.T_ATTEMPTS])
+    info = {"mode": ctx.mode, "sweeps": sweeps, "accelerated_sweeps": int(stats[kernel.T_ACCEPTED]),
+            "order": opts.order, "w_p": ctx.problem.w_p, "objective": float(stats[kernel.T_BEST_E]),
+            "attempts": attempts, "stalls": stalls, "path": "compiled"}
     events = [SingularEvent("stall", "not diagnosed (compiled multistart: restarted)", count=stalls)] if stalls else []
-    attempts = int(stats[kernel.T_ATTEMPTS])
-    return Attempt(robot.wrap_continuous(best_q), status, int(stats[kernel.T_SWEEPS]), events, [], info), \
+    return Attempt(robot.wrap_continuous(q) if ctx.continuous else q, status, sweeps, events, [], info), \
         max(0, attempts - 1)
+
+
+class _Context:
+    """Everything a compiled FRDM solve on one robot with one set of options and tolerances passes to the
+    kernel, built once: per call only the target (copied into the problem's own arrays), the start, the
+    seed and the budget change. Not for concurrent solves on one Robot (its Pinocchio data is shared too)."""
+
+    def __init__(self, robot: Robot, opts: FRDMOptions, tol_pos: float, tol_rot: float):
+        cm = chain_model(robot)
+        self.cm, self.n, self.continuous = cm, cm.n, bool((cm.kind == CONTINUOUS).any())
+        self.problem = _compiled_problem(cm, pin.SE3.Identity(), opts, tol_pos, tol_rot)
+        self.pstar, self.Rstar = self.problem.pstar, self.problem.Rstar
+        self.settings, self.order, self.cap = opts.settings(), ORDERS[opts.order], opts.sweep_cap
+        self.chunk = float(clock_chunk(JOINT_SWEEPS_PER_LOOK, cm.n))
+        self.mode = "frdm" + (" (plain)" if opts.plain else "")
+        self.seed: int | None = None
+        self.seed_value = np.zeros(1, dtype=np.uint64)  # the generator state of ``self.seed``
+
+    def run(self, oMtarget: pin.SE3, q0: np.ndarray | None, seed: int | None, attempts: int,
+            deadline: float) -> tuple[int, np.ndarray, np.ndarray]:
+        """(code, kept q (a new array), stats) of attempts from q0 (None: drawn) and seeded restarts."""
+        self.pstar[:] = oMtarget.translation
+        self.Rstar[:] = oMtarget.rotation
+        if seed is None or seed != self.seed:  # a loop usually passes one seed: its state is made once
+            self.seed_value = restarts.seed_state(seed)
+            self.seed = seed
+        rng_state = self.seed_value.copy()
+        cm = self.cm
+        q = restarts.first_start(q0, cm.kind, cm.lower, cm.upper, rng_state)
+        best_q = q.copy()
+        stats = np.zeros(kernel.STATS_SIZE)
+        code = _MULTISTART(q, cm.chain, self.problem, self.settings, self.order, self.cap, rng_state, attempts,
+                           self.chunk, best_q, stats)
+        attempts -= int(stats[kernel.T_ATTEMPTS])
+        if code != kernel.CONVERGED and attempts > 0 and time.perf_counter() <= deadline:
+            def chunk(attempts_left: int) -> int:
+                return _MULTISTART(q, cm.chain, self.problem, self.settings, self.order, self.cap, rng_state,
+                                   attempts_left, float(stats[kernel.T_SWEEPS] + self.chunk), best_q, stats)
+
+            code = restarts.run_in_chunks(chunk, attempts, stats, deadline, kernel.CONVERGED)
+        return code, best_q, stats
+
+
+def _context(robot: Robot, opts: FRDMOptions, tol_pos: float, tol_rot: float) -> _Context:
+    """The robot's context for these options and tolerances (kept on the Robot, a few per robot)."""
+    last = _LAST
+    if last and last[0] is robot and last[1] is opts and last[2] == tol_pos and last[3] == tol_rot:
+        return last[4]
+    contexts: dict = robot.derived("frdm_contexts", _new_dict)
+    key = (opts, tol_pos, tol_rot)
+    ctx = contexts.get(key)
+    if ctx is None:
+        if len(contexts) >= 16:  # a caller sweeping tolerances: keep the memory bounded
+            contexts.clear()
+        ctx = contexts[key] = _Context(robot, opts, tol_pos, tol_rot)
+    _LAST[:] = [robot, opts, tol_pos, tol_rot, ctx]
+    return ctx
+
+
+_LAST: list = []  # the context of the last call (a loop asks for the same one every time)
+
+
+def _new_dict(_: Robot) -> dict:
+    return {}
 
 
 def _compiled_problem(cm: ChainModel, oMtarget: pin.SE3, opts: FRDMOptions, tol_pos: float,
@@ -138,7 +187,8 @@ def _compiled_problem(cm: ChainModel, oMtarget: pin.SE3, opts: FRDMOptions, tol_
         lower, upper = cm.lower, cm.upper
     else:
         lower, upper = _unbounded(cm.n), _unbounded(cm.n, 1.0)
-    return kernel.Problem(lower, upper, _all_free(cm.n), oMtarget.translation, np.ascontiguousarray(oMtarget.rotation),
+    return kernel.Problem(lower, upper, _all_free(cm.n), np.array(oMtarget.translation),
+                          np.array(oMtarget.rotation, order="C"),
                           opts.position_weight(cm.length), opts.axis_weights(), float(tol_pos), float(tol_rot),
                           opts.mode != "orientation", opts.mode != "position",
                           no_rest(cm.n), 0.0)
