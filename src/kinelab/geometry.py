@@ -36,6 +36,13 @@ def pose_error(oMa: pin.SE3, oMb: pin.SE3) -> tuple[float, float]:
     return math.hypot(*err.translation.tolist()), math.hypot(*pin.log3(err.rotation).tolist())
 
 
+def stack_homogeneous(points: np.ndarray, rotations: np.ndarray) -> np.ndarray:
+    """(B, 4, 4) homogeneous matrices from (B, 3) points [m] and (B, 3, 3) rotations."""
+    H = np.zeros((points.shape[0], 4, 4))
+    H[:, :3, :3], H[:, :3, 3], H[:, 3, 3] = rotations, points, 1.0
+    return H
+
+
 def pose_errors(H_a: np.ndarray, H_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """:func:`pose_error` for (B, 4, 4) stacks of homogeneous matrices: (position errors [m], rotation
     angles [rad]), the angle as atan2(|vee(M − Mᵀ)|/2, (tr M − 1)/2) with M = R_aᵀR_b (accurate near 0 and π).

@@ -92,6 +92,41 @@ def test_each_problem_keeps_its_fastest_round_with_that_rounds_verdict():
     assert 20_000 <= row.median_solved_us < 50_000  # problem 0 counts its 20 ms round, not the 80 ms one
 
 
+def _recording(log, name):
+    def prepare(robot, budget):
+        def solve(case, seed):
+            log.append((name, case.index, seed))
+            return case.q_target, 1
+        return solve
+    return prepare
+
+
+@pytest.mark.parametrize("schedule", ["blocked", "interleaved"])
+def test_schedules_order_the_calls_and_each_round_brings_fresh_seeds(schedule):
+    ur5 = kinelab.load("ur5")
+    problems = protocol.cases(ur5, 3, 0)
+    log = []
+    solvers = {"a": _recording(log, "a"), "b": _recording(log, "b")}
+    runner.run_robot(ur5, solvers, problems, budget=1.0, seed=100, missing={}, repeats=2, schedule=schedule)
+    timed = log[6:]  # three warm-up calls per solver come first
+    if schedule == "interleaved":  # per problem both solvers, the first one rotating
+        assert [(s, i) for s, i, _ in timed[:6]] == [("a", 0), ("b", 0), ("b", 1), ("a", 1), ("a", 2), ("b", 2)]
+    else:  # a solver's whole set, then the other's
+        assert [(s, i) for s, i, _ in timed[:6]] == [("a", 0), ("a", 1), ("a", 2), ("b", 0), ("b", 1), ("b", 2)]
+    seeds = {(s, i): set() for s, i, _ in timed}
+    for s, i, seed in timed:
+        seeds[(s, i)].add(seed)
+    assert all(len(v) == 2 for v in seeds.values())  # two rounds, two different seeds per problem
+    assert {seed for s, i, seed in timed if i == 1} == {101, 104}  # seed + index + round × n
+
+
+def test_warm_starts_lie_near_their_targets_within_the_limits(ur5):
+    for case in protocol.cases(ur5, 20, 3, start="warm", sigma=0.02):
+        assert ur5.within_limits(case.q_start)
+        assert np.abs(case.q_start - case.q_target).max() < 0.02 * 6
+        assert not np.array_equal(case.q_start, case.q_target)
+
+
 def test_bench_refuses_empty_protocols():
     for kwargs in ({"n": 0}, {"repeats": 0}, {"budget": 0.0}):
         with pytest.raises(kinelab.KinelabError, match="bench needs"):
@@ -124,3 +159,18 @@ def test_synthetic_chains_mix_joint_kinds_and_load(tmp_path):
     robot = scaling.synthetic_robot(15)
     assert robot.n == 15 and robot.joint_kinds.count("prismatic") == 3
     assert isinstance(robot.fk(robot.neutral()), pin.SE3)
+
+
+def test_the_loops_protocols_judge_every_answer_with_pinocchio():
+    from kinelab.report.bench import loops
+
+    ur5 = kinelab.load("ur5")
+    rows = loops.throughput(ur5, n=30, seed=1, start="warm", sigma=0.02, repeats=2)
+    by_loop = {r["loop"]: r for r in rows}
+    assert {"frdm solve() loop", "frdm solve_batch"} <= set(by_loop)
+    assert by_loop["frdm solve_batch"]["success_pct"] == 100.0 and by_loop["frdm solve_batch"]["spread"] >= 1.0
+    tracked = {r["tracker"]: r for r in loops.tracking(ur5, seed=2, samples=200, repeats=1)}
+    assert tracked["frdm+lm track"]["reached"] == 200
+    assert 0 < tracked["frdm track"]["max_step_over_path_step"] < 10
+    text = loops.markdown(rows, list(tracked.values()))
+    assert "| ur5 | frdm solve_batch | warm σ=0.02 |" in text and "| ur5 | frdm+lm track | 200/200 |" in text

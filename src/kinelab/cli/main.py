@@ -277,13 +277,18 @@ def cmd_bench(args) -> int:
 
         scaled = scaling.run(progress=not args.json)
     result = bench.run(robots=args.robots, n=args.n, seed=args.seed, solvers=args.solvers,
-                       budget=args.budget_ms / 1e3, progress=not args.json, repeats=args.repeats)
+                       budget=args.budget_ms / 1e3, progress=not args.json, repeats=args.repeats, start=args.start,
+                       sigma=args.sigma, schedule=args.schedule)
     if scaled is not None:
         result["scaling"] = scaled
     if args.tracking:
         from kinelab.studies import paper000_era
 
         result["tracking"] = paper000_era.tracking_bench(repeats=args.repeats)
+    if args.loops:
+        from kinelab.report.bench import loops
+
+        result["loops"] = loops.run(args.robots, seed=args.seed, repeats=args.repeats, progress=not args.json)
     if args.out:
         render.write_bench(result, args.out)
     if args.json:
@@ -294,6 +299,8 @@ def cmd_bench(args) -> int:
             print(scaling.markdown(result["scaling"]))
         if "tracking" in result:
             print(paper000_era.tracking_markdown(result["tracking"]))
+        if "loops" in result:
+            print(loops.markdown(result["loops"]["throughput"], result["loops"]["tracking"]))
         if args.out:
             print(f"results written to {args.out}")
     return 0
@@ -464,16 +471,24 @@ def _add_animate(sub: Any) -> None:
 
 def _add_bench(sub: Any) -> None:
     s = sub.add_parser("bench", help="the IK benchmark: kinelab's solvers and the installed peers")
-    s.add_argument("--robots", nargs="+", default=None, help="robots (default: panda ur5 stanford era)")
+    s.add_argument("--robots", nargs="+", default=None,
+                   help="robots (default: panda ur5 stanford era xarm7 z1 kinova ur10 so101 youbot)")
     s.add_argument("--n", type=int, default=200, help="targets per robot")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--solvers", nargs="+", default=None, help="solvers to run (default: all available)")
     s.add_argument("--budget-ms", type=float, default=5.0, help="time budget per solve [ms]")
     s.add_argument("--repeats", type=int, default=3, help="rounds over the set; per problem the fastest counts")
+    s.add_argument("--start", choices=("random", "warm"), default="random",
+                   help="starts: random in the limits, or warm: the target's q plus N(0, sigma) per joint")
+    s.add_argument("--sigma", type=float, default=0.2, help="warm starts' noise per joint [rad or m]")
+    s.add_argument("--schedule", choices=("blocked", "interleaved"), default="blocked",
+                   help="blocked: a solver runs the whole set, then the next; interleaved: every solver per problem")
     s.add_argument("--scaling", action="store_true", help="also time FRDM on synthetic chains of 7-100 links")
     s.add_argument("--tracking", action="store_true", help="also time tracking along the ERA passages (FRDM, DLS)")
+    s.add_argument("--loops", action="store_true",
+                   help="also the loops users run: throughput (solve loop, solve_batch, ik_LM) and path tracking")
     s.add_argument("--out", help="write bench.json, bench.md and bench.png here")
-    s.add_argument("--json", action="store_true")
+    s.add_argument("--json", action="store_true", help="print the results as JSON instead of tables")
     s.set_defaults(func=cmd_bench)
 
 

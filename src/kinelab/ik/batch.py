@@ -17,7 +17,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.errors import ConfigurationError
-from kinelab.geometry import pose_errors
+from kinelab.geometry import pose_errors, stack_homogeneous
 from kinelab.ik.frdm import batch as frdm_batch
 from kinelab.ik.frdm.batch import Rows
 from kinelab.ik.multistart import seed_states
@@ -129,7 +129,7 @@ def _starts(robot: Robot, q0: Any, count: int) -> np.ndarray | None:
     if arr.shape != (count, robot.n):
         raise ConfigurationError(f"q0 must be None, {robot.n} numbers or ({count}, {robot.n}) for {count} targets "
                                  f"of {robot.name}, got shape {arr.shape}")
-    for b in np.flatnonzero(~np.isfinite(arr).all(axis=1) | ~np.array([robot.within_limits(r) for r in arr])):
+    for b in np.flatnonzero(~np.isfinite(arr).all(axis=1) | ~robot.within_limits_batch(arr)):
         robot.check_q(arr[b], limits=True, what=f"q0[{b}]")
     return np.array(arr, dtype=float)
 
@@ -165,10 +165,9 @@ def _judged(robot: Robot, rows: Rows, points: np.ndarray, rotations: np.ndarray,
     dp, dr, success = np.full(count, np.nan), np.full(count, np.nan), np.zeros(count, dtype=bool)
     solved = np.flatnonzero(rows.status != Status.TIME_BUDGET.value)
     if solved.size:
-        H_target = np.zeros((solved.size, 4, 4))
-        H_target[:, :3, :3], H_target[:, :3, 3], H_target[:, 3, 3] = rotations[solved], points[solved], 1.0
+        H_target = stack_homogeneous(points[solved], rotations[solved])
         dp[solved], dr[solved] = pose_errors(H_target, robot.fk_batch(rows.Q[solved]))
-        within = np.array([robot.within_limits(q) for q in rows.Q[solved]])
+        within = robot.within_limits_batch(rows.Q[solved])
         success[solved] = (dp[solved] <= tol_pos) & (dr[solved] <= tol_rot) & within
     status = rows.status
     status[success] = Status.CONVERGED.value

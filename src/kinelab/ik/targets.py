@@ -64,30 +64,46 @@ def as_target_arrays(targets) -> tuple[np.ndarray, np.ndarray]:
     """Check a sequence of targets; returns (points (N, 3) [m], rotations (N, 3, 3)), base frame.
 
     ``targets`` is a sequence of ``pin.SE3`` (or unit biquaternions), or an (N, 4, 4) array of
-    homogeneous matrices. A bad target is named by its index.
+    homogeneous matrices. A bad target is named by its index. The checks are those of
+    :func:`as_target`, made on the whole stack at once.
 
     Raises:
         TargetError: an empty sequence, a wrong shape or a bad target (its index named).
     """
-    if isinstance(targets, np.ndarray) and targets.dtype.kind in "fiu" and targets.ndim == 3:
-        if targets.shape[1:] != (4, 4):
-            raise TargetError(f"targets as an array must have shape (N, 4, 4), got {targets.shape}")
-        targets = [pin.SE3(np.asarray(h, dtype=float)) if np.all(np.isfinite(h)) else np.asarray(h)
-                   for h in targets]
+    H = _stack(targets)
+    finite = np.isfinite(H).all(axis=(1, 2))
+    R = H[:, :3, :3]
+    with np.errstate(invalid="ignore"):
+        gram = np.abs(np.einsum("bki,bkj->bij", R, R) - np.eye(3)).max(axis=(1, 2))
+        det = np.linalg.det(np.where(finite[:, None, None], R, 0.0))
+    bad = ~finite | ~(gram <= 1e-6) | (det < 0) | (np.abs(H[:, 3] - (0.0, 0.0, 0.0, 1.0)).max(axis=1) > 0)
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        why = ("has NaN or infinite entries" if not finite[k] else
+               "its last row is not (0, 0, 0, 1)" if gram[k] <= 1e-6 and det[k] >= 0 else
+               "its rotation is not a rotation matrix (RᵀR ≠ I or det R < 0)")
+        raise TargetError(f"targets[{k}] {why}")
+    return np.ascontiguousarray(H[:, :3, 3]), np.ascontiguousarray(R)
+
+
+def _stack(targets) -> np.ndarray:
+    """The targets as an (N, 4, 4) float array (N ≥ 1), or a TargetError naming the first that is no pose."""
+    if isinstance(targets, np.ndarray) and targets.dtype.kind in "fiu":
+        if targets.ndim != 3 or targets.shape[1:] != (4, 4) or targets.shape[0] == 0:
+            raise TargetError(f"targets as an array must have shape (N, 4, 4) with N ≥ 1, got {targets.shape}")
+        return np.asarray(targets, dtype=float)
     try:
-        count = len(targets)
+        items = list(targets)
     except TypeError:
         raise TargetError(f"targets must be a sequence of pin.SE3, got {type(targets).__name__}") from None
-    if count == 0:
+    if not items:
         raise TargetError("targets is empty: give at least one pin.SE3")
-    points, rotations = np.empty((count, 3)), np.empty((count, 3, 3))
-    for k, target in enumerate(targets):
-        try:
-            if isinstance(target, np.ndarray):
-                raise TargetError("has NaN or infinite entries")
-            checked = as_target(target)
-        except TargetError as err:
-            raise TargetError(f"targets[{k}]: {err}") from None
-        points[k] = checked.translation
-        rotations[k] = checked.rotation
-    return points, rotations
+    for k, target in enumerate(items):
+        if isinstance(target, DualQuat):
+            try:
+                items[k] = as_target(target)
+            except TargetError as err:
+                raise TargetError(f"targets[{k}]: {err}") from None
+        elif not isinstance(target, pin.SE3):
+            raise TargetError(f"targets[{k}] must be a pin.SE3 (or a unit DualQuat), got {type(target).__name__}")
+    return np.array([t.homogeneous for t in items])

@@ -81,7 +81,7 @@ def run(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts: np.ndar
     Q = np.zeros((count, cm.n)) if starts is None else np.array(starts, dtype=float)
     codes, stats = np.zeros(count, dtype=np.int64), np.zeros((count, STATS_SIZE))
     lower, upper = (cm.lower, cm.upper) if opts.use_limits else (np.full(cm.n, -np.inf), np.full(cm.n, np.inf))
-    step = ROWS_PER_LOOK * numba.get_num_threads()
+    step = count if deadline == np.inf else ROWS_PER_LOOK * numba.get_num_threads()  # no budget: one call
     for a in range(0, count, step):
         if time.perf_counter() > deadline:
             break

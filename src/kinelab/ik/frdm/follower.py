@@ -6,9 +6,9 @@ import time
 from typing import Any
 
 import numpy as np
-import pinocchio as pin
 
-from kinelab.ik.chain import chain_model
+from kinelab.geometry import pose_errors, stack_homogeneous, wrap_to_pi
+from kinelab.ik.chain import CONTINUOUS, chain_model
 from kinelab.ik.frdm import kernel, path_kernel
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.result import SingularEvent, Status, TrackResult
@@ -56,14 +56,13 @@ def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: 
                        float(tol_rot), opts.mode != "orientation", opts.mode != "position", opts.settings(), order,
                        int(max_sweeps), float(rest_weight), REST_SWEEPS, centre, CENTRE_PULL,
                        LM_ITERATIONS if opts.polish else 0, codes, sweeps)
-    dp, dr, status = np.empty(count), np.empty(count), []
-    for k in range(count):
-        Q[k] = robot.wrap_continuous(Q[k])
-        dp[k], dr[k] = robot.tool_error(Q[k], _pose(points[k], rotations[k]))
-        ok = dp[k] <= tol_pos and dr[k] <= tol_rot and robot.within_limits(Q[k])
-        code = int(codes[k])
-        status.append(Status.CONVERGED.value if ok else
-                      _STATUS.get(code, Status.MAX_ITERATIONS).value)
+    continuous = cm.kind == CONTINUOUS
+    if continuous.any():
+        Q[:, continuous] = wrap_to_pi(Q[:, continuous])
+    dp, dr = pose_errors(stack_homogeneous(points, rotations), robot.fk_batch(Q))
+    ok = (dp <= tol_pos) & (dr <= tol_rot) & robot.within_limits_batch(Q)
+    status = [Status.CONVERGED.value if ok[k] else _STATUS.get(int(codes[k]), Status.MAX_ITERATIONS).value
+              for k in range(count)]
     per_sample = (time.perf_counter() - t0) / count  # the kernel and Pinocchio's check of every answer
     events = [SingularEvent("stall", "not diagnosed (compiled follower)", sample=k)
               for k in range(count) if codes[k] in (kernel.STALL_STEP, kernel.STALL_WINDOW)]
@@ -71,5 +70,3 @@ def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: 
                        mode="frdm+lm (compiled follower)" if opts.polish else "frdm (compiled follower)")
 
 
-def _pose(point: np.ndarray, rotation: np.ndarray) -> pin.SE3:
-    return pin.SE3(rotation, point)

@@ -17,6 +17,7 @@ import time
 import warnings
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -48,7 +49,12 @@ def tool_link(robot: Robot) -> str:
     return _tool_link(robot)
 
 
-def _rtb(robot: Robot, budget: float) -> SolveFn:
+def rtb_ets(robot: Robot) -> Any:
+    """roboticstoolbox's ETS of the robot's base → tool chain (its URDF import), checked for the joint count.
+
+    Raises:
+        ImportError: roboticstoolbox is not installed; ValueError: it sees another number of joints.
+    """
     import roboticstoolbox as rtb
 
     with warnings.catch_warnings():
@@ -56,6 +62,11 @@ def _rtb(robot: Robot, budget: float) -> SolveFn:
         ets = rtb.Robot.URDF(str(kinematic_urdf(robot))).ets(end=tool_link(robot))
     if ets.n != robot.n:
         raise ValueError(f"roboticstoolbox sees {ets.n} joints, kinelab {robot.n}")
+    return ets
+
+
+def _rtb(robot: Robot, budget: float) -> SolveFn:
+    ets = rtb_ets(robot)
 
     def run(case: Case, seed: int):
         # tol bounds E = ½ eᵀe (e in m and rad): 5e-13 keeps both parts below 1e-6

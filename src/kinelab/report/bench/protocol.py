@@ -1,7 +1,9 @@
 """``kinelab bench``: the IK benchmark protocol, kinelab's solvers against the peer libraries.
 
 Protocol (per robot): ``n`` seeded random configurations within the limits give the targets (their
-Pinocchio FK); every solver starts from the same seeded random configuration per target. A result
+Pinocchio FK); every solver starts from the same configuration per target: a seeded random one
+(``start="random"``), or the target's own configuration plus seeded Gaussian noise of ``sigma`` rad
+(or m) per joint, clipped into the limits (``start="warm"``, the loop of a controller). A result
 counts as solved only when, checked here with Pinocchio's FK, the position error is below 1e-6 m and
 the rotation error below 1e-6 rad, q is within the joint limits, and the call returned within the
 budget (5 ms by default; restarts inside it are the solver's business). The solvers take turns over
@@ -23,7 +25,9 @@ TOL_POS = 1e-6  # [m]
 TOL_ROT = 1e-6  # [rad]
 BUDGET = 0.005  # [s]
 REPEATS = 3  # rounds over the problem set; per problem the fastest run counts
-DEFAULT_ROBOTS = ("panda", "ur5", "stanford", "era")
+DEFAULT_ROBOTS = ("panda", "ur5", "stanford", "era", "xarm7", "z1", "kinova", "ur10", "so101", "youbot")
+STARTS = ("random", "warm")
+SCHEDULES = ("blocked", "interleaved")
 
 
 @dataclass(frozen=True)
@@ -36,12 +40,16 @@ class Case:
     oMtarget: pin.SE3
 
 
-def cases(robot: Robot, n: int, seed: int) -> list[Case]:
-    """``n`` seeded problems: targets and starts drawn uniformly within the joint limits."""
+def cases(robot: Robot, n: int, seed: int, start: str = "random", sigma: float = 0.2) -> list[Case]:
+    """``n`` seeded problems: targets drawn uniformly within the joint limits; starts drawn uniformly
+    (``start="random"``) or the target's configuration plus N(0, sigma²) per joint, clipped into the
+    limits (``"warm"``; sigma in rad or m)."""
     rng = np.random.default_rng(seed)
     out = []
     for i in range(n):
         q_target, q_start = robot.random_q(rng), robot.random_q(rng)
+        if start == "warm":
+            q_start = np.clip(q_target + rng.normal(0.0, sigma, robot.n), robot.lower, robot.upper)
         out.append(Case(i, q_target, q_start, robot.fk(q_target)))
     return out
 
@@ -67,3 +75,14 @@ def check_solution(robot: Robot, q: np.ndarray | None, oMtarget: pin.SE3, elapse
 # A solver under test: prepare(robot, budget) → solve(case, seed) → (q or None, iterations or -1)
 SolveFn = Callable[[Case, int], tuple[np.ndarray | None, int]]
 Prepare = Callable[[Robot, float], SolveFn]
+
+
+def smooth_path(robot: Robot, seed: int, samples: int = 2000, amplitude: float = 0.6) -> np.ndarray:
+    """A smooth joint-space path (samples × n): each joint a sinusoid of seeded phase and rate (0.5–1.5 periods)
+    over ± ``amplitude`` of its range about mid-range (continuous joints: of [−π, π]). The tracking
+    protocol's targets are its FK; its own largest joint step is the yardstick of a branch jump."""
+    rng = np.random.default_rng(seed)
+    lo, hi = np.maximum(robot.lower, -np.pi), np.minimum(robot.upper, np.pi)
+    phase, rate = rng.uniform(0, 2 * np.pi, robot.n), rng.uniform(0.5, 1.5, robot.n)
+    t = np.linspace(0, 2 * np.pi, samples)
+    return (lo + hi) / 2 + amplitude * (hi - lo) / 2 * np.sin(np.outer(t, rate) + phase)

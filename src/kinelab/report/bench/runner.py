@@ -22,6 +22,8 @@ from kinelab.report.bench.protocol import (
     BUDGET,
     DEFAULT_ROBOTS,
     REPEATS,
+    SCHEDULES,
+    STARTS,
     TOL_POS,
     TOL_ROT,
     Case,
@@ -84,10 +86,32 @@ class _Tally:
 
 
 def run_robot(robot: Robot, solvers: dict[str, Prepare], problems: list[Case], budget: float, seed: int,
-              missing: dict[str, str], repeats: int = REPEATS) -> list[Row]:
-    """Every solver on every problem of one robot, ``repeats`` times over, the solvers taking turns (the
-    order rotating each round); per problem the fastest run counts, with its verdict. A slow spell of a
-    shared machine then costs no solver its figures, and each runs its problems back to back, warm."""
+              missing: dict[str, str], repeats: int = REPEATS, schedule: str = "blocked") -> list[Row]:
+    """Every solver on every problem of one robot, ``repeats`` times over; per problem the fastest run
+    counts, with its verdict. ``blocked``: the solvers take turns over the whole set (the order rotating
+    each round), each running its problems back to back, warm. ``interleaved``: per problem every solver in
+    turn (the order rotating per problem and round), so each call finds the caches another library left.
+    Round r gives kinelab's solvers the seeds seed + index + r·n (fresh restarts, as the peers' are)."""
+    tallies = _prepared(robot, solvers, problems, budget, seed, missing)
+    count = len(problems)
+    for r in range(repeats):
+        round_seed = seed + r * count
+        if schedule == "interleaved":
+            for i, case in enumerate(problems):
+                k = (r + i) % max(1, len(tallies))
+                for tally in tallies[k:] + tallies[:k]:
+                    tally.attempt(i, case, budget, round_seed)
+            continue
+        k = r % max(1, len(tallies))
+        for tally in tallies[k:] + tallies[:k]:
+            for i, case in enumerate(problems):
+                tally.attempt(i, case, budget, round_seed)
+    return [t.row() for t in tallies]
+
+
+def _prepared(robot: Robot, solvers: dict[str, Prepare], problems: list[Case], budget: float, seed: int,
+              missing: dict[str, str]) -> list[_Tally]:
+    """A tally per solver that could load the robot, each warmed up (compilation, caches)."""
     tallies = []
     for name, prepare in solvers.items():
         try:
@@ -99,12 +123,7 @@ def run_robot(robot: Robot, solvers: dict[str, Prepare], problems: list[Case], b
             missing[f"{name} on {robot.name}"] = f"{type(exc).__name__}: {exc}"[:200]
             continue
         tallies.append(_Tally(robot, name, solve_fn, len(problems)))
-    for r in range(repeats):
-        k = r % max(1, len(tallies))
-        for tally in tallies[k:] + tallies[:k]:
-            for i, case in enumerate(problems):
-                tally.attempt(i, case, budget, seed)
-    return [t.row() for t in tallies]
+    return tallies
 
 
 def available_solvers() -> tuple[dict[str, Prepare], dict[str, str]]:
@@ -116,10 +135,14 @@ def available_solvers() -> tuple[dict[str, Prepare], dict[str, str]]:
 
 
 def run(robots: list[str] | None = None, n: int = 200, seed: int = 0, solvers: list[str] | None = None,
-        budget: float = BUDGET, progress: bool = False, repeats: int = REPEATS) -> dict[str, Any]:
+        budget: float = BUDGET, progress: bool = False, repeats: int = REPEATS, start: str = "random",
+        sigma: float = 0.2, schedule: str = "blocked") -> dict[str, Any]:
     """Run the protocol; returns a JSON-ready dict with the rows, the machine and the versions."""
     if n < 1 or repeats < 1 or not budget > 0:
         raise KinelabError(f"bench needs n ≥ 1, repeats ≥ 1 and a positive budget (got {n}, {repeats}, {budget} s)")
+    if start not in STARTS or schedule not in SCHEDULES or not 0 < sigma < 10:
+        raise KinelabError(f"bench takes start in {STARTS}, schedule in {SCHEDULES} and 0 < sigma < 10 rad "
+                           f"(got {start!r}, {schedule!r}, {sigma})")
     names = list(robots or DEFAULT_ROBOTS)
     loaded = [load(name) for name in names]
     table, missing = available_solvers()
@@ -131,14 +154,15 @@ def run(robots: list[str] | None = None, n: int = 200, seed: int = 0, solvers: l
         table = {k: table[k] for k in solvers}
     rows = []
     for robot in tqdm(loaded, desc="bench", disable=not progress, unit="robot"):
-        rows += run_robot(robot, table, cases(robot, n, seed), budget, seed, missing, repeats)
+        rows += run_robot(robot, table, cases(robot, n, seed, start, sigma), budget, seed, missing, repeats, schedule)
     return {
         "date": time.strftime("%Y-%m-%d %H:%M:%S"),
         "machine": {"platform": platform.platform(), "processor": platform.processor() or platform.machine(),
                     "python": platform.python_version()},
         "versions": _versions(),
         "protocol": {"n": n, "seed": seed, "repeats": repeats, "budget_s": budget, "tol_pos_m": TOL_POS,
-                     "tol_rot_rad": TOL_ROT},
+                     "tol_rot_rad": TOL_ROT, "start": start, "sigma": sigma if start == "warm" else None,
+                     "schedule": schedule},
         "rows": [asdict(r) for r in rows],
         "not_run": missing,
     }

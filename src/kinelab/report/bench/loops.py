@@ -1,0 +1,159 @@
+"""``kinelab bench --loops``: the loops users run. Throughput (a Python loop of ``solve`` against one
+``solve_batch`` call, and roboticstoolbox's ``ik_LM`` in a loop when installed) and tracking (smooth
+joint-space paths, each sample warm-started from the previous answer: ``track`` in its two modes against
+an ``ik_LM`` loop of one search per sample). Every answer is judged by Pinocchio here; the contenders run
+in interleaved blocks, ``repeats`` times, and the figures keep the best block and the spread.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+from tqdm import tqdm
+
+from kinelab.ik.batch import solve_batch
+from kinelab.ik.frdm.tracking import track
+from kinelab.ik.solve import solve
+from kinelab.report.bench import peers
+from kinelab.report.bench.protocol import DEFAULT_ROBOTS, TOL_POS, TOL_ROT, cases, smooth_path
+from kinelab.robot import Robot, load
+
+Runner = Callable[[], tuple[np.ndarray, float]]  # → (answers (N, n), seconds)
+
+
+def _judge(robot: Robot, Q: np.ndarray, targets: list[pin.SE3]) -> np.ndarray:
+    """Per answer: Pinocchio confirms both tolerances within the limits."""
+    ok = np.zeros(len(targets), dtype=bool)
+    for k, (q, target) in enumerate(zip(Q, targets, strict=True)):
+        if np.all(np.isfinite(q)):
+            dp, dr = robot.tool_error(q, target)
+            ok[k] = dp <= TOL_POS and dr <= TOL_ROT and robot.within_limits(q)
+    return ok
+
+
+def _blocks(runners: dict[str, Runner], repeats: int) -> dict[str, list[tuple[np.ndarray, float]]]:
+    """Each runner once per round, the order rotating between rounds."""
+    names = list(runners)
+    out: dict[str, list[tuple[np.ndarray, float]]] = {name: [] for name in names}
+    for r in range(repeats):
+        k = r % len(names)
+        for name in names[k:] + names[:k]:
+            out[name].append(runners[name]())
+    return out
+
+
+def throughput(robot: Robot, n: int = 2000, seed: int = 0, start: str = "warm", sigma: float = 0.02,
+               repeats: int = 3) -> list[dict[str, Any]]:
+    """Solves per second of a solve() loop, solve_batch and (if installed) an ik_LM loop on n problems."""
+    problems = cases(robot, n, seed, start, sigma)
+    targets = [c.oMtarget for c in problems]
+    starts = np.array([c.q_start for c in problems])
+    H = np.array([t.homogeneous for t in targets])
+
+    def loop() -> tuple[np.ndarray, float]:
+        t0 = time.perf_counter()
+        Q = np.array([solve(robot, t, q0=q, seed=seed + k, time_budget=0.005).q
+                      for k, (t, q) in enumerate(zip(targets, starts, strict=True))])
+        return Q, time.perf_counter() - t0
+
+    def batch() -> tuple[np.ndarray, float]:
+        t0 = time.perf_counter()
+        res = solve_batch(robot, H, q0=starts, seed=seed)
+        return res.q, time.perf_counter() - t0
+
+    runners: dict[str, Runner] = {"frdm solve() loop": loop, "frdm solve_batch": batch}
+    with contextlib.suppress(ImportError, ValueError):
+        ets = peers.rtb_ets(robot)
+
+        def lm_loop() -> tuple[np.ndarray, float]:
+            t0 = time.perf_counter()
+            Q = np.array([ets.ik_LM(h, q0=q, tol=5e-13, joint_limits=True).q
+                          for h, q in zip(H, starts, strict=True)])
+            return Q, time.perf_counter() - t0
+
+        runners["rtb ik_LM loop"] = lm_loop
+    for run in runners.values():  # warm-up: compilation, caches
+        run()
+    rows = []
+    for name, results in _blocks(runners, repeats).items():
+        rates = np.array([n / seconds for _, seconds in results])
+        rows.append({"robot": robot.name, "loop": name, "start": start, "sigma": sigma if start == "warm" else None,
+                     "solves_per_s": float(rates.max()), "spread": float(rates.max() / rates.min()),
+                     "success_pct": 100.0 * float(_judge(robot, results[int(rates.argmax())][0], targets).mean())})
+    return rows
+
+
+def tracking(robot: Robot, seed: int = 0, samples: int = 2000, repeats: int = 3) -> list[dict[str, Any]]:
+    """A smooth path (:func:`~kinelab.report.bench.protocol.smooth_path`) followed by track() (FRDM; FRDM +
+    LM polish) and, if installed, a loop of one ik_LM search per sample from the previous answer."""
+    Q_path = smooth_path(robot, seed, samples)
+    targets = [robot.fk(q) for q in Q_path]
+    path_step = float(np.abs(np.diff(Q_path, axis=0)).max())
+
+    def tracker(**options: Any) -> Runner:
+        def run() -> tuple[np.ndarray, float]:
+            t0 = time.perf_counter()
+            res = track(robot, targets, Q_path[0], **options)
+            return res.q, time.perf_counter() - t0
+        return run
+
+    runners: dict[str, Runner] = {"frdm track": tracker(), "frdm+lm track": tracker(polish=True)}
+    with contextlib.suppress(ImportError, ValueError):
+        ets = peers.rtb_ets(robot)
+
+        def lm_loop() -> tuple[np.ndarray, float]:
+            q, rows = Q_path[0].copy(), []
+            t0 = time.perf_counter()
+            for t in targets:
+                sol = ets.ik_LM(t.homogeneous, q0=q, slimit=1, tol=5e-13, joint_limits=True)
+                q = np.asarray(sol.q, dtype=float) if sol.success else q
+                rows.append(q)
+            return np.array(rows), time.perf_counter() - t0
+
+        runners["rtb ik_LM loop (one search)"] = lm_loop
+    for run in runners.values():
+        run()
+    rows = []
+    for name, results in _blocks(runners, repeats).items():
+        seconds = np.array([s for _, s in results])
+        Q = results[int(seconds.argmin())][0]
+        steps = np.abs(np.diff(np.vstack([Q_path[0], Q]), axis=0)).max()
+        rows.append({"robot": robot.name, "tracker": name, "samples": samples,
+                     "reached": int(_judge(robot, Q, targets).sum()),
+                     "max_step_over_path_step": float(steps / path_step),
+                     "us_per_sample": float(seconds.min() / samples * 1e6),
+                     "spread": float(seconds.max() / seconds.min())})
+    return rows
+
+
+def run(robots: list[str] | None, seed: int = 0, repeats: int = 3, n: int = 2000, samples: int = 2000,
+        progress: bool = False) -> dict[str, list[dict[str, Any]]]:
+    """Both protocols on each robot (default: the bench's ten arms): throughput warm (σ = 0.02) and random,
+    and tracking one smooth path."""
+    out: dict[str, list[dict[str, Any]]] = {"throughput": [], "tracking": []}
+    for name in tqdm(list(robots or DEFAULT_ROBOTS), desc="loops", disable=not progress, unit="robot"):
+        robot = load(name)
+        out["throughput"] += throughput(robot, n, seed, "warm", 0.02, repeats)
+        out["throughput"] += throughput(robot, n, seed, "random", 0.2, repeats)
+        out["tracking"] += tracking(robot, seed, samples, repeats)
+    return out
+
+
+def markdown(throughput_rows: list[dict[str, Any]], tracking_rows: list[dict[str, Any]]) -> str:
+    """Two tables: throughput and tracking."""
+    lines = ["| robot | loop | start | solves/s (best) | spread | success % |", "|---|---|---|---:|---:|---:|"]
+    for r in throughput_rows:
+        start = r["start"] + (f" σ={r['sigma']}" if r["sigma"] else "")
+        lines.append(f"| {r['robot']} | {r['loop']} | {start} | {r['solves_per_s']:,.0f} | {r['spread']:.2f} | "
+                     f"{r['success_pct']:.1f} |")
+    lines += ["", "| robot | tracker | reached | max step / path step | µs per sample (best) | spread |",
+              "|---|---|---:|---:|---:|---:|"]
+    for r in tracking_rows:
+        lines.append(f"| {r['robot']} | {r['tracker']} | {r['reached']}/{r['samples']} | "
+                     f"{r['max_step_over_path_step']:.1f} | {r['us_per_sample']:.1f} | {r['spread']:.2f} |")
+    return "\n".join(lines)
