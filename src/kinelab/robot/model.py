@@ -352,7 +352,7 @@ class Robot:
         """:meth:`within_limits` per row of a (B, n) array (default slack): a (B,) bool array."""
         Q = np.asarray(Q, dtype=float)
         inside: np.ndarray = (self._lower_check - LIMIT_SLACK <= Q) & (self._upper_check + LIMIT_SLACK >= Q)
-        return inside.all(axis=1)
+        return np.asarray(inside.all(axis=1))
 
     def to_pin_q(self, q) -> np.ndarray:
         """One number per joint → Pinocchio's q (continuous joints become cos, sin); a new array."""
