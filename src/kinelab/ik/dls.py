@@ -49,6 +49,12 @@ class DLSOptions:
 
 
 Options = DLSOptions
+# the damping grows with the squared error (Levenberg–Marquardt after Sugihara): far from the target the
+# steps shorten instead of overshooting into the limits, near it they are Gauss–Newton's
+ERROR_DAMPING = 1e-3
+# an attempt whose squared error fell by less than STALL_FALL over STALL_ITERATIONS iterations is stalled:
+# a restart then costs less than the iterations it has left
+STALL_ITERATIONS, STALL_FALL = 5, 0.05
 
 
 def attempt(
@@ -61,7 +67,8 @@ def attempt(
     options: DLSOptions | None = None,
     **kwargs: Any,
 ) -> Attempt:
-    """Damped Gauss–Newton on the tool's log6 error in the tool frame, from ``q0``.
+    """Damped Gauss–Newton on the tool's log6 error in the tool frame, from ``q0``; the damping is
+    ``damping`` plus 1e-3 of the squared error, and an attempt whose error stops falling ends as stalled.
 
     Args:
         robot: the robot; oMtarget: the wanted tool pose in the base frame; q0: the start [rad or m].
@@ -78,6 +85,7 @@ def attempt(
     limits = PinLimits(robot)
     q = robot.to_pin_q(q0)
     eye = np.eye(6)
+    errors: list[float] = []
     for it in range(max_iterations):
         pin.computeJointJacobians(model, data, q)  # FK and every joint Jacobian in one pass
         oMtool = pin.updateFramePlacement(model, data, fid)
@@ -88,8 +96,12 @@ def attempt(
             return Attempt(robot.from_pin_q(q), Status.CONVERGED, it)
         if time.perf_counter() > deadline:
             return Attempt(robot.from_pin_q(q), Status.TIME_BUDGET, it)
+        size = float(err @ err)
+        errors.append(size)
+        if len(errors) > STALL_ITERATIONS and size > (1.0 - STALL_FALL) * errors[-1 - STALL_ITERATIONS]:
+            return Attempt(robot.from_pin_q(q), Status.STALLED, it)  # held at a limit or a local minimum
         J = pin.getFrameJacobian(model, data, fid, pin.LOCAL)
         J = pin.Jlog6(tMd.inverse()) @ J
-        v = J.T @ np.linalg.solve(J @ J.T + damping * eye, err)
+        v = J.T @ np.linalg.solve(J @ J.T + (damping + ERROR_DAMPING * size) * eye, err)
         q = limits.project(pin.integrate(model, q, step * v))
     return Attempt(robot.from_pin_q(q), Status.MAX_ITERATIONS, max_iterations)

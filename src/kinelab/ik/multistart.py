@@ -9,7 +9,7 @@ from typing import Any
 import numba
 import numpy as np
 
-from kinelab.ik.chain import random_configuration
+from kinelab.ik.chain import PRISMATIC, ChainModel, random_configuration
 
 
 def seed_state(seed: int | None) -> np.ndarray:
@@ -43,6 +43,25 @@ def first_start(q0: np.ndarray | None, kind: np.ndarray, lower: np.ndarray, uppe
     q = np.empty(kind.shape[0])
     random_configuration(q, kind, lower, upper, rng_state)
     return q
+
+
+def restart_windows(cm: ChainModel, q_start: np.ndarray, pstar: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Where restarts are drawn: the joint limits, except for a prismatic joint whose range exceeds twice the
+    chain's length L (a mobile base's ±10 m platform). There, within L of the value that carries the tool
+    from where it is at the start to the target point along the joint's axis, clipped to the limits: a
+    restart anywhere in the platform's box leaves the arm metres from a target it could reach.
+
+    Args:
+        cm: the chain; q_start: the first start [rad or m]; pstar: the target point [m], base frame.
+    """
+    lower, upper, L = cm.lower, cm.upper, cm.length
+    wide = (cm.kind == PRISMATIC) & (upper - lower > 2.0 * L)
+    if not wide.any():
+        return lower, upper
+    v = cm.vectors(q_start)
+    centre = q_start + v["e"] @ (np.asarray(pstar, dtype=float) - v["N"])
+    return (np.where(wide, np.clip(centre - L, lower, upper), lower),
+            np.where(wide, np.clip(centre + L, lower, upper), upper))
 
 
 def run_in_chunks(chunk: Callable[[int], int], attempts: int, stats: np.ndarray, deadline: float,

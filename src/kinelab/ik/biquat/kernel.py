@@ -72,8 +72,9 @@ def integrate(q, ch, pb, max_steps):
 
 
 @njit(cache=True)
-def multistart(q, ch, lower, upper, pb, rng_state, max_attempts, step_budget, stats):
-    """Attempts from q, then from seeded uniform starts, until one converges inside the joint limits.
+def multistart(q, ch, lower, upper, pb, rng_state, max_attempts, step_budget, stats, restart_lower, restart_upper):
+    """Attempts from q, then from seeded uniform starts in the restart windows (``restart_lower``,
+    ``restart_upper``), until one converges inside the joint limits (``lower``, ``upper``).
 
     Called in chunks: an attempt that ``step_budget`` (a total) cuts is resumed by the next call from the
     same q with the steps it has left, so the answer does not depend on where the chunks end. stats has the
@@ -83,7 +84,7 @@ def multistart(q, ch, lower, upper, pb, rng_state, max_attempts, step_budget, st
     for _ in range(max_attempts):
         if stats[T_CUT] == 0.0:
             if stats[T_ATTEMPTS] > 0.0:
-                random_configuration(q, ch.kind, lower, upper, rng_state)
+                random_configuration(q, ch.kind, restart_lower, restart_upper, rng_state)
             stats[T_ATTEMPT_STEPS] = 0.0
             stats[T_ATTEMPT_TIME] = 0.0
         stats[T_CUT] = 0.0

@@ -145,9 +145,11 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: 
     stats = np.zeros(kernel.STATS_SIZE)
     chunk_steps = clock_chunk(JOINT_STEPS_PER_LOOK, cm.n)
 
+    restart_lower, restart_upper = restarts.restart_windows(cm, q, oMtarget.translation)
+
     def chunk(attempts_left: int) -> int:
         return _MULTISTART(q, cm.chain, cm.lower, cm.upper, prob, rng_state, attempts_left,
-                           float(stats[kernel.T_STEPS] + chunk_steps), stats)
+                           float(stats[kernel.T_STEPS] + chunk_steps), stats, restart_lower, restart_upper)
 
     code = restarts.run_in_chunks(chunk, max_restarts + 1, stats, deadline, kernel.CONVERGED)
     if code == kernel.CONVERGED:
