@@ -2,12 +2,14 @@ import json
 import os
 import subprocess
 import sys
+import time
 
 import numpy as np
 import pytest
 
 import kinelab
 from kinelab import cli
+from kinelab.cli.main import compiling_notice
 from kinelab.studies import paper001_stanford as seed001
 
 
@@ -215,3 +217,13 @@ def test_a_failed_report_leaves_the_previous_one_whole(tmp_path, monkeypatch):
         render.write_validate_report(validate.Report(robots=[], n=1, seed=0), out)
     assert (out / "report.json").read_text() == "previous"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]  # no temporary folder left behind
+
+
+def test_a_slow_compilation_is_announced_on_stderr_and_a_quick_one_is_not(capsys):
+    with compiling_notice(after=0.01):
+        time.sleep(0.2)
+    assert "compiling its solver kernels" in capsys.readouterr().err
+    with compiling_notice(after=5.0):
+        pass
+    time.sleep(0.05)
+    assert capsys.readouterr().err == ""

@@ -8,10 +8,13 @@ continuous joints only (prismatic joints stay in metres).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import os
 import sys
+import threading
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -152,8 +155,24 @@ def _bypass_options(robot, args) -> dict:
     return out
 
 
+@contextlib.contextmanager
+def compiling_notice(after: float = 1.0) -> Iterator[None]:
+    """Say on stderr that the kernels are being compiled when the block takes longer than ``after`` [s]:
+    the first run on a machine compiles them (numba) and keeps them for the next runs."""
+    timer = threading.Timer(after, lambda: print(
+        "kinelab: compiling its solver kernels for this machine (once; later runs load them) ...",
+        file=sys.stderr, flush=True))
+    timer.daemon = True
+    timer.start()
+    try:
+        yield
+    finally:
+        timer.cancel()
+
+
 def cmd_ik(args) -> int:
     from kinelab.ik import solve, target_from_xyz_rpy
+    from kinelab.ik.solve import solver_module
 
     robot = load(args.robot, tool=args.tool)
     if (args.target_q is None) == (args.target_xyz is None):
@@ -177,6 +196,10 @@ def cmd_ik(args) -> int:
     if args.solver == "biquat":
         options.update({k: v for k, v in (("law", args.law), ("integrator", args.integrator), ("step", args.step),
                                           ("k", args.gain)) if v is not None})
+    prepare = getattr(solver_module(args.solver), "prepare", None)
+    if prepare is not None:
+        with compiling_notice():
+            prepare(robot)
     result = solve(robot, target, solver=args.solver, q0=q0, seed=args.seed, tol_pos=args.tol_pos,
                    tol_rot=args.tol_rot, time_budget=args.time_budget, **options)
     out = {"robot": robot.name, "target": pose_dict(target), **result.to_dict()}
