@@ -323,7 +323,8 @@ def cmd_bench(args) -> int:
         if "tracking" in result:
             print(paper000_era.tracking_markdown(result["tracking"]))
         if "loops" in result:
-            print(loops.markdown(result["loops"]["throughput"], result["loops"]["tracking"]))
+            print(loops.markdown(result["loops"]["throughput"], result["loops"]["tracking"],
+                                 result["loops"]["budgets"]))
         if args.out:
             print(f"results written to {args.out}")
     return 0

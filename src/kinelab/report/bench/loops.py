@@ -131,21 +131,44 @@ def tracking(robot: Robot, seed: int = 0, samples: int = 2000, repeats: int = 3)
     return rows
 
 
+def budgets(robot: Robot, budget: float = 0.005, n: int = 200, seed: int = 0,
+            solvers: tuple[str, ...] = ("frdm", "biquat", "dls")) -> list[dict[str, Any]]:
+    """How well each solver keeps ``time_budget`` [s]: n solves that cannot succeed (tolerances of 1e-300)
+    from random starts, solvers interleaved per problem; the wall time of each call, outside the solver."""
+    problems = cases(robot, n, seed)
+    times: dict[str, list[float]] = {name: [] for name in solvers}
+    for name in solvers:  # warm-up: compilation
+        solve(robot, problems[0].oMtarget, solver=name, q0=problems[0].q_start, seed=seed, time_budget=budget)
+    for k, case in enumerate(problems):
+        for name in solvers[k % len(solvers):] + solvers[:k % len(solvers)]:
+            t0 = time.perf_counter()
+            solve(robot, case.oMtarget, solver=name, q0=case.q_start, seed=seed + k, tol_pos=1e-300, tol_rot=1e-300,
+                  time_budget=budget)
+            times[name].append(time.perf_counter() - t0)
+    allowed = budget * 1.05 + 1e-4
+    return [{"robot": robot.name, "solver": name, "budget_ms": budget * 1e3,
+             "p50_ms": float(np.percentile(t, 50) * 1e3), "p99_ms": float(np.percentile(t, 99) * 1e3),
+             "max_ms": float(np.max(t) * 1e3), "kept": bool(np.percentile(t, 99) <= allowed)}
+            for name, t in times.items()]
+
+
 def run(robots: list[str] | None, seed: int = 0, repeats: int = 3, n: int = 2000, samples: int = 2000,
         progress: bool = False) -> dict[str, list[dict[str, Any]]]:
     """Both protocols on each robot (default: the bench's ten arms): throughput warm (σ = 0.02) and random,
     and tracking one smooth path."""
-    out: dict[str, list[dict[str, Any]]] = {"throughput": [], "tracking": []}
+    out: dict[str, list[dict[str, Any]]] = {"throughput": [], "tracking": [], "budgets": []}
     for name in tqdm(list(robots or DEFAULT_ROBOTS), desc="loops", disable=not progress, unit="robot"):
         robot = load(name)
         out["throughput"] += throughput(robot, n, seed, "warm", 0.02, repeats)
         out["throughput"] += throughput(robot, n, seed, "random", 0.2, repeats)
         out["tracking"] += tracking(robot, seed, samples, repeats)
+        out["budgets"] += budgets(robot, seed=seed)
     return out
 
 
-def markdown(throughput_rows: list[dict[str, Any]], tracking_rows: list[dict[str, Any]]) -> str:
-    """Two tables: throughput and tracking."""
+def markdown(throughput_rows: list[dict[str, Any]], tracking_rows: list[dict[str, Any]],
+             budget_rows: list[dict[str, Any]] | None = None) -> str:
+    """The tables: throughput, tracking and (if given) budgets."""
     lines = ["| robot | loop | start | solves/s (best) | spread | success % |", "|---|---|---|---:|---:|---:|"]
     for r in throughput_rows:
         start = r["start"] + (f" σ={r['sigma']}" if r["sigma"] else "")
@@ -156,4 +179,10 @@ def markdown(throughput_rows: list[dict[str, Any]], tracking_rows: list[dict[str
     for r in tracking_rows:
         lines.append(f"| {r['robot']} | {r['tracker']} | {r['reached']}/{r['samples']} | "
                      f"{r['max_step_over_path_step']:.1f} | {r['us_per_sample']:.1f} | {r['spread']:.2f} |")
+    if budget_rows:
+        lines += ["", "| robot | solver | budget | p50 | p99 | max | p99 ≤ budget + 5 % + 0.1 ms |",
+                  "|---|---|---:|---:|---:|---:|---|"]
+        for r in budget_rows:
+            lines.append(f"| {r['robot']} | {r['solver']} | {r['budget_ms']:.1f} ms | {r['p50_ms']:.2f} ms | "
+                         f"{r['p99_ms']:.2f} ms | {r['max_ms']:.2f} ms | {'yes' if r['kept'] else 'NO'} |")
     return "\n".join(lines)
