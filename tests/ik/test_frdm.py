@@ -354,7 +354,7 @@ def test_mixed_order_restarts_turn_the_sweep_direction(robots):
             q, best, stats = q0.copy(), q0.copy(), np.zeros(5)
             problem = kernel.Problem(vm.lower, vm.upper, np.ones(vm.n, dtype=np.bool_), target.translation,
                                      target.rotation, 3.0 / vm.length**2, np.ones(3), 1e-6, 1e-6, True, True,
-                                     np.zeros(vm.n), 0.0)
+                                     np.zeros(vm.n), 0.0, -1)
             settings = kernel.Settings(1.0, 1e-10, 10, 0.1, 5)
             code = kernel.multistart(q, vm.chain, problem, settings, ORDERS[name], 100, seed_state(7), 2, 1e9, best,
                                      stats)

@@ -12,6 +12,7 @@ import contextlib
 import json
 import math
 import os
+import re
 import sys
 import threading
 from collections.abc import Iterator
@@ -201,17 +202,19 @@ def cmd_ik(args) -> int:
         with compiling_notice():
             prepare(robot)
     result = solve(robot, target, solver=args.solver, q0=q0, seed=args.seed, tol_pos=args.tol_pos,
-                   tol_rot=args.tol_rot, time_budget=args.time_budget, **options)
+                   tol_rot=args.tol_rot, time_budget=args.time_budget, task=args.task, axis=args.axis, **options)
     out = {"robot": robot.name, "target": pose_dict(target), **result.to_dict()}
     if args.json:
         _print_json(out)
     else:
         q_show = np.where([k != "prismatic" for k in robot.joint_kinds], np.rad2deg(result.q), result.q) \
             if args.deg else result.q
-        print(f"{robot.name} {args.solver}: {result.status.value} (success: {result.success})")
+        print(f"{robot.name} {args.solver}, task {result.task}: {result.status.value} (success: {result.success})")
         print(f"  q{' [deg, m]' if args.deg else ' [rad, m]'}  {np.array2string(q_show, precision=6)}")
-        print(f"  position error {result.position_error:.3e} m, rotation error {result.rotation_error:.3e} rad "
-              "(Pinocchio FK)")
+        free = {"position": (False, True), "orientation": (True, False)}.get(args.task, (False, False))
+        print(f"  position error {result.position_error:.3e} m{' (free)' if free[0] else ''}, "
+              f"{'axis' if args.task == 'axis' else 'rotation'} error {result.rotation_error:.3e} rad"
+              f"{' (free)' if free[1] else ''} (Pinocchio FK)")
         print(f"  {result.iterations} iterations, {result.restarts} restarts, {result.wall_time * 1e3:.2f} ms, "
               f"mode {result.mode}")
         if "model_time" in result.info:
@@ -219,7 +222,9 @@ def cmd_ik(args) -> int:
             print(f"  model time {result.info['model_time']:.4g} s, final M0 = "
                   + (f"{m0:+.6f}" if m0 is not None else "n/a (give --target-q for the sign of N)"))
         if result.message:
-            print(f"  {result.message}")
+            print("  " + re.sub(r"task='(\w+)'", r"--task \1", result.message))
+        if not result.success and args.task != "position" and args.target_xyz is not None and args.target_rpy is None:
+            print("  (no --target-rpy: the target rotation is the identity; --task position ignores it)")
     return 0 if result.success else 1
 
 
@@ -442,7 +447,12 @@ def _add_ik(sub: Any) -> None:
     s.add_argument("--solver", default="frdm", help="frdm, biquat or dls (the Pinocchio reference)")
     s.add_argument("--target-q", nargs="+", type=float, help="target as a configuration (its FK pose)")
     s.add_argument("--target-xyz", nargs=3, type=float, help="target position [m] in the base frame")
-    s.add_argument("--target-rpy", nargs=3, type=float, help="target roll, pitch, yaw (rad; deg with --deg)")
+    s.add_argument("--target-rpy", nargs=3, type=float,
+                   help="target roll, pitch, yaw (rad; deg with --deg); without it the target rotation is the identity")
+    s.add_argument("--task", choices=("pose", "position", "axis", "orientation"), default="pose",
+                   help="the components to meet: pose (all), position, axis (point and one tool axis, roll free), "
+                        "orientation")
+    s.add_argument("--axis", choices=("x", "y", "z"), default="z", help="the tool axis of --task axis")
     s.add_argument("--start-q", nargs="+", type=float, help="first start (default: seeded random)")
     s.add_argument("--deg", action="store_true", help="angles in degrees (revolute/continuous joints, rpy)")
     s.add_argument("--seed", type=int, default=0)

@@ -17,13 +17,14 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.errors import ConfigurationError
-from kinelab.geometry import pose_errors, stack_homogeneous
+from kinelab.geometry import stack_homogeneous
 from kinelab.ik.frdm import batch as frdm_batch
 from kinelab.ik.frdm.batch import Rows
 from kinelab.ik.multistart import seed_states
 from kinelab.ik.result import Status
-from kinelab.ik.solve import check_arguments, solve, solver_module
+from kinelab.ik.solve import check_arguments, for_task, solve, solver_module
 from kinelab.ik.targets import as_target_arrays
+from kinelab.ik.tasks import POSE, Task
 from kinelab.ik.workspace import reach_bound
 from kinelab.robot import Robot
 
@@ -68,7 +69,8 @@ class BatchIKResult:
 
 def solve_batch(robot: Robot, targets: Any, q0: Any = None, seed: int | None = None, solver: str = "frdm",
                 tol_pos: float = 1e-6, tol_rot: float = 1e-6, max_restarts: int = 1000,
-                time_budget: float | None = None, options: Any = None, **solver_options: Any) -> BatchIKResult:
+                time_budget: float | None = None, options: Any = None, task: str = "pose", axis: str = "z",
+                **solver_options: Any) -> BatchIKResult:
     """Solve IK for every target of a batch (each a tool pose in the robot's base frame).
 
     Args:
@@ -84,6 +86,7 @@ def solve_batch(robot: Robot, targets: Any, q0: Any = None, seed: int | None = N
         time_budget: wall-clock budget [s] of the whole batch (None: none); rows not started when it runs
             out are left unsolved with status ``time_budget`` and NaN in q.
         options: the solver's options object, as for :func:`kinelab.solve`.
+        task: the components to meet, as for :func:`kinelab.solve`; axis: the tool axis of task "axis".
         solver_options: or its fields as keyword arguments.
 
     Returns:
@@ -96,6 +99,9 @@ def solve_batch(robot: Robot, targets: Any, q0: Any = None, seed: int | None = N
     """
     module = solver_module(solver)
     opts = module.Options.of(options, **solver_options)
+    tk = Task.of(task, axis)
+    if tk is not POSE:
+        opts = for_task(solver, opts, tk)
     check_arguments(tol_pos, tol_rot, 1.0 if time_budget is None else time_budget, max_restarts, seed, "refuse")
     points, rotations = as_target_arrays(targets)
     starts = _starts(robot, q0, points.shape[0])
@@ -112,9 +118,9 @@ def solve_batch(robot: Robot, targets: Any, q0: Any = None, seed: int | None = N
     else:
         t0 = time.perf_counter()
         rows = _per_target(robot, points, rotations, starts, seed, solver, tol_pos, tol_rot, max_restarts,
-                           time_budget, opts)
+                           time_budget, opts, tk)
         mode = f"{solver} (per target)"
-    return _judged(robot, rows, points, rotations, tol_pos, tol_rot, seed, t0, solver, mode)
+    return _judged(robot, rows, points, rotations, tol_pos, tol_rot, seed, t0, solver, mode, tk)
 
 
 def _starts(robot: Robot, q0: Any, count: int) -> np.ndarray | None:
@@ -142,7 +148,7 @@ def _beyond(robot: Robot, points: np.ndarray) -> np.ndarray:
 
 def _per_target(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts: np.ndarray | None, seed: int,
                 solver: str, tol_pos: float, tol_rot: float, max_restarts: int, time_budget: float | None,
-                opts: Any) -> Rows:
+                opts: Any, task: Task) -> Rows:
     """solve() row by row (solvers without a compiled batch); rows after the budget are left unsolved."""
     count, n = points.shape[0], robot.n
     rows = Rows.unsolved(count, n)
@@ -152,23 +158,24 @@ def _per_target(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts:
         if left <= 0:
             break
         res = solve(robot, pin.SE3(rotations[b], points[b]), solver, None if starts is None else starts[b],
-                    seed + b, tol_pos, tol_rot, min(left, 1e9), max_restarts, "refuse", opts)
+                    seed + b, tol_pos, tol_rot, min(left, 1e9), max_restarts, "refuse", opts, task.name,
+                    "xyz"[task.axis] if task.axis >= 0 else "z")
         rows.Q[b], rows.iterations[b], rows.restarts[b] = res.q, res.iterations, res.restarts
         rows.status[b] = res.status.value
     return rows
 
 
 def _judged(robot: Robot, rows: Rows, points: np.ndarray, rotations: np.ndarray, tol_pos: float, tol_rot: float,
-            seed: int, t0: float, solver: str, mode: str) -> BatchIKResult:
+            seed: int, t0: float, solver: str, mode: str, task: Task) -> BatchIKResult:
     """Pinocchio's verdict on every solved row; statuses as :func:`kinelab.solve` gives them."""
     count = points.shape[0]
     dp, dr, success = np.full(count, np.nan), np.full(count, np.nan), np.zeros(count, dtype=bool)
     solved = np.flatnonzero(rows.status != Status.TIME_BUDGET.value)
     if solved.size:
         H_target = stack_homogeneous(points[solved], rotations[solved])
-        dp[solved], dr[solved] = pose_errors(H_target, robot.fk_batch(rows.Q[solved]))
+        dp[solved], dr[solved] = task.errors_batch(H_target, robot.fk_batch(rows.Q[solved]))
         within = robot.within_limits_batch(rows.Q[solved])
-        success[solved] = (dp[solved] <= tol_pos) & (dr[solved] <= tol_rot) & within
+        success[solved] = task.met_batch(dp[solved], dr[solved], tol_pos, tol_rot) & within
     status = rows.status
     status[success] = Status.CONVERGED.value
     failed = ~success & (status != Status.TIME_BUDGET.value)

@@ -101,9 +101,11 @@ class IKResult:
     bypasses: list[BypassRecord] = field(default_factory=list)
     message: str = ""
     info: dict = field(default_factory=dict)
+    task: str = "pose"  # the components judged: pose, position, axis (with its axis) or orientation
 
     def to_dict(self) -> dict:
         return {
+            "task": self.task,
             "q": np.asarray(self.q).tolist(),
             "success": self.success,
             "status": self.status.value,

@@ -23,6 +23,7 @@ from kinelab.errors import OptionError, SolverNotFoundError
 from kinelab.ik.limits import wrap_q
 from kinelab.ik.result import Attempt, BypassRecord, IKResult, SingularEvent, Status
 from kinelab.ik.targets import as_target
+from kinelab.ik.tasks import COMPONENTS, POSE, Task
 from kinelab.ik.workspace import out_of_reach
 from kinelab.robot import Robot
 
@@ -97,6 +98,8 @@ def solve(
     max_restarts: int = 1000,
     start_outside_limits: str = "project",
     options: Any = None,
+    task: str = "pose",
+    axis: str = "z",
     **solver_options: Any,
 ) -> IKResult:
     """Solve IK for the tool pose ``target`` (``pin.SE3`` in the robot's base frame).
@@ -114,16 +117,23 @@ def solve(
         max_restarts: random restarts after the first attempt.
         start_outside_limits: "project" (default: move q0 into the limits, with a warning) or "refuse".
         options: the solver's options object (``FRDMOptions``, ``BiquatOptions``, ``DLSOptions``).
+        task: which components of the target to meet: "pose" (all), "position" (the tool point), "axis"
+            (the tool point and the tool axis ``axis``, the roll about it free) or "orientation"
+            (:mod:`kinelab.ik.tasks`); FRDM and DLS take every task, the biquaternion solver "pose".
+        axis: the tool axis of task "axis": "x", "y" or "z".
         solver_options: or its fields as keyword arguments.
 
     Returns:
-        The result, checked by Pinocchio.
+        The result, checked by Pinocchio on the components the task constrains (``result.task``).
 
     Raises:
         SolverNotFoundError, OptionError, TargetError, ConfigurationError: bad input, named.
     """
     module = solver_module(solver)
     opts = module.Options.of(options, **solver_options)
+    tk = Task.of(task, axis)
+    if tk is not POSE:
+        opts = for_task(solver, opts, tk)
     prepare = getattr(module, "prepare", None)
     if prepare is not None:
         prepare(robot)  # compilation and model building are not the solve's time
@@ -131,7 +141,7 @@ def solve(
     target = as_target(target)
     check_arguments(tol_pos, tol_rot, time_budget, max_restarts, seed, start_outside_limits)
     rng = _LazyRng(seed)
-    problem = _Problem(robot, target, solver, tol_pos, tol_rot, t_start, t_start + time_budget, seed)
+    problem = _Problem(robot, target, solver, tol_pos, tol_rot, t_start, t_start + time_budget, seed, tk)
     beyond = out_of_reach(robot, target.translation)
     if beyond > 0:
         max_restarts = 0  # proved out of reach: one attempt gives the best pose, restarts cannot help
@@ -139,6 +149,18 @@ def solve(
         start = None if q0 is None else _start(robot, q0, rng, start_outside_limits)  # None: the kernel draws it
         return _fast(module, problem, start, max_restarts, opts)
     return _loop(module, problem, _start(robot, q0, rng, start_outside_limits), max_restarts, opts, rng, beyond)
+
+
+def for_task(solver: str, opts: Any, task: Task) -> Any:
+    """The solver's options for a task other than "pose" (its ``for_task``).
+
+    Raises:
+        OptionError: the solver meets whole poses only.
+    """
+    if not hasattr(opts, "for_task"):
+        raise OptionError("task", task.name, f"'pose' for solver {solver!r}, which drives the whole pose; "
+                          "solvers 'frdm' and 'dls' take 'position', 'axis' and 'orientation' too")
+    return opts.for_task(task)
 
 
 def check_arguments(tol_pos: float, tol_rot: float, time_budget: float, max_restarts: int, seed: int | None,
@@ -172,12 +194,17 @@ class _Problem:
     t_start: float
     deadline: float
     seed: int | None
+    task: Task = POSE
     finals: list[tuple[Status, float]] = field(default_factory=list)
 
     def judge(self, q: np.ndarray) -> tuple[bool, float, float]:
-        """Pinocchio's verdict on q: (success, position error [m], rotation error [rad])."""
-        dp, dr = self.robot.tool_error_of_float_q(q, self.target)
-        return dp <= self.tol_pos and dr <= self.tol_rot and self.robot.within_limits(q), dp, dr
+        """Pinocchio's verdict on q: (success, position error [m], rotation error [rad]) on the task's
+        components (the rotation error of task "axis" is the angle between the tool axes)."""
+        if self.task is POSE:
+            dp, dr = self.robot.tool_error_of_float_q(q, self.target)
+            return dp <= self.tol_pos and dr <= self.tol_rot and self.robot.within_limits(q), dp, dr
+        dp, dr = self.task.errors(self.target, self.robot.tool_pose_of_float_q(q))
+        return self.task.met(dp, dr, self.tol_pos, self.tol_rot) and self.robot.within_limits(q), dp, dr
 
 
 def _loop(module: Any, pb: _Problem, start: np.ndarray, max_restarts: int, opts: Any, rng: _LazyRng,
@@ -210,8 +237,8 @@ def _loop(module: Any, pb: _Problem, start: np.ndarray, max_restarts: int, opts:
     return IKResult(
         q=att.q, success=best_ok, status=status, position_error=dp, rotation_error=dr,
         iterations=iterations, restarts=restarts, wall_time=time.perf_counter() - pb.t_start, solver=pb.solver,
-        mode=att.info.get("mode", pb.solver), singular_events=events, bypasses=bypasses, message=message,
-        info=att.info,
+        mode=att.info.get("mode", pb.solver), singular_events=events, bypasses=bypasses,
+        message=_explained(pb, best_ok, message), info=att.info, task=_task_label(pb.task),
     )
 
 
@@ -228,8 +255,25 @@ def _fast(module: Any, pb: _Problem, start: np.ndarray | None, max_restarts: int
     return IKResult(
         q=att.q, success=success, status=status, position_error=dp, rotation_error=dr, iterations=att.iterations,
         restarts=restarts, wall_time=time.perf_counter() - pb.t_start, solver=pb.solver, mode=att.info["mode"],
-        singular_events=att.events, message=message, info=att.info,
+        singular_events=att.events, message=_explained(pb, success, message), info=att.info,
+        task=_task_label(pb.task),
     )
+
+
+def _task_label(task: Task) -> str:
+    return task.name if task.axis < 0 else f"axis {'xyz'[task.axis]}"
+
+
+def _explained(pb: _Problem, success: bool, message: str) -> str:
+    """The message, with the reason a short arm misses a whole pose and the tasks that fit it."""
+    n = pb.robot.n
+    if success or n >= COMPONENTS[pb.task.name]:
+        return message
+    fits = [t for t in ("axis", "position") if COMPONENTS[t] <= n] or ["position"]
+    note = (f"{pb.robot.name} has {n} joints and can meet at most {n} of the {COMPONENTS[pb.task.name]} "
+            f"components of task {pb.task.name!r}; try task={fits[0]!r}"
+            + (f" or task={fits[1]!r}" if len(fits) > 1 else ""))
+    return f"{message}; {note}" if message else note
 
 
 def _status(success: bool, att: Attempt, finals: list[tuple[Status, float]], beyond: float, tol_pos: float,

@@ -460,6 +460,11 @@ class Robot:
         """(position error [m], rotation angle error [rad]) of the tool at q against oMtarget (Pinocchio FK)."""
         return self.tool_error_of_float_q(self.check_q(q), oMtarget)
 
+    def tool_pose_of_float_q(self, q: np.ndarray) -> pin.SE3:
+        """oMtool (Pinocchio FK) for a q known to be n finite floats (a solver's answer): no check repeated."""
+        pin.forwardKinematics(self.model, self.data, q if self._identity_q else self._pin_q(q))
+        return pin.updateFramePlacement(self.model, self.data, self.tool_frame_id)
+
     def tool_error_of_float_q(self, q: np.ndarray, oMtarget: pin.SE3) -> tuple[float, float]:
         """:meth:`tool_error` for a q known to be n finite floats (a solver's answer): no check repeated."""
         pin.forwardKinematics(self.model, self.data, q if self._identity_q else self._pin_q(q))

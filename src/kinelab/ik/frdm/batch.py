@@ -88,7 +88,8 @@ def run(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts: np.ndar
         z = slice(a, min(a + step, count))
         solve_rows(Q[z], starts is None, cm.chain, lower, upper, np.ones(cm.n, dtype=np.bool_), points[z],
                    rotations[z], opts.position_weight(cm.length), opts.axis_weights(), float(tol_pos), float(tol_rot),
-                   opts.mode != "orientation", opts.mode != "position", opts.settings(), ORDERS[opts.order],
+                   opts.mode != "orientation", opts.mode != "position", opts.rot_axis, opts.settings(),
+                   ORDERS[opts.order],
                    opts.sweep_cap, rng_states[z], attempts[z], float(clock_chunk(solver.JOINT_SWEEPS_PER_LOOK, cm.n)),
                    codes[z], stats[z])
         rows.Q[z] = Q[z]
@@ -119,7 +120,7 @@ def chunked(q, ch, pb, st, order, max_sweeps, rng_state, attempts, chunk_sweeps,
 
 @njit(cache=True, parallel=True)
 def solve_rows(Q, draw_start, ch, lower, upper, free, pstars, Rstars, w_p, w_ax, tol_pos, tol_rot, check_pos,
-               check_rot, st, order, max_sweeps, rng_states, attempts, chunk_sweeps, codes, stats):
+               check_rot, rot_axis, st, order, max_sweeps, rng_states, attempts, chunk_sweeps, codes, stats):
     """Solve rows [0, B) in parallel; row b's start is Q[b] (drawn from its generator when draw_start).
 
     Inputs, in order:
@@ -127,7 +128,7 @@ def solve_rows(Q, draw_start, ch, lower, upper, free, pstars, Rstars, w_p, w_ax,
         draw_start (bool): draw every start from its row's generator (the single solve's ``q0=None``).
         ch, lower, upper, free: the chain, its windows and free mask (shared).
         pstars (np.ndarray): (B, 3) target points [m]; Rstars: (B, 3, 3) target rotations.
-        w_p, w_ax, tol_pos, tol_rot, check_pos, check_rot, st, order, max_sweeps: as the single solve.
+        w_p, w_ax, tol_pos, tol_rot, check_pos, check_rot, rot_axis, st, order, max_sweeps: as the single solve.
         rng_states (np.ndarray): (B, 1) uint64 generator state per row.
         attempts (np.ndarray): (B,) attempts allowed per row (1 for a target proved out of reach).
         chunk_sweeps (float): sweeps per chunk (the single solve's clock chunk).
@@ -139,7 +140,7 @@ def solve_rows(Q, draw_start, ch, lower, upper, free, pstars, Rstars, w_p, w_ax,
         if draw_start:
             random_configuration(q, ch.kind, lower, upper, rng_states[b])
         pb = Problem(lower, upper, free, pstars[b], Rstars[b], w_p, w_ax, tol_pos, tol_rot, check_pos, check_rot,
-                     rest, 0.0)
+                     rest, 0.0, rot_axis)
         best_q = q.copy()
         row_stats = np.zeros(STATS_SIZE)
         codes[b] = chunked(q, ch, pb, st, order, max_sweeps, rng_states[b], attempts[b], chunk_sweeps, best_q,

@@ -64,6 +64,7 @@ class Problem(NamedTuple):
     check_rot: bool
     q_rest: np.ndarray  # (n,) rest configuration [rad or m] the rest term pulls towards
     w_rest: float  # weight of the rest term (0: none, the paper's objective)
+    rot_axis: int  # rotation check: −1 the whole rotation; 0, 1, 2 only that tool axis (roll free)
 
 
 class Settings(NamedTuple):
@@ -122,10 +123,22 @@ def total_objective(q, kind, p, R, pb):
 
 
 @njit(cache=True, inline="always")
-def _within(p, R, pstar, Rstar, tol_pos, tol_rot, check_pos, check_rot):
-    """Both tolerances met (those checked): position [m] and rotation angle [rad]."""
+def _within(p, R, pstar, Rstar, tol_pos, tol_rot, check_pos, check_rot, rot_axis):
+    """Both tolerances met (those checked): position [m] and rotation angle [rad] (of R*ᵀR, or with
+    ``rot_axis`` ≥ 0 between that tool axis and the target's)."""
     dp = np.sqrt((p[0] - pstar[0]) ** 2 + (p[1] - pstar[1]) ** 2 + (p[2] - pstar[2]) ** 2)
-    return (not check_pos or dp <= tol_pos) and (not check_rot or rotation_angle(R, Rstar) <= tol_rot)
+    if check_pos and not dp <= tol_pos:
+        return False
+    if not check_rot:
+        return True
+    if rot_axis < 0:
+        return rotation_angle(R, Rstar) <= tol_rot
+    k = rot_axis
+    c0 = R[1, k] * Rstar[2, k] - R[2, k] * Rstar[1, k]
+    c1 = R[2, k] * Rstar[0, k] - R[0, k] * Rstar[2, k]
+    c2 = R[0, k] * Rstar[1, k] - R[1, k] * Rstar[0, k]
+    dot = R[0, k] * Rstar[0, k] + R[1, k] * Rstar[1, k] + R[2, k] * Rstar[2, k]
+    return np.arctan2(np.sqrt(c0 * c0 + c1 * c1 + c2 * c2), dot) <= tol_rot
 
 
 @njit(cache=True, inline="always")
@@ -400,7 +413,7 @@ def _fk_converged(q, ch, pb, e, o, p, R, since_fk):
     """Recompute the FK if the state was carried incrementally, then test both tolerances."""
     if since_fk > 0:
         chain_fk(ch, q, e, o, p, R)
-    return _within(p, R, pb.pstar, pb.Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot)
+    return _within(p, R, pb.pstar, pb.Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot, pb.rot_axis)
 
 
 @njit(cache=True, inline="always")
@@ -444,7 +457,7 @@ def run(q: np.ndarray, ch: Chain, pb: Problem, st: Settings, order: int, max_swe
             since_fk = 0
         if state[S_SWEEPS] == 0.0:
             state[S_E_WINDOW] = total_objective(q, kind, p, R, pb)
-        if _within(p, R, pstar, Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot) and \
+        if _within(p, R, pstar, Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot, pb.rot_axis) and \
                 _fk_converged(q, ch, pb, e, o, p, R, since_fk):  # converged only on an exact FK
             state[S_E] = total_objective(q, kind, p, R, pb)
             return CONVERGED, s

@@ -80,6 +80,7 @@ class Problem:
         self.w_p = options.position_weight(cm.length)
         self.w_ax = options.axis_weights()
         self.check_pos, self.check_rot = options.mode != "orientation", options.mode != "position"
+        self.rot_axis = options.rot_axis
         self.tol_pos, self.tol_rot = float(tol_pos), float(tol_rot)
         self.lower = cm.lower.copy() if options.use_limits else np.full(cm.n, -np.inf)
         self.upper = cm.upper.copy() if options.use_limits else np.full(cm.n, np.inf)
@@ -89,7 +90,8 @@ class Problem:
     def tuple(self) -> kernel.Problem:
         """The kernel's view of the problem (arrays shared, so bypasses show through)."""
         return kernel.Problem(self.lower, self.upper, self.free, self.pstar, self.Rstar, self.w_p, self.w_ax,
-                              self.tol_pos, self.tol_rot, self.check_pos, self.check_rot, no_rest(len(self.free)), 0.0)
+                              self.tol_pos, self.tol_rot, self.check_pos, self.check_rot, no_rest(len(self.free)), 0.0,
+                              self.rot_axis)
 
 
 def _scaled_sigma_min(robot: Robot, q: np.ndarray, length: float) -> float:

@@ -14,10 +14,11 @@ import numpy as np
 from kinelab.errors import OptionError
 from kinelab.ik import options as opt
 from kinelab.ik.frdm import kernel
+from kinelab.ik.tasks import Task
 
 ORDERS = {"tip2base": kernel.TIP_TO_BASE, "base2tip": kernel.BASE_TO_TIP, "alternate": kernel.ALTERNATE,
           "mixed": kernel.MIXED}
-MODES = ("pose", "position", "orientation")
+MODES = ("pose", "position", "axis", "orientation")
 ACCELERATIONS = ("anderson", "none")
 BYPASSES = ("kicks", "intervals", "freeze", "auto_kick")
 # Defaults measured on panda, ur5, stanford and era (docs/bench): w_p = 3/L², a 10-sweep stall window.
@@ -31,7 +32,9 @@ class FRDMOptions:
     """Options of one FRDM solve.
 
     Attributes:
-        mode: "pose", "position" (tool point only) or "orientation" (tool axes only).
+        mode: "pose", "position" (tool point only), "axis" (tool point and the tool axis ``tool_axis``, the
+            roll about it free) or "orientation" (tool axes only).
+        tool_axis: the axis of mode "axis": "x", "y" or "z".
         w_p: position weight [1/m²]; None: ``w_p_factor``/L² with L the chain's characteristic length
             (scale-aware: the same factor serves a 0.3 m arm and the 11 m ERA).
         w_p_factor: the dimensionless factor of the default w_p.
@@ -60,6 +63,7 @@ class FRDMOptions:
     """
 
     mode: str = "pose"
+    tool_axis: str = "z"
     w_p: float | None = None
     w_p_factor: float = W_P_FACTOR
     w_axes: tuple[float, float, float] = (1.0, 1.0, 1.0)
@@ -91,6 +95,7 @@ class FRDMOptions:
     def __post_init__(self) -> None:
         opt.choice("mode", self.mode, MODES, what="FRDM mode")
         opt.choice("order", self.order, tuple(ORDERS), what="sweep order")
+        opt.choice("tool_axis", self.tool_axis, ("x", "y", "z"), what="tool axis")
         opt.choice("accel", self.accel, ACCELERATIONS, what="acceleration")
         opt.positive("w_p", self.w_p, allow_none=True)
         opt.positive("w_p_factor", self.w_p_factor)
@@ -187,6 +192,15 @@ class FRDMOptions:
             return 0.0
         return float(self.w_p_factor) / float(length) ** 2 if self.w_p is None else float(self.w_p)
 
+    @property
+    def rot_axis(self) -> int:
+        """The kernel's rotation check: the tool axis index in mode "axis", −1 (the whole rotation) otherwise."""
+        return "xyz".index(self.tool_axis) if self.mode == "axis" else -1
+
+    def for_task(self, task: Task) -> FRDMOptions:
+        """These options for a :class:`~kinelab.ik.tasks.Task` (FRDM's modes are its tasks), cached."""
+        return self if task.name == "pose" else _for_task(self, task)
+
     def axis_weights(self) -> np.ndarray:
         """Weights of the tool x, y, z axes; 0 in position mode (a shared read-only array)."""
         return self._axis_weights
@@ -194,8 +208,15 @@ class FRDMOptions:
     @functools.cached_property
     def _axis_weights(self) -> np.ndarray:
         w = np.zeros(3) if self.mode == "position" else np.array(self.w_axes, dtype=float)
+        if self.mode == "axis":  # one tool axis pulled onto the target's: the roll about it is free
+            w = np.where(np.arange(3) == self.rot_axis, w, 0.0)
         w.flags.writeable = False
         return w
+
+
+@functools.lru_cache(maxsize=64)
+def _for_task(opts: FRDMOptions, task: Task) -> FRDMOptions:
+    return dataclasses.replace(opts, mode=task.name, tool_axis="xyz"[task.axis] if task.axis >= 0 else opts.tool_axis)
 
 
 def _nonzero_finite(value: object) -> bool:

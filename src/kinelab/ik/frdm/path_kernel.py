@@ -52,12 +52,12 @@ def follow(Q, q0, ch, lower, upper, free, pstars, Rstars, w_p, w_ax, tol_pos, to
             for i in range(n):
                 rest[i] = q_prev[i] + pull * (centre[i] - q_prev[i])
             pb = Problem(lower, upper, free, pstars[k], Rstars[k], w_p, w_ax, tol_pos, tol_rot, check_pos, check_rot,
-                         rest, w_rest)
+                         rest, w_rest, -1)
             mem.state[:] = 0.0
             code, spent = run(q, ch, pb, st, order, rest_sweeps, mem)
         if code != CONVERGED:
             pb = Problem(lower, upper, free, pstars[k], Rstars[k], w_p, w_ax, tol_pos, tol_rot, check_pos, check_rot,
-                         q_prev, 0.0)
+                         q_prev, 0.0, -1)
             mem.state[:] = 0.0
             code, more = run(q, ch, pb, st, order, max_sweeps, mem)
             spent += more
@@ -82,7 +82,7 @@ def lm_polish(q, ch, pb, iterations):
     err = np.empty(6)
     for it in range(iterations):
         chain_fk(ch, q, e, o, p, R)
-        if _within(p, R, pb.pstar, pb.Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot):
+        if _within(p, R, pb.pstar, pb.Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot, pb.rot_axis):
             return CONVERGED, it
         _world_error(p, R, pb, err)
         for i in range(n):
@@ -100,7 +100,7 @@ def lm_polish(q, ch, pb, iterations):
         for i in range(n):
             q[i] = min(max(q[i] + dq[i], pb.lower[i]), pb.upper[i])
     chain_fk(ch, q, e, o, p, R)
-    if _within(p, R, pb.pstar, pb.Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot):
+    if _within(p, R, pb.pstar, pb.Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot, pb.rot_axis):
         return CONVERGED, iterations
     return -1, iterations
 

@@ -191,7 +191,7 @@ def _compiled_problem(cm: ChainModel, oMtarget: pin.SE3, opts: FRDMOptions, tol_
                           np.array(oMtarget.rotation, order="C"),
                           opts.position_weight(cm.length), opts.axis_weights(), float(tol_pos), float(tol_rot),
                           opts.mode != "orientation", opts.mode != "position",
-                          no_rest(cm.n), 0.0)
+                          no_rest(cm.n), 0.0, opts.rot_axis)
 
 
 @functools.cache

@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from kinelab.ik.chain import PRISMATIC, chain_model
 from kinelab.report.bench.protocol import TOL_POS, TOL_ROT, Case, Prepare, SolveFn
 from kinelab.robot import Robot
 
@@ -63,6 +64,42 @@ def rtb_ets(robot: Robot) -> Any:
     if ets.n != robot.n:
         raise ValueError(f"roboticstoolbox sees {ets.n} joints, kinelab {robot.n}")
     return ets
+
+
+def rtb_chain_ets(robot: Robot) -> Any:
+    """roboticstoolbox's ETS built from kinelab's own joint data (placements, axes, limits), for chains
+    whose URDF rtb imports wrongly (axes not along x, y or z): each joint is SE3(placement · A) · Rz(q)
+    (or tz(q)) · SE3(Aᵀ), A a rotation taking z onto the joint axis. Checked against Pinocchio's FK.
+
+    Raises:
+        ImportError: roboticstoolbox is not installed; ValueError: its FK disagrees with Pinocchio's.
+    """
+    from roboticstoolbox import ET, ETS
+
+    ch = chain_model(robot).chain
+    parts = []
+    for i in range(robot.n):
+        A = _z_onto(ch.axis_local[i])
+        before, after = np.eye(4), np.eye(4)
+        before[:3, :3], before[:3, 3], after[:3, :3] = ch.placement_R[i] @ A, ch.placement_t[i], A.T
+        qlim = [robot.lower[i], robot.upper[i]]
+        parts += [ET.SE3(before), ET.tz(qlim=qlim) if ch.kind[i] == PRISMATIC else ET.Rz(qlim=qlim), ET.SE3(after)]
+    tool = np.eye(4)
+    tool[:3, :3], tool[:3, 3] = ch.tool_R, ch.tool_t
+    ets = ETS([*parts, ET.SE3(tool)])  # type: ignore[operator]  # one list: chaining with * renumbered joints
+    q = robot.random_q(0)
+    if not np.allclose(np.asarray(ets.fkine(q).A), robot.fk(q).homogeneous, atol=1e-9):
+        raise ValueError("the ETS built from the chain disagrees with Pinocchio's FK")
+    return ets
+
+
+def _z_onto(axis: np.ndarray) -> np.ndarray:
+    """A rotation matrix whose third column is the unit vector ``axis``."""
+    z = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    x = np.cross(helper, z)
+    x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(z, x), z])
 
 
 def _rtb(robot: Robot, budget: float) -> SolveFn:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +18,8 @@ from tqdm import tqdm
 
 from kinelab.ik.chain import chain_model
 from kinelab.ik.frdm import kernel
+from kinelab.ik.solve import solve
+from kinelab.report.bench import peers
 from kinelab.robot import Robot
 
 LENGTHS = (7, 15, 30, 60, 100)
@@ -58,7 +61,7 @@ def time_per_sweep(robot: Robot, sweeps: int = 500, repeats: int = 30) -> float:
     far = pin.SE3(np.eye(3), np.array([100.0, 0.0, 0.0]))  # unreachable: the kernel never stops early
     problem = kernel.Problem(cm.lower, cm.upper, np.ones(cm.n, dtype=np.bool_), far.translation.copy(),
                              far.rotation.copy(), 1.0 / cm.length**2, np.ones(3), 1e-300, 1e-300, True, True,
-                             np.zeros(cm.n), 0.0)
+                             np.zeros(cm.n), 0.0, -1)
     settings = kernel.Settings(1.0, -1.0, sweeps + 1, -1.0, 0)
     best = np.inf
     for _ in range(repeats + 1):
@@ -71,18 +74,31 @@ def time_per_sweep(robot: Robot, sweeps: int = 500, repeats: int = 30) -> float:
     return best
 
 
-def time_per_solve(robot: Robot, count: int = 20, seed: int = 0) -> tuple[float, float]:
-    """(median seconds per solve, success rate) of :func:`kinelab.solve` on reachable random targets."""
-    from kinelab.ik import solve
-
+def time_per_solve(robot: Robot, count: int = 20, seed: int = 0, solver: str = "frdm") -> tuple[float, float]:
+    """(median seconds per solve, success rate) of :func:`kinelab.solve` on reachable random targets (0.5 s
+    budget each), or of roboticstoolbox's ``ik_LM`` on an ETS built from the same chain (``solver="ik_LM"``),
+    every answer judged by Pinocchio."""
     rng = np.random.default_rng(seed)
+    problems = [(robot.fk(robot.random_q(rng)), robot.random_q(rng)) for _ in range(count)]
+    run = _ik_lm(robot) if solver == "ik_LM" else None
     times, ok = [], 0
-    for k in range(count):
-        target = robot.fk(robot.random_q(rng))
-        res = solve(robot, target, q0=robot.random_q(rng), seed=k, time_budget=0.5)
-        times.append(res.wall_time)
-        ok += res.success
+    for k, (target, q0) in enumerate(problems):
+        t0 = time.perf_counter()
+        q = run(target, q0) if run is not None else solve(robot, target, solver=solver, q0=q0, seed=k,
+                                                            time_budget=0.5).q
+        times.append(time.perf_counter() - t0)
+        dp, dr = robot.tool_error(q, target)
+        ok += dp <= 1e-6 and dr <= 1e-6 and robot.within_limits(q)
     return float(np.median(times)), ok / count
+
+
+def _ik_lm(robot: Robot) -> Callable[[pin.SE3, np.ndarray], np.ndarray]:
+    ets = peers.rtb_chain_ets(robot)
+
+    def run(target: pin.SE3, q0: np.ndarray) -> np.ndarray:
+        return np.asarray(ets.ik_LM(target.homogeneous, q0=q0, tol=5e-13, joint_limits=True).q, dtype=float)
+
+    return run
 
 
 def linear_fit(x, y) -> tuple[float, float, float]:
@@ -99,17 +115,30 @@ def run(lengths: tuple[int, ...] = LENGTHS, seed: int = 0, progress: bool = Fals
     for n in tqdm(lengths, desc="scaling", disable=not progress, unit="chain"):
         robot = synthetic_robot(n, seed)
         sweep_s = time_per_sweep(robot)
-        solve_s, rate = time_per_solve(robot, solves, seed) if solves else (float("nan"), float("nan"))
-        rows.append({"links": n, "us_per_sweep": sweep_s * 1e6, "us_per_solve": solve_s * 1e6, "solved": rate})
+        row = {"links": n, "us_per_sweep": sweep_s * 1e6}
+        for solver in ("frdm", "dls", "ik_LM") if solves else ():
+            try:
+                solve_s, rate = time_per_solve(robot, solves, seed, solver)
+            except ImportError:  # roboticstoolbox not installed
+                continue
+            row[f"{solver}_us_per_solve"], row[f"{solver}_solved"] = solve_s * 1e6, rate
+        rows.append(row)
     a, b, r2 = linear_fit([r["links"] for r in rows], [r["us_per_sweep"] for r in rows])
     return {"rows": rows, "fit_us_per_sweep": {"intercept": a, "slope_per_link": b, "r2": r2}}
 
 
 def markdown(result: dict) -> str:
     fit = result["fit_us_per_sweep"]
-    lines = ["| links | µs per sweep | µs per solve (median) | solved |", "|---|---|---|---|"]
-    lines += [f"| {r['links']} | {r['us_per_sweep']:.2f} | {r['us_per_solve']:.0f} | {100 * r['solved']:.0f} % |"
-              for r in result["rows"]]
+    lines = ["| links | FRDM µs per sweep | FRDM µs per solve | solved | DLS µs per solve | solved | "
+             "ik_LM µs per solve | solved |", "|---|---|---|---|---|---|---|---|"]
+    for r in result["rows"]:
+        cells = [f"{r['us_per_sweep']:.2f}"]
+        for solver in ("frdm", "dls", "ik_LM"):
+            if f"{solver}_us_per_solve" in r:
+                cells += [f"{r[f'{solver}_us_per_solve']:.0f}", f"{100 * r[f'{solver}_solved']:.0f} %"]
+            else:
+                cells += ["–", "–"]
+        lines.append(f"| {r['links']} | " + " | ".join(cells) + " |")
     lines.append(f"\nTime per sweep ≈ {fit['intercept']:.2f} + {fit['slope_per_link']:.3f} µs × links, "
                  f"R² = {fit['r2']:.4f}.")
     return "\n".join(lines)

@@ -1,0 +1,97 @@
+"""Tasks: position, axis and orientation targets, judged by Pinocchio on the components they constrain."""
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import kinelab
+from kinelab import OptionError, load
+
+ARMS = ("so101", "finger_edu", "ur5", "panda", "youbot")
+TASKS = ("position", "axis", "orientation")
+
+
+def task_targets(robot, task, count, seed):
+    """FK-generated targets; position targets get random (mostly unreachable) orientations, axis targets a
+    random roll about the tool z axis (the free component)."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for _ in range(count):
+        T = robot.fk(robot.random_q(rng))
+        if task == "position":
+            T = pin.SE3(pin.exp3(rng.normal(size=3)), T.translation)
+        elif task == "axis":
+            T = pin.SE3(T.rotation @ pin.exp3(np.array([0.0, 0.0, rng.uniform(-3, 3)])), T.translation)
+        out.append(T)
+    return out
+
+
+def judged_here(robot, q, target, task):
+    """The test's own verdict from Pinocchio's FK: only the task's components, within the limits."""
+    M = robot.fk(q)
+    dp = np.linalg.norm(M.translation - target.translation)
+    full = np.linalg.norm(pin.log3(target.rotation.T @ M.rotation))
+    u, v = M.rotation[:, 2], target.rotation[:, 2]
+    axis = np.arctan2(np.linalg.norm(np.cross(u, v)), u @ v)
+    within = robot.within_limits(q)
+    return within and {"position": dp <= 1e-6, "axis": dp <= 1e-6 and axis <= 1e-6,
+                       "orientation": full <= 1e-6}[task]
+
+
+@pytest.mark.parametrize("solver", ["frdm", "dls"])
+@pytest.mark.parametrize("task", TASKS)
+@pytest.mark.parametrize("name", ARMS)
+def test_each_task_is_solved_and_judged_on_its_components_only(name, task, solver):
+    robot = load(name)
+    targets = task_targets(robot, task, 12, seed=10 * ARMS.index(name) + TASKS.index(task))
+    solved = 0
+    for k, target in enumerate(targets):
+        res = kinelab.solve(robot, target, solver=solver, task=task, seed=k, time_budget=0.3)
+        assert res.success == judged_here(robot, res.q, target, task), (k, res.status, res.message)
+        assert res.task == ("axis z" if task == "axis" else task)
+        solved += res.success
+    assert solved >= 11  # measured: FRDM and DLS miss 2 of 40 axis targets on so101 (FRDM on panda too)
+
+
+def test_a_position_task_ignores_an_unreachable_orientation_that_the_pose_task_cannot_meet():
+    robot = load("so101")
+    target = kinelab.target_from_xyz_rpy([0.2, 0.0, 0.15])  # identity rotation: out of a 5-joint arm's reach
+    pose = kinelab.solve(robot, target, seed=1, time_budget=0.1)
+    assert not pose.success
+    assert "so101 has 5 joints" in pose.message and "task='axis'" in pose.message
+    position = kinelab.solve(robot, target, task="position", seed=1, time_budget=0.1)
+    assert position.success and position.position_error <= 1e-6 and position.rotation_error > 0.1
+
+
+def test_the_axis_task_leaves_the_roll_free_and_holds_the_other_axes():
+    robot = load("ur5")
+    q = robot.random_q(3)
+    T = robot.fk(q)
+    for axis, column in (("x", 0), ("y", 1), ("z", 2)):
+        rolled = pin.SE3(T.rotation @ pin.exp3(np.eye(3)[column] * 1.0), T.translation)  # 1 rad about that axis
+        res = kinelab.solve(robot, rolled, task="axis", axis=axis, seed=0, time_budget=0.3)
+        assert res.success and res.task == f"axis {axis}"
+        M = robot.fk(res.q)
+        assert np.allclose(M.rotation[:, column], rolled.rotation[:, column], atol=2e-6)
+
+
+def test_the_biquaternion_solver_and_unknown_tasks_are_refused_with_what_is_valid():
+    robot = load("ur5")
+    target = robot.fk(robot.random_q(0))
+    with pytest.raises(OptionError, match="'pose' for solver 'biquat'"):
+        kinelab.solve(robot, target, solver="biquat", task="position")
+    with pytest.raises(OptionError, match="pose, position, axis, orientation"):
+        kinelab.solve(robot, target, task="reach")
+    with pytest.raises(OptionError, match="'x', 'y' or 'z'"):
+        kinelab.solve(robot, target, task="axis", axis="w")
+
+
+def test_a_batch_takes_the_task_and_agrees_with_single_solves():
+    robot = load("panda")
+    targets = task_targets(robot, "axis", 20, seed=4)
+    batch = kinelab.solve_batch(robot, targets, seed=9, task="axis")
+    for b in range(20):
+        one = kinelab.solve(robot, targets[b], seed=9 + b, task="axis", time_budget=60.0)
+        np.testing.assert_array_equal(batch.q[b], one.q)
+        assert batch.success[b] == one.success == judged_here(robot, one.q, targets[b], "axis")
+        assert batch.rotation_error[b] == pytest.approx(one.rotation_error, abs=1e-9)
