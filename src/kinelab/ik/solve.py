@@ -21,9 +21,11 @@ import pinocchio as pin
 
 from kinelab.errors import OptionError, SolverNotFoundError
 from kinelab.ik.limits import wrap_q
+from kinelab.ik.multistart import TypedKernel
 from kinelab.ik.result import Attempt, BypassRecord, IKResult, SingularEvent, Status
 from kinelab.ik.targets import as_target
 from kinelab.ik.tasks import COMPONENTS, POSE, Task
+from kinelab.ik.verdict import pose_verdict
 from kinelab.ik.workspace import out_of_reach
 from kinelab.robot import Robot
 
@@ -38,6 +40,7 @@ class SolverModule(Protocol):
                 deadline: float, options: Any = None) -> Attempt: ...
 
 
+_VERDICT = TypedKernel(pose_verdict)  # its arguments are always Pinocchio's matrices and float arrays
 BUILTIN = {"frdm": "kinelab.ik.frdm.solver", "biquat": "kinelab.ik.biquat.solver", "dls": "kinelab.ik.dls"}
 SOLVERS: dict[str, Any] = {}
 
@@ -137,6 +140,8 @@ def solve(
     prepare = getattr(module, "prepare", None)
     if prepare is not None:
         prepare(robot)  # compilation and model building are not the solve's time
+    if not _CHECKS_COMPILED:
+        _compile_checks(robot)
     t_start = time.perf_counter()
     target = as_target(target)
     check_arguments(tol_pos, tol_rot, time_budget, max_restarts, seed, start_outside_limits)
@@ -161,6 +166,16 @@ def for_task(solver: str, opts: Any, task: Task) -> Any:
         raise OptionError("task", task.name, f"'pose' for solver {solver!r}, which drives the whole pose; "
                           "solvers 'frdm' and 'dls' take 'position', 'axis' and 'orientation' too")
     return opts.for_task(task)
+
+
+_CHECKS_COMPILED: list[bool] = []
+
+
+def _compile_checks(robot: Robot) -> None:
+    """Compile (or load) the target check and the verdict once per process, outside any solve's clock."""
+    target = as_target(pin.SE3.Identity())
+    _Problem(robot, target, "", 1.0, 1.0, 0.0, 0.0, None).judge(robot.neutral())
+    _CHECKS_COMPILED.append(True)
 
 
 def check_arguments(tol_pos: float, tol_rot: float, time_budget: float, max_restarts: int, seed: int | None,
@@ -201,8 +216,12 @@ class _Problem:
         """Pinocchio's verdict on q: (success, position error [m], rotation error [rad]) on the task's
         components (the rotation error of task "axis" is the angle between the tool axes)."""
         if self.task is POSE:
-            dp, dr = self.robot.tool_error_of_float_q(q, self.target)
-            return dp <= self.tol_pos and dr <= self.tol_rot and self.robot.within_limits(q), dp, dr
+            if not (q.dtype == np.float64 and q.ndim == 1 and q.flags.c_contiguous):  # the kernel's one signature
+                q = np.ascontiguousarray(q, dtype=float)
+            lower, upper = self.robot.check_bounds
+            dp, dr, within = _VERDICT(self.target.homogeneous, self.robot.tool_pose_of_float_q(q).homogeneous, q,
+                                      lower, upper)
+            return dp <= self.tol_pos and dr <= self.tol_rot and within, dp, dr
         dp, dr = self.task.errors(self.target, self.robot.tool_pose_of_float_q(q))
         return self.task.met(dp, dr, self.tol_pos, self.tol_rot) and self.robot.within_limits(q), dp, dr
 

@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pinocchio as pin
 
 from kinelab.dq.algebra import DualQuat
 from kinelab.errors import TargetError
+from kinelab.ik.multistart import TypedKernel
+from kinelab.ik.verdict import NOT_A_ROTATION, NOT_FINITE, pose_defect
+
+_POSE_DEFECT = TypedKernel(pose_defect)
 
 
 def from_xyz_rpy(xyz, rpy=(0.0, 0.0, 0.0)) -> pin.SE3:
@@ -37,16 +39,10 @@ def as_target(target) -> pin.SE3:
             f"got {type(target).__name__}; "
             "build one with kinelab.target_from_xyz_rpy or kinelab.target_from_xyz_quat_wxyz"
         )
-    H = target.homogeneous.tolist()  # Python floats: a dozen checks cost less than numpy's calls
-    if not math.isfinite(sum(H[0]) + sum(H[1]) + sum(H[2])) and not all(  # NaN, ±inf poison the sum
-            math.isfinite(v) for row in H[:3] for v in row):
+    defect = _POSE_DEFECT(target.homogeneous)
+    if defect == NOT_FINITE:
         raise TargetError("target has NaN or infinite entries")
-    (a, b, c, _), (d, e, f, _), (g, h, i, _) = H[:3]
-    det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
-    gram_error = max(  # RᵀR − I
-        abs(a * a + d * d + g * g - 1.0), abs(b * b + e * e + h * h - 1.0), abs(c * c + f * f + i * i - 1.0),
-        abs(a * b + d * e + g * h), abs(a * c + d * f + g * i), abs(b * c + e * f + h * i))
-    if gram_error > 1e-6 or det < 0:
+    if defect == NOT_A_ROTATION:
         raise TargetError("target rotation is not a rotation matrix (RᵀR ≠ I or det R < 0)")
     return target
 

@@ -234,6 +234,9 @@ class Robot:
         self._upper_check = np.where(continuous, np.inf, self.upper)
         # the same bounds with the default slack, as Python floats: a solve checks limits twice, and a
         # loop over seven floats costs a fifth of the numpy expression
+        self.check_bounds = (self._lower_check - LIMIT_SLACK, self._upper_check + LIMIT_SLACK)
+        """(lower, upper) that :meth:`within_limits` compares with: the limits widened by LIMIT_SLACK,
+        ∓inf for continuous joints."""
         self._lower_list = (self._lower_check - LIMIT_SLACK).tolist()
         self._upper_list = (self._upper_check + LIMIT_SLACK).tolist()
 
