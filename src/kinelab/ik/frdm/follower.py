@@ -7,8 +7,8 @@ from typing import Any
 
 import numpy as np
 
-from kinelab.geometry import pose_errors, stack_homogeneous, wrap_to_pi
-from kinelab.ik.chain import CONTINUOUS, chain_model
+from kinelab.geometry import pose_errors, stack_homogeneous
+from kinelab.ik.chain import chain_model
 from kinelab.ik.frdm import kernel, path_kernel
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.result import SingularEvent, Status, TrackResult
@@ -18,7 +18,7 @@ from kinelab.robot import Robot
 REST_WEIGHT = 0.01  # objective units (the weighted pose error is ~1 at a chain length's distance)
 REST_SWEEPS = 10  # sweeps of the first phase of a sample
 LM_ITERATIONS = 20  # Levenberg–Marquardt steps of the polish (mode "frdm+lm")
-CENTRE_PULL = 0.1  # share of the way from the previous answer to mid-range taken as the rest configuration
+CENTRE_PULL = 0.01  # share of the way from the previous answer to mid-range taken as the rest configuration
 # any other code (a kernel's converged that Pinocchio does not confirm, the polish's −1): max_iterations
 _STATUS = {kernel.STALL_STEP: Status.STALLED, kernel.STALL_WINDOW: Status.STALLED, kernel.BUDGET: Status.MAX_ITERATIONS}
 
@@ -38,7 +38,8 @@ def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: 
         opts: FRDM options (order, weights, stall window).
 
     Returns:
-        A :class:`~kinelab.ik.frdm.tracking.TrackResult` with mode "frdm (compiled follower)".
+        A :class:`~kinelab.ik.frdm.tracking.TrackResult` with mode "frdm (compiled follower)". Continuous
+        joints are not wrapped: the rows are a continuous path, as a controller wants them.
     """
     if rest_weight is None:
         rest_weight = REST_WEIGHT if robot.n > 6 else 0.0
@@ -56,9 +57,6 @@ def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: 
                        float(tol_rot), opts.mode != "orientation", opts.mode != "position", opts.settings(), order,
                        int(max_sweeps), float(rest_weight), REST_SWEEPS, centre, CENTRE_PULL,
                        LM_ITERATIONS if opts.polish else 0, codes, sweeps)
-    continuous = cm.kind == CONTINUOUS
-    if continuous.any():
-        Q[:, continuous] = wrap_to_pi(Q[:, continuous])
     dp, dr = pose_errors(stack_homogeneous(points, rotations), robot.fk_batch(Q))
     ok = (dp <= tol_pos) & (dr <= tol_rot) & robot.within_limits_batch(Q)
     status = [Status.CONVERGED.value if ok[k] else _STATUS.get(int(codes[k]), Status.MAX_ITERATIONS).value

@@ -36,7 +36,8 @@ def follow(Q, q0, ch, lower, upper, free, pstars, Rstars, w_p, w_ax, tol_pos, to
         max_sweeps (int): sweep cap of each phase.
         w_rest (float): weight of the rest term in the first phase (0: one plain phase).
         rest_sweeps (int): sweep cap of the first phase.
-        centre (np.ndarray), pull (float): the rest configuration is q_prev + pull (centre − q_prev).
+        centre (np.ndarray), pull (float): the rest configuration is q_prev + s (centre − q_prev), s = pull times
+            the joint's limit measure (see :func:`_limit_pull`).
         lm_iterations (int): Levenberg–Marquardt steps after FRDM for a sample still short (0: none).
         codes, sweeps (np.ndarray): (N,) outputs: run() code and sweeps spent per sample.
     """
@@ -50,7 +51,7 @@ def follow(Q, q0, ch, lower, upper, free, pstars, Rstars, w_p, w_ax, tol_pos, to
         code = -1
         if w_rest > 0.0:
             for i in range(n):
-                rest[i] = q_prev[i] + pull * (centre[i] - q_prev[i])
+                rest[i] = q_prev[i] + _limit_pull(q_prev[i], lower[i], upper[i], pull) * (centre[i] - q_prev[i])
             pb = Problem(lower, upper, free, pstars[k], Rstars[k], w_p, w_ax, tol_pos, tol_rot, check_pos, check_rot,
                          rest, w_rest, -1)
             mem.state[:] = 0.0
@@ -68,6 +69,17 @@ def follow(Q, q0, ch, lower, upper, free, pstars, Rstars, w_p, w_ax, tol_pos, to
         q_prev[:] = q
         codes[k] = code
         sweeps[k] = spent
+
+
+@njit(cache=True)
+def _limit_pull(x, lo, hi, pull):
+    """The share of the way to mid-range the rest configuration takes for a joint at x: ``pull`` times the
+    Chan–Dubey measure (hi − lo)² / (4 (x − lo)(hi − x)), 1 at mid-range and growing without bound at a
+    limit, capped at 1/2: a joint in mid-range is left where it is, one near a limit is drawn back."""
+    dl, du = x - lo, hi - x
+    if not (dl > 0.0 and du > 0.0) or dl + du == np.inf:
+        return pull if dl + du != np.inf else 0.0
+    return min(0.5, pull * (dl + du) * (dl + du) / (4.0 * dl * du))
 
 
 @njit(cache=True)
