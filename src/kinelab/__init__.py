@@ -18,6 +18,7 @@ from kinelab.errors import (
     OptionError,
     RobotNotFoundError,
     SolverNotFoundError,
+    SRDFError,
     TargetError,
     URDFError,
 )
@@ -52,6 +53,7 @@ __all__ = [
     "Robot",
     "RobotNotFoundError",
     "SolverNotFoundError",
+    "SRDFError",
     "Status",
     "TargetError",
     "TrackResult",

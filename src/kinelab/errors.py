@@ -31,6 +31,10 @@ class URDFError(KinelabError):
     """A URDF that cannot be read: missing, malformed, or not describing a usable chain."""
 
 
+class SRDFError(KinelabError):
+    """An SRDF file that cannot be read, or that names joints, links or groups the robot does not have."""
+
+
 class ChainError(KinelabError):
     """The base-to-tool path is not a serial chain kinelab can use (ambiguous tool, loop, joint type)."""
 

@@ -61,7 +61,7 @@ def test_fk_stanford_matches_the_papers_rotation(capsys):
     (["fk", "stanford", "0", "0", "nan", "0", "0", "0"], "finite"),
     (["fk", "stanford", "0", "0", "2", "0", "0", "0"], "outside its limits"),
     (["fk", "ur5", "0", "0", "0", "0", "0", "0", "--tool", "flange"], "unknown frame 'flange'"),
-    (["fk", "stanford", "0", "x"], "invalid float value"),
+    (["fk", "stanford", "0", "x"], "'x' is not a number"),
     (["nosuchcommand"], "invalid choice"),
     (["animate", "era-knee"], "passages are: era-elbow, era-wrist, era-shoulder"),
 ])
@@ -227,3 +227,34 @@ def test_a_slow_compilation_is_announced_on_stderr_and_a_quick_one_is_not(capsys
         pass
     time.sleep(0.05)
     assert capsys.readouterr().err == ""
+
+
+PANDA_SRDF = str(kinelab.robot.catalog.erd_share_dir() / "example-robot-data" / "robots" / "panda_description"
+                 / "srdf" / "panda.srdf")
+
+
+def test_a_named_srdf_configuration_stands_for_q_and_a_base_reroots_the_chain(capsys):
+    code, out, _ = run(capsys, "fk", "panda", "default", "--srdf", PANDA_SRDF, "--json")
+    assert code == 0
+    q = kinelab.load("panda", srdf=PANDA_SRDF).named_q("default")
+    assert np.allclose(json.loads(out)["position_m"], kinelab.load("panda").fk(q).translation)
+    code, out, _ = run(capsys, "ik", "panda", "--target-q", "default", "--srdf", PANDA_SRDF, "--group", "arm",
+                       "--json")
+    assert code == 0 and json.loads(out)["success"]
+    code, out, _ = run(capsys, "fk", "panda", "-1", "0", "1", "0", "--base", "panda_link3", "--json")
+    full = kinelab.load("panda")
+    q_full = [0.0, 0.0, 0.0, -1.0, 0.0, 1.0, 0.0]
+    expected = full.frame_placement(q_full, "panda_link3").inverse() * full.fk(q_full)
+    assert code == 0 and np.allclose(json.loads(out)["position_m"], expected.translation)
+
+
+@pytest.mark.parametrize(("argv", "said"), [
+    (["fk", "panda", "home", "--srdf", PANDA_SRDF], "no configuration 'home'; configurations: default"),
+    (["fk", "panda", "0", "x", "0", "0", "0", "0", "0"], "'x' is not a number"),
+    (["fk", "panda", "default"], "without an SRDF"),
+    (["info", "panda", "--group", "arm"], "needs srdf="),
+    (["info", "panda", "--package-dir", "/nonexistent/dir"], "does not exist"),
+])
+def test_bad_robot_sources_at_the_cli_give_one_line_and_exit_2(capsys, argv, said):
+    code, out, err = run(capsys, *argv)
+    assert code == 2 and said in err and len(err.strip().splitlines()) == 1

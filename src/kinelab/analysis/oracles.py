@@ -87,7 +87,8 @@ def tool_link(robot: Robot) -> str:
 
 
 class YourdfpyFK:
-    """FK of the robot's tool link relative to its root link, computed by yourdfpy."""
+    """FK of the robot's tool link relative to its base link (the URDF root unless ``load(base=...)``),
+    computed by yourdfpy."""
 
     def __init__(self, robot: Robot):
         self.robot = robot
@@ -96,7 +97,7 @@ class YourdfpyFK:
             build_collision_scene_graph=False, load_collision_meshes=False,
         )
         self.tool_link = tool_link(robot)
-        self.base_link = self.urdf.base_link
+        self.base_link = robot.base if robot.base in self.urdf.link_map else self.urdf.base_link
         self._cfg = {name: robot.locked.get(name, 0.0) for name in self.urdf.actuated_joint_names}
 
     def fk(self, q) -> pin.SE3:

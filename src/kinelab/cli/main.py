@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from kinelab.errors import KinelabError
+from kinelab.errors import ConfigurationError, KinelabError
 from kinelab.geometry import quat_wxyz_from_matrix
 from kinelab.robot import Robot, catalog, load
 
@@ -31,12 +31,35 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"kinelab: error: {message} (see 'kinelab {self.prog.split()[-1]} --help')\n")
 
 
-def _q_from_cli(robot: Robot, values: list[float], deg: bool, what: str = "q") -> np.ndarray:
-    q = robot.check_q(values, what=what)
+def _q_from_cli(robot: Robot, values: list[str], deg: bool, what: str = "q") -> np.ndarray:
+    """One number per joint (rad or m; degrees with --deg), or the name of an SRDF configuration."""
+    if len(values) == 1 and not _is_number(values[0]):
+        return robot.named_q(values[0])
+    numbers = []
+    for v in values:
+        if not _is_number(v):
+            raise ConfigurationError(f"{what}: {v!r} is not a number (give {robot.n} numbers, or one SRDF "
+                                     "configuration name with --srdf)")
+        numbers.append(float(v))
+    q = robot.check_q(numbers, what=what)
     if deg:
         angular = np.array([k != "prismatic" for k in robot.joint_kinds])
         q = np.where(angular, np.deg2rad(q), q)
     return q
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _load(args: argparse.Namespace) -> Robot:
+    """The robot a per-robot command names, with its --tool, --base, --srdf, --group and --package-dir."""
+    return load(args.robot, tool=args.tool, base=args.base, srdf=args.srdf, group=args.group,
+                package_dirs=args.package_dir)
 
 
 def pose_dict(oMtool: pin.SE3) -> dict:
@@ -74,7 +97,7 @@ def _joint_row(j) -> dict:
 
 
 def cmd_info(args) -> int:
-    robot = load(args.robot, tool=args.tool)
+    robot = _load(args)
     info = {
         "robot": robot.name,
         "urdf": str(robot.urdf_path),
@@ -104,7 +127,7 @@ def cmd_info(args) -> int:
 
 
 def cmd_fk(args) -> int:
-    robot = load(args.robot, tool=args.tool)
+    robot = _load(args)
     q = _q_from_cli(robot, args.q, args.deg)
     robot.check_q(q, limits=not args.ignore_limits)
     oMtool = robot.fk(q)
@@ -175,7 +198,7 @@ def cmd_ik(args) -> int:
     from kinelab.ik import solve, target_from_xyz_rpy
     from kinelab.ik.solve import solver_module
 
-    robot = load(args.robot, tool=args.tool)
+    robot = _load(args)
     if (args.target_q is None) == (args.target_xyz is None):
         raise KinelabError("give the target as --target-q Q... or as --target-xyz X Y Z [--target-rpy R P Y]")
     options: dict[str, Any] = {}
@@ -231,7 +254,7 @@ def cmd_ik(args) -> int:
 def cmd_singular(args) -> int:
     from kinelab.analysis import families, singular
 
-    robot = load(args.robot, tool=args.tool)
+    robot = _load(args)
     if args.sweep is not None:
         if args.q:
             raise KinelabError("give either a configuration or --sweep N, not both")
@@ -363,7 +386,7 @@ def _serve(scene) -> int:
 def cmd_view(args) -> int:
     from kinelab.view import scene as viz
 
-    robot = load(args.robot, tool=args.tool)
+    robot = _load(args)
     q = _q_from_cli(robot, args.q, args.deg) if args.q else robot.neutral()
     robot.check_q(q, limits=not args.ignore_limits)
     scene = viz.Scene(robot).show(q)
@@ -404,11 +427,20 @@ def _robot_arguments(s: argparse.ArgumentParser, q_help: str | None = None, limi
     """The arguments every per-robot command shares: ROBOT [Q...] [--deg] [--tool] [--ignore-limits]."""
     s.add_argument("robot", help="registered name or URDF path")
     if q_help:
-        s.add_argument("q", nargs="*", type=float, help=q_help)
+        s.add_argument("q", nargs="*", help=q_help + " (or the name of an SRDF configuration, with --srdf)")
         s.add_argument("--deg", action="store_true", help="angles of revolute/continuous joints in degrees")
-    s.add_argument("--tool", help="tool frame (default: the robot's own)")
+    _add_source_args(s)
     if limits:
         s.add_argument("--ignore-limits", action="store_true", help="allow q outside the joint limits")
+
+
+def _add_source_args(s: argparse.ArgumentParser) -> None:
+    """Where the chain starts and ends, and the files that describe the robot beyond its URDF."""
+    s.add_argument("--tool", help="tool frame (default: the robot's own)")
+    s.add_argument("--base", help="frame the chain starts from (default: the URDF root); poses are in this frame")
+    s.add_argument("--srdf", help="SRDF file: named configurations (give a name as Q) and groups")
+    s.add_argument("--group", help="SRDF group whose chain gives base and tool")
+    s.add_argument("--package-dir", action="append", help="where package:// meshes resolve (repeatable)")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -445,7 +477,7 @@ def _add_ik(sub: Any) -> None:
     s = sub.add_parser("ik", help="inverse kinematics to a target pose or configuration")
     s.add_argument("robot", help="registered name or URDF path")
     s.add_argument("--solver", default="frdm", help="frdm, biquat or dls (the Pinocchio reference)")
-    s.add_argument("--target-q", nargs="+", type=float, help="target as a configuration (its FK pose)")
+    s.add_argument("--target-q", nargs="+", help="target as a configuration (its FK pose), or an SRDF name")
     s.add_argument("--target-xyz", nargs=3, type=float, help="target position [m] in the base frame")
     s.add_argument("--target-rpy", nargs=3, type=float,
                    help="target roll, pitch, yaw (rad; deg with --deg); without it the target rotation is the identity")
@@ -453,7 +485,7 @@ def _add_ik(sub: Any) -> None:
                    help="the components to meet: pose (all), position, axis (point and one tool axis, roll free), "
                         "orientation")
     s.add_argument("--axis", choices=("x", "y", "z"), default="z", help="the tool axis of --task axis")
-    s.add_argument("--start-q", nargs="+", type=float, help="first start (default: seeded random)")
+    s.add_argument("--start-q", nargs="+", help="first start (default: seeded random), or an SRDF name")
     s.add_argument("--deg", action="store_true", help="angles in degrees (revolute/continuous joints, rpy)")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--tol-pos", type=float, default=1e-6, help="[m]")
@@ -470,8 +502,8 @@ def _add_ik(sub: Any) -> None:
     s.add_argument("--integrator", choices=["euler", "rk4", "adaptive"], help="biquat: integrator")
     s.add_argument("--step", type=float, help="biquat: fixed step h [s] (the paper: 0.01; default 1/k)")
     s.add_argument("--gain", type=float, help="biquat: gain k [1/s] (default 1)")
-    s.add_argument("--tool", help="tool frame (default: the robot's own)")
-    s.add_argument("--json", action="store_true")
+    _add_source_args(s)
+    s.add_argument("--json", action="store_true", help="print the result as JSON")
     s.set_defaults(func=cmd_ik)
 
 

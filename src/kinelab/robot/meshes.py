@@ -6,6 +6,7 @@ dropped with a warning (the robot still loads and still draws its primitive shap
 
 from __future__ import annotations
 
+import os
 import tempfile
 import warnings
 import xml.etree.ElementTree as ET
@@ -13,19 +14,48 @@ from pathlib import Path
 
 import pinocchio as pin
 
+from kinelab.errors import URDFError
 from kinelab.robot import catalog
+
+
+def mesh_package_dirs(user: list[str] | None = None) -> list[str]:
+    """Where ``package://`` URIs are looked up, in order: the user's directories, those of
+    ``ROS_PACKAGE_PATH``, then example-robot-data's.
+
+    Raises:
+        URDFError: a user directory that does not exist (named, with the list given).
+    """
+    dirs = [str(d) for d in (user or [])]
+    for d in dirs:
+        if not Path(d).is_dir():
+            raise URDFError(f"package directory {d!r} does not exist (package_dirs={dirs})")
+    ros = [d for d in os.environ.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if d]
+    return dirs + ros + catalog.package_dirs()
+
+
+def _package_candidates(rest: str, dirs: list[str]) -> list[Path]:
+    """``NAME/path`` under each directory: DIR/NAME/path, DIR/path when DIR is the package NAME itself, and
+    DIR/*/NAME/path one level down (a workspace's src folder)."""
+    name, _, inner = rest.partition("/")
+    out = []
+    for d in map(Path, dirs):
+        out.append(d / rest)
+        if d.name == name:
+            out.append(d / inner)
+        out += [package / inner for package in sorted(d.glob(f"*/{name}"))[:1]]
+    return out
 
 
 def resolve_uri(uri: str, urdf_dir: str | Path, package_dirs: list[str] | None = None) -> Path | None:
     """The file a URDF mesh URI names, or None if it cannot be found.
 
-    ``package://NAME/rest`` is looked up as ``DIR/NAME/rest`` under each of ``package_dirs`` (default:
-    the example-robot-data directories); ``file://`` and plain paths are taken relative to the URDF.
+    ``package://NAME/rest`` is looked up under each of ``package_dirs`` (default: :func:`mesh_package_dirs`)
+    as described in :func:`_package_candidates`; ``file://`` and plain paths are taken relative to the URDF.
     """
-    dirs = catalog.package_dirs() if package_dirs is None else list(package_dirs)
+    dirs = mesh_package_dirs() if package_dirs is None else list(package_dirs)
     if uri.startswith("package://"):
         rest = uri[len("package://"):]
-        candidates = [Path(d) / rest for d in dirs] + [Path(urdf_dir) / rest.split("/", 1)[-1]]
+        candidates = _package_candidates(rest, dirs) + [Path(urdf_dir) / rest.split("/", 1)[-1]]
     else:
         plain = uri[len("file://"):] if uri.startswith("file://") else uri
         candidates = [Path(plain) if Path(plain).is_absolute() else Path(urdf_dir) / plain]
@@ -51,13 +81,20 @@ def missing_meshes(urdf_path: str | Path, package_dirs: list[str] | None = None)
     return [u for u in uris if resolve_uri(u, urdf_dir, package_dirs) is None]
 
 
-def _without_unresolved_visuals(urdf_path: Path, package_dirs: list[str] | None) -> Path:
+def _with_resolved_meshes(urdf_path: Path, package_dirs: list[str]) -> Path:
+    """A copy of the URDF whose visual meshes name the files kinelab resolved (absolute paths), and without
+    the visuals whose mesh cannot be found: Pinocchio then reads exactly what kinelab found."""
     tree = ET.parse(urdf_path)
     for link in tree.getroot().iter("link"):
         for vis in list(link.findall("visual")):
             mesh = vis.find("geometry/mesh")
-            if mesh is not None and resolve_uri(mesh.get("filename", ""), urdf_path.parent, package_dirs) is None:
+            if mesh is None:
+                continue
+            found = resolve_uri(mesh.get("filename", ""), urdf_path.parent, package_dirs)
+            if found is None:
                 link.remove(vis)
+            else:
+                mesh.set("filename", str(found.resolve()))
     out = Path(tempfile.mkdtemp(prefix="kinelab-")) / urdf_path.name
     tree.write(out)
     return out
@@ -66,12 +103,13 @@ def _without_unresolved_visuals(urdf_path: Path, package_dirs: list[str] | None)
 def build_visual_model(
     model: pin.Model, urdf_path: str | Path, package_dirs: list[str] | None = None
 ) -> pin.GeometryModel:
-    """Pinocchio's VISUAL geometry of ``model`` (the full, unreduced model of the URDF)."""
+    """Pinocchio's VISUAL geometry of ``model`` (the full, unreduced model of the URDF), its meshes found
+    as :func:`resolve_uri` finds them; a visual whose mesh cannot be found is left out with a warning."""
     urdf_path = Path(urdf_path)
-    dirs = catalog.package_dirs() if package_dirs is None else list(package_dirs)
+    dirs = mesh_package_dirs() if package_dirs is None else list(package_dirs)
     missing = missing_meshes(urdf_path, dirs)
     if missing:
         warnings.warn(f"{len(missing)} mesh(es) of {urdf_path.name} not found (first: {missing[0]}); "
                       "those visuals are left out", stacklevel=2)
-        urdf_path = _without_unresolved_visuals(urdf_path, dirs)
-    return pin.buildGeomFromUrdf(model, str(urdf_path), pin.GeometryType.VISUAL, package_dirs=dirs)
+    resolved = _with_resolved_meshes(urdf_path, dirs)
+    return pin.buildGeomFromUrdf(model, str(resolved), pin.GeometryType.VISUAL, package_dirs=dirs)

@@ -35,10 +35,13 @@ from kinelab.errors import (
     JointLimitError,
     JointNotFoundError,
     OptionError,
+    SRDFError,
     URDFError,
 )
 from kinelab.geometry import pose_error, wrap_to_pi
 from kinelab.robot import catalog
+from kinelab.robot.meshes import build_visual_model, mesh_package_dirs
+from kinelab.robot.srdf import Srdf, read_srdf
 from kinelab.robot.urdf import UrdfTree, read_tree
 
 _REVOLUTE = {"JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned"}
@@ -182,18 +185,33 @@ class Robot:
         tool: str | None = None,
         locked: dict[str, float] | None = None,
         name: str | None = None,
+        base: str | None = None,
+        package_dirs: list[str] | None = None,
+        srdf: str | Path | None = None,
+        group: str | None = None,
     ):
         self.urdf_path = Path(urdf_path)
+        self.package_dirs = mesh_package_dirs(package_dirs)
         tree = read_tree(self.urdf_path)
         full = _build_full_model(self.urdf_path)
         self.name = name or full.name or self.urdf_path.stem
-        self.base = tree.root
+        self.srdf = self._read_srdf(srdf, tree)
+        if group is not None:
+            tool, base = self._group_frames(group, tree, tool, base)
+        self.base = base or tree.root
         self.tool = tool or self._default_tool(tree, full)
         tool_id = _frame_id(full, self.tool, self.name)
         chain = [j for j in full.supports[full.frames[tool_id].parentJoint] if j != 0]
+        if base is not None:
+            chain = self._below_base(full, chain, base)
         self._check_chain(full, chain, tree)
-        self.locked = self._locked_values(full, chain, locked or {})
+        reference = self.srdf.reference() if self.srdf else {}
+        held = {j: v for j, v in reference.items() if full.existJointName(j) and full.getJointId(j) not in chain}
+        self.locked = self._locked_values(full, chain, {**held, **(locked or {})})
+        self._bMw: pin.SE3 | None = None
         self._reduce(full)
+        if base is not None and base != tree.root:
+            self._reroot(base)
         self._index_joints()
         self._length: float | None = None
         self._derived: dict[str, Any] = {}
@@ -275,11 +293,67 @@ class Robot:
                 )
 
     @staticmethod
+    def _read_srdf(srdf: str | Path | None, tree: UrdfTree) -> Srdf | None:
+        if srdf is None:
+            return None
+        found = read_srdf(srdf)
+        found.check_joints(list(tree.joint_of.values()))
+        return found
+
+    def _group_frames(self, group: str, tree: UrdfTree, tool: str | None, base: str | None) -> tuple[str, str | None]:
+        """(tool, base) for an SRDF group: those given win over the group's."""
+        if self.srdf is None:
+            raise SRDFError(f"group={group!r} needs srdf= (the file that defines the group)")
+        g_tool, g_base = self.srdf.tool_and_base(group, {j: link for link, j in tree.joint_of.items()})
+        return tool or g_tool, base or g_base
+
+    def named_q(self, name: str) -> np.ndarray:
+        """The chain configuration [rad or m] of the SRDF's named configuration ``name`` (``group_state``).
+
+        Raises:
+            SRDFError: no SRDF, an unknown name (the names listed), or a chain joint the configuration omits.
+        """
+        if self.srdf is None:
+            raise SRDFError(f"{self.name} was loaded without an SRDF: load(..., srdf=PATH) to use named "
+                            "configurations")
+        values = self.srdf.state(name)
+        missing = [j for j in self.joint_names if j not in values]
+        if missing:
+            raise SRDFError(f"{self.srdf.path.name}: configuration {name!r} gives no value for chain joint "
+                            f"{missing[0]!r}")
+        return np.array([values[j] for j in self.joint_names])
+
+    def _below_base(self, full: pin.Model, chain: list[int], base: str) -> list[int]:
+        """The chain's joints between frame ``base`` and the tool; the base must lie on the root → tool path."""
+        base_id = _frame_id(full, base, self.name)
+        above = [j for j in full.supports[full.frames[base_id].parentJoint] if j != 0]
+        if any(j not in chain for j in above):
+            raise ChainError(f"{self.name}: base frame {base!r} is not on the path from the root to the tool "
+                             f"{self.tool!r} (a base must be an ancestor of the tool)")
+        return [j for j in chain if j not in above]
+
+    def _reroot(self, base: str) -> None:
+        """Express the reduced model in the ``base`` frame: every placement on the universe is premultiplied by
+        baseMworld (the joints above the base are locked, so the base is fixed in the world)."""
+        data = self.model.createData()
+        pin.framesForwardKinematics(self.model, data, pin.neutral(self.model))
+        bMw = self._bMw = data.oMf[_frame_id(self.model, base, self.name)].inverse()
+        for jid in range(1, self.model.njoints):
+            if self.model.parents[jid] == 0:
+                self.model.jointPlacements[jid] = bMw * self.model.jointPlacements[jid]
+        for fid in range(self.model.nframes):
+            frame = self.model.frames[fid]
+            if frame.parentJoint == 0:
+                frame.placement = bMw * frame.placement
+                self.model.frames[fid] = frame
+        self.data = self.model.createData()
+
+    @staticmethod
     def _locked_values(full: pin.Model, chain: list[int], user: dict[str, float]) -> dict[str, float]:
-        chain_names = [full.names[j] for j in chain]
+        names = [full.names[j] for j in range(1, full.njoints)]
         for jname in user:
-            if jname not in chain_names:
-                raise JointNotFoundError(jname, chain_names)
+            if jname not in names:
+                raise JointNotFoundError(jname, names)
         locked = {}
         for jid in range(1, full.njoints):
             jname = full.names[jid]
@@ -514,16 +588,20 @@ class Robot:
     def visual_model(self, package_dirs: list[str] | None = None) -> pin.GeometryModel:
         """Visual geometry matched to ``self.model`` (locked joints folded in), meshes resolved.
 
-        ``package://`` URIs resolve under ``package_dirs`` (default: example-robot-data's); visuals
-        whose mesh cannot be found are left out with a warning.
+        ``package://`` URIs resolve under ``package_dirs`` (default: those given to :func:`load`, then
+        ``ROS_PACKAGE_PATH``'s, then example-robot-data's); visuals whose mesh cannot be found are left out
+        with a warning.
         """
-        from kinelab.robot.meshes import build_visual_model
-
-        geom = build_visual_model(self._full, self.urdf_path, package_dirs)
-        if not self._lock_ids:
-            return geom
-        _, reduced = pin.buildReducedModel(self._full, geom, self._lock_ids, self._q_ref)
-        return reduced
+        geom = build_visual_model(self._full, self.urdf_path, package_dirs or self.package_dirs)
+        if self._lock_ids:
+            _, geom = pin.buildReducedModel(self._full, geom, self._lock_ids, self._q_ref)
+        if self._bMw is not None:  # re-rooted at the base frame, as the model was
+            for gid in range(geom.ngeoms):
+                obj = geom.geometryObjects[gid]
+                if obj.parentJoint == 0:
+                    obj.placement = self._bMw * obj.placement
+                    geom.geometryObjects[gid] = obj
+        return geom
 
     @property
     def frame_names(self) -> list[str]:
@@ -565,16 +643,31 @@ def _local_axes(model: pin.Model) -> list[np.ndarray]:
     return axes
 
 
-def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, float] | None = None) -> Robot:
+def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, float] | None = None,
+         base: str | None = None, package_dirs: list[str] | None = None, srdf: str | Path | None = None,
+         group: str | None = None) -> Robot:
     """Load a registered robot (``kinelab.robots()``) or a URDF file as a :class:`Robot`.
 
     Args:
         name_or_path: a registered name such as ``"era"`` or ``"panda"``, or a path to a URDF.
         tool: the tool frame; default: the registered tool, else a frame named ``tool``, else the
             single leaf link (an error lists the leaves when there are several).
-        locked: chain joints to hold fixed, name → value (rad or m).
+        locked: joints to hold fixed, name → value (rad or m): chain joints, or joints off the chain (held
+            at zero, clipped into their limits, when not named).
+        base: the frame the chain starts from (default: the URDF root); it must lie on the root → tool
+            path. Joints above it are locked, and every pose (FK, targets) is expressed in this frame.
+        package_dirs: directories where ``package://NAME/...`` mesh URIs resolve (as ``DIR/NAME/...``, or
+            DIR itself when it is the package NAME), before ``ROS_PACKAGE_PATH``'s and example-robot-data's.
+            Kinematics never read meshes; the viewer does.
+        srdf: an SRDF file: its named configurations (:meth:`Robot.named_q`), its groups, and the values at
+            which joints off the chain are held (the first configuration naming a joint; ``locked`` wins).
+        group: an SRDF group whose chain (base → tip), end effector or last joint gives base and tool.
+
+    Raises:
+        RobotNotFoundError, URDFError, SRDFError, ChainError, FrameNotFoundError, JointNotFoundError: named.
     """
     path, entry = catalog.resolve(name_or_path)
-    if entry is not None:
-        return Robot(path, tool=tool or entry.tool, locked=locked, name=entry.name)
-    return Robot(path, tool=tool, locked=locked)
+    if entry is not None and not group:
+        tool = tool or entry.tool
+    return Robot(path, tool=tool, locked=locked, name=entry.name if entry else None, base=base,
+                 package_dirs=package_dirs, srdf=srdf, group=group)

@@ -29,7 +29,7 @@ from kinelab.ik.result import Attempt, Status
 from kinelab.robot import Robot
 
 Options = BiquatOptions
-JOINT_STEPS_PER_LOOK = 128  # integration steps × joints between two looks at the clock (≈ 0.1–0.2 ms of work)
+JOINT_STEPS_PER_LOOK = 48  # integration steps × joints between two looks at the clock (≈ 0.05 ms of work)
 _MULTISTART = TypedKernel(kernel.multistart)
 
 

@@ -91,6 +91,7 @@ def run(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts: np.ndar
                    opts.mode != "orientation", opts.mode != "position", opts.rot_axis, opts.settings(),
                    ORDERS[opts.order],
                    opts.sweep_cap, rng_states[z], attempts[z], float(clock_chunk(solver.JOINT_SWEEPS_PER_LOOK, cm.n)),
+                   float(clock_chunk(solver.JOINT_SWEEPS_PER_LATER_LOOK, cm.n)),
                    codes[z], stats[z])
         rows.Q[z] = Q[z]
         rows.status[z] = np.where(codes[z] == CONVERGED, Status.CONVERGED.value,
@@ -104,14 +105,17 @@ def run(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts: np.ndar
 
 
 @njit(cache=True)
-def chunked(q, ch, pb, st, order, max_sweeps, rng_state, attempts, chunk_sweeps, best_q, stats):
-    """The kernel's multistart in chunks of ``chunk_sweeps`` sweeps, as the timed single solve runs it
+def chunked(q, ch, pb, st, order, max_sweeps, rng_state, attempts, chunk_sweeps, later_sweeps, best_q, stats):
+    """The kernel's multistart in chunks of ``chunk_sweeps`` sweeps, then ``later_sweeps``, as the timed single
+    solve runs it
     (:func:`kinelab.ik.multistart.run_in_chunks`) but without the clock. Returns the last code."""
     code = -1
+    chunk = chunk_sweeps
     while attempts > 0:
         before = stats[T_ATTEMPTS]
-        code = multistart(q, ch, pb, st, order, max_sweeps, rng_state, attempts, stats[T_SWEEPS] + chunk_sweeps,
+        code = multistart(q, ch, pb, st, order, max_sweeps, rng_state, attempts, stats[T_SWEEPS] + chunk,
                           best_q, stats)
+        chunk = later_sweeps
         attempts -= int(stats[T_ATTEMPTS] - before)
         if code == CONVERGED:
             break
@@ -120,7 +124,8 @@ def chunked(q, ch, pb, st, order, max_sweeps, rng_state, attempts, chunk_sweeps,
 
 @njit(cache=True, parallel=True)
 def solve_rows(Q, draw_start, ch, lower, upper, free, pstars, Rstars, w_p, w_ax, tol_pos, tol_rot, check_pos,
-               check_rot, rot_axis, st, order, max_sweeps, rng_states, attempts, chunk_sweeps, codes, stats):
+               check_rot, rot_axis, st, order, max_sweeps, rng_states, attempts, chunk_sweeps, later_sweeps, codes,
+               stats):
     """Solve rows [0, B) in parallel; row b's start is Q[b] (drawn from its generator when draw_start).
 
     Inputs, in order:
@@ -131,7 +136,7 @@ def solve_rows(Q, draw_start, ch, lower, upper, free, pstars, Rstars, w_p, w_ax,
         w_p, w_ax, tol_pos, tol_rot, check_pos, check_rot, rot_axis, st, order, max_sweeps: as the single solve.
         rng_states (np.ndarray): (B, 1) uint64 generator state per row.
         attempts (np.ndarray): (B,) attempts allowed per row (1 for a target proved out of reach).
-        chunk_sweeps (float): sweeps per chunk (the single solve's clock chunk).
+        chunk_sweeps, later_sweeps (float): sweeps of the first chunk and of the later ones (the single solve's).
         codes (np.ndarray): (B,) run() code per row; stats: (B, STATS_SIZE) the slots T_* per row.
     """
     rest = np.zeros(Q.shape[1])
@@ -143,7 +148,8 @@ def solve_rows(Q, draw_start, ch, lower, upper, free, pstars, Rstars, w_p, w_ax,
                      rest, 0.0, rot_axis)
         best_q = q.copy()
         row_stats = np.zeros(STATS_SIZE)
-        codes[b] = chunked(q, ch, pb, st, order, max_sweeps, rng_states[b], attempts[b], chunk_sweeps, best_q,
+        codes[b] = chunked(q, ch, pb, st, order, max_sweeps, rng_states[b], attempts[b], chunk_sweeps, later_sweeps,
+                           best_q,
                            row_stats)
         Q[b] = best_q
         stats[b] = row_stats

@@ -28,9 +28,10 @@ from kinelab.robot import Robot
 
 Options = FRDMOptions
 _MULTISTART = TypedKernel(kernel.multistart)
-# joint steps between two looks at the clock (0.03-0.1 ms of work): a budget is then overrun by about that
-# much whatever the chain's length, within the 5 % + 0.1 ms kinelab promises at a 5 ms budget
+# joint steps before the first look at the clock (most solves end within them: one kernel call), and then
+# between two looks (≈ 0.03 ms of work: a budget is overrun by about that much whatever the chain's length)
 JOINT_SWEEPS_PER_LOOK = 256
+JOINT_SWEEPS_PER_LATER_LOOK = 64
 
 
 def prepare(robot: Robot) -> None:
@@ -127,6 +128,7 @@ class _Context:
         self.pstar, self.Rstar = self.problem.pstar, self.problem.Rstar
         self.settings, self.order, self.cap = opts.settings(), ORDERS[opts.order], opts.sweep_cap
         self.chunk = float(clock_chunk(JOINT_SWEEPS_PER_LOOK, cm.n))
+        self.later_chunk = float(clock_chunk(JOINT_SWEEPS_PER_LATER_LOOK, cm.n))
         self.mode = "frdm" + (" (plain)" if opts.plain else "")
         self.seed: int | None = None
         self.seed_value = np.zeros(1, dtype=np.uint64)  # the generator state of ``self.seed``
@@ -150,7 +152,7 @@ class _Context:
         if code != kernel.CONVERGED and attempts > 0 and time.perf_counter() <= deadline:
             def chunk(attempts_left: int) -> int:
                 return _MULTISTART(q, cm.chain, self.problem, self.settings, self.order, self.cap, rng_state,
-                                   attempts_left, float(stats[kernel.T_SWEEPS] + self.chunk), best_q, stats)
+                                   attempts_left, float(stats[kernel.T_SWEEPS] + self.later_chunk), best_q, stats)
 
             code = restarts.run_in_chunks(chunk, attempts, stats, deadline, kernel.CONVERGED)
         return code, best_q, stats

@@ -1,0 +1,126 @@
+"""SRDF: the groups (a chain base → tip, or a list of joints) and the named configurations of a robot.
+
+Only what kinematics needs is read: ``<group>`` (with ``<chain>``, ``<joint>`` and nested ``<group>``),
+``<group_state>`` and ``<end_effector>``. Collision pairs and virtual joints are ignored.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from kinelab.errors import SRDFError
+
+
+@dataclass(frozen=True)
+class Group:
+    """A planning group: a chain (base link, tip link), joints, and the groups it includes."""
+
+    name: str
+    chain: tuple[str, str] | None = None
+    joints: tuple[str, ...] = ()
+    subgroups: tuple[str, ...] = ()
+
+
+@dataclass
+class Srdf:
+    """The groups, named configurations (name → joint → value [rad or m]) and end effectors of one SRDF."""
+
+    path: Path
+    groups: dict[str, Group] = field(default_factory=dict)
+    states: dict[str, dict[str, float]] = field(default_factory=dict)
+    end_effectors: dict[str, str] = field(default_factory=dict)  # group → parent link
+    virtual_joints: tuple[str, ...] = ()  # a floating base's joint (declared, or given a pose): skipped
+
+    def group(self, name: str) -> Group:
+        """The group named, or an SRDFError listing the groups."""
+        if name not in self.groups:
+            raise SRDFError(f"{self.path.name} has no group {name!r}; groups: {', '.join(self.groups) or 'none'}")
+        return self.groups[name]
+
+    def state(self, name: str) -> dict[str, float]:
+        """The named configuration, or an SRDFError listing the names."""
+        if name not in self.states:
+            raise SRDFError(f"{self.path.name} has no configuration {name!r}; configurations: "
+                            f"{', '.join(self.states) or 'none'}")
+        return self.states[name]
+
+    def group_joints(self, name: str) -> list[str]:
+        """The joints a group lists, its subgroups' included (a chain group lists none: see ``chain``)."""
+        g = self.group(name)
+        out = list(g.joints)
+        for sub in g.subgroups:
+            out += [j for j in self.group_joints(sub) if j not in out]
+        return out
+
+    def check_joints(self, known: list[str]) -> None:
+        """Refuse a group or configuration naming a joint the robot does not have (file and joint named)."""
+        for where, names in [*((f"group {g!r}", self.group_joints(g)) for g in self.groups),
+                             *((f"configuration {s!r}", list(v)) for s, v in self.states.items())]:
+            unknown = [j for j in names if j not in known and j not in self.virtual_joints]
+            if unknown:
+                raise SRDFError(f"{self.path.name}: {where} names joint {unknown[0]!r}, which the robot does not have")
+
+    def tool_and_base(self, group: str, child_link: dict[str, str]) -> tuple[str, str | None]:
+        """(tool link, base link or None for the root) of a group: its chain's tip and base, else its end
+        effector's parent link, else the child link of its last joint (``child_link``: joint → link)."""
+        g = self.group(group)
+        if g.chain is not None:
+            return g.chain[1], g.chain[0]
+        if group in self.end_effectors:
+            return self.end_effectors[group], None
+        joints = self.group_joints(group)
+        if not joints:
+            raise SRDFError(f"{self.path.name}: group {group!r} has no chain and no joints to take a tool from")
+        return child_link[joints[-1]], None
+
+    def reference(self) -> dict[str, float]:
+        """Every joint value the named configurations give, the first configuration naming a joint winning."""
+        out: dict[str, float] = {}
+        for values in self.states.values():
+            for joint, value in values.items():
+                if joint not in self.virtual_joints:
+                    out.setdefault(joint, value)
+        return out
+
+
+def read_srdf(path: str | Path) -> Srdf:
+    """Read the groups, named configurations and end effectors of an SRDF file.
+
+    Raises:
+        SRDFError: a missing or malformed file, a configuration value that is not a number.
+    """
+    path = Path(path)
+    try:
+        root = ET.parse(path).getroot()
+    except (OSError, ET.ParseError) as exc:
+        raise SRDFError(f"cannot read SRDF {path}: {exc}") from None
+    out = Srdf(path)
+    for g in root.findall("group"):  # top-level definitions (a nested <group name=.../> only refers to one)
+        chain = g.find("chain")
+        out.groups.setdefault(g.get("name", ""), Group(
+            g.get("name", ""),
+            (chain.get("base_link", ""), chain.get("tip_link", "")) if chain is not None else None,
+            tuple(j.get("name", "") for j in g.findall("joint")),
+            tuple(s.get("name", "") for s in g.findall("group"))))
+    virtual = [v.get("name", "") for v in root.iter("virtual_joint")]
+    for st in root.iter("group_state"):
+        values = out.states[st.get("name", "")] = {}
+        for j in st.findall("joint"):
+            if len(j.get("value", "").split()) > 1:  # a floating base's pose (x y z qx qy qz qw): not a chain joint
+                virtual.append(j.get("name", ""))
+            else:
+                values[j.get("name", "")] = _number(j, path)
+    out.virtual_joints = tuple(dict.fromkeys(virtual))
+    for ee in root.iter("end_effector"):
+        out.end_effectors.setdefault(ee.get("group", ""), ee.get("parent_link", ""))
+    return out
+
+
+def _number(joint: ET.Element, path: Path) -> float:
+    try:
+        return float(joint.get("value", "").split()[0])
+    except (ValueError, IndexError):
+        raise SRDFError(f"{path.name}: joint {joint.get('name')!r} of a group_state has value "
+                        f"{joint.get('value')!r}, not a number") from None
