@@ -13,6 +13,7 @@ import kinelab
 from kinelab.ik import solve
 from kinelab.ik.chain import chain_model as vector_model
 from kinelab.ik.frdm import kernel, reference
+from kinelab.ik.multistart import seed_state
 
 ROBOTS = ("stanford", "era", "youbot", "panda", "ur5", "kinova")
 
@@ -342,7 +343,6 @@ def test_compiled_multistart_is_seeded_and_checked_by_pinocchio(robots):
 def test_mixed_order_restarts_turn_the_sweep_direction(robots):
     """order="mixed": attempt 1 sweeps base → tip, the restart tip → base, from the same seeded start."""
     from kinelab.ik.frdm.options import ORDERS
-    from kinelab.ik.multistart import seed_state
 
     robot = robots["stanford"]
     vm = vector_model(robot)
@@ -351,19 +351,48 @@ def test_mixed_order_restarts_turn_the_sweep_direction(robots):
         target, q0 = robot.fk(robot.random_q(rng)), robot.random_q(rng)
         last = {}
         for name in ("mixed", "base2tip", "tip2base"):
-            q, best, stats = q0.copy(), q0.copy(), np.zeros(5)
+            q, best, stats = q0.copy(), q0.copy(), np.zeros(kernel.STATS_SIZE)
             problem = kernel.Problem(vm.lower, vm.upper, np.ones(vm.n, dtype=np.bool_), target.translation,
                                      target.rotation, 3.0 / vm.length**2, np.ones(3), 1e-6, 1e-6, True, True,
                                      np.zeros(vm.n), 0.0, -1)
             settings = kernel.Settings(1.0, 1e-10, 10, 0.1, 5)
             code = kernel.multistart(q, vm.chain, problem, settings, ORDERS[name], 100, seed_state(7), 2, 1e9, best,
-                                     stats)
+                                     stats, kernel.new_memory(vm.n, 5))
             last[name] = (q, stats[0], code)
         if last["mixed"][1] == 2 and last["base2tip"][1] == 2 and last["tip2base"][1] == 2:
             np.testing.assert_array_equal(last["mixed"][0], last["tip2base"][0])  # the restart ran tip → base
             assert not np.array_equal(last["mixed"][0], last["base2tip"][0])
             return
     pytest.fail("no start found whose first attempt fails both ways")
+
+
+@pytest.mark.parametrize("chunk", [3, 7, 40])
+def test_the_answer_does_not_depend_on_where_the_clock_chunks_end(chunk):
+    """The multistart called in chunks of a few sweeps (as a timed solve calls it) resumes each cut attempt
+    with its history: the same answer, sweep for sweep, as one uncut call."""
+    robot = kinelab.load("panda")
+    vm = vector_model(robot)
+    rng = np.random.default_rng(11)
+    settings = kernel.Settings(1.0, 1e-10, 10, 0.1, 5)
+    for _ in range(5):
+        target, q0 = robot.fk(robot.random_q(rng)), robot.random_q(rng)
+        problem = kernel.Problem(vm.lower, vm.upper, np.ones(vm.n, dtype=np.bool_), target.translation,
+                                 target.rotation, 3.0 / vm.length**2, np.ones(3), 1e-9, 1e-9, True, True,
+                                 np.zeros(vm.n), 0.0, -1)
+        results = []
+        for size in (1e9, chunk):
+            q, best, stats, mem = q0.copy(), q0.copy(), np.zeros(kernel.STATS_SIZE), kernel.new_memory(vm.n, 5)
+            rng_state, attempts, code = seed_state(3), 20, -1
+            while attempts > 0:
+                before = stats[kernel.T_ATTEMPTS]
+                code = kernel.multistart(q, vm.chain, problem, settings, kernel.MIXED, 100, rng_state, attempts,
+                                         stats[kernel.T_SWEEPS] + size, best, stats, mem)
+                attempts -= int(stats[kernel.T_ATTEMPTS] - before)
+                if code == kernel.CONVERGED:
+                    break
+            results.append((code, best.copy(), stats[kernel.T_SWEEPS], stats[kernel.T_ATTEMPTS]))
+        assert results[0][0] == results[1][0] and results[0][2:] == results[1][2:]
+        np.testing.assert_array_equal(results[0][1], results[1][1])
 
 
 def test_a_cold_first_solve_compiles_before_its_clock_starts(tmp_path):
@@ -402,7 +431,8 @@ def test_the_typed_entry_point_gives_the_dispatchers_answer(robots):
         out = []
         for call in (frdm_solver._MULTISTART, kernel.multistart):
             q, best, stats = q0.copy(), q0.copy(), np.zeros(kernel.STATS_SIZE)
-            code = call(q, cm.chain, problem, opts.settings(), 3, 100, seed_state(k), 5, 1e9, best, stats)
+            code = call(q, cm.chain, problem, opts.settings(), 3, 100, seed_state(k), 5, 1e9, best, stats,
+                        kernel.new_memory(cm.n, opts.accel_m))
             out.append((code, best, stats))
         assert out[0][0] == out[1][0]
         np.testing.assert_array_equal(out[0][1], out[1][1])

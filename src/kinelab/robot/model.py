@@ -13,6 +13,7 @@ Jacobians are 6 × n with rows [linear; angular] (Pinocchio's order); the method
 from __future__ import annotations
 
 import contextlib
+import functools
 import itertools
 import math
 import operator
@@ -41,6 +42,7 @@ from kinelab.errors import (
 from kinelab.geometry import pose_error, wrap_to_pi
 from kinelab.robot import catalog
 from kinelab.robot.meshes import build_visual_model, mesh_package_dirs
+from kinelab.robot.mjcf import is_mjcf, read_mjcf
 from kinelab.robot.srdf import Srdf, read_srdf
 from kinelab.robot.urdf import UrdfTree, read_tree
 
@@ -137,6 +139,9 @@ def _locked_value(full: pin.Model, jid: int, value: object) -> float:
     return number
 
 
+SAMPLE_TURNS = 4  # random configurations keep revolute joints within ±4 turns (see Robot.random_q)
+
+
 def data_bytes(nv: int) -> int:
     """Bytes a Pinocchio Data takes for nv velocities: it allocates nv × nv × nv tensors (second-order
     derivatives) and a 6 × nv × nv one, whatever the algorithms used, so its size grows as nv³."""
@@ -192,8 +197,11 @@ class Robot:
     ):
         self.urdf_path = Path(urdf_path)
         self.package_dirs = mesh_package_dirs(package_dirs)
-        tree = read_tree(self.urdf_path)
-        full = _build_full_model(self.urdf_path)
+        if is_mjcf(self.urdf_path):
+            full, tree = read_mjcf(self.urdf_path)
+        else:
+            tree = read_tree(self.urdf_path)
+            full = _build_full_model(self.urdf_path)
         self.name = name or full.name or self.urdf_path.stem
         self.srdf = self._read_srdf(srdf, tree)
         if group is not None:
@@ -221,12 +229,18 @@ class Robot:
         q_ref = pin.neutral(full)
         for jname, value in self.locked.items():
             jid = full.getJointId(jname)
-            kind = _kind(full.joints[jid]) or "revolute"
+            kind = _kind(full.joints[jid])
+            if kind is None:  # a free or spherical joint above the chain: held at its neutral pose
+                continue
             nq = full.joints[jid].nq
             q_ref[full.idx_qs[jid] : full.idx_qs[jid] + nq] = _one_to_pin(kind, value)[:nq]
         lock_ids = [full.getJointId(j) for j in self.locked]
         self._full, self._lock_ids, self._q_ref = full, lock_ids, q_ref
-        self.model = pin.buildReducedModel(full, lock_ids, q_ref) if lock_ids else full
+        try:
+            self.model = pin.buildReducedModel(full, lock_ids, q_ref) if lock_ids else full
+        except ValueError as exc:  # Pinocchio cannot fold a locked joint whose name a link also bears
+            raise ChainError(f"{self.name}: Pinocchio cannot lock the joints off the chain ({exc}); give "
+                             "another tool= or base=") from None
         _check_data_size(self.model, self.name)
         self.data = self.model.createData()
         self.tool_frame_id = _frame_id(self.model, self.tool, self.name)
@@ -470,14 +484,23 @@ class Robot:
         return np.clip(np.zeros(self.n), self.lower, self.upper)
 
     def random_q(self, rng: np.random.Generator | int | None = None) -> np.ndarray:
-        """A configuration drawn uniformly within the limits (continuous joints on [−π, π])."""
+        """A configuration drawn uniformly within the limits (continuous joints on [−π, π]; a revolute joint
+        whose limits lie beyond ±SAMPLE_TURNS turns, such as a rotor declared with ±1e16 rad, on ±SAMPLE_TURNS
+        turns: every pose it can take, at angles where rounding does not swamp a step)."""
         rng = np.random.default_rng(rng)
-        return rng.uniform(self.lower, self.upper)
+        return rng.uniform(*self._sample_bounds)
 
     def random_qs(self, count: int, rng: np.random.Generator | int | None = None) -> np.ndarray:
-        """``count`` configurations (rows) drawn uniformly within the limits."""
+        """``count`` configurations (rows) drawn as :meth:`random_q` draws one."""
         rng = np.random.default_rng(rng)
-        return rng.uniform(self.lower, self.upper, size=(count, self.n))
+        return rng.uniform(*self._sample_bounds, size=(count, self.n))
+
+    @functools.cached_property
+    def _sample_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        revolute = np.array([k != "prismatic" for k in self.joint_kinds])
+        span = SAMPLE_TURNS * 2 * np.pi
+        return (np.where(revolute, np.maximum(self.lower, -span), self.lower),
+                np.where(revolute, np.minimum(self.upper, span), self.upper))
 
     # -- kinematics ----------------------------------------------------------------------------
     def _forward(self, q) -> None:
@@ -592,7 +615,10 @@ class Robot:
         ``ROS_PACKAGE_PATH``'s, then example-robot-data's); visuals whose mesh cannot be found are left out
         with a warning.
         """
-        geom = build_visual_model(self._full, self.urdf_path, package_dirs or self.package_dirs)
+        if is_mjcf(self.urdf_path):
+            geom = pin.buildGeomFromMJCF(self._full, str(self.urdf_path), pin.GeometryType.VISUAL)
+        else:
+            geom = build_visual_model(self._full, self.urdf_path, package_dirs or self.package_dirs)
         if self._lock_ids:
             _, geom = pin.buildReducedModel(self._full, geom, self._lock_ids, self._q_ref)
         if self._bMw is not None:  # re-rooted at the base frame, as the model was

@@ -18,7 +18,17 @@ from numba import njit, prange
 from kinelab.geometry import wrap_to_pi
 from kinelab.ik.chain import CONTINUOUS, chain_model, random_configuration
 from kinelab.ik.frdm import solver
-from kinelab.ik.frdm.kernel import CONVERGED, STATS_SIZE, T_ATTEMPTS, T_STALLS, T_SWEEPS, Problem, multistart
+from kinelab.ik.frdm.kernel import (
+    CONVERGED,
+    STATE_SIZE,
+    STATS_SIZE,
+    T_ATTEMPTS,
+    T_STALLS,
+    T_SWEEPS,
+    Memory,
+    Problem,
+    multistart,
+)
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.multistart import clock_chunk
 from kinelab.ik.result import Status
@@ -105,7 +115,7 @@ def run(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts: np.ndar
 
 
 @njit(cache=True)
-def chunked(q, ch, pb, st, order, max_sweeps, rng_state, attempts, chunk_sweeps, later_sweeps, best_q, stats):
+def chunked(q, ch, pb, st, order, max_sweeps, rng_state, attempts, chunk_sweeps, later_sweeps, best_q, stats, mem):
     """The kernel's multistart in chunks of ``chunk_sweeps`` sweeps, then ``later_sweeps``, as the timed single
     solve runs it
     (:func:`kinelab.ik.multistart.run_in_chunks`) but without the clock. Returns the last code."""
@@ -114,7 +124,7 @@ def chunked(q, ch, pb, st, order, max_sweeps, rng_state, attempts, chunk_sweeps,
     while attempts > 0:
         before = stats[T_ATTEMPTS]
         code = multistart(q, ch, pb, st, order, max_sweeps, rng_state, attempts, stats[T_SWEEPS] + chunk,
-                          best_q, stats)
+                          best_q, stats, mem)
         chunk = later_sweeps
         attempts -= int(stats[T_ATTEMPTS] - before)
         if code == CONVERGED:
@@ -139,7 +149,8 @@ def solve_rows(Q, draw_start, ch, lower, upper, free, pstars, Rstars, w_p, w_ax,
         chunk_sweeps, later_sweeps (float): sweeps of the first chunk and of the later ones (the single solve's).
         codes (np.ndarray): (B,) run() code per row; stats: (B, STATS_SIZE) the slots T_* per row.
     """
-    rest = np.zeros(Q.shape[1])
+    n = Q.shape[1]
+    rest = np.zeros(n)
     for b in prange(Q.shape[0]):
         q = Q[b].copy()
         if draw_start:
@@ -148,8 +159,9 @@ def solve_rows(Q, draw_start, ch, lower, upper, free, pstars, Rstars, w_p, w_ax,
                      rest, 0.0, rot_axis)
         best_q = q.copy()
         row_stats = np.zeros(STATS_SIZE)
+        mem = Memory(np.zeros((st.accel_m + 1, n)), np.zeros((st.accel_m + 1, n)), np.zeros(STATE_SIZE), np.zeros(0),
+                     np.zeros((2 * n + 4, 3)))
         codes[b] = chunked(q, ch, pb, st, order, max_sweeps, rng_states[b], attempts[b], chunk_sweeps, later_sweeps,
-                           best_q,
-                           row_stats)
+                           best_q, row_stats, mem)
         Q[b] = best_q
         stats[b] = row_stats

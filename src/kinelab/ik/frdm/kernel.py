@@ -41,11 +41,11 @@ TIP_TO_BASE, BASE_TO_TIP, ALTERNATE, MIXED = 0, 1, 2, 3  # sweep order codes (MI
 CONVERGED, STALL_STEP, STALL_WINDOW, BUDGET = 0, 1, 2, 3
 
 # slots of an attempt's state array
-S_HISTORY, S_SWEEPS, S_E_WINDOW, S_WINDOW_START, S_ACCEPTED, S_E, S_KICKED = range(7)
-STATE_SIZE = 7
+S_HISTORY, S_SWEEPS, S_E_WINDOW, S_WINDOW_START, S_ACCEPTED, S_E, S_KICKED, S_HELD, S_SINCE_FK = range(9)
+STATE_SIZE = 9
 # slots of a multistart's statistics array
-T_ATTEMPTS, T_SWEEPS, T_STALLS, T_ACCEPTED, T_BEST_E = range(5)
-STATS_SIZE = 5
+T_ATTEMPTS, T_SWEEPS, T_STALLS, T_ACCEPTED, T_BEST_E, T_CUT = range(6)
+STATS_SIZE = 6
 
 
 class Problem(NamedTuple):
@@ -84,12 +84,41 @@ class Memory(NamedTuple):
     G: np.ndarray  # (accel_m + 1, n) ring of sweep residuals F(x) − x
     state: np.ndarray  # (STATE_SIZE,) slots S_*
     trace: np.ndarray  # per-sweep objective (length 0: not recorded)
+    held: np.ndarray  # (2n + 4, 3): e, o, p, R of a run the sweep budget cut (S_HELD = 1), for its resumption
 
 
 def new_memory(n: int, accel_m: int, trace_length: int = 0) -> Memory:
     """Zeroed work arrays for an attempt on an n-joint chain."""
     return Memory(np.zeros((accel_m + 1, n)), np.zeros((accel_m + 1, n)), np.zeros(STATE_SIZE),
-                  np.full(trace_length, -1.0))
+                  np.full(trace_length, -1.0), np.zeros((2 * n + 4, 3)))
+
+
+@njit(cache=True, inline="always")
+def _hold(mem, e, o, p, R, since_fk):
+    """Keep the carried state of a cut run, so that resuming it repeats exactly what one run would do."""
+    n = e.shape[0]
+    held = mem.held
+    held[:n] = e
+    held[n:2 * n] = o
+    held[2 * n] = p
+    held[2 * n + 1:] = R
+    mem.state[S_HELD] = 1.0
+    mem.state[S_SINCE_FK] = since_fk
+
+
+@njit(cache=True, inline="always")
+def _resume(mem, e, o, p, R):
+    """The held state back into e, o, p, R; returns (fresh, since_fk)."""
+    if mem.state[S_HELD] == 0.0:
+        return False, 0
+    n = e.shape[0]
+    held = mem.held
+    e[:] = held[:n]
+    o[:] = held[n:2 * n]
+    p[:] = held[2 * n]
+    R[:] = held[2 * n + 1:]
+    mem.state[S_HELD] = 0.0
+    return True, int(mem.state[S_SINCE_FK])
 
 
 @njit(cache=True, inline="always")
@@ -449,8 +478,9 @@ def run(q: np.ndarray, ch: Chain, pb: Problem, st: Settings, order: int, max_swe
     x_old = w.x_old
     e, o, p, R = np.empty((n, 3)), np.empty((n, 3)), np.empty(3), np.empty((3, 3))
     ec, oc, pc, Rc = np.empty((n, 3)), np.empty((n, 3)), np.empty(3), np.empty((3, 3))
-    fresh = False  # e, o, p, R hold the state at q (carried by the last sweep or an accepted extrapolation)
-    since_fk = 0  # sweeps since p, R came from a chain FK (incremental updates carry rounding)
+    # fresh: e, o, p, R hold the state at q (carried by the last sweep or an accepted extrapolation);
+    # since_fk: sweeps since p, R came from a chain FK (incremental updates carry rounding)
+    fresh, since_fk = _resume(mem, e, o, p, R)
     for s in range(max_sweeps):
         if not fresh or since_fk >= REFRESH_SWEEPS:
             chain_fk(ch, q, e, o, p, R)
@@ -488,32 +518,43 @@ def run(q: np.ndarray, ch: Chain, pb: Problem, st: Settings, order: int, max_swe
         state[S_E] = E1
         if _window_stalled(state, st, E1):
             return STALL_WINDOW, s + 1
+    if fresh:
+        _hold(mem, e, o, p, R, since_fk)
     return BUDGET, max_sweeps
 
 
 @njit(cache=True)
-def multistart(q, ch, pb, st, order, max_sweeps, rng_state, max_attempts, sweep_budget, best_q, stats):
+def multistart(q, ch, pb, st, order, max_sweeps, rng_state, max_attempts, sweep_budget, best_q, stats, mem):
     """Attempts from q, then from seeded uniform starts, until one converges, ``max_attempts`` have run or
-    ``sweep_budget`` sweeps are spent. A stall ends an attempt (a restart, not a bypass).
+    ``sweep_budget`` sweeps (a total) are spent. A stall ends an attempt (a restart, not a bypass).
 
-    On return q holds the converged configuration (or the last start), best_q the lowest-objective one;
-    stats has the slots T_*. Returns a run() code.
+    Called in chunks: an attempt the sweep budget cuts is resumed by the next call from where it stopped, its
+    Anderson history and monitor state kept in ``mem`` (stats[T_CUT] = 1 meanwhile), so the answer does not
+    depend on where the chunks end. On return q holds the converged configuration (or the current one),
+    best_q the lowest-objective one; stats has the slots T_*. Returns a run() code.
     """
-    n = q.shape[0]
-    mem = Memory(np.zeros((st.accel_m + 1, n)), np.zeros((st.accel_m + 1, n)), np.zeros(STATE_SIZE), np.zeros(0))
-    best = np.inf
+    best = stats[T_BEST_E] if stats[T_ATTEMPTS] > 0.0 or stats[T_CUT] != 0.0 else np.inf
     code = BUDGET
-    for a in range(max_attempts):
-        if a > 0:
-            random_configuration(q, ch.kind, pb.lower, pb.upper, rng_state)
-        mem.state[:] = 0.0
-        budget = min(max_sweeps, int(sweep_budget - stats[T_SWEEPS]))
+    done = 0
+    while done < max_attempts:
+        if stats[T_CUT] == 0.0:
+            if stats[T_ATTEMPTS] > 0.0:
+                random_configuration(q, ch.kind, pb.lower, pb.upper, rng_state)
+            mem.state[:] = 0.0
+        stats[T_CUT] = 0.0
+        left = max_sweeps - int(mem.state[S_SWEEPS])
+        budget = min(left, int(sweep_budget - stats[T_SWEEPS]))
         attempt_order = order
         if order == MIXED:  # base → tip on the first attempt and every other restart, tip → base between
             attempt_order = BASE_TO_TIP if int(stats[T_ATTEMPTS]) % 2 == 0 else TIP_TO_BASE
         code, s = run(q, ch, pb, st, attempt_order, budget, mem)
-        stats[T_ATTEMPTS] += 1.0
         stats[T_SWEEPS] += s
+        if code == BUDGET and budget < left:  # cut by the chunk: the next call resumes this attempt
+            stats[T_CUT] = 1.0
+            stats[T_BEST_E] = best
+            return BUDGET
+        stats[T_ATTEMPTS] += 1.0
+        done += 1
         stats[T_ACCEPTED] += mem.state[S_ACCEPTED]
         if mem.state[S_E] < best:
             best = mem.state[S_E]

@@ -140,6 +140,7 @@ class Runner:
 
     def kernel_run(self, q: np.ndarray, budget: int) -> tuple[int, int]:
         """Up to ``budget`` sweeps of the compiled kernel from q (in place)."""
+        self.state[kernel.S_HELD] = 0.0  # the monitor may have moved q since: the kernel recomputes the FK
         return _RUN(q, self.vm.chain, self.prob.tuple(), self.settings, self.order, int(budget), self.mem)
 
     def solve(self, q: np.ndarray, deadline: float, bypass: Bypass, max_events: int) -> Status:

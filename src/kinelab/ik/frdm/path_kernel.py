@@ -42,7 +42,8 @@ def follow(Q, q0, ch, lower, upper, free, pstars, Rstars, w_p, w_ax, tol_pos, to
         codes, sweeps (np.ndarray): (N,) outputs: run() code and sweeps spent per sample.
     """
     n = q0.shape[0]
-    mem = Memory(np.zeros((st.accel_m + 1, n)), np.zeros((st.accel_m + 1, n)), np.zeros(STATE_SIZE), np.zeros(0))
+    mem = Memory(np.zeros((st.accel_m + 1, n)), np.zeros((st.accel_m + 1, n)), np.zeros(STATE_SIZE), np.zeros(0),
+                 np.zeros((2 * n + 4, 3)))
     q = q0.copy()
     q_prev = q0.copy()
     rest = q0.copy()

@@ -130,6 +130,7 @@ class _Context:
         self.chunk = float(clock_chunk(JOINT_SWEEPS_PER_LOOK, cm.n))
         self.later_chunk = float(clock_chunk(JOINT_SWEEPS_PER_LATER_LOOK, cm.n))
         self.mode = "frdm" + (" (plain)" if opts.plain else "")
+        self.memory = kernel.new_memory(cm.n, opts.accel_m)  # reused: every attempt resets what it reads
         self.seed: int | None = None
         self.seed_value = np.zeros(1, dtype=np.uint64)  # the generator state of ``self.seed``
 
@@ -147,12 +148,13 @@ class _Context:
         best_q = q.copy()
         stats = np.zeros(kernel.STATS_SIZE)
         code = _MULTISTART(q, cm.chain, self.problem, self.settings, self.order, self.cap, rng_state, attempts,
-                           self.chunk, best_q, stats)
+                           self.chunk, best_q, stats, self.memory)
         attempts -= int(stats[kernel.T_ATTEMPTS])
         if code != kernel.CONVERGED and attempts > 0 and time.perf_counter() <= deadline:
             def chunk(attempts_left: int) -> int:
                 return _MULTISTART(q, cm.chain, self.problem, self.settings, self.order, self.cap, rng_state,
-                                   attempts_left, float(stats[kernel.T_SWEEPS] + self.later_chunk), best_q, stats)
+                                   attempts_left, float(stats[kernel.T_SWEEPS] + self.later_chunk), best_q, stats,
+                                   self.memory)
 
             code = restarts.run_in_chunks(chunk, attempts, stats, deadline, kernel.CONVERGED)
         return code, best_q, stats

@@ -1,0 +1,70 @@
+"""MJCF files: Pinocchio's parser for the kinematics, kinelab's body tree for tool and base; checked against
+the same arm written as a URDF (yourdfpy cannot read MJCF)."""
+
+import numpy as np
+import pytest
+
+import kinelab
+from kinelab import ChainError, load
+from kinelab.analysis.oracles import fk_vs_yourdfpy, jacobians_vs_fd
+
+BODIES = """
+    <body name="base" pos="0 0 0">{free}
+      <body name="l1" pos="0 0 0.3">
+        <joint name="j1" type="hinge" axis="0 0 1" range="{r1}" limited="true"/>
+        <body name="l2" pos="0 0.1 0.2" axisangle="1 0 0 {tilt}">
+          <joint name="j2" type="hinge" axis="0 1 0" range="{r2}" limited="true"/>
+          <body name="l3" pos="0 0 0.25">
+            <joint name="j3" type="slide" axis="0 0 1" range="0 0.2" limited="true"/>
+            <body name="tool" pos="0 0 0.1"/>
+          </body>
+        </body>
+      </body>
+    </body>"""
+URDF = """<?xml version="1.0"?>
+<robot name="arm3"><link name="base"/><link name="l1"/><link name="l2"/><link name="l3"/><link name="tool"/>
+<joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><origin xyz="0 0 0.3"/>
+<axis xyz="0 0 1"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint>
+<joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0 0.1 0.2" rpy="0.3 0 0"/>
+<axis xyz="0 1 0"/><limit lower="-1.5" upper="1.5" effort="1" velocity="1"/></joint>
+<joint name="j3" type="prismatic"><parent link="l2"/><child link="l3"/><origin xyz="0 0 0.25"/>
+<axis xyz="0 0 1"/><limit lower="0" upper="0.2" effort="1" velocity="1"/></joint>
+<joint name="jt" type="fixed"><parent link="l3"/><child link="tool"/><origin xyz="0 0 0.1"/></joint>
+</robot>"""
+
+
+def write_mjcf(tmp_path, degrees=False, free=False, name="arm.xml"):
+    compiler = "" if degrees else '<compiler angle="radian"/>'
+    r1, r2, tilt = ("-114.59156 114.59156", "-85.943669 85.943669", "17.188734") if degrees else \
+        ("-2 2", "-1.5 1.5", "0.3")
+    body = BODIES.format(r1=r1, r2=r2, tilt=tilt, free='<freejoint name="float"/>' if free else "")
+    path = tmp_path / name
+    path.write_text(f'<mujoco model="arm3">{compiler}<worldbody>{body}</worldbody></mujoco>')
+    return path
+
+
+@pytest.mark.parametrize("degrees", [False, True])
+def test_an_mjcf_arm_equals_the_same_arm_written_as_a_urdf(tmp_path, degrees):
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text(URDF)
+    mj, ur = load(write_mjcf(tmp_path, degrees)), load(urdf)
+    assert (mj.tool, mj.base, mj.joint_names) == ("tool", "base", ["j1", "j2", "j3"])
+    np.testing.assert_allclose(mj.lower, ur.lower, atol=1e-6)  # slide range kept in metres in degree mode
+    np.testing.assert_allclose(mj.upper, ur.upper, atol=1e-6)
+    for q in ur.random_qs(50, 3):
+        np.testing.assert_allclose(mj.fk(q).homogeneous, ur.fk(q).homogeneous, atol=1e-7 if degrees else 1e-12)
+    agreement = fk_vs_yourdfpy(ur, count=50)  # and the URDF twin against an independent parser
+    assert agreement.max_position <= 1e-9 and agreement.max_rotation <= 1e-9
+    assert jacobians_vs_fd(mj, count=20).max_rotation <= 1e-6
+    target = mj.fk(mj.random_q(5))
+    assert kinelab.solve(mj, target, task="position", seed=0).success
+
+
+def test_a_free_joint_on_the_chain_is_refused_and_a_base_below_it_is_taken(tmp_path):
+    path = write_mjcf(tmp_path, free=True)
+    with pytest.raises(ChainError, match="'float'"):
+        load(path)
+    arm = load(path, base="base")
+    assert arm.joint_names == ["j1", "j2", "j3"] and arm.base == "base"
+    expected = [0.0, 0.1 - 0.35 * np.sin(0.3), 0.5 + 0.35 * np.cos(0.3)]  # by hand: l2 tilted 0.3 rad about x
+    np.testing.assert_allclose(arm.fk(np.zeros(3)).translation, expected, atol=1e-12)
