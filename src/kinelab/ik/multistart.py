@@ -46,16 +46,19 @@ def first_start(q0: np.ndarray | None, kind: np.ndarray, lower: np.ndarray, uppe
 
 
 def restart_windows(cm: ChainModel, q_start: np.ndarray, pstar: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Where restarts are drawn: the joint limits, except for a prismatic joint whose range exceeds twice the
-    chain's length L (a mobile base's ±10 m platform). There, within L of the value that carries the tool
-    from where it is at the start to the target point along the joint's axis, clipped to the limits: a
-    restart anywhere in the platform's box leaves the arm metres from a target it could reach.
+    """Where restarts are drawn: the joint limits, except for a prismatic joint ahead of every rotary joint
+    whose range exceeds twice the chain's length L (a mobile base's ±10 m platform, not a boom). There,
+    within L of the value that carries the tool from where it is at the start to the target point along the
+    joint's axis, clipped to the limits: a restart anywhere in the platform's box leaves the arm metres from
+    a target it could reach.
 
     Args:
         cm: the chain; q_start: the first start [rad or m]; pstar: the target point [m], base frame.
     """
     lower, upper, L = cm.lower, cm.upper, cm.length
-    wide = (cm.kind == PRISMATIC) & (upper - lower > 2.0 * L)
+    rotary = np.flatnonzero(cm.kind != PRISMATIC)
+    before_arm = np.arange(cm.n) < (rotary[0] if rotary.size else cm.n)  # a base's joints come first
+    wide = (cm.kind == PRISMATIC) & (upper - lower > 2.0 * L) & before_arm
     if not wide.any():
         return lower, upper
     v = cm.vectors(q_start)

@@ -21,7 +21,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from kinelab.errors import KinelabError
-from kinelab.report.bench import scaling
+from kinelab.report.bench import loops, scaling
 from kinelab.report.validate import Report
 from kinelab.studies import paper000_era as ep
 from kinelab.studies import paper001_stanford as seed001
@@ -181,6 +181,9 @@ def _write_bench_files(result: dict[str, Any], folder: Path) -> None:
         sections.append(scaling.markdown(result["scaling"]))
     if "tracking" in result:
         sections.append(ep.tracking_markdown(result["tracking"]))
+    if "loops" in result:
+        sections.append(loops.markdown(result["loops"]["throughput"], result["loops"]["tracking"],
+                                       result["loops"]["budgets"]))
     (folder / "bench.md").write_text("\n\n".join(sections) + "\n")
     bench_figure(result, folder / "bench.png")
 

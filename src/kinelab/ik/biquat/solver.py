@@ -29,7 +29,10 @@ from kinelab.ik.result import Attempt, Status
 from kinelab.robot import Robot
 
 Options = BiquatOptions
-JOINT_STEPS_PER_LOOK = 48  # integration steps × joints between two looks at the clock (≈ 0.05 ms of work)
+# integration steps × joints before the first look at the clock (most solves end within them), then between
+# two looks (≈ 0.05 ms of work); a cut attempt is resumed, so the answer does not depend on these
+JOINT_STEPS_PER_LOOK = 192
+JOINT_STEPS_PER_LATER_LOOK = 48
 _MULTISTART = TypedKernel(kernel.multistart)
 
 
@@ -143,13 +146,14 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: 
     rng_state = restarts.seed_state(seed)
     q = restarts.first_start(q0, cm.kind, cm.lower, cm.upper, rng_state)
     stats = np.zeros(kernel.STATS_SIZE)
-    chunk_steps = clock_chunk(JOINT_STEPS_PER_LOOK, cm.n)
+    steps = [clock_chunk(JOINT_STEPS_PER_LOOK, cm.n), clock_chunk(JOINT_STEPS_PER_LATER_LOOK, cm.n)]
 
     restart_lower, restart_upper = restarts.restart_windows(cm, q, oMtarget.translation)
 
     def chunk(attempts_left: int) -> int:
+        size = steps[0] if stats[kernel.T_STEPS] == 0 else steps[1]
         return _MULTISTART(q, cm.chain, cm.lower, cm.upper, prob, rng_state, attempts_left,
-                           float(stats[kernel.T_STEPS] + chunk_steps), stats, restart_lower, restart_upper)
+                           float(stats[kernel.T_STEPS] + size), stats, restart_lower, restart_upper)
 
     code = restarts.run_in_chunks(chunk, max_restarts + 1, stats, deadline, kernel.CONVERGED)
     if code == kernel.CONVERGED:
