@@ -23,6 +23,7 @@ from kinelab.errors import (
     URDFError,
 )
 from kinelab.ik.batch import BatchIKResult, solve_batch
+from kinelab.ik.branches import solve_all
 from kinelab.ik.frdm.options import FRDMOptions
 from kinelab.ik.frdm.tracking import TrackResult, track
 from kinelab.ik.result import IKResult, Status
@@ -62,6 +63,7 @@ __all__ = [
     "load",
     "robots",
     "solve",
+    "solve_all",
     "solve_batch",
     "target_from_xyz_quat_wxyz",
     "target_from_xyz_rpy",
