@@ -9,7 +9,7 @@ import pytest
 
 import kinelab
 from kinelab import cli
-from kinelab.cli.main import compiling_notice
+from kinelab.cli.main import _plural, compiling_notice
 from kinelab.studies import paper001_stanford as seed001
 
 
@@ -59,7 +59,7 @@ def test_fk_stanford_matches_the_papers_rotation(capsys):
     (["info", "nosuch"], "registered robots are: stanford"),
     (["fk", "stanford", "1", "2"], "must have 6 numbers"),
     (["fk", "stanford", "0", "0", "nan", "0", "0", "0"], "finite"),
-    (["fk", "stanford", "0", "0", "2", "0", "0", "0"], "outside its limits"),
+    (["singular", "stanford", "0", "0", "2", "0", "0", "0"], "outside its limits"),  # fk computes and says so
     (["fk", "ur5", "0", "0", "0", "0", "0", "0", "--tool", "flange"], "unknown frame 'flange'"),
     (["fk", "stanford", "0", "x"], "'x' is not a number"),
     (["nosuchcommand"], "invalid choice"),
@@ -258,3 +258,23 @@ def test_a_named_srdf_configuration_stands_for_q_and_a_base_reroots_the_chain(ca
 def test_bad_robot_sources_at_the_cli_give_one_line_and_exit_2(capsys, argv, said):
     code, out, err = run(capsys, *argv)
     assert code == 2 and said in err and len(err.strip().splitlines()) == 1
+
+
+def test_version_hint_and_an_fk_outside_the_limits(capsys):
+    with pytest.raises(SystemExit) as done:
+        cli.main(["--version"])
+    assert done.value.code == 0 and capsys.readouterr().out.strip() == f"kinelab {kinelab.__version__}"
+    with pytest.raises(SystemExit) as done:
+        cli.main(["ik", "ur5", "--task", "reach"])
+    assert done.value.code == 2 and capsys.readouterr().err.rstrip().endswith("(see 'kinelab ik --help')")
+    code, out, _ = run(capsys, "fk", "panda", *["0"] * 7, "--json")  # joint4's limits exclude 0: said, not refused
+    result = json.loads(out)
+    assert code == 0 and result["outside_limits"] == [
+        "panda_joint4 = 0 rad is outside its limits [-3.072, -0.0698] rad"]
+    assert np.allclose(result["position_m"], kinelab.load("panda").fk(np.zeros(7)).translation)
+    assert (_plural(1, "restart"), _plural(0, "restart")) == ("1 restart", "0 restarts")
+
+
+def test_printed_vectors_carry_no_negative_zero(capsys):
+    code, out, _ = run(capsys, "singular", "ur5", "0", "0", "0", "0", "0", "0")
+    assert code == 0 and "moves nothing" in out and "-0.0," not in out and "-0.0]" not in out

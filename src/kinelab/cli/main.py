@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from kinelab import __version__ as kinelab_version
 from kinelab.errors import ConfigurationError, KinelabError
 from kinelab.geometry import quat_wxyz_from_matrix
 from kinelab.robot import Robot, catalog, load
@@ -28,7 +29,8 @@ from kinelab.robot import Robot, catalog, load
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message: str):  # one line, exit 2, as for every user error
-        self.exit(2, f"kinelab: error: {message} (see 'kinelab {self.prog.split()[-1]} --help')\n")
+        command = " ".join(self.prog.split()[1:])  # "" for the top parser, "ik" for a subcommand
+        self.exit(2, f"kinelab: error: {message} (see 'kinelab {command + ' ' if command else ''}--help')\n")
 
 
 def _q_from_cli(robot: Robot, values: list[str], deg: bool, what: str = "q") -> np.ndarray:
@@ -129,18 +131,39 @@ def cmd_info(args) -> int:
 def cmd_fk(args) -> int:
     robot = _load(args)
     q = _q_from_cli(robot, args.q, args.deg)
-    robot.check_q(q, limits=not args.ignore_limits)
-    oMtool = robot.fk(q)
-    out = {"robot": robot.name, "base": robot.base, "tool": robot.tool, "q": q.tolist(), **pose_dict(oMtool)}
+    outside = _outside_limits(robot, q)
+    oMtool = robot.fk(q)  # FK is defined at any q: a q outside the limits is computed and said, not refused
+    out = {"robot": robot.name, "base": robot.base, "tool": robot.tool, "q": q.tolist(), **pose_dict(oMtool),
+           "outside_limits": outside}
     if args.json:
         _print_json(out)
         return 0
     print(f"{robot.name}: pose of {robot.tool!r} in {robot.base!r}")
+    for note in outside:
+        print(f"  note: {note} (the pose is computed all the same)")
     print(f"  position [m]   {np.array2string(oMtool.translation, precision=6)}")
     print(f"  quat_wxyz      {np.array2string(np.array(out['quat_wxyz']), precision=6)}")
     print(f"  rpy [rad]      {np.array2string(np.array(out['rpy_rad']), precision=6)}")
     print("  rotation       " + np.array2string(oMtool.rotation, precision=6, prefix="  rotation       "))
     return 0
+
+
+def _outside_limits(robot: Robot, q: np.ndarray) -> list[str]:
+    """One line per joint of q outside its limits (empty when q is within them)."""
+    out = []
+    for j, value in zip(robot.joints, q, strict=True):
+        if j.kind != "continuous" and not j.lower - 1e-9 <= value <= j.upper + 1e-9:
+            out.append(f"{j.name} = {value:g} {j.unit} is outside its limits [{j.lower:.4g}, {j.upper:.4g}] {j.unit}")
+    return out
+
+
+def _rounded(values: np.ndarray, digits: int) -> list[float]:
+    """Rounded for printing, without the −0.0 that rounding a tiny negative number leaves."""
+    return (np.round(np.asarray(values, dtype=float), digits) + 0.0).tolist()
+
+
+def _plural(count: int, word: str) -> str:
+    return f"{count} {word}" if count == 1 else f"{count} {word}s"
 
 
 def _bypass_value(robot, joint: str, text: str, deg: bool, flag: str) -> float:
@@ -238,7 +261,8 @@ def cmd_ik(args) -> int:
         print(f"  position error {result.position_error:.3e} m{' (free)' if free[0] else ''}, "
               f"{'axis' if args.task == 'axis' else 'rotation'} error {result.rotation_error:.3e} rad"
               f"{' (free)' if free[1] else ''} (Pinocchio FK)")
-        print(f"  {result.iterations} iterations, {result.restarts} restarts, {result.wall_time * 1e3:.2f} ms, "
+        print(f"  {_plural(result.iterations, 'iteration')}, {_plural(result.restarts, 'restart')}, "
+              f"{result.wall_time * 1e3:.2f} ms, "
               f"mode {result.mode}")
         if "model_time" in result.info:
             m0 = result.info.get("M0")
@@ -288,14 +312,14 @@ def cmd_singular(args) -> int:
     for d in a.lost_directions:
         parts = []
         if d.translation_axis is not None:
-            axis, share = np.round(d.translation_axis, 3).tolist(), 100 * d.translation_share
+            axis, share = _rounded(d.translation_axis, 3), 100 * d.translation_share
             parts.append(f"translation {axis} ({share:.0f} %)")
         if d.rotation_axis is not None:
-            axis, share = np.round(d.rotation_axis, 3).tolist(), 100 * d.rotation_share
+            axis, share = _rounded(d.rotation_axis, 3), 100 * d.rotation_share
             parts.append(f"rotation about {axis} ({share:.0f} %)")
         print(f"  lost tool motion (base axes, at the tool): {' + '.join(parts)}")
     for m in a.null_motions:
-        print(f"  joint motion that moves nothing: {np.round(m, 4).tolist()}")
+        print(f"  joint motion that moves nothing: {_rounded(m, 4)}")
     return 0
 
 
@@ -416,7 +440,7 @@ def cmd_animate(args) -> int:
     summary = result.summary()
     print(f"{args.passage} {'without' if args.without_bypass else 'with'} bypass: {summary['reached']} of "
           f"{summary['samples']} samples reached, largest joint step {summary['max_joint_step']:.3f} rad, "
-          f"{summary['monitor_events']} monitor events")
+          f"{_plural(summary['monitor_events'], 'monitor event')}")
     return _publish(scene, args.html)
 
 
@@ -446,6 +470,7 @@ def _add_source_args(s: argparse.ArgumentParser) -> None:
 def build_parser() -> argparse.ArgumentParser:
     """The ``kinelab`` command line: one subparser per command."""
     p = _Parser(prog="kinelab", description="Kinematics of serial arms, checked against Pinocchio.")
+    p.add_argument("--version", action="version", version=f"kinelab {kinelab_version}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
     for add in (_add_robots, _add_info, _add_fk, _add_ik, _add_singular, _add_view, _add_animate, _add_bench,
                 _add_validate):
