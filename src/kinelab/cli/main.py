@@ -157,7 +157,7 @@ def _outside_limits(robot: Robot, q: np.ndarray) -> list[str]:
     return out
 
 
-def _rounded(values: np.ndarray, digits: int) -> list[float]:
+def _rounded(values: Any, digits: int) -> list[float]:
     """Rounded for printing, without the −0.0 that rounding a tiny negative number leaves."""
     return (np.round(np.asarray(values, dtype=float), digits) + 0.0).tolist()
 

@@ -86,7 +86,7 @@ def rtb_chain_ets(robot: Robot) -> Any:
         parts += [ET.SE3(before), ET.tz(qlim=qlim) if ch.kind[i] == PRISMATIC else ET.Rz(qlim=qlim), ET.SE3(after)]
     tool = np.eye(4)
     tool[:3, :3], tool[:3, 3] = ch.tool_R, ch.tool_t
-    ets = ETS([*parts, ET.SE3(tool)])  # type: ignore[operator]  # one list: chaining with * renumbered joints
+    ets = ETS([*parts, ET.SE3(tool)])  # type: ignore[operator, unused-ignore]  # one list: * renumbered joints
     q = robot.random_q(0)
     if not np.allclose(np.asarray(ets.fkine(q).A), robot.fk(q).homogeneous, atol=1e-9):
         raise ValueError("the ETS built from the chain disagrees with Pinocchio's FK")
