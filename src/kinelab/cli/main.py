@@ -249,30 +249,33 @@ def cmd_ik(args) -> int:
             prepare(robot)
     result = solve(robot, target, solver=args.solver, q0=q0, seed=args.seed, tol_pos=args.tol_pos,
                    tol_rot=args.tol_rot, time_budget=args.time_budget, task=args.task, axis=args.axis, **options)
-    out = {"robot": robot.name, "target": pose_dict(target), **result.to_dict()}
     if args.json:
-        _print_json(out)
+        _print_json({"robot": robot.name, "target": pose_dict(target), **result.to_dict()})
     else:
-        q_show = np.where([k != "prismatic" for k in robot.joint_kinds], np.rad2deg(result.q), result.q) \
-            if args.deg else result.q
-        print(f"{robot.name} {args.solver}, task {result.task}: {result.status.value} (success: {result.success})")
-        print(f"  q{' [deg, m]' if args.deg else ' [rad, m]'}  {np.array2string(q_show, precision=6)}")
-        free = {"position": (False, True), "orientation": (True, False)}.get(args.task, (False, False))
-        print(f"  position error {result.position_error:.3e} m{' (free)' if free[0] else ''}, "
-              f"{'axis' if args.task == 'axis' else 'rotation'} error {result.rotation_error:.3e} rad"
-              f"{' (free)' if free[1] else ''} (Pinocchio FK)")
-        print(f"  {_plural(result.iterations, 'iteration')}, {_plural(result.restarts, 'restart')}, "
-              f"{result.wall_time * 1e3:.2f} ms, "
-              f"mode {result.mode}")
-        if "model_time" in result.info:
-            m0 = result.info.get("M0")
-            print(f"  model time {result.info['model_time']:.4g} s, final M0 = "
-                  + (f"{m0:+.6f}" if m0 is not None else "n/a (give --target-q for the sign of N)"))
-        if result.message:
-            print("  " + re.sub(r"task='(\w+)'", r"--task \1", result.message))
-        if not result.success and args.task != "position" and args.target_xyz is not None and args.target_rpy is None:
-            print("  (no --target-rpy: the target rotation is the identity; --task position ignores it)")
+        _print_ik(robot, args, result)
     return 0 if result.success else 1
+
+
+def _print_ik(robot: Robot, args: argparse.Namespace, result: Any) -> None:
+    """The text form of an IK result: status, q, Pinocchio's errors on the task's components, effort."""
+    q_show = np.where([k != "prismatic" for k in robot.joint_kinds], np.rad2deg(result.q), result.q) \
+        if args.deg else result.q
+    print(f"{robot.name} {args.solver}, task {result.task}: {result.status.value} (success: {result.success})")
+    print(f"  q{' [deg, m]' if args.deg else ' [rad, m]'}  {np.array2string(q_show, precision=6)}")
+    free = {"position": (False, True), "orientation": (True, False)}.get(args.task, (False, False))
+    print(f"  position error {result.position_error:.3e} m{' (free)' if free[0] else ''}, "
+          f"{'axis' if args.task == 'axis' else 'rotation'} error {result.rotation_error:.3e} rad"
+          f"{' (free)' if free[1] else ''} (Pinocchio FK)")
+    print(f"  {_plural(result.iterations, 'iteration')}, {_plural(result.restarts, 'restart')}, "
+          f"{result.wall_time * 1e3:.2f} ms, mode {result.mode}")
+    if "model_time" in result.info:
+        m0 = result.info.get("M0")
+        print(f"  model time {result.info['model_time']:.4g} s, final M0 = "
+              + (f"{m0:+.6f}" if m0 is not None else "n/a (give --target-q for the sign of N)"))
+    if result.message:
+        print("  " + re.sub(r"task='(\w+)'", r"--task \1", result.message))
+    if not result.success and args.task != "position" and args.target_xyz is not None and args.target_rpy is None:
+        print("  (no --target-rpy: the target rotation is the identity; --task position ignores it)")
 
 
 def cmd_singular(args) -> int:

@@ -33,14 +33,17 @@ def solve_all(robot: Robot, target: pin.SE3, task: str = "pose", axis: str = "z"
     """The distinct solutions found for ``target`` within ``time_budget``, each checked by Pinocchio.
 
     Args:
-        robot: the robot; target: oMtarget (base frame).
-        task, axis: the components to meet (as :func:`kinelab.solve`).
+        robot: the robot.
+        target: oMtarget (base frame).
+        task: the components to meet (as :func:`kinelab.solve`).
+        axis: the tool axis of task "axis".
         time_budget: wall-clock budget [s]; rounds of ROUND seeded starts run until it is spent.
         seed: base seed (None: fresh entropy); the same seed finds the same solutions when the budget allows
             the same number of rounds.
         q_ref: sort the solutions by distance to this configuration (rad or m; revolute joints modulo 2π);
             default: by the order found.
-        tol_pos: [m]; tol_rot: [rad].
+        tol_pos: [m].
+        tol_rot: [rad].
         solver: "frdm" (one compiled batch per round) or "dls".
         max_solutions: stop once this many distinct solutions are found (None: use the whole budget).
         solver_options: the solver's options as keyword arguments.

@@ -120,9 +120,8 @@ def solve(
         max_restarts: random restarts after the first attempt.
         start_outside_limits: "project" (default: move q0 into the limits, with a warning) or "refuse".
         options: the solver's options object (``FRDMOptions``, ``BiquatOptions``, ``DLSOptions``).
-        task: which components of the target to meet: "pose" (all), "position" (the tool point), "axis"
-            (the tool point and the tool axis ``axis``, the roll about it free) or "orientation"
-            (:mod:`kinelab.ik.tasks`); FRDM and DLS take every task, the biquaternion solver "pose".
+        task: "pose" (all), "position", "axis" (the tool point and tool axis ``axis``, roll free) or
+            "orientation" (:mod:`kinelab.ik.tasks`); the biquaternion solver takes "pose" only.
         axis: the tool axis of task "axis": "x", "y" or "z".
         solver_options: or its fields as keyword arguments.
 
@@ -137,11 +136,7 @@ def solve(
     tk = Task.of(task, axis)
     if tk is not POSE:
         opts = for_task(solver, opts, tk)
-    prepare = getattr(module, "prepare", None)
-    if prepare is not None:
-        prepare(robot)  # compilation and model building are not the solve's time
-    if not _CHECKS_COMPILED:
-        _compile_checks(robot)
+    _prepare(module, robot)
     t_start = time.perf_counter()
     target = as_target(target)
     check_arguments(tol_pos, tol_rot, time_budget, max_restarts, seed, start_outside_limits)
@@ -171,6 +166,15 @@ def for_task(solver: str, opts: Any, task: Task) -> Any:
 _CHECKS_COMPILED: list[bool] = []
 
 
+def _prepare(module: Any, robot: Robot) -> None:
+    """Compilation and model building, which are not a solve's time: the solver's, and the checks'."""
+    prepare = getattr(module, "prepare", None)
+    if prepare is not None:
+        prepare(robot)
+    if not _CHECKS_COMPILED:
+        _compile_checks(robot)
+
+
 def _compile_checks(robot: Robot) -> None:
     """Compile (or load) the target check and the verdict once per process, outside any solve's clock."""
     target = as_target(pin.SE3.Identity())
@@ -179,22 +183,35 @@ def _compile_checks(robot: Robot) -> None:
 
 
 def check_arguments(tol_pos: float, tol_rot: float, time_budget: float, max_restarts: int, seed: int | None,
-                     start_outside_limits: str) -> None:
+                    start_outside_limits: str) -> None:
     """Refuse what solve() cannot honour, naming the argument, the value and what is valid."""
-    if (type(tol_pos) is float and type(tol_rot) is float and type(time_budget) is float  # the common case,
-            and 0.0 < tol_pos < math.inf and 0.0 < tol_rot < math.inf and 0.0 < time_budget < math.inf  # fast
-            and type(max_restarts) is int and max_restarts >= 0 and (seed is None or (type(seed) is int and seed >= 0))
-            and start_outside_limits in ("project", "refuse")):
+    if _plain_positive(tol_pos, tol_rot, time_budget) and _plain_counts(max_restarts, seed) \
+            and start_outside_limits in ("project", "refuse"):  # the common case, checked fast
         return
     for name, value in (("tol_pos", tol_pos), ("tol_rot", tol_rot), ("time_budget", time_budget)):
         if isinstance(value, bool) or not isinstance(value, numbers.Real) or not 0 < value < math.inf:
             raise OptionError(name, value, "a finite number > 0")
-    if isinstance(max_restarts, bool) or not isinstance(max_restarts, numbers.Integral) or max_restarts < 0:
+    if not _count(max_restarts):
         raise OptionError("max_restarts", max_restarts, "an integer ≥ 0")
-    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0):
+    if seed is not None and not _count(seed):
         raise OptionError("seed", seed, "an integer ≥ 0, or None for fresh entropy")
     if start_outside_limits not in ("project", "refuse"):
         raise OptionError("start_outside_limits", start_outside_limits, "'project' or 'refuse'")
+
+
+def _plain_positive(a: Any, b: Any, c: Any) -> bool:
+    """All three Python floats in (0, inf)."""
+    return (type(a) is float and type(b) is float and type(c) is float
+            and 0.0 < a < math.inf and 0.0 < b < math.inf and 0.0 < c < math.inf)
+
+
+def _plain_counts(max_restarts: Any, seed: Any) -> bool:
+    return type(max_restarts) is int and max_restarts >= 0 and (seed is None or (type(seed) is int and seed >= 0))
+
+
+def _count(value: Any) -> bool:
+    """An integer ≥ 0 (a bool is not a count)."""
+    return not isinstance(value, bool) and isinstance(value, numbers.Integral) and int(value) >= 0
 
 
 @dataclass(slots=True)

@@ -236,6 +236,16 @@ def _carry_axis(Rg, tg, e, o, i):
 
 
 @njit(cache=True, inline="always")
+def _slide(e0, e1, e2, p, pstar, w_p, relax, off_rest, w_rest):
+    """A prismatic joint's exact step [m] along (e0, e1, e2): the position error's projection, weighed against
+    the rest term (``off_rest`` = q_i − r_i), times ``relax``."""
+    if w_p <= 0.0 and w_rest <= 0.0:
+        return 0.0
+    along = e0 * (pstar[0] - p[0]) + e1 * (pstar[1] - p[1]) + e2 * (pstar[2] - p[2])
+    return relax * (w_p * along - w_rest * off_rest) / (w_p + w_rest)
+
+
+@njit(cache=True, inline="always")
 def sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, relax, base_to_tip, q_rest, w_rest):
     """One sweep over the free joints, tip → base or base → tip; updates q, p, R in place.
 
@@ -262,11 +272,7 @@ def sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, rela
         lo = lower[i] - q[i]
         hi = upper[i] - q[i]
         if kind[i] == PRISMATIC:
-            s = 0.0
-            if w_p > 0.0 or w_rest > 0.0:
-                along = e0 * (pstar[0] - p[0]) + e1 * (pstar[1] - p[1]) + e2 * (pstar[2] - p[2])
-                s = relax * (w_p * along - w_rest * (q[i] - q_rest[i])) / (w_p + w_rest)
-            s = min(max(s, lo), hi)
+            s = min(max(_slide(e0, e1, e2, p, pstar, w_p, relax, q[i] - q_rest[i], w_rest), lo), hi)
             if s == 0.0:
                 continue
             p[0] += e0 * s
@@ -456,6 +462,21 @@ def _window_stalled(state, st, E1):
     return False
 
 
+@njit(cache=True, inline="always")
+def _base_to_tip(order, state):
+    """This sweep's direction: the order's, base → tip after a kick; clears the kick flag."""
+    forward = order == BASE_TO_TIP or (order == ALTERNATE and int(state[S_SWEEPS]) % 2 == 1) or state[S_KICKED] != 0.0
+    state[S_KICKED] = 0.0
+    return forward
+
+
+@njit(cache=True, inline="always")
+def _count_sweep(state, trace, E):
+    state[S_SWEEPS] += 1.0
+    if int(state[S_SWEEPS]) - 1 < trace.shape[0]:
+        trace[int(state[S_SWEEPS]) - 1] = E
+
+
 @njit(cache=True)
 def run(q: np.ndarray, ch: Chain, pb: Problem, st: Settings, order: int, max_sweeps: int,
         mem: Memory) -> tuple[int, int]:
@@ -492,17 +513,13 @@ def run(q: np.ndarray, ch: Chain, pb: Problem, st: Settings, order: int, max_swe
             state[S_E] = total_objective(q, kind, p, R, pb)
             return CONVERGED, s
         x_old[:] = q
-        base_to_tip = order == BASE_TO_TIP or (order == ALTERNATE and int(state[S_SWEEPS]) % 2 == 1) \
-            or state[S_KICKED] != 0.0
-        state[S_KICKED] = 0.0
+        base_to_tip = _base_to_tip(order, state)
         moved = sweep(q, e, o, kind, lower, upper, free, p, R, pstar, Rstar, w_p, w_ax, st.relax, base_to_tip,
                       pb.q_rest, pb.w_rest)
         fresh = base_to_tip
         since_fk += 1
         E1 = total_objective(q, kind, p, R, pb)
-        state[S_SWEEPS] += 1.0
-        if int(state[S_SWEEPS]) - 1 < trace.shape[0]:
-            trace[int(state[S_SWEEPS]) - 1] = E1
+        _count_sweep(state, trace, E1)
         if moved < st.eps_q:
             state[S_E] = E1
             return STALL_STEP, s + 1

@@ -59,27 +59,23 @@ def track(
         tol_pos: position tolerance per sample [m].
         tol_rot: rotation tolerance per sample [rad].
         max_sweeps: sweep cap per sample.
-        jump_limit: largest joint change per sample [rad or m] before the jump monitor fires (None: off).
+        jump_limit: largest joint step [rad or m] before the jump monitor fires (None: off).
         kicks: the bypass kicks (see :class:`~kinelab.ik.frdm.options.FRDMOptions`).
         intervals: the bypass intervals.
         freeze: the joints to freeze.
-        policy: the bypass policy; None (default) with no bypass table runs the compiled follower, ``()``
-            the monitored loop without bypass (every monitor event logged).
+        policy: None (default, no bypass table): the compiled follower; ``()``: the monitored loop, no bypass.
         restrict: restrictions ("intervals", "freeze") held on every sample of the path.
         hold: samples a restriction stays on after the monitor switched it on.
-        stall_window: the monitor's window [sweeps]; a path sample starts close to its answer, so a slow
-            start is an escape from a singularity, not a local minimum to abandon.
+        stall_window: the monitor's window [sweeps] (long: a slow start on a path escapes a singularity).
         stall_rel: the relative fall required over the window.
-        rest_weight: compiled follower only: weight of the rest term that keeps each answer near the
-            previous one; None: 0.01 on arms with more than six joints, 0 (plain FRDM) otherwise.
+        rest_weight: compiled follower only: weight of the rest term (None: 0.01 beyond six joints, else 0).
         **frdm_options: other :class:`~kinelab.ik.frdm.options.FRDMOptions` fields (order, w_p, accel, ...).
 
     Returns:
-        One row of q per sample with its Pinocchio-measured errors, statuses and the monitor log.
+        One row of q per sample, Pinocchio's errors, statuses, the monitor log (:class:`TrackResult`).
 
     Raises:
-        ConfigurationError: q0 of the wrong shape or outside the limits.
-        KinelabError: a restriction named without its table.
+        ConfigurationError: a bad q0; KinelabError: a restriction named without its table.
     """
     q_prev = robot.check_q(q0, limits=True, what="q0")
     _check_restrict(restrict, intervals, freeze)
@@ -89,8 +85,8 @@ def track(
     options = {"max_sweeps": max_sweeps, "kicks": kicks, "intervals": intervals, "freeze": freeze,
                "policy": tuple(s for s in (policy or ()) if s not in RESTRICTIONS),
                "stall_window": stall_window, "stall_rel": stall_rel, **frdm_options}
-    path = _Path(robot, tol_pos, tol_rot, options, restrict,
-                 [s for s in (policy or ()) if s in RESTRICTIONS], jump_limit, hold)
+    path = _Path(robot, tol_pos, tol_rot, options, restrict, [s for s in (policy or ()) if s in RESTRICTIONS],
+                 jump_limit, hold)
     for k, target in enumerate(targets):
         q_prev = path.sample(k, target, q_prev)
     return path.result()
