@@ -483,21 +483,21 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _add_robots(sub: Any) -> None:
     s = sub.add_parser("robots", help="list the registered robots")
-    s.add_argument("--json", action="store_true")
+    s.add_argument("--json", action="store_true", help="print the result as JSON")
     s.set_defaults(func=cmd_robots)
 
 
 def _add_info(sub: Any) -> None:
     s = sub.add_parser("info", help="joints, types, limits, DOF and tool frame of a robot")
     _robot_arguments(s, limits=False)
-    s.add_argument("--json", action="store_true")
+    s.add_argument("--json", action="store_true", help="print the result as JSON")
     s.set_defaults(func=cmd_info)
 
 
 def _add_fk(sub: Any) -> None:
     s = sub.add_parser("fk", help="tool pose at a configuration")
     _robot_arguments(s, "one number per joint (rad and m; deg with --deg)")
-    s.add_argument("--json", action="store_true")
+    s.add_argument("--json", action="store_true", help="print the result as JSON")
     s.set_defaults(func=cmd_fk)
 
 
@@ -515,7 +515,7 @@ def _add_ik(sub: Any) -> None:
     s.add_argument("--axis", choices=("x", "y", "z"), default="z", help="the tool axis of --task axis")
     s.add_argument("--start-q", nargs="+", help="first start (default: seeded random), or an SRDF name")
     s.add_argument("--deg", action="store_true", help="angles in degrees (revolute/continuous joints, rpy)")
-    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--seed", type=int, default=0, help="seed of the random starts or samples (an integer ≥ 0)")
     s.add_argument("--tol-pos", type=float, default=1e-6, help="[m]")
     s.add_argument("--tol-rot", type=float, default=1e-6, help="[rad]")
     s.add_argument("--time-budget", type=float, default=1.0, help="[s]")
@@ -541,8 +541,8 @@ def _add_singular(sub: Any) -> None:
     s.add_argument("--sweep", type=int, help="sample N configurations within the limits and report families")
     s.add_argument("--grid", action="store_true", help="sweep a stratified grid instead of uniform samples")
     s.add_argument("--force", action="store_true", help="run a sweep even when its memory estimate is over the limit")
-    s.add_argument("--seed", type=int, default=0)
-    s.add_argument("--json", action="store_true")
+    s.add_argument("--seed", type=int, default=0, help="seed of the random starts or samples (an integer ≥ 0)")
+    s.add_argument("--json", action="store_true", help="print the result as JSON")
     s.set_defaults(func=cmd_singular)
 
 
@@ -568,7 +568,7 @@ def _add_bench(sub: Any) -> None:
     s.add_argument("--robots", nargs="+", default=None,
                    help="robots (default: panda ur5 stanford era xarm7 z1 kinova ur10 so101 youbot)")
     s.add_argument("--n", type=int, default=200, help="targets per robot")
-    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--seed", type=int, default=0, help="seed of the random starts or samples (an integer ≥ 0)")
     s.add_argument("--solvers", nargs="+", default=None, help="solvers to run (default: all available)")
     s.add_argument("--budget-ms", type=float, default=5.0, help="time budget per solve [ms]")
     s.add_argument("--repeats", type=int, default=3, help="rounds over the set; per problem the fastest counts")
@@ -590,10 +590,10 @@ def _add_validate(sub: Any) -> None:
     s = sub.add_parser("validate", help="check every kinelab computation against Pinocchio on the bundled robots")
     s.add_argument("--robots", nargs="+", default=None, help="robots to check (default: the embedded set)")
     s.add_argument("--n", type=int, default=None, help="random configurations per check")
-    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--seed", type=int, default=0, help="seed of the random starts or samples (an integer ≥ 0)")
     s.add_argument("--out", default="kinelab-report",
                    help="the report folder (Markdown, HTML with the figures, JSON); default ./kinelab-report")
-    s.add_argument("--json", action="store_true")
+    s.add_argument("--json", action="store_true", help="print the result as JSON")
     s.set_defaults(func=cmd_validate)
 
 
