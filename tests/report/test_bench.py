@@ -174,3 +174,16 @@ def test_the_loops_protocols_judge_every_answer_with_pinocchio():
     assert 0 < tracked["frdm track"]["max_step_over_path_step"] < 10
     text = loops.markdown(rows, list(tracked.values()))
     assert "| ur5 | frdm solve_batch | warm σ=0.02 |" in text and "| ur5 | frdm+lm track | 200/200 |" in text
+
+
+def test_task_protocols_judge_the_constrained_components_and_skip_solvers_without_the_task(ur5):
+    position = protocol.cases(ur5, 5, 2, task="position")
+    for case in position:  # the point is reachable, the random rotation mostly not: only the point counts
+        assert np.allclose(case.oMtarget.translation, ur5.fk(case.q_target).translation)
+        assert protocol.check_solution(ur5, case.q_target, case.oMtarget, 0.0, task="position")[0]
+    assert not all(protocol.check_solution(ur5, c.q_target, c.oMtarget, 0.0)[0] for c in position)
+    for case in protocol.cases(ur5, 5, 3, task="axis"):  # rolled about the tool z: the axis task still met
+        assert protocol.check_solution(ur5, case.q_target, case.oMtarget, 0.0, task="axis")[0]
+    result = runner.run(robots=["ur5"], n=3, solvers=["frdm", "biquat"], budget=0.05, repeats=1, task="position")
+    assert [r["solver"] for r in result["rows"]] == ["frdm"] and "biquat" in result["not_run"]
+    assert result["protocol"]["task"] == "position"

@@ -356,7 +356,7 @@ def cmd_bench(args) -> int:
         scaled = scaling.run(progress=not args.json)
     result = bench.run(robots=args.robots, n=args.n, seed=args.seed, solvers=args.solvers,
                        budget=args.budget_ms / 1e3, progress=not args.json, repeats=args.repeats, start=args.start,
-                       sigma=args.sigma, schedule=args.schedule)
+                       sigma=args.sigma, schedule=args.schedule, task=args.task)
     if scaled is not None:
         result["scaling"] = scaled
     if args.tracking:
@@ -575,6 +575,8 @@ def _add_bench(sub: Any) -> None:
     s.add_argument("--start", choices=("random", "warm"), default="random",
                    help="starts: random in the limits, or warm: the target's q plus N(0, sigma) per joint")
     s.add_argument("--sigma", type=float, default=0.2, help="warm starts' noise per joint [rad or m]")
+    s.add_argument("--task", choices=("pose", "position", "axis", "orientation"), default="pose",
+                   help="the components judged (position: random target rotations; axis: tool z, random roll)")
     s.add_argument("--schedule", choices=("blocked", "interleaved"), default="blocked",
                    help="blocked: a solver runs the whole set, then the next; interleaved: every solver per problem")
     s.add_argument("--scaling", action="store_true", help="also time FRDM on synthetic chains of 7-100 links")

@@ -15,7 +15,7 @@ def kinelab_solver(solver: str, **options: Any) -> Prepare:
     def prepare(robot: Robot, budget: float) -> SolveFn:
         def run(case: Case, seed: int) -> tuple:
             res = solve(robot, case.oMtarget, solver=solver, q0=case.q_start, seed=seed, time_budget=budget,
-                        tol_pos=TOL_POS, tol_rot=TOL_ROT, **options)
+                        tol_pos=TOL_POS, tol_rot=TOL_ROT, task=case.task, **options)
             return res.q, res.iterations
 
         return run

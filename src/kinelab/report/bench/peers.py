@@ -102,12 +102,20 @@ def _z_onto(axis: np.ndarray) -> np.ndarray:
     return np.column_stack([x, np.cross(z, x), z])
 
 
+MASKS = {"pose": None, "position": np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0]),
+         "orientation": np.array([0.0, 0.0, 0.0, 1.0, 1.0, 1.0])}  # ik_LM's error weights; no "axis" mask exists
+# the tasks each peer can be asked (the others are reported as not run)
+TASKS = {"rtb-ik_LM": ("pose", "position", "orientation"), "trac-ik": ("pose",), "ikpy": ("pose",),
+         "pink": ("pose",)}
+
+
 def _rtb(robot: Robot, budget: float) -> SolveFn:
     ets = rtb_ets(robot)
 
     def run(case: Case, seed: int):
         # tol bounds E = ½ eᵀe (e in m and rad): 5e-13 keeps both parts below 1e-6
-        sol = ets.ik_LM(case.oMtarget.homogeneous, q0=case.q_start, tol=5e-13, joint_limits=True)
+        sol = ets.ik_LM(case.oMtarget.homogeneous, q0=case.q_start, tol=5e-13, joint_limits=True,
+                        mask=MASKS[case.task])
         return np.asarray(sol.q, dtype=float), int(sol.iterations)
 
     return run

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from kinelab.ik.tasks import Task
 from kinelab.robot import Robot
 
 TOL_POS = 1e-6  # [m]
@@ -38,24 +39,33 @@ class Case:
     q_target: np.ndarray
     q_start: np.ndarray
     oMtarget: pin.SE3
+    task: str = "pose"  # the components judged (kinelab.ik.tasks); the tool axis of "axis" is z
 
 
-def cases(robot: Robot, n: int, seed: int, start: str = "random", sigma: float = 0.2) -> list[Case]:
+def cases(robot: Robot, n: int, seed: int, start: str = "random", sigma: float = 0.2,
+          task: str = "pose") -> list[Case]:
     """``n`` seeded problems: targets drawn uniformly within the joint limits; starts drawn uniformly
     (``start="random"``) or the target's configuration plus N(0, sigma²) per joint, clipped into the
-    limits (``"warm"``; sigma in rad or m)."""
+    limits (``"warm"``; sigma in rad or m). Task "position" gives each target a random rotation (mostly
+    out of reach: only the point counts), task "axis" a random roll about the tool z axis (the free one)."""
     rng = np.random.default_rng(seed)
     out = []
     for i in range(n):
         q_target, q_start = robot.random_q(rng), robot.random_q(rng)
         if start == "warm":
             q_start = np.clip(q_target + rng.normal(0.0, sigma, robot.n), robot.lower, robot.upper)
-        out.append(Case(i, q_target, q_start, robot.fk(q_target)))
+        oMtarget = robot.fk(q_target)
+        if task == "position":
+            oMtarget = pin.SE3(pin.exp3(rng.normal(size=3)), oMtarget.translation)
+        elif task == "axis":
+            oMtarget = pin.SE3(oMtarget.rotation @ pin.exp3(np.array([0.0, 0.0, rng.uniform(-np.pi, np.pi)])),
+                               oMtarget.translation)
+        out.append(Case(i, q_target, q_start, oMtarget, task))
     return out
 
 
 def check_solution(robot: Robot, q: np.ndarray | None, oMtarget: pin.SE3, elapsed: float, budget: float = BUDGET,
-                   tol_pos: float = TOL_POS, tol_rot: float = TOL_ROT) -> tuple[bool, str]:
+                   tol_pos: float = TOL_POS, tol_rot: float = TOL_ROT, task: str = "pose") -> tuple[bool, str]:
     """The protocol's verdict on one answer: (solved, reason). Pinocchio's FK is the judge."""
     if q is None:
         return False, "no answer"
@@ -66,8 +76,9 @@ def check_solution(robot: Robot, q: np.ndarray | None, oMtarget: pin.SE3, elapse
         return False, "over budget"
     if not robot.within_limits(q):
         return False, "outside the joint limits"
-    dp, dr = robot.tool_error(q, oMtarget)
-    if dp > tol_pos or dr > tol_rot:
+    judge = Task.of(task)
+    dp, dr = judge.errors(oMtarget, robot.fk(q))
+    if not judge.met(dp, dr, tol_pos, tol_rot):
         return False, f"pose error {dp:.1e} m, {dr:.1e} rad"
     return True, "solved"
 

@@ -16,6 +16,7 @@ import numpy as np
 from tqdm import tqdm
 
 from kinelab.errors import KinelabError
+from kinelab.ik.tasks import TASKS
 from kinelab.report.bench import peers
 from kinelab.report.bench.adapters import KINELAB_SOLVERS
 from kinelab.report.bench.protocol import (
@@ -65,7 +66,7 @@ class _Tally:
         except Exception:  # noqa: BLE001 - a solver that raises on a problem has failed that problem
             q, it = None, -1
         elapsed = time.perf_counter() - t0
-        ok, why = check_solution(self.robot, q, case.oMtarget, elapsed, budget)
+        ok, why = check_solution(self.robot, q, case.oMtarget, elapsed, budget, task=case.task)
         kept = self.best[k]
         if kept is None or elapsed < kept[0]:
             self.best[k] = (elapsed, ok, why, it)
@@ -136,7 +137,7 @@ def available_solvers() -> tuple[dict[str, Prepare], dict[str, str]]:
 
 def run(robots: list[str] | None = None, n: int = 200, seed: int = 0, solvers: list[str] | None = None,
         budget: float = BUDGET, progress: bool = False, repeats: int = REPEATS, start: str = "random",
-        sigma: float = 0.2, schedule: str = "blocked") -> dict[str, Any]:
+        sigma: float = 0.2, schedule: str = "blocked", task: str = "pose") -> dict[str, Any]:
     """Run the protocol; returns a JSON-ready dict with the rows, the machine and the versions."""
     if n < 1 or repeats < 1 or not budget > 0:
         raise KinelabError(f"bench needs n ≥ 1, repeats ≥ 1 and a positive budget (got {n}, {repeats}, {budget} s)")
@@ -152,9 +153,11 @@ def run(robots: list[str] | None = None, n: int = 200, seed: int = 0, solvers: l
                 raise KinelabError(f"unknown or unavailable solver {unknown[0]!r}; available: {', '.join(table)}"
                                + (f"; not installed: {', '.join(missing)}" if missing else ""))
         table = {k: table[k] for k in solvers}
+    table = _taking(table, task, missing)
     rows = []
     for robot in tqdm(loaded, desc="bench", disable=not progress, unit="robot"):
-        rows += run_robot(robot, table, cases(robot, n, seed, start, sigma), budget, seed, missing, repeats, schedule)
+        problems = cases(robot, n, seed, start, sigma, task)
+        rows += run_robot(robot, table, problems, budget, seed, missing, repeats, schedule)
     return {
         "date": time.strftime("%Y-%m-%d %H:%M:%S"),
         "machine": {"platform": platform.platform(), "processor": platform.processor() or platform.machine(),
@@ -162,10 +165,24 @@ def run(robots: list[str] | None = None, n: int = 200, seed: int = 0, solvers: l
         "versions": _versions(),
         "protocol": {"n": n, "seed": seed, "repeats": repeats, "budget_s": budget, "tol_pos_m": TOL_POS,
                      "tol_rot_rad": TOL_ROT, "start": start, "sigma": sigma if start == "warm" else None,
-                     "schedule": schedule},
+                     "schedule": schedule, "task": task},
         "rows": [asdict(r) for r in rows],
         "not_run": missing,
     }
+
+
+def _taking(table: dict[str, Prepare], task: str, missing: dict[str, str]) -> dict[str, Prepare]:
+    """The solvers that can be asked ``task`` (the others are listed in ``missing`` with the reason)."""
+    if task not in TASKS:
+        raise KinelabError(f"bench takes task in {TASKS}, got {task!r}")
+    kept = {}
+    for name, prepare in table.items():
+        takes = peers.TASKS.get(name, ("pose",) if name == "biquat" else TASKS)
+        if task in takes:
+            kept[name] = prepare
+        else:
+            missing[name] = f"takes task {', '.join(takes)}, not {task!r}"
+    return kept
 
 
 def _versions() -> dict[str, str]:
