@@ -36,7 +36,8 @@ class FRDMOptions:
             roll about it free) or "orientation" (tool axes only).
         tool_axis: the axis of mode "axis": "x", "y" or "z".
         w_p: position weight [1/m²]; None: ``w_p_factor``/L² with L the chain's characteristic length
-            (scale-aware: the same factor serves a 0.3 m arm and the 11 m ERA).
+            (scale-aware: the same factor serves a 0.3 m arm and the 11 m ERA), a third of it in mode "axis"
+            (one tool axis weighed against the point instead of three).
         w_p_factor: the dimensionless factor of the default w_p.
         w_axes: weights of the tool x, y, z axes (≥ 0, three numbers).
         order: "tip2base", "base2tip", "alternate" (each way in turn) or "mixed" (base → tip here; in the
@@ -190,7 +191,11 @@ class FRDMOptions:
         """w_p [1/m²] for a chain of characteristic length ``length`` [m]; 0 in orientation mode."""
         if self.mode == "orientation":
             return 0.0
-        return float(self.w_p_factor) / float(length) ** 2 if self.w_p is None else float(self.w_p)
+        if self.w_p is not None:
+            return float(self.w_p)
+        # mode "axis" weighs one tool axis against the point where "pose" weighs three: the same balance
+        share = 1.0 / 3.0 if self.mode == "axis" else 1.0
+        return share * float(self.w_p_factor) / float(length) ** 2
 
     @property
     def rot_axis(self) -> int:
