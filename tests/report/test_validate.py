@@ -45,3 +45,10 @@ def test_era_checks_cover_the_three_passages_and_print_tolerances_exactly():
     table = render.validate_table(validate.Report(robots=["era"], checks=checks))
     step_row = next(line for line in table.splitlines() if "elbow, bypass: largest joint step" in line)
     assert " 0.25 rad" in step_row  # a 0.25 rad bound printed as such, not rounded to "2e-01"
+
+
+def test_json_alone_writes_no_report_folder(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    code = cli.main(["validate", "--robots", "ur5", "--n", "10", "--json"])
+    assert code == 0 and json.loads(capsys.readouterr().out)["passed"]
+    assert list(tmp_path.iterdir()) == []  # no ./kinelab-report

@@ -329,17 +329,17 @@ def cmd_singular(args) -> int:
 def cmd_validate(args) -> int:
     from kinelab.report import render, validate
 
-    if args.out:
-        render.check_output_folder(args.out)  # before the work, not after it
+    out = args.out or (None if args.json else "kinelab-report")  # --json alone writes no folder
+    if out:
+        render.check_output_folder(out)  # before the work, not after it
     report = validate.run(robots=args.robots, n=args.n, seed=args.seed, progress=not args.json)
-    if args.out:
-        render.write_validate_report(report, args.out)
+    if out:
+        render.write_validate_report(report, out)
     if args.json:
         _print_json(report.to_dict())
     else:
         print(render.validate_table(report))
-        if args.out:
-            print(f"report written to {args.out}")
+        print(f"report written to {out}")
     return 0 if report.passed else 1
 
 
@@ -593,8 +593,9 @@ def _add_validate(sub: Any) -> None:
     s.add_argument("--robots", nargs="+", default=None, help="robots to check (default: the embedded set)")
     s.add_argument("--n", type=int, default=None, help="random configurations per check")
     s.add_argument("--seed", type=int, default=0, help="seed of the random starts or samples (an integer ≥ 0)")
-    s.add_argument("--out", default="kinelab-report",
-                   help="the report folder (Markdown, HTML with the figures, JSON); default ./kinelab-report")
+    s.add_argument("--out", default=None,
+                   help="the report folder (Markdown, HTML with the figures, JSON); default ./kinelab-report, "
+                        "none with --json")
     s.add_argument("--json", action="store_true", help="print the result as JSON")
     s.set_defaults(func=cmd_validate)
 
