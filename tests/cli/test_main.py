@@ -254,6 +254,7 @@ def test_a_named_srdf_configuration_stands_for_q_and_a_base_reroots_the_chain(ca
     (["fk", "panda", "default"], "without an SRDF"),
     (["info", "panda", "--group", "arm"], "needs srdf="),
     (["info", "panda", "--package-dir", "/nonexistent/dir"], "does not exist"),
+    (["info", "panda", "--xacro-arg", "noequals"], "--xacro-arg takes NAME=VALUE"),
 ])
 def test_bad_robot_sources_at_the_cli_give_one_line_and_exit_2(capsys, argv, said):
     code, out, err = run(capsys, *argv)

@@ -61,7 +61,17 @@ def _is_number(text: str) -> bool:
 def _load(args: argparse.Namespace) -> Robot:
     """The robot a per-robot command names, with its --tool, --base, --srdf, --group and --package-dir."""
     return load(args.robot, tool=args.tool, base=args.base, srdf=args.srdf, group=args.group,
-                package_dirs=args.package_dir)
+                package_dirs=args.package_dir, xacro_args=_xacro_args(args.xacro_arg))
+
+
+def _xacro_args(items: list[str] | None) -> dict[str, str] | None:
+    """--xacro-arg NAME=VALUE flags as a dict (a flag without '=' is refused)."""
+    if not items:
+        return None
+    bad = [item for item in items if "=" not in item]
+    if bad:
+        raise KinelabError(f"--xacro-arg takes NAME=VALUE, got {bad[0]!r}")
+    return dict(item.split("=", 1) for item in items)
 
 
 def pose_dict(oMtool: pin.SE3) -> dict:
@@ -468,6 +478,7 @@ def _add_source_args(s: argparse.ArgumentParser) -> None:
     s.add_argument("--srdf", help="SRDF file: named configurations (give a name as Q) and groups")
     s.add_argument("--group", help="SRDF group whose chain gives base and tool")
     s.add_argument("--package-dir", action="append", help="where package:// meshes resolve (repeatable)")
+    s.add_argument("--xacro-arg", action="append", metavar="NAME=VALUE", help="an argument of a .xacro robot")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -40,7 +40,7 @@ from kinelab.errors import (
     URDFError,
 )
 from kinelab.geometry import pose_error, wrap_to_pi
-from kinelab.robot import catalog
+from kinelab.robot import catalog, xacro
 from kinelab.robot.meshes import build_visual_model, mesh_package_dirs
 from kinelab.robot.mjcf import is_mjcf, read_mjcf
 from kinelab.robot.srdf import Srdf, read_srdf
@@ -194,8 +194,10 @@ class Robot:
         package_dirs: list[str] | None = None,
         srdf: str | Path | None = None,
         group: str | None = None,
+        xacro_args: dict[str, str] | None = None,
     ):
-        self.urdf_path = Path(urdf_path)
+        self.source = Path(urdf_path)
+        self.urdf_path = xacro.expand(self.source, xacro_args) if xacro.is_xacro(self.source) else self.source
         self.package_dirs = mesh_package_dirs(package_dirs)
         if is_mjcf(self.urdf_path):
             full, tree = read_mjcf(self.urdf_path)
@@ -671,7 +673,7 @@ def _local_axes(model: pin.Model) -> list[np.ndarray]:
 
 def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, float] | None = None,
          base: str | None = None, package_dirs: list[str] | None = None, srdf: str | Path | None = None,
-         group: str | None = None) -> Robot:
+         group: str | None = None, xacro_args: dict[str, str] | None = None) -> Robot:
     """Load a registered robot (``kinelab.robots()``) or a URDF file as a :class:`Robot`.
 
     Args:
@@ -688,6 +690,8 @@ def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, fl
         srdf: an SRDF file: its named configurations (:meth:`Robot.named_q`), its groups, and the values at
             which joints off the chain are held (the first configuration naming a joint; ``locked`` wins).
         group: an SRDF group whose chain (base → tip), end effector or last joint gives base and tool.
+        xacro_args: arguments of a ``.xacro`` source (name → value), expanded with xacrodoc (the extra
+            ``kinelab[xacro]``); MJCF sources (root ``<mujoco>``) are read by Pinocchio's MJCF parser.
 
     Raises:
         RobotNotFoundError, URDFError, SRDFError, ChainError, FrameNotFoundError, JointNotFoundError: named.
@@ -696,4 +700,4 @@ def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, fl
     if entry is not None and not group:
         tool = tool or entry.tool
     return Robot(path, tool=tool, locked=locked, name=entry.name if entry else None, base=base,
-                 package_dirs=package_dirs, srdf=srdf, group=group)
+                 package_dirs=package_dirs, srdf=srdf, group=group, xacro_args=xacro_args)
