@@ -9,6 +9,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from kinelab.ik.chain import rotation_angle
+
 NOT_FINITE, NOT_A_ROTATION = 1, 2
 
 
@@ -39,14 +41,10 @@ def pose_defect(H: np.ndarray) -> int:
 def pose_verdict(H_target: np.ndarray, H_tool: np.ndarray, q: np.ndarray, lower: np.ndarray,
                  upper: np.ndarray) -> tuple[float, float, bool]:
     """(position error [m], rotation angle of R*ᵀR [rad], q within [lower, upper]) for homogeneous matrices
-    of the target and of the tool (from Pinocchio's FK); the angle as atan2(|vee(M − Mᵀ)|/2, (tr M − 1)/2)."""
+    of the target and of the tool (from Pinocchio's FK); the angle is the chain kernels' own
+    :func:`~kinelab.ik.chain.rotation_angle`."""
     d0, d1, d2 = H_target[0, 3] - H_tool[0, 3], H_target[1, 3] - H_tool[1, 3], H_target[2, 3] - H_tool[2, 3]
-    M = np.empty((3, 3))
-    for i in range(3):
-        for j in range(3):
-            M[i, j] = H_target[0, i] * H_tool[0, j] + H_target[1, i] * H_tool[1, j] + H_target[2, i] * H_tool[2, j]
-    sx, sy, sz = M[2, 1] - M[1, 2], M[0, 2] - M[2, 0], M[1, 0] - M[0, 1]
-    angle = np.arctan2(0.5 * np.sqrt(sx * sx + sy * sy + sz * sz), 0.5 * (M[0, 0] + M[1, 1] + M[2, 2] - 1.0))
+    angle = rotation_angle(H_tool[:3, :3], H_target[:3, :3])
     within = True
     for i in range(q.shape[0]):
         within = within and lower[i] <= q[i] <= upper[i]

@@ -444,7 +444,8 @@ class Robot:
     def within_limits_batch(self, Q: np.ndarray) -> np.ndarray:
         """:meth:`within_limits` per row of a (B, n) array (default slack): a (B,) bool array."""
         Q = np.asarray(Q, dtype=float)
-        inside: np.ndarray = (self._lower_check - LIMIT_SLACK <= Q) & (self._upper_check + LIMIT_SLACK >= Q)
+        lower, upper = self.check_bounds
+        inside: np.ndarray = (lower <= Q) & (upper >= Q)
         return np.asarray(inside.all(axis=1))
 
     def to_pin_q(self, q) -> np.ndarray:
@@ -560,18 +561,12 @@ class Robot:
 
     def tool_error(self, q, oMtarget: pin.SE3) -> tuple[float, float]:
         """(position error [m], rotation angle error [rad]) of the tool at q against oMtarget (Pinocchio FK)."""
-        return self.tool_error_of_float_q(self.check_q(q), oMtarget)
+        return pose_error(oMtarget, self.tool_pose_of_float_q(self.check_q(q)))
 
     def tool_pose_of_float_q(self, q: np.ndarray) -> pin.SE3:
         """oMtool (Pinocchio FK) for a q known to be n finite floats (a solver's answer): no check repeated."""
         pin.forwardKinematics(self.model, self.data, q if self._identity_q else self._pin_q(q))
         return pin.updateFramePlacement(self.model, self.data, self.tool_frame_id)
-
-    def tool_error_of_float_q(self, q: np.ndarray, oMtarget: pin.SE3) -> tuple[float, float]:
-        """:meth:`tool_error` for a q known to be n finite floats (a solver's answer): no check repeated."""
-        pin.forwardKinematics(self.model, self.data, q if self._identity_q else self._pin_q(q))
-        oMtool = pin.updateFramePlacement(self.model, self.data, self.tool_frame_id)
-        return pose_error(oMtarget, oMtool)
 
     def frame_placement(self, q, frame: str) -> pin.SE3:
         """oMframe: pose of any frame of the reduced model in the base frame."""
