@@ -26,8 +26,8 @@ from kinelab.ik.batch import BatchIKResult, solve_batch
 from kinelab.ik.branches import solve_all
 from kinelab.ik.frdm.options import FRDMOptions
 from kinelab.ik.frdm.tracking import TrackResult, track
+from kinelab.ik.preferred import solve
 from kinelab.ik.result import IKResult, Status
-from kinelab.ik.solve import solve
 from kinelab.ik.targets import from_xyz_quat_wxyz as target_from_xyz_quat_wxyz
 from kinelab.ik.targets import from_xyz_rpy as target_from_xyz_rpy
 from kinelab.robot import Joint, Robot, load

@@ -1,6 +1,7 @@
 """Inverse kinematics: :func:`solve` for every solver, the targets, the result.
 
 - :mod:`~kinelab.ik.solve`: the entry point (restarts, budget, Pinocchio's verdict).
+- :mod:`~kinelab.ik.preferred`: the public ``solve`` (one answer, or the branch nearest ``prefer``).
 - :mod:`~kinelab.ik.targets`, :mod:`~kinelab.ik.result`: what goes in and what comes out.
 - :mod:`~kinelab.ik.chain`: the compiled chain FK, joint codes and RNG every kernel shares.
 - :mod:`~kinelab.ik.multistart`: seeded restarts run in compiled chunks.
@@ -9,8 +10,9 @@
 """
 
 from kinelab.errors import TargetError
+from kinelab.ik.preferred import solve
 from kinelab.ik.result import IKResult, Status
-from kinelab.ik.solve import register, solve
+from kinelab.ik.solve import register
 from kinelab.ik.targets import from_xyz_quat_wxyz as target_from_xyz_quat_wxyz
 from kinelab.ik.targets import from_xyz_rpy as target_from_xyz_rpy
 
