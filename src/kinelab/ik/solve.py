@@ -232,15 +232,14 @@ class _Problem:
     def judge(self, q: np.ndarray) -> tuple[bool, float, float]:
         """Pinocchio's verdict on q: (success, position error [m], rotation error [rad]) on the task's
         components (the rotation error of task "axis" is the angle between the tool axes)."""
-        if self.task is POSE:
-            if not (q.dtype == np.float64 and q.ndim == 1 and q.flags.c_contiguous):  # the kernel's one signature
-                q = np.ascontiguousarray(q, dtype=float)
-            lower, upper = self.robot.check_bounds
-            dp, dr, within = _VERDICT(self.target.homogeneous, self.robot.tool_pose_of_float_q(q).homogeneous, q,
-                                      lower, upper)
-            return dp <= self.tol_pos and dr <= self.tol_rot and within, dp, dr
-        dp, dr = self.task.errors(self.target, self.robot.tool_pose_of_float_q(q))
-        return self.task.met(dp, dr, self.tol_pos, self.tol_rot) and self.robot.within_limits(q), dp, dr
+        if not (q.dtype == np.float64 and q.ndim == 1 and q.flags.c_contiguous):  # the kernel's one signature
+            q = np.ascontiguousarray(q, dtype=float)
+        lower, upper = self.robot.check_bounds
+        dp, dr, within = _VERDICT(self.target.homogeneous, self.robot.tool_pose_of_float_q(q).homogeneous, q,
+                                  lower, upper, self.task.axis)
+        task = self.task
+        ok = within and (not task.position or dp <= self.tol_pos) and (not task.rotation or dr <= self.tol_rot)
+        return ok, dp, dr
 
 
 def _loop(module: Any, pb: _Problem, start: np.ndarray, max_restarts: int, opts: Any, rng: _LazyRng,

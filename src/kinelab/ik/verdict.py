@@ -39,12 +39,19 @@ def pose_defect(H: np.ndarray) -> int:
 
 @njit(cache=True)
 def pose_verdict(H_target: np.ndarray, H_tool: np.ndarray, q: np.ndarray, lower: np.ndarray,
-                 upper: np.ndarray) -> tuple[float, float, bool]:
-    """(position error [m], rotation angle of R*ᵀR [rad], q within [lower, upper]) for homogeneous matrices
-    of the target and of the tool (from Pinocchio's FK); the angle is the chain kernels' own
-    :func:`~kinelab.ik.chain.rotation_angle`."""
+                 upper: np.ndarray, axis: int) -> tuple[float, float, bool]:
+    """(position error [m], rotation error [rad], q within [lower, upper]) for homogeneous matrices of the
+    target and of the tool (from Pinocchio's FK). The rotation error is the angle of R*ᵀR (the chain
+    kernels' own :func:`~kinelab.ik.chain.rotation_angle`), or with ``axis`` = 0, 1, 2 the angle between
+    the tool's and the target's x, y or z axes (task "axis"; −1 for the whole rotation)."""
     d0, d1, d2 = H_target[0, 3] - H_tool[0, 3], H_target[1, 3] - H_tool[1, 3], H_target[2, 3] - H_tool[2, 3]
-    angle = rotation_angle(H_tool[:3, :3], H_target[:3, :3])
+    if axis < 0:
+        angle = rotation_angle(H_tool[:3, :3], H_target[:3, :3])
+    else:
+        u0, u1, u2 = H_tool[0, axis], H_tool[1, axis], H_tool[2, axis]
+        v0, v1, v2 = H_target[0, axis], H_target[1, axis], H_target[2, axis]
+        c0, c1, c2 = u1 * v2 - u2 * v1, u2 * v0 - u0 * v2, u0 * v1 - u1 * v0
+        angle = np.arctan2(np.sqrt(c0 * c0 + c1 * c1 + c2 * c2), u0 * v0 + u1 * v1 + u2 * v2)
     within = True
     for i in range(q.shape[0]):
         within = within and lower[i] <= q[i] <= upper[i]
