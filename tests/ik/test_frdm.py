@@ -12,7 +12,7 @@ from helpers import revolute, write_urdf
 import kinelab
 from kinelab.ik import solve
 from kinelab.ik.chain import chain_model as vector_model
-from kinelab.ik.frdm import kernel, reference
+from kinelab.ik.frdm import attempts, kernel, reference
 from kinelab.ik.multistart import seed_state
 
 ROBOTS = ("stanford", "era", "youbot", "panda", "ur5", "kinova")
@@ -355,8 +355,8 @@ def test_mixed_order_restarts_turn_the_sweep_direction(robots):
             problem = kernel.Problem(vm.lower, vm.upper, np.ones(vm.n, dtype=np.bool_), target.translation,
                                      target.rotation, 3.0 / vm.length**2, np.ones(3), 1e-6, 1e-6, True, True,
                                      np.zeros(vm.n), 0.0, -1)
-            settings = kernel.Settings(1.0, 1e-10, 10, 0.1, 5)
-            code = kernel.multistart(q, vm.chain, problem, settings, ORDERS[name], 100, seed_state(7), 2, 1e9, best,
+            settings = kernel.Settings(1.0, 1e-10, 10, 0.1, 5, 0)  # no polish: both attempts run
+            code = attempts.multistart(q, vm.chain, problem, settings, ORDERS[name], 100, seed_state(7), 2, 1e9, best,
                                      stats, kernel.new_memory(vm.n, 5))
             last[name] = (q, stats[0], code)
         if last["mixed"][1] == 2 and last["base2tip"][1] == 2 and last["tip2base"][1] == 2:
@@ -373,7 +373,7 @@ def test_the_answer_does_not_depend_on_where_the_clock_chunks_end(chunk):
     robot = kinelab.load("panda")
     vm = vector_model(robot)
     rng = np.random.default_rng(11)
-    settings = kernel.Settings(1.0, 1e-10, 10, 0.1, 5)
+    settings = kernel.Settings(1.0, 1e-10, 10, 0.1, 5, 10)
     for _ in range(5):
         target, q0 = robot.fk(robot.random_q(rng)), robot.random_q(rng)
         problem = kernel.Problem(vm.lower, vm.upper, np.ones(vm.n, dtype=np.bool_), target.translation,
@@ -382,12 +382,12 @@ def test_the_answer_does_not_depend_on_where_the_clock_chunks_end(chunk):
         results = []
         for size in (1e9, chunk):
             q, best, stats, mem = q0.copy(), q0.copy(), np.zeros(kernel.STATS_SIZE), kernel.new_memory(vm.n, 5)
-            rng_state, attempts, code = seed_state(3), 20, -1
-            while attempts > 0:
+            rng_state, left, code = seed_state(3), 20, -1
+            while left > 0:
                 before = stats[kernel.T_ATTEMPTS]
-                code = kernel.multistart(q, vm.chain, problem, settings, kernel.MIXED, 100, rng_state, attempts,
-                                         stats[kernel.T_SWEEPS] + size, best, stats, mem)
-                attempts -= int(stats[kernel.T_ATTEMPTS] - before)
+                code = attempts.multistart(q, vm.chain, problem, settings, kernel.MIXED, 100, rng_state, left,
+                                           stats[kernel.T_SWEEPS] + size, best, stats, mem)
+                left -= int(stats[kernel.T_ATTEMPTS] - before)
                 if code == kernel.CONVERGED:
                     break
             results.append((code, best.copy(), stats[kernel.T_SWEEPS], stats[kernel.T_ATTEMPTS]))
@@ -429,7 +429,7 @@ def test_the_typed_entry_point_gives_the_dispatchers_answer(robots):
         target, q0 = robot.fk(robot.random_q(rng)), robot.random_q(rng)
         problem = frdm_solver._compiled_problem(cm, target, opts, 1e-6, 1e-6)
         out = []
-        for call in (frdm_solver._MULTISTART, kernel.multistart):
+        for call in (frdm_solver._MULTISTART, attempts.multistart):
             q, best, stats = q0.copy(), q0.copy(), np.zeros(kernel.STATS_SIZE)
             code = call(q, cm.chain, problem, opts.settings(), 3, 100, seed_state(k), 5, 1e9, best, stats,
                         kernel.new_memory(cm.n, opts.accel_m))

@@ -18,6 +18,7 @@ from numba import njit, prange
 from kinelab.geometry import wrap_to_pi
 from kinelab.ik.chain import CONTINUOUS, chain_model, random_configuration
 from kinelab.ik.frdm import solver
+from kinelab.ik.frdm.attempts import multistart
 from kinelab.ik.frdm.kernel import (
     CONVERGED,
     STATE_SIZE,
@@ -27,7 +28,6 @@ from kinelab.ik.frdm.kernel import (
     T_SWEEPS,
     Memory,
     Problem,
-    multistart,
 )
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.multistart import clock_chunk

@@ -27,7 +27,6 @@ from kinelab.ik.chain import (
     TWO_PI,
     Chain,
     chain_fk,
-    random_configuration,
     rotate_about,
     rotate_rows,
     rotation_angle,
@@ -44,8 +43,8 @@ CONVERGED, STALL_STEP, STALL_WINDOW, BUDGET = 0, 1, 2, 3
 S_HISTORY, S_SWEEPS, S_E_WINDOW, S_WINDOW_START, S_ACCEPTED, S_E, S_KICKED, S_HELD, S_SINCE_FK = range(9)
 STATE_SIZE = 9
 # slots of a multistart's statistics array
-T_ATTEMPTS, T_SWEEPS, T_STALLS, T_ACCEPTED, T_BEST_E, T_CUT = range(6)
-STATS_SIZE = 6
+T_ATTEMPTS, T_SWEEPS, T_STALLS, T_ACCEPTED, T_BEST_E, T_CUT, T_POLISHED = range(7)
+STATS_SIZE = 7
 
 
 class Problem(NamedTuple):
@@ -75,6 +74,7 @@ class Settings(NamedTuple):
     window: int  # sweeps over which the objective must fall by window_rel
     window_rel: float
     accel_m: int  # Anderson memory (0: plain FRDM)
+    polish: int  # Gauss–Newton steps tried on a stalled attempt before the restart (0: none)
 
 
 class Memory(NamedTuple):
@@ -538,55 +538,6 @@ def run(q: np.ndarray, ch: Chain, pb: Problem, st: Settings, order: int, max_swe
     if fresh:
         _hold(mem, e, o, p, R, since_fk)
     return BUDGET, max_sweeps
-
-
-@njit(cache=True)
-def multistart(q, ch, pb, st, order, max_sweeps, rng_state, max_attempts, sweep_budget, best_q, stats, mem):
-    """Attempts from q, then from seeded uniform starts, until one converges, ``max_attempts`` have run or
-    ``sweep_budget`` sweeps (a total) are spent. A stall ends an attempt (a restart, not a bypass).
-
-    Called in chunks: an attempt the sweep budget cuts is resumed by the next call from where it stopped, its
-    Anderson history and monitor state kept in ``mem`` (stats[T_CUT] = 1 meanwhile), so the answer does not
-    depend on where the chunks end. On return q holds the converged configuration (or the current one),
-    best_q the lowest-objective one; stats has the slots T_*. Returns a run() code.
-    """
-    best = stats[T_BEST_E] if stats[T_ATTEMPTS] > 0.0 or stats[T_CUT] != 0.0 else np.inf
-    code = BUDGET
-    done = 0
-    while done < max_attempts:
-        if stats[T_CUT] == 0.0:
-            if stats[T_ATTEMPTS] > 0.0:
-                random_configuration(q, ch.kind, pb.lower, pb.upper, rng_state)
-            mem.state[:] = 0.0
-        stats[T_CUT] = 0.0
-        left = max_sweeps - int(mem.state[S_SWEEPS])
-        budget = min(left, int(sweep_budget - stats[T_SWEEPS]))
-        attempt_order = order
-        if order == MIXED:  # base → tip on the first attempt and every other restart, tip → base between
-            attempt_order = BASE_TO_TIP if int(stats[T_ATTEMPTS]) % 2 == 0 else TIP_TO_BASE
-        code, s = run(q, ch, pb, st, attempt_order, budget, mem)
-        stats[T_SWEEPS] += s
-        if code == BUDGET and budget < left:  # cut by the chunk: the next call resumes this attempt
-            stats[T_CUT] = 1.0
-            stats[T_BEST_E] = best
-            return BUDGET
-        stats[T_ATTEMPTS] += 1.0
-        done += 1
-        stats[T_ACCEPTED] += mem.state[S_ACCEPTED]
-        if mem.state[S_E] < best:
-            best = mem.state[S_E]
-            best_q[:] = q
-        if code == CONVERGED:
-            best_q[:] = q
-            stats[T_BEST_E] = mem.state[S_E]
-            return CONVERGED
-        if code == STALL_STEP or code == STALL_WINDOW:  # noqa: SIM109 - plain comparisons for numba
-            stats[T_STALLS] += 1.0
-        if stats[T_SWEEPS] >= sweep_budget:
-            stats[T_BEST_E] = best
-            return BUDGET
-    stats[T_BEST_E] = best
-    return code
 
 
 @functools.cache

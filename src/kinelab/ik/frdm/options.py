@@ -60,6 +60,8 @@ class FRDMOptions:
         active: bypasses switched on before the first sweep.
         max_bypass_events: how many monitor events the policy answers before the attempt gives up.
         polish: follow FRDM with damped-least-squares steps (reported as mode "frdm+polish").
+        stall_polish: Gauss–Newton steps the compiled multistart tries on a stalled attempt before its
+            restart (:mod:`~kinelab.ik.frdm.attempts`; 0: the paper's FRDM alone).
         trace: keep the objective after every sweep in ``info["trace"]``.
     """
 
@@ -84,6 +86,7 @@ class FRDMOptions:
     active: tuple[str, ...] | None = None
     max_bypass_events: int = 3
     polish: bool = False
+    stall_polish: int = 10
     trace: bool = False
 
     def __hash__(self) -> int:  # computed once: solve() looks its compiled context up by these options
@@ -106,6 +109,7 @@ class FRDMOptions:
         opt.positive("stall_window", self.stall_window, allow_none=True, integer=True)
         opt.positive("stall_rel", self.stall_rel, allow_none=True)
         opt.positive("max_bypass_events", self.max_bypass_events, integer=True, zero=True)
+        opt.positive("stall_polish", self.stall_polish, integer=True, zero=True)
         for name in ("use_limits", "polish", "trace"):
             opt.flag(name, getattr(self, name))
         opt.positive("relax", self.relax)
@@ -181,7 +185,7 @@ class FRDMOptions:
     @functools.cached_property
     def _settings(self) -> kernel.Settings:
         return kernel.Settings(float(self.relax), float(self.eps_q), int(self.window), float(self.window_rel),
-                               int(self.accel_m))
+                               int(self.accel_m), int(self.stall_polish))
 
     def settings(self) -> kernel.Settings:
         """The kernel's sweep and monitor settings (an immutable tuple, built once)."""
@@ -204,7 +208,16 @@ class FRDMOptions:
 
     def for_task(self, task: Task) -> FRDMOptions:
         """These options for a :class:`~kinelab.ik.tasks.Task` (FRDM's modes are its tasks), cached."""
-        return self if task.name == "pose" else _for_task(self, task)
+        if task.name == "pose":
+            return self
+        cached = self._task_options.get(task)  # a loop asks every call: hashing these options costs µs
+        if cached is None:
+            cached = self._task_options[task] = _for_task(self, task)
+        return cached
+
+    @functools.cached_property
+    def _task_options(self) -> dict:
+        return {}
 
     def axis_weights(self) -> np.ndarray:
         """Weights of the tool x, y, z axes; 0 in position mode (a shared read-only array)."""

@@ -16,8 +16,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from kinelab.ik.chain import PRISMATIC, chain_fk
-from kinelab.ik.frdm.kernel import CONVERGED, STATE_SIZE, Memory, Problem, _within, run
+from kinelab.ik.frdm.attempts import lm_polish
+from kinelab.ik.frdm.kernel import CONVERGED, STATE_SIZE, Memory, Problem, run
 
 
 @njit(cache=True)
@@ -81,53 +81,3 @@ def _limit_pull(x, lo, hi, pull):
     if not (dl > 0.0 and du > 0.0) or dl + du == np.inf:
         return pull if dl + du != np.inf else 0.0
     return min(0.5, pull * (dl + du) * (dl + du) / (4.0 * dl * du))
-
-
-@njit(cache=True)
-def lm_polish(q, ch, pb, iterations):
-    """Levenberg–Marquardt on the world-frame error [p* − p; log(R* Rᵀ)], steps kept in the windows.
-
-    Returns (CONVERGED or −1, iterations spent); q is updated in place.
-    """
-    n = q.shape[0]
-    e, o, p, R = np.empty((n, 3)), np.empty((n, 3)), np.empty(3), np.empty((3, 3))
-    J = np.empty((6, n))
-    err = np.empty(6)
-    for it in range(iterations):
-        chain_fk(ch, q, e, o, p, R)
-        if _within(p, R, pb.pstar, pb.Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot, pb.rot_axis):
-            return CONVERGED, it
-        _world_error(p, R, pb, err)
-        for i in range(n):
-            if ch.kind[i] == PRISMATIC:
-                J[0:3, i] = e[i]
-                J[3:6, i] = 0.0
-            else:
-                J[0:3, i] = np.cross(e[i], p - o[i])
-                J[3:6, i] = e[i]
-        A = J.T @ J
-        damping = 1e-9 + 1e-3 * (err @ err)
-        for i in range(n):
-            A[i, i] += damping
-        dq = np.linalg.solve(A, J.T @ err)
-        for i in range(n):
-            q[i] = min(max(q[i] + dq[i], pb.lower[i]), pb.upper[i])
-    chain_fk(ch, q, e, o, p, R)
-    if _within(p, R, pb.pstar, pb.Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot, pb.rot_axis):
-        return CONVERGED, iterations
-    return -1, iterations
-
-
-@njit(cache=True)
-def _world_error(p, R, pb, err):
-    """err = [w·(p* − p); log(R* Rᵀ)] with the constrained components only (w = √w_p: the objective's scale
-    is irrelevant to a Gauss–Newton step, but an unchecked component must not pull)."""
-    for k in range(3):
-        err[k] = pb.pstar[k] - p[k] if pb.check_pos else 0.0
-    M = pb.Rstar @ R.T
-    cos_a = min(1.0, max(-1.0, (M[0, 0] + M[1, 1] + M[2, 2] - 1.0) / 2.0))
-    angle = np.arccos(cos_a)
-    scale = 0.5 if angle < 1e-8 else angle / (2.0 * np.sin(angle))
-    w = (M[2, 1] - M[1, 2], M[0, 2] - M[2, 0], M[1, 0] - M[0, 1])
-    for k in range(3):
-        err[3 + k] = scale * w[k] if pb.check_rot else 0.0

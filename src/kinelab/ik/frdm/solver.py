@@ -19,6 +19,7 @@ from kinelab.ik import dls
 from kinelab.ik import multistart as restarts
 from kinelab.ik.chain import CONTINUOUS, ChainModel, chain_model
 from kinelab.ik.frdm import kernel
+from kinelab.ik.frdm.attempts import multistart as compiled_multistart
 from kinelab.ik.frdm.kernel import no_rest
 from kinelab.ik.frdm.monitor import Bypass, Problem, Runner
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
@@ -27,7 +28,7 @@ from kinelab.ik.result import Attempt, SingularEvent, Status
 from kinelab.robot import Robot
 
 Options = FRDMOptions
-_MULTISTART = TypedKernel(kernel.multistart)
+_MULTISTART = TypedKernel(compiled_multistart)
 # joint steps before the first look at the clock (most solves end within them: one kernel call), and then
 # between two looks (≈ 0.03 ms of work: a budget is overrun by about that much whatever the chain's length)
 JOINT_SWEEPS_PER_LOOK = 256
@@ -110,7 +111,7 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: 
     sweeps, stalls, attempts = int(stats[kernel.T_SWEEPS]), int(stats[kernel.T_STALLS]), int(stats[kernel.T_ATTEMPTS])
     info = {"mode": ctx.mode, "sweeps": sweeps, "accelerated_sweeps": int(stats[kernel.T_ACCEPTED]),
             "order": opts.order, "w_p": ctx.problem.w_p, "objective": float(stats[kernel.T_BEST_E]),
-            "attempts": attempts, "stalls": stalls, "path": "compiled"}
+            "attempts": attempts, "stalls": stalls, "polished": int(stats[kernel.T_POLISHED]), "path": "compiled"}
     events = [SingularEvent("stall", "not diagnosed (compiled multistart: restarted)", count=stalls)] if stalls else []
     return Attempt(robot.wrap_continuous(q) if ctx.continuous else q, status, sweeps, events, [], info), \
         max(0, attempts - 1)
