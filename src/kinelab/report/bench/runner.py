@@ -17,7 +17,7 @@ from tqdm import tqdm
 
 from kinelab.errors import KinelabError
 from kinelab.ik.tasks import TASKS
-from kinelab.report.bench import peers
+from kinelab.report.bench import fabrik, peers
 from kinelab.report.bench.adapters import KINELAB_SOLVERS
 from kinelab.report.bench.protocol import (
     BUDGET,
@@ -130,6 +130,7 @@ def _prepared(robot: Robot, solvers: dict[str, Prepare], problems: list[Case], b
 def available_solvers() -> tuple[dict[str, Prepare], dict[str, str]]:
     """kinelab's solvers and the peers that are installed; the second dict says why a peer is absent."""
     solvers: dict[str, Prepare] = dict(KINELAB_SOLVERS)
+    solvers["fabrik"] = fabrik.prepare  # the FRDM paper's yardstick, written here (position only)
     found, missing = peers.available()
     solvers.update(found)
     return solvers, missing
@@ -177,7 +178,7 @@ def _taking(table: dict[str, Prepare], task: str, missing: dict[str, str]) -> di
         raise KinelabError(f"bench takes task in {TASKS}, got {task!r}")
     kept = {}
     for name, prepare in table.items():
-        takes = peers.TASKS.get(name, ("pose",) if name == "biquat" else TASKS)
+        takes = peers.TASKS.get(name, ("pose",) if name == "biquat" else ("position",) if name == "fabrik" else TASKS)
         if task in takes:
             kept[name] = prepare
         else:
