@@ -11,10 +11,12 @@ from __future__ import annotations
 import contextlib
 import io
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
+from kinelab.errors import ConfigurationError
 from kinelab.robot import Robot
 from kinelab.view.server import Server
 
@@ -65,13 +67,17 @@ class Scene:
 
     def look_at_robot(self, q=None) -> Scene:
         """Aim the camera at the robot as it stands at q, far enough to see the arm stretched any way."""
-        q = self.robot.neutral() if q is None else q
+        return self._aim(self.robot.neutral() if q is None else q, extent=(0.0, 0.0))
+
+    def _aim(self, q, extent: tuple[float, float]) -> Scene:
+        """Aim at the robot at q, or at a grid of copies spanning ``extent`` (along the base x and y) [m]."""
         points = np.array([m.translation for m in self.robot.joint_placements(q).values()])
-        reach = self._reach
+        reach = self._reach + 0.9 * max(extent)
         # meshcat's orbit controls always look at the world origin: bring the robot to it instead, the
         # point a little above its first joint at the origin, the grid moving with it
         center = points[1:].mean(axis=0) if len(points) > 1 else points[0]
-        shift = pin.SE3(np.eye(3), -np.array([center[0], center[1], points[0][2] + 0.4 * reach]))
+        shift = pin.SE3(np.eye(3), -np.array([center[0] + extent[0] / 2, center[1] + extent[1] / 2,
+                                              points[0][2] + 0.4 * self._reach]))
         self.viewer.set_transform(shift.homogeneous)
         self.viewer["/Grid"].set_transform(shift.homogeneous)
         # the camera's position is in three.js axes (y up)
@@ -181,3 +187,60 @@ class Scene:
         """Stop the server this scene started (a viewer passed in is left alone)."""
         if self.server is not None:
             self.server.stop()
+
+
+
+def side_by_side(robot: Robot, qs: list, spacing: float | None = None, viewer: Any = None) -> Scene:
+    """One scene with the robot drawn once per configuration as a stick figure (joints as spheres, the
+    segments between joint origins and the tool point as cylinders), side by side on a grid (columns
+    along the base y axis, rows along x): the branches of one IK target, say, each with its tool frame.
+    Stick figures keep the page small (a meshed copy repeats the robot's mesh files: 9 MB per copy of a
+    UR5) and the joints visible.
+
+    Args:
+        robot: the robot.
+        qs: the configurations (one number per joint each, rad or m), at least one.
+        spacing: distance between neighbouring copies [m]; default 1.2 × the arm's reach.
+        viewer: a meshcat viewer to draw in (default: a new one on 127.0.0.1).
+
+    Returns:
+        A :class:`Scene` whose viewer holds the row (``save_html`` writes it; ``close`` stops its server).
+
+    Raises:
+        ConfigurationError: a q of the wrong length, non-finite, or no q at all.
+    """
+    checked = [robot.check_q(q) for q in qs]
+    if not checked:
+        raise ConfigurationError("side_by_side needs at least one configuration; got none")
+    scene = Scene(robot, viewer=viewer)
+    scene.viewer[scene.root].delete()
+    scene.viewer["frames"].delete()
+    for default in ("/Grid", "/Axes"):  # meshcat's floor and world triad would cross the copies
+        scene.viewer[default].set_property("visible", False)
+    spacing = spacing or 1.2 * scene._reach
+    columns = int(np.ceil(np.sqrt(len(checked))))
+    rows = int(np.ceil(len(checked) / columns))
+    for k, q in enumerate(checked):
+        offset = pin.SE3(np.eye(3), np.array([(k // columns) * spacing, (k % columns) * spacing, 0.0]))
+        points = [m.translation for m in robot.joint_placements(q).values()] + [robot.fk(q).translation]
+        _stick_figure(scene.viewer["branches"][str(k)], [offset.act(p) for p in points], scene.frame_length)
+        scene.frame(f"tool_{k}", offset * robot.fk(q))
+    return scene._aim(checked[0], extent=((rows - 1) * spacing, (columns - 1) * spacing))
+
+
+def _stick_figure(node, points: list[np.ndarray], size: float) -> None:
+    """Spheres at the points and cylinders between consecutive distinct ones, under the meshcat ``node``."""
+    import meshcat.geometry as g
+
+    radius = 0.08 * size
+    for k, p in enumerate(points):
+        node[f"joint{k}"].set_object(g.Sphere(1.6 * radius), g.MeshLambertMaterial(color=0x4363D8))
+        node[f"joint{k}"].set_transform(pin.SE3(np.eye(3), p).homogeneous)
+    for k, (a, b) in enumerate(zip(points, points[1:], strict=False)):
+        length = float(np.linalg.norm(b - a))
+        if length < 1e-9:
+            continue
+        # meshcat's cylinder stands along its local y axis: turn y onto the segment
+        along = pin.Quaternion.FromTwoVectors(np.array([0.0, 1.0, 0.0]), (b - a) / length).matrix()
+        node[f"link{k}"].set_object(g.Cylinder(length, radius), g.MeshLambertMaterial(color=0xA9A9A9))
+        node[f"link{k}"].set_transform(pin.SE3(along, (a + b) / 2).homogeneous)
