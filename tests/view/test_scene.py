@@ -80,3 +80,22 @@ def test_the_empty_reference_really_is_empty_of_the_robot(tmp_path):
     share = browser.changed_share(browser.screenshot(tmp_path / "a.html", tmp_path / "a.png"),
                               browser.screenshot(tmp_path / "b.html", tmp_path / "b.png"))
     assert share < 0.001  # two renders of the same page agree: the comparison measures the robot
+
+
+def test_side_by_side_draws_one_stick_figure_and_tool_frame_per_configuration():
+    robot = kinelab.load("ur5")
+    qs = [robot.random_q(k) for k in range(5)]
+    s = viz.side_by_side(robot, qs, spacing=1.0)
+    html = s.static_html()
+    s.close()
+    paths = browser.scene_paths(html)
+    for k in range(5):
+        joints = {p for p in paths if p.startswith(f"/meshcat/branches/{k}/joint")}
+        assert len(joints) == robot.n + 1  # every joint origin and the tool point
+        assert f"/meshcat/frames/tool_{k}/axis2" in paths
+    assert not any(p.startswith("/meshcat/" + robot.name) for p in paths)  # no meshed copy
+    assert len(html) < 3_000_000  # meshcat's viewer script and five stick figures (a meshed UR5 alone: 9 MB)
+    with pytest.raises(kinelab.ConfigurationError, match="at least one"):
+        viz.side_by_side(robot, [])
+    with pytest.raises(kinelab.ConfigurationError):
+        viz.side_by_side(robot, [np.zeros(3)])
