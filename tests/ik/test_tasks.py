@@ -121,3 +121,18 @@ def test_a_stalled_attempt_is_finished_by_gauss_newton_steps_on_the_task_compone
         full = kinelab.solve(robot, target, task="axis", seed=0, time_budget=0.05)
         assert full.success and judged_here(robot, full.q, target, "axis")
     assert stalled >= 5 and finished >= 3  # measured: 12 stalled, 4 finished from the first stall
+
+
+def test_a_point_is_a_position_target_and_refused_as_a_pose_with_the_task_named():
+    robot = load("so101")
+    point = robot.fk(robot.random_q(3)).translation
+    res = kinelab.solve(robot, list(point), task="position", seed=0)
+    assert res.success and np.linalg.norm(robot.fk(res.q).translation - point) <= 1e-6
+    assert kinelab.solve_all(robot, tuple(point), task="position", seed=0, max_solutions=1)[0].success
+    for task in ("pose", "axis", "orientation"):
+        with pytest.raises(kinelab.TargetError, match="task='position'"):
+            kinelab.solve(robot, point, task=task)
+    with pytest.raises(kinelab.TargetError, match="NaN"):
+        kinelab.solve(robot, [0.1, np.inf, 0.0], task="position")
+    with pytest.raises(kinelab.TargetError, match="pin.SE3"):
+        kinelab.solve(robot, [0.1, 0.2], task="position")

@@ -54,7 +54,7 @@ def solve_all(robot: Robot, target: pin.SE3, task: str = "pose", axis: str = "z"
     Raises:
         TargetError, ConfigurationError, OptionError: bad input, named.
     """
-    target = as_target(target)
+    target = as_target(target, task)
     check_arguments(tol_pos, tol_rot, time_budget, 0, seed, "refuse")
     if max_solutions is not None and (not isinstance(max_solutions, int) or max_solutions < 1):
         raise OptionError("max_solutions", max_solutions, "an integer ≥ 1, or None")

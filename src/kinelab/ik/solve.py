@@ -138,7 +138,7 @@ def solve(
         opts = for_task(solver, opts, tk)
     _prepare(module, robot)
     t_start = time.perf_counter()
-    target = as_target(target)
+    target = as_target(target, tk.name)
     check_arguments(tol_pos, tol_rot, time_budget, max_restarts, seed, start_outside_limits)
     rng = _LazyRng(seed)
     problem = _Problem(robot, target, solver, tol_pos, tol_rot, t_start, t_start + time_budget, seed, tk)

@@ -29,8 +29,19 @@ def from_xyz_quat_wxyz(xyz, quat_wxyz) -> pin.SE3:
     return pin.SE3(pin.Quaternion(w, x, y, z).toRotationMatrix(), xyz)
 
 
-def as_target(target) -> pin.SE3:
-    """Check a target: a ``pin.SE3`` with finite entries and a proper rotation, or a unit biquaternion."""
+def as_target(target, task: str = "pose") -> pin.SE3:
+    """Check a target: a ``pin.SE3`` with finite entries and a proper rotation, or a unit biquaternion; for
+    task "position" also a point (three numbers [m], base frame), taken with the identity rotation.
+
+    Raises:
+        TargetError: anything else, or a point given for a task that constrains the rotation.
+    """
+    if not isinstance(target, pin.SE3 | DualQuat) and _is_point(target):
+        if task != "position":
+            raise TargetError(f"a point (three numbers) was given as the target of task {task!r}, which needs "
+                              "a rotation too; pass task='position' to reach the point with any rotation, or a "
+                              "pin.SE3 (kinelab.target_from_xyz_rpy) for a pose")
+        return pin.SE3(np.eye(3), _finite(target, 3, "the target point"))
     if isinstance(target, DualQuat):
         return target.require_unit("the target biquaternion").to_se3()
     if not isinstance(target, pin.SE3):
@@ -45,6 +56,16 @@ def as_target(target) -> pin.SE3:
     if defect == NOT_A_ROTATION:
         raise TargetError("target rotation is not a rotation matrix (RᵀR ≠ I or det R < 0)")
     return target
+
+
+def _is_point(target) -> bool:
+    """A list, tuple or array of three numbers."""
+    if isinstance(target, list | tuple | np.ndarray):
+        try:
+            return np.shape(target) == (3,)
+        except ValueError:
+            return False
+    return False
 
 
 def _finite(values, size: int, what: str) -> np.ndarray:
