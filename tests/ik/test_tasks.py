@@ -136,3 +136,16 @@ def test_a_point_is_a_position_target_and_refused_as_a_pose_with_the_task_named(
         kinelab.solve(robot, [0.1, np.inf, 0.0], task="position")
     with pytest.raises(kinelab.TargetError, match="pin.SE3"):
         kinelab.solve(robot, [0.1, 0.2], task="position")
+
+
+def test_an_orientation_a_three_joint_finger_cannot_make_gets_an_honest_status_and_message():
+    robot = load("finger_edu")
+    target = pin.SE3(pin.exp3(np.array([2.0, 0.5, 0.3])), np.zeros(3))
+    res = kinelab.solve(robot, target, task="orientation", seed=0, time_budget=0.05)
+    assert not res.success and res.status in (kinelab.Status.STALLED, kinelab.Status.TIME_BUDGET)
+    assert "met the rotation" in res.message and " m " not in res.message  # only the judged component
+    assert res.rotation_error == pytest.approx(judged_rotation(robot, res.q, target), abs=1e-12)
+
+
+def judged_rotation(robot, q, target):
+    return float(np.linalg.norm(pin.log3(target.rotation.T @ robot.fk(q).rotation)))

@@ -287,6 +287,10 @@ def _fast(module: Any, pb: _Problem, start: np.ndarray | None, max_restarts: int
         status = Status.CONVERGED
     elif status == Status.CONVERGED:
         status, message = Status.STALLED, "the solver converged but its answer failed Pinocchio's check"
+    else:
+        errors = [f"{dp:.3g} m"] * pb.task.position + [f"{dr:.3g} rad"] * pb.task.rotation
+        message = (f"none of {restarts + 1} starts met the {pb.task.constrained} to the tolerances; the best "
+                   f"answer is {' and '.join(errors)} from the target")
     return IKResult(
         q=att.q, success=success, status=status, position_error=dp, rotation_error=dr, iterations=att.iterations,
         restarts=restarts, wall_time=time.perf_counter() - pb.t_start, solver=pb.solver, mode=att.info["mode"],
