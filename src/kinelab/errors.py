@@ -27,6 +27,11 @@ class RobotNotFoundError(KinelabError):
         )
 
 
+class DescriptionError(KinelabError):
+    """An ``rd:NAME`` source that cannot be opened: robot_descriptions missing, an unknown name, or a
+    description whose repository is not in robot_descriptions' cache."""
+
+
 class URDFError(KinelabError):
     """A URDF that cannot be read: missing, malformed, or not describing a usable chain."""
 

@@ -179,6 +179,7 @@ def test_singular_on_an_arm_with_fewer_than_six_joints(capsys):
     (["singular", "ur5", "--sweep", "0"], "at least one sample"),
     (["ik", "ur5", "--target-xyz", "0.3", "0.2", "0.4", "--seed", "-1"], "seed"),
     (["bench", "--out", "/proc/kinelab-bench", "--n", "1"], "not a writable folder"),
+    (["fk", "rd:ur5_descripton", "0", "0", "0", "0", "0", "0"], "close names: rd:ur5_description"),
 ])
 def test_bad_values_end_in_one_line_and_exit_2_before_any_work(argv, needle):
     proc = subprocess.run([sys.executable, "-m", "kinelab.cli", *argv], capture_output=True, text=True,

@@ -109,7 +109,8 @@ def build_visual_model(
     dirs = mesh_package_dirs() if package_dirs is None else list(package_dirs)
     missing = missing_meshes(urdf_path, dirs)
     if missing:
-        warnings.warn(f"{len(missing)} mesh(es) of {urdf_path.name} not found (first: {missing[0]}); "
-                      "those visuals are left out", stacklevel=2)
+        warnings.warn(f"{len(missing)} mesh(es) of {urdf_path} not found (first: {missing[0]}; searched "
+                      f"{', '.join(dirs) or 'no package directory'}); those visuals are left out: pass "
+                      "package_dirs= (CLI --package-dir) or set ROS_PACKAGE_PATH", stacklevel=2)
     resolved = _with_resolved_meshes(urdf_path, dirs)
     return pin.buildGeomFromUrdf(model, str(resolved), pin.GeometryType.VISUAL, package_dirs=dirs)

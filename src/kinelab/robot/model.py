@@ -40,7 +40,7 @@ from kinelab.errors import (
     URDFError,
 )
 from kinelab.geometry import pose_error, wrap_to_pi
-from kinelab.robot import catalog, xacro
+from kinelab.robot import catalog, descriptions, xacro
 from kinelab.robot.meshes import build_visual_model, mesh_package_dirs
 from kinelab.robot.mjcf import is_mjcf, read_mjcf
 from kinelab.robot.srdf import Srdf, read_srdf
@@ -672,7 +672,9 @@ def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, fl
     """Load a registered robot (``kinelab.robots()``) or a URDF file as a :class:`Robot`.
 
     Args:
-        name_or_path: a registered name such as ``"era"`` or ``"panda"``, or a path to a URDF.
+        name_or_path: a registered name such as ``"era"`` or ``"panda"``, a path to a URDF, xacro or MJCF
+            file, or ``"rd:NAME"``: a description of robot_descriptions (the extra
+            ``kinelab[descriptions]``), read from its cache (:mod:`~kinelab.robot.descriptions`).
         tool: the tool frame; default: the registered tool, else a frame named ``tool``, else the
             single leaf link (an error lists the leaves when there are several).
         locked: joints to hold fixed, name → value (rad or m): chain joints, or joints off the chain (held
@@ -689,8 +691,13 @@ def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, fl
             ``kinelab[xacro]``); MJCF sources (root ``<mujoco>``) are read by Pinocchio's MJCF parser.
 
     Raises:
-        RobotNotFoundError, URDFError, SRDFError, ChainError, FrameNotFoundError, JointNotFoundError: named.
+        RobotNotFoundError, DescriptionError, URDFError, SRDFError, ChainError, FrameNotFoundError,
+        JointNotFoundError: named.
     """
+    if str(name_or_path).startswith(descriptions.PREFIX):
+        found = descriptions.resolve(str(name_or_path))
+        return Robot(found.path, tool=tool, locked=locked, name=found.name, base=base,
+                     package_dirs=[*(package_dirs or []), *found.package_dirs], srdf=srdf, group=group)
     path, entry = catalog.resolve(name_or_path)
     if entry is not None and not group:
         tool = tool or entry.tool
