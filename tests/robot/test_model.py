@@ -164,12 +164,15 @@ def test_closed_loop_is_refused(tmp_path):
         kinelab.load(write_urdf(tmp_path, body))
 
 
-def test_mimic_joint_on_the_chain_is_refused(tmp_path):
+def test_mimic_joint_on_the_chain_follows_its_leader_and_frdm_refuses_it(tmp_path):
+    """(#15: mimic joints load through Pinocchio's model; tests/robot/test_mimic.py checks them.)"""
     body = ('<link name="base"/><link name="a"/><link name="b"/>'
             + revolute("ja", "base", "a")
             + revolute("jb", "a", "b", extra='<mimic joint="ja" multiplier="1"/>'))
+    robot = kinelab.load(write_urdf(tmp_path, body))
+    assert robot.joint_names == ["ja"] and list(robot.mimics) == ["jb"]
     with pytest.raises(kinelab.ChainError, match="jb.*mimic"):
-        kinelab.load(write_urdf(tmp_path, body))
+        kinelab.solve(robot, robot.fk([0.3]))
 
 
 def test_floating_joint_on_the_chain_is_refused(tmp_path):

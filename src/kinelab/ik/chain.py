@@ -85,9 +85,15 @@ def build(robot: Robot) -> ChainModel:
     """The chain model of ``robot`` (every joint 1-DoF and in series: checked here).
 
     Raises:
-        ChainError: a joint not in series with the previous one, or a tool frame not on the last joint.
+        ChainError: a joint not in series with the previous one, a tool frame not on the last joint, or a
+            mimic joint (these kernels step one coordinate at a time about its own axis).
     """
     model = robot.model
+    if robot.mimics:
+        mimic = next(iter(robot.mimics.values()))
+        raise ChainError(f"{robot.name}: joint {mimic.name!r} mimics {mimic.leader!r}; the FRDM and biquaternion "
+                         "kernels turn one joint at a time and do not model coupled joints: use solver='dls' "
+                         "(Pinocchio's model couples them)")
     for jid in range(1, model.njoints):
         if model.parents[jid] != jid - 1:
             raise ChainError(f"joint {model.names[jid]!r} is not in series with the previous one")

@@ -71,11 +71,35 @@ class Joint:
         return "m" if self.kind == "prismatic" else "rad"
 
 
-def _build_full_model(path: Path) -> pin.Model:
+@dataclass(frozen=True)
+class Mimic:
+    """A chain joint that follows another: q_follower = multiplier · q_leader + offset (rad or m)."""
+
+    name: str
+    leader: str
+    multiplier: float
+    offset: float
+    lower: float  # the follower's own limits
+    upper: float
+
+
+def _narrowed(leader: str, lo: float, hi: float, mimics) -> tuple[float, float]:
+    """The leader's limits narrowed so that every follower stays within its own (an empty range: ChainError)."""
+    for m in mimics:
+        if m.leader == leader and m.multiplier != 0.0:
+            a, b = sorted(((m.lower - m.offset) / m.multiplier, (m.upper - m.offset) / m.multiplier))
+            lo, hi = max(lo, a), min(hi, b)
+            if lo > hi:
+                raise ChainError(f"joint {m.name!r} mimics {leader!r}: no value of {leader!r} keeps both "
+                                 "within their limits")
+    return lo, hi
+
+
+def _build_full_model(path: Path, mimic: bool = False) -> pin.Model:
     said: list[str] = []
     try:
         with _c_stderr_captured(said):  # urdfdom prints its complaints on the process's stderr
-            model = pin.buildModelFromUrdf(str(path))
+            model = pin.buildModelFromUrdf(str(path), mimic=mimic)
     except (RuntimeError, ValueError, UnicodeDecodeError) as exc:
         detail = " ".join([str(exc), *said]).strip()
         raise URDFError(f"Pinocchio cannot read {path}: {detail}") from None
@@ -210,10 +234,11 @@ class Robot:
             tool, base = self._group_frames(group, tree, tool, base)
         self.base = base or tree.root
         self.tool = tool or self._default_tool(tree, full)
-        tool_id = _frame_id(full, self.tool, self.name)
-        chain = [j for j in full.supports[full.frames[tool_id].parentJoint] if j != 0]
-        if base is not None:
-            chain = self._below_base(full, chain, base)
+        chain = self._chain(full, base)
+        self.mimics: dict[str, Mimic] = {}
+        """Chain joints that follow another chain joint (URDF ``<mimic>``): name → :class:`Mimic`."""
+        if any(full.names[j] in tree.mimic and full.names[j] not in (locked or {}) for j in chain):
+            full, chain = self._with_mimics(full, chain, tree, base)
         self._check_chain(full, chain, tree)
         reference = self.srdf.reference() if self.srdf else {}
         held = {j: v for j, v in reference.items() if full.existJointName(j) and full.getJointId(j) not in chain}
@@ -297,16 +322,38 @@ class Robot:
     def _check_chain(full: pin.Model, chain: list[int], tree: UrdfTree) -> None:
         for jid in chain:
             jname = full.names[jid]
-            if jname in tree.mimic:
-                raise ChainError(
-                    f"joint {jname!r} mimics {tree.mimic[jname]!r}; mimic joints on the base-tool chain "
-                    "are not supported (lock it or choose another tool frame)"
-                )
+            if full.joints[jid].shortname() == "JointModelMimic":
+                continue  # follows its leader (Robot._with_mimics checked it is on the chain)
             if _kind(full.joints[jid]) is None:
                 raise ChainError(
                     f"joint {jname!r} is a {full.joints[jid].shortname()}: kinelab chains take revolute, "
                     "continuous and prismatic joints only"
                 )
+
+    def _chain(self, full: pin.Model, base: str | None) -> list[int]:
+        """Joint ids from the base (or the root) to the tool frame."""
+        tool_id = _frame_id(full, self.tool, self.name)
+        chain = [j for j in full.supports[full.frames[tool_id].parentJoint] if j != 0]
+        return self._below_base(full, chain, base) if base is not None else chain
+
+    def _with_mimics(self, plain: pin.Model, chain: list[int], tree: UrdfTree,
+                     base: str | None) -> tuple[pin.Model, list[int]]:
+        """Pinocchio's model with its mimic joints (a follower has no coordinate of its own), the chain in it,
+        and ``self.mimics``; each leader's limits narrowed so that its followers stay within theirs."""
+        for jid in chain:
+            name = plain.names[jid]
+            if name in tree.mimic and plain.getJointId(tree.mimic[name]) not in chain:
+                raise ChainError(f"joint {name!r} mimics {tree.mimic[name]!r}, which is off the base-tool chain: "
+                                 f"hold it at a value (locked={{{name!r}: value}}) or choose another tool frame")
+        full = _build_full_model(self.urdf_path, mimic=True)
+        for jid in range(1, full.njoints):
+            follower = full.joints[jid].extract()
+            if full.joints[jid].shortname() == "JointModelMimic" and jid in self._chain(full, base):
+                name, leader = full.names[jid], tree.mimic[full.names[jid]]
+                iq = plain.idx_qs[plain.getJointId(name)]
+                self.mimics[name] = Mimic(name, leader, float(follower.scaling), float(follower.offset),
+                                          float(plain.lowerPositionLimit[iq]), float(plain.upperPositionLimit[iq]))
+        return full, self._chain(full, base)
 
     @staticmethod
     def _read_srdf(srdf: str | Path | None, tree: UrdfTree) -> Srdf | None:
@@ -387,12 +434,15 @@ class Robot:
         table = []
         for jid in range(1, m.njoints):
             jm = m.joints[jid]
+            if jm.nq == 0:  # a mimic joint: its leader's coordinate moves it
+                continue
             kind = _kind(jm)
             iq, iv = jm.idx_q, jm.idx_v
             if kind == "continuous":
                 lo, hi = -np.pi, np.pi
             else:
                 lo, hi = float(m.lowerPositionLimit[iq]), float(m.upperPositionLimit[iq])
+                lo, hi = _narrowed(m.names[jid], lo, hi, self.mimics.values())
             ax, ay, az = (float(a) for a in axes[jid - 1])
             table.append(Joint(m.names[jid], kind or "revolute", lo, hi, iq, iv, (ax, ay, az)))
         return table
@@ -577,7 +627,7 @@ class Robot:
     def joint_placements(self, q) -> dict[str, pin.SE3]:
         """oMjoint for every chain joint: the joint frame (after its motion) in the base frame."""
         self._forward(q)
-        return {j.name: pin.SE3(self.data.oMi[i + 1]) for i, j in enumerate(self.joints)}
+        return {j.name: pin.SE3(self.data.oMi[self.model.getJointId(j.name)]) for j in self.joints}
 
     def _jacobian(self, q, frame: pin.ReferenceFrame) -> np.ndarray:
         q_pin = self.to_pin_q(q)
@@ -659,6 +709,9 @@ def _local_axes(model: pin.Model) -> list[np.ndarray]:
     axes = []
     for jid in range(1, model.njoints):
         joint = model.joints[jid]
+        if joint.nq == 0:  # a mimic joint has no axis of its own in kinelab's q
+            axes.append(np.zeros(3))
+            continue
         axis = getattr(joint.extract(), "axis", None)
         if axis is None:  # an aligned joint: JointModelRX, PY, RUBZ, ...
             axis = _AXES[joint.shortname()[-1]]
@@ -691,8 +744,8 @@ def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, fl
             ``kinelab[xacro]``); MJCF sources (root ``<mujoco>``) are read by Pinocchio's MJCF parser.
 
     Raises:
-        RobotNotFoundError, DescriptionError, URDFError, SRDFError, ChainError, FrameNotFoundError,
-        JointNotFoundError: named.
+        RobotNotFoundError, DescriptionError, URDFError, SRDFError, ChainError, FrameNotFoundError: named.
+        JointNotFoundError: a locked joint that does not exist (the valid names listed).
     """
     if str(name_or_path).startswith(descriptions.PREFIX):
         found = descriptions.resolve(str(name_or_path))
