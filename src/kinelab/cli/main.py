@@ -90,14 +90,17 @@ def _print_json(obj) -> None:
 
 def cmd_robots(args) -> int:
     rows = [
-        {"name": e.name, "source": e.source, "tool": e.tool, "description": e.description}
+        {"name": e.name, "source": e.source, "file": e.relpath, "chain": e.chain, "tool": e.tool, "base": e.base,
+         "srdf": e.srdf, "group": e.group, "description": e.description}
         for e in catalog.ENTRIES.values()
     ]
     if args.json:
         _print_json(rows)
     else:
+        width = max(len(e.name) for e in catalog.ENTRIES.values()) + 2
         for r in rows:
-            print(f"{r['name']:<11} {r['source']:<19} {r['description']}")
+            print(f"{r['name']:<{width}}{r['description']}")
+            print(f"{'':<{width}}{r['source']}: {r['file']}; chain {r['chain']}")
     return 0
 
 

@@ -16,13 +16,24 @@ from kinelab.errors import RobotNotFoundError
 
 @dataclass(frozen=True)
 class Entry:
-    """One registered robot: where its URDF is and which frame is its tool."""
+    """One registered robot: where its URDF is, which frames are its tool and base (or which SRDF group
+    gives them), and where the choice comes from."""
 
     name: str
     source: str  # "kinelab" (bundled) or "example-robot-data"
     relpath: str  # below the bundled urdf/ directory or the example-robot-data robots/ directory
-    tool: str
+    tool: str | None
     description: str
+    base: str | None = None  # None: the URDF root
+    srdf: str | None = None  # below the same directory as relpath
+    group: str | None = None  # the SRDF group that gives base and tool
+
+    @property
+    def chain(self) -> str:
+        """Where the chain comes from, in words (``kinelab robots``)."""
+        if self.group:
+            return f"SRDF group {self.group!r} of {Path(self.srdf or '').name}"
+        return f"{self.base or 'root'} → {self.tool}"
 
 
 BUNDLED = (
@@ -49,6 +60,24 @@ ERD_ARMS = (
           "SO-101 arm, 5R, gripper locked"),
     Entry("finger_edu", "example-robot-data", "finger_edu_description/robots/finger_edu.urdf", "finger_tip_link",
           "TriFinger EDU finger, 3R"),
+    Entry("baxter_left", "example-robot-data", "baxter_description/urdf/baxter.urdf", "left_gripper",
+          "Rethink Baxter, left arm from the torso, 7R", base="torso"),
+    Entry("baxter_right", "example-robot-data", "baxter_description/urdf/baxter.urdf", "right_gripper",
+          "Rethink Baxter, right arm from the torso, 7R", base="torso"),
+    Entry("pr2_left", "example-robot-data", "pr2_description/urdf/pr2.urdf", None,
+          "PR2, left arm from the torso lift link, 7R", srdf="pr2_description/srdf/pr2_manipulation.srdf",
+          group="left_arm"),
+    Entry("pr2_right", "example-robot-data", "pr2_description/urdf/pr2.urdf", None,
+          "PR2, right arm from the torso lift link, 7R", srdf="pr2_description/srdf/pr2_manipulation.srdf",
+          group="right_arm"),
+    Entry("talos_left", "example-robot-data", "talos_data/robots/talos_full_v2.urdf", None,
+          "PAL TALOS humanoid, left arm from the torso, 7R", srdf="talos_data/srdf/talos.srdf", group="l_arm"),
+    Entry("talos_right", "example-robot-data", "talos_data/robots/talos_full_v2.urdf", None,
+          "PAL TALOS humanoid, right arm from the torso, 7R", srdf="talos_data/srdf/talos.srdf", group="r_arm"),
+    Entry("tiago", "example-robot-data", "tiago_description/robots/tiago.urdf", "arm_tool_link",
+          "PAL TIAGo, arm from the torso lift link, 7R", base="torso_lift_link"),
+    Entry("tiago_pro", "example-robot-data", "tiago_pro_description/robots/tiago_pro.urdf", "arm_right_tool_link",
+          "PAL TIAGo Pro, right arm from the torso lift link, 7R", base="torso_lift_link"),
 )
 
 ENTRIES = {e.name: e for e in BUNDLED + ERD_ARMS}
@@ -94,13 +123,22 @@ def package_dirs() -> list[str]:
     return dirs
 
 
+def srdf_path(entry: Entry) -> Path | None:
+    """The entry's SRDF file, or None."""
+    if entry.srdf is None:
+        return None
+    root = bundled_urdf_dir() if entry.source == "kinelab" else erd_robots_dir()
+    return None if root is None else root / entry.srdf
+
+
 def names() -> list[str]:
     """All registered robot names, bundled ones first."""
     return list(ENTRIES)
 
 
 def resolve(name_or_path: str | Path) -> tuple[Path, Entry | None]:
-    """Turn a registered name or a URDF path into (urdf path, catalogue entry or None)."""
+    """Turn a registered name or a URDF path into (urdf path, catalogue entry or None); an entry's SRDF
+    lies below the same directory as its URDF (:func:`srdf_path`)."""
     key = str(name_or_path)
     entry = ENTRIES.get(key)
     if entry is not None:

@@ -753,6 +753,9 @@ def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, fl
                      package_dirs=[*(package_dirs or []), *found.package_dirs], srdf=srdf, group=group)
     path, entry = catalog.resolve(name_or_path)
     if entry is not None and not group:
-        tool = tool or entry.tool
+        tool, base = tool or entry.tool, base or entry.base
+        if entry.group and not (tool or base):
+            group = entry.group
+        srdf = srdf or catalog.srdf_path(entry)
     return Robot(path, tool=tool, locked=locked, name=entry.name if entry else None, base=base,
                  package_dirs=package_dirs, srdf=srdf, group=group, xacro_args=xacro_args)
