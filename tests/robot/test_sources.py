@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import ros_package
 
 import kinelab
 from kinelab import ChainError, SRDFError, URDFError, load
@@ -68,55 +69,6 @@ def test_bad_srdf_uses_and_bad_bases_are_named(tmp_path):
         load("panda", srdf=tmp_path / "missing.srdf")
     with pytest.raises(ChainError, match="not on the path from the root"):
         load("panda", base="panda_leftfinger", tool="panda_hand_tcp")
-
-
-ASCII_STL = """solid box
-facet normal 0 0 -1
-outer loop
-vertex 0 0 0
-vertex 0.1 0 0
-vertex 0 0.1 0
-endloop
-endfacet
-facet normal 0 -1 0
-outer loop
-vertex 0 0 0
-vertex 0 0 0.1
-vertex 0.1 0 0
-endloop
-endfacet
-facet normal -1 0 0
-outer loop
-vertex 0 0 0
-vertex 0 0.1 0
-vertex 0 0 0.1
-endloop
-endfacet
-facet normal 1 1 1
-outer loop
-vertex 0.1 0 0
-vertex 0 0 0.1
-vertex 0 0.1 0
-endloop
-endfacet
-endsolid box
-"""
-
-
-def ros_package(root: Path) -> Path:
-    """A ROS-style package mypkg (package.xml, urdf/, meshes/box.stl) under root; returns the URDF."""
-    pkg = root / "mypkg"
-    (pkg / "urdf").mkdir(parents=True)
-    (pkg / "meshes").mkdir()
-    (pkg / "package.xml").write_text('<?xml version="1.0"?><package format="2"><name>mypkg</name></package>')
-    (pkg / "meshes" / "box.stl").write_text(ASCII_STL)
-    urdf = pkg / "urdf" / "arm.urdf"
-    urdf.write_text(
-        '<?xml version="1.0"?><robot name="arm"><link name="base"/>'
-        '<link name="l1"><visual><geometry><mesh filename="package://mypkg/meshes/box.stl"/></geometry></visual></link>'
-        '<joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><origin xyz="0 0 0.3"/>'
-        '<axis xyz="0 0 1"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint></robot>')
-    return urdf
 
 
 def _mesh_paths(robot):

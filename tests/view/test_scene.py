@@ -5,6 +5,7 @@ import os
 import browser
 import numpy as np
 import pytest
+from helpers import ros_package
 
 import kinelab
 from kinelab.view import scene as viz
@@ -99,3 +100,22 @@ def test_side_by_side_draws_one_stick_figure_and_tool_frame_per_configuration():
         viz.side_by_side(robot, [])
     with pytest.raises(kinelab.ConfigurationError):
         viz.side_by_side(robot, [np.zeros(3)])
+
+
+@needs_browser
+def test_a_mesh_of_a_ros_package_is_drawn_in_the_browser(tmp_path):
+    """The package mesh (found through package_dirs) is in the scene tree, and a real browser draws it: the
+    picture differs from the same page without the robot."""
+    if CHROMIUM is None:
+        pytest.fail("CI must have chromium: .ci/run installs Debian's chromium")
+    urdf = ros_package(tmp_path / "ws")
+    robot = kinelab.load(urdf, package_dirs=[str(tmp_path / "ws")])
+    s = viz.Scene(robot).show([0.3])
+    (mesh_node,) = s.node_paths()
+    assert "/meshcat/" + mesh_node in browser.scene_paths(s.static_html())
+    with_mesh = s.save_html(tmp_path / "mesh.html")
+    (tmp_path / "empty.html").write_text(browser.without_robot_html(s))
+    s.close()
+    share = browser.changed_share(browser.screenshot(with_mesh, tmp_path / "mesh.png"),
+                                  browser.screenshot(tmp_path / "empty.html", tmp_path / "empty.png"))
+    assert share > 0.003, f"the package mesh covers only {share:.2%} of the picture"
