@@ -72,3 +72,22 @@ def without_robot_html(scene: Scene) -> str:
     html = scene.static_html()
     scene.pinviz.loadViewerModel(rootNodeName=scene.root)
     return html
+
+
+def changed_box(png_a: str | Path, png_b: str | Path, threshold: int = 24) -> tuple[int, int, int, int] | None:
+    """(top, bottom, left, right) pixel rows and columns of the pixels that differ between two PNGs (None if none)."""
+    a = np.asarray(Image.open(png_a).convert("RGB"), dtype=int)
+    b = np.asarray(Image.open(png_b).convert("RGB"), dtype=int)
+    mask = np.max(np.abs(a - b), axis=2) > threshold
+    if not mask.any():
+        return None
+    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    return int(rows[0]), int(rows[-1]), int(cols[0]), int(cols[-1])
+
+
+def grey_rows(png: str | Path) -> np.ndarray:
+    """Per pixel row, how many pixels are grey (the floor grid's lines) rather than the blue background."""
+    a = np.asarray(Image.open(png).convert("RGB"), dtype=int)
+    r, g, b = a[..., 0], a[..., 1], a[..., 2]
+    grey = (np.abs(r - g) < 30) & (np.abs(g - b) < 30) & (r > 90)
+    return grey.sum(axis=1)

@@ -280,3 +280,63 @@ def test_version_hint_and_an_fk_outside_the_limits(capsys):
 def test_printed_vectors_carry_no_negative_zero(capsys):
     code, out, _ = run(capsys, "singular", "ur5", "0", "0", "0", "0", "0", "0")
     assert code == 0 and "moves nothing" in out and "-0.0," not in out and "-0.0]" not in out
+
+
+def test_freeze_and_interval_hold_from_the_start_and_the_text_says_so(capsys):
+    code, out, _ = run(capsys, "ik", "era", "--target-xyz", "4", "2", "6", "--freeze", "joint1=0", "--seed", "0")
+    q = np.array(json.loads(run(capsys, "ik", "era", "--target-xyz", "4", "2", "6", "--freeze", "joint1=0",
+                                "--seed", "0", "--json")[1])["q"])
+    assert q[0] == 0.0  # held, not merely switched on by the monitor
+    assert "bypasses: freeze from the start" in out
+    code, out, _ = run(capsys, "ik", "era", "--target-xyz", "4", "2", "6", "--interval", "joint4=-90:0", "--deg",
+                       "--seed", "0", "--json")
+    res = json.loads(out)
+    assert -np.pi / 2 - 1e-9 <= res["q"][3] <= 1e-9  # within the interval whatever the status
+    assert any(b["bypass"] == "intervals" and b.get("sweep", 0) == 0 for b in res["info"]["answer_bypasses"])
+
+
+def test_on_singular_keeps_the_papers_monitor_switched_policy_and_says_what_the_answer_used(capsys):
+    code, out, _ = run(capsys, "ik", "era", "--target-xyz", "4", "2", "6", "--freeze", "joint1=0",
+                       "--on-singular", "freeze", "--seed", "0")
+    assert code == 0 and "the answer's attempt: monitor" in out and "over all" in out
+    code, _, err = run(capsys, "ik", "era", "--target-xyz", "4", "2", "6", "--on-singular", "freeze")
+    assert code == 2 and "--on-singular" in err
+
+
+def test_an_answer_outside_the_limits_is_never_presented_without_saying_so(capsys):
+    code, out, _ = run(capsys, "ik", "so101", "--solver", "biquat", "--target-xyz", "0.2", "0", "0.1",
+                       "--tol-rot", "1e-5", "--seed", "0", "--json")
+    res = json.loads(out)
+    assert not kinelab.load("so101").within_limits(np.array(res["q"]))  # the biquaternion law's answer, seed 0
+    assert res["status"] == "outside_limits" and not res["success"] and code == 1
+    assert res["position_error_m"] <= 1e-6 and res["rotation_error_rad"] <= 1e-5  # the pose itself is met
+    assert "joint 'wrist_flex' is at" in res["message"] and "outside its limits" in res["message"]
+
+
+def test_view_draws_any_finite_q_with_a_note_for_joints_outside_their_limits(capsys, tmp_path):
+    code, out, err = run(capsys, "view", "panda", "0", "0", "0", "0", "0", "0", "0", "--html",
+                         str(tmp_path / "p.html"))
+    assert code == 0 and "panda_joint4 = 0 rad is outside its limits" in err
+    assert "panda at q = [0, 0, 0, 0, 0, 0, 0]" in out
+    assert 'id="kinelab-caption"' in (tmp_path / "p.html").read_text()
+    code, _, err = run(capsys, "view", "panda", "0", "nan", "0", "0", "0", "0", "0", "--html", str(tmp_path / "q.html"))
+    assert code == 2 and ("NaN" in err or "finite" in err)
+
+
+def test_every_option_of_every_command_has_help():
+    import argparse
+
+    from kinelab.cli.main import build_parser
+
+    missing = []
+
+    def walk(parser, path):
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                for name, sub in action.choices.items():
+                    walk(sub, [*path, name])
+            elif action.dest != "help" and not action.help:
+                missing.append((path, action.option_strings or action.dest))
+
+    walk(build_parser(), [])
+    assert missing == []

@@ -119,3 +119,36 @@ def test_a_mesh_of_a_ros_package_is_drawn_in_the_browser(tmp_path):
     share = browser.changed_share(browser.screenshot(with_mesh, tmp_path / "mesh.png"),
                                   browser.screenshot(tmp_path / "empty.html", tmp_path / "empty.png"))
     assert share > 0.003, f"the package mesh covers only {share:.2%} of the picture"
+
+
+@needs_browser
+@pytest.mark.parametrize("name", [*BUNDLED, "panda", "so101"])
+def test_the_view_frames_the_robot_over_its_floor_with_a_caption(name, tmp_path):
+    """The display pose fills at least 30 % of the page's height without touching its edges, the floor grid
+    shows below the robot, and the caption names the robot and its q."""
+    if CHROMIUM is None:
+        pytest.fail("CI must have chromium: .ci/run installs Debian's chromium")
+    robot = kinelab.load(name)
+    s = viz.Scene(robot)
+    html = s.static_html()
+    assert 'id="kinelab-caption"' in html and f"{name} at q = [" in html and "floor grid" in html
+    shot = browser.screenshot(s.save_html(tmp_path / "robot.html"), tmp_path / "robot.png")
+    (tmp_path / "empty.html").write_text(browser.without_robot_html(s))
+    empty = browser.screenshot(tmp_path / "empty.html", tmp_path / "empty.png")
+    s.close()
+    top, bottom, left, right = browser.changed_box(shot, empty)
+    height, width = 480, 640
+    assert bottom - top >= 0.3 * height, f"the robot spans {bottom - top} of {height} rows"
+    assert top > 0 and bottom < height - 1 and left > 0 and right < width - 1  # not cut by the frame
+    assert browser.grey_rows(empty)[bottom + 1:].sum() > 300  # floor lines below the robot's lowest pixel
+
+
+def test_the_singular_overlay_explains_its_marks_in_the_caption():
+    robot = kinelab.load("era")
+    s = viz.Scene(robot).show(np.zeros(7))
+    s.singular_directions(np.zeros(7))
+    html = s.static_html()
+    s.close()
+    caption = html[html.index('id="kinelab-caption"'):]
+    assert "σ_min/σ_max = " in caption and "rank 5 of 6" in caption
+    assert "magenta line: a tool direction the arm cannot move in" in caption

@@ -175,8 +175,8 @@ def _rounded(values: Any, digits: int) -> list[float]:
     return (np.round(np.asarray(values, dtype=float), digits) + 0.0).tolist()
 
 
-def _plural(count: int, word: str) -> str:
-    return f"{count} {word}" if count == 1 else f"{count} {word}s"
+def _plural(count: int, word: str, plural: str | None = None) -> str:
+    return f"{count} {word}" if count == 1 else f"{count} {plural or word + 's'}"
 
 
 def _bypass_value(robot, joint: str, text: str, deg: bool, flag: str) -> float:
@@ -188,23 +188,30 @@ def _bypass_value(robot, joint: str, text: str, deg: bool, flag: str) -> float:
     return float(np.deg2rad(value)) if deg and kind != "prismatic" else value
 
 
+ON_SINGULAR = {"kick": "kicks", "interval": "intervals", "freeze": "freeze"}
+
+
 def _bypass_options(robot, args) -> dict:
-    """FRDM's bypasses from --kick J=D, --interval J=LO:HI and --freeze J[=V] (rad, m; deg with --deg)."""
+    """FRDM's bypasses from --kick J=D, --interval J=LO:HI and --freeze J[=V] (rad, m; deg with --deg).
+
+    --interval and --freeze hold from the first sweep; a kick is applied when the monitor fires, and so is any
+    bypass named by --on-singular (the paper's monitor-switched policy, in the order given).
+    """
     specs = {"kicks": args.kick or [], "intervals": args.interval or [], "freeze": args.freeze or []}
     if not any(specs.values()):
+        if args.on_singular:
+            raise KinelabError("--on-singular switches bypasses given by --kick, --interval or --freeze; none is")
         return {}
     if args.solver != "frdm":
         raise KinelabError("--kick, --interval and --freeze are FRDM's bypasses; use --solver frdm")
-    out: dict[str, dict] = {}
+    out: dict[str, Any] = {}
     for spec in specs["kicks"]:
-        joint, sep, value = spec.partition("=")
-        if not sep:
-            raise KinelabError(f"--kick wants JOINT=DELTA, got {spec!r}")
+        joint, value = _split_spec(spec, "--kick", "JOINT=DELTA")
         out.setdefault("kicks", {})[joint] = _bypass_value(robot, joint, value, args.deg, "--kick")
     for spec in specs["intervals"]:
-        joint, sep, bounds = spec.partition("=")
+        joint, bounds = _split_spec(spec, "--interval", "JOINT=LOWER:UPPER")
         lo, colon, hi = bounds.partition(":")
-        if not (sep and colon):
+        if not colon:
             raise KinelabError(f"--interval wants JOINT=LOWER:UPPER, got {spec!r}")
         out.setdefault("intervals", {})[joint] = (_bypass_value(robot, joint, lo, args.deg, "--interval"),
                                                   _bypass_value(robot, joint, hi, args.deg, "--interval"))
@@ -212,7 +219,25 @@ def _bypass_options(robot, args) -> dict:
         joint, sep, value = spec.partition("=")
         robot.joint_index(joint)  # an unknown joint is named with the valid ones
         out.setdefault("freeze", {})[joint] = _bypass_value(robot, joint, value, args.deg, "--freeze") if sep else None
-    return out
+    return {**out, **_policy(out, args.on_singular or [])}
+
+
+def _split_spec(spec: str, flag: str, form: str) -> tuple[str, str]:
+    joint, sep, value = spec.partition("=")
+    if not sep:
+        raise KinelabError(f"{flag} wants {form}, got {spec!r}")
+    return joint, value
+
+
+def _policy(bypasses: dict, on_singular: list[str]) -> dict:
+    """FRDM's ``active`` (held from the start) and ``policy`` (switched by the monitor) for the CLI's flags."""
+    switched = [ON_SINGULAR[name] for name in on_singular]
+    for name, key in zip(on_singular, switched, strict=True):
+        if key not in bypasses:
+            raise KinelabError(f"--on-singular {name} needs --{name} JOINT=...")
+    held = tuple(key for key in ("intervals", "freeze") if key in bypasses and key not in switched)
+    policy = tuple(switched) + (("kicks",) if "kicks" in bypasses and "kicks" not in switched else ())
+    return {**({"active": held} if held else {}), "policy": policy or ("auto_kick",)}
 
 
 @contextlib.contextmanager
@@ -271,6 +296,8 @@ def cmd_ik(args) -> int:
 
 def _print_ik(robot: Robot, args: argparse.Namespace, result: Any) -> None:
     """The text form of an IK result: status, q, Pinocchio's errors on the task's components, effort."""
+    from kinelab.ik.result import Status
+
     q_show = np.where([k != "prismatic" for k in robot.joint_kinds], np.rad2deg(result.q), result.q) \
         if args.deg else result.q
     print(f"{robot.name} {args.solver}, task {result.task}: {result.status.value} (success: {result.success})")
@@ -281,14 +308,35 @@ def _print_ik(robot: Robot, args: argparse.Namespace, result: Any) -> None:
           f"{' (free)' if free[1] else ''} (Pinocchio FK)")
     print(f"  {_plural(result.iterations, 'iteration')}, {_plural(result.restarts, 'restart')}, "
           f"{result.wall_time * 1e3:.2f} ms, mode {result.mode}")
-    if "model_time" in result.info:
+    if result.info.get("model_time"):
         m0 = result.info.get("M0")
         print(f"  model time {result.info['model_time']:.4g} s, final M0 = "
               + (f"{m0:+.6f}" if m0 is not None else "n/a (give --target-q for the sign of N)"))
+    _print_events(result)
     if result.message:
         print("  " + re.sub(r"task='(\w+)'", r"--task \1", result.message))
-    if not result.success and args.task != "position" and args.target_xyz is not None and args.target_rpy is None:
+    if not result.success and result.status is not Status.OUTSIDE_LIMITS and args.task != "position" \
+            and args.target_xyz is not None and args.target_rpy is None:
         print("  (no --target-rpy: the target rotation is the identity; --task position ignores it)")
+
+
+def _print_events(result: Any) -> None:
+    """What the monitor saw and which bypasses were applied: in the answer's own attempt, and over the restarts."""
+    attempts = result.restarts + 1
+    if "answer_events" in result.info:
+        own, held = result.info["answer_events"], result.info["answer_bypasses"]
+        fired = f"fired {_plural(len(own), 'time')}" if own else "did not fire"
+        applied = ", ".join(f"{b['bypass']} " + ("from the start" if b.get("sweep", 0) == 0 else
+                                                 f"at sweep {b['sweep']}") for b in held) or "none"
+        print(f"  the answer's attempt: monitor {fired}; bypasses: {applied}")
+    fired_all = sum(e.count or 1 for e in result.singular_events)
+    monitor = f"monitor fired {_plural(fired_all, 'time')}" if fired_all else "monitor did not fire"
+    if "answer_events" not in result.info:  # the compiled multistart: a stall is answered by a restart
+        print(f"  {_plural(attempts, 'attempt')}: {monitor}" + (" (each stall restarted)" if fired_all else ""))
+    elif attempts > 1:
+        switched = sum(1 for b in result.bypasses if b.sweep not in (None, 0))
+        print(f"  over all {_plural(attempts, 'attempt')}: {monitor}"
+              + (f", {_plural(switched, 'bypass', 'bypasses')} switched on by it" if switched else ""))
 
 
 def cmd_singular(args) -> int:
@@ -399,13 +447,21 @@ def cmd_bench(args) -> int:
 
 
 def _publish(scene, html: str | None) -> int:
-    """Write the scene as a static page, or serve it live until interrupted."""
+    """Write the scene as a static page (its caption in the page), or serve it live until interrupted (the
+    caption printed under the address: the live page has none)."""
     if html:
         scene.save_html(html)
         scene.close()
         print(f"wrote {html}")
+        _print_caption(scene)
         return 0
     return _serve(scene)
+
+
+def _print_caption(scene) -> None:
+    print(scene.title)
+    for line in scene.legend.values():
+        print(f"  {line}")
 
 
 def _serve(scene) -> int:
@@ -414,6 +470,8 @@ def _serve(scene) -> int:
 
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))  # so that the finally below stops the server
     print(f"meshcat is serving on {scene.url} (Ctrl-C to stop)", flush=True)
+    _print_caption(scene)
+    sys.stdout.flush()
     try:
         while True:
             time.sleep(1.0)
@@ -427,8 +485,10 @@ def cmd_view(args) -> int:
     from kinelab.view import scene as viz
 
     robot = _load(args)
-    q = _q_from_cli(robot, args.q, args.deg) if args.q else robot.neutral()
-    robot.check_q(q, limits=not args.ignore_limits)
+    q = robot.check_q(_q_from_cli(robot, args.q, args.deg) if args.q else robot.display_q())
+    if not args.ignore_limits:
+        for note in _outside_limits(robot, q):  # drawn all the same: a view is defined at any q
+            print(f"kinelab: note: {note}", file=sys.stderr)
     scene = viz.Scene(robot).show(q)
     if args.singular:
         scene.singular_directions(q)
@@ -471,7 +531,9 @@ def _robot_arguments(s: argparse.ArgumentParser, q_help: str | None = None, limi
         s.add_argument("--deg", action="store_true", help="angles of revolute/continuous joints in degrees")
     _add_source_args(s)
     if limits:
-        s.add_argument("--ignore-limits", action="store_true", help="allow q outside the joint limits")
+        s.add_argument("--ignore-limits", action="store_true",
+                       help="accept q outside the joint limits (fk and view compute any finite q and note the joints "
+                            "outside; this flag drops the note)")
 
 
 def _add_source_args(s: argparse.ArgumentParser) -> None:
@@ -537,9 +599,12 @@ def _add_ik(sub: Any) -> None:
     s.add_argument("--kick", action="append", metavar="JOINT=DELTA",
                    help="frdm bypass: signed step added when the monitor fires (repeatable)")
     s.add_argument("--interval", action="append", metavar="JOINT=LO:HI",
-                   help="frdm bypass: tighter window switched on when the monitor fires (repeatable)")
+                   help="frdm bypass: keep the joint within [LO, HI] from the start (repeatable)")
     s.add_argument("--freeze", action="append", metavar="JOINT[=VALUE]",
-                   help="frdm bypass: joint held (where it is, or at VALUE) when the monitor fires (repeatable)")
+                   help="frdm bypass: hold the joint at VALUE (or where it starts) from the start (repeatable)")
+    s.add_argument("--on-singular", nargs="+", choices=tuple(ON_SINGULAR), metavar="BYPASS",
+                   help="switch these bypasses on only when the monitor fires, in this order (the paper's "
+                        "policy): kick, interval, freeze")
     s.add_argument("--law", choices=["simple", "regular"], help="biquat: control law (9)/(16) or (11)/(12)")
     s.add_argument("--integrator", choices=["euler", "rk4", "adaptive"], help="biquat: integrator")
     s.add_argument("--step", type=float, help="biquat: fixed step h [s] (the paper: 0.01; default 1/k)")

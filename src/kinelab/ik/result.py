@@ -18,6 +18,7 @@ class Status(str, Enum):
     STALLED = "stalled"  # stopped at a stationary point (local minimum, joint limit) short of the target
     MAX_ITERATIONS = "max_iterations"
     TIME_BUDGET = "time_budget"
+    OUTSIDE_LIMITS = "outside_limits"  # the pose is met, but only with a joint outside its limits
 
 
 @dataclass(frozen=True)

@@ -269,11 +269,16 @@ def _loop(module: Any, pb: _Problem, start: np.ndarray, max_restarts: int, opts:
     assert best is not None
     _, att, dp, dr = best
     status, message = _status(best_ok, att, pb.finals, beyond, pb.tol_pos, time.perf_counter() > pb.deadline)
+    if not best_ok:
+        status, message = _outside_limits(pb, att.q, dp, dr, status, message)
+    # the answer's own attempt, apart from the restarts' (a user asks whether a bypass made this answer)
+    info = {**att.info, "answer_events": [e.to_dict() for e in att.events],
+            "answer_bypasses": [b.to_dict() for b in att.bypasses]}
     return IKResult(
         q=att.q, success=best_ok, status=status, position_error=dp, rotation_error=dr,
         iterations=iterations, restarts=restarts, wall_time=time.perf_counter() - pb.t_start, solver=pb.solver,
         mode=att.info.get("mode", pb.solver), singular_events=events, bypasses=bypasses,
-        message=_explained(pb, best_ok, message), info=att.info, task=_task_label(pb.task),
+        message=_explained(pb, status, message), info=info, task=_task_label(pb.task),
     )
 
 
@@ -291,10 +296,12 @@ def _fast(module: Any, pb: _Problem, start: np.ndarray | None, max_restarts: int
         errors = [f"{dp:.3g} m"] * pb.task.position + [f"{dr:.3g} rad"] * pb.task.rotation
         message = (f"none of {restarts + 1} starts met the {pb.task.constrained} to the tolerances; the best "
                    f"answer is {' and '.join(errors)} from the target")
+    if not success:
+        status, message = _outside_limits(pb, att.q, dp, dr, status, message)
     return IKResult(
         q=att.q, success=success, status=status, position_error=dp, rotation_error=dr, iterations=att.iterations,
         restarts=restarts, wall_time=time.perf_counter() - pb.t_start, solver=pb.solver, mode=att.info["mode"],
-        singular_events=att.events, message=_explained(pb, success, message), info=att.info,
+        singular_events=att.events, message=_explained(pb, status, message), info=att.info,
         task=_task_label(pb.task),
     )
 
@@ -303,10 +310,30 @@ def _task_label(task: Task) -> str:
     return task.name if task.axis < 0 else f"axis {'xyz'[task.axis]}"
 
 
-def _explained(pb: _Problem, success: bool, message: str) -> str:
+def _outside_limits(pb: _Problem, q: np.ndarray, dp: float, dr: float, status: Status,
+                    message: str) -> tuple[Status, str]:
+    """A failed answer with a joint outside its limits: status OUTSIDE_LIMITS when the task's components are
+    met (only the limits fail), the joint named either way."""
+    robot = pb.robot
+    lower, upper = robot.check_bounds
+    outside = [i for i in range(robot.n) if not lower[i] <= q[i] <= upper[i]]
+    if not outside:
+        return status, message
+    i = outside[0]
+    unit = "m" if robot.joint_kinds[i] == "prismatic" else "rad"
+    where = (f"joint {robot.joint_names[i]!r} is at {q[i]:.6g} {unit}, outside its limits "
+             f"[{robot.lower[i]:.6g}, {robot.upper[i]:.6g}]"
+             + (f" (and {len(outside) - 1} more)" if len(outside) > 1 else ""))
+    met = (not pb.task.position or dp <= pb.tol_pos) and (not pb.task.rotation or dr <= pb.tol_rot)
+    if met:
+        return Status.OUTSIDE_LIMITS, f"the {pb.task.constrained} are met, but {where}"
+    return status, f"{message}; the best answer has {where}" if message else f"the best answer has {where}"
+
+
+def _explained(pb: _Problem, status: Status, message: str) -> str:
     """The message, with the reason a short arm misses a whole pose and the tasks that fit it."""
     n = pb.robot.n
-    if success or n >= COMPONENTS[pb.task.name]:
+    if status in (Status.CONVERGED, Status.OUTSIDE_LIMITS) or n >= COMPONENTS[pb.task.name]:
         return message
     fits = [t for t in ("axis", "position") if COMPONENTS[t] <= n] or ["position"]
     note = (f"{pb.robot.name} has {n} joints and can meet at most {n} of the {COMPONENTS[pb.task.name]} "

@@ -27,6 +27,7 @@ class Entry:
     base: str | None = None  # None: the URDF root
     srdf: str | None = None  # below the same directory as relpath
     group: str | None = None  # the SRDF group that gives base and tool
+    display: tuple[float, ...] | None = None  # a well-conditioned pose to show [rad, m] (None: computed)
 
     @property
     def chain(self) -> str:
@@ -37,12 +38,17 @@ class Entry:
 
 
 BUNDLED = (
+    # display poses: the paper's target (stanford), an arm bent at every joint (era), the youBot's arm bent
+    # forward on its platform at the origin; σ_min/σ_max of the scaled Jacobian 0.11, 0.12 and 0.045
     Entry("stanford", "kinelab", "stanford.urdf", "tool",
-          "Stanford arm RRPRRR, frames of Lomovtseva & Chelnokov (seed 001)"),
+          "Stanford arm RRPRRR, frames of Lomovtseva & Chelnokov (seed 001)",
+          display=(0.34906585, 0.6981317, 0.3, -0.61086524, 1.04719755, -0.78539816)),
     Entry("era", "kinelab", "era.urdf", "tool",
-          "European Robotic Arm, 7R symmetric, approximate geometry (seed 000)"),
+          "European Robotic Arm, 7R symmetric, approximate geometry (seed 000)",
+          display=(0.3, 0.5, -0.6, -1.3, 0.6, 0.4, 0.2)),
     Entry("youbot", "kinelab", "youbot.urdf", "tool",
-          "KUKA youBot arm on its planar base, Q = (X_C, Y_C, theta, theta1..theta5) (seed 003)"),
+          "KUKA youBot arm on its planar base, Q = (X_C, Y_C, theta, theta1..theta5) (seed 003)",
+          display=(0.0, 0.0, 0.0, 0.3, 0.5, 0.9, 0.7, 0.0)),
 )
 
 ERD_ARMS = (

@@ -250,6 +250,8 @@ class Robot:
         self._index_joints()
         self._length: float | None = None
         self._derived: dict[str, Any] = {}
+        self.display_pose: np.ndarray | None = None
+        """The registered pose to show the robot in (:meth:`display_q`), or None."""
 
     def _reduce(self, full: pin.Model) -> None:
         """The model with every locked joint folded in at its value, and its joint table."""
@@ -536,6 +538,15 @@ class Robot:
         """Zero for every joint, moved into its limits where zero is outside them."""
         return np.clip(np.zeros(self.n), self.lower, self.upper)
 
+    def display_q(self) -> np.ndarray:
+        """A pose to show the robot in when none is given [rad, m]: the registered display pose, else the
+        best-conditioned of 64 seeded configurations in the middle half of each joint's range (largest
+        σ_min/σ_max of the tool Jacobian, linear rows divided by the characteristic length). All-zero poses
+        are often singular (a stretched arm), which makes a poor first picture."""
+        if self.display_pose is not None:
+            return self.display_pose.copy()
+        return self.derived("display_q", _best_conditioned).copy()
+
     def random_q(self, rng: np.random.Generator | int | None = None) -> np.ndarray:
         """A configuration drawn uniformly within the limits (continuous joints on [−π, π]; a revolute joint
         whose limits lie beyond ±SAMPLE_TURNS turns, such as a rotor declared with ±1e16 rad, on ±SAMPLE_TURNS
@@ -703,6 +714,24 @@ class Robot:
 _AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
 
 
+def _best_conditioned(robot: Robot) -> np.ndarray:
+    rng = np.random.default_rng(0)
+    lo = np.where(np.isfinite(robot.lower), robot.lower, -np.pi)
+    hi = np.where(np.isfinite(robot.upper), robot.upper, np.pi)
+    mid, half = (lo + hi) / 2, np.minimum((hi - lo) / 4, np.pi / 2)
+    length = robot.characteristic_length()
+    best, best_ratio = robot.neutral(), -1.0
+    for _ in range(64):
+        q = mid + rng.uniform(-1.0, 1.0, robot.n) * half
+        J = robot.jacobian_local_world_aligned(q)
+        J[:3] /= length
+        s = np.linalg.svd(J, compute_uv=False)
+        ratio = s[min(robot.n, 6) - 1] / s[0] if s[0] > 0 else 0.0
+        if ratio > best_ratio:
+            best, best_ratio = q, ratio
+    return best
+
+
 def _local_axes(model: pin.Model) -> list[np.ndarray]:
     """Unit axis of every 1-DoF joint in its own frame, from the joint models themselves (no Data: a
     Pinocchio Data holds nv³-sized tensors, so building one per joint made a load cubic in size)."""
@@ -757,5 +786,8 @@ def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, fl
         if entry.group and not (tool or base):
             group = entry.group
         srdf = srdf or catalog.srdf_path(entry)
-    return Robot(path, tool=tool, locked=locked, name=entry.name if entry else None, base=base,
-                 package_dirs=package_dirs, srdf=srdf, group=group, xacro_args=xacro_args)
+    robot = Robot(path, tool=tool, locked=locked, name=entry.name if entry else None, base=base,
+                  package_dirs=package_dirs, srdf=srdf, group=group, xacro_args=xacro_args)
+    if entry is not None and entry.display is not None and robot.n == len(entry.display):
+        robot.display_pose = np.array(entry.display)
+    return robot

@@ -18,6 +18,8 @@ import pinocchio as pin
 
 from kinelab.errors import ConfigurationError
 from kinelab.robot import Robot
+from kinelab.view.caption import with_caption
+from kinelab.view.framing import frame_points
 from kinelab.view.server import Server
 
 AXIS_COLORS = (0xE6194B, 0x3CB44B, 0x4363D8)  # x red, y green, z blue
@@ -45,7 +47,10 @@ class Scene:
         self.pinviz.loadViewerModel(rootNodeName=self.root)
         self.frame_length = frame_length or 0.5 * robot.characteristic_length()
         self._reach = self._arm_reach()
-        self.show(robot.neutral())
+        self.title = robot.name
+        self.legend: dict[str, str] = {}  # what each mark means, by mark (the caption's lines)
+        self.viewer["/Axes"].set_property("visible", False)  # an unlabelled world triad; the tool frame is drawn
+        self.show(robot.display_q())
         if open:
             self.viewer.open()
 
@@ -66,23 +71,31 @@ class Scene:
         return max(reach, 0.3)
 
     def look_at_robot(self, q=None) -> Scene:
-        """Aim the camera at the robot as it stands at q, far enough to see the arm stretched any way."""
-        return self._aim(self.robot.neutral() if q is None else q, extent=(0.0, 0.0))
+        """Frame the robot as it stands at q (default: its display pose): the floor under its base, the
+        camera far enough for the robot to fill most of the page's height."""
+        return self._aim(self._points(self.robot.display_q() if q is None else q))
 
-    def _aim(self, q, extent: tuple[float, float]) -> Scene:
-        """Aim at the robot at q, or at a grid of copies spanning ``extent`` (along the base x and y) [m]."""
-        points = np.array([m.translation for m in self.robot.joint_placements(q).values()])
-        reach = self._reach + 0.9 * max(extent)
-        # meshcat's orbit controls always look at the world origin: bring the robot to it instead, the
-        # point a little above its first joint at the origin, the grid moving with it
-        center = points[1:].mean(axis=0) if len(points) > 1 else points[0]
-        shift = pin.SE3(np.eye(3), -np.array([center[0] + extent[0] / 2, center[1] + extent[1] / 2,
-                                              points[0][2] + 0.4 * self._reach]))
-        self.viewer.set_transform(shift.homogeneous)
-        self.viewer["/Grid"].set_transform(shift.homogeneous)
-        # the camera's position is in three.js axes (y up)
-        self.viewer["/Cameras/default/rotated/<object>"].set_property("position", [0.85 * reach, 0.3 * reach,
-                                                                                  0.65 * reach])
+    def _points(self, q) -> np.ndarray:
+        """Points the robot occupies at q: its joint origins, its tool point and its visuals' origins [m]."""
+        robot = self.robot
+        data, gdata = robot.model.createData(), pin.GeometryData(self.geom)
+        pin.forwardKinematics(robot.model, data, robot.to_pin_q(q))
+        pin.updateGeometryPlacements(robot.model, data, self.geom, gdata)
+        joints = [m.translation for m in robot.joint_placements(q).values()]
+        return np.array([*joints, robot.fk(q).translation, *(M.translation for M in gdata.oMg)])
+
+    def _aim(self, points: np.ndarray) -> Scene:
+        """Frame ``points`` (base frame): meshcat turns its camera about the viewer's origin, so the scene
+        moves to put their centre there, the grid under the base, the camera at the framing distance."""
+        import meshcat.geometry as g
+
+        view = frame_points(points, floor_z=0.0, margin=0.05 * self.robot.characteristic_length())
+        self.viewer.set_transform(view.scene_shift())
+        self.viewer["/Grid"].set_property("visible", False)
+        self.viewer["floor"].set_object(g.LineSegments(g.PointsGeometry(view.floor_segments()),
+                                                       g.LineBasicMaterial(color=0x9A9A9A)))
+        self.viewer["/Cameras/default/rotated/<object>"].set_property("position", view.camera_position())
+        self.legend["floor"] = f"floor grid: {view.cell:g} m cells, at the base's height"
         return self
 
     # -- static scene ---------------------------------------------------------------------------
@@ -91,6 +104,8 @@ class Scene:
         q = self.robot.check_q(q)
         self.pinviz.display(self.robot.to_pin_q(q))
         self.frame("tool", self.robot.fk(q))
+        self.title = f"{self.robot.name} at q = [{', '.join(f'{v:.4g}' for v in q)}] (rad, m)"
+        self.legend["tool"] = f"tool frame {self.robot.tool!r}: x red, y green, z blue"
         return self.look_at_robot(q)
 
     def frame(self, name: str, oMframe: pin.SE3, length: float | None = None) -> Scene:
@@ -142,8 +157,11 @@ class Scene:
             tool_points.append(oMtool.translation)
         if draw_path:
             self.path(np.array(tool_points))
+            self.legend["path"] = "orange line: the tool's path"
         self.viewer.set_animation(anim, play=play)
-        return self
+        every = max(1, len(qs) // 24)
+        self.title = f"{self.robot.name}: {len(qs)} configurations, {dt:g} s apart"
+        return self._aim(np.vstack([self._points(q) for q in qs[::every]] + [np.array(tool_points)]))
 
     # -- singularities --------------------------------------------------------------------------
     def singular_directions(self, q, scale: float | None = None) -> Scene:
@@ -171,12 +189,24 @@ class Scene:
         self.viewer["singular"]["sigma"].set_object(g.Sphere(0.15 * self.frame_length),
                                                     g.MeshLambertMaterial(color=color))
         self.viewer["singular"]["sigma"].set_transform(pin.SE3(np.eye(3), oMtool.translation).homogeneous)
+        self.legend["sigma"] = (f"sphere at the tool: σ_min/σ_max = {ratio:.3g} (red at 1e-6 and below, green at 0.1 "
+                                f"and above); rank {a.rank} of {a.full_rank}")
+        kinds = {kind for k, d in enumerate(a.lost_directions)
+                 for kind, share in (("translation", d.translation_share), ("rotation", d.rotation_share))
+                 if share >= 1e-3}
+        if "translation" in kinds:
+            self.legend["lost_translation"] = ("magenta line: a tool direction the arm cannot move in "
+                                               "(length: its share)")
+        if "rotation" in kinds:
+            self.legend["lost_rotation"] = "cyan line: an axis the tool cannot turn about (length: its share)"
+        if not a.lost_directions:
+            self.legend["lost"] = "no direction is lost at this q (full rank)"
         return self
 
     # -- export ---------------------------------------------------------------------------------
     def static_html(self) -> str:
         """The whole scene (and its animation) as one self-contained HTML page (works offline)."""
-        return self.viewer.static_html()
+        return with_caption(self.viewer.static_html(), self.title, list(self.legend.values()))
 
     def save_html(self, path: str | Path) -> Path:
         path = Path(path)
@@ -215,17 +245,19 @@ def side_by_side(robot: Robot, qs: list, spacing: float | None = None, viewer: A
     scene = Scene(robot, viewer=viewer)
     scene.viewer[scene.root].delete()
     scene.viewer["frames"].delete()
-    for default in ("/Grid", "/Axes"):  # meshcat's floor and world triad would cross the copies
-        scene.viewer[default].set_property("visible", False)
     spacing = spacing or 1.2 * scene._reach
     columns = int(np.ceil(np.sqrt(len(checked))))
-    rows = int(np.ceil(len(checked) / columns))
+    occupied = []
     for k, q in enumerate(checked):
         offset = pin.SE3(np.eye(3), np.array([(k // columns) * spacing, (k % columns) * spacing, 0.0]))
         points = [m.translation for m in robot.joint_placements(q).values()] + [robot.fk(q).translation]
         _stick_figure(scene.viewer["branches"][str(k)], [offset.act(p) for p in points], scene.frame_length)
         scene.frame(f"tool_{k}", offset * robot.fk(q))
-    return scene._aim(checked[0], extent=((rows - 1) * spacing, (columns - 1) * spacing))
+        occupied += [offset.act(p) for p in points] + [offset.translation]
+    scene.title = f"{robot.name}: {len(checked)} configurations side by side"
+    scene.legend = {"figures": "joints: blue spheres; links: grey cylinders; copies in rows along the base x axis",
+                    "tool": "tool frames: x red, y green, z blue"}
+    return scene._aim(np.array(occupied))
 
 
 def _stick_figure(node, points: list[np.ndarray], size: float) -> None:
