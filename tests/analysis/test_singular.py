@@ -167,3 +167,42 @@ def test_arms_with_fewer_than_six_joints_report_the_twists_they_cannot_make(name
         for d in a.lost_directions:
             assert d.sigma == 0.0
             assert np.max(np.abs(np.array(d.twist) @ J)) < 1e-9
+
+
+UR_TRUE = {f"{joint} = {v}" for joint in ("wrist_2_joint", "elbow_joint") for v in ("0", "π", "−π", "2π", "−2π")}
+
+
+def test_ur5_sweep_reports_only_relations_that_keep_the_rank_down():
+    """The UR5's simple singular families are the wrist (wrist_2 = kπ) and the elbow (elbow = kπ); its
+    shoulder singularity (wrist centre over the base axis) has no simple joint relation and says so."""
+    ur5 = kinelab.load("ur5")
+    res = families.sweep(ur5, samples=2000, method="grid", seed=0)
+    assert res.samples == 3 ** 6  # the grid that fits in 2000, reported as run
+    for f in res.families:
+        assert independent_rank(ur5, f.representative) < 6
+        if f.verified:
+            assert {r.text for r in f.relations} <= UR_TRUE, f.text
+            assert families.holds_along(ur5, f.relations, f.representative, seed=7) == 1.0
+        else:
+            assert f.text.startswith("(no simple relation")
+    assert not any("wrist_3_joint" in f.text and f.verified for f in res.families)  # the last joint never matters
+
+
+def test_stanford_sweep_finds_the_retracted_boom_the_wrist_and_the_vertical_boom():
+    stanford = kinelab.load("stanford")
+    res = families.sweep(stanford, samples=3000, seed=0)
+    verified = {f.text for f in res.families if f.verified}
+    assert {"joint3 = 0", "joint5 = 0"} <= verified  # boom retracted (at its lower limit); wrist axes aligned
+    assert verified <= {"joint3 = 0", "joint5 = 0", "joint2 = π/2", "joint2 = −π/2"}
+    q = next(f.representative for f in res.families if f.text == "joint5 = 0").copy()
+    q[5] += 1.0  # the relation holds whatever joint6 does
+    assert singular.analyze(stanford, q).singular
+
+
+def test_a_coincidental_relation_is_pruned_and_a_missing_one_is_not_invented():
+    ur5 = kinelab.load("ur5")
+    q = np.array([0.3, -1.1, 0.7, -0.4, 0.0, np.pi / 2])  # wrist singular, the last joint at π/2 by chance
+    relations, verified = families.characterise(ur5, q)
+    assert verified and [r.text for r in relations] == ["wrist_2_joint = 0"]
+    q = np.array([0.3, -1.1, 0.7, -0.4, 0.9, 0.2])  # regular: nothing to explain
+    assert families.holds_along(ur5, families.joint_relations(ur5, q), q) < 1.0

@@ -340,3 +340,12 @@ def test_every_option_of_every_command_has_help():
 
     walk(build_parser(), [])
     assert missing == []
+
+
+def test_a_sweep_prints_the_samples_it_ran_and_representatives_that_paste_back(capsys):
+    code, out, _ = run(capsys, "singular", "ur5", "--sweep", "2000", "--grid")
+    assert code == 0 and "729 samples (a grid of 2000 asked for)" in out
+    line = next(x for x in out.splitlines() if "e.g. q = " in x)
+    q = line.split("e.g. q = ")[1].split()
+    code, out, _ = run(capsys, "singular", "ur5", *q)
+    assert code == 0 and "(SINGULAR)" in out  # full precision: still singular when pasted back

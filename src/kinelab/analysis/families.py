@@ -17,7 +17,7 @@ from kinelab.errors import KinelabError
 from kinelab.robot import Robot
 
 RELATION_TOL = 1e-3  # [rad or m] a joint relation holds within this
-SPECIAL_VALUES = (0.0, np.pi / 2, -np.pi / 2, np.pi, -np.pi)
+SPECIAL_VALUES = (0.0, np.pi / 2, -np.pi / 2, np.pi, -np.pi, 2 * np.pi, -2 * np.pi)
 FAMILY_MARGIN = 0.1  # [rad] a sample this close to every relation of a known family is explained by it
 
 
@@ -65,40 +65,112 @@ class Relation:
 
 
 def _label(c: float) -> str:
-    return {0.0: "0", np.pi / 2: "π/2", -np.pi / 2: "−π/2", np.pi: "π", -np.pi: "−π"}[c]
+    for value, text in ((0.0, "0"), (np.pi / 2, "π/2"), (np.pi, "π"), (2 * np.pi, "2π")):
+        if abs(abs(c) - value) < 1e-12:
+            return text if c >= 0 else "−" + text
+    return f"{c:.6g}"
+
+
+def _values(robot: Robot, index: tuple[int, ...]) -> list[float]:
+    """Values a relation on these joints is tried at: 0, ±π/2, ±π, ±2π (angles), and a single joint's limits."""
+    out = [0.0] if robot.joint_kinds[index[0]] == "prismatic" and len(index) == 1 else list(SPECIAL_VALUES)
+    if len(index) == 1:
+        i = index[0]
+        out += [v for v in (robot.lower[i], robot.upper[i]) if np.isfinite(v)]
+    return out
+
+
+def _combos(robot: Robot) -> list[tuple[tuple[int, ...], tuple[int, ...]]]:
+    """Single joints (any kind), sums and differences of two and of three angular joints."""
+    angular = [i for i, k in enumerate(robot.joint_kinds) if k != "prismatic"]
+    combos: list[tuple[tuple[int, ...], tuple[int, ...]]] = [((i,), (1,)) for i in range(robot.n)]
+    combos += [((i, j), (1, s)) for i, j in itertools.combinations(angular, 2) for s in (1, -1)]
+    combos += [((a, b, d), (1, s, t)) for a, b, d in itertools.combinations(angular, 3)
+               for s in (1, -1) for t in (1, -1)]
+    return combos
 
 
 def joint_relations(robot: Robot, q, tol: float = RELATION_TOL) -> list[Relation]:
-    """Simple relations the configuration satisfies: joints at 0, ±π/2, ±π; sums and differences of two
-    joints, and sums of three consecutive angular joints, at those values (joint names in the text);
-    relations implied by single-joint ones (θ2 = 0 and θ3 = 0 imply θ2 ± θ3 = 0) are left out."""
+    """Simple relations the configuration satisfies: single joints at 0, ±π/2, ±π, ±2π or at a limit; sums
+    and differences of two or three angular joints at 0, ±π/2, ±π, ±2π (joint names in the text); relations
+    implied by single-joint ones (θ2 = 0 and θ3 = 0 imply θ2 ± θ3 = 0) are left out."""
     names = robot.joint_names
-    angular = [i for i, k in enumerate(robot.joint_kinds) if k != "prismatic"]
-    combos: list[tuple[tuple[int, ...], tuple[int, ...]]] = [((i,), (1,)) for i in angular]
-    combos += [((i, j), (1, s)) for i, j in itertools.combinations(angular, 2) for s in (1, -1)]
-    combos += [((a, b, d), (1, 1, 1)) for a, b, d in zip(angular, angular[1:], angular[2:], strict=False)]
     out: list[Relation] = []
     fixed: set[int] = set()
-    for index, sign in combos:
-        if len(index) > 1 and all(i in fixed for i in index):
+    for index, sign in _combos(robot):
+        if len(index) > 1 and sum(i not in fixed for i in index) < 2:
             continue
         total = sum(s * q[i] for i, s in zip(index, sign, strict=True))
-        c = next((c for c in SPECIAL_VALUES if abs(total - c) < tol), None)
+        c = next((c for c in _values(robot, index) if abs(total - c) < tol), None)
         if c is None:
             continue
         lhs = names[index[0]] + "".join(f" {'+' if s > 0 else '−'} {names[i]}"
                                         for i, s in zip(index[1:], sign[1:], strict=True))
-        out.append(Relation(index, sign, c, f"{lhs} = {_label(c)}"))
+        out.append(Relation(index, sign, float(c), f"{lhs} = {_label(c)}"))
         if len(index) == 1:
             fixed.add(index[0])
     return out
 
 
+MOVES = 8  # configurations a relation set is tested at, away from the one it was found at
+MOVE = 0.5  # [rad] (a tenth of the range for a slide) how far the other joints move
+
+
+def moved_along(robot: Robot, relations: list[Relation], q, rng: np.random.Generator) -> np.ndarray | None:
+    """q with every joint moved at random, then put back on the relations (the nearest point satisfying all of
+    them); None when that leaves the limits."""
+    span = np.where(np.isfinite(robot.upper - robot.lower), robot.upper - robot.lower, 2 * np.pi)
+    step = np.where([k == "prismatic" for k in robot.joint_kinds], 0.1 * span, MOVE)
+    moved = np.asarray(q, dtype=float) + rng.uniform(-1.0, 1.0, robot.n) * step
+    if relations:  # the nearest point of the relations' affine set (they may share joints)
+        A = np.zeros((len(relations), robot.n))
+        for row, r in enumerate(relations):
+            A[row, list(r.index)] = r.sign
+        b = np.array([r.value for r in relations])
+        moved += np.linalg.pinv(A) @ (b - A @ moved)
+    if any(r.residual(moved) > 1e-9 for r in relations) or not robot.within_limits(moved):
+        return None
+    return moved
+
+
+def holds_along(robot: Robot, relations: list[Relation], q, seed: int = 0, length: float | None = None) -> float:
+    """The share of MOVES configurations satisfying ``relations`` (moved from q, see :func:`moved_along`) at
+    which the Jacobian loses rank: 1.0 when the relations are enough for the singularity."""
+    rng = np.random.default_rng(seed)
+    hits = tries = 0
+    for _ in range(4 * MOVES):
+        moved = moved_along(robot, relations, q, rng)
+        if moved is None:
+            continue
+        tries += 1
+        hits += analyze(robot, moved, length).singular
+        if tries == MOVES:
+            break
+    return hits / tries if tries else 0.0
+
+
+def characterise(robot: Robot, q, length: float | None = None) -> tuple[list[Relation], bool]:
+    """The relations that explain the singularity at q, and whether they do: the simple relations q satisfies,
+    pruned to those without which the rank drop no longer holds along the family (coincidences such as a
+    last joint at π/2 go); (relations found, False) when even all of them do not keep the rank down."""
+    found = joint_relations(robot, q)
+    if not found or holds_along(robot, found, q, length=length) < 1.0:
+        return found, False
+    kept = list(found)
+    for r in sorted(found, key=lambda r: -len(r.index)):  # try to drop sums before single joints
+        trial = [k for k in kept if k is not r]
+        if trial and holds_along(robot, trial, q, length=length) == 1.0:
+            kept = trial
+    return kept, True
+
+
 def _merge_coincidences(groups: dict[tuple, list]) -> dict[tuple, list]:
-    """A relation set that strictly contains another family's carries a chance coincidence: merge it there."""
+    """A verified relation set that strictly contains another verified family's carries a chance coincidence:
+    merge it there. Keys are (relations, verified)."""
     merged: dict[tuple, list] = {}
-    for key in sorted(groups, key=len):
-        home = next((k for k in merged if k and set(k) < set(key)), None)
+    for key in sorted(groups, key=lambda k: len(k[0])):
+        rel, verified = key
+        home = next((k for k in merged if k[0] and verified and k[1] and set(k[0]) < set(rel)), None)
         merged.setdefault(home or key, []).extend(groups[key])
     return merged
 
@@ -112,10 +184,20 @@ class Family:
     representative: np.ndarray
     rank: int
     sigma_ratio: float
+    verified: bool = True  # the relations keep the rank down along the family (False: they hold at q only)
+
+    @property
+    def text(self) -> str:
+        """The relations in words."""
+        joined = " and ".join(r.text for r in self.relations)
+        if self.verified and joined:
+            return joined
+        return "(no simple relation" + (f"; at these q: {joined}, which alone do not keep it singular)" if joined
+                                        else ")")
 
     def to_dict(self) -> dict:
-        return {"relations": [r.text for r in self.relations], "count": self.count,
-                "representative_q": self.representative.tolist(), "rank": self.rank,
+        return {"relations": [r.text for r in self.relations], "verified": self.verified, "text": self.text,
+                "count": self.count, "representative_q": self.representative.tolist(), "rank": self.rank,
                 "sigma_min_over_max": self.sigma_ratio}
 
 
@@ -207,10 +289,10 @@ def sweep(robot: Robot, samples: int = 5000, seed: int = 0, refine_top: int = 40
     order = [i for i in np.argsort(ratios) if ratios[i] < NEAR_SINGULAR]
     groups, refined, singular_count = _refine_samples(robot, qs, order, lower, upper, L, refine_top, progress)
     families = []
-    for rel, members in sorted(_merge_coincidences(groups).items(), key=lambda kv: -len(kv[1])):
+    for (rel, verified), members in sorted(_merge_coincidences(groups).items(), key=lambda kv: -len(kv[1])):
         a = analyze(robot, members[0], L)
         families.append(Family(list(rel), len(members), members[0], a.rank,
-                               float(a.singular_values[a.full_rank - 1] / a.singular_values[0])))
+                               float(a.singular_values[a.full_rank - 1] / a.singular_values[0]), verified))
     return SweepResult(families, len(qs), int(np.sum(ratios < NEAR_SINGULAR)), refined, singular_count, notes,
                        ratios)
 
@@ -222,11 +304,11 @@ def _refine_samples(robot: Robot, qs: np.ndarray, order: list[int], lower: np.nd
     A family of lower dimension (the youBot's θ2 = θ3 = 0) is sampled far less often than one of
     codimension 1; leaving the explained samples out is what lets a sweep find it.
     """
-    groups: dict[tuple[Relation, ...], list[np.ndarray]] = {}
+    groups: dict[tuple[tuple[Relation, ...], bool], list[np.ndarray]] = {}
     refined = singular_count = 0
     with tqdm(total=refine_top, desc="refine", disable=not progress, unit="q", leave=False) as bar:
         while refined < refine_top and order:
-            known = [rel for rel in groups if rel]
+            known = [rel for rel, verified in groups if rel and verified]
             pick = next((i for i in order if not any(all(r.residual(qs[i]) < FAMILY_MARGIN for r in rel)
                                                      for rel in known)), None)
             if pick is None:
@@ -237,5 +319,6 @@ def _refine_samples(robot: Robot, qs: np.ndarray, order: list[int], lower: np.nd
             bar.update()
             if analyze(robot, q, L).singular:
                 singular_count += 1
-                groups.setdefault(tuple(joint_relations(robot, q)), []).append(q)
+                relations, verified = characterise(robot, q, L)
+                groups.setdefault((tuple(relations), verified), []).append(q)
     return groups, refined, singular_count

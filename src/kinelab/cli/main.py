@@ -355,13 +355,13 @@ def cmd_singular(args) -> int:
             return 0
         for note in result.notes:
             print(f"note: {note}")
-        print(f"{robot.name}: {args.sweep} samples, {out['near_singular']} near-singular (σ_min/σ_max < "
-              f"{singular.NEAR_SINGULAR:g}), {out['refined']} refined, {out['singular']} singular after refinement")
+        asked = f" (a grid of {args.sweep} asked for)" if result.samples != args.sweep else ""
+        print(f"{robot.name}: {_plural(result.samples, 'sample')}{asked}, {out['near_singular']} near-singular "
+              f"(σ_min/σ_max < {singular.NEAR_SINGULAR:g}), {out['refined']} refined, {out['singular']} singular "
+              "after refinement")
         for f in result.families:
-            q_show = np.round(f.representative, 4).tolist()
-            relations = " and ".join(r.text for r in f.relations) or "(no simple relation)"
-            print(f"  rank {f.rank}, {f.count:4d} found: {relations}")
-            print(f"      e.g. q = {q_show}")
+            print(f"  rank {f.rank}, {f.count:4d} found: {f.text}")
+            print(f"      e.g. q = {' '.join(repr(float(v)) for v in f.representative)}")
         return 0
     if not args.q:
         raise KinelabError("give a configuration Q1 ... Qn or --sweep N")
