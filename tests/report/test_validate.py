@@ -1,5 +1,7 @@
 import json
 
+import pytest
+
 from kinelab import cli
 from kinelab.report import render, validate
 
@@ -44,7 +46,7 @@ def test_era_checks_cover_the_three_passages_and_print_tolerances_exactly():
     assert all(c.passed for c in checks), [c for c in checks if not c.passed]
     table = render.validate_table(validate.Report(robots=["era"], checks=checks))
     step_row = next(line for line in table.splitlines() if "elbow, bypass: largest joint step" in line)
-    assert " 0.25 rad" in step_row  # a 0.25 rad bound printed as such, not rounded to "2e-01"
+    assert "≤ 0.25" in step_row and " rad " in step_row  # a 0.25 rad bound printed as such, not "2e-01"
 
 
 def test_json_alone_writes_no_report_folder(tmp_path, monkeypatch, capsys):
@@ -52,3 +54,62 @@ def test_json_alone_writes_no_report_folder(tmp_path, monkeypatch, capsys):
     code = cli.main(["validate", "--robots", "ur5", "--n", "10", "--json"])
     assert code == 0 and json.loads(capsys.readouterr().out)["passed"]
     assert list(tmp_path.iterdir()) == []  # no ./kinelab-report
+
+
+def _report_with_one_failure():
+    ok = validate.Check("era", "FK position: yourdfpy vs Pinocchio", 2e-16, 1e-9, "m", "200 random q")
+    bad = validate.Check("era", "seed 000 wrist, q5, q6 < 80°: worst tool error", 2e-6, 1e-6, "m")
+    shows = validate.Check("era", "seed 000 wrist, without bypass: the paper's drift shows", 1.0, 1.0, "yes/no",
+                           at_least=True)
+    return validate.Report(robots=["era"], checks=[ok, bad, shows], n=10)
+
+
+def test_the_terminal_table_wraps_long_names_within_their_column_and_reads_positively():
+    report = _report_with_one_failure()
+    lines = render.validate_table(report, width=80).splitlines()
+    assert all(len(line) <= 80 for line in lines)
+    assert lines[-1] == "2 passed, 1 failed"
+    drift = next(line for line in lines if "without bypass" in line)
+    assert " yes " in drift and drift.endswith("PASS")  # yes/no shown, not a 0/1 "(0 = shown)"
+    assert any(line.strip() == "worst tool error" for line in lines)  # the long name wrapped in its column
+
+
+def test_the_html_report_puts_the_verdict_first_and_a_section_per_paper_with_captioned_figures(tmp_path):
+    from kinelab.report.page import validate_html
+
+    figure = tmp_path / "era_wrist.png"
+    fig = render.Figure(figsize=(2, 1))
+    fig.subplots().plot([0, 1], [0, 1])
+    fig.savefig(figure)
+    page = validate_html(_report_with_one_failure(), {"era_wrist.png": figure.read_bytes()})
+    assert page.index("class='verdict fail'") < page.index("<h2>")  # verdict and summary first
+    assert "Failed: era: seed 000 wrist, q5, q6 &lt; 80°: worst tool error" in page
+    assert "<tr class='failed'>" in page and page.count("<tr class='failed'>") == 1
+    section = page[page.index("Seed paper 000"):]
+    assert "<figcaption>Figure: Seed 000, ERA wrist passage" in section and "data:image/png;base64," in section
+    assert page.index("Machine and versions") > page.index("<figcaption>")  # the machine last
+    assert "<script" not in page and "http" not in page  # self-contained
+
+
+def test_a_browser_shows_the_verdict_banner_at_the_top_of_the_report(tmp_path):
+    """Headless Chromium renders the page: the red FAIL banner sits in the first rows, the failed row is
+    tinted, the page's width is the browser's (no horizontal overflow of the tables)."""
+    import os
+
+    import browser
+    import numpy as np
+    from PIL import Image
+
+    from kinelab.report.page import validate_html
+
+    if browser.find_chromium() is None:
+        if os.environ.get("CI"):
+            pytest.fail("CI must have chromium: .ci/run installs Debian's chromium")
+        pytest.skip("Debian's chromium is not installed here")
+    (tmp_path / "report.html").write_text(validate_html(_report_with_one_failure(), {}))
+    png = browser.screenshot(tmp_path / "report.html", tmp_path / "report.png", size=(900, 700))
+    rgb = np.asarray(Image.open(png).convert("RGB"), dtype=int)
+    red = (np.abs(rgb - (0xB3, 0x26, 0x1E)).max(axis=2) < 12)
+    tint = (np.abs(rgb - (0xFD, 0xEC, 0xEA)).max(axis=2) < 6)
+    assert red[:160].sum() > 5000  # the banner, first thing on the page
+    assert tint.sum() > 2000  # the failed check's row

@@ -13,6 +13,7 @@ import json
 import math
 import os
 import re
+import shutil
 import sys
 import threading
 from collections.abc import Iterator
@@ -399,7 +400,7 @@ def cmd_validate(args) -> int:
     if args.json:
         _print_json(report.to_dict())
     else:
-        print(render.validate_table(report))
+        print(render.validate_table(report, width=shutil.get_terminal_size((120, 24)).columns))
         print(f"report written to {out}")
     return 0 if report.passed else 1
 

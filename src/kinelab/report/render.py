@@ -6,13 +6,12 @@ choice, so rendering never changes the caller's matplotlib settings.
 
 from __future__ import annotations
 
-import base64
 import contextlib
-import html
 import json
 import os
 import shutil
 import tempfile
+import textwrap
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -22,6 +21,7 @@ from matplotlib.figure import Figure
 
 from kinelab.errors import KinelabError
 from kinelab.report.bench import loops, scaling
+from kinelab.report.page import CAPTIONS, validate_html
 from kinelab.report.validate import Report
 from kinelab.studies import paper000_era as ep
 from kinelab.studies import paper001_stanford as seed001
@@ -69,13 +69,19 @@ def atomic_folder(out: str | Path) -> Iterator[Path]:
         shutil.rmtree(old, ignore_errors=True)
 
 
-def validate_table(report: Report) -> str:
-    """The checks as an aligned text table with a closing 'N passed, M failed' line."""
-    lines = [f"{'robot':<10} {'check':<56} {'measured':>10} {'tolerance':>10}  result"]
+def validate_table(report: Report, width: int = 120) -> str:
+    """The checks as a text table whose columns fit ``width`` characters (long check names wrap within their
+    column), with a closing 'N passed, M failed' line."""
+    robot_w = max(5, *(len(c.robot) for c in report.checks)) if report.checks else 5
+    fixed = robot_w + 2 + 2 + 10 + 2 + 12 + 1 + 6 + 6  # the columns and gaps around the check name
+    name_w = max(24, min(max((len(c.name) for c in report.checks), default=24), width - fixed))
+    lines = [f"{'robot':<{robot_w}}  {'check':<{name_w}}  {'measured':>10}  {'limit':<12} {'unit':<6}result"]
     for c in report.checks:
-        unit = f" {c.unit}" if c.unit else ""
-        lines.append(f"{c.robot:<10} {c.name:<56} {c.value:>10.2e} {c.tolerance:>10.3g}{unit:<4} "
+        wrapped = textwrap.wrap(c.name, name_w) or [""]
+        unit = "" if c.unit in ("yes/no", "%") else c.unit
+        lines.append(f"{c.robot:<{robot_w}}  {wrapped[0]:<{name_w}}  {c.measured:>10}  {c.limit:<12} {unit:<6}"
                      f"{'PASS' if c.passed else 'FAIL'}")
+        lines += [f"{'':<{robot_w}}  {more}" for more in wrapped[1:]]
     failed = sum(not c.passed for c in report.checks)
     lines.append(f"{len(report.checks) - failed} passed, {failed} failed")
     return "\n".join(lines)
@@ -130,24 +136,12 @@ def _write_validate_files(report: Report, folder: Path) -> None:
     figures = validate_figures(report, folder)
     (folder / "report.json").write_text(json.dumps(report.to_dict(), indent=2))
     md = ["# kinelab validate", "", f"Robots: {', '.join(report.robots)}; n = {report.n}; seed = {report.seed}.", "",
-          "| robot | check | measured | tolerance | result |", "|---|---|---|---|---|"]
-    md += [f"| {c.robot} | {c.name} | {c.value:.2e} {c.unit} | {c.tolerance:.3g} | {'PASS' if c.passed else 'FAIL'} |"
-           for c in report.checks]
-    md += [""] + [f"![{name}]({name})" for name in figures]
+          "| robot | check | measured | limit | result |", "|---|---|---|---|---|"]
+    md += [f"| {c.robot} | {c.name} | {c.measured} {c.unit if c.unit not in ('yes/no', '%') else ''} | {c.limit} | "
+           f"{'PASS' if c.passed else 'FAIL'} |" for c in report.checks]
+    md += [""] + [f"![{CAPTIONS.get(name, name)}]({name})" for name in figures]
     (folder / "report.md").write_text("\n".join(md) + "\n")
-    rows = "".join(
-        f"<tr><td>{html.escape(c.robot)}</td><td>{html.escape(c.name)}</td><td>{c.value:.2e} {c.unit}</td>"
-        f"<td>{c.tolerance:.3g}</td><td>{'PASS' if c.passed else 'FAIL'}</td></tr>"
-        for c in report.checks
-    )
-    (folder / "report.html").write_text(
-        "<!doctype html><meta charset='utf-8'><title>kinelab validate</title>"
-        f"<h1>kinelab validate: {'PASS' if report.passed else 'FAIL'}</h1>"
-        "<table border=1><tr><th>robot</th><th>check</th><th>measured</th><th>tolerance</th><th>result</th></tr>"
-        f"{rows}</table>"
-        + "".join(f"<p><img alt='{name}' src='data:image/png;base64,"
-                  f"{base64.b64encode((folder / name).read_bytes()).decode()}'></p>" for name in figures)
-    )
+    (folder / "report.html").write_text(validate_html(report, {n: (folder / n).read_bytes() for n in figures}))
 
 
 def bench_markdown(result: dict[str, Any]) -> str:

@@ -25,7 +25,8 @@ DEFAULT_N = 200
 
 @dataclass(frozen=True)
 class Check:
-    """One validated figure: ``value`` must be ≤ ``tolerance`` (both in ``unit``)."""
+    """One validated figure: ``value`` must be ≤ ``tolerance`` (both in ``unit``), or ≥ it when ``at_least``;
+    a check with ``unit == "yes/no"`` holds when ``value`` is 1 (yes)."""
 
     robot: str
     name: str
@@ -33,10 +34,28 @@ class Check:
     tolerance: float
     unit: str
     detail: str = ""
+    at_least: bool = False
 
     @property
     def passed(self) -> bool:
-        return bool(np.isfinite(self.value) and self.value <= self.tolerance)
+        if not np.isfinite(self.value):
+            return False
+        return bool(self.value >= self.tolerance if self.at_least else self.value <= self.tolerance)
+
+    @property
+    def measured(self) -> str:
+        """The value as shown: yes/no, a share in %, or a number."""
+        if self.unit == "yes/no":
+            return "yes" if self.value >= 1 else "no"
+        return f"{100 * self.value:.1f} %" if self.unit == "%" else f"{self.value:.2e}"
+
+    @property
+    def limit(self) -> str:
+        """The tolerance as shown, with ≤ or ≥."""
+        if self.unit == "yes/no":
+            return "yes"
+        shown = f"{100 * self.tolerance:g} %" if self.unit == "%" else f"{self.tolerance:.3g}"
+        return ("≥ " if self.at_least else "≤ ") + shown
 
 
 @dataclass
@@ -115,9 +134,9 @@ def solver_checks(robot: Robot, n: int, seed: int) -> list[Check]:
             times.append(res.wall_time)
             iters.append(res.iterations)
             worst = max(worst, dp if ok else 0.0)
-        rows.append(Check(robot.name, f"{solver}: share of targets not solved (Pinocchio-checked)", failures / count,
-                          allowed, "", f"{count} targets, median {np.median(times) * 1e3:.2f} ms, median "
-                          f"{np.median(iters):.0f} iterations, worst solved error {worst:.1e} m"))
+        rows.append(Check(robot.name, f"{solver}: targets solved (Pinocchio-checked)", 1 - failures / count,
+                          1 - allowed, "%", f"{count} targets, median {np.median(times) * 1e3:.2f} ms, median "
+                          f"{np.median(iters):.0f} iterations, worst solved error {worst:.1e} m", at_least=True))
     return rows
 
 
@@ -158,11 +177,14 @@ def youbot_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     found = "arm_joint_2 = 0 and arm_joint_3 = 0" in texts
     return [
         Check(robot.name, "seed 003: paper's J vs finite differences of X(Q)", J_fd, 1e-6, ""),
-        Check(robot.name, "seed 003: paper's J rank ≠ 5 at θ2 = θ3 = 0 (count)", off_paper, 0, "", f"{count} Q"),
-        Check(robot.name, "seed 003: Pinocchio SVD rank ≠ 5 at θ2 = θ3 = 0 (count)", off_pin, 0, "", f"{count} Q"),
-        Check(robot.name, "seed 003: paper's J rank ≠ 6 over the limit box (count)", box, 0, "", f"{count} Q"),
-        Check(robot.name, "seed 003: sweep finds θ2 = θ3 = 0 (0 = found)", 0.0 if found else 1.0, 0.0, "",
-              "families: " + "; ".join(texts)),
+        Check(robot.name, "seed 003: paper's J has rank 5 at θ2 = θ3 = 0", 1 - off_paper / count, 1.0, "%",
+              f"{count} Q", at_least=True),
+        Check(robot.name, "seed 003: Pinocchio's SVD gives rank 5 at θ2 = θ3 = 0", 1 - off_pin / count, 1.0, "%",
+              f"{count} Q", at_least=True),
+        Check(robot.name, "seed 003: paper's J has rank 6 over the limit box", 1 - box / count, 1.0, "%",
+              f"{count} Q", at_least=True),
+        Check(robot.name, "seed 003: the sweep finds θ2 = θ3 = 0", 1.0 if found else 0.0, 1.0, "yes/no",
+              "families: " + "; ".join(texts), at_least=True),
     ]
 
 
@@ -185,8 +207,8 @@ def _elbow_checks(robot: Robot, ep) -> list[Check]:
               float(w.position_error[reach].max()), 1e-6, "m",
               f"without bypass {wo.position_error[reach].max():.2f} m, "
               f"reached {wo.reached[reach].sum()}/{reach.sum()}"),
-        Check(robot.name, "seed 000 elbow, bypass: samples leaving the fold's quadrants",
-              ep.quadrant_violations(w, passage), 0, ""),
+        Check(robot.name, "seed 000 elbow, bypass: samples keeping the fold in its quadrants",
+              1 - ep.quadrant_violations(w, passage) / passage.samples, 1.0, "%", at_least=True),
     ]
 
 
@@ -212,8 +234,8 @@ def _lock_checks(robot: Robot, ep) -> list[Check]:
                   float(np.abs(laps_w[1:]).max()), 1e-5, "rad"),
             Check(robot.name, f"seed 000 {name}, {bypass}: worst tool error", float(w.position_error.max()), 1e-6,
                   "m", f"reached {w.reached.sum()}/{passage.samples}"),
-            Check(robot.name, f"seed 000 {name}, without: paper's drift absent (0 = shown)", 0.0 if shown else 1.0,
-                  0.0, "", f"per-lap change {drift}"),
+            Check(robot.name, f"seed 000 {name}, without bypass: the paper's drift shows", 1.0 if shown else 0.0,
+                  1.0, "yes/no", f"per-lap change {drift}", at_least=True),
         ]
     return checks
 
@@ -235,6 +257,6 @@ def run(robots: list[str] | None = None, n: int | None = None, seed: int = 0, pr
     loaded = [load(name) for name in names]  # fail early, before any work, on a bad name
     report = Report(robots=names, n=n, seed=seed)
     steps = [(robot, fn) for robot in loaded for fn in [*GENERAL_CHECKS, *PAPER_CHECKS.get(robot.name, [])]]
-    for robot, fn in tqdm(steps, desc="validate", disable=not progress, unit="check"):
+    for robot, fn in tqdm(steps, desc="validate (check groups)", disable=not progress, unit="group"):
         report.checks.extend(fn(robot, n, seed))
     return report
