@@ -110,13 +110,12 @@ plt.tight_layout()
 # %% [markdown]
 # ## In the browser
 #
-# `kinelab.view.scene.Scene` draws a robot with meshcat (its server listens on 127.0.0.1 only). Here the youBot at
-# a random configuration; under CI the page is embedded as static HTML.
+# `kinelab.view.scene.Scene` draws a robot with meshcat (its server listens on 127.0.0.1 only; `scene.url` is
+# the live viewer). Here the youBot at a random configuration, embedded as a static page: it stays visible
+# when the notebook is saved or exported, caption included.
 
 # %%
-import os
-
 from kinelab.view import scene as viz
 
 scene = viz.Scene(youbot).show(youbot.random_q(rng))
-scene.viewer.render_static() if os.environ.get("CI") else scene.viewer.jupyter_cell()
+scene.notebook_html()

@@ -25,7 +25,6 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import kinelab
-from kinelab.ik import solve
 from kinelab.ik.chain import chain_model as vector_model
 from kinelab.studies import paper000_era as ep
 
@@ -44,7 +43,7 @@ print("type flags p:", v["p"], "  limits L(2, n) [deg]:\n", np.round(np.rad2deg(
 
 # %%
 target = era.fk(era.random_q(3))
-res = solve(era, target, seed=1)
+res = kinelab.solve(era, target, seed=1)
 print(res.status.value, "| position error", f"{res.position_error:.1e} m",
       "| rotation error", f"{res.rotation_error:.1e} rad",
       "|", res.iterations, "sweeps |", f"{res.wall_time * 1e3:.2f} ms", "| mode", res.mode)

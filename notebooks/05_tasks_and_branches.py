@@ -122,7 +122,7 @@ print(f"prefer=q_ref: distance to q_ref {distance(ur5, preferred.q, q_true):.1e}
 
 # %%
 view = viz.side_by_side(ur5, [b.q for b in branches])
-view.viewer.render_static()
+view.notebook_html()
 
 # %% [markdown]
 # ## The SO-101's branches of an axis task
@@ -136,7 +136,7 @@ for k, b in enumerate(axis_branches):
     print(f"  {k}: q = {np.array2string(b.q, precision=3, suppress_small=True)}  "
           f"errors {b.position_error:.0e} m, {b.rotation_error:.0e} rad")
 view_so101 = viz.side_by_side(so101, [b.q for b in axis_branches])
-view_so101.viewer.render_static()
+view_so101.notebook_html()
 
 # %%
 view.close()

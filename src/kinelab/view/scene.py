@@ -9,6 +9,7 @@ bundled robots draw their primitive shapes. Nothing opens a browser unless asked
 from __future__ import annotations
 
 import contextlib
+import html
 import io
 from pathlib import Path
 from typing import Any
@@ -207,6 +208,14 @@ class Scene:
     def static_html(self) -> str:
         """The whole scene (and its animation) as one self-contained HTML page (works offline)."""
         return with_caption(self.viewer.static_html(), self.title, list(self.legend.values()))
+
+    def notebook_html(self, height: int = 420) -> Any:
+        """The static page (caption included) as an IPython HTML object for a notebook cell: it stays visible
+        in a saved or exported notebook, where the live viewer's frame would be dead."""
+        from IPython.display import HTML
+
+        page = html.escape(self.static_html(), quote=True)
+        return HTML(f'<iframe srcdoc="{page}" style="width:100%;height:{height}px;border:0"></iframe>')
 
     def save_html(self, path: str | Path) -> Path:
         path = Path(path)
