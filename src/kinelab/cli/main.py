@@ -553,7 +553,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--version", action="version", version=f"kinelab {kinelab_version}")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
     for add in (_add_robots, _add_info, _add_fk, _add_ik, _add_singular, _add_view, _add_animate, _add_bench,
-                _add_validate):
+                _add_map, _add_validate):
         add(sub)
     return p
 
@@ -666,6 +666,48 @@ def _add_bench(sub: Any) -> None:
     s.add_argument("--out", help="write bench.json, bench.md and bench.png here")
     s.add_argument("--json", action="store_true", help="print the results as JSON instead of tables")
     s.set_defaults(func=cmd_bench)
+
+
+def _add_map(sub: Any) -> None:
+    s = sub.add_parser("map", help="reachability maps (kinelab.maps)")
+    kinds = s.add_subparsers(dest="kind", required=True, metavar="KIND", parser_class=_Parser)
+    r = kinds.add_parser("reach", help="the share of orientations the arm reaches in each voxel of its workspace")
+    r.add_argument("robot", help="a registered name or a model file (see kinelab robots)")
+    r.add_argument("--voxel", type=float, default=0.1, help="voxel side [m]")
+    r.add_argument("--orientations", type=int, default=16, help="target orientations per voxel")
+    r.add_argument("--task", choices=("pose", "axis"), default="pose",
+                   help="pose, or axis: the tool z axis along spread directions, the roll free")
+    r.add_argument("--restarts", type=int, default=20, help="random restarts per target")
+    r.add_argument("--seed", type=int, default=0, help="seed of the random starts or samples (an integer ≥ 0)")
+    r.add_argument("--chunk", type=int, default=64, help="voxels per chunk (the unit of work and of storage)")
+    r.add_argument("--out", help="a Zarr directory: written chunk by chunk, resumed if it holds this map unfinished")
+    r.add_argument("--force", action="store_true", help="run a map of more than 2 million targets")
+    r.add_argument("--json", action="store_true", help="print the summary as JSON")
+    r.set_defaults(func=cmd_map_reach)
+
+
+def cmd_map_reach(args) -> int:
+    import time
+
+    from kinelab import maps
+
+    robot = load(args.robot)
+    spec = maps.MapSpec(voxel=args.voxel, orientations=args.orientations, task=args.task, restarts=args.restarts,
+                        seed=args.seed, chunk_voxels=args.chunk)
+    t0 = time.perf_counter()
+    result = maps.reachability(robot, spec, out=args.out, force=args.force, progress=not args.json)
+    reach = result.array("reachability")
+    summary = {"robot": robot.name, "voxels": int(len(reach)), "targets": int(len(reach) * spec.orientations),
+               "reached_voxels": int((reach > 0).sum()), "mean_reachability": float(np.nanmean(reach)),
+               "seconds": time.perf_counter() - t0, "out": args.out}
+    if args.json:
+        _print_json(summary)
+    else:
+        print(f"{robot.name}: {_plural(summary['voxels'], 'voxel')} of {args.voxel:g} m × {spec.orientations} "
+              f"orientations; {summary['reached_voxels']} voxels reached, mean reachability "
+              f"{summary['mean_reachability']:.3f}; {summary['seconds']:.1f} s"
+              + (f"; written to {args.out}" if args.out else ""))
+    return 0
 
 
 def _add_validate(sub: Any) -> None:

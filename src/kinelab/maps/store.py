@@ -1,0 +1,116 @@
+"""A reachability map in memory or on disk (a Zarr directory, written chunk by chunk).
+
+On disk: arrays ``centres`` (V, 3) [m], ``reachability``, ``manipulability``, ``sigma_ratio`` (V,) and
+``done`` (one flag per chunk, set after the chunk's values are written, so an interrupted run resumes at
+the first chunk not done), with the metadata in the group's attributes: robot name, SHA-256 of its model
+file, the spec, the voxel count and the kinelab version. Zarr is the optional extra ``kinelab[maps]``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from kinelab.errors import KinelabError
+from kinelab.robot import Robot
+
+INSTALL_HINT = "pip install 'kinelab[maps]' (zarr)"
+VALUES = ("reachability", "manipulability", "sigma_ratio")
+
+
+def _zarr() -> Any:
+    try:
+        import zarr
+    except ImportError:
+        raise KinelabError(f"writing or reading a map file needs zarr: {INSTALL_HINT}") from None
+    return zarr
+
+
+def metadata(robot: Robot, spec: Any, voxels: int) -> dict:
+    """What identifies a map: the robot, its model file's hash, the spec and the kinelab version."""
+    from kinelab import __version__
+
+    return {"robot": robot.name, "source_sha256": hashlib.sha256(Path(robot.urdf_path).read_bytes()).hexdigest(),
+            "spec": spec.to_dict(), "voxels": int(voxels), "kinelab": __version__,
+            "base": robot.base, "tool": robot.tool}
+
+
+class ReachabilityMap:
+    """The map's arrays (numpy, or Zarr arrays on disk) and its metadata."""
+
+    def __init__(self, meta: dict, arrays: dict[str, Any], path: Path | None = None):
+        self.meta, self.path = meta, path
+        self.centres, self.done = arrays["centres"], arrays["done"]
+        self.values = {k: arrays[k] for k in VALUES}
+
+    @property
+    def chunks(self) -> int:
+        return len(self.done)
+
+    def write(self, index: int, values: dict[str, np.ndarray]) -> None:
+        """Store chunk ``index``'s values, then mark it done."""
+        size = self.meta["spec"]["chunk_voxels"]
+        for name in VALUES:
+            self.values[name][index * size:index * size + len(values[name])] = values[name]
+        self.done[index] = True
+
+    def array(self, name: str) -> np.ndarray:
+        """One of ``reachability``, ``manipulability``, ``sigma_ratio`` (or ``centres``) as a numpy array."""
+        return np.asarray(self.centres[:] if name == "centres" else self.values[name][:])
+
+
+def open_map(out: str | Path | None, robot: Robot, spec: Any, centres: np.ndarray) -> ReachabilityMap:
+    """A new map (in memory, or a new Zarr directory), or the unfinished one at ``out`` if it is the same map.
+
+    Raises:
+        KinelabError: ``out`` holds another map (the differing item named), or zarr is missing.
+    """
+    meta = metadata(robot, spec, len(centres))
+    chunks = -(-len(centres) // spec.chunk_voxels)
+    if out is None:
+        arrays = {"centres": centres, "done": np.zeros(chunks, dtype=bool),
+                  **{k: np.full(len(centres), np.nan) for k in VALUES}}
+        return ReachabilityMap(meta, arrays)
+    zarr, path = _zarr(), Path(out)
+    if path.exists():
+        found = load(path)
+        _same(found.meta, meta, path)
+        return found
+    group = zarr.open_group(str(path), mode="w")
+    group.attrs.update(meta)
+    group.create_dataset("centres", data=centres, chunks=(spec.chunk_voxels, 3))
+    for name in VALUES:
+        group.create_dataset(name, shape=(len(centres),), chunks=(spec.chunk_voxels,), dtype="f8", fill_value=np.nan)
+    group.create_dataset("done", shape=(chunks,), chunks=(1,), dtype=bool, fill_value=False)
+    return ReachabilityMap(meta, {k: group[k] for k in ("centres", "done", *VALUES)}, path)
+
+
+def load(path: str | Path) -> ReachabilityMap:
+    """Open a map written by :func:`kinelab.maps.reachability`.
+
+    Raises:
+        KinelabError: no map there, or a map written by another kinelab version (named).
+    """
+    from kinelab import __version__
+
+    zarr, path = _zarr(), Path(path)
+    try:
+        group = zarr.open_group(str(path), mode="r+")
+        meta = dict(group.attrs)
+        arrays = {k: group[k] for k in ("centres", "done", *VALUES)}
+    except (KeyError, ValueError, FileNotFoundError, zarr.errors.GroupNotFoundError):
+        raise KinelabError(f"{path} is not a kinelab reachability map") from None
+    if meta.get("kinelab") != __version__:
+        raise KinelabError(f"{path} was written by kinelab {meta.get('kinelab')}, this is {__version__}: "
+                           "compute the map again")
+    return ReachabilityMap(meta, arrays, path)
+
+
+def _same(found: dict, wanted: dict, path: Path) -> None:
+    for key in ("robot", "source_sha256", "base", "tool", "spec", "voxels"):
+        if found.get(key) != wanted.get(key):
+            raise KinelabError(f"{path} holds another map ({key}: {found.get(key)!r}, asked for "
+                               f"{wanted.get(key)!r}); give another --out or remove it")

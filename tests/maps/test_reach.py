@@ -1,0 +1,114 @@
+"""Reachability maps: reachable FK points, unreachable far voxels, the same map whatever the chunking or an
+interruption, and clear errors for bad input."""
+
+import numpy as np
+import pytest
+
+import kinelab
+from kinelab import KinelabError, maps
+from kinelab.maps import grid, reach, store
+
+
+@pytest.fixture(scope="module")
+def ur5():
+    return kinelab.load("ur5")
+
+
+def test_orientations_cover_so3_evenly():
+    R = grid.rotations(64)
+    assert np.allclose(np.einsum("kij,kil->kjl", R, R), np.eye(3), atol=1e-12)
+    assert np.allclose(np.linalg.det(R), 1.0)
+    # every rotation of a dense random set lies near one of the 64 (no empty region of SO(3))
+    rng = np.random.default_rng(0)
+    from scipy.spatial.transform import Rotation
+
+    probes = Rotation.random(500, random_state=rng).as_matrix()
+    nearest = [min(np.arccos(np.clip((np.trace(P.T @ Q) - 1) / 2, -1, 1)) for Q in R) for P in probes]
+    assert max(nearest) < 1.2  # radians; 64 evenly spread rotations leave no hole wider than this
+
+
+def test_fk_points_are_reachable_and_points_beyond_the_reach_are_not(ur5):
+    spec = reach.MapSpec(orientations=24, chunk_voxels=64, restarts=10)
+    rng = np.random.default_rng(1)
+    points = np.array([ur5.fk(ur5.random_q(rng)).translation for _ in range(40)])
+    values = reach.compute_chunk(ur5, spec, points, 0)
+    assert (values["reachability"] > 0).mean() >= 0.9  # measured: 40 of 40
+    from kinelab.ik.workspace import reach_bound
+
+    anchor, radius = reach_bound(ur5)
+    far = np.asarray(anchor) + 1.05 * radius * grid.axis_rotations(16)[:, :, 2]
+    assert np.all(reach.compute_chunk(ur5, spec, far, 0)["reachability"] == 0)
+
+
+def test_a_reached_target_is_pinocchio_checked(ur5):
+    spec = reach.MapSpec(orientations=8, restarts=10)
+    centre = ur5.fk(ur5.random_q(3)).translation[None]
+    H = reach.targets_of(centre, grid.rotations(8))
+    res = kinelab.solve_batch(ur5, H, seed=spec.seed, max_restarts=spec.restarts)
+    for q, T, ok in zip(res.q, H, res.success, strict=True):
+        if ok:
+            dp, dr = ur5.tool_error(q, kinelab.target_from_xyz_quat_wxyz(T[:3, 3], _quat(T[:3, :3])))
+            assert dp <= 1e-6 and dr <= 1e-6 and ur5.within_limits(q)
+    assert reach.compute_chunk(ur5, spec, centre, 0)["reachability"][0] == res.success.mean()
+
+
+def _quat(R):
+    import pinocchio as pin
+
+    q = pin.Quaternion(R)
+    return [q.w, q.x, q.y, q.z]
+
+
+def test_an_interrupted_map_resumes_to_the_same_arrays_as_one_run(ur5, tmp_path):
+    pytest.importorskip("zarr")
+    spec = reach.MapSpec(voxel=0.25, orientations=4, chunk_voxels=50, restarts=5)
+    whole = maps.reachability(ur5, spec)
+    centres = grid.voxel_centres(ur5, spec.voxel)
+    partial = store.open_map(tmp_path / "m.zarr", ur5, spec, centres)
+    for c in range(2):  # the run stopped after two chunks
+        partial.write(c, reach.compute_chunk(ur5, spec, centres, c))
+    resumed = maps.reachability(ur5, spec, out=str(tmp_path / "m.zarr"))
+    assert all(resumed.done[:])
+    for name in ("reachability", "manipulability", "sigma_ratio"):
+        np.testing.assert_array_equal(resumed.array(name), whole.array(name))
+    np.testing.assert_array_equal(maps.load(tmp_path / "m.zarr").array("reachability"), whole.array("reachability"))
+
+
+def test_bad_maps_are_refused_with_the_reason(ur5, tmp_path, monkeypatch):
+    pytest.importorskip("zarr")
+    with pytest.raises(KinelabError, match="voxel side must be a positive"):
+        maps.reachability(ur5, voxel=0.0)
+    with pytest.raises(KinelabError, match="targets .* without force=True"):
+        maps.reachability(ur5, voxel=0.01, orientations=50)
+    with pytest.raises(KinelabError, match="task 'pose' or 'axis'"):
+        maps.reachability(ur5, task="position")
+    spec = reach.MapSpec(voxel=0.3, orientations=2, restarts=2)
+    maps.reachability(ur5, spec, out=str(tmp_path / "a.zarr"))
+    with pytest.raises(KinelabError, match="holds another map \\(robot"):
+        maps.reachability(kinelab.load("panda"), spec, out=str(tmp_path / "a.zarr"))
+    with pytest.raises(KinelabError, match="holds another map \\(spec"):
+        maps.reachability(ur5, reach.MapSpec(voxel=0.3, orientations=3, restarts=2), out=str(tmp_path / "a.zarr"))
+    monkeypatch.setattr(kinelab, "__version__", "0.0.0-other")
+    with pytest.raises(KinelabError, match="written by kinelab"):
+        maps.load(tmp_path / "a.zarr")
+    with pytest.raises(KinelabError, match="not a kinelab reachability map"):
+        maps.load(tmp_path / "nothing-here")
+
+
+def test_kinelab_map_reach_writes_a_map_and_a_second_run_resumes_it_unchanged(tmp_path, capsys):
+    pytest.importorskip("zarr")
+    import json
+
+    from kinelab import cli
+
+    argv = ["map", "reach", "ur5", "--voxel", "0.3", "--orientations", "3", "--restarts", "3",
+            "--out", str(tmp_path / "m.zarr"), "--json"]
+    assert cli.main(argv) == 0
+    first = json.loads(capsys.readouterr().out)
+    before = maps.load(tmp_path / "m.zarr").array("reachability")
+    assert cli.main(argv) == 0  # every chunk already done: nothing recomputed, the same map
+    again = json.loads(capsys.readouterr().out)
+    np.testing.assert_array_equal(maps.load(tmp_path / "m.zarr").array("reachability"), before)
+    assert again["mean_reachability"] == first["mean_reachability"] and first["voxels"] == len(before)
+    assert cli.main(["map", "reach", "ur5", "--voxel", "0"]) == 2
+    assert "positive length" in capsys.readouterr().err
