@@ -682,6 +682,8 @@ def _add_map(sub: Any) -> None:
     r.add_argument("--chunk", type=int, default=64, help="voxels per chunk (the unit of work and of storage)")
     r.add_argument("--out", help="a Zarr directory: written chunk by chunk, resumed if it holds this map unfinished")
     r.add_argument("--force", action="store_true", help="run a map of more than 2 million targets")
+    r.add_argument("--scheduler", metavar="ADDRESS", help="run the chunks on this Dask scheduler (kinelab[cluster])")
+    r.add_argument("--workers", type=int, help="run the chunks on a local Dask cluster of this many processes")
     r.add_argument("--json", action="store_true", help="print the summary as JSON")
     r.set_defaults(func=cmd_map_reach)
 
@@ -694,8 +696,21 @@ def cmd_map_reach(args) -> int:
     robot = load(args.robot)
     spec = maps.MapSpec(voxel=args.voxel, orientations=args.orientations, task=args.task, restarts=args.restarts,
                         seed=args.seed, chunk_voxels=args.chunk)
+    if args.scheduler and args.workers:
+        raise KinelabError("give --scheduler ADDRESS or --workers N, not both")
+    if args.workers is not None and args.workers < 1:
+        raise KinelabError(f"--workers must be at least 1, got {args.workers}")
+    client = None
+    if args.scheduler or args.workers:
+        from kinelab.maps import cluster
+
+        client = cluster.client_for(args.scheduler, args.workers)
     t0 = time.perf_counter()
-    result = maps.reachability(robot, spec, out=args.out, force=args.force, progress=not args.json)
+    try:
+        result = maps.reachability(robot, spec, out=args.out, force=args.force, progress=not args.json, client=client)
+    finally:
+        if client is not None:
+            client.close()
     reach = result.array("reachability")
     summary = {"robot": robot.name, "voxels": int(len(reach)), "targets": int(len(reach) * spec.orientations),
                "reached_voxels": int((reach > 0).sum()), "mean_reachability": float(np.nanmean(reach)),

@@ -92,7 +92,7 @@ def compute_chunk(robot: Robot, spec: MapSpec, centres: np.ndarray, index: int) 
 
 
 def reachability(robot: Robot, spec: MapSpec | None = None, out: str | None = None, force: bool = False,
-                 progress: bool = False, **fields) -> Any:
+                 progress: bool = False, client: Any = None, **fields) -> Any:
     """The reachability map of ``robot``, computed in this process chunk by chunk (written to ``out`` as they
     finish when given: an interrupted run resumes from the chunks already there).
 
@@ -102,6 +102,8 @@ def reachability(robot: Robot, spec: MapSpec | None = None, out: str | None = No
         out: a Zarr directory to write (None: in memory only).
         force: run a map of more than MAX_TARGETS targets.
         progress: show a progress bar over the chunks.
+        client: a ``dask.distributed.Client``: the chunks run on its cluster (:mod:`kinelab.maps.cluster`);
+            None: in this process, on all cores.
 
     Returns:
         The :class:`~kinelab.maps.store.ReachabilityMap`.
@@ -123,6 +125,11 @@ def reachability(robot: Robot, spec: MapSpec | None = None, out: str | None = No
                            "orientations make it smaller")
     target = store.open_map(out, robot, spec, centres)
     todo = [c for c in range(target.chunks) if not target.done[c]]
+    if client is not None:
+        from kinelab.maps.cluster import run_chunks
+
+        run_chunks(client, robot, spec, centres, todo, target, progress)
+        return target
     for c in tqdm(todo, desc="map", disable=not progress, unit="chunk"):
         target.write(c, compute_chunk(robot, spec, centres, c))
     return target
