@@ -6,7 +6,8 @@ import pytest
 
 import kinelab
 from kinelab import KinelabError, maps
-from kinelab.maps import grid, reach, store
+from kinelab.maps import chunk as reach
+from kinelab.maps import grid, store
 
 
 @pytest.fixture(scope="module")

@@ -2,11 +2,13 @@
 
 - :mod:`~kinelab.maps.grid`: the voxel grid and the orientations spread over SO(3) (or over the sphere of
   tool axes).
-- :mod:`~kinelab.maps.reach`: one chunk of the map, a pure function of (robot, spec, chunk index).
+- :mod:`~kinelab.maps.chunk`: one chunk of the map, a pure function of (robot, spec, chunk index).
+- :mod:`~kinelab.maps.reach`: the whole map, in this process or on Dask (:mod:`~kinelab.maps.cluster`).
 - :mod:`~kinelab.maps.store`: the map on disk (Zarr), its metadata, and resuming an interrupted run.
 """
 
-from kinelab.maps.reach import MapSpec, reachability
+from kinelab.maps.chunk import MapSpec
+from kinelab.maps.reach import reachability
 from kinelab.maps.store import ReachabilityMap, load
 
 __all__ = ["MapSpec", "ReachabilityMap", "load", "reachability"]

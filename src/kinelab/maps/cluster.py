@@ -51,7 +51,7 @@ def chunk_task(how: dict, spec: Any, centres: np.ndarray, index: int) -> tuple[i
     """One chunk on a worker: (index, values). One numba thread per task: the cluster gives the parallelism."""
     import numba
 
-    from kinelab.maps.reach import compute_chunk
+    from kinelab.maps.chunk import compute_chunk
 
     numba.set_num_threads(1)
     return index, compute_chunk(_worker_robot(how), spec, centres, index)
