@@ -686,6 +686,63 @@ def _add_map(sub: Any) -> None:
     r.add_argument("--workers", type=int, help="run the chunks on a local Dask cluster of this many processes")
     r.add_argument("--json", action="store_true", help="print the summary as JSON")
     r.set_defaults(func=cmd_map_reach)
+    b = kinds.add_parser("base", help="platform positions (and headings) from which a mobile manipulator reaches "
+                                      "a grasp")
+    b.add_argument("robot", help="a mobile manipulator with joints platform_x, platform_y, platform_yaw (youbot)")
+    b.add_argument("--grasp", nargs=6, type=float, required=True, metavar=("X", "Y", "Z", "R", "P", "YAW"),
+                   help="the grasp pose: position [m] and roll, pitch, yaw [rad] in the world frame")
+    b.add_argument("--step", type=float, default=0.05, help="x-y grid spacing [m]")
+    b.add_argument("--top", type=int, default=5, help="how many of the best poses to print")
+    b.add_argument("--seed", type=int, default=0, help="seed of the random starts or samples (an integer ≥ 0)")
+    b.add_argument("--json", action="store_true", help="print the reachable poses as JSON")
+    b.set_defaults(func=cmd_map_base)
+    g = kinds.add_parser("singular", help="σ_min/σ_max over joint-space samples (the engine of singular --sweep)")
+    g.add_argument("robot", help="a registered name or a model file (see kinelab robots)")
+    g.add_argument("--samples", type=int, default=5000, help="configurations to sample")
+    g.add_argument("--grid", action="store_true", help="a stratified grid instead of uniform samples")
+    g.add_argument("--seed", type=int, default=0, help="seed of the random starts or samples (an integer ≥ 0)")
+    g.add_argument("--json", action="store_true", help="print the summary as JSON")
+    g.set_defaults(func=cmd_map_singular)
+
+
+def cmd_map_base(args) -> int:
+    from kinelab import maps
+    from kinelab.ik import target_from_xyz_rpy
+
+    robot = load(args.robot)
+    grasp = target_from_xyz_rpy(args.grasp[:3], args.grasp[3:])
+    result = maps.base_map(robot, grasp, step=args.step, seed=args.seed)
+    best = result.ranked(args.top)
+    rows = [{"x": float(result.poses[i, 0]), "y": float(result.poses[i, 1]), "yaw": float(result.poses[i, 2]),
+             "manipulability": float(result.manipulability[i]), "arm_q": result.q[i].tolist()} for i in best]
+    if args.json:
+        _print_json({"robot": robot.name, "candidates": len(result.poses), "reachable": int(result.reachable.sum()),
+                     "best": rows})
+        return 0
+    print(f"{robot.name}: the grasp is reached from {int(result.reachable.sum())} of "
+          f"{_plural(len(result.poses), 'platform position')} ({args.step:g} m grid); the best:")
+    for r in rows:
+        print(f"  x {r['x']:+.3f} m  y {r['y']:+.3f} m  yaw {r['yaw']:+.4f} rad  "
+              f"manipulability {r['manipulability']:.3g}")
+    return 0
+
+
+def cmd_map_singular(args) -> int:
+    from kinelab import maps
+
+    robot = load(args.robot)
+    result = maps.singularity(robot, samples=args.samples, seed=args.seed, method="grid" if args.grid else "random",
+                              progress=not args.json)
+    ratio = result.sigma_ratio
+    summary = {"robot": robot.name, "samples": int(len(ratio)), "rank_deficient": int(result.rank_deficient.sum()),
+               "near_singular": int((ratio < 0.01).sum()), "median_sigma_ratio": float(np.median(ratio))}
+    if args.json:
+        _print_json(summary)
+    else:
+        print(f"{robot.name}: {_plural(len(ratio), 'sample')}; {summary['near_singular']} near-singular "
+              f"(σ_min/σ_max < 0.01), {summary['rank_deficient']} rank-deficient; median σ_min/σ_max "
+              f"{summary['median_sigma_ratio']:.3g}")
+    return 0
 
 
 def cmd_map_reach(args) -> int:

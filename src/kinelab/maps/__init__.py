@@ -4,11 +4,16 @@
   tool axes).
 - :mod:`~kinelab.maps.chunk`: one chunk of the map, a pure function of (robot, spec, chunk index).
 - :mod:`~kinelab.maps.reach`: the whole map, in this process or on Dask (:mod:`~kinelab.maps.cluster`).
+- :mod:`~kinelab.maps.base`: inverse reachability of a mobile base; :mod:`~kinelab.maps.singular`: σ over
+  joint space.
 - :mod:`~kinelab.maps.store`: the map on disk (Zarr), its metadata, and resuming an interrupted run.
 """
 
+from kinelab.maps.base import BaseMap, base_map
 from kinelab.maps.chunk import MapSpec
 from kinelab.maps.reach import reachability
+from kinelab.maps.singular import SingularityMap, singularity
 from kinelab.maps.store import ReachabilityMap, load
 
-__all__ = ["MapSpec", "ReachabilityMap", "load", "reachability"]
+__all__ = ["BaseMap", "MapSpec", "ReachabilityMap", "SingularityMap", "base_map", "load", "reachability",
+           "singularity"]

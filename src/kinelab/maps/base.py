@@ -1,0 +1,84 @@
+"""Inverse reachability of a mobile manipulator: from which platform positions (x, y) does the robot reach
+a grasp, and with which heading? For each position of an x–y grid around the grasp, the robot with its
+platform's x and y held there (the heading and the arm free: six coordinates on the youBot, against the
+six components of the grasp) is asked for the grasp, every answer checked by Pinocchio; the reachable
+positions are ranked by the arm's manipulability there. (A grid over the heading as well would ask a
+5-joint arm for a full pose from a fixed platform, which it meets only by chance.)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab.errors import KinelabError
+from kinelab.ik.batch import solve_batch
+from kinelab.ik.targets import as_target
+from kinelab.ik.workspace import reach_bound
+from kinelab.robot import Robot, load
+
+PLATFORM = ("platform_x", "platform_y", "platform_yaw")
+
+
+@dataclass(frozen=True)
+class BaseMap:
+    """Candidate platform poses and what the arm can do from each.
+
+    Attributes:
+        poses: (P, 3) platform x [m], y [m], yaw [rad] in the world frame.
+        reachable: (P,) the arm reaches the grasp from there (Pinocchio-checked, within the limits).
+        manipulability: (P,) Yoshikawa measure of the arm's Jacobian (linear rows / L) at the answer; 0 where
+            not reachable.
+        q: (P, n_arm) the arm's answer [rad] (NaN where not reachable).
+    """
+
+    poses: np.ndarray
+    reachable: np.ndarray
+    manipulability: np.ndarray
+    q: np.ndarray
+
+    def ranked(self, count: int = 10) -> np.ndarray:
+        """Indices of the best ``count`` reachable poses, highest manipulability first."""
+        order = np.argsort(-np.where(self.reachable, self.manipulability, -1.0))
+        return order[: min(count, int(self.reachable.sum()))]
+
+
+def base_map(robot: Robot, grasp: pin.SE3, step: float = 0.05, restarts: int = 10, seed: int = 0) -> BaseMap:
+    """The platform poses from which ``robot`` (a mobile manipulator whose first joints are the platform's x,
+    y and yaw) reaches ``grasp`` (oMgrasp, world frame).
+
+    Args:
+        robot: the whole robot (the youBot: its platform joints PLATFORM, then the arm).
+        grasp: the tool pose to reach [m, world frame].
+        step: spacing of the x–y grid [m], over the disc the arm can reach the grasp from.
+        restarts: random restarts per candidate position.
+        seed: base seed.
+
+    Raises:
+        KinelabError: a robot without the platform joints, or a bad step.
+    """
+    missing = [j for j in PLATFORM if j not in robot.joint_names]
+    if missing:
+        raise KinelabError(f"{robot.name} has no platform joint {missing[0]!r}: a base map needs joints "
+                           f"{', '.join(PLATFORM)}")
+    if not (isinstance(step, int | float) and np.isfinite(step) and step > 0):
+        raise KinelabError(f"a base map needs a grid step > 0 [m], got {step!r}")
+    grasp = as_target(grasp)
+    turning = load(str(robot.source), tool=robot.tool, base=robot.base, locked={j: 0.0 for j in PLATFORM[:2]})
+    anchor, radius = reach_bound(turning)
+    reach_xy = radius + float(np.hypot(anchor[0], anchor[1]))
+    ticks = np.arange(-np.ceil(reach_xy / step), np.ceil(reach_xy / step) + 1) * step
+    xy = np.array([(grasp.translation[0] + a, grasp.translation[1] + b) for a in ticks for b in ticks
+                   if np.hypot(a, b) <= reach_xy])
+    targets = np.array([(pin.SE3(np.eye(3), np.array([-x, -y, 0.0])) * grasp).homogeneous for x, y in xy])
+    res = solve_batch(turning, targets, seed=seed, max_restarts=restarts)
+    manip = np.zeros(len(xy))
+    if res.success.any():
+        J = turning.jacobian_batch(res.q[res.success], frame="local_world_aligned")[:, :, 1:]  # the arm's columns
+        J[:, :3] /= turning.characteristic_length()
+        manip[res.success] = np.prod(np.linalg.svd(J, compute_uv=False)[:, : min(6, turning.n - 1)], axis=1)
+    yaw = np.where(res.success, res.q[:, 0], np.nan)
+    q = np.where(res.success[:, None], res.q[:, 1:], np.nan)
+    return BaseMap(np.column_stack([xy, yaw]), res.success.copy(), manip, q)
