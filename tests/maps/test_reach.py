@@ -113,3 +113,20 @@ def test_kinelab_map_reach_writes_a_map_and_a_second_run_resumes_it_unchanged(tm
     assert again["mean_reachability"] == first["mean_reachability"] and first["voxels"] == len(before)
     assert cli.main(["map", "reach", "ur5", "--voxel", "0"]) == 2
     assert "positive length" in capsys.readouterr().err
+
+
+def test_the_map_views_draw_the_reached_voxels(ur5):
+    import browser
+
+    from kinelab.view import maps as view_maps
+
+    rmap = maps.reachability(ur5, reach.MapSpec(voxel=0.3, orientations=3, restarts=3))
+    scene = view_maps.reachability_cloud(ur5, rmap)
+    html = scene.static_html()
+    scene.close()
+    assert "/meshcat/reachability" in browser.scene_paths(html)
+    assert "reached voxels of 0.3 m" in html
+    ax = view_maps.reachability_slice(rmap)
+    layer = ax.collections[0].get_offsets()
+    assert len(layer) > 10 and ax.get_title().startswith("reachability index at z = ")
+    np.testing.assert_array_equal(view_maps.colours(np.array([0.0, 1.0]))[:, 0], [1.0, 0.0, 0.0])

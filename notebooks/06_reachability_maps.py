@@ -1,0 +1,90 @@
+# ---
+# jupyter:
+#   jupytext:
+#     formats: ipynb,py:percent
+#   kernelspec:
+#     display_name: Python 3
+#     language: python
+#     name: python3
+# ---
+
+# %% [markdown]
+# # 06 · Reachability maps
+#
+# Where can the arm put its tool, in how many orientations, and how well-conditioned is it there? And for a
+# mobile manipulator: where must the platform stand to reach a grasp? `kinelab.maps` answers both, every
+# reached target checked by Pinocchio. The maps are computed chunk by chunk (each chunk a pure function of
+# the robot, the spec and its index), so the same map comes out of one process, a resumed run or a Dask
+# cluster (`kinelab map reach ur5 --workers 2`, extra `kinelab[cluster]`).
+#
+# Units: metres and radians; every position is in the robot's base frame.
+
+# %%
+import matplotlib.pyplot as plt
+import numpy as np
+
+import kinelab
+from kinelab import maps
+from kinelab.view import maps as view_maps
+
+ur5 = kinelab.load("ur5")
+spec = maps.MapSpec(voxel=0.1, orientations=8, restarts=5)
+ur5_map = maps.reachability(ur5, spec)
+reach = ur5_map.array("reachability")
+print(f"{len(reach)} voxels of {spec.voxel} m inside the reach bound, {spec.orientations} orientations each; "
+      f"{(reach > 0).sum()} reached, {(reach == 1).sum()} in every orientation")
+
+# %% [markdown]
+# ## The map in 3-D
+#
+# Each reached voxel is a point coloured by its reachability index (the share of its eight orientations,
+# spread evenly over SO(3), that the arm reaches): green inside, yellow and red towards the edge of the
+# workspace, where only a few tool orientations remain.
+
+# %%
+cloud = view_maps.reachability_cloud(ur5, ur5_map, meshes=False)  # a stick figure: the page stays small
+cloud.notebook_html()
+
+# %% [markdown]
+# ## A slice through the base
+#
+# The horizontal layer of voxels through the middle of the map.
+
+# %%
+ax = view_maps.reachability_slice(ur5_map)
+plt.tight_layout()
+
+# %% [markdown]
+# ## Where should the youBot stand?
+#
+# A grasp in front of the youBot's platform. The platform's x and y are gridded around the grasp; at each
+# position the heading and the five arm joints are solved (six coordinates for the grasp's six components),
+# and the reachable positions are ranked by the arm's manipulability.
+
+# %%
+youbot = kinelab.load("youbot")
+grasp = youbot.fk(youbot.display_q())
+base = maps.base_map(youbot, grasp, step=0.05)
+print(f"reachable from {base.reachable.sum()} of {len(base.poses)} platform positions")
+for i in base.ranked(3):
+    x, y, yaw = base.poses[i]
+    print(f"  x {x:+.3f} m, y {y:+.3f} m, heading {np.rad2deg(yaw):+7.1f}°, manipulability "
+          f"{base.manipulability[i]:.3g}")
+
+ok = base.reachable
+plt.figure(figsize=(5.5, 4.5))
+plt.scatter(base.poses[~ok, 0], base.poses[~ok, 1], s=6, c="lightgrey", label="not reachable")
+art = plt.scatter(base.poses[ok, 0], base.poses[ok, 1], s=25, c=base.manipulability[ok], cmap="viridis",
+                  label="reachable")
+plt.quiver(base.poses[ok, 0], base.poses[ok, 1], np.cos(base.poses[ok, 2]), np.sin(base.poses[ok, 2]),
+           scale=25, width=0.004, color="k")
+plt.plot(*grasp.translation[:2], "r*", ms=14, label="grasp")
+plt.colorbar(art, label="manipulability"); plt.gca().set_aspect("equal")
+plt.xlabel("platform x [m]"); plt.ylabel("platform y [m]"); plt.legend(fontsize=8, loc="lower left")
+
+# %% [markdown]
+# Every reachable position was checked with the whole robot: Pinocchio's FK of (x, y, heading, arm q) meets
+# the grasp to 1e-6 m and 1e-6 rad within the limits (the tests hold this for each one).
+
+# %%
+cloud.close()

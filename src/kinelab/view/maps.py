@@ -1,0 +1,67 @@
+"""Maps drawn: a reachability map as a meshcat point cloud over the robot, and as a matplotlib slice."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from kinelab.robot import Robot
+from kinelab.view.scene import Scene, _stick_figure
+
+
+def colours(values: np.ndarray) -> np.ndarray:
+    """(3, N) RGB in [0, 1] for values in [0, 1]: red at 0, yellow at 0.5, green at 1."""
+    v = np.clip(np.nan_to_num(values), 0.0, 1.0)
+    return np.vstack([np.clip(2 * (1 - v), 0, 1), np.clip(2 * v, 0, 1), np.zeros_like(v)])
+
+
+def reachability_cloud(robot: Robot, rmap: Any, q: Any = None, viewer: Any = None, meshes: bool = True) -> Scene:
+    """The robot at q (default: its display pose) with the map's reached voxels as points coloured by their
+    reachability index; the caption says what the colours mean.
+
+    Args:
+        robot: the map's robot.
+        rmap: a :class:`~kinelab.maps.store.ReachabilityMap`.
+        q: the robot's configuration [rad or m].
+        viewer: a meshcat viewer to draw in (default: a new one on 127.0.0.1).
+        meshes: draw the robot's meshes (False: a stick figure, which keeps a saved page small).
+    """
+    import meshcat.geometry as g
+
+    q = robot.display_q() if q is None else q
+    scene = Scene(robot, viewer=viewer).show(q)
+    if not meshes:
+        scene.viewer[scene.root].delete()
+        points_q = [m.translation for m in robot.joint_placements(q).values()] + [robot.fk(q).translation]
+        _stick_figure(scene.viewer["robot"], points_q, scene.frame_length)
+    reach = rmap.array("reachability")
+    keep = reach > 0
+    points = rmap.array("centres")[keep].T
+    voxel = rmap.meta["spec"]["voxel"]
+    scene.viewer["reachability"].set_object(g.PointCloud(points, colours(reach[keep]), size=0.25 * voxel))
+    scene._aim(np.vstack([points.T, scene._points(q)]))
+    scene.legend["map"] = (f"points: the {int(keep.sum())} reached voxels of {voxel:g} m, red = 1 of "
+                           f"{rmap.meta['spec']['orientations']} orientations reached, green = all")
+    return scene
+
+
+def reachability_slice(rmap: Any, axis: int = 2, value: float | None = None, ax: Any = None) -> Any:
+    """The reachability index on the voxel layer nearest ``value`` [m] along base axis ``axis`` (default: the
+    layer through the map's centre), as a matplotlib image; returns the axes."""
+    import matplotlib.pyplot as plt
+
+    centres, reach = rmap.array("centres"), rmap.array("reachability")
+    levels = np.unique(np.round(centres[:, axis], 9))
+    level = levels[np.argmin(np.abs(levels - (np.median(levels) if value is None else value)))]
+    layer = np.isclose(centres[:, axis], level)
+    u, v = [k for k in range(3) if k != axis]
+    ax = ax or plt.figure(figsize=(5, 4.2)).subplots()
+    art = ax.scatter(centres[layer, u], centres[layer, v], c=reach[layer], cmap="RdYlGn", vmin=0, vmax=1,
+                     marker="s", s=18)
+    ax.set_aspect("equal")
+    ax.set_xlabel(f"{'xyz'[u]} [m]")
+    ax.set_ylabel(f"{'xyz'[v]} [m]")
+    ax.set_title(f"reachability index at {'xyz'[axis]} = {level:.3g} m")
+    ax.figure.colorbar(art, ax=ax, label="share of orientations reached")
+    return ax
