@@ -130,3 +130,37 @@ def test_the_map_views_draw_the_reached_voxels(ur5):
     layer = ax.collections[0].get_offsets()
     assert len(layer) > 10 and ax.get_title().startswith("reachability index at z = ")
     np.testing.assert_array_equal(view_maps.colours(np.array([0.0, 1.0]))[:, 0], [1.0, 0.0, 0.0])
+
+
+def test_an_interrupted_cli_run_resumes_to_the_identical_map(ur5, tmp_path):
+    """kinelab map reach stopped by Ctrl-C after a few chunks, then run again: the same map as one run."""
+    pytest.importorskip("zarr")
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "m.zarr"
+    argv = [sys.executable, "-m", "kinelab.cli", "map", "reach", "ur5", "--voxel", "0.15", "--orientations", "4",
+            "--restarts", "3", "--chunk", "16", "--out", str(out), "--json"]
+    env = {**os.environ, "PYTHONWARNINGS": "ignore"}
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    deadline = time.time() + 120
+    done = 0
+    while time.time() < deadline and proc.poll() is None:
+        time.sleep(0.2)
+        try:
+            done = int(np.sum(maps.load(out).done[:]))
+        except KinelabError:
+            continue  # not created yet
+        if done >= 3:
+            proc.send_signal(signal.SIGINT)
+            break
+    proc.communicate(timeout=60)
+    interrupted = maps.load(out)
+    assert proc.returncode == 130 and 3 <= int(np.sum(interrupted.done[:])) < interrupted.chunks
+    assert subprocess.run(argv, capture_output=True, text=True, env=env, timeout=600).returncode == 0
+    whole = maps.reachability(ur5, reach.MapSpec(voxel=0.15, orientations=4, restarts=3, chunk_voxels=16))
+    for name in ("reachability", "manipulability", "sigma_ratio"):
+        np.testing.assert_array_equal(maps.load(out).array(name), whole.array(name))

@@ -34,7 +34,7 @@ def metadata(robot: Robot, spec: Any, voxels: int) -> dict:
     from kinelab import __version__
 
     return {"robot": robot.name, "source_sha256": hashlib.sha256(Path(robot.urdf_path).read_bytes()).hexdigest(),
-            "spec": spec.to_dict(), "voxels": int(voxels), "kinelab": __version__,
+            "spec": spec.to_dict(), "solver": "frdm", "voxels": int(voxels), "kinelab": __version__,
             "base": robot.base, "tool": robot.tool}
 
 
