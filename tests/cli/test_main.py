@@ -179,7 +179,7 @@ def test_singular_on_an_arm_with_fewer_than_six_joints(capsys):
     (["singular", "ur5", "--sweep", "0"], "at least one sample"),
     (["ik", "ur5", "--target-xyz", "0.3", "0.2", "0.4", "--seed", "-1"], "seed"),
     (["bench", "--out", "/proc/kinelab-bench", "--n", "1"], "not a writable folder"),
-    (["fk", "rd:ur5_descripton", "0", "0", "0", "0", "0", "0"], "close names: rd:ur5_description"),
+    (["fk", "rd:finger_edu_descripton", "0", "0", "0"], "close names: rd:finger_edu_description"),
 ])
 def test_bad_values_end_in_one_line_and_exit_2_before_any_work(argv, needle):
     proc = subprocess.run([sys.executable, "-m", "kinelab.cli", *argv], capture_output=True, text=True,
@@ -310,7 +310,7 @@ def test_an_answer_outside_the_limits_is_never_presented_without_saying_so(capsy
     assert not kinelab.load("so101").within_limits(np.array(res["q"]))  # the biquaternion law's answer, seed 0
     assert res["status"] == "outside_limits" and not res["success"] and code == 1
     assert res["position_error_m"] <= 1e-6 and res["rotation_error_rad"] <= 1e-5  # the pose itself is met
-    assert "joint 'wrist_flex' is at" in res["message"] and "outside its limits" in res["message"]
+    assert "joint 'wrist_flex' at" in res["message"] and "outside its limits" in res["message"]
 
 
 def test_view_draws_any_finite_q_with_a_note_for_joints_outside_their_limits(capsys, tmp_path):

@@ -12,23 +12,27 @@ from kinelab import DescriptionError
 from kinelab.robot import catalog
 
 
+# a description of example-robot-data in robot_descriptions 2.x and 3.x alike
+NAME = "finger_edu_description"
+
+
 def test_an_unknown_description_is_named_with_close_names():
-    with pytest.raises(DescriptionError, match="rd:ur5_description"):
-        kinelab.load("rd:ur5_descripton")
+    with pytest.raises(DescriptionError, match=f"rd:{NAME}"):
+        kinelab.load("rd:finger_edu_descripton")
 
 
 def test_a_description_missing_from_the_cache_says_it_needs_the_network(tmp_path, monkeypatch):
     monkeypatch.setenv("ROBOT_DESCRIPTIONS_CACHE", str(tmp_path / "cache"))
     with pytest.raises(DescriptionError, match="not in robot_descriptions' cache .*needs the network"):
-        kinelab.load("rd:ur5_description")
+        kinelab.load(f"rd:{NAME}")
     assert not (tmp_path / "cache").exists()  # nothing was cloned or created
 
 
 def _fake_cache(tmp_path, monkeypatch):
-    """robot_descriptions' cache holding an example-robot-data clone with only the UR description, at a
+    """robot_descriptions' cache holding an example-robot-data clone with only the finger's description, at a
     commit named by ROBOT_DESCRIPTION_COMMIT (so robot_descriptions checks it out without fetching)."""
     work = tmp_path / "work" / "example-robot-data"
-    shutil.copytree(catalog.erd_robots_dir() / "ur_description", work / "robots" / "ur_description")
+    shutil.copytree(catalog.erd_robots_dir() / NAME, work / "robots" / NAME)
     git = ["git", "-c", "user.name=t", "-c", "user.email=t@t", "-c", "commit.gpgsign=false"]
     subprocess.run([*git, "init", "-q"], cwd=work, check=True)
     subprocess.run([*git, "add", "."], cwd=work, check=True)
@@ -39,7 +43,7 @@ def _fake_cache(tmp_path, monkeypatch):
     shutil.move(str(work), str(cache / f"example-robot-data-{sha}" / "example-robot-data"))
     monkeypatch.setenv("ROBOT_DESCRIPTIONS_CACHE", str(cache))
     monkeypatch.setenv("ROBOT_DESCRIPTION_COMMIT", sha)
-    for name in [m for m in sys.modules if m.startswith("robot_descriptions.ur5")]:
+    for name in [m for m in sys.modules if m.startswith(f"robot_descriptions.{NAME}")]:
         monkeypatch.delitem(sys.modules, name)  # its paths are computed at import
     return cache
 
@@ -47,8 +51,8 @@ def _fake_cache(tmp_path, monkeypatch):
 @pytest.mark.skipif(shutil.which("git") is None, reason="robot_descriptions' cache is a git clone")
 def test_a_cached_description_loads_and_its_meshes_resolve_from_the_cache(tmp_path, monkeypatch):
     cache = _fake_cache(tmp_path, monkeypatch)
-    robot = kinelab.load("rd:ur5_description", tool="tool0")
-    reference = kinelab.load("ur5")
+    robot = kinelab.load(f"rd:{NAME}", tool="finger_tip_link")
+    reference = kinelab.load("finger_edu")
     rng = np.random.default_rng(0)
     for _ in range(20):
         q = reference.random_q(rng)

@@ -321,12 +321,12 @@ def _outside_limits(pb: _Problem, q: np.ndarray, dp: float, dr: float, status: S
         return status, message
     i = outside[0]
     unit = "m" if robot.joint_kinds[i] == "prismatic" else "rad"
-    where = (f"joint {robot.joint_names[i]!r} is at {q[i]:.6g} {unit}, outside its limits "
+    where = (f"joint {robot.joint_names[i]!r} at {q[i]:.6g} {unit}, outside its limits "
              f"[{robot.lower[i]:.6g}, {robot.upper[i]:.6g}]"
              + (f" (and {len(outside) - 1} more)" if len(outside) > 1 else ""))
     met = (not pb.task.position or dp <= pb.tol_pos) and (not pb.task.rotation or dr <= pb.tol_rot)
-    if met:
-        return Status.OUTSIDE_LIMITS, f"the {pb.task.constrained} are met, but {where}"
+    if met and status is not Status.UNREACHABLE:  # proved out of reach within the limits: that says more
+        return Status.OUTSIDE_LIMITS, f"the {pb.task.constrained} are met, but only with {where}"
     return status, f"{message}; the best answer has {where}" if message else f"the best answer has {where}"
 
 
