@@ -11,7 +11,6 @@ import kinelab
 from kinelab import DescriptionError
 from kinelab.robot import catalog
 
-
 # a description of example-robot-data in robot_descriptions 2.x and 3.x alike
 NAME = "finger_edu_description"
 
