@@ -66,6 +66,17 @@ def scaled_jacobian(robot: Robot, q, length: float | None = None) -> np.ndarray:
     return J
 
 
+def conditioning_batch(J: np.ndarray, length: float) -> tuple[np.ndarray, np.ndarray]:
+    """(manipulability, σ_min/σ_max) of a stack of (B, 6, n) LOCAL_WORLD_ALIGNED Jacobians once their linear
+    rows are divided by ``length`` [m] (a copy is scaled): the product of the min(6, n) largest singular values
+    (Yoshikawa's measure) and the ratio of the last of them to the first."""
+    scaled = J.copy()
+    scaled[:, :3] /= length
+    s = np.linalg.svd(scaled, compute_uv=False)
+    full = min(6, J.shape[2])
+    return np.prod(s[:, :full], axis=1), s[:, full - 1] / s[:, 0]
+
+
 def _rank(s: np.ndarray) -> int:
     return int(np.sum(s > RANK_RTOL * s[0])) if s.size and s[0] > 0 else 0
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from kinelab.analysis.singular import conditioning_batch
 from kinelab.errors import KinelabError
 from kinelab.ik.batch import solve_batch
 from kinelab.ik.targets import as_target
@@ -77,8 +78,7 @@ def base_map(robot: Robot, grasp: pin.SE3, step: float = 0.05, restarts: int = 1
     manip = np.zeros(len(xy))
     if res.success.any():
         J = turning.jacobian_batch(res.q[res.success], frame="local_world_aligned")[:, :, 1:]  # the arm's columns
-        J[:, :3] /= turning.characteristic_length()
-        manip[res.success] = np.prod(np.linalg.svd(J, compute_uv=False)[:, : min(6, turning.n - 1)], axis=1)
+        manip[res.success] = conditioning_batch(J, turning.characteristic_length())[0]
     yaw = np.where(res.success, res.q[:, 0], np.nan)
     q = np.where(res.success[:, None], res.q[:, 1:], np.nan)
     return BaseMap(np.column_stack([xy, yaw]), res.success.copy(), manip, q)

@@ -13,6 +13,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from kinelab.analysis.singular import conditioning_batch
 from kinelab.errors import KinelabError
 from kinelab.ik.batch import solve_batch
 from kinelab.maps import grid
@@ -81,11 +82,7 @@ def compute_chunk(robot: Robot, spec: MapSpec, centres: np.ndarray, index: int) 
     ratio = np.ones(len(chunk) * spec.orientations)
     if res.success.any():
         J = robot.jacobian_batch(res.q[res.success], frame="local_world_aligned")
-        J[:, :3] /= robot.characteristic_length()
-        s = np.linalg.svd(J, compute_uv=False)
-        full = min(6, robot.n)
-        manip[res.success] = np.prod(s[:, :full], axis=1)
-        ratio[res.success] = s[:, full - 1] / s[:, 0]
+        manip[res.success], ratio[res.success] = conditioning_batch(J, robot.characteristic_length())
     return {"reachability": ok.mean(axis=1), "manipulability": manip.reshape(ok.shape).max(axis=1),
             "sigma_ratio": ratio.reshape(ok.shape).min(axis=1)}
 

@@ -8,7 +8,6 @@ chunks in flight and an interrupted run resumes like an in-process one.
 
 from __future__ import annotations
 
-import hashlib
 import os
 from pathlib import Path
 from typing import Any
@@ -16,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from kinelab.errors import KinelabError
+from kinelab.maps.store import model_sha256
 from kinelab.robot import Robot
 
 INSTALL_HINT = "pip install 'kinelab[cluster]' (dask.distributed)"
@@ -30,7 +30,7 @@ def recipe(robot: Robot) -> dict:
 
     source = robot.name if robot.name in catalog.names() else str(Path(robot.source).resolve())
     return {"source": source, "tool": robot.tool, "base": robot.base,
-            "sha256": hashlib.sha256(Path(robot.urdf_path).read_bytes()).hexdigest()}
+            "sha256": model_sha256(robot)}
 
 
 def _worker_robot(how: dict) -> Robot:
@@ -39,7 +39,7 @@ def _worker_robot(how: dict) -> Robot:
     key = (how["source"], how["tool"], how["base"], how["sha256"])
     if key not in _ROBOTS:
         robot = load(how["source"], tool=how["tool"], base=how["base"])
-        found = hashlib.sha256(Path(robot.urdf_path).read_bytes()).hexdigest()
+        found = model_sha256(robot)
         if found != how["sha256"]:
             raise KinelabError(f"worker {os.getpid()} has another {how['source']} (SHA-256 {found[:12]}…, the client's "
                                f"{how['sha256'][:12]}…)")

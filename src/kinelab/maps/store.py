@@ -29,11 +29,16 @@ def _zarr() -> Any:
     return zarr
 
 
+def model_sha256(robot: Robot) -> str:
+    """SHA-256 of the robot's model file (the map's, and every worker's, proof of the same robot)."""
+    return hashlib.sha256(Path(robot.urdf_path).read_bytes()).hexdigest()
+
+
 def metadata(robot: Robot, spec: Any, voxels: int) -> dict:
     """What identifies a map: the robot, its model file's hash, the spec and the kinelab version."""
     from kinelab import __version__
 
-    return {"robot": robot.name, "source_sha256": hashlib.sha256(Path(robot.urdf_path).read_bytes()).hexdigest(),
+    return {"robot": robot.name, "source_sha256": model_sha256(robot),
             "spec": spec.to_dict(), "solver": "frdm", "voxels": int(voxels), "kinelab": __version__,
             "base": robot.base, "tool": robot.tool}
 

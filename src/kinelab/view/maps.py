@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 
 from kinelab.robot import Robot
-from kinelab.view.scene import Scene, _stick_figure
+from kinelab.view.scene import Scene, _stick_figure, chain_points
 
 
 def colours(values: np.ndarray) -> np.ndarray:
@@ -33,8 +33,7 @@ def reachability_cloud(robot: Robot, rmap: Any, q: Any = None, viewer: Any = Non
     scene = Scene(robot, viewer=viewer).show(q)
     if not meshes:
         scene.viewer[scene.root].delete()
-        points_q = [m.translation for m in robot.joint_placements(q).values()] + [robot.fk(q).translation]
-        _stick_figure(scene.viewer["robot"], points_q, scene.frame_length)
+        _stick_figure(scene.viewer["robot"], chain_points(robot, q), scene.frame_length)
     reach = rmap.array("reachability")
     keep = reach > 0
     points = rmap.array("centres")[keep].T

@@ -65,7 +65,7 @@ class Scene:
 
     def _arm_reach(self) -> float:
         q = self.robot.neutral()
-        points = [m.translation for m in self.robot.joint_placements(q).values()] + [self.robot.fk(q).translation]
+        points = chain_points(self.robot, q)
         reach = sum(float(np.linalg.norm(b - a)) for a, b in zip(points, points[1:], strict=False))
         # an arm's slide adds its stroke; a mobile base's long rails (over 2 m) would only shrink the arm
         reach += sum(j.upper - j.lower for j in self.robot.joints if j.kind == "prismatic" and j.upper - j.lower < 2)
@@ -78,12 +78,10 @@ class Scene:
 
     def _points(self, q) -> np.ndarray:
         """Points the robot occupies at q: its joint origins, its tool point and its visuals' origins [m]."""
-        robot = self.robot
-        data, gdata = robot.model.createData(), pin.GeometryData(self.geom)
-        pin.forwardKinematics(robot.model, data, robot.to_pin_q(q))
-        pin.updateGeometryPlacements(robot.model, data, self.geom, gdata)
-        joints = [m.translation for m in robot.joint_placements(q).values()]
-        return np.array([*joints, robot.fk(q).translation, *(M.translation for M in gdata.oMg)])
+        chain = chain_points(self.robot, q)  # leaves the robot's own Data at q
+        gdata = pin.GeometryData(self.geom)
+        pin.updateGeometryPlacements(self.robot.model, self.robot.data, self.geom, gdata)
+        return np.array([*chain, *(M.translation for M in gdata.oMg)])
 
     def _aim(self, points: np.ndarray) -> Scene:
         """Frame ``points`` (base frame): meshcat turns its camera about the viewer's origin, so the scene
@@ -259,7 +257,7 @@ def side_by_side(robot: Robot, qs: list, spacing: float | None = None, viewer: A
     occupied = []
     for k, q in enumerate(checked):
         offset = pin.SE3(np.eye(3), np.array([(k // columns) * spacing, (k % columns) * spacing, 0.0]))
-        points = [m.translation for m in robot.joint_placements(q).values()] + [robot.fk(q).translation]
+        points = chain_points(robot, q)
         _stick_figure(scene.viewer["branches"][str(k)], [offset.act(p) for p in points], scene.frame_length)
         scene.frame(f"tool_{k}", offset * robot.fk(q))
         occupied += [offset.act(p) for p in points] + [offset.translation]
@@ -267,6 +265,11 @@ def side_by_side(robot: Robot, qs: list, spacing: float | None = None, viewer: A
     scene.legend = {"figures": "joints: blue spheres; links: grey cylinders; copies in rows along the base x axis",
                     "tool": "tool frames: x red, y green, z blue"}
     return scene._aim(np.array(occupied))
+
+
+def chain_points(robot: Robot, q: Any) -> list[np.ndarray]:
+    """The joint origins and the tool point at q [m, base frame], base first."""
+    return [m.translation for m in robot.joint_placements(q).values()] + [robot.fk(q).translation]
 
 
 def _stick_figure(node, points: list[np.ndarray], size: float) -> None:
