@@ -40,8 +40,9 @@ print("dual part: kinelab / paper =", np.round(N.dual_wxyz * np.sign(N.real_wxyz
 
 # %%
 run = s1.reproduce()              # law (9)/(16), K = 1, Euler, h = 0.01 s
-traj = run.info["trajectory"]
-print(run.status.value, "model time", round(run.info["model_time"], 2), "s; final M0 =", round(run.info["M0"], 6))
+traj = run.diagnostics.trajectory
+diag = run.diagnostics
+print(run.status.value, "model time", round(diag.model_time, 2), "s; final M0 =", round(diag.M0, 6))
 print("q at the end [deg, m]:", np.round(np.where([1, 1, 0, 1, 1, 1], np.rad2deg(run.q), run.q), 3))
 
 # %% [markdown]
@@ -57,7 +58,7 @@ print("q at the end [deg, m]:", np.round(np.where([1, 1, 0, 1, 1, 1], np.rad2deg
 
 # %%
 eps = 5e-7
-M0_start = traj["M"][0]
+M0_start = traj.M[0]
 rot0, mom0 = np.linalg.norm(M0_start[1:4]), np.linalg.norm(M0_start[5:8])
 t_rot, t_mom = s1.part_times(traj, eps)
 print(f"|m⃗(0)| = {rot0:.3f}, |m0⃗(0)| = {mom0:.3f} (kinelab's units), {mom0 / 10:.4f} (the paper's)")
@@ -77,8 +78,8 @@ print(f"a single part at 1e-6 from a unit error: ln(1e6) = {np.log(1e6):.1f} s; 
 # control.
 
 # %%
-t, q, M, U = traj["t"], traj["q"], traj["M"], traj["U"]
-M = M * np.sign(run.info["M0"]) * np.sign(M[-1, 0])  # the trajectory is stored with m0 ≥ 0
+t, q, M, U = traj.t, traj.q, traj.M, traj.U
+M = M * np.sign(run.diagnostics.M0) * np.sign(M[-1, 0])  # the trajectory is stored with m0 ≥ 0
 fig, axes = plt.subplots(1, 3, figsize=(14, 3.8))
 for i, name in enumerate(["q1", "q2", "q4", "q5", "q6"]):
     j = [0, 1, 3, 4, 5][i]
@@ -106,9 +107,9 @@ plt.tight_layout()
 # %%
 for k, k_v in [(1, None), (1, 2), (1, 4), (2, None)]:
     r = s1.reproduce(k=k, k_v=k_v)
-    t_rot, t_mom = s1.part_times(r.info["trajectory"])
+    t_rot, t_mom = s1.part_times(r.diagnostics.trajectory)
     print(f"k = {k}, k_v = {k_v or k}:  rotation part {t_rot:5.2f} s, moment part {t_mom:5.2f} s, "
-          f"done at {r.info['model_time']:5.2f} s")
+          f"done at {r.diagnostics.model_time:5.2f} s")
 
 # %% [markdown]
 # In kinelab's units the rotation part is the slower one here (|m⃗(0)| = 0.95 against |m0⃗(0)| = 0.14),
@@ -124,8 +125,9 @@ for k, k_v in [(1, None), (1, 2), (1, 4), (2, None)]:
 start = s1.near_pi_start(1e-4)
 for law in ["simple", "regular"]:
     r = s1.reproduce(start_q=start, law=law, integrator="rk4")
-    w = np.linalg.norm(r.info["trajectory"]["U"][:, :3], axis=1)
-    print(f"{law:8s} {r.status.value:10s} peak |ω| = {w.max():10.2f} rad/s   model time {r.info['model_time']:.2f} s")
+    w = np.linalg.norm(r.diagnostics.trajectory.U[:, :3], axis=1)
+    print(f"{law:8s} {r.status.value:10s} peak |ω| = {w.max():10.2f} rad/s   "
+          f"model time {r.diagnostics.model_time:.2f} s")
 
 # %% [markdown]
 # The simple law asks for a peak angular rate of about 4·10⁴ rad/s (2k·tan(φ/2)); the regular law never

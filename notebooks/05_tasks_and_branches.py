@@ -101,7 +101,7 @@ branches = kinelab.solve_all(ur5, oMgoal, seed=0, time_budget=0.05, q_ref=q_true
 print(f"{len(branches)} distinct solutions in 50 ms; each checked by Pinocchio:")
 for k, b in enumerate(branches):
     print(f"  {k}: q = {np.array2string(b.q, precision=3, suppress_small=True)}  "
-          f"errors {b.position_error:.0e} m, {b.rotation_error:.0e} rad, reached by {b.info['found']} starts")
+          f"errors {b.position_error:.0e} m, {b.rotation_error:.0e} rad, reached by {b.diagnostics.found} starts")
 
 # %% [markdown]
 # This target has 6 real solutions within the limits by the closed form (the tests' oracle), and all 6 are
@@ -114,7 +114,7 @@ plain = kinelab.solve(ur5, oMgoal, seed=1)
 preferred = kinelab.solve(ur5, oMgoal, seed=1, prefer=q_true, time_budget=0.05)
 print(f"plain solve: distance to q_ref {distance(ur5, plain.q, q_true):.3f} rad")
 print(f"prefer=q_ref: distance to q_ref {distance(ur5, preferred.q, q_true):.1e} rad "
-      f"(among {preferred.info['branches']} branches)")
+      f"(among {preferred.diagnostics.branches} branches)")
 
 # %% [markdown]
 # The branches side by side (stick figures: joints as blue spheres, tool frames as x red, y green,

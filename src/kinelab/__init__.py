@@ -23,12 +23,10 @@ from kinelab.errors import (
     TargetError,
     URDFError,
 )
-from kinelab.ik.batch import BatchIKResult, solve_batch
-from kinelab.ik.branches import solve_all
+from kinelab.ik.api import solve, solve_all, solve_batch, track
+from kinelab.ik.batch import BatchIKResult
 from kinelab.ik.frdm.options import FRDMOptions
-from kinelab.ik.frdm.tracking import TrackResult, track
-from kinelab.ik.preferred import solve
-from kinelab.ik.result import IKResult, Status
+from kinelab.ik.result import Diagnostics, IKResult, Status, TrackResult
 from kinelab.ik.targets import from_xyz_quat_wxyz as target_from_xyz_quat_wxyz
 from kinelab.ik.targets import from_xyz_rpy as target_from_xyz_rpy
 from kinelab.robot import Joint, Robot, load
@@ -45,6 +43,7 @@ __all__ = [
     "ChainError",
     "ConfigurationError",
     "DescriptionError",
+    "Diagnostics",
     "FRDMOptions",
     "FrameNotFoundError",
     "IKResult",

@@ -74,20 +74,20 @@ def test_the_papers_run_reaches_1e6_as_checked_by_pinocchio(paper_run):
 def test_model_time_is_the_closed_form_prediction(paper_run):
     """K = 1, Euler h = 0.01: |m⃗| shrinks by (1 − kh) per step from |m⃗(0)| to the threshold 5e-7
     (the continuous law would take ln(|m⃗(0)|/5e-7) = 14.46 s)."""
-    m_start = np.linalg.norm(paper_run.info["trajectory"]["M"][0][1:4])
+    m_start = np.linalg.norm(paper_run.diagnostics.trajectory.M[0][1:4])
     h = 0.01
     predicted = h * np.ceil(np.log(m_start / 5e-7) / -np.log(1 - h))
-    assert paper_run.info["model_time"] == pytest.approx(predicted, abs=1e-9)
-    assert 10 < paper_run.info["model_time"] < 20  # kinelab: 14.4 s; the paper reports about 40 s
+    assert paper_run.diagnostics.model_time == pytest.approx(predicted, abs=1e-9)
+    assert 10 < paper_run.diagnostics.model_time < 20  # kinelab: 14.4 s; the paper reports about 40 s
 
 
 def test_final_M0_is_minus_one_as_in_the_paper(paper_run):
-    assert paper_run.info["M0"] == pytest.approx(-1.0, abs=1e-9)
+    assert pytest.approx(-1.0, abs=1e-9) == paper_run.diagnostics.M0
 
 
 def test_separate_gains_speed_up_the_moment_part_by_their_ratio():
-    base = s1.part_times(s1.reproduce(k_v=None).info["trajectory"])
-    fast = s1.part_times(s1.reproduce(k_v=4.0).info["trajectory"])
+    base = s1.part_times(s1.reproduce(k_v=None).diagnostics.trajectory)
+    fast = s1.part_times(s1.reproduce(k_v=4.0).diagnostics.trajectory)
     assert fast[1] == pytest.approx(base[1] / 4, rel=0.1)
     assert fast[0] == pytest.approx(base[0], rel=0.01)  # the rotation part keeps its rate
 
@@ -96,7 +96,7 @@ def test_law_9_blows_up_near_pi_where_the_regular_law_converges():
     start = s1.near_pi_start(1e-4)
     simple = s1.reproduce(start_q=start, integrator="rk4")
     regular = s1.reproduce(start_q=start, law="regular", integrator="rk4")
-    peak = [np.abs(r.info["trajectory"]["U"][:, :3]).max() for r in (simple, regular)]
+    peak = [np.abs(r.diagnostics.trajectory.U[:, :3]).max() for r in (simple, regular)]
     assert peak[0] > 1e4  # 2k tan(φ/2) with φ = π − 1e-4
     assert peak[1] < 2.0 and regular.status.value == "converged"
     robot = kinelab.load("stanford")
@@ -124,7 +124,7 @@ def test_biquat_answers_are_confirmed_by_pinocchio(name):
 def test_redundant_chain_reports_its_damping():
     robot = kinelab.load("panda")
     res = solve(robot, robot.fk(robot.random_q(2)), solver="biquat", seed=0)
-    assert res.info["damping"] > 0
+    assert res.diagnostics.damping > 0
 
 
 def test_chain_product_target_is_used_for_the_sign():
@@ -186,7 +186,7 @@ def test_compiled_preset_takes_the_same_steps_as_the_python_integrator(name):
         problem = biquat_kernel.Problem(target.translation.copy(), target.rotation.copy(), 1.0, 1.0, 0.5, 30, 5e-7,
                                         5e-7, damping)
         code, steps, t = biquat_kernel.integrate(q, vm.chain, problem, 30)
-        assert steps == ref.iterations and t == pytest.approx(ref.info["model_time"], abs=1e-9)
+        assert steps == ref.iterations and t == pytest.approx(ref.diagnostics.model_time, abs=1e-9)
         if code == biquat_kernel.CONVERGED:
             assert ref.status.value == "converged"
             gap = q - ref.q  # the Python attempt wraps revolute joints by 2π into their limits
@@ -202,7 +202,7 @@ def test_compiled_multistart_is_seeded_and_checked():
         target = robot.fk(robot.random_q(rng))
         a = solve(robot, target, solver="biquat", seed=k)
         b = solve(robot, target, solver="biquat", seed=k)
-        assert a.info["path"] == "compiled" and a.success and robot.within_limits(a.q)
+        assert a.diagnostics.path == "compiled" and a.success and robot.within_limits(a.q)
         np.testing.assert_array_equal(a.q, b.q)
         assert robot.tool_error(a.q, target)[0] <= 1e-6
 

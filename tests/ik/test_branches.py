@@ -143,7 +143,7 @@ def test_solve_with_prefer_returns_the_branch_nearest_the_reference():
         nearest = min(analytic, key=lambda q: distance(robot, q, q_ref + 0.05))
         res = kinelab.solve(robot, target, seed=k, time_budget=0.05, prefer=q_ref + 0.05)
         assert res.success and robot.tool_error(res.q, target)[0] <= 1e-6
-        assert distance(robot, res.q, nearest) < 1e-2 and res.info["branches"] >= 2
+        assert distance(robot, res.q, nearest) < 1e-2 and res.diagnostics.branches >= 2
     beyond = kinelab.target_from_xyz_rpy([5.0, 0.0, 0.0], [0.0, 0.0, 0.0])
     res = kinelab.solve(robot, beyond, seed=0, time_budget=0.02, prefer=q_ref)
     assert not res.success and res.status is kinelab.Status.UNREACHABLE

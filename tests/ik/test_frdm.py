@@ -179,7 +179,7 @@ def test_accelerated_runs_are_monotone_too(robots):
     robot = robots["era"]
     target = robot.fk(robot.random_q(4))
     res = solve(robot, target, q0=robot.random_q(5), max_restarts=0, trace=True, time_budget=5.0)
-    trace = np.array(res.info["trace"])
+    trace = np.array(res.diagnostics.trace)
     assert len(trace) >= 2 and np.all(np.diff(trace) <= 1e-15 * trace[:-1] + 1e-300)
 
 
@@ -333,11 +333,11 @@ def test_compiled_multistart_is_seeded_and_checked_by_pinocchio(robots):
         target = robot.fk(robot.random_q(rng))
         a = solve(robot, target, seed=k, time_budget=1.0)
         b = solve(robot, target, seed=k, time_budget=1.0)
-        assert a.info["path"] == "compiled" and a.success
+        assert a.diagnostics.path == "compiled" and a.success
         np.testing.assert_array_equal(a.q, b.q)
         assert robot.tool_error(a.q, target)[0] <= 1e-6 and robot.within_limits(a.q)
     loop = solve(robot, target, seed=0, policy=("auto_kick",))
-    assert "path" not in loop.info and loop.success
+    assert loop.diagnostics.path is None and loop.success
 
 
 def test_mixed_order_restarts_turn_the_sweep_direction(robots):

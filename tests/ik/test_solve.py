@@ -82,7 +82,7 @@ def test_the_same_seed_gives_the_same_answer_in_another_process():
 
 @pytest.mark.parametrize("solver, options", [("frdm", kinelab.FRDMOptions()), ("dls", None), ("biquat", None)])
 def test_an_options_object_and_keyword_options_together_are_refused(ur5, solver, options):
-    from kinelab.ik.solve import solver_module
+    from kinelab.ik.registry import solver_module
 
     opts = options or solver_module(solver).Options()
     with pytest.raises(kinelab.OptionError, match="not both"):

@@ -25,7 +25,7 @@ def smooth_path(robot, seed, samples=2000, amplitude=0.6):
 def test_the_follower_reaches_every_sample_of_a_smooth_path(name, seed, options, step_factor):
     robot = load(name)
     Q, targets = smooth_path(robot, seed)
-    res = kinelab.track(robot, targets, Q[0], **options)
+    res = kinelab.track(robot, targets, q0=Q[0], **options)
     assert res.q.shape == (2000, robot.n)
     assert res.reached.all(), [(k, res.status[k]) for k in np.flatnonzero(~res.reached)[:5]]
     for k in range(0, 2000, 97):  # the verdict is Pinocchio's: check a spread of samples again here
@@ -40,7 +40,7 @@ def test_the_follower_reports_an_unreachable_sample_and_carries_on():
     robot = load("ur5")
     Q, targets = smooth_path(robot, 3, samples=60)
     targets[30] = pin.SE3(targets[30].rotation, np.array([5.0, 0.0, 0.0]))  # 5 m out: beyond the UR5's reach
-    res = kinelab.track(robot, targets, Q[0], polish=True)
+    res = kinelab.track(robot, targets, q0=Q[0], polish=True)
     assert not res.reached[30] and res.status[30] != "converged"
     assert res.position_error[30] > 4.0
     assert res.reached[40:].all()  # within ten samples it is back on the path
@@ -51,10 +51,74 @@ def test_bad_targets_are_named_by_index():
     Q, targets = smooth_path(robot, 3, samples=5)
     targets[3] = "not a pose"
     with pytest.raises(TargetError, match=r"targets\[3\]"):
-        kinelab.track(robot, targets, Q[0])
+        kinelab.track(robot, targets, q0=Q[0])
     with pytest.raises(TargetError, match="empty"):
-        kinelab.track(robot, [], Q[0])
+        kinelab.track(robot, [], q0=Q[0])
     homogeneous = np.array([t.homogeneous for t in targets[:3]])
     homogeneous[1, 0, 3] = np.nan
     with pytest.raises(TargetError, match=r"targets\[1\]"):
-        kinelab.track(robot, homogeneous, Q[0])
+        kinelab.track(robot, homogeneous, q0=Q[0])
+
+
+def _own_verdict(robot, q, target, task="pose", tol=1e-6):
+    """The test's own check: Pinocchio's FK of q against the target on the task's components, within the limits."""
+    err = target.actInv(robot.fk(q))
+    dp = np.linalg.norm(robot.fk(q).translation - target.translation)
+    dr = np.linalg.norm(pin.log3(err.rotation))
+    return (dp <= tol or task == "orientation") and (dr <= tol or task == "position") and robot.within_limits(q)
+
+
+def test_the_monitored_path_reports_only_what_pinocchio_confirms():
+    """kinelab 0.1: a monitored sample's status was the solver's own (16 of 20 'reached' with rotation errors up
+    to 3.1 rad when FRDM's mode was position while the task was the pose)."""
+    robot = load("ur5")
+    Q, targets = smooth_path(robot, 5, samples=20, amplitude=0.9)
+    res = kinelab.track(robot, targets, q0=Q[0], policy=(), mode="position")
+    assert res.reached.sum() < 20  # the rotation is not met by a position-only FRDM
+    for k in range(20):
+        assert res.reached[k] == _own_verdict(robot, res.q[k], targets[k]), k
+
+
+def test_a_sample_outside_the_limits_is_not_reached_even_when_the_solver_may_leave_them():
+    robot = load("ur5")
+    Q, targets = smooth_path(robot, 6, samples=30, amplitude=0.95)
+    res = kinelab.track(robot, targets, q0=Q[0], policy=(), use_limits=False)
+    outside = [k for k in range(30) if not robot.within_limits(res.q[k])]
+    assert all(not res.reached[k] for k in outside)
+    assert all(res.reached[k] == _own_verdict(robot, res.q[k], targets[k]) for k in range(30))
+
+
+@pytest.mark.parametrize("bad", [{"tol_pos": float("inf")}, {"tol_rot": 0.0}, {"tol_pos": -1.0},
+                                 {"max_sweeps": -3}, {"hold": 1.5}, {"rest_weight": float("nan")},
+                                 {"jump_limit": 0.0}, {"restrict": "freeze"}, {"solver": "dls"}])
+def test_track_refuses_bad_arguments_by_name(bad):
+    robot = load("ur5")
+    Q, targets = smooth_path(robot, 3, samples=3)
+    with pytest.raises(kinelab.OptionError, match=next(iter(bad))):
+        kinelab.track(robot, targets, q0=Q[0], **bad)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_every_reached_sample_is_met_whatever_the_options(seed):
+    """A property test over random options, monitored loop and follower alike: 'reached' is Pinocchio's verdict."""
+    rng = np.random.default_rng(seed)
+    robot = load(["ur5", "panda", "so101"][seed % 3])
+    task = ["pose", "position", "axis"][rng.integers(3)] if robot.n >= 6 else "position"
+    options = {"policy": (), "use_limits": bool(rng.integers(2)), "order": ["tip2base", "base2tip"][rng.integers(2)],
+               "polish": bool(rng.integers(2))}
+    if rng.integers(2):
+        options = {"polish": options["polish"]}  # the compiled follower
+    Q, targets = smooth_path(robot, seed, samples=25, amplitude=0.8)
+    tol = float(rng.choice([1e-6, 1e-4]))
+    res = kinelab.track(robot, targets, q0=Q[0], task=task, tol_pos=tol, tol_rot=tol, **options)
+    axis_task = task == "axis"
+    for k in range(25):
+        q, target = res.q[k], targets[k]
+        dp = np.linalg.norm(robot.fk(q).translation - target.translation)
+        if axis_task:
+            u, v = robot.fk(q).rotation[:, 2], target.rotation[:, 2]
+            dr = np.arctan2(np.linalg.norm(np.cross(u, v)), u @ v)
+        else:
+            dr = np.linalg.norm(pin.log3(target.rotation.T @ robot.fk(q).rotation))
+        met = dp <= tol and (task == "position" or dr <= tol) and robot.within_limits(q)
+        assert res.reached[k] == met, (k, task, options, dp, dr)

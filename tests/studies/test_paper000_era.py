@@ -5,7 +5,7 @@ import pinocchio as pin
 import pytest
 
 from kinelab.errors import KinelabError
-from kinelab.ik.frdm.tracking import track
+from kinelab.ik.api import track
 from kinelab.robot import load
 from kinelab.studies import paper000_era as ep
 
@@ -99,7 +99,7 @@ def test_wrist_without_bypass_sums_angles_in_q5_and_q7(wrist):
 
 def test_wrist_freezing_q1_does_not_help_on_this_model(wrist):
     passage, _ = wrist
-    res = track(load("era"), passage.targets, passage.q0, freeze={"joint1": None}, restrict=("freeze",),
+    res = track(load("era"), passage.targets, q0=passage.q0, freeze={"joint1": None}, restrict=("freeze",),
                 **ep.TRACK_OPTIONS)
     laps = np.rad2deg(ep.lap_changes(res, passage))
     assert (laps[:, 4] < -5).all()  # q1 takes no part in the spin, so the drift stays
@@ -136,9 +136,9 @@ def test_restrict_needs_its_table():
     era = load("era")
     passage = ep.shoulder_passage(era, laps=1)
     with pytest.raises(KinelabError, match="no freeze table"):
-        track(era, passage.targets, passage.q0, restrict=("freeze",))
-    with pytest.raises(KinelabError, match="restrict takes"):
-        track(era, passage.targets, passage.q0, restrict=("kicks",))
+        track(era, passage.targets, q0=passage.q0, restrict=("freeze",))
+    with pytest.raises(KinelabError, match="'intervals' and 'freeze'"):
+        track(era, passage.targets, q0=passage.q0, restrict=("kicks",))
 
 
 def test_a_single_straight_pass_through_the_wrist_lock_is_smooth_on_this_model():
@@ -147,7 +147,7 @@ def test_a_single_straight_pass_through_the_wrist_lock_is_smooth_on_this_model()
     oMlock = era.fk(ep.WRIST_LOCK)
     targets = [pin.SE3(oMlock.rotation, oMlock.translation + np.array([x, 0.0, 0.0])) for x in np.linspace(-1, 1, 41)]
     start = ep.solver.attempt(era, targets[0], ep.WRIST_LOCK, 1e-9, 1e-9, np.inf, max_sweeps=3000)
-    res = track(era, targets, start.q, policy=(), **ep.TRACK_OPTIONS)
+    res = track(era, targets, q0=start.q, policy=(), **ep.TRACK_OPTIONS)
     _every_sample_reached(res)
     assert res.q[:, 5].min() < np.deg2rad(85) and res.q[:, 5].max() > np.deg2rad(95)  # q6 crosses 90°
     assert res.max_joint_step < 0.05 and not res.events
@@ -158,7 +158,7 @@ def test_the_drift_grows_with_the_position_weight():
     and FRDM turns the arm further per lap (shoulder, first lap)."""
     era = load("era")
     passage = ep.shoulder_passage(era, laps=1)
-    turns = [abs(ep.lap_changes(track(era, passage.targets, passage.q0, policy=(), w_p_factor=w), passage)[0, 0])
+    turns = [abs(ep.lap_changes(track(era, passage.targets, q0=passage.q0, policy=(), w_p_factor=w), passage)[0, 0])
              for w in (1.0, 3.0, 10.0)]
     assert turns[0] < turns[1] < turns[2]
     assert turns[0] > np.deg2rad(5)  # present even at the lightest weight

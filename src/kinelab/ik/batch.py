@@ -9,7 +9,7 @@ count); the other solvers and FRDM's monitored options run ``solve`` row by row 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numba
@@ -18,15 +18,17 @@ import pinocchio as pin
 
 from kinelab.errors import ConfigurationError
 from kinelab.geometry import stack_homogeneous
+from kinelab.ik.driver import solve_one
 from kinelab.ik.frdm import batch as frdm_batch
 from kinelab.ik.frdm.batch import Rows
 from kinelab.ik.multistart import seed_states
+from kinelab.ik.request import Request
 from kinelab.ik.result import Status
-from kinelab.ik.solve import check_arguments, for_task, solve, solver_module
 from kinelab.ik.targets import as_target_arrays
-from kinelab.ik.tasks import POSE, Task
 from kinelab.ik.workspace import reach_bound
 from kinelab.robot import Robot
+
+VERDICT_SECONDS_PER_ROW = 2e-6  # [s] Pinocchio's FK and the error of one row, kept out of the solvers' share
 
 
 @dataclass
@@ -67,10 +69,7 @@ class BatchIKResult:
                 "mode": self.mode}
 
 
-def solve_batch(robot: Robot, targets: Any, q0: Any = None, seed: int | None = None, solver: str = "frdm",
-                tol_pos: float = 1e-6, tol_rot: float = 1e-6, max_restarts: int = 1000,
-                time_budget: float | None = None, options: Any = None, task: str = "pose", axis: str = "z",
-                **solver_options: Any) -> BatchIKResult:
+def run_batch(robot: Robot, targets: Any, q0: Any, req: Request) -> BatchIKResult:
     """Solve IK for every target of a batch (each a tool pose in the robot's base frame).
 
     Args:
@@ -78,16 +77,9 @@ def solve_batch(robot: Robot, targets: Any, q0: Any = None, seed: int | None = N
         targets: a sequence of ``pin.SE3`` or an (B, 4, 4) array of homogeneous matrices (oMtarget).
         q0: starts: None (each row draws its own from its seed), one configuration for every row, or (B, n)
             [rad or m]; within the joint limits.
-        seed: base seed, an int ≥ 0 (row b uses seed + b); None draws one (reported in the result).
-        solver: "frdm", "biquat" or "dls".
-        tol_pos: [m].
-        tol_rot: [rad].
-        max_restarts: random restarts per row after its first attempt.
-        time_budget: wall-clock budget [s] of the whole batch (None: none); rows not started when it runs
-            out are left unsolved with status ``time_budget`` and NaN in q.
-        options: the solver's options object, as for :func:`kinelab.solve`.
-        task: the components to meet, as for :func:`kinelab.solve`; axis: the tool axis of task "axis".
-        solver_options: or its fields as keyword arguments.
+        req: the validated request; its seed is the base seed (row b uses seed + b; None: one is drawn and
+            reported), its time budget bounds the whole batch (rows not started when it runs out are left
+            unsolved with status ``time_budget`` and NaN in q).
 
     Returns:
         The :class:`BatchIKResult`, every row judged by Pinocchio's FK.
@@ -95,32 +87,31 @@ def solve_batch(robot: Robot, targets: Any, q0: Any = None, seed: int | None = N
     Raises:
         TargetError: a bad target (its index named).
         ConfigurationError: q0 of the wrong shape, NaN or outside the limits (row named).
-        OptionError: a bad option or argument (SolverNotFoundError: an unknown solver).
     """
-    module = solver_module(solver)
-    opts = module.Options.of(options, **solver_options)
-    tk = Task.of(task, axis)
-    if tk is not POSE:
-        opts = for_task(solver, opts, tk)
-    check_arguments(tol_pos, tol_rot, 1.0 if time_budget is None else time_budget, max_restarts, seed, "refuse")
+    compiled = req.solver == "frdm" and req.options.compiled
+    if compiled:
+        frdm_batch.prepare(robot)  # compilation is not the batch's time
+    t0 = time.perf_counter()
     points, rotations = as_target_arrays(targets)
     starts = _starts(robot, q0, points.shape[0])
-    if seed is None:
-        seed = int(np.random.SeedSequence().generate_state(1, np.uint64)[0] >> np.uint64(2))
-    if solver == "frdm" and opts.compiled:
-        frdm_batch.prepare(robot)
-        t0 = time.perf_counter()
-        attempts = np.where(_beyond(robot, points) > 0, 1, max_restarts + 1)
-        deadline = np.inf if time_budget is None else t0 + time_budget
+    seed = fresh_seed() if req.seed is None else req.seed
+    # the budget covers the whole call: the solvers stop early enough to leave time for Pinocchio's verdict
+    deadline = np.inf if req.time_budget is None else \
+        t0 + req.time_budget - min(VERDICT_SECONDS_PER_ROW * points.shape[0], 0.5 * req.time_budget)
+    if compiled:
+        attempts = np.where(_beyond(robot, points) > 0, 1, req.max_restarts + 1)
         rows = frdm_batch.run(robot, points, rotations, starts, seed_states(seed, points.shape[0]), attempts,
-                              tol_pos, tol_rot, deadline, opts)
+                              req.tol_pos, req.tol_rot, deadline, req.options)
         mode = f"frdm (compiled batch, {numba.get_num_threads()} threads)"
     else:
-        t0 = time.perf_counter()
-        rows = _per_target(robot, points, rotations, starts, seed, solver, tol_pos, tol_rot, max_restarts,
-                           time_budget, opts, tk)
-        mode = f"{solver} (per target)"
-    return _judged(robot, rows, points, rotations, tol_pos, tol_rot, seed, t0, solver, mode, tk)
+        rows = _per_target(robot, points, rotations, starts, replace(req, seed=seed), deadline)
+        mode = f"{req.solver} (per target)"
+    return _judged(robot, rows, points, rotations, req, seed, t0, mode)
+
+
+def fresh_seed() -> int:
+    """A base seed drawn from fresh entropy (an int ≥ 0 that leaves room for seed + row)."""
+    return int(np.random.SeedSequence().generate_state(1, np.uint64)[0] >> np.uint64(2))
 
 
 def _starts(robot: Robot, q0: Any, count: int) -> np.ndarray | None:
@@ -143,43 +134,42 @@ def _starts(robot: Robot, q0: Any, count: int) -> np.ndarray | None:
 def _beyond(robot: Robot, points: np.ndarray) -> np.ndarray:
     """Per target: how far [m] its position lies beyond the reach bound (≤ 0: maybe reachable)."""
     anchor, radius = reach_bound(robot)
-    return np.linalg.norm(points - np.asarray(anchor), axis=1) - radius
+    beyond: np.ndarray = np.linalg.norm(points - np.asarray(anchor), axis=1) - radius
+    return beyond
 
 
-def _per_target(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts: np.ndarray | None, seed: int,
-                solver: str, tol_pos: float, tol_rot: float, max_restarts: int, time_budget: float | None,
-                opts: Any, task: Task) -> Rows:
-    """solve() row by row (solvers without a compiled batch); rows after the budget are left unsolved."""
+def _per_target(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts: np.ndarray | None,
+                req: Request, deadline: float) -> Rows:
+    """The driver row by row (solvers without a compiled batch); rows after the deadline are left unsolved."""
     count, n = points.shape[0], robot.n
     rows = Rows.unsolved(count, n)
-    deadline = np.inf if time_budget is None else time.perf_counter() + time_budget
+    seed = int(req.seed or 0)
     for b in range(count):
         left = deadline - time.perf_counter()
         if left <= 0:
             break
-        res = solve(robot, pin.SE3(rotations[b], points[b]), solver, None if starts is None else starts[b],
-                    seed + b, tol_pos, tol_rot, min(left, 1e9), max_restarts, "refuse", opts, task.name,
-                    "xyz"[task.axis] if task.axis >= 0 else "z")
+        row = replace(req, seed=seed + b, time_budget=min(left, 1e9), start_outside_limits="refuse")
+        res = solve_one(robot, pin.SE3(rotations[b], points[b]), None if starts is None else starts[b], row)
         rows.Q[b], rows.iterations[b], rows.restarts[b] = res.q, res.iterations, res.restarts
         rows.status[b] = res.status.value
     return rows
 
 
-def _judged(robot: Robot, rows: Rows, points: np.ndarray, rotations: np.ndarray, tol_pos: float, tol_rot: float,
-            seed: int, t0: float, solver: str, mode: str, task: Task) -> BatchIKResult:
+def _judged(robot: Robot, rows: Rows, points: np.ndarray, rotations: np.ndarray, req: Request, seed: int,
+            t0: float, mode: str) -> BatchIKResult:
     """Pinocchio's verdict on every solved row; statuses as :func:`kinelab.solve` gives them."""
-    count = points.shape[0]
+    count, task = points.shape[0], req.task
     dp, dr, success = np.full(count, np.nan), np.full(count, np.nan), np.zeros(count, dtype=bool)
     solved = np.flatnonzero(rows.status != Status.TIME_BUDGET.value)
     if solved.size:
         H_target = stack_homogeneous(points[solved], rotations[solved])
         dp[solved], dr[solved] = task.errors_batch(H_target, robot.fk_batch(rows.Q[solved]))
         within = robot.within_limits_batch(rows.Q[solved])
-        success[solved] = task.met_batch(dp[solved], dr[solved], tol_pos, tol_rot) & within
+        success[solved] = task.met_batch(dp[solved], dr[solved], req.tol_pos, req.tol_rot) & within
     status = rows.status
     status[success] = Status.CONVERGED.value
     failed = ~success & (status != Status.TIME_BUDGET.value)
     status[failed & (_beyond(robot, points) > 0)] = Status.UNREACHABLE.value
     status[failed & (status == Status.CONVERGED.value)] = Status.STALLED.value  # the solver's test passed only
     return BatchIKResult(rows.Q, success, rows.status, dp, dr, rows.iterations, rows.restarts, seed,
-                         time.perf_counter() - t0, solver, mode)
+                         time.perf_counter() - t0, req.solver, mode)

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, field, fields, replace
 from enum import Enum
 from typing import Any
 
@@ -79,6 +79,90 @@ class BypassRecord:
         return {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self).items() if v is not None}
 
 
+@dataclass(frozen=True)
+class BiquatTrajectory:
+    """The biquaternion solver's recorded run (``BiquatOptions(record=True)``), one row per step.
+
+    Attributes:
+        t: (K,) model time [s]; q: (K, nq) Pinocchio configurations; M: (K, 8) the error biquaternion M*
+            (real w, x, y, z, then dual w, x, y, z); U: (K, 6) the control [v; ω].
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    M: np.ndarray
+    U: np.ndarray
+
+
+@dataclass(frozen=True, repr=False)
+class Diagnostics:
+    """How a solve ran: each field is set by the solvers it applies to, None elsewhere.
+
+    Attributes:
+        path: "compiled" (a compiled kernel ran the attempts) or None (the Python loop).
+        attempts: attempts run (the first start and its restarts); stalls: attempts that stalled.
+        message: a solver's own note (a biquaternion run stopped by a singular matrix, say).
+        sweeps, accelerated_sweeps: FRDM sweeps of the answer's run, and those Anderson's extrapolation kept.
+        order, relax, w_p: FRDM's sweep order, relaxation and position weight [1/m²].
+        objective: FRDM's objective at the answer; polished: stalled attempts finished by Gauss–Newton steps;
+            polish_iterations: DLS steps after FRDM (``polish=True``); trace: the objective after every sweep.
+        model_time: the biquaternion run's model time [s]; steps: its integration steps; M0: the scalar of
+            N̄∘Λ at the end (±1 at the target); damping, law, integrator: how it ran; outside_limits: compiled
+            attempts restarted because their answer left the limits; trajectory: the recorded run.
+        answer_events, answer_bypasses: the monitor events and bypasses of the answer's own attempt (the
+            result's ``singular_events``/``bypasses`` cover every attempt).
+        branches: distinct solutions found (``solve(prefer=)``); found: starts that reached this solution and
+            starts: starts run (``solve_all``).
+    """
+
+    path: str | None = None
+    attempts: int | None = None
+    stalls: int | None = None
+    message: str | None = None
+    sweeps: int | None = None
+    accelerated_sweeps: int | None = None
+    order: str | None = None
+    relax: float | None = None
+    w_p: float | None = None
+    objective: float | None = None
+    polished: int | None = None
+    polish_iterations: int | None = None
+    trace: tuple[float, ...] | None = None
+    model_time: float | None = None
+    steps: int | None = None
+    M0: float | None = None
+    damping: float | None = None
+    law: str | None = None
+    integrator: str | None = None
+    outside_limits: int | None = None
+    trajectory: BiquatTrajectory | None = None
+    answer_events: tuple[SingularEvent, ...] = ()
+    answer_bypasses: tuple[BypassRecord, ...] = ()
+    branches: int | None = None
+    found: int | None = None
+    starts: int | None = None
+
+    def __repr__(self) -> str:
+        return "Diagnostics(" + ", ".join(f"{k}={v!r}" for k, v in self.to_dict().items()) + ")"
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form: the fields that are set (events as dicts; the recorded trajectory left out)."""
+        out: dict[str, Any] = {}
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if value is None or f.name == "trajectory":
+                continue
+            if f.name in ("answer_events", "answer_bypasses"):
+                value = [v.to_dict() for v in value]
+            elif isinstance(value, tuple):
+                value = list(value)
+            out[f.name] = value
+        return out
+
+
+NO_DIAGNOSTICS = Diagnostics()
+
+
 @dataclass
 class IKResult:
     """The outcome of :func:`kinelab.solve`.
@@ -101,10 +185,11 @@ class IKResult:
     singular_events: list[SingularEvent] = field(default_factory=list)
     bypasses: list[BypassRecord] = field(default_factory=list)
     message: str = ""
-    info: dict = field(default_factory=dict)
+    diagnostics: Diagnostics = NO_DIAGNOSTICS
     task: str = "pose"  # the components judged: pose, position, axis (with its axis) or orientation
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON form (the CLI's ``ik --json``; fields are only ever added)."""
         return {
             "task": self.task,
             "q": np.asarray(self.q).tolist(),
@@ -120,24 +205,24 @@ class IKResult:
             "singular_events": [e.to_dict() for e in self.singular_events],
             "bypasses": [b.to_dict() for b in self.bypasses],
             "message": self.message,
-            "info": {k: v for k, v in self.info.items() if _jsonable(v)},
+            "info": self.diagnostics.to_dict(),
         }
-
-
-def _jsonable(value) -> bool:
-    return isinstance(value, (int, float, str, bool, list, dict)) or value is None
 
 
 @dataclass
 class Attempt:
-    """One solver run from one start, before kinelab's Pinocchio check (internal to ``solve``)."""
+    """One solver run from one start, before kinelab's Pinocchio check (internal to the driver).
+
+    ``mode`` names the variant that ran ("frdm (anderson)", "biquat (simple, ...)"); empty: the solver's name.
+    """
 
     q: np.ndarray
     status: Status
     iterations: int
     events: list[SingularEvent] = field(default_factory=list)
     bypasses: list[BypassRecord] = field(default_factory=list)
-    info: dict = field(default_factory=dict)
+    diagnostics: Diagnostics = NO_DIAGNOSTICS
+    mode: str = ""
 
 
 @dataclass
@@ -174,7 +259,8 @@ class TrackResult:
         """The same as :attr:`reached` (the name :class:`~kinelab.ik.result.IKResult` uses)."""
         return self.reached
 
-    def summary(self) -> dict:
+    def summary(self) -> dict[str, Any]:
+        """Samples, reached, the worst errors and step, monitor counts, the median time per sample."""
         return {
             "samples": len(self.status),
             "reached": int(self.reached.sum()),

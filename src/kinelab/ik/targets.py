@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from kinelab.dq.algebra import DualQuat
 from kinelab.errors import TargetError
@@ -13,13 +16,13 @@ from kinelab.ik.verdict import NOT_A_ROTATION, NOT_FINITE, pose_defect
 _POSE_DEFECT = TypedKernel(pose_defect)
 
 
-def from_xyz_rpy(xyz, rpy=(0.0, 0.0, 0.0)) -> pin.SE3:
+def from_xyz_rpy(xyz: ArrayLike, rpy: ArrayLike = (0.0, 0.0, 0.0)) -> pin.SE3:
     """oMtarget from a position [m] and roll-pitch-yaw angles [rad] (R = Rz(yaw) Ry(pitch) Rx(roll))."""
     xyz, rpy = _finite(xyz, 3, "xyz"), _finite(rpy, 3, "rpy")
     return pin.SE3(pin.rpy.rpyToMatrix(*rpy), xyz)
 
 
-def from_xyz_quat_wxyz(xyz, quat_wxyz) -> pin.SE3:
+def from_xyz_quat_wxyz(xyz: ArrayLike, quat_wxyz: ArrayLike) -> pin.SE3:
     """oMtarget from a position [m] and a unit quaternion in (w, x, y, z) order."""
     xyz, quat = _finite(xyz, 3, "xyz"), _finite(quat_wxyz, 4, "quat_wxyz")
     norm = np.linalg.norm(quat)
@@ -29,7 +32,7 @@ def from_xyz_quat_wxyz(xyz, quat_wxyz) -> pin.SE3:
     return pin.SE3(pin.Quaternion(w, x, y, z).toRotationMatrix(), xyz)
 
 
-def as_target(target, task: str = "pose") -> pin.SE3:
+def as_target(target: Any, task: str = "pose") -> pin.SE3:
     """Check a target: a ``pin.SE3`` with finite entries and a proper rotation, or a unit biquaternion; for
     task "position" also a point (three numbers [m], base frame), taken with the identity rotation.
 
@@ -58,7 +61,7 @@ def as_target(target, task: str = "pose") -> pin.SE3:
     return target
 
 
-def _is_point(target) -> bool:
+def _is_point(target: Any) -> bool:
     """A list, tuple or array of three numbers."""
     if isinstance(target, list | tuple | np.ndarray):
         try:
@@ -68,7 +71,7 @@ def _is_point(target) -> bool:
     return False
 
 
-def _finite(values, size: int, what: str) -> np.ndarray:
+def _finite(values: ArrayLike, size: int, what: str) -> np.ndarray:
     arr = np.asarray(values, dtype=float)
     if arr.shape != (size,):
         raise TargetError(f"{what} must have {size} numbers, got shape {arr.shape}")
@@ -77,7 +80,7 @@ def _finite(values, size: int, what: str) -> np.ndarray:
     return arr
 
 
-def as_target_arrays(targets) -> tuple[np.ndarray, np.ndarray]:
+def as_target_arrays(targets: Any) -> tuple[np.ndarray, np.ndarray]:
     """Check a sequence of targets; returns (points (N, 3) [m], rotations (N, 3, 3)), base frame.
 
     ``targets`` is a sequence of ``pin.SE3`` (or unit biquaternions), or an (N, 4, 4) array of
@@ -103,7 +106,7 @@ def as_target_arrays(targets) -> tuple[np.ndarray, np.ndarray]:
     return np.ascontiguousarray(H[:, :3, 3]), np.ascontiguousarray(R)
 
 
-def _stack(targets) -> np.ndarray:
+def _stack(targets: Any) -> np.ndarray:
     """The targets as an (N, 4, 4) float array (N ≥ 1), or a TargetError naming the first that is no pose."""
     if isinstance(targets, np.ndarray) and targets.dtype.kind in "fiu":
         if targets.ndim != 3 or targets.shape[1:] != (4, 4) or targets.shape[0] == 0:

@@ -15,7 +15,7 @@ import pinocchio as pin
 
 from kinelab.analysis.singular import conditioning_batch
 from kinelab.errors import KinelabError
-from kinelab.ik.batch import solve_batch
+from kinelab.ik.api import solve_batch
 from kinelab.ik.targets import as_target
 from kinelab.ik.workspace import reach_bound
 from kinelab.robot import Robot, load

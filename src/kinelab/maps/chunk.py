@@ -15,7 +15,7 @@ import numpy as np
 
 from kinelab.analysis.singular import conditioning_batch
 from kinelab.errors import KinelabError
-from kinelab.ik.batch import solve_batch
+from kinelab.ik.api import solve_batch
 from kinelab.maps import grid
 from kinelab.robot import Robot
 

@@ -6,67 +6,20 @@ choice, so rendering never changes the caller's matplotlib settings.
 
 from __future__ import annotations
 
-import contextlib
 import json
-import os
-import shutil
-import tempfile
 import textwrap
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from matplotlib.figure import Figure
 
-from kinelab.errors import KinelabError
 from kinelab.report.bench import loops, scaling
+from kinelab.report.outfolder import atomic_folder
 from kinelab.report.page import CAPTIONS, validate_html
 from kinelab.report.validate import Report
 from kinelab.studies import paper000_era as ep
 from kinelab.studies import paper001_stanford as seed001
-
-
-def check_output_folder(out: str | Path) -> Path:
-    """Make sure a report can be written to the folder ``out`` before any work is done.
-
-    Raises:
-        KinelabError: ``out`` is a file, or no folder can be created or written there.
-    """
-    final = Path(out)
-    if final.exists() and not final.is_dir():
-        raise KinelabError(f"cannot write the report to {out}: it is a file, not a folder")
-    existing = final.parent.resolve()
-    while not existing.exists():
-        existing = existing.parent
-    try:  # a real probe: permission bits say nothing to root, nor about read-only or special filesystems
-        shutil.rmtree(tempfile.mkdtemp(prefix=".kinelab-probe-", dir=existing))
-    except OSError:
-        raise KinelabError(f"cannot write the report to {out}: {existing} is not a writable folder") from None
-    return final
-
-
-@contextlib.contextmanager
-def atomic_folder(out: str | Path) -> Iterator[Path]:
-    """A temporary folder beside ``out`` that replaces ``out`` only when the block ends normally: an
-    interrupted or failed report leaves the previous one (or nothing) in place, never a mixture."""
-    final = check_output_folder(out)
-    final.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{final.name}.", dir=final.parent))
-    try:
-        yield tmp
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    umask = os.umask(0)
-    os.umask(umask)
-    tmp.chmod(0o777 & ~umask)
-    old = final.with_name(f".{final.name}.old-{os.getpid()}") if final.exists() else None
-    if old is not None:
-        final.rename(old)
-    tmp.rename(final)
-    if old is not None:
-        shutil.rmtree(old, ignore_errors=True)
 
 
 def validate_table(report: Report, width: int = 120) -> str:
@@ -111,11 +64,11 @@ def validate_figures(report: Report, folder: Path) -> list[str]:
             passage = ep.PASSAGES[name]()
             names.append(_passage_figure(ep.run(passage), name, joints, folder))
     if "stanford" in report.robots:
-        traj = seed001.reproduce().info["trajectory"]
+        traj = seed001.reproduce().diagnostics.trajectory
         fig = Figure(figsize=(5, 3.2))
         ax = fig.subplots()
-        ax.semilogy(traj["t"], np.linalg.norm(traj["M"][:, 1:4], axis=1), label="|m⃗| (rotation part)")
-        ax.semilogy(traj["t"], np.linalg.norm(traj["M"][:, 5:8], axis=1), label="|m0⃗| (moment part)")
+        ax.semilogy(traj.t, np.linalg.norm(traj.M[:, 1:4], axis=1), label="|m⃗| (rotation part)")
+        ax.semilogy(traj.t, np.linalg.norm(traj.M[:, 5:8], axis=1), label="|m0⃗| (moment part)")
         ax.set_xlabel("model time [s]")
         ax.set_title("seed 001: error biquaternion, K = 1")
         ax.legend()
@@ -127,7 +80,7 @@ def validate_figures(report: Report, folder: Path) -> list[str]:
 
 def write_validate_report(report: Report, out: str | Path) -> Path:
     """Write report.json, report.md, report.html and the figures into the folder ``out`` (all or nothing)."""
-    with atomic_folder(out) as folder:
+    with atomic_folder(out, "validate") as folder:
         _write_validate_files(report, folder)
     return Path(out)
 
@@ -163,7 +116,7 @@ def bench_markdown(result: dict[str, Any]) -> str:
 
 def write_bench(result: dict[str, Any], out: str | Path) -> Path:
     """bench.json, bench.md and bench.png in the folder ``out`` (all or nothing)."""
-    with atomic_folder(out) as folder:
+    with atomic_folder(out, "bench") as folder:
         _write_bench_files(result, folder)
     return Path(out)
 

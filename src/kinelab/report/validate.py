@@ -144,14 +144,14 @@ def seed001_run_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     """Seed 001's run: from the paper's start to its target with K = 1, h = 0.01 s."""
     run = seed001.reproduce(robot, record=True)
     dp, dr = robot.tool_error(run.q, robot.fk(seed001.TARGET_Q))
-    m_start = float(np.linalg.norm(run.info["trajectory"]["M"][0][1:4]))
+    m_start = float(np.linalg.norm(run.diagnostics.trajectory.M[0][1:4]))
     predicted = 0.01 * np.ceil(np.log(m_start / 5e-7) / -np.log(1 - 0.01))
     return [
         Check(robot.name, "seed 001: the paper's run reaches 1e-6 (position)", dp, 1e-6, "m",
-              f"model time {run.info['model_time']:.2f} s at K = 1 (paper: about 40 s)"),
+              f"model time {run.diagnostics.model_time:.2f} s at K = 1 (paper: about 40 s)"),
         Check(robot.name, "seed 001: the paper's run reaches 1e-6 (rotation)", dr, 1e-6, "rad"),
-        Check(robot.name, "seed 001: final M0 = -1 as in the paper", abs(run.info["M0"] + 1.0), 1e-9, ""),
-        Check(robot.name, "seed 001: model time vs closed-form prediction", abs(run.info["model_time"] - predicted),
+        Check(robot.name, "seed 001: final M0 = -1 as in the paper", abs(run.diagnostics.M0 + 1.0), 1e-9, ""),
+        Check(robot.name, "seed 001: model time vs closed-form prediction", abs(run.diagnostics.model_time - predicted),
               1e-9, "s", f"{predicted:.2f} s predicted"),
     ]
 

@@ -21,13 +21,14 @@ import os
 import sys
 import tempfile
 import warnings
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any, TypeVar, cast
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from kinelab.errors import (
     ChainError,
@@ -83,7 +84,7 @@ class Mimic:
     upper: float
 
 
-def _narrowed(leader: str, lo: float, hi: float, mimics) -> tuple[float, float]:
+def _narrowed(leader: str, lo: float, hi: float, mimics: Iterable[Mimic]) -> tuple[float, float]:
     """The leader's limits narrowed so that every follower stays within its own (an empty range: ChainError)."""
     for m in mimics:
         if m.leader == leader and m.multiplier != 0.0:
@@ -219,9 +220,12 @@ class Robot:
         srdf: str | Path | None = None,
         group: str | None = None,
         xacro_args: dict[str, str] | None = None,
+        trust_xacro: bool = False,
     ):
         self.source = Path(urdf_path)
-        self.urdf_path = xacro.expand(self.source, xacro_args) if xacro.is_xacro(self.source) else self.source
+        self.xacro_args, self.trust_xacro = dict(xacro_args or {}), bool(trust_xacro)
+        self.urdf_path = xacro.expand(self.source, xacro_args, trusted=self.trust_xacro) \
+            if xacro.is_xacro(self.source) else self.source
         self.package_dirs = mesh_package_dirs(package_dirs)
         if is_mjcf(self.urdf_path):
             full, tree = read_mjcf(self.urdf_path)
@@ -240,6 +244,7 @@ class Robot:
         if any(full.names[j] in tree.mimic and full.names[j] not in (locked or {}) for j in chain):
             full, chain = self._with_mimics(full, chain, tree, base)
         self._check_chain(full, chain, tree)
+        tree.check_mimics(self.urdf_path, [full.names[j] for j in chain], (locked or {}))
         reference = self.srdf.reference() if self.srdf else {}
         held = {j: v for j, v in reference.items() if full.existJointName(j) and full.getJointId(j) not in chain}
         self.locked = self._locked_values(full, chain, {**held, **(locked or {})})
@@ -301,12 +306,19 @@ class Robot:
         self._lower_list = (self._lower_check - LIMIT_SLACK).tolist()
         self._upper_list = (self._upper_check + LIMIT_SLACK).tolist()
 
+    @property
+    def source_format(self) -> str:
+        """The format of the file the robot was read from: "URDF", "xacro" or "MJCF"."""
+        if xacro.is_xacro(self.source):
+            return "xacro"
+        return "MJCF" if is_mjcf(self.urdf_path) else "URDF"
+
     def derived(self, key: str, build: Callable[[Robot], T]) -> T:
         """Data derived from this robot (a solver's chain arrays, say), built on first use and kept here,
         so it lives exactly as long as the Robot."""
         if key not in self._derived:
             self._derived[key] = build(self)
-        return self._derived[key]
+        return cast(T, self._derived[key])
 
     # -- construction ------------------------------------------------------------------------
     @staticmethod
@@ -456,7 +468,7 @@ class Robot:
             raise JointNotFoundError(name, self.joint_names)
         return self.joint_names.index(name)
 
-    def check_q(self, q, *, limits: bool = False, what: str = "q") -> np.ndarray:
+    def check_q(self, q: ArrayLike, *, limits: bool = False, what: str = "q") -> np.ndarray:
         """``q`` as a float array of length n, refusing wrong shapes, NaN/inf and (if asked) limits."""
         try:
             raw = q if type(q) is np.ndarray else np.asarray(q)
@@ -484,7 +496,7 @@ class Robot:
                 raise JointLimitError(j.name, arr[i], j.lower, j.upper, j.unit)
         return arr
 
-    def within_limits(self, q, slack: float = LIMIT_SLACK) -> bool:
+    def within_limits(self, q: ArrayLike, slack: float = LIMIT_SLACK) -> bool:
         """True when every bounded joint lies within its limits (plus ``slack``); continuous joints have none."""
         if slack == LIMIT_SLACK:
             values = (q if type(q) is np.ndarray else np.asarray(q, dtype=float)).tolist()
@@ -493,6 +505,14 @@ class Robot:
         arr = np.asarray(q, dtype=float)
         return bool((arr >= self._lower_check - slack).all() and (arr <= self._upper_check + slack).all())
 
+    def outside_limits(self, q: ArrayLike) -> list[str]:
+        """One line per joint of ``q`` outside its limits (beyond LIMIT_SLACK), naming the joint, the value and the
+        limits; empty when q is within them (continuous joints have none)."""
+        values = np.asarray(q, dtype=float)
+        lower, upper = self.check_bounds
+        return [f"{j.name} = {v:g} {j.unit} is outside its limits [{j.lower:.4g}, {j.upper:.4g}] {j.unit}"
+                for j, v, lo, hi in zip(self.joints, values.tolist(), lower, upper, strict=True) if not lo <= v <= hi]
+
     def within_limits_batch(self, Q: np.ndarray) -> np.ndarray:
         """:meth:`within_limits` per row of a (B, n) array (default slack): a (B,) bool array."""
         Q = np.asarray(Q, dtype=float)
@@ -500,12 +520,12 @@ class Robot:
         inside: np.ndarray = (lower <= Q) & (upper >= Q)
         return np.asarray(inside.all(axis=1))
 
-    def to_pin_q(self, q) -> np.ndarray:
+    def to_pin_q(self, q: ArrayLike) -> np.ndarray:
         """One number per joint → Pinocchio's q (continuous joints become cos, sin); a new array."""
         pin_q = self._pin_q(q)
         return pin_q.copy() if pin_q is q else pin_q
 
-    def _pin_q(self, q) -> np.ndarray:
+    def _pin_q(self, q: ArrayLike) -> np.ndarray:
         """Pinocchio's q for reading only: q itself when the two orders coincide (no copy)."""
         arr = self.check_q(q)
         if self._identity_q:
@@ -517,7 +537,7 @@ class Robot:
         out[self._cont_idx + 1] = np.sin(angles)
         return out
 
-    def from_pin_q(self, q_pin) -> np.ndarray:
+    def from_pin_q(self, q_pin: ArrayLike) -> np.ndarray:
         """Pinocchio's q → one number per joint (continuous joints as atan2(sin, cos) in (−π, π])."""
         q_pin = np.asarray(q_pin, dtype=float)
         if q_pin.shape != (self.nq,):
@@ -527,7 +547,7 @@ class Robot:
         out[self._cont_pos] = np.arctan2(q_pin[self._cont_idx + 1], q_pin[self._cont_idx])
         return out
 
-    def wrap_continuous(self, q) -> np.ndarray:
+    def wrap_continuous(self, q: ArrayLike) -> np.ndarray:
         """q with continuous joints wrapped into (−π, π] (the same pose)."""
         q = np.array(q, dtype=float)
         if self._cont_pos.size:
@@ -544,8 +564,8 @@ class Robot:
         σ_min/σ_max of the tool Jacobian, linear rows divided by the characteristic length). All-zero poses
         are often singular (a stretched arm), which makes a poor first picture."""
         if self.display_pose is not None:
-            return self.display_pose.copy()
-        return self.derived("display_q", _best_conditioned).copy()
+            return np.array(self.display_pose, dtype=float)
+        return np.array(self.derived("display_q", _best_conditioned), dtype=float)
 
     def random_q(self, rng: np.random.Generator | int | None = None) -> np.ndarray:
         """A configuration drawn uniformly within the limits (continuous joints on [−π, π]; a revolute joint
@@ -567,11 +587,11 @@ class Robot:
                 np.where(revolute, np.minimum(self.upper, span), self.upper))
 
     # -- kinematics ----------------------------------------------------------------------------
-    def _forward(self, q) -> None:
+    def _forward(self, q: ArrayLike) -> None:
         pin.forwardKinematics(self.model, self.data, self._pin_q(q))
         pin.updateFramePlacements(self.model, self.data)
 
-    def fk(self, q) -> pin.SE3:
+    def fk(self, q: ArrayLike) -> pin.SE3:
         """oMtool: pose of the tool frame in the base frame at ``q`` (m, rad)."""
         self._forward(q)
         return pin.SE3(self.data.oMf[self.tool_frame_id])
@@ -620,7 +640,7 @@ class Robot:
             self.check_q(arr[b], what=f"{what}[{b}]")
         return arr
 
-    def tool_error(self, q, oMtarget: pin.SE3) -> tuple[float, float]:
+    def tool_error(self, q: ArrayLike, oMtarget: pin.SE3) -> tuple[float, float]:
         """(position error [m], rotation angle error [rad]) of the tool at q against oMtarget (Pinocchio FK)."""
         return pose_error(oMtarget, self.tool_pose_of_float_q(self.check_q(q)))
 
@@ -629,42 +649,42 @@ class Robot:
         pin.forwardKinematics(self.model, self.data, q if self._identity_q else self._pin_q(q))
         return pin.updateFramePlacement(self.model, self.data, self.tool_frame_id)
 
-    def frame_placement(self, q, frame: str) -> pin.SE3:
+    def frame_placement(self, q: ArrayLike, frame: str) -> pin.SE3:
         """oMframe: pose of any frame of the reduced model in the base frame."""
         fid = _frame_id(self.model, frame, self.name)
         self._forward(q)
         return pin.SE3(self.data.oMf[fid])
 
-    def joint_placements(self, q) -> dict[str, pin.SE3]:
+    def joint_placements(self, q: ArrayLike) -> dict[str, pin.SE3]:
         """oMjoint for every chain joint: the joint frame (after its motion) in the base frame."""
         self._forward(q)
         return {j.name: pin.SE3(self.data.oMi[self.model.getJointId(j.name)]) for j in self.joints}
 
-    def _jacobian(self, q, frame: pin.ReferenceFrame) -> np.ndarray:
+    def _jacobian(self, q: ArrayLike, frame: pin.ReferenceFrame) -> np.ndarray:
         q_pin = self.to_pin_q(q)
         J = pin.computeFrameJacobian(self.model, self.data, q_pin, self.tool_frame_id, frame)
         return np.array(J).reshape(6, self.nv)  # a 1-DoF chain comes back as a flat 6-vector
 
-    def jacobian_local(self, q) -> np.ndarray:
+    def jacobian_local(self, q: ArrayLike) -> np.ndarray:
         """6 × n tool Jacobian in the tool frame (LOCAL): twist [v; ω] of the tool in its own axes."""
         return self._jacobian(q, pin.LOCAL)
 
-    def jacobian_world(self, q) -> np.ndarray:
+    def jacobian_world(self, q: ArrayLike) -> np.ndarray:
         """6 × n tool Jacobian in the base frame (WORLD): spatial twist, v at the base origin."""
         return self._jacobian(q, pin.WORLD)
 
-    def jacobian_local_world_aligned(self, q) -> np.ndarray:
+    def jacobian_local_world_aligned(self, q: ArrayLike) -> np.ndarray:
         """6 × n tool Jacobian with base axes at the tool origin (LOCAL_WORLD_ALIGNED)."""
         return self._jacobian(q, pin.LOCAL_WORLD_ALIGNED)
 
-    def integrate(self, q, dq) -> np.ndarray:
+    def integrate(self, q: ArrayLike, dq: ArrayLike) -> np.ndarray:
         """q ⊕ dq through ``pin.integrate`` (dq: n velocities × 1 s), back in one-number-per-joint form."""
         dq = np.asarray(dq, dtype=float)
         return self.from_pin_q(pin.integrate(self.model, self.to_pin_q(q), dq))
 
-    def difference(self, q0, q1) -> np.ndarray:
+    def difference(self, q0: ArrayLike, q1: ArrayLike) -> np.ndarray:
         """q1 ⊖ q0 through ``pin.difference``: the n velocities that take q0 to q1 in 1 s."""
-        return pin.difference(self.model, self.to_pin_q(q0), self.to_pin_q(q1))
+        return np.asarray(pin.difference(self.model, self.to_pin_q(q0), self.to_pin_q(q1)), dtype=float)
 
     def visual_model(self, package_dirs: list[str] | None = None) -> pin.GeometryModel:
         """Visual geometry matched to ``self.model`` (locked joints folded in), meshes resolved.
@@ -750,7 +770,8 @@ def _local_axes(model: pin.Model) -> list[np.ndarray]:
 
 def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, float] | None = None,
          base: str | None = None, package_dirs: list[str] | None = None, srdf: str | Path | None = None,
-         group: str | None = None, xacro_args: dict[str, str] | None = None) -> Robot:
+         group: str | None = None, xacro_args: dict[str, str] | None = None, *,
+         trust_xacro: bool = False) -> Robot:
     """Load a registered robot (``kinelab.robots()``) or a URDF file as a :class:`Robot`.
 
     Args:
@@ -771,6 +792,8 @@ def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, fl
         group: an SRDF group whose chain (base → tip), end effector or last joint gives base and tool.
         xacro_args: arguments of a ``.xacro`` source (name → value), expanded with xacrodoc (the extra
             ``kinelab[xacro]``); MJCF sources (root ``<mujoco>``) are read by Pinocchio's MJCF parser.
+        trust_xacro: let a ``.xacro`` source run what xacro runs (``$(eval ...)``, ``$(env ...)``,
+            ``load_yaml``); without it those are refused with their line (:mod:`~kinelab.robot.xacro`).
 
     Raises:
         RobotNotFoundError, DescriptionError, URDFError, SRDFError, ChainError, FrameNotFoundError: named.
@@ -787,7 +810,7 @@ def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, fl
             group = entry.group
         srdf = srdf or catalog.srdf_path(entry)
     robot = Robot(path, tool=tool, locked=locked, name=entry.name if entry else None, base=base,
-                  package_dirs=package_dirs, srdf=srdf, group=group, xacro_args=xacro_args)
+                  package_dirs=package_dirs, srdf=srdf, group=group, xacro_args=xacro_args, trust_xacro=trust_xacro)
     if entry is not None and entry.display is not None and robot.n == len(entry.display):
         robot.display_pose = np.array(entry.display)
     return robot

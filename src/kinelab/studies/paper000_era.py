@@ -40,8 +40,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from kinelab.ik.api import track
 from kinelab.ik.frdm import solver
-from kinelab.ik.frdm.tracking import TrackResult, track
+from kinelab.ik.result import TrackResult
 from kinelab.robot import Robot, load
 
 FULL_REACH = 1.228 + 0.340 + 4.072 + 4.072 + 0.340 + 1.228  # [m] joint 1 to the tool, straight
@@ -160,9 +161,9 @@ def run(passage: Passage, robot: Robot | None = None, **options) -> PassageRun:
     ``TRACK_OPTIONS`` (see there)."""
     robot = robot or load("era")
     options = {**TRACK_OPTIONS, **options}
-    without = track(robot, passage.targets, passage.q0, policy=(), **options)
+    without = track(robot, passage.targets, q0=passage.q0, policy=(), **options)
     q0 = passage.q0 if passage.q0_bypass is None else passage.q0_bypass
-    with_bypass = track(robot, passage.targets, q0, **passage.bypass, **options)
+    with_bypass = track(robot, passage.targets, q0=q0, **passage.bypass, **options)
     return PassageRun(passage, without, with_bypass)
 
 

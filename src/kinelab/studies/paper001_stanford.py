@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from kinelab.ik.result import BiquatTrajectory
+
 # Target and start configurations (q1, q2, q3 [m], q4, q5, q6); angles in degrees as printed.
 TARGET_Q_DEG = (20.0, 40.0, 0.3, -35.0, 60.0, -45.0)
 START_Q_DEG = (-30.0, 15.0, 0.1, 36.0, -90.0, 45.0)
@@ -39,7 +41,7 @@ def reproduce(robot=None, law: str = "simple", integrator: str = "euler", step: 
               k0: float = 0.0, k_v: float | None = None, start_q=None, record: bool = True):
     """The paper's run: from START_Q to the target N = Λ(TARGET_Q), K = k + s k0, step h [s].
 
-    Returns the solver's Attempt; ``info`` holds model_time [s], M0 (the scalar of N̄∘Λ at the end, the
+    Returns the solver's Attempt; its ``diagnostics`` hold model_time [s], M0 (the scalar of N̄∘Λ at the end, the
     chain product keeping Λ continuous) and, with ``record``, the trajectory (t, q, M*, U).
     """
     from kinelab.dq import kinematics as biquat_kinematics
@@ -53,9 +55,9 @@ def reproduce(robot=None, law: str = "simple", integrator: str = "euler", step: 
                           step=step, k=k, k0=k0, k_v=k_v, target_biquaternion=N, record=record)
 
 
-def part_times(trajectory: dict, eps: float = 5e-7) -> tuple[float, float]:
+def part_times(trajectory: BiquatTrajectory, eps: float = 5e-7) -> tuple[float, float]:
     """Model times [s] at which the rotation part |m⃗| and the moment part |m0⃗| of M* first fall below eps."""
-    t, M = trajectory["t"], trajectory["M"]
+    t, M = trajectory.t, trajectory.M
     rot, mom = np.linalg.norm(M[:, 1:4], axis=1), np.linalg.norm(M[:, 5:8], axis=1)
     first = [t[np.argmax(x < eps)] if (x < eps).any() else float("nan") for x in (rot, mom)]
     return float(first[0]), float(first[1])

@@ -17,7 +17,7 @@ from kinelab.ik.biquat import laws
 from kinelab.ik.biquat.options import BiquatOptions
 from kinelab.ik.chain import chain_fk, chain_model, jacobian_local
 from kinelab.ik.limits import PinLimits
-from kinelab.ik.result import Status
+from kinelab.ik.result import BiquatTrajectory, Status
 from kinelab.robot import Robot
 
 _ZERO2 = np.zeros(2)
@@ -38,8 +38,9 @@ class Trajectory:
         self.M.append(np.array(M))
         self.U.append(np.concatenate(U))
 
-    def arrays(self) -> dict[str, np.ndarray]:
-        return {"t": np.array(self.t), "q": np.array(self.q), "M": np.array(self.M), "U": np.array(self.U)}
+    def arrays(self) -> BiquatTrajectory:
+        """The recorded rows as arrays."""
+        return BiquatTrajectory(np.array(self.t), np.array(self.q), np.array(self.M), np.array(self.U))
 
 
 class System:

@@ -38,7 +38,7 @@ class BiquatOptions:
         max_steps: step cap of one attempt; None: 30 with the newton preset, 20000 otherwise.
         clamp: after each Euler step, wrap revolute joints by 2π and clip q into the limits; None: off.
         target_biquaternion: N itself, when the sign of the target matters; it must be the target's pose.
-        record: keep the trajectory (t, q, M*, U) in ``info["trajectory"]``.
+        record: keep the trajectory (t, q, M*, U) in ``diagnostics.trajectory``.
     """
 
     law: str = "simple"

@@ -25,7 +25,7 @@ from kinelab.ik.biquat.options import LAWS, BiquatOptions
 from kinelab.ik.chain import chain_model
 from kinelab.ik.limits import wrap_q
 from kinelab.ik.multistart import TypedKernel, clock_chunk
-from kinelab.ik.result import Attempt, Status
+from kinelab.ik.result import Attempt, Diagnostics, Status
 from kinelab.robot import Robot
 
 Options = BiquatOptions
@@ -102,19 +102,18 @@ def attempt(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol
         else:
             q_pin, t, steps, status, _ = fixed(system, robot.to_pin_q(q0), stop, opts.integrator, traj)
     except (KinelabError, np.linalg.LinAlgError, FloatingPointError) as exc:
-        return Attempt(robot.neutral(), Status.SINGULAR, 0, info={"mode": f"biquat ({opts.law})", "message": str(exc)})
+        return Attempt(robot.neutral(), Status.SINGULAR, 0, diagnostics=Diagnostics(message=str(exc)),
+                       mode=f"biquat ({opts.law})")
     q_end = robot.from_pin_q(q_pin)
     M0 = None
     if opts.target_biquaternion is not None or opts.record:
         # Λ by the chain product, continuous in q: the scalar of N̄∘Λ tells which of ±1 was reached
         M0 = float((N.conj() * biquat_kinematics.pose(robot, q_end)).real_wxyz[0])
     preset = "newton " if opts.newton and opts.integrator != "adaptive" else ""
-    info = {"mode": f"biquat ({opts.law}, {preset}{opts.integrator}, h={opts.h:g}, k={opts.gain:g})",
-            "model_time": t, "steps": steps, "M0": M0, "damping": system.damping, "law": opts.law,
-            "integrator": opts.integrator}
-    if traj is not None:
-        info["trajectory"] = traj.arrays()
-    return Attempt(wrap_q(robot, robot.wrap_continuous(q_end)), status, steps, info=info)
+    diag = Diagnostics(model_time=t, steps=steps, M0=M0, damping=system.damping, law=opts.law,
+                       integrator=opts.integrator, trajectory=None if traj is None else traj.arrays())
+    mode = f"biquat ({opts.law}, {preset}{opts.integrator}, h={opts.h:g}, k={opts.gain:g})"
+    return Attempt(wrap_q(robot, robot.wrap_continuous(q_end)), status, steps, diagnostics=diag, mode=mode)
 
 
 def _target_biquaternion(opts: BiquatOptions, oMtarget: pin.SE3) -> DualQuat:
@@ -162,11 +161,12 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: 
         status = Status.TIME_BUDGET
     else:
         status = Status.SINGULAR if code == kernel.SINGULAR else Status.MAX_ITERATIONS
-    info = {"mode": f"biquat (simple, newton euler, h={1.0 / k:g}, k={k:g}, compiled)",
-            "model_time": float(stats[kernel.T_MODEL_TIME]), "steps": int(stats[kernel.T_STEPS]), "M0": None,
-            "damping": damping, "law": "simple", "integrator": "euler", "attempts": int(stats[kernel.T_ATTEMPTS]),
-            "outside_limits": int(stats[kernel.T_OUTSIDE]), "path": "compiled"}
-    return Attempt(q, status, int(stats[kernel.T_STEPS]), info=info), max(0, int(stats[kernel.T_ATTEMPTS]) - 1)
+    diag = Diagnostics(model_time=float(stats[kernel.T_MODEL_TIME]), steps=int(stats[kernel.T_STEPS]),
+                       damping=damping, law="simple", integrator="euler", attempts=int(stats[kernel.T_ATTEMPTS]),
+                       outside_limits=int(stats[kernel.T_OUTSIDE]), path="compiled")
+    mode = f"biquat (simple, newton euler, h={1.0 / k:g}, k={k:g}, compiled)"
+    restarts_run = max(0, int(stats[kernel.T_ATTEMPTS]) - 1)
+    return Attempt(q, status, int(stats[kernel.T_STEPS]), diagnostics=diag, mode=mode), restarts_run
 
 
 _COMPILED: list[bool] = []

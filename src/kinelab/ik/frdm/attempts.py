@@ -5,7 +5,7 @@ FRDM's sweeps are coordinate descent: near a singular configuration, or on a tas
 redundant (task "axis" on a 6-joint arm), their rate tends to 1 and an attempt stalls a little short of
 1e-6 (5e-4 m on a Stanford target with the boom nearly retracted). A few Gauss–Newton steps from there
 converge where a restart would start over: ``FRDMOptions.stall_polish`` steps are tried on each stalled
-attempt before the restart (0: the paper's FRDM alone), counted in ``info["polished"]``.
+attempt before the restart (0: the paper's FRDM alone), counted in ``diagnostics.polished``.
 """
 
 from __future__ import annotations

@@ -8,10 +8,10 @@ the other targets.
 
 from __future__ import annotations
 
+import threading
 import time
 from dataclasses import dataclass
 
-import numba
 import numpy as np
 from numba import njit, prange
 
@@ -34,7 +34,7 @@ from kinelab.ik.multistart import clock_chunk
 from kinelab.ik.result import Status
 from kinelab.robot import Robot
 
-ROWS_PER_LOOK = 256  # rows per thread between two looks at the clock
+NOT_STARTED, STOPPED = -2, -3  # a row's code when the budget ran out before it started, or while it ran
 
 
 @dataclass
@@ -68,7 +68,8 @@ _COMPILED: list[bool] = []
 
 def run(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts: np.ndarray | None, rng_states: np.ndarray,
         attempts: np.ndarray, tol_pos: float, tol_rot: float, deadline: float, opts: FRDMOptions) -> Rows:
-    """Solve the rows in slices of ROWS_PER_LOOK per thread, looking at the clock between slices.
+    """Solve every row in one parallel kernel call; with a deadline, a timer stops the rows at it (each row looks
+    between its chunks of sweeps, the points at which the single solve looks at the clock).
 
     Args:
         robot: the robot.
@@ -83,7 +84,8 @@ def run(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts: np.ndar
         opts: compiled FRDM options.
 
     Returns:
-        Rows with the kernel's status (converged, stalled, max_iterations; time_budget where not started).
+        Rows with the kernel's status (converged, stalled, max_iterations; time_budget for a row the deadline
+        stopped, with its best answer so far, and for one it reached before the row started, with NaN).
     """
     cm = chain_model(robot)
     count = points.shape[0]
@@ -91,23 +93,30 @@ def run(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts: np.ndar
     Q = np.zeros((count, cm.n)) if starts is None else np.array(starts, dtype=float)
     codes, stats = np.zeros(count, dtype=np.int64), np.zeros((count, STATS_SIZE))
     lower, upper = (cm.lower, cm.upper) if opts.use_limits else (np.full(cm.n, -np.inf), np.full(cm.n, np.inf))
-    step = count if deadline == np.inf else ROWS_PER_LOOK * numba.get_num_threads()  # no budget: one call
-    for a in range(0, count, step):
-        if time.perf_counter() > deadline:
-            break
-        z = slice(a, min(a + step, count))
-        solve_rows(Q[z], starts is None, cm.chain, lower, upper, np.ones(cm.n, dtype=np.bool_), points[z],
-                   rotations[z], opts.position_weight(cm.length), opts.axis_weights(), float(tol_pos), float(tol_rot),
+    stop = np.zeros(1, dtype=np.int64)  # set by a timer thread at the deadline; every row looks between chunks
+    timer = None if deadline == np.inf else threading.Timer(max(0.0, deadline - time.perf_counter()),
+                                                             stop.fill, (1,))
+    if timer is not None:
+        timer.daemon = True
+        timer.start()
+    try:
+        solve_rows(Q, starts is None, cm.chain, lower, upper, np.ones(cm.n, dtype=np.bool_), points, rotations,
+                   opts.position_weight(cm.length), opts.axis_weights(), float(tol_pos), float(tol_rot),
                    opts.mode != "orientation", opts.mode != "position", opts.rot_axis, opts.settings(),
-                   ORDERS[opts.order],
-                   opts.sweep_cap, rng_states[z], attempts[z], float(clock_chunk(solver.JOINT_SWEEPS_PER_LOOK, cm.n)),
-                   float(clock_chunk(solver.JOINT_SWEEPS_PER_LATER_LOOK, cm.n)),
-                   codes[z], stats[z])
-        rows.Q[z] = Q[z]
-        rows.status[z] = np.where(codes[z] == CONVERGED, Status.CONVERGED.value,
-                                  np.where(stats[z, T_STALLS] > 0, Status.STALLED.value, Status.MAX_ITERATIONS.value))
-        rows.iterations[z] = stats[z, T_SWEEPS]
-        rows.restarts[z] = np.maximum(0, stats[z, T_ATTEMPTS] - 1)
+                   ORDERS[opts.order], opts.sweep_cap, rng_states, attempts,
+                   float(clock_chunk(solver.JOINT_SWEEPS_PER_LOOK, cm.n)),
+                   float(clock_chunk(solver.JOINT_SWEEPS_PER_LATER_LOOK, cm.n)), codes, stats, stop)
+    finally:
+        if timer is not None:
+            timer.cancel()
+    started = codes != NOT_STARTED
+    rows.Q[started] = Q[started]
+    rows.status[started] = np.where(codes[started] == CONVERGED, Status.CONVERGED.value,
+                                    np.where(codes[started] == STOPPED, Status.TIME_BUDGET.value,
+                                             np.where(stats[started, T_STALLS] > 0, Status.STALLED.value,
+                                                      Status.MAX_ITERATIONS.value)))
+    rows.iterations[:] = stats[:, T_SWEEPS]
+    rows.restarts[:] = np.maximum(0, stats[:, T_ATTEMPTS] - 1)
     continuous = cm.kind == CONTINUOUS
     if continuous.any():
         rows.Q[:, continuous] = wrap_to_pi(rows.Q[:, continuous])
@@ -115,13 +124,16 @@ def run(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts: np.ndar
 
 
 @njit(cache=True)
-def chunked(q, ch, pb, st, order, max_sweeps, rng_state, attempts, chunk_sweeps, later_sweeps, best_q, stats, mem):
+def chunked(q, ch, pb, st, order, max_sweeps, rng_state, attempts, chunk_sweeps, later_sweeps, best_q, stats, mem,
+            stop):
     """The kernel's multistart in chunks of ``chunk_sweeps`` sweeps, then ``later_sweeps``, as the timed single
-    solve runs it
-    (:func:`kinelab.ik.multistart.run_in_chunks`) but without the clock. Returns the last code."""
+    solve runs it (:func:`kinelab.ik.multistart.run_in_chunks`), looking at ``stop[0]`` (set at the deadline)
+    where the single solve looks at the clock. Returns the last code (NOT_STARTED, STOPPED at the deadline)."""
     code = -1
     chunk = chunk_sweeps
     while attempts > 0:
+        if stop[0] != 0:
+            return STOPPED if stats[T_ATTEMPTS] > 0 else NOT_STARTED
         before = stats[T_ATTEMPTS]
         code = multistart(q, ch, pb, st, order, max_sweeps, rng_state, attempts, stats[T_SWEEPS] + chunk,
                           best_q, stats, mem)
@@ -132,10 +144,10 @@ def chunked(q, ch, pb, st, order, max_sweeps, rng_state, attempts, chunk_sweeps,
     return code
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, nogil=True)  # nogil: the deadline timer thread must run meanwhile
 def solve_rows(Q, draw_start, ch, lower, upper, free, pstars, Rstars, w_p, w_ax, tol_pos, tol_rot, check_pos,
                check_rot, rot_axis, st, order, max_sweeps, rng_states, attempts, chunk_sweeps, later_sweeps, codes,
-               stats):
+               stats, stop):
     """Solve rows [0, B) in parallel; row b's start is Q[b] (drawn from its generator when draw_start).
 
     Inputs, in order:
@@ -148,6 +160,7 @@ def solve_rows(Q, draw_start, ch, lower, upper, free, pstars, Rstars, w_p, w_ax,
         attempts (np.ndarray): (B,) attempts allowed per row (1 for a target proved out of reach).
         chunk_sweeps, later_sweeps (float): sweeps of the first chunk and of the later ones (the single solve's).
         codes (np.ndarray): (B,) run() code per row; stats: (B, STATS_SIZE) the slots T_* per row.
+        stop (np.ndarray): (1,) int64, non-zero once the deadline has passed (written by another thread).
     """
     n = Q.shape[1]
     rest = np.zeros(n)
@@ -162,6 +175,6 @@ def solve_rows(Q, draw_start, ch, lower, upper, free, pstars, Rstars, w_p, w_ax,
         mem = Memory(np.zeros((st.accel_m + 1, n)), np.zeros((st.accel_m + 1, n)), np.zeros(STATE_SIZE), np.zeros(0),
                      np.zeros((2 * n + 4, 3)))
         codes[b] = chunked(q, ch, pb, st, order, max_sweeps, rng_states[b], attempts[b], chunk_sweeps, later_sweeps,
-                           best_q, row_stats, mem)
+                           best_q, row_stats, mem, stop)
         Q[b] = best_q
         stats[b] = row_stats

@@ -7,12 +7,13 @@ from typing import Any
 
 import numpy as np
 
-from kinelab.geometry import pose_errors, stack_homogeneous
+from kinelab.geometry import stack_homogeneous
 from kinelab.ik.chain import chain_model
 from kinelab.ik.frdm import kernel, path_kernel
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.result import SingularEvent, Status, TrackResult
 from kinelab.ik.targets import as_target_arrays
+from kinelab.ik.tasks import POSE, Task
 from kinelab.robot import Robot
 
 REST_WEIGHT = 0.01  # objective units (the weighted pose error is ~1 at a chain length's distance)
@@ -24,7 +25,7 @@ _STATUS = {kernel.STALL_STEP: Status.STALLED, kernel.STALL_WINDOW: Status.STALLE
 
 
 def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: float, max_sweeps: int,
-           rest_weight: float | None, opts: FRDMOptions) -> TrackResult:
+           rest_weight: float | None, opts: FRDMOptions, task: Task = POSE) -> TrackResult:
     """Solve every sample of a path in the compiled follower; each answer judged by Pinocchio.
 
     Args:
@@ -36,6 +37,7 @@ def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: 
         max_sweeps: sweep cap of each phase of a sample.
         rest_weight: weight of the rest term (None: :data:`REST_WEIGHT` on arms with more than six joints).
         opts: FRDM options (order, weights, stall window).
+        task: the components judged (FRDM's mode in ``opts`` is the same task).
 
     Returns:
         A :class:`~kinelab.ik.frdm.tracking.TrackResult` with mode "frdm (compiled follower)". Continuous
@@ -57,8 +59,8 @@ def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: 
                        float(tol_rot), opts.mode != "orientation", opts.mode != "position", opts.settings(), order,
                        int(max_sweeps), float(rest_weight), REST_SWEEPS, centre, CENTRE_PULL,
                        LM_ITERATIONS if opts.polish else 0, codes, sweeps)
-    dp, dr = pose_errors(stack_homogeneous(points, rotations), robot.fk_batch(Q))
-    ok = (dp <= tol_pos) & (dr <= tol_rot) & robot.within_limits_batch(Q)
+    dp, dr = task.errors_batch(stack_homogeneous(points, rotations), robot.fk_batch(Q))
+    ok = task.met_batch(dp, dr, tol_pos, tol_rot) & robot.within_limits_batch(Q) & np.isfinite(Q).all(axis=1)
     status = [Status.CONVERGED.value if ok[k] else _STATUS.get(int(codes[k]), Status.MAX_ITERATIONS).value
               for k in range(count)]
     per_sample = (time.perf_counter() - t0) / count  # the kernel and Pinocchio's check of every answer

@@ -62,7 +62,7 @@ class FRDMOptions:
         polish: follow FRDM with damped-least-squares steps (reported as mode "frdm+polish").
         stall_polish: Gauss–Newton steps the compiled multistart tries on a stalled attempt before its
             restart (:mod:`~kinelab.ik.frdm.attempts`; 0: the paper's FRDM alone).
-        trace: keep the objective after every sweep in ``info["trace"]``.
+        trace: keep the objective after every sweep in ``diagnostics.trace``.
     """
 
     mode: str = "pose"
@@ -92,7 +92,7 @@ class FRDMOptions:
     def __hash__(self) -> int:  # computed once: solve() looks its compiled context up by these options
         cached = self.__dict__.get("_hash")
         if cached is None:
-            cached = hash(tuple(getattr(self, f.name) for f in dataclasses.fields(self)))
+            cached = hash(tuple(_hashable(getattr(self, f.name)) for f in dataclasses.fields(self)))
             object.__setattr__(self, "_hash", cached)
         return cached
 
@@ -139,6 +139,11 @@ class FRDMOptions:
             if not _interval(window):
                 raise OptionError("intervals", {name: window}, "a non-empty (lower, upper) per joint",
                                   f"bypass interval for {name!r} is empty or malformed: {window!r}")
+        for name, value in (self.freeze or {}).items():
+            if value is not None and not (isinstance(value, numbers.Real) and not isinstance(value, bool)
+                                          and math.isfinite(value)):
+                raise OptionError("freeze", {name: value}, "a finite value per joint [rad or m], or None (where "
+                                  "the joint is)")
         for name in ("policy", "active"):
             steps = getattr(self, name)
             if steps is not None:
@@ -232,9 +237,49 @@ class FRDMOptions:
         return w
 
 
+SWITCHABLE = {"kick": "kicks", "interval": "intervals", "freeze": "freeze"}
+
+
+def bypass_plan(tables: dict[str, Any], on_singular: tuple[str, ...] = ()) -> dict[str, Any]:
+    """FRDM's ``active`` and ``policy`` options for bypass tables given by a user (the CLI's flags).
+
+    The paper's rule: intervals and frozen joints hold from the first sweep unless named in ``on_singular``,
+    kicks are applied when the monitor fires; the bypasses named in ``on_singular`` ("kick", "interval",
+    "freeze") are switched on by the monitor in that order, kicks last when not named; with no bypass the
+    monitor answers by an automatic kick.
+
+    Args:
+        tables: the bypass tables given ("kicks", "intervals", "freeze" → their dicts).
+        on_singular: bypasses to switch on only when the monitor fires, in order.
+
+    Returns:
+        The option fields ``active`` (when some table holds from the start) and ``policy``.
+
+    Raises:
+        OptionError: a name in ``on_singular`` that is not a bypass, or one whose table was not given.
+    """
+    for name in on_singular:
+        if name not in SWITCHABLE:
+            raise OptionError("on_singular", name, ", ".join(SWITCHABLE))
+        if SWITCHABLE[name] not in tables:
+            raise OptionError("on_singular", name, f"a bypass with its table: {name!r} needs its joints "
+                              f"(--{name} JOINT=... on the command line, {SWITCHABLE[name]}= in Python)")
+    switched = tuple(SWITCHABLE[name] for name in on_singular)
+    held = tuple(key for key in ("intervals", "freeze") if key in tables and key not in switched)
+    policy = switched + (("kicks",) if "kicks" in tables and "kicks" not in switched else ())
+    return {**({"active": held} if held else {}), "policy": policy or ("auto_kick",)}
+
+
 @functools.lru_cache(maxsize=64)
 def _for_task(opts: FRDMOptions, task: Task) -> FRDMOptions:
     return dataclasses.replace(opts, mode=task.name, tool_axis="xyz"[task.axis] if task.axis >= 0 else opts.tool_axis)
+
+
+def _hashable(value: object) -> object:
+    """A bypass table (a dict joint → value) as a sorted tuple of items; anything else as it is."""
+    if isinstance(value, dict):
+        return tuple(sorted((k, tuple(v) if isinstance(v, list) else v) for k, v in value.items()))
+    return value
 
 
 def _nonzero_finite(value: object) -> bool:

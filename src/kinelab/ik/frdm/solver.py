@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import functools
 import time
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -24,7 +25,7 @@ from kinelab.ik.frdm.kernel import no_rest
 from kinelab.ik.frdm.monitor import Bypass, Problem, Runner
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.multistart import TypedKernel, clock_chunk
-from kinelab.ik.result import Attempt, SingularEvent, Status
+from kinelab.ik.result import Attempt, Diagnostics, SingularEvent, Status
 from kinelab.robot import Robot
 
 Options = FRDMOptions
@@ -77,16 +78,14 @@ def attempt(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol
     for step in bypass.active:
         q = run.apply(bypass, step, q)
     status = run.solve(q, deadline, bypass, opts.max_bypass_events)
-    info = {"mode": "frdm" + (" (plain)" if opts.plain else ""), "sweeps": run.sweeps,
-            "accelerated_sweeps": run.accepted, "order": opts.order, "w_p": prob.w_p, "relax": opts.relax,
-            "objective": run.E}
-    if opts.trace:
-        info["trace"] = run.trace_values()
-    att = Attempt(robot.wrap_continuous(run.q), status, run.sweeps, run.events, run.bypass_log, info)
+    diag = Diagnostics(sweeps=run.sweeps, accelerated_sweeps=run.accepted, order=opts.order, w_p=prob.w_p,
+                       relax=opts.relax, objective=run.E, trace=tuple(run.trace_values()) if opts.trace else None)
+    att = Attempt(robot.wrap_continuous(run.q), status, run.sweeps, run.events, run.bypass_log, diag,
+                  "frdm" + (" (plain)" if opts.plain else ""))
     if opts.polish and status != Status.CONVERGED:
         pol = dls.attempt(robot, oMtarget, run.q, tol_pos, tol_rot, deadline, max_iterations=20)
         att = Attempt(pol.q, pol.status, run.sweeps + pol.iterations, run.events, run.bypass_log,
-                      {**info, "mode": "frdm+polish", "polish_iterations": pol.iterations})
+                      replace(diag, polish_iterations=pol.iterations), "frdm+polish")
     return att
 
 
@@ -109,11 +108,11 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: 
     else:
         status = Status.STALLED if stats[kernel.T_STALLS] > 0 else Status.MAX_ITERATIONS
     sweeps, stalls, attempts = int(stats[kernel.T_SWEEPS]), int(stats[kernel.T_STALLS]), int(stats[kernel.T_ATTEMPTS])
-    info = {"mode": ctx.mode, "sweeps": sweeps, "accelerated_sweeps": int(stats[kernel.T_ACCEPTED]),
-            "order": opts.order, "w_p": ctx.problem.w_p, "objective": float(stats[kernel.T_BEST_E]),
-            "attempts": attempts, "stalls": stalls, "polished": int(stats[kernel.T_POLISHED]), "path": "compiled"}
+    diag = Diagnostics(sweeps=sweeps, accelerated_sweeps=int(stats[kernel.T_ACCEPTED]), order=opts.order,
+                       w_p=ctx.problem.w_p, objective=float(stats[kernel.T_BEST_E]), attempts=attempts, stalls=stalls,
+                       polished=int(stats[kernel.T_POLISHED]), path="compiled")
     events = [SingularEvent("stall", "not diagnosed (compiled multistart: restarted)", count=stalls)] if stalls else []
-    return Attempt(robot.wrap_continuous(q) if ctx.continuous else q, status, sweeps, events, [], info), \
+    return Attempt(robot.wrap_continuous(q) if ctx.continuous else q, status, sweeps, events, [], diag, ctx.mode), \
         max(0, attempts - 1)
 
 

@@ -17,131 +17,160 @@ point (the ERA wrist and shoulder passages), where no monitor fires before the d
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
-from kinelab.errors import KinelabError
+from kinelab.errors import OptionError
+from kinelab.ik import options as opt
 from kinelab.ik.frdm import solver
 from kinelab.ik.frdm.follower import follow
 from kinelab.ik.frdm.options import FRDMOptions
+from kinelab.ik.request import Request
 from kinelab.ik.result import Attempt, BypassRecord, SingularEvent, Status, TrackResult
+from kinelab.ik.targets import as_target_arrays
 from kinelab.robot import Robot
 
+RESTRICTIONS = ("intervals", "freeze")
+# FRDM's defaults on a path: a longer sweep cap and stall window than a single solve's, since a warm start
+# that is slow at first (a singular passage) must not be abandoned: there is no restart on a path
+PATH_DEFAULTS = {"max_sweeps": 2000, "stall_window": 100, "stall_rel": 1e-6}
 
-def track(
-    robot: Robot,
-    targets: list[pin.SE3],
-    q0: np.ndarray,
-    *,
-    tol_pos: float = 1e-6,
-    tol_rot: float = 1e-6,
-    max_sweeps: int = 2000,
-    jump_limit: float | None = 0.2,
-    kicks: dict | None = None,
-    intervals: dict | None = None,
-    freeze: dict | None = None,
-    policy: tuple[str, ...] | None = None,
-    restrict: tuple[str, ...] = (),
-    hold: int = 10,
-    stall_window: int = 100,
-    stall_rel: float = 1e-6,
-    rest_weight: float | None = None,
-    **frdm_options: Any,
-) -> TrackResult:
-    """Solve each target in turn, warm-started from the previous answer.
+
+@dataclass(frozen=True)
+class PathSettings:
+    """How :func:`kinelab.track` follows a path, beside the solver's options.
+
+    Attributes:
+        jump_limit: largest joint step [rad or m] between samples before the jump monitor fires (None: off).
+        restrict: restrictions ("intervals", "freeze") held on every sample of the path.
+        hold: samples a restriction stays on after the monitor switched it on (an integer ≥ 1).
+        rest_weight: compiled follower only: weight of the rest term (None: 0.01 beyond six joints, else 0).
+    """
+
+    jump_limit: float | None = 0.2
+    restrict: tuple[str, ...] = ()
+    hold: int = 10
+    rest_weight: float | None = None
+
+    def __post_init__(self) -> None:
+        opt.positive("jump_limit", self.jump_limit, allow_none=True)
+        opt.positive("hold", self.hold, integer=True)
+        opt.positive("rest_weight", self.rest_weight, allow_none=True, zero=True)
+        restrict = self.restrict
+        if isinstance(restrict, str) or not isinstance(restrict, (tuple, list)) \
+                or any(s not in RESTRICTIONS for s in restrict):
+            raise OptionError("restrict", restrict, "a tuple of 'intervals' and 'freeze'")
+        object.__setattr__(self, "restrict", tuple(restrict))
+
+
+def path_options(options: Any, solver_options: dict[str, Any]) -> dict[str, Any]:
+    """The FRDM option keywords of a path: :data:`PATH_DEFAULTS` under the caller's (none when an options
+    object is given: it is taken as it is)."""
+    return solver_options if options is not None else {**PATH_DEFAULTS, **solver_options}
+
+
+def run_track(robot: Robot, targets: Any, q0: np.ndarray, req: Request, settings: PathSettings) -> TrackResult:
+    """Solve each target in turn, warm-started from the previous answer, each sample judged by Pinocchio.
 
     Args:
         robot: the robot.
         targets: oMtarget per sample (base frame).
-        q0: the configuration at the start of the path [rad or m].
-        tol_pos: position tolerance per sample [m].
-        tol_rot: rotation tolerance per sample [rad].
-        max_sweeps: sweep cap per sample.
-        jump_limit: largest joint step [rad or m] before the jump monitor fires (None: off).
-        kicks: the bypass kicks (see :class:`~kinelab.ik.frdm.options.FRDMOptions`).
-        intervals: the bypass intervals.
-        freeze: the joints to freeze.
-        policy: None (default, no bypass table): the compiled follower; ``()``: the monitored loop, no bypass.
-        restrict: restrictions ("intervals", "freeze") held on every sample of the path.
-        hold: samples a restriction stays on after the monitor switched it on.
-        stall_window: the monitor's window [sweeps] (long: a slow start on a path escapes a singularity).
-        stall_rel: the relative fall required over the window.
-        rest_weight: compiled follower only: weight of the rest term (None: 0.01 beyond six joints, else 0).
-        **frdm_options: other :class:`~kinelab.ik.frdm.options.FRDMOptions` fields (order, w_p, accel, ...).
+        q0: the checked configuration at the start of the path [rad or m].
+        req: the validated request (solver "frdm"; its options hold the bypass tables and the policy).
+        settings: the path's own settings.
 
     Returns:
-        One row of q per sample, Pinocchio's errors, statuses, the monitor log (:class:`TrackResult`).
+        One row of q per sample, Pinocchio's errors on the task's components, statuses, the monitor log.
 
     Raises:
-        ConfigurationError: a bad q0; KinelabError: a restriction named without its table.
+        OptionError: a restriction named without its table.
     """
-    q_prev = robot.check_q(q0, limits=True, what="q0")
-    _check_restrict(restrict, intervals, freeze)
-    if policy is None and not (kicks or intervals or freeze or restrict):
-        return follow(robot, targets, q_prev, tol_pos, tol_rot, max_sweeps, rest_weight,
-                      FRDMOptions(stall_window=stall_window, stall_rel=stall_rel, **frdm_options))
-    options = {"max_sweeps": max_sweeps, "kicks": kicks, "intervals": intervals, "freeze": freeze,
-               "policy": tuple(s for s in (policy or ()) if s not in RESTRICTIONS),
-               "stall_window": stall_window, "stall_rel": stall_rel, **frdm_options}
-    path = _Path(robot, tol_pos, tol_rot, options, restrict, [s for s in (policy or ()) if s in RESTRICTIONS],
-                 jump_limit, hold)
-    for k, target in enumerate(targets):
-        q_prev = path.sample(k, target, q_prev)
+    opts: FRDMOptions = req.options
+    _check_restrict(settings.restrict, opts.intervals, opts.freeze)
+    if _followable(opts) and not settings.restrict:
+        return follow(robot, targets, q0, req.tol_pos, req.tol_rot, opts.sweep_cap, settings.rest_weight, opts,
+                      req.task)
+    policy = opts.policy or ()
+    attempt_opts = replace(opts, policy=tuple(s for s in policy if s not in RESTRICTIONS))
+    path = _Path(robot, req, attempt_opts, settings, [s for s in policy if s in RESTRICTIONS])
+    points, rotations = as_target_arrays(targets)
+    q_prev = q0
+    for k in range(points.shape[0]):
+        q_prev = path.sample(k, pin.SE3(rotations[k], points[k]), q_prev)
     return path.result()
 
 
-RESTRICTIONS = ("intervals", "freeze")
+def _followable(opts: FRDMOptions) -> bool:
+    """The compiled follower serves the path: no bypass table, policy or trace named (the polish it has)."""
+    return (opts.kicks is None and opts.intervals is None and opts.freeze is None and opts.policy is None
+            and opts.active is None and not opts.trace)
 
 
-def _check_restrict(restrict: tuple[str, ...], intervals: dict | None, freeze: dict | None) -> None:
-    unknown = [s for s in restrict if s not in RESTRICTIONS]
-    if unknown:
-        raise KinelabError(f"restrict takes 'intervals' and 'freeze', not {unknown}")
+def _check_restrict(restrict: tuple[str, ...], intervals: Any, freeze: Any) -> None:
     for name, table in (("intervals", intervals), ("freeze", freeze)):
         if name in restrict and not table:
-            raise KinelabError(f"restrict names {name!r} but no {name} table was given")
+            raise OptionError("restrict", restrict, f"a restriction with its table: restrict names {name!r} but "
+                              f"no {name} table was given ({name}={{joint: ...}})")
 
 
 class _Path:
     """The samples solved so far, the restrictions held and the monitor log of one tracked path."""
 
-    def __init__(self, robot: Robot, tol_pos: float, tol_rot: float, options: dict[str, Any],
-                 restrict: tuple[str, ...], restrictions: list[str], jump_limit: float | None, hold: int):
-        self.robot, self.tol_pos, self.tol_rot, self.options = robot, tol_pos, tol_rot, options
-        self.restrict, self.restrictions, self.jump_limit, self.hold = restrict, restrictions, jump_limit, hold
+    def __init__(self, robot: Robot, req: Request, opts: FRDMOptions, settings: PathSettings,
+                 restrictions: list[str]):
+        self.robot, self.req, self.opts, self.settings = robot, req, opts, settings
+        self.restrictions = restrictions
         self.held: dict[str, int] = {}
         self.rows: list[np.ndarray] = []
         self.figures: list[tuple[float, float, str, int, float]] = []
         self.events: list[SingularEvent] = []
-        self.bypasses: list[BypassRecord] = [BypassRecord(s, sample=0, hold="path") for s in restrict]
+        self.bypasses: list[BypassRecord] = [BypassRecord(s, sample=0, hold="path") for s in settings.restrict]
+        budget = req.time_budget
+        self.deadline = np.inf if budget is None else time.perf_counter() + budget
 
     def _solve(self, target: pin.SE3, q_start: np.ndarray, active: tuple[str, ...]) -> Attempt:
-        return solver.attempt(self.robot, target, q_start, self.tol_pos, self.tol_rot, np.inf, active=active,
-                              **self.options)
+        return solver.attempt(self.robot, target, q_start, self.req.tol_pos, self.req.tol_rot, self.deadline,
+                              replace(self.opts, active=active))
 
     def sample(self, k: int, target: pin.SE3, q_prev: np.ndarray) -> np.ndarray:
         """Solve sample k warm-started from q_prev, switching a restriction on if a monitor fires."""
         t0 = time.perf_counter()
-        active = (*self.restrict, *(s for s, left in self.held.items() if left > 0 and s not in self.restrict))
+        restrict, hold = self.settings.restrict, self.settings.hold
+        active = (*restrict, *(s for s, left in self.held.items() if left > 0 and s not in restrict))
         att = self._solve(target, q_prev, active)
         step = float(np.max(np.abs(att.q - q_prev)))
-        jumped = self.jump_limit is not None and step > self.jump_limit
+        jump_limit = self.settings.jump_limit
+        jumped = jump_limit is not None and step > jump_limit
         self.events += [ev.at_sample(k) for ev in att.events]
         if jumped:
             self.events.append(SingularEvent("jump", sample=k, max_joint_step=step))
         pending = [s for s in self.restrictions if s not in active]
         if (att.events or jumped) and (att.status != Status.CONVERGED or jumped) and pending:
-            self.held[pending[0]] = self.hold
-            self.bypasses.append(BypassRecord(pending[0], sample=k, hold=self.hold))
+            self.held[pending[0]] = hold
+            self.bypasses.append(BypassRecord(pending[0], sample=k, hold=hold))
             att = self._solve(target, q_prev, (*active, pending[0]))
         self.bypasses += [b.at_sample(k) for b in att.bypasses if b.bypass not in RESTRICTIONS]
         self.held = {s: left - 1 for s, left in self.held.items() if left > 1}
-        dp, dr = self.robot.tool_error(att.q, target)
+        dp, dr, status = self._judged(att, target)
         self.rows.append(att.q)
-        self.figures.append((dp, dr, att.status.value, att.iterations, time.perf_counter() - t0))
+        self.figures.append((dp, dr, status.value, att.iterations, time.perf_counter() - t0))
         return att.q
+
+    def _judged(self, att: Attempt, target: pin.SE3) -> tuple[float, float, Status]:
+        """Pinocchio's verdict on the sample: the task's components within tolerance and q within the limits
+        (the solver's own status is kept only to say why a sample failed)."""
+        robot, req = self.robot, self.req
+        dp, dr = req.task.errors(target, robot.tool_pose_of_float_q(np.ascontiguousarray(att.q, dtype=float)))
+        met = req.task.met(dp, dr, req.tol_pos, req.tol_rot)
+        within = bool(np.all(np.isfinite(att.q))) and robot.within_limits(att.q)
+        if met and within:
+            return dp, dr, Status.CONVERGED
+        if met:
+            return dp, dr, Status.OUTSIDE_LIMITS
+        return dp, dr, Status.STALLED if att.status == Status.CONVERGED else att.status
 
     def result(self) -> TrackResult:
         """The path's TrackResult."""

@@ -16,9 +16,7 @@ import numpy as np
 import pinocchio as pin
 from tqdm import tqdm
 
-from kinelab.ik.batch import solve_batch
-from kinelab.ik.frdm.tracking import track
-from kinelab.ik.solve import solve
+from kinelab.ik.api import solve, solve_batch, track
 from kinelab.report.bench import peers
 from kinelab.report.bench.protocol import DEFAULT_ROBOTS, TOL_POS, TOL_ROT, cases, smooth_path
 from kinelab.robot import Robot, load
@@ -99,7 +97,7 @@ def tracking(robot: Robot, seed: int = 0, samples: int = 2000, repeats: int = 3)
     def tracker(**options: Any) -> Runner:
         def run() -> tuple[np.ndarray, float]:
             t0 = time.perf_counter()
-            res = track(robot, targets, Q_path[0], **options)
+            res = track(robot, targets, q0=Q_path[0], **options)
             return res.q, time.perf_counter() - t0
         return run
 

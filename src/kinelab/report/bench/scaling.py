@@ -16,9 +16,9 @@ import numpy as np
 import pinocchio as pin
 from tqdm import tqdm
 
+from kinelab.ik.api import solve
 from kinelab.ik.chain import chain_model
 from kinelab.ik.frdm import kernel
-from kinelab.ik.solve import solve
 from kinelab.report.bench import peers
 from kinelab.robot import Robot
 

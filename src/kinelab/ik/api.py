@@ -1,0 +1,229 @@
+"""The public IK entry points: :func:`solve`, :func:`solve_batch`, :func:`solve_all` and :func:`track`.
+
+One vocabulary: the robot and the target (or targets) positionally, everything else by keyword with the
+same names, defaults and meanings everywhere — ``solver``, ``q0``, ``seed``, ``tol_pos`` [m], ``tol_rot``
+[rad], ``time_budget`` [s, the whole call], ``max_restarts``, ``start_outside_limits``, ``task``, ``axis``,
+and the solver's options as ``options=`` (a ``FRDMOptions``, ``BiquatOptions`` or ``DLSOptions``) or as
+their fields by keyword. Each entry point builds one validated :class:`~kinelab.ik.request.Request` and hands
+it to the driver (:mod:`kinelab.ik.driver`), the batch (:mod:`kinelab.ik.batch`), the branch search
+(:mod:`kinelab.ik.branches`) or the path follower (:mod:`kinelab.ik.frdm.tracking`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import replace
+from typing import Any
+
+import pinocchio as pin
+
+from kinelab.errors import OptionError
+from kinelab.ik.batch import BatchIKResult, run_batch
+from kinelab.ik.branches import find_all
+from kinelab.ik.driver import solve_one
+from kinelab.ik.frdm.tracking import PathSettings, path_options, run_track
+from kinelab.ik.registry import solver_module
+from kinelab.ik.request import make_request
+from kinelab.ik.result import IKResult, TrackResult
+from kinelab.ik.targets import as_target_arrays
+from kinelab.robot import Robot
+
+# The order of the arguments after (robot, target) in kinelab 0.1's positional signatures: a call that still
+# passes them positionally is told which keyword its value was
+_OLD_ORDER = {
+    "solve": ("solver", "q0", "seed", "tol_pos", "tol_rot", "time_budget", "max_restarts"),
+    "solve_batch": ("q0", "seed", "solver", "tol_pos", "tol_rot", "max_restarts", "time_budget"),
+    "solve_all": ("task", "axis", "time_budget", "seed", "q_ref", "tol_pos", "tol_rot"),
+    "track": ("q0",),
+}
+
+
+def refuse_positional(function: str, extra: tuple[Any, ...]) -> None:
+    """Raise the TypeError of a call that passed more than the robot and its target(s) positionally.
+
+    Raises:
+        TypeError: always, naming the keyword the first extra value stands for.
+    """
+    order = _OLD_ORDER.get(function, ())
+    keyword = order[0] if order else "the keyword it stands for"
+    raise TypeError(f"{function}() takes the robot and the target(s) positionally and everything else by "
+                    f"keyword: pass {keyword}={extra[0]!r} (got {len(extra)} more positional argument"
+                    f"{'s' if len(extra) > 1 else ''})")
+
+
+def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0: Any = None,
+          seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float = 1.0,
+          max_restarts: int = 1000, start_outside_limits: str = "project", options: Any = None,
+          task: str = "pose", axis: str = "z", prefer: Any = None, **solver_options: Any) -> IKResult:
+    """Solve IK for the tool pose ``target`` (``pin.SE3`` in the robot's base frame).
+
+    Args:
+        robot: the robot (:func:`kinelab.load`).
+        target: oMtarget, the wanted tool pose in the base frame (a point, three numbers [m], for task
+            "position").
+        positional: nothing: every argument after the target is keyword-only.
+        solver: "frdm", "biquat" or "dls" (the Pinocchio reference).
+        q0: first start (one number per joint, rad or m); default a seeded random configuration.
+        seed: seed of the random starts, an int ≥ 0 (None: fresh entropy). A solve that does not run out of
+            budget returns the same answer for the same seed in any process; one that does depends on speed.
+        tol_pos: position tolerance [m].
+        tol_rot: rotation tolerance [rad] (angle of R*ᵀR, or between the tool axes for task "axis").
+        time_budget: wall-clock budget [s] for all attempts together.
+        max_restarts: random restarts after the first attempt.
+        start_outside_limits: "project" (default: move q0 into the limits, with a warning) or "refuse".
+        options: the solver's options object (``FRDMOptions``, ``BiquatOptions``, ``DLSOptions``).
+        task: "pose" (all), "position", "axis" (the tool point and tool axis ``axis``, roll free) or
+            "orientation" (:mod:`kinelab.ik.tasks`); the biquaternion solver takes "pose" only.
+        axis: the tool axis of task "axis": "x", "y" or "z".
+        prefer: a reference configuration (rad or m): search every branch within ``time_budget`` and return
+            the one nearest it (revolute joints compared modulo 2π); None (default): the first answer found.
+            The search spends the whole budget; solvers "frdm" and "dls"; ``q0`` and ``max_restarts`` do
+            not apply to it (given with ``prefer``, they are refused).
+        solver_options: the solver's option fields as keyword arguments (instead of ``options``).
+
+    Returns:
+        The result, checked by Pinocchio on the components the task constrains (``result.task``); with
+        ``prefer``, ``diagnostics.branches`` is the number of distinct solutions found.
+
+    Raises:
+        TypeError: arguments after the target given positionally.
+        SolverNotFoundError, OptionError, TargetError, ConfigurationError: bad input, named.
+    """
+    if positional:
+        refuse_positional("solve", positional)
+    req = make_request(solver, seed, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options,
+                       task, axis, solver_options)
+    if prefer is None:
+        return solve_one(robot, target, q0, req)
+    if q0 is not None:
+        raise OptionError("q0", "given", "None with prefer= (the branch search draws its own starts)")
+    found = find_all(robot, target, req, q_ref=prefer)
+    if found:
+        return replace(found[0], diagnostics=replace(found[0].diagnostics, branches=len(found)))
+    return solve_one(robot, target, None, req)
+
+
+def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frdm", q0: Any = None,
+                seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6,
+                time_budget: float | None = None, max_restarts: int = 1000, start_outside_limits: str = "refuse",
+                options: Any = None, task: str = "pose", axis: str = "z", **solver_options: Any) -> BatchIKResult:
+    """Solve IK for every target of a batch: row b is what :func:`solve` gives for ``targets[b]`` alone with
+    ``seed = seed + b`` and start ``q0[b]``, when neither runs out of time.
+
+    FRDM with compiled options runs the rows in parallel inside one kernel (every core; the answers do not
+    depend on the thread count); the other solvers and FRDM's monitored options run the rows one by one.
+
+    Args:
+        robot: the robot.
+        targets: a sequence of ``pin.SE3`` or an (B, 4, 4) array of homogeneous matrices (oMtarget).
+        positional: nothing: every argument after the targets is keyword-only.
+        solver, seed, tol_pos, tol_rot, max_restarts, options, task, axis, solver_options: as :func:`solve`
+            (``seed``: the base seed, row b uses seed + b; None draws one, reported in the result).
+        q0: starts: None (each row draws its own from its seed), one configuration for every row, or (B, n)
+            [rad or m]; within the joint limits.
+        time_budget: wall-clock budget [s] of the whole batch (None, the default: none); rows not started
+            when it runs out are left unsolved with status ``time_budget`` and NaN in q.
+        start_outside_limits: "refuse" (the default here: a batch of starts is data, checked row by row).
+
+    Returns:
+        The :class:`~kinelab.ik.batch.BatchIKResult`, every row judged by Pinocchio's FK.
+
+    Raises:
+        TypeError: arguments after the targets given positionally.
+        TargetError: a bad target (its index named); ConfigurationError: a bad q0 (its row named);
+        OptionError, SolverNotFoundError: a bad option or argument.
+    """
+    if positional:
+        refuse_positional("solve_batch", positional)
+    req = make_request(solver, seed, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options,
+                       task, axis, solver_options)
+    return run_batch(robot, targets, q0, req)
+
+
+def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", seed: int | None = None,
+              tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float = 0.05, options: Any = None,
+              task: str = "pose", axis: str = "z", q_ref: Any = None, max_solutions: int | None = None,
+              **solver_options: Any) -> list[IKResult]:
+    """The distinct solutions (branches) of ``target`` that seeded starts find within ``time_budget``.
+
+    Args:
+        robot: the robot.
+        target: oMtarget (base frame).
+        positional: nothing: every argument after the target is keyword-only.
+        solver: "frdm" (one compiled batch per round of starts) or "dls".
+        seed, tol_pos, tol_rot, options, task, axis, solver_options: as :func:`solve`.
+        time_budget: wall-clock budget [s] of the search (default 0.05 s: every branch of a UR5 or Stanford
+            target in 197 of 200 cases).
+        q_ref: sort the solutions by distance to this configuration (rad or m; revolute joints modulo 2π).
+        max_solutions: stop once this many distinct solutions are found (None: use the whole budget).
+
+    Returns:
+        One :class:`IKResult` per distinct solution, nearest ``q_ref`` first when given.
+
+    Raises:
+        TypeError: arguments after the target given positionally.
+        TargetError, ConfigurationError, OptionError: bad input, named.
+    """
+    if positional:
+        refuse_positional("solve_all", positional)
+    req = make_request(solver, seed, tol_pos, tol_rot, time_budget, 0, "refuse", options, task, axis,
+                       solver_options)
+    return find_all(robot, target, req, q_ref=q_ref, max_solutions=max_solutions)
+
+
+def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any = None, solver: str = "frdm",
+          seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float | None = None,
+          options: Any = None, task: str = "pose", axis: str = "z", jump_limit: float | None = 0.2,
+          restrict: tuple[str, ...] = (), hold: int = 10, rest_weight: float | None = None,
+          **solver_options: Any) -> TrackResult:
+    """Follow a path: solve each target in turn, warm-started from the previous answer (no restarts).
+
+    With no bypass, policy or restriction named, the whole path runs in the compiled follower; otherwise
+    the monitored loop runs, switching the restrictions a policy names on when a monitor fires
+    (:mod:`kinelab.ik.frdm.tracking`). Every sample is judged by Pinocchio on the task's components within
+    the joint limits.
+
+    Args:
+        robot: the robot.
+        targets: oMtarget per sample (a sequence of ``pin.SE3`` or an (N, 4, 4) array, base frame).
+        positional: nothing: every argument after the targets is keyword-only.
+        q0: the configuration at the start of the path [rad or m], within the limits; None: the first target
+            is solved by :func:`solve` (with ``seed``) and the path starts there.
+        solver: "frdm" (the only path follower).
+        seed: seed of the first solve when ``q0`` is None.
+        tol_pos, tol_rot, task, axis: per sample, as :func:`solve`.
+        time_budget: wall-clock budget [s] of the whole path (None, the default: none); the monitored loop
+            stops each attempt at it.
+        options: an ``FRDMOptions`` (taken as it is), or its fields as keywords (``kicks``, ``intervals``,
+            ``freeze``, ``policy``, ``order``, ``w_p``, ...) over the path's defaults (max_sweeps 2000,
+            stall_window 100, stall_rel 1e-6).
+        jump_limit: largest joint step [rad or m] before the jump monitor fires (None: off).
+        restrict: restrictions ("intervals", "freeze") held on every sample of the path.
+        hold: samples a restriction stays on after the monitor switched it on.
+        rest_weight: compiled follower only: weight of the rest term (None: 0.01 beyond six joints, else 0).
+
+    Returns:
+        One row of q per sample, Pinocchio's errors, statuses, the monitor log (:class:`TrackResult`).
+
+    Raises:
+        TypeError: arguments after the targets given positionally.
+        OptionError: a bad option, a solver other than "frdm", a restriction named without its table.
+        ConfigurationError, JointLimitError, TargetError: a bad q0 or target, named.
+    """
+    if positional:
+        refuse_positional("track", positional)
+    if solver_module(solver) is not solver_module("frdm"):
+        raise OptionError("solver", solver, "'frdm' (track follows a path with FRDM's warm-started sweeps)")
+    settings = PathSettings(jump_limit, restrict, hold, rest_weight)
+    req = make_request(solver, seed, tol_pos, tol_rot, time_budget, 0, "refuse", options, task, axis,
+                       path_options(options, solver_options))
+    points, rotations = as_target_arrays(targets)
+    if q0 is None:
+        first = solve(robot, pin.SE3(rotations[0], points[0]), seed=seed, tol_pos=tol_pos, tol_rot=tol_rot,
+                      task=task, axis=axis)
+        if not first.success:
+            raise OptionError("q0", None, "a start configuration: the path's first target could not be solved "
+                              f"({first.status.value}: {first.message})")
+        q0 = first.q
+    return run_track(robot, targets, robot.check_q(q0, limits=True, what="q0"), req, settings)
+

@@ -1,0 +1,252 @@
+"""The driver: one solve of one target for a validated :class:`~kinelab.ik.request.Request`.
+
+It runs the chosen solver from a start and then from seeded random starts until one succeeds or the time
+budget or restart count runs out, and re-checks the answer with Pinocchio's FK: ``success`` means the
+returned q is within the joint limits and its tool pose is within ``tol_pos`` [m] and ``tol_rot`` [rad] of
+the target on the components the task constrains. Every public entry point (:mod:`kinelab.ik.api`) ends here.
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab.ik.limits import wrap_q
+from kinelab.ik.multistart import TypedKernel
+from kinelab.ik.request import Request
+from kinelab.ik.result import Attempt, BypassRecord, IKResult, SingularEvent, Status
+from kinelab.ik.targets import as_target
+from kinelab.ik.tasks import COMPONENTS, POSE, Task
+from kinelab.ik.verdict import pose_verdict
+from kinelab.ik.workspace import out_of_reach
+from kinelab.robot import Robot
+
+_VERDICT = TypedKernel(pose_verdict)  # its arguments are always Pinocchio's matrices and float arrays
+
+
+class _LazyRng:
+    """A seeded generator made on first use (making one costs more than most solves)."""
+
+    def __init__(self, seed: int | None):
+        self.seed = seed
+        self._rng: np.random.Generator | None = None
+
+    def uniform(self, low: np.ndarray, high: np.ndarray, size: int | None = None) -> np.ndarray:
+        if self._rng is None:
+            self._rng = np.random.default_rng(self.seed)
+        drawn: np.ndarray = self._rng.uniform(low, high, size)
+        return drawn
+
+
+def _start(robot: Robot, q0: Any, rng: _LazyRng, on_limits: str) -> np.ndarray:
+    if q0 is None:
+        return rng.uniform(robot.lower, robot.upper)
+    q = robot.check_q(q0, what="q0")
+    if robot.within_limits(q):
+        return q
+    if on_limits == "refuse":
+        robot.check_q(q, limits=True, what="q0")
+    projected: np.ndarray = np.clip(wrap_q(robot, q), robot.lower, robot.upper)
+    warnings.warn(f"q0 is outside the joint limits of {robot.name}; projected into them", stacklevel=4)
+    return projected
+
+
+def solve_one(robot: Robot, target: Any, q0: Any, req: Request) -> IKResult:
+    """Solve IK for one target.
+
+    Args:
+        robot: the robot.
+        target: oMtarget (``pin.SE3`` in the base frame; a point for task "position").
+        q0: the first start [rad or m], or None (a seeded random configuration).
+        req: the validated request.
+
+    Returns:
+        The result, checked by Pinocchio on the components the task constrains.
+
+    Raises:
+        TargetError, ConfigurationError, JointLimitError: bad target or start, named.
+    """
+    module, opts = req.module, req.options
+    _prepare(module, robot)
+    t_start = time.perf_counter()
+    target = as_target(target, req.task.name)
+    rng = _LazyRng(req.seed)
+    budget = 1e9 if req.time_budget is None else req.time_budget
+    problem = _Problem(robot, target, req.solver, req.tol_pos, req.tol_rot, t_start, t_start + budget, req.seed,
+                       req.task, req.task_label)
+    max_restarts = req.max_restarts
+    beyond = out_of_reach(robot, target.translation)
+    if beyond > 0:
+        max_restarts = 0  # proved out of reach: one attempt gives the best pose, restarts cannot help
+    elif getattr(opts, "compiled", False) and hasattr(module, "multistart"):
+        start = None if q0 is None else _start(robot, q0, rng, req.start_outside_limits)  # None: the kernel draws
+        return _fast(module, problem, start, max_restarts, opts)
+    return _loop(module, problem, _start(robot, q0, rng, req.start_outside_limits), max_restarts, opts, rng, beyond)
+
+
+_CHECKS_COMPILED: list[bool] = []
+
+
+def _prepare(module: Any, robot: Robot) -> None:
+    """Compilation and model building, which are not a solve's time: the solver's, and the checks'."""
+    prepare = getattr(module, "prepare", None)
+    if prepare is not None:
+        prepare(robot)
+    if not _CHECKS_COMPILED:
+        _compile_checks(robot)
+
+
+def _compile_checks(robot: Robot) -> None:
+    """Compile (or load) the target check and the verdict once per process, outside any solve's clock."""
+    target = as_target(pin.SE3.Identity())
+    _Problem(robot, target, "", 1.0, 1.0, 0.0, 0.0, None).judge(robot.neutral())
+    _CHECKS_COMPILED.append(True)
+
+
+@dataclass(slots=True)
+class _Problem:
+    """What one solve is asked, handed between solve's helpers."""
+
+    robot: Robot
+    target: pin.SE3
+    solver: str
+    tol_pos: float
+    tol_rot: float
+    t_start: float
+    deadline: float
+    seed: int | None
+    task: Task = POSE
+    task_label: str = "pose"
+    finals: list[tuple[Status, float]] = field(default_factory=list)
+
+    def judge(self, q: np.ndarray) -> tuple[bool, float, float]:
+        """Pinocchio's verdict on q: (success, position error [m], rotation error [rad]) on the task's
+        components (the rotation error of task "axis" is the angle between the tool axes)."""
+        if not (q.dtype == np.float64 and q.ndim == 1 and q.flags.c_contiguous):  # the kernel's one signature
+            q = np.ascontiguousarray(q, dtype=float)
+        lower, upper = self.robot.check_bounds
+        dp, dr, within = _VERDICT(self.target.homogeneous, self.robot.tool_pose_of_float_q(q).homogeneous, q,
+                                  lower, upper, self.task.axis)
+        task = self.task
+        ok = within and (not task.position or dp <= self.tol_pos) and (not task.rotation or dr <= self.tol_rot)
+        return ok, dp, dr
+
+
+def _loop(module: Any, pb: _Problem, start: np.ndarray, max_restarts: int, opts: Any, rng: _LazyRng,
+          beyond: float) -> IKResult:
+    """Attempts from the start, then from seeded random starts, each judged by Pinocchio."""
+    robot = pb.robot
+    scale = robot.characteristic_length()
+    best: tuple[float, Attempt, float, float] | None = None
+    best_ok = False
+    iterations = restarts = 0
+    events: list[SingularEvent] = []
+    bypasses: list[BypassRecord] = []
+    for k in range(max_restarts + 1):
+        att = module.attempt(robot, pb.target, start, pb.tol_pos, pb.tol_rot, pb.deadline, opts)
+        iterations += att.iterations
+        events += att.events
+        bypasses += att.bypasses
+        ok, dp, dr = pb.judge(att.q)
+        score = dp / scale + dr
+        if best is None or ok or score < best[0]:
+            best, best_ok = (score, att, dp, dr), ok
+        pb.finals.append((att.status, dp))
+        if ok or time.perf_counter() > pb.deadline or k == max_restarts:
+            break
+        restarts += 1
+        start = rng.uniform(robot.lower, robot.upper)
+    assert best is not None
+    _, att, dp, dr = best
+    status, message = _status(best_ok, att, pb.finals, beyond, pb.tol_pos, time.perf_counter() > pb.deadline)
+    if not best_ok:
+        status, message = _outside_limits(pb, att.q, dp, dr, status, message)
+    # the answer's own attempt, apart from the restarts' (a user asks whether a bypass made this answer)
+    diag = replace(att.diagnostics, answer_events=tuple(att.events), answer_bypasses=tuple(att.bypasses))
+    return IKResult(
+        q=att.q, success=best_ok, status=status, position_error=dp, rotation_error=dr,
+        iterations=iterations, restarts=restarts, wall_time=time.perf_counter() - pb.t_start, solver=pb.solver,
+        mode=att.mode or pb.solver, singular_events=events, bypasses=bypasses,
+        message=_explained(pb, status, message), diagnostics=diag, task=pb.task_label,
+    )
+
+
+def _fast(module: Any, pb: _Problem, start: np.ndarray | None, max_restarts: int, opts: Any) -> IKResult:
+    """Restarts inside the solver's compiled kernel; the answer is then checked by Pinocchio."""
+    att, restarts = module.multistart(pb.robot, pb.target, start, pb.tol_pos, pb.tol_rot, pb.deadline, pb.seed,
+                                      max_restarts, opts)
+    success, dp, dr = pb.judge(att.q)
+    status, message = att.status, ""
+    if success:
+        status = Status.CONVERGED
+    elif status == Status.CONVERGED:
+        status, message = Status.STALLED, "the solver converged but its answer failed Pinocchio's check"
+    else:
+        errors = [f"{dp:.3g} m"] * pb.task.position + [f"{dr:.3g} rad"] * pb.task.rotation
+        message = (f"none of {restarts + 1} starts met the {pb.task.constrained} to the tolerances; the best "
+                   f"answer is {' and '.join(errors)} from the target")
+    if not success:
+        status, message = _outside_limits(pb, att.q, dp, dr, status, message)
+    return IKResult(
+        q=att.q, success=success, status=status, position_error=dp, rotation_error=dr, iterations=att.iterations,
+        restarts=restarts, wall_time=time.perf_counter() - pb.t_start, solver=pb.solver, mode=att.mode,
+        singular_events=att.events, message=_explained(pb, status, message), diagnostics=att.diagnostics,
+        task=pb.task_label,
+    )
+
+
+def _outside_limits(pb: _Problem, q: np.ndarray, dp: float, dr: float, status: Status,
+                    message: str) -> tuple[Status, str]:
+    """A failed answer with a joint outside its limits: status OUTSIDE_LIMITS when the task's components are
+    met (only the limits fail), the joint named either way."""
+    robot = pb.robot
+    lower, upper = robot.check_bounds
+    outside = [i for i in range(robot.n) if not lower[i] <= q[i] <= upper[i]]
+    if not outside:
+        return status, message
+    i = outside[0]
+    unit = "m" if robot.joint_kinds[i] == "prismatic" else "rad"
+    where = (f"joint {robot.joint_names[i]!r} at {q[i]:.6g} {unit}, outside its limits "
+             f"[{robot.lower[i]:.6g}, {robot.upper[i]:.6g}]"
+             + (f" (and {len(outside) - 1} more)" if len(outside) > 1 else ""))
+    met = (not pb.task.position or dp <= pb.tol_pos) and (not pb.task.rotation or dr <= pb.tol_rot)
+    if met and status is not Status.UNREACHABLE:  # proved out of reach within the limits: that says more
+        return Status.OUTSIDE_LIMITS, f"the {pb.task.constrained} are met, but only with {where}"
+    return status, f"{message}; the best answer has {where}" if message else f"the best answer has {where}"
+
+
+def _explained(pb: _Problem, status: Status, message: str) -> str:
+    """The message, with the reason a short arm misses a whole pose and the tasks that fit it."""
+    n = pb.robot.n
+    if status in (Status.CONVERGED, Status.OUTSIDE_LIMITS) or n >= COMPONENTS[pb.task.name]:
+        return message
+    fits = [t for t in ("axis", "position") if COMPONENTS[t] <= n] or ["position"]
+    note = (f"{pb.robot.name} has {n} joints and can meet at most {n} of the {COMPONENTS[pb.task.name]} "
+            f"components of task {pb.task.name!r}; try task={fits[0]!r}"
+            + (f" or task={fits[1]!r}" if len(fits) > 1 else ""))
+    return f"{message}; {note}" if message else note
+
+
+def _status(success: bool, att: Attempt, finals: list[tuple[Status, float]], beyond: float, tol_pos: float,
+            out_of_time: bool) -> tuple[Status, str]:
+    if success:
+        return Status.CONVERGED, ""
+    if beyond > 0:
+        return Status.UNREACHABLE, f"the target position is at least {beyond:.4g} m beyond the robot's reach"
+    stationary = [dp for st, dp in finals if st in (Status.STALLED, Status.SINGULAR)]
+    agree = len(stationary) >= 3 and len(stationary) == len(finals) and min(stationary) > tol_pos
+    if agree and max(stationary) - min(stationary) <= 1e-3 * min(stationary) + 1e-9:
+        return Status.UNREACHABLE, (
+            f"every one of {len(finals)} starts stopped at a stationary point {min(stationary):.4g} m from the "
+            "target: it is very likely out of the workspace"
+        )
+    if att.status == Status.CONVERGED:  # the solver's own test passed but Pinocchio's or the limits did not
+        return Status.STALLED, "the solver converged but its answer failed Pinocchio's check or the joint limits"
+    if out_of_time and att.status != Status.TIME_BUDGET:
+        return Status.TIME_BUDGET, f"best attempt ended {att.status.value}; then the time budget ran out"
+    return att.status, ""

@@ -1,0 +1,125 @@
+"""The validated request every IK entry point builds: one set of names, defaults and checks.
+
+:func:`kinelab.solve`, :func:`kinelab.solve_batch`, :func:`kinelab.solve_all`, :func:`kinelab.track` and the
+prepared :class:`kinelab.IK` take the same keywords (``solver``, ``seed``, ``tol_pos``, ``tol_rot``,
+``time_budget``, ``max_restarts``, ``start_outside_limits``, ``task``, ``axis``, ``options`` or the
+solver's option fields as keywords). Each turns them into one :class:`Request`, checked here once, and hands
+it to the driver; no entry point checks an argument of its own.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import dataclass
+from typing import Any
+
+from kinelab.errors import OptionError
+from kinelab.ik.registry import solver_module
+from kinelab.ik.tasks import POSE, Task
+
+START_POLICIES = ("project", "refuse")
+
+
+@dataclass(frozen=True, slots=True)
+class Request:
+    """What a solve is asked, validated.
+
+    Attributes:
+        solver: the solver's name; module: its module (:mod:`kinelab.ik.registry`).
+        options: the solver's options object, already adapted to ``task``.
+        task: the components to meet.
+        tol_pos: position tolerance [m]; tol_rot: rotation tolerance [rad].
+        time_budget: wall-clock budget of the call [s] (None: none).
+        max_restarts: random restarts after the first attempt (per target).
+        seed: base seed of the random starts (None: fresh entropy).
+        start_outside_limits: "project" (move a start into the limits, with a warning) or "refuse".
+    """
+
+    solver: str
+    module: Any
+    options: Any
+    task: Task
+    tol_pos: float
+    tol_rot: float
+    time_budget: float | None
+    max_restarts: int
+    seed: int | None
+    start_outside_limits: str
+
+    @property
+    def task_label(self) -> str:
+        """The task as results name it: "pose", "position", "orientation" or "axis z" (with its axis)."""
+        return self.task.name if self.task.axis < 0 else f"axis {'xyz'[self.task.axis]}"
+
+
+def make_request(solver: str = "frdm", seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6,
+                 time_budget: float | None = 1.0, max_restarts: int = 1000, start_outside_limits: str = "project",
+                 options: Any = None, task: str = "pose", axis: str = "z",
+                 solver_options: dict[str, Any] | None = None) -> Request:
+    """Check every argument once and build the :class:`Request`.
+
+    Raises:
+        SolverNotFoundError: an unknown solver.
+        OptionError: a bad value (named, with what is valid), an option the solver does not have, both
+            ``options`` and option keywords, or a task the solver cannot meet.
+    """
+    module = solver_module(solver)
+    opts = module.Options.of(options, **(solver_options or {}))
+    tk = Task.of(task, axis)
+    if tk is not POSE:
+        opts = for_task(solver, opts, tk)
+    check_arguments(tol_pos, tol_rot, time_budget, max_restarts, seed, start_outside_limits)
+    return Request(solver, module, opts, tk, float(tol_pos), float(tol_rot),
+                   None if time_budget is None else float(time_budget), int(max_restarts),
+                   None if seed is None else int(seed), start_outside_limits)
+
+
+def for_task(solver: str, opts: Any, task: Task) -> Any:
+    """The solver's options for a task other than "pose" (its ``for_task``).
+
+    Raises:
+        OptionError: the solver meets whole poses only.
+    """
+    if not hasattr(opts, "for_task"):
+        raise OptionError("task", task.name, f"'pose' for solver {solver!r}, which drives the whole pose; "
+                          "solvers 'frdm' and 'dls' take 'position', 'axis' and 'orientation' too")
+    return opts.for_task(task)
+
+
+def check_arguments(tol_pos: Any, tol_rot: Any, time_budget: Any, max_restarts: Any, seed: Any,
+                    start_outside_limits: Any) -> None:
+    """Refuse what no entry point can honour, naming the argument, the value and what is valid.
+
+    Raises:
+        OptionError: the first bad argument.
+    """
+    if _plain_positive(tol_pos, tol_rot, 1.0 if time_budget is None else time_budget) \
+            and _plain_counts(max_restarts, seed) and start_outside_limits in START_POLICIES:
+        return  # the common case, checked fast
+    for name, value in (("tol_pos", tol_pos), ("tol_rot", tol_rot), ("time_budget", time_budget)):
+        if name == "time_budget" and value is None:
+            continue
+        if isinstance(value, bool) or not isinstance(value, numbers.Real) or not 0 < float(value) < math.inf:
+            raise OptionError(name, value, "a finite number > 0" + (" or None" if name == "time_budget" else ""))
+    if not count_ok(max_restarts):
+        raise OptionError("max_restarts", max_restarts, "an integer ≥ 0")
+    if seed is not None and not count_ok(seed):
+        raise OptionError("seed", seed, "an integer ≥ 0, or None for fresh entropy")
+    if not isinstance(start_outside_limits, str) or start_outside_limits not in START_POLICIES:
+        raise OptionError("start_outside_limits", start_outside_limits, "'project' or 'refuse'")
+
+
+def _plain_positive(a: Any, b: Any, c: Any) -> bool:
+    """All three Python floats in (0, inf)."""
+    return (type(a) is float and type(b) is float and type(c) is float
+            and 0.0 < a < math.inf and 0.0 < b < math.inf and 0.0 < c < math.inf)
+
+
+def _plain_counts(max_restarts: Any, seed: Any) -> bool:
+    return type(max_restarts) is int and max_restarts >= 0 and (seed is None or (type(seed) is int and seed >= 0))
+
+
+def count_ok(value: Any) -> bool:
+    """An integer ≥ 0 (a bool is not a count)."""
+    return not isinstance(value, bool) and isinstance(value, numbers.Integral) and int(value) >= 0
