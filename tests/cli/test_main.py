@@ -9,7 +9,8 @@ import pytest
 
 import kinelab
 from kinelab import cli
-from kinelab.cli.main import _plural, compiling_notice
+from kinelab.cli.common import compiling_notice
+from kinelab.cli.common import plural as _plural
 from kinelab.studies import paper001_stanford as seed001
 
 

@@ -1,0 +1,93 @@
+"""``kinelab bench``: kinelab's solvers and the installed peers, side by side."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from kinelab.cli.common import print_json, seed_argument
+from kinelab.ik.tasks import TASKS
+from kinelab.report.outfolder import check_output_folder
+
+
+def add(sub: Any) -> None:
+    """The ``bench`` subcommand."""
+    s = sub.add_parser("bench", help="the IK benchmark: kinelab's solvers and the installed peers")
+    s.add_argument("--robots", nargs="+", default=None,
+                   help="robots (default: panda ur5 stanford era xarm7 z1 kinova ur10 so101 youbot)")
+    s.add_argument("--n", type=int, default=200, help="targets per robot (default 200)")
+    seed_argument(s)
+    s.add_argument("--solvers", nargs="+", default=None, help="solvers to run (default: all available)")
+    s.add_argument("--budget-ms", type=float, default=5.0, help="time budget per solve [ms] (default 5)")
+    s.add_argument("--repeats", type=int, default=3,
+                   help="rounds over the set; per problem the fastest counts (default 3)")
+    s.add_argument("--start", choices=("random", "warm"), default="random",
+                   help="starts: random in the limits (default), or warm: the target's q plus N(0, sigma) per joint")
+    s.add_argument("--sigma", type=float, default=0.2, help="warm starts' noise per joint [rad or m] (default 0.2)")
+    s.add_argument("--task", choices=TASKS, default="pose",
+                   help="the components judged (default pose; position: random target rotations; axis: tool z, "
+                        "random roll)")
+    s.add_argument("--schedule", choices=("blocked", "interleaved"), default="blocked",
+                   help="blocked (default): a solver runs the whole set, then the next; interleaved: every solver "
+                        "per problem")
+    s.add_argument("--scaling", action="store_true", help="also time FRDM on synthetic chains of 7-100 links")
+    s.add_argument("--tracking", action="store_true", help="also time tracking along the ERA passages (FRDM, DLS)")
+    s.add_argument("--loops", action="store_true",
+                   help="also the loops users run: throughput (solve loop, solve_batch, ik_LM) and path tracking")
+    s.add_argument("--out", help="write bench.json, bench.md and bench.png here")
+    s.add_argument("--json", action="store_true", help="print the results as JSON instead of tables")
+    s.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run the protocols asked for, print their tables (or JSON), write the files with --out."""
+    from kinelab.report import render
+    from kinelab.report.bench import runner as bench
+
+    if args.out:
+        check_output_folder(args.out, "bench")
+    scaled = None
+    if args.scaling:  # first: the peers' solver threads and caches would disturb this timing afterwards
+        from kinelab.report.bench import scaling
+
+        scaled = scaling.run(progress=not args.json)
+    result = bench.run(robots=args.robots, n=args.n, seed=args.seed, solvers=args.solvers,
+                       budget=args.budget_ms / 1e3, progress=not args.json, repeats=args.repeats, start=args.start,
+                       sigma=args.sigma, schedule=args.schedule, task=args.task)
+    if scaled is not None:
+        result["scaling"] = scaled
+    if args.tracking:
+        from kinelab.studies import paper000_era
+
+        result["tracking"] = paper000_era.tracking_bench(repeats=args.repeats)
+    if args.loops:
+        from kinelab.report.bench import loops
+
+        result["loops"] = loops.run(args.robots, seed=args.seed, repeats=args.repeats, progress=not args.json)
+    if args.out:
+        render.write_bench(result, args.out)
+    if args.json:
+        print_json(result)
+        return 0
+    _print_tables(result)
+    if args.out:
+        print(f"results written to {args.out}")
+    return 0
+
+
+def _print_tables(result: dict[str, Any]) -> None:
+    from kinelab.report import render
+
+    print(render.bench_markdown(result))
+    if "scaling" in result:
+        from kinelab.report.bench import scaling
+
+        print(scaling.markdown(result["scaling"]))
+    if "tracking" in result:
+        from kinelab.studies import paper000_era
+
+        print(paper000_era.tracking_markdown(result["tracking"]))
+    if "loops" in result:
+        from kinelab.report.bench import loops
+
+        print(loops.markdown(result["loops"]["throughput"], result["loops"]["tracking"], result["loops"]["budgets"]))

@@ -1,0 +1,152 @@
+"""What every command shares: the one-line parser errors, the robot arguments, q on the command line, output.
+
+Angles on the command line are radians unless ``--deg`` is given; ``--deg`` applies to revolute and
+continuous joints only (prismatic joints stay in metres).
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import sys
+import threading
+from collections.abc import Iterator
+from typing import Any, NoReturn
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab.errors import ConfigurationError, KinelabError
+from kinelab.geometry import quat_wxyz_from_matrix
+from kinelab.robot import Robot, load
+
+
+class Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line and exit code 2, as for every user error."""
+
+    def error(self, message: str) -> NoReturn:
+        command = " ".join(self.prog.split()[1:])  # "" for the top parser, "ik" for a subcommand
+        self.exit(2, f"kinelab: error: {message} (see 'kinelab {command + ' ' if command else ''}--help')\n")
+
+
+def q_from_cli(robot: Robot, values: list[str], deg: bool, what: str = "q") -> np.ndarray:
+    """One number per joint (rad or m; degrees with --deg), or the name of an SRDF configuration.
+
+    Raises:
+        ConfigurationError: a value that is not a number, or the wrong count.
+    """
+    if len(values) == 1 and not _is_number(values[0]):
+        return robot.named_q(values[0])
+    numbers = []
+    for v in values:
+        if not _is_number(v):
+            raise ConfigurationError(f"{what}: {v!r} is not a number (give {robot.n} numbers, or one SRDF "
+                                     "configuration name with --srdf)")
+        numbers.append(float(v))
+    q = robot.check_q(numbers, what=what)
+    if deg:
+        angular = np.array([k != "prismatic" for k in robot.joint_kinds])
+        q = np.where(angular, np.deg2rad(q), q)
+    return q
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def load_robot(args: argparse.Namespace) -> Robot:
+    """The robot a per-robot command names, with its --tool, --base, --srdf, --group, --package-dir and
+    --xacro-arg."""
+    return load(args.robot, tool=args.tool, base=args.base, srdf=args.srdf, group=args.group,
+                package_dirs=args.package_dir, xacro_args=_xacro_args(args.xacro_arg), trust_xacro=args.trust_xacro)
+
+
+def _xacro_args(items: list[str] | None) -> dict[str, str] | None:
+    """--xacro-arg NAME=VALUE flags as a dict (a flag without '=' is refused)."""
+    if not items:
+        return None
+    bad = [item for item in items if "=" not in item]
+    if bad:
+        raise KinelabError(f"--xacro-arg takes NAME=VALUE, got {bad[0]!r}")
+    return dict(item.split("=", 1) for item in items)
+
+
+def robot_arguments(s: argparse.ArgumentParser, q_help: str | None = None, limits: bool = True) -> None:
+    """The arguments every per-robot command shares: ROBOT [Q...] [--deg] [--tool ...] [--ignore-limits]."""
+    s.add_argument("robot", help="registered name or model file (URDF, xacro, MJCF)")
+    if q_help:
+        s.add_argument("q", nargs="*", help=q_help + " (or the name of an SRDF configuration, with --srdf)")
+        s.add_argument("--deg", action="store_true", help="angles of revolute/continuous joints in degrees")
+    source_arguments(s)
+    if limits:
+        s.add_argument("--ignore-limits", action="store_true",
+                       help="accept q outside the joint limits (fk and view compute any finite q and note the joints "
+                            "outside; this flag drops the note)")
+
+
+def source_arguments(s: argparse.ArgumentParser) -> None:
+    """Where the chain starts and ends, and the files that describe the robot beyond its model file."""
+    s.add_argument("--tool", help="tool frame (default: the robot's own)")
+    s.add_argument("--base", help="frame the chain starts from (default: the URDF root); poses are in this frame")
+    s.add_argument("--srdf", help="SRDF file: named configurations (give a name as Q) and groups")
+    s.add_argument("--group", help="SRDF group whose chain gives base and tool")
+    s.add_argument("--package-dir", action="append", help="where package:// meshes resolve (repeatable)")
+    s.add_argument("--xacro-arg", action="append", metavar="NAME=VALUE", help="an argument of a .xacro robot")
+    s.add_argument("--trust-xacro", action="store_true",
+                   help="let a .xacro robot run what xacro runs ($(eval), $(env), load_yaml); refused without it")
+
+
+def json_flag(s: argparse.ArgumentParser, what: str = "the result") -> None:
+    """The --json flag of a command that prints results."""
+    s.add_argument("--json", action="store_true", help=f"print {what} as JSON")
+
+
+def seed_argument(s: argparse.ArgumentParser) -> None:
+    """--seed, the same on every command."""
+    s.add_argument("--seed", type=int, default=0, help="seed of the random starts or samples (an integer ≥ 0)")
+
+
+def pose_dict(oMtool: pin.SE3) -> dict[str, Any]:
+    """The JSON form of a pose: position [m], rotation matrix, quat_wxyz, rpy [rad]."""
+    return {
+        "position_m": oMtool.translation.tolist(),
+        "rotation_matrix": oMtool.rotation.tolist(),
+        "quat_wxyz": quat_wxyz_from_matrix(oMtool.rotation).tolist(),
+        "rpy_rad": pin.rpy.matrixToRpy(oMtool.rotation).tolist(),
+    }
+
+
+def print_json(obj: Any) -> None:
+    """Print ``obj`` as indented JSON."""
+    print(json.dumps(obj, indent=2))
+
+
+def rounded(values: Any, digits: int) -> list[float]:
+    """Rounded for printing, without the −0.0 that rounding a tiny negative number leaves."""
+    out: list[float] = (np.round(np.asarray(values, dtype=float), digits) + 0.0).tolist()
+    return out
+
+
+def plural(count: int, word: str, plural_form: str | None = None) -> str:
+    """"1 sample", "2 samples" (or the plural form given)."""
+    return f"{count} {word}" if count == 1 else f"{count} {plural_form or word + 's'}"
+
+
+@contextlib.contextmanager
+def compiling_notice(after: float = 1.0) -> Iterator[None]:
+    """Say on stderr that the kernels are being compiled when the block takes longer than ``after`` [s]:
+    the first run on a machine compiles them (numba) and keeps them for the next runs."""
+    timer = threading.Timer(after, lambda: print(
+        "kinelab: compiling its solver kernels for this machine (once; later runs load them) ...",
+        file=sys.stderr, flush=True))
+    timer.daemon = True
+    timer.start()
+    try:
+        yield
+    finally:
+        timer.cancel()

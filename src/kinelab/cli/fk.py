@@ -1,0 +1,39 @@
+"""``kinelab fk``: the tool pose at a configuration."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+import numpy as np
+
+from kinelab.cli.common import json_flag, load_robot, pose_dict, print_json, q_from_cli, robot_arguments
+
+
+def add(sub: Any) -> None:
+    """The ``fk`` subcommand."""
+    s = sub.add_parser("fk", help="tool pose at a configuration")
+    robot_arguments(s, "one number per joint (rad and m; deg with --deg)")
+    json_flag(s)
+    s.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Print oMtool at q: position, quaternion (w, x, y, z), roll-pitch-yaw and the rotation matrix."""
+    robot = load_robot(args)
+    q = q_from_cli(robot, args.q, args.deg)
+    outside = [] if args.ignore_limits else robot.outside_limits(q)
+    oMtool = robot.fk(q)  # FK is defined at any q: a q outside the limits is computed and said, not refused
+    out = {"robot": robot.name, "base": robot.base, "tool": robot.tool, "q": q.tolist(), **pose_dict(oMtool),
+           "outside_limits": outside}
+    if args.json:
+        print_json(out)
+        return 0
+    print(f"{robot.name}: pose of {robot.tool!r} in {robot.base!r}")
+    for note in outside:
+        print(f"  note: {note} (the pose is computed all the same)")
+    print(f"  position [m]   {np.array2string(oMtool.translation, precision=6)}")
+    print(f"  quat_wxyz      {np.array2string(np.array(out['quat_wxyz']), precision=6)}")
+    print(f"  rpy [rad]      {np.array2string(np.array(out['rpy_rad']), precision=6)}")
+    print("  rotation       " + np.array2string(oMtool.rotation, precision=6, prefix="  rotation       "))
+    return 0

@@ -1,0 +1,198 @@
+"""``kinelab ik``: inverse kinematics to a target pose or configuration, with FRDM's bypasses as flags."""
+
+from __future__ import annotations
+
+import argparse
+import re
+from typing import Any
+
+import numpy as np
+
+from kinelab.cli.common import (
+    compiling_notice,
+    json_flag,
+    load_robot,
+    plural,
+    pose_dict,
+    print_json,
+    q_from_cli,
+    seed_argument,
+    source_arguments,
+)
+from kinelab.errors import KinelabError
+from kinelab.ik.frdm.options import SWITCHABLE, bypass_plan
+from kinelab.ik.result import IKResult, Status
+from kinelab.ik.tasks import AXES, TASKS
+from kinelab.robot import Robot
+
+
+def add(sub: Any) -> None:
+    """The ``ik`` subcommand."""
+    s = sub.add_parser("ik", help="inverse kinematics to a target pose or configuration")
+    s.add_argument("robot", help="registered name or model file (URDF, xacro, MJCF)")
+    s.add_argument("--solver", default="frdm", help="frdm, biquat or dls (the Pinocchio reference); default frdm")
+    s.add_argument("--target-q", nargs="+", help="target as a configuration (its FK pose), or an SRDF name")
+    s.add_argument("--target-xyz", nargs=3, type=float, help="target position [m] in the base frame")
+    s.add_argument("--target-rpy", nargs=3, type=float,
+                   help="target roll, pitch, yaw (rad; deg with --deg); without it the target rotation is the identity")
+    s.add_argument("--task", choices=TASKS, default="pose",
+                   help="the components to meet: pose (all, the default), position, axis (point and one tool axis, "
+                        "roll free), orientation")
+    s.add_argument("--axis", choices=AXES, default="z", help="the tool axis of --task axis (default z)")
+    s.add_argument("--start-q", nargs="+", help="first start (default: seeded random), or an SRDF name")
+    s.add_argument("--deg", action="store_true", help="angles in degrees (revolute/continuous joints, rpy)")
+    seed_argument(s)
+    s.add_argument("--tol-pos", type=float, default=1e-6, help="position tolerance [m] (default 1e-6)")
+    s.add_argument("--tol-rot", type=float, default=1e-6, help="rotation tolerance [rad] (default 1e-6)")
+    s.add_argument("--time-budget", type=float, default=1.0, help="wall-clock budget [s] (default 1)")
+    s.add_argument("--polish", action="store_true", help="frdm: add damped-least-squares polish steps")
+    s.add_argument("--kick", action="append", metavar="JOINT=DELTA",
+                   help="frdm bypass: signed step added when the monitor fires (repeatable)")
+    s.add_argument("--interval", action="append", metavar="JOINT=LO:HI",
+                   help="frdm bypass: keep the joint within [LO, HI] from the start (repeatable)")
+    s.add_argument("--freeze", action="append", metavar="JOINT[=VALUE]",
+                   help="frdm bypass: hold the joint at VALUE (or where it starts) from the start (repeatable)")
+    s.add_argument("--on-singular", nargs="+", choices=tuple(SWITCHABLE), metavar="BYPASS",
+                   help="switch these bypasses on only when the monitor fires, in this order (the paper's "
+                        "policy): kick, interval, freeze")
+    s.add_argument("--law", choices=["simple", "regular"], help="biquat: control law (9)/(16) or (11)/(12)")
+    s.add_argument("--integrator", choices=["euler", "rk4", "adaptive"], help="biquat: integrator")
+    s.add_argument("--step", type=float, help="biquat: fixed step h [s] (the paper: 0.01; default 1/k)")
+    s.add_argument("--gain", type=float, help="biquat: gain k [1/s] (default 1)")
+    source_arguments(s)
+    json_flag(s)
+    s.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Solve, print the result (or its JSON form); exit 0 when reached, 1 when not."""
+    from kinelab.ik import solve
+    from kinelab.ik.registry import solver_module
+
+    robot = load_robot(args)
+    target, options = _target(robot, args)
+    q0 = None if args.start_q is None else q_from_cli(robot, args.start_q, args.deg, "--start-q")
+    if args.solver == "frdm" and args.polish:
+        options["polish"] = True
+    options.update(_bypass_options(robot, args))
+    if args.solver == "biquat":
+        options.update({k: v for k, v in (("law", args.law), ("integrator", args.integrator), ("step", args.step),
+                                          ("k", args.gain)) if v is not None})
+    prepare = getattr(solver_module(args.solver), "prepare", None)
+    if prepare is not None:
+        with compiling_notice():
+            prepare(robot)
+    result = solve(robot, target, solver=args.solver, q0=q0, seed=args.seed, tol_pos=args.tol_pos,
+                   tol_rot=args.tol_rot, time_budget=args.time_budget, task=args.task, axis=args.axis, **options)
+    if args.json:
+        print_json({"robot": robot.name, "target": pose_dict(target), **result.to_dict()})
+    else:
+        _print_ik(robot, args, result)
+    return 0 if result.success else 1
+
+
+def _target(robot: Robot, args: argparse.Namespace) -> tuple[Any, dict[str, Any]]:
+    """The target pose, and the biquaternion solver's signed target when it is given as a configuration."""
+    from kinelab.ik import target_from_xyz_rpy
+
+    if (args.target_q is None) == (args.target_xyz is None):
+        raise KinelabError("give the target as --target-q Q... or as --target-xyz X Y Z [--target-rpy R P Y]")
+    options: dict[str, Any] = {}
+    if args.target_q is None:
+        rpy = np.array(args.target_rpy if args.target_rpy is not None else [0.0, 0.0, 0.0])
+        return target_from_xyz_rpy(args.target_xyz, np.deg2rad(rpy) if args.deg else rpy), options
+    q_target = robot.check_q(q_from_cli(robot, args.target_q, args.deg, "--target-q"), limits=True,
+                             what="--target-q")
+    if args.solver == "biquat":
+        from kinelab.dq import kinematics as biquat_kinematics
+
+        options["target_biquaternion"] = biquat_kinematics.pose(robot, q_target)  # N with its sign
+    return robot.fk(q_target), options
+
+
+def _bypass_value(robot: Robot, joint: str, text: str, deg: bool, flag: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise KinelabError(f"{flag} {joint}: {text!r} is not a number") from None
+    kind = robot.joint_kinds[robot.joint_index(joint)]
+    return float(np.deg2rad(value)) if deg and kind != "prismatic" else value
+
+
+def _bypass_options(robot: Robot, args: argparse.Namespace) -> dict[str, Any]:
+    """FRDM's bypass tables from --kick J=D, --interval J=LO:HI and --freeze J[=V] (rad, m; deg with --deg), with
+    the policy :func:`kinelab.ik.frdm.options.bypass_plan` gives for --on-singular."""
+    specs = {"kicks": args.kick or [], "intervals": args.interval or [], "freeze": args.freeze or []}
+    if not any(specs.values()):
+        if args.on_singular:
+            raise KinelabError("--on-singular switches bypasses given by --kick, --interval or --freeze; none is")
+        return {}
+    if args.solver != "frdm":
+        raise KinelabError("--kick, --interval and --freeze are FRDM's bypasses; use --solver frdm")
+    out: dict[str, Any] = {}
+    for spec in specs["kicks"]:
+        joint, value = _split_spec(spec, "--kick", "JOINT=DELTA")
+        out.setdefault("kicks", {})[joint] = _bypass_value(robot, joint, value, args.deg, "--kick")
+    for spec in specs["intervals"]:
+        joint, bounds = _split_spec(spec, "--interval", "JOINT=LOWER:UPPER")
+        lo, colon, hi = bounds.partition(":")
+        if not colon:
+            raise KinelabError(f"--interval wants JOINT=LOWER:UPPER, got {spec!r}")
+        out.setdefault("intervals", {})[joint] = (_bypass_value(robot, joint, lo, args.deg, "--interval"),
+                                                  _bypass_value(robot, joint, hi, args.deg, "--interval"))
+    for spec in specs["freeze"]:
+        joint, sep, value = spec.partition("=")
+        robot.joint_index(joint)  # an unknown joint is named with the valid ones
+        out.setdefault("freeze", {})[joint] = _bypass_value(robot, joint, value, args.deg, "--freeze") if sep else None
+    return {**out, **bypass_plan(out, tuple(args.on_singular or ()))}
+
+
+def _split_spec(spec: str, flag: str, form: str) -> tuple[str, str]:
+    joint, sep, value = spec.partition("=")
+    if not sep:
+        raise KinelabError(f"{flag} wants {form}, got {spec!r}")
+    return joint, value
+
+
+def _print_ik(robot: Robot, args: argparse.Namespace, result: IKResult) -> None:
+    """The text form of an IK result: status, q, Pinocchio's errors on the task's components, effort."""
+    q_show = np.where([k != "prismatic" for k in robot.joint_kinds], np.rad2deg(result.q), result.q) \
+        if args.deg else result.q
+    print(f"{robot.name} {args.solver}, task {result.task}: {result.status.value} (success: {result.success})")
+    print(f"  q{' [deg, m]' if args.deg else ' [rad, m]'}  {np.array2string(q_show, precision=6)}")
+    free = {"position": (False, True), "orientation": (True, False)}.get(args.task, (False, False))
+    print(f"  position error {result.position_error:.3e} m{' (free)' if free[0] else ''}, "
+          f"{'axis' if args.task == 'axis' else 'rotation'} error {result.rotation_error:.3e} rad"
+          f"{' (free)' if free[1] else ''} (Pinocchio FK)")
+    print(f"  {plural(result.iterations, 'iteration')}, {plural(result.restarts, 'restart')}, "
+          f"{result.wall_time * 1e3:.2f} ms, mode {result.mode}")
+    if result.diagnostics.model_time:
+        m0 = result.diagnostics.M0
+        print(f"  model time {result.diagnostics.model_time:.4g} s, final M0 = "
+              + (f"{m0:+.6f}" if m0 is not None else "n/a (give --target-q for the sign of N)"))
+    _print_events(result)
+    if result.message:
+        print("  " + re.sub(r"task='(\w+)'", r"--task \1", result.message))
+    if not result.success and result.status is not Status.OUTSIDE_LIMITS and args.task != "position" \
+            and args.target_xyz is not None and args.target_rpy is None:
+        print("  (no --target-rpy: the target rotation is the identity; --task position ignores it)")
+
+
+def _print_events(result: IKResult) -> None:
+    """What the monitor saw and which bypasses were applied: in the answer's own attempt, and over the restarts."""
+    attempts = result.restarts + 1
+    looped = result.diagnostics.path != "compiled"  # the compiled multistart answers a stall by a restart
+    if looped:
+        own, held = result.diagnostics.answer_events, result.diagnostics.answer_bypasses
+        fired = f"fired {plural(len(own), 'time')}" if own else "did not fire"
+        applied = ", ".join(f"{b.bypass} " + ("from the start" if not b.sweep else f"at sweep {b.sweep}")
+                            for b in held) or "none"
+        print(f"  the answer's attempt: monitor {fired}; bypasses: {applied}")
+    fired_all = sum(e.count or 1 for e in result.singular_events)
+    monitor = f"monitor fired {plural(fired_all, 'time')}" if fired_all else "monitor did not fire"
+    if not looped:
+        print(f"  {plural(attempts, 'attempt')}: {monitor}" + (" (each stall restarted)" if fired_all else ""))
+    elif attempts > 1:
+        switched = sum(1 for b in result.bypasses if b.sweep not in (None, 0))
+        print(f"  over all {plural(attempts, 'attempt')}: {monitor}"
+              + (f", {plural(switched, 'bypass', 'bypasses')} switched on by it" if switched else ""))

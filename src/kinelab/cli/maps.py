@@ -1,0 +1,144 @@
+"""``kinelab map reach|base|singular``: reachability, base placement and singularity maps (kinelab.maps)."""
+
+from __future__ import annotations
+
+import argparse
+import time
+from typing import Any
+
+import numpy as np
+
+from kinelab.cli.common import Parser, load_robot, plural, print_json, seed_argument, source_arguments
+from kinelab.errors import KinelabError
+
+
+def add(sub: Any) -> None:
+    """The ``map`` subcommand and its three kinds."""
+    s = sub.add_parser("map", help="reachability, base placement and singularity maps (kinelab.maps)")
+    kinds = s.add_subparsers(dest="kind", required=True, metavar="KIND", parser_class=Parser)
+    _add_reach(kinds)
+    _add_base(kinds)
+    g = kinds.add_parser("singular", help="σ_min/σ_max over joint-space samples (the engine of singular --sweep)")
+    g.add_argument("robot", help="a registered name or a model file (see kinelab robots)")
+    g.add_argument("--samples", type=int, default=5000, help="configurations to sample (default 5000)")
+    g.add_argument("--grid", action="store_true", help="a stratified grid instead of uniform samples")
+    seed_argument(g)
+    source_arguments(g)
+    g.add_argument("--json", action="store_true", help="print the summary as JSON")
+    g.set_defaults(func=run_singular)
+
+
+def _add_reach(kinds: Any) -> None:
+    r = kinds.add_parser("reach", help="the share of orientations the arm reaches in each voxel of its workspace")
+    r.add_argument("robot", help="a registered name or a model file (see kinelab robots)")
+    r.add_argument("--voxel", type=float, default=0.1, help="voxel side [m] (default 0.1)")
+    r.add_argument("--orientations", type=int, default=16, help="target orientations per voxel (default 16)")
+    r.add_argument("--task", choices=("pose", "axis"), default="pose",
+                   help="pose (default), or axis: the tool z axis along spread directions, the roll free")
+    r.add_argument("--restarts", type=int, default=20, help="random restarts per target (default 20)")
+    seed_argument(r)
+    r.add_argument("--chunk", type=int, default=64, help="voxels per chunk, the unit of work and storage (default 64)")
+    r.add_argument("--out", help="a Zarr directory: written chunk by chunk, resumed if it holds this map unfinished")
+    r.add_argument("--force", action="store_true", help="run a map of more than 2 million targets")
+    r.add_argument("--scheduler", metavar="ADDRESS", help="run the chunks on this Dask scheduler (kinelab[cluster])")
+    r.add_argument("--workers", type=int, help="run the chunks on a local Dask cluster of this many processes")
+    source_arguments(r)
+    r.add_argument("--json", action="store_true", help="print the summary as JSON")
+    r.set_defaults(func=run_reach)
+
+
+def _add_base(kinds: Any) -> None:
+    b = kinds.add_parser("base", help="platform positions (and headings) from which a mobile manipulator reaches "
+                                      "a grasp")
+    b.add_argument("robot", help="a mobile manipulator with joints platform_x, platform_y, platform_yaw (youbot)")
+    b.add_argument("--grasp", nargs=6, type=float, required=True, metavar=("X", "Y", "Z", "R", "P", "YAW"),
+                   help="the grasp pose: position [m] and roll, pitch, yaw [rad] in the world frame")
+    b.add_argument("--step", type=float, default=0.05, help="x-y grid spacing [m] (default 0.05)")
+    b.add_argument("--top", type=int, default=5, help="how many of the best poses to print (default 5)")
+    seed_argument(b)
+    source_arguments(b)
+    b.add_argument("--json", action="store_true", help="print the reachable poses as JSON")
+    b.set_defaults(func=run_base)
+
+
+def run_base(args: argparse.Namespace) -> int:
+    """The platform positions that reach the grasp, best manipulability first."""
+    from kinelab import maps
+    from kinelab.ik import target_from_xyz_rpy
+
+    robot = load_robot(args)
+    grasp = target_from_xyz_rpy(args.grasp[:3], args.grasp[3:])
+    result = maps.base_map(robot, grasp, step=args.step, seed=args.seed)
+    best = result.ranked(args.top)
+    rows = [{"x": float(result.poses[i, 0]), "y": float(result.poses[i, 1]), "yaw": float(result.poses[i, 2]),
+             "manipulability": float(result.manipulability[i]), "arm_q": result.q[i].tolist()} for i in best]
+    reached = int(result.reachable.sum())
+    if args.json:
+        print_json({"robot": robot.name, "candidates": len(result.poses), "reachable": reached, "best": rows})
+        return 0
+    if not rows:
+        print(f"{robot.name}: the grasp is reached from none of {plural(len(result.poses), 'platform position')} "
+              f"({args.step:g} m grid around it)")
+        return 0
+    print(f"{robot.name}: the grasp is reached from {reached} of "
+          f"{plural(len(result.poses), 'platform position')} ({args.step:g} m grid); the best:")
+    for r in rows:
+        print(f"  x {r['x']:+.3f} m  y {r['y']:+.3f} m  yaw {r['yaw']:+.4f} rad  "
+              f"manipulability {r['manipulability']:.3g}")
+    return 0
+
+
+def run_singular(args: argparse.Namespace) -> int:
+    """σ_min/σ_max over samples: how many near-singular, how many rank-deficient."""
+    from kinelab import maps
+    from kinelab.analysis.singular import NEAR_SINGULAR
+
+    robot = load_robot(args)
+    result = maps.singularity(robot, samples=args.samples, seed=args.seed, method="grid" if args.grid else "random",
+                              progress=not args.json)
+    ratio = result.sigma_ratio
+    summary = {"robot": robot.name, "samples": int(len(ratio)), "rank_deficient": int(result.rank_deficient.sum()),
+               "near_singular": int((ratio < NEAR_SINGULAR).sum()), "median_sigma_ratio": float(np.median(ratio))}
+    if args.json:
+        print_json(summary)
+    else:
+        print(f"{robot.name}: {plural(len(ratio), 'sample')}; {summary['near_singular']} near-singular "
+              f"(σ_min/σ_max < {NEAR_SINGULAR:g}), {summary['rank_deficient']} rank-deficient; median σ_min/σ_max "
+              f"{summary['median_sigma_ratio']:.3g}")
+    return 0
+
+
+def run_reach(args: argparse.Namespace) -> int:
+    """Build (or resume) the reachability map and print its summary."""
+    from kinelab import maps
+
+    robot = load_robot(args)
+    spec = maps.MapSpec(voxel=args.voxel, orientations=args.orientations, task=args.task, restarts=args.restarts,
+                        seed=args.seed, chunk_voxels=args.chunk)
+    if args.scheduler and args.workers:
+        raise KinelabError("give --scheduler ADDRESS or --workers N, not both")
+    if args.workers is not None and args.workers < 1:
+        raise KinelabError(f"--workers must be at least 1, got {args.workers}")
+    client = None
+    if args.scheduler is not None or args.workers:
+        from kinelab.maps import cluster
+
+        client = cluster.client_for(args.scheduler, args.workers)
+    t0 = time.perf_counter()
+    try:
+        result = maps.reachability(robot, spec, out=args.out, force=args.force, progress=not args.json, client=client)
+    finally:
+        if client is not None:
+            client.close()
+    reach = result.array("reachability")
+    summary = {"robot": robot.name, "voxels": int(len(reach)), "targets": int(len(reach) * spec.orientations),
+               "reached_voxels": int((reach > 0).sum()), "mean_reachability": float(np.nanmean(reach)),
+               "seconds": time.perf_counter() - t0, "out": args.out}
+    if args.json:
+        print_json(summary)
+    else:
+        print(f"{robot.name}: {plural(summary['voxels'], 'voxel')} of {args.voxel:g} m × {spec.orientations} "
+              f"orientations; {summary['reached_voxels']} voxels reached, mean reachability "
+              f"{summary['mean_reachability']:.3f}; {summary['seconds']:.1f} s"
+              + (f"; written to {args.out}" if args.out else ""))
+    return 0

@@ -1,0 +1,72 @@
+"""``kinelab robots`` (the registered names) and ``kinelab info`` (a robot's chain, joints and limits)."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+import numpy as np
+
+from kinelab.cli.common import json_flag, load_robot, print_json, robot_arguments
+from kinelab.robot import Joint, catalog
+
+
+def add(sub: Any) -> None:
+    """The ``robots`` and ``info`` subcommands."""
+    s = sub.add_parser("robots", help="list the registered robots")
+    json_flag(s)
+    s.set_defaults(func=run_robots)
+    s = sub.add_parser("info", help="joints, types, limits, DOF and tool frame of a robot")
+    robot_arguments(s, limits=False)
+    json_flag(s)
+    s.set_defaults(func=run_info)
+
+
+def run_robots(args: argparse.Namespace) -> int:
+    """Each registered name with its description, file and chain."""
+    rows = [
+        {"name": e.name, "source": e.source, "file": e.relpath, "chain": e.chain, "tool": e.tool, "base": e.base,
+         "srdf": e.srdf, "group": e.group, "description": e.description}
+        for e in catalog.ENTRIES.values()
+    ]
+    if args.json:
+        print_json(rows)
+        return 0
+    width = max(len(e.name) for e in catalog.ENTRIES.values()) + 2
+    for r in rows:
+        print(f"{r['name']:<{width}}{r['description']}")
+        print(f"{'':<{width}}{r['source']}: {r['file']}; chain {r['chain']}")
+    return 0
+
+
+def _joint_row(j: Joint) -> dict[str, Any]:
+    row: dict[str, Any] = {"name": j.name, "type": j.kind, "lower": j.lower, "upper": j.upper, "unit": j.unit}
+    if j.kind != "prismatic":
+        row["lower_deg"], row["upper_deg"] = float(np.rad2deg(j.lower)), float(np.rad2deg(j.upper))
+    return row
+
+
+def run_info(args: argparse.Namespace) -> int:
+    """The robot's chain: base, tool, joints with their limits, the locked joints."""
+    robot = load_robot(args)
+    info = {"robot": robot.name, "urdf": str(robot.urdf_path), "base": robot.base, "tool": robot.tool,
+            "dof": robot.n, "nq": robot.nq, "nv": robot.nv, "joints": [_joint_row(j) for j in robot.joints],
+            "locked": robot.locked, "mimics": {name: m.leader for name, m in robot.mimics.items()},
+            "format": robot.source_format}
+    if args.json:
+        print_json(info)
+        return 0
+    print(f"{robot.name}: {robot.n} DOF (nq={robot.nq}, nv={robot.nv}), base {robot.base!r} -> tool {robot.tool!r}")
+    print(f"{robot.source_format}: {robot.urdf_path}")
+    print(f"  {'#':>2} {'joint':<22} {'type':<11} {'lower':>12} {'upper':>12}")
+    for i, j in enumerate(robot.joints, start=1):
+        if j.kind == "prismatic":
+            lo, hi = f"{j.lower:.4f} m", f"{j.upper:.4f} m"
+        else:
+            lo, hi = f"{np.rad2deg(j.lower):.3f} deg", f"{np.rad2deg(j.upper):.3f} deg"
+        print(f"  {i:>2} {j.name:<22} {j.kind:<11} {lo:>12} {hi:>12}")
+    for name, m in robot.mimics.items():
+        print(f"mimic: {name} follows {m.leader}")
+    if robot.locked:
+        print(f"locked: {', '.join(f'{k}={v:g}' for k, v in robot.locked.items())}")
+    return 0

@@ -1,0 +1,105 @@
+"""``kinelab view`` (a robot in meshcat) and ``kinelab animate`` (the ERA passages of seed paper 000)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from typing import Any
+
+from kinelab.cli.common import load_robot, plural, q_from_cli, robot_arguments
+from kinelab.errors import KinelabError
+from kinelab.robot import load
+
+MIN_DT, MAX_DT = 1e-3, 60.0  # [s] per animation sample
+
+
+def add(sub: Any) -> None:
+    """The ``view`` and ``animate`` subcommands."""
+    s = sub.add_parser("view", help="show a robot in meshcat (live on 127.0.0.1, or --html for a static page)")
+    robot_arguments(s, "configuration (default: the robot's display pose)")
+    s.add_argument("--singular", action="store_true", help="draw the lost directions and σ_min at q")
+    s.add_argument("--html", help="write a self-contained HTML page instead of serving")
+    s.set_defaults(func=run_view)
+    s = sub.add_parser("animate", help="animate a solver run in meshcat (the ERA passages)")
+    s.add_argument("passage", help="era-elbow, era-wrist or era-shoulder (seed paper 000)")
+    s.add_argument("--without-bypass", action="store_true", help="the run without the paper's bypass")
+    s.add_argument("--dt", type=float, default=0.1, help="seconds per path sample in the animation (default 0.1)")
+    s.add_argument("--html", help="write a self-contained HTML page instead of serving")
+    s.set_defaults(func=run_animate)
+
+
+def run_view(args: argparse.Namespace) -> int:
+    """Draw the robot at q (any finite q; joints outside their limits are noted)."""
+    from kinelab.view import scene as viz
+
+    robot = load_robot(args)
+    q = robot.check_q(q_from_cli(robot, args.q, args.deg) if args.q else robot.display_q())
+    if not args.ignore_limits:
+        for note in robot.outside_limits(q):  # drawn all the same: a view is defined at any q
+            print(f"kinelab: note: {note}", file=sys.stderr)
+    scene = viz.Scene(robot).show(q)
+    if args.singular:
+        scene.singular_directions(q)
+    return _publish(scene, args.html)
+
+
+def run_animate(args: argparse.Namespace) -> int:
+    """Animate one ERA passage with or without the paper's bypass."""
+    from kinelab.studies import paper000_era
+    from kinelab.view import scene as viz
+
+    passages = {f"era-{name}": build for name, build in paper000_era.PASSAGES.items()}
+    if args.passage not in passages:
+        raise KinelabError(f"unknown passage {args.passage!r}; passages are: {', '.join(passages)}")
+    if not (math.isfinite(args.dt) and MIN_DT <= args.dt <= MAX_DT):
+        raise KinelabError(f"--dt {args.dt} is not valid: seconds per sample, between {MIN_DT:g} and {MAX_DT:g}")
+    robot = load("era")
+    passage = passages[args.passage](robot)
+    run = paper000_era.run(passage, robot)
+    result = run.without if args.without_bypass else run.with_bypass
+    scene = viz.Scene(robot, name=f"era ({'without' if args.without_bypass else 'with'} bypass)")
+    scene.animate(result.q, dt=args.dt)
+    one_lap = passage.targets[: (passage.lap or passage.samples) + 1]
+    for k, target in enumerate(one_lap[:: max(1, len(one_lap) // 8)]):
+        scene.frame(f"target{k}", target, 0.5 * scene.frame_length)
+    summary = result.summary()
+    print(f"{args.passage} {'without' if args.without_bypass else 'with'} bypass: {summary['reached']} of "
+          f"{summary['samples']} samples reached, largest joint step {summary['max_joint_step']:.3f} rad, "
+          f"{plural(summary['monitor_events'], 'monitor event')}")
+    return _publish(scene, args.html)
+
+
+def _publish(scene: Any, html: str | None) -> int:
+    """Write the scene as a static page (its caption in the page), or serve it live until interrupted (the
+    caption printed under the address: the live page has none)."""
+    if html:
+        scene.save_html(html)
+        scene.close()
+        print(f"wrote {html}")
+        _print_caption(scene)
+        return 0
+    return _serve(scene)
+
+
+def _print_caption(scene: Any) -> None:
+    print(scene.title)
+    for line in scene.legend.values():
+        print(f"  {line}")
+
+
+def _serve(scene: Any) -> int:
+    import signal
+    import time
+
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))  # so that the finally below stops the server
+    print(f"meshcat is serving on {scene.url} (Ctrl-C to stop)", flush=True)
+    _print_caption(scene)
+    sys.stdout.flush()
+    try:
+        while True:
+            time.sleep(1.0)
+    except KeyboardInterrupt:
+        return 0
+    finally:
+        scene.close()
