@@ -40,7 +40,7 @@ def test_a_link_that_is_its_own_parent(tmp_path):
 def test_a_mimic_joint_naming_a_missing_joint(tmp_path):
     j2 = revolute("j2", "b", "c", extra='<mimic joint="nosuch"/>')
     path = write_urdf(tmp_path, _chain(revolute("j1", "a", "b"), j2))
-    with pytest.raises(kinelab.URDFError, match="'j2' mimics 'nosuch', which is not a joint"):
+    with pytest.raises(kinelab.URDFError, match="'j2' mimics 'nosuch', which is not a joint of this file; hold it"):
         kinelab.load(path)
 
 
@@ -131,3 +131,25 @@ def test_the_cli_says_one_line_even_when_pinocchios_parser_complains(tmp_path):
         assert len(proc.stderr.strip().splitlines()) == 1
     else:
         assert "Error" not in proc.stderr
+
+
+# What Pinocchio's parser reads, kinelab loads: each case once, in a file written here.
+def test_a_comment_nested_in_a_comment_loads(tmp_path):
+    body = "<!-- outer <!-- inner --> tail of the outer -->" + _chain(revolute("j1", "a", "b"))
+    robot = kinelab.load(write_urdf(tmp_path, body))
+    assert robot.joint_names == ["j1", "j2"]
+    np.testing.assert_allclose(robot.fk([0.3, -0.2]).translation, [0, 0, 1.0], atol=1e-12)
+
+
+def test_an_undeclared_namespace_prefix_loads(tmp_path):
+    body = '<xacro:property name="unused" value="1"/>' + _chain(revolute("j1", "a", "b"))
+    robot = kinelab.load(write_urdf(tmp_path, body))
+    assert robot.n == 2 and robot.tool == "c"
+
+
+def test_a_mimic_off_the_chain_whose_leader_is_missing_is_locked_with_one_warning(tmp_path):
+    finger = '<link name="f"/>' + revolute("jf", "b", "f", extra='<mimic joint="nosuch"/>')
+    path = write_urdf(tmp_path, _chain(revolute("j1", "a", "b")) + finger)
+    with pytest.warns(UserWarning, match="'jf' mimics 'nosuch'.*off the chain and locked") as said:
+        robot = kinelab.load(path, tool="c")
+    assert len(said) == 1 and robot.joint_names == ["j1", "j2"] and "jf" in robot.locked

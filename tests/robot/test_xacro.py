@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import kinelab
+import kinelab.cli
 from kinelab import URDFError, load
 
 pytest.importorskip("xacrodoc")
@@ -46,3 +47,56 @@ def test_a_bad_xacro_is_named_with_xacros_reason(tmp_path):
         load(bad)
     with pytest.raises(URDFError, match="no such xacro file"):
         load(tmp_path / "missing.urdf.xacro")
+
+
+HOSTILE = {  # construct refused → xacro text that uses it and expands to nothing when trusted
+    "$(eval ...)": """<xacro:property name="p" value="exec('open(&quot;{marker}&quot;, &quot;w&quot;)', {{}}) is None"/>
+  <xacro:if value="$(eval ${{p}})"></xacro:if>""",
+    "$(env ...)": """<xacro:if value="${{len('$(env HOME)') >= 0}}"></xacro:if>""",
+    "$(optenv ...)": """<xacro:if value="$(optenv KINELAB_NO_SUCH_VARIABLE 1)"></xacro:if>""",
+    "load_yaml": """<xacro:if value="${{len(xacro.load_yaml('/etc/hostname')) >= 0}}"></xacro:if>""",
+    "a '__' name": """<xacro:if value="${{len('x.__class__') > 0}}"></xacro:if>""",
+}
+KEYS = {"$(eval ...)": "$(eval", "$(env ...)": "$(env", "$(optenv ...)": "$(optenv", "load_yaml": "load_yaml",
+        "a '__' name": "__class__"}
+
+
+def _hostile(tmp_path, construct):
+    marker = tmp_path / "ran"
+    body = HOSTILE[construct].format(marker=marker)
+    path = tmp_path / "bad.urdf.xacro"
+    path.write_text(XACRO.replace('<link name="base"/>', f'<link name="base"/>\n  {body}'))
+    return path, marker
+
+
+@pytest.mark.parametrize("construct", list(HOSTILE))
+def test_a_xacro_that_would_run_code_or_read_the_machine_is_refused_with_its_line(tmp_path, construct):
+    path, marker = _hostile(tmp_path, construct)
+    line = next(k for k, text in enumerate(path.read_text().splitlines(), 1) if KEYS[construct] in text)
+    with pytest.raises(URDFError, match=rf"at line {line} would run code or read the machine.*trust_xacro") as err:
+        load(path)
+    assert construct in str(err.value) and not marker.exists()
+    assert load(path, trust_xacro=True).n == 2  # the same file, trusted by name, expands
+
+
+def test_the_user_can_trust_a_xacro_by_name_and_then_it_runs(tmp_path):
+    path, marker = _hostile(tmp_path, "$(eval ...)")
+    robot = load(path, trust_xacro=True)
+    assert marker.exists() and robot.trust_xacro and robot.n == 2
+
+
+def test_the_cli_refuses_in_one_line_and_takes_trust_xacro(tmp_path, capsys):
+    path, marker = _hostile(tmp_path, "$(env ...)")
+    assert kinelab.cli.main(["info", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "$(env ...)" in err and "--trust-xacro" in err
+    assert kinelab.cli.main(["info", str(path), "--trust-xacro"]) == 0
+
+
+def test_a_map_worker_gets_the_user_s_trust_and_arguments(tmp_path):
+    from kinelab.maps.cluster import recipe
+
+    path = tmp_path / "arm.urdf.xacro"
+    path.write_text(XACRO)
+    how = recipe(load(path, xacro_args={"reach": "0.5"}))
+    assert how["trust_xacro"] is False and how["xacro_args"] == {"reach": "0.5"}

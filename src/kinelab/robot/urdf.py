@@ -3,15 +3,22 @@ file must meet to be a model (so that errors name the file, the element and the 
 
 Rules: one root link; no link that is its own parent; every joint has a parent and a child; origins are
 finite and within ``MAX_OFFSET`` of their parent; axes are finite and not zero; limits are finite with
-lower ≤ upper; a mimic joint names a joint that exists; the text decodes in the encoding the XML
-declares (UTF-8 when it declares none).
+lower ≤ upper; the text decodes in the encoding the XML declares (UTF-8 when it declares none).
+
+What Pinocchio's own parser (urdfdom on tinyxml2) reads, this reader reads too: a comment nested inside a
+comment (xacro output has them) and a namespace prefix used without its declaration (``<xacro:...>`` left in
+a file) are tolerated; a mimic joint whose leader the file lacks is kept as a plain joint, with one warning
+(Pinocchio ignores the tag when it builds the model without mimic joints).
 """
 
 from __future__ import annotations
 
 import math
+import re
+import warnings
 import xml.etree.ElementTree as ET
-from dataclasses import dataclass
+from collections.abc import Iterable
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from kinelab.errors import ChainError, URDFError
@@ -29,6 +36,22 @@ class UrdfTree:
     mimic: dict[str, str]  # joint -> the joint it mimics
     links: list[str]
     leaves: list[str]
+    broken_mimic: dict[str, str] = field(default_factory=dict)  # joint -> a leader the file lacks
+
+    def check_mimics(self, path: Path, chain: list[str], locked: Iterable[str]) -> None:
+        """A mimic joint whose leader is missing: refused on the chain (unless locked), locked with one warning
+        off it (Pinocchio's model ignores the tag there too).
+
+        Raises:
+            URDFError: such a joint on the chain.
+        """
+        held = set(locked)
+        for name, leader in self.broken_mimic.items():
+            if name in chain and name not in held:
+                raise URDFError(f"{path}: joint {name!r} mimics {leader!r}, which is not a joint of this file; "
+                                f"hold it at a value (locked={{{name!r}: value}}) or fix the file")
+            warnings.warn(f"{path.name}: joint {name!r} mimics {leader!r}, which is not a joint of this file; "
+                          "it is off the chain and locked", stacklevel=5)
 
 
 def read_tree(path: Path) -> UrdfTree:
@@ -62,14 +85,15 @@ def read_tree(path: Path) -> UrdfTree:
                 raise URDFError(f"{path}: joint {joint_of[child]!r} names link {link!r}, "
                                 "which the file does not define")
     joint_names = {j.get("name", "?") for j in xml.findall("joint")}
-    for name, leader in mimic.items():
-        if leader not in joint_names:
-            raise URDFError(f"{path}: joint {name!r} mimics {leader!r}, which is not a joint of this file")
+    broken = {name: leader for name, leader in mimic.items() if leader not in joint_names}
+    for name in broken:
+        del mimic[name]
     roots = [link for link in links if link not in parent_of]
     if len(roots) != 1:
         raise URDFError(f"malformed URDF {path}: expected one root link, found {roots}")
     parents = set(parent_of.values())
-    return UrdfTree(roots[0], parent_of, joint_of, mimic, links, [link for link in links if link not in parents])
+    return UrdfTree(roots[0], parent_of, joint_of, mimic, links, [link for link in links if link not in parents],
+                    broken)
 
 
 def _parse(path: Path) -> ET.Element:
@@ -78,12 +102,40 @@ def _parse(path: Path) -> ET.Element:
     try:
         xml = ET.parse(path).getroot()
     except ET.ParseError as exc:
-        raise URDFError(f"malformed URDF {path}: {exc} (the text must be UTF-8 or declare its encoding)") from None
+        xml = _parse_leniently(path, exc)
     except (UnicodeDecodeError, LookupError) as exc:
         raise URDFError(f"URDF {path} cannot be decoded: {exc}") from None
     if xml.tag != "robot":
         raise URDFError(f"malformed URDF {path}: the root element is <{xml.tag}>, expected <robot>")
     return xml
+
+
+_COMMENT = re.compile(r"<!--.*?-->", re.S)
+_PREFIX = re.compile(r"<\/?([A-Za-z_][\w.-]*):|\s([A-Za-z_][\w.-]*):[\w.-]+\s*=")
+_ROOT_TAG = re.compile(r"<robot\b")
+
+
+def _parse_leniently(path: Path, first: ET.ParseError) -> ET.Element:
+    """The file as Pinocchio's parser reads it: comments cut out (a nested one leaves its tail as text) and every
+    undeclared namespace prefix declared on <robot>; the first error is reported when that does not help."""
+    try:
+        text = path.read_bytes().decode(_declared_encoding(path))
+    except (UnicodeDecodeError, LookupError) as exc:
+        raise URDFError(f"URDF {path} cannot be decoded: {exc}") from None
+    text = re.sub(r"^\s*<\?xml[^>]*\?>", "", _COMMENT.sub("", text))
+    prefixes = {p for pair in _PREFIX.findall(text) for p in pair if p and p not in ("xml", "xmlns")}
+    declared = set(re.findall(r"xmlns:([\w.-]+)\s*=", text))
+    extra = "".join(f' xmlns:{p}="urn:kinelab:undeclared:{p}"' for p in sorted(prefixes - declared))
+    try:
+        return ET.fromstring(_ROOT_TAG.sub("<robot" + extra, text, count=1))
+    except ET.ParseError:
+        raise URDFError(f"malformed URDF {path}: {first} (the text must be UTF-8 or declare its encoding)") from None
+
+
+def _declared_encoding(path: Path) -> str:
+    head = path.read_bytes()[:200].decode("ascii", "replace")
+    found = re.search(r"encoding\s*=\s*[\"']([\w.-]+)[\"']", head)
+    return found.group(1) if found else "utf-8"
 
 
 def _check_joint(path: Path, joint: ET.Element) -> tuple[str, str]:
