@@ -91,6 +91,7 @@ def test_the_html_report_puts_the_verdict_first_and_a_section_per_paper_with_cap
     assert "<script" not in page and "http" not in page  # self-contained
 
 
+@pytest.mark.browser
 def test_a_browser_shows_the_verdict_banner_at_the_top_of_the_report(tmp_path):
     """Headless Chromium renders the page: the red FAIL banner sits in the first rows, the failed row is
     tinted, the page's width is the browser's (no horizontal overflow of the tables)."""
