@@ -1,8 +1,11 @@
 """The same map in this process and on a local Dask cluster of 1 and 2 worker processes, a worker killed
 mid-run, and an unreachable scheduler."""
 
+import contextlib
 import os
 import signal
+import socket
+import struct
 import threading
 import time
 
@@ -33,6 +36,9 @@ def in_process(ur5):
 def test_a_local_cluster_computes_the_identical_map(ur5, in_process, workers):
     client = cluster.client_for(None, workers)
     try:
+        assert client.scheduler.address.startswith("tls://127.0.0.1:")  # temporary TLS credentials, loopback
+        http = client.cluster.scheduler.http_server  # no HTTP server left listening
+        assert all(sock.fileno() == -1 for sock in http._sockets.values())
         on_dask = maps.reachability(ur5, SPEC, client=client)
     finally:
         client.close()
@@ -81,3 +87,42 @@ def test_an_unreachable_scheduler_is_named_within_seconds():
     with pytest.raises(KinelabError, match="cannot reach the Dask scheduler at 'tcp://127.0.0.1:9'"):
         cluster.client_for("tcp://127.0.0.1:9", None)
     assert time.perf_counter() - t0 < 30
+
+
+@pytest.mark.parametrize("address", ["", "abc", "tcp://", "tcp://host", "http://127.0.0.1:80", "127.0.0.1:0",
+                                     "tcp://127.0.0.1:70000", "tcp://a b:1"])
+def test_a_malformed_scheduler_address_is_refused_with_the_form_expected(address):
+    with pytest.raises(KinelabError, match="give tcp://HOST:PORT"):
+        cluster.client_for(address, None)
+
+
+def test_a_bare_host_and_port_is_taken_as_tcp():
+    assert cluster.check_address("127.0.0.1:8786") == "tcp://127.0.0.1:8786"
+    assert cluster.check_address("tls://[::1]:8786") == "tls://[::1]:8786"
+
+
+def _stranger(reply: bytes):
+    """A loopback server that accepts and answers ``reply`` (or keeps silent), as a web server on the port would."""
+    server = socket.create_server(("127.0.0.1", 0))
+
+    def serve():
+        with contextlib.suppress(OSError):
+            conn, _ = server.accept()
+            with conn:
+                if reply:
+                    conn.sendall(reply)
+                time.sleep(8)
+
+    threading.Thread(target=serve, daemon=True).start()
+    return server
+
+
+@pytest.mark.parametrize("reply", [b"", b"HTTP/1.1 400 Bad Request\r\n\r\n", struct.pack("<Q", 3 << 60)])
+def test_a_stranger_on_the_port_is_named_within_seconds_and_allocates_nothing(reply):
+    server = _stranger(reply)
+    address = f"tcp://127.0.0.1:{server.getsockname()[1]}"
+    t0 = time.perf_counter()
+    with pytest.raises(KinelabError, match="not as a Dask scheduler"):
+        cluster.client_for(address, None)
+    assert time.perf_counter() - t0 < cluster.CONNECT_TIMEOUT + 1
+    server.close()
