@@ -1,3 +1,5 @@
+from pathlib import Path
+
 import numpy as np
 import pytest
 from helpers import BUNDLED, ERD_ARMS
@@ -14,3 +16,18 @@ def robots():
 @pytest.fixture
 def rng():
     return np.random.default_rng(12345)
+
+
+_SLOW = frozenset(line.strip() for line in (Path(__file__).parent / "slow.txt").read_text().splitlines()
+                  if line.strip() and not line.startswith("#"))
+
+
+def pytest_collection_modifyitems(config, items):
+    """Markers by where a test lives: ``notebooks`` (the notebooks and their renderer), ``slow`` (tests/slow.txt);
+    ``browser`` is set on the tests themselves."""
+    for item in items:
+        path = Path(str(item.fspath))
+        if path.suffix == ".ipynb" or path.name == "test_notebooks.py":
+            item.add_marker(pytest.mark.notebooks)
+        if item.nodeid in _SLOW:
+            item.add_marker(pytest.mark.slow)

@@ -53,6 +53,7 @@ def test_animation_with_tool_path_and_singular_overlay():
     assert html.count("data:application/octet-binary") > len(paths)  # the animation travels as a command too
 
 
+@pytest.mark.browser
 @needs_browser
 @pytest.mark.parametrize("name", BUNDLED)
 def test_a_real_browser_draws_the_robot(name, tmp_path):
@@ -71,6 +72,7 @@ def test_a_real_browser_draws_the_robot(name, tmp_path):
     assert live_share > 0.003, f"the live viewer shows only {live_share:.2%} of changed pixels"
 
 
+@pytest.mark.browser
 @needs_browser
 def test_the_empty_reference_really_is_empty_of_the_robot(tmp_path):
     robot = kinelab.load("era")
@@ -102,6 +104,7 @@ def test_side_by_side_draws_one_stick_figure_and_tool_frame_per_configuration():
         viz.side_by_side(robot, [np.zeros(3)])
 
 
+@pytest.mark.browser
 @needs_browser
 def test_a_mesh_of_a_ros_package_is_drawn_in_the_browser(tmp_path):
     """The package mesh (found through package_dirs) is in the scene tree, and a real browser draws it: the
@@ -121,6 +124,7 @@ def test_a_mesh_of_a_ros_package_is_drawn_in_the_browser(tmp_path):
     assert share > 0.003, f"the package mesh covers only {share:.2%} of the picture"
 
 
+@pytest.mark.browser
 @needs_browser
 @pytest.mark.parametrize("name", [*BUNDLED, "panda", "so101"])
 def test_the_view_frames_the_robot_over_its_floor_with_a_caption(name, tmp_path):
