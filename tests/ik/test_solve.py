@@ -60,7 +60,8 @@ def test_an_unattainable_tolerance_ends_at_the_budget(solver, links):
     res = kinelab.solve(robot, target, solver=solver, q0=robot.random_q(3), seed=0, tol_pos=1e-300,
                         tol_rot=1e-300, time_budget=budget, max_restarts=10**9)  # the budget must bind
     assert not res.success and res.status.value == "time_budget"
-    assert budget <= res.wall_time < budget + 0.01  # generous for a shared machine; the bench measures the p99
+    # behaviour, not speed: it ran until the budget and then stopped (the bench measures the overrun's p99)
+    assert budget <= res.wall_time < budget + 1.0
 
 
 def test_the_same_seed_gives_the_same_answer_in_another_process():

@@ -241,3 +241,30 @@ def test_yourdfpy_loads_real_meshes_through_the_same_resolver():
     urdf = yourdfpy.URDF.load(str(panda.urdf_path), load_meshes=True,
                               filename_handler=yourdfpy_filename_handler(panda.urdf_path))
     assert len(urdf.scene.geometry) >= 8
+
+
+def test_a_robot_from_an_in_memory_model_is_the_robot_of_its_file():
+    """Robot.from_model takes the pin.Model a pink or mink user already has; the chain is the file's."""
+    loaded = kinelab.load("panda")
+    whole = pin.buildModelFromUrdf(str(loaded.urdf_path))
+    robot = kinelab.Robot.from_model(whole, tool="panda_hand_tcp")
+    assert robot.joint_names == loaded.joint_names and robot.source is None and robot.source_format == "pin.Model"
+    rng = np.random.default_rng(4)
+    for q in robot.random_qs(20, rng):
+        assert np.allclose(robot.fk(q).homogeneous, loaded.fk(q).homogeneous, atol=1e-12)
+    assert whole.nq == 9  # the fingers are locked in the robot's copy, not in the caller's model
+    target = loaded.fk(loaded.random_q(rng))
+    res = kinelab.solve(robot, target, seed=0)
+    assert res.success and np.allclose(loaded.fk(res.q).homogeneous, target.homogeneous, atol=1e-6)
+
+
+def test_from_model_re_roots_at_a_base_and_refuses_what_it_cannot_use():
+    loaded = kinelab.load("ur5", base="shoulder_link")
+    whole = pin.buildModelFromUrdf(str(loaded.urdf_path))
+    robot = kinelab.Robot.from_model(whole, tool=loaded.tool, base="shoulder_link")
+    q = loaded.random_q(1)
+    assert robot.n == loaded.n and np.allclose(robot.fk(q).homogeneous, loaded.fk(q).homogeneous, atol=1e-12)
+    with pytest.raises(kinelab.FrameNotFoundError, match="nosuch"):
+        kinelab.Robot.from_model(whole, tool="nosuch")
+    with pytest.raises(kinelab.ChainError, match="pinocchio.Model"):
+        kinelab.Robot.from_model("panda.urdf", tool="x")

@@ -84,7 +84,7 @@ def test_a_chain_too_long_for_pinocchio_is_refused_at_once_with_the_estimate(tmp
     import time
 
     from kinelab.report.bench import scaling
-    from kinelab.robot.model import max_joints
+    from kinelab.robot.build import max_joints
 
     path = tmp_path / "long.urdf"
     path.write_text(scaling.synthetic_urdf(max_joints() + 200))

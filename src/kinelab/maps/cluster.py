@@ -35,6 +35,9 @@ def recipe(robot: Robot) -> dict:
     worker's copy must have."""
     from kinelab.robot import catalog
 
+    if robot.source is None:
+        raise KinelabError(f"{robot.name} was made from an in-memory model, which Dask workers cannot load: save "
+                           "it as a URDF and load that, or run the map in this process")
     source = robot.name if robot.name in catalog.names() else str(Path(robot.source).resolve())
     return {"source": source, "tool": robot.tool, "base": robot.base, "xacro_args": robot.xacro_args,
             "trust_xacro": robot.trust_xacro, "sha256": model_sha256(robot)}

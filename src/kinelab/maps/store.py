@@ -31,6 +31,8 @@ def _zarr() -> Any:
 
 def model_sha256(robot: Robot) -> str:
     """SHA-256 of the robot's model file (the map's, and every worker's, proof of the same robot)."""
+    if robot.urdf_path is None:  # an in-memory model: its own serialisation
+        return hashlib.sha256(robot.model.saveToString().encode()).hexdigest()
     return hashlib.sha256(Path(robot.urdf_path).read_bytes()).hexdigest()
 
 

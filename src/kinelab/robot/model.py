@@ -12,17 +12,10 @@ Jacobians are 6 × n with rows [linear; angular] (Pinocchio's order); the method
 
 from __future__ import annotations
 
-import contextlib
 import functools
 import itertools
-import math
 import operator
-import os
-import sys
-import tempfile
-import warnings
-from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar, cast
 
@@ -30,257 +23,69 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from kinelab.errors import (
-    ChainError,
-    ConfigurationError,
-    FrameNotFoundError,
-    JointLimitError,
-    JointNotFoundError,
-    OptionError,
-    SRDFError,
-    URDFError,
-)
+from kinelab.errors import ConfigurationError, JointLimitError, JointNotFoundError, OptionError, SRDFError
 from kinelab.geometry import pose_error, wrap_to_pi
 from kinelab.robot import catalog, descriptions, xacro
-from kinelab.robot.meshes import build_visual_model, mesh_package_dirs
-from kinelab.robot.mjcf import is_mjcf, read_mjcf
-from kinelab.robot.srdf import Srdf, read_srdf
-from kinelab.robot.urdf import UrdfTree, read_tree
+from kinelab.robot.build import LIMIT_SLACK, Built, build_file, build_model, frame_id
+from kinelab.robot.joints import Joint, Mimic
+from kinelab.robot.meshes import build_visual_model
+from kinelab.robot.mjcf import is_mjcf
 
-_REVOLUTE = {"JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned"}
-_PRISMATIC = {"JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned"}
-_CONTINUOUS = {"JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "JointModelRevoluteUnboundedUnaligned"}
 T = TypeVar("T")
-MAX_DATA_BYTES = 2**31  # 2 GiB for one Pinocchio Data (see data_bytes)
-LIMIT_SLACK = 1e-9  # joint values this far past a limit still count as within it (rad or m)
-
-
-@dataclass(frozen=True)
-class Joint:
-    """One chain joint: ``kind`` is revolute, prismatic or continuous; limits in rad or m."""
-
-    name: str
-    kind: str
-    lower: float
-    upper: float
-    idx_q: int  # first index in Pinocchio's q
-    idx_v: int  # index in Pinocchio's v (and Jacobian column)
-    axis_local: tuple[float, float, float]
-
-    @property
-    def unit(self) -> str:
-        return "m" if self.kind == "prismatic" else "rad"
-
-
-@dataclass(frozen=True)
-class Mimic:
-    """A chain joint that follows another: q_follower = multiplier · q_leader + offset (rad or m)."""
-
-    name: str
-    leader: str
-    multiplier: float
-    offset: float
-    lower: float  # the follower's own limits
-    upper: float
-
-
-def _narrowed(leader: str, lo: float, hi: float, mimics: Iterable[Mimic]) -> tuple[float, float]:
-    """The leader's limits narrowed so that every follower stays within its own (an empty range: ChainError)."""
-    for m in mimics:
-        if m.leader == leader and m.multiplier != 0.0:
-            a, b = sorted(((m.lower - m.offset) / m.multiplier, (m.upper - m.offset) / m.multiplier))
-            lo, hi = max(lo, a), min(hi, b)
-            if lo > hi:
-                raise ChainError(f"joint {m.name!r} mimics {leader!r}: no value of {leader!r} keeps both "
-                                 "within their limits")
-    return lo, hi
-
-
-def _build_full_model(path: Path, mimic: bool = False) -> pin.Model:
-    said: list[str] = []
-    try:
-        with _c_stderr_captured(said):  # urdfdom prints its complaints on the process's stderr
-            model = pin.buildModelFromUrdf(str(path), mimic=mimic)
-    except (RuntimeError, ValueError, UnicodeDecodeError) as exc:
-        detail = " ".join([str(exc), *said]).strip()
-        raise URDFError(f"Pinocchio cannot read {path}: {detail}") from None
-    if said:
-        warnings.warn(f"Pinocchio's URDF parser on {path.name}: {' '.join(said)}", stacklevel=3)
-    return model
-
-
-@contextlib.contextmanager
-def _c_stderr_captured(said: list[str]) -> Iterator[None]:
-    """File descriptor 2 redirected to a temporary file for the block; its lines appended to ``said``."""
-    sys.stderr.flush()
-    saved = os.dup(2)
-    with tempfile.TemporaryFile(mode="w+b") as sink:
-        os.dup2(sink.fileno(), 2)
-        try:
-            yield
-        finally:
-            os.dup2(saved, 2)
-            os.close(saved)
-            sink.seek(0)
-            said.extend(line.strip() for line in sink.read().decode("utf-8", "replace").splitlines() if line.strip())
-
-
-def _frame_id(model: pin.Model, name: str, robot: str) -> int:
-    """Id of frame ``name``, preferring the link (BODY) frame where a joint shares the name."""
-    body = [i for i, f in enumerate(model.frames) if f.name == name and f.type == pin.FrameType.BODY]
-    if body:
-        return body[0]
-    ids = [i for i, f in enumerate(model.frames) if f.name == name]
-    if not ids:
-        raise FrameNotFoundError(name, [f.name for f in model.frames], robot)
-    return ids[0]
-
-
-def _kind(joint_model: pin.JointModel) -> str | None:
-    short = joint_model.shortname()
-    if short in _REVOLUTE:
-        return "revolute"
-    if short in _PRISMATIC:
-        return "prismatic"
-    if short in _CONTINUOUS:
-        return "continuous"
-    return None
-
-
-def _locked_value(full: pin.Model, jid: int, value: object) -> float:
-    """A user's locked value for joint jid: a finite number within the joint's limits."""
-    name = full.names[jid]
-    try:
-        number = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise ConfigurationError(f"locked[{name!r}] must be a number, got {value!r}") from None
-    if not math.isfinite(number):
-        raise ConfigurationError(f"locked[{name!r}] is {number}: locked values must be finite")
-    iq = full.idx_qs[jid]
-    if full.joints[jid].nq == 1:
-        lo, hi = float(full.lowerPositionLimit[iq]), float(full.upperPositionLimit[iq])
-        if not lo - LIMIT_SLACK <= number <= hi + LIMIT_SLACK:
-            raise JointLimitError(name, number, lo, hi)
-    return number
-
-
 SAMPLE_TURNS = 4  # random configurations keep revolute joints within ±4 turns (see Robot.random_q)
-
-
-def data_bytes(nv: int) -> int:
-    """Bytes a Pinocchio Data takes for nv velocities: it allocates nv × nv × nv tensors (second-order
-    derivatives) and a 6 × nv × nv one, whatever the algorithms used, so its size grows as nv³."""
-    return 8 * (8 * nv**3 + 6 * nv**2 + 64 * nv)  # measured: 513 MB at nv = 200, 1.7 GB at nv = 300
-
-
-def _check_data_size(model: pin.Model, name: str) -> None:
-    need = data_bytes(model.nv)
-    if need > MAX_DATA_BYTES:
-        raise ChainError(
-            f"{name}: the chain has {model.nv} joints, and a Pinocchio Data for it would take about "
-            f"{need / 2**30:.1f} GiB (Pinocchio allocates nv³-sized tensors); kinelab loads chains whose Data "
-            f"fits in {MAX_DATA_BYTES / 2**30:g} GiB (about {max_joints()} joints)"
-        )
-
-
-def max_joints() -> int:
-    """The longest chain whose Pinocchio Data fits in MAX_DATA_BYTES."""
-    nv = 1
-    while data_bytes(nv + 1) <= MAX_DATA_BYTES:
-        nv += 1
-    return nv
-
-
-def _read_only(arr: np.ndarray) -> np.ndarray:
-    arr.flags.writeable = False  # the checks derived from the limits would not see an edit
-    return arr
-
-
-def _one_to_pin(kind: str, value: float) -> list[float]:
-    return [np.cos(value), np.sin(value)] if kind == "continuous" else [value]
+__all__ = ["LIMIT_SLACK", "Joint", "Mimic", "Robot", "load"]
 
 
 class Robot:
-    """A serial chain base → tool, with Pinocchio as the kinematic reference.
+    """A serial chain base → tool, with Pinocchio as the kinematic reference: a model, its joint space, its
+    kinematics.
 
-    Build with :func:`kinelab.load`. Joints off the base → tool path (fingers, other branches) are
-    locked; ``locked`` locks chain joints too. Attributes: ``name``, ``urdf_path``, ``model``,
-    ``data``, ``tool`` (frame name), ``tool_frame_id``, ``joints``, ``joint_names``, ``lower``,
-    ``upper`` (one number per joint, rad or m), ``n``, ``nq``, ``nv``, ``locked``.
+    Build with :func:`kinelab.load` (a file or a registered name) or :meth:`Robot.from_model` (an in-memory
+    ``pin.Model``); :mod:`kinelab.robot.build` makes every decision of the build, this class uses the result.
+    Attributes: ``name``, ``source`` and ``urdf_path`` (None for an in-memory model), ``model``, ``data``,
+    ``tool`` (frame name), ``tool_frame_id``, ``base``, ``joints``, ``joint_names``, ``lower``, ``upper``
+    (one number per joint, rad or m), ``n``, ``nq``, ``nv``, ``locked``, ``mimics``, ``srdf``.
     """
 
-    def __init__(
-        self,
-        urdf_path: str | Path,
-        tool: str | None = None,
-        locked: dict[str, float] | None = None,
-        name: str | None = None,
-        base: str | None = None,
-        package_dirs: list[str] | None = None,
-        srdf: str | Path | None = None,
-        group: str | None = None,
-        xacro_args: dict[str, str] | None = None,
-        trust_xacro: bool = False,
-    ):
-        self.source = Path(urdf_path)
-        self.xacro_args, self.trust_xacro = dict(xacro_args or {}), bool(trust_xacro)
-        self.urdf_path = xacro.expand(self.source, xacro_args, trusted=self.trust_xacro) \
-            if xacro.is_xacro(self.source) else self.source
-        self.package_dirs = mesh_package_dirs(package_dirs)
-        if is_mjcf(self.urdf_path):
-            full, tree = read_mjcf(self.urdf_path)
-        else:
-            tree = read_tree(self.urdf_path)
-            full = _build_full_model(self.urdf_path)
-        self.name = name or full.name or self.urdf_path.stem
-        self.srdf = self._read_srdf(srdf, tree)
-        if group is not None:
-            tool, base = self._group_frames(group, tree, tool, base)
-        self.base = base or tree.root
-        self.tool = tool or self._default_tool(tree, full)
-        chain = self._chain(full, base)
-        self.mimics: dict[str, Mimic] = {}
-        """Chain joints that follow another chain joint (URDF ``<mimic>``): name → :class:`Mimic`."""
-        if any(full.names[j] in tree.mimic and full.names[j] not in (locked or {}) for j in chain):
-            full, chain = self._with_mimics(full, chain, tree, base)
-        self._check_chain(full, chain, tree)
-        tree.check_mimics(self.urdf_path, [full.names[j] for j in chain], (locked or {}))
-        reference = self.srdf.reference() if self.srdf else {}
-        held = {j: v for j, v in reference.items() if full.existJointName(j) and full.getJointId(j) not in chain}
-        self.locked = self._locked_values(full, chain, {**held, **(locked or {})})
-        self._bMw: pin.SE3 | None = None
-        self._reduce(full)
-        if base is not None and base != tree.root:
-            self._reroot(base)
+    def __init__(self, built: Built):
+        """A Robot over a build's result (:func:`kinelab.load` and :meth:`from_model` make one).
+
+        Args:
+            built: the frozen result of :mod:`kinelab.robot.build`.
+        """
+        self.name, self.source, self.urdf_path = built.name, built.source, built.urdf_path
+        self.model, self.tool, self.base = built.model, built.tool, built.base
+        self.joints, self.mimics, self.locked = list(built.joints), built.mimics, built.locked
+        self.srdf, self.package_dirs = built.srdf, built.package_dirs
+        self.xacro_args, self.trust_xacro = built.xacro_args, built.trust_xacro
+        self._built = built
+        self.data = self.model.createData()
+        self.tool_frame_id = frame_id(self.model, self.tool, self.name)
         self._index_joints()
         self._length: float | None = None
         self._derived: dict[str, Any] = {}
         self.display_pose: np.ndarray | None = None
         """The registered pose to show the robot in (:meth:`display_q`), or None."""
 
-    def _reduce(self, full: pin.Model) -> None:
-        """The model with every locked joint folded in at its value, and its joint table."""
-        q_ref = pin.neutral(full)
-        for jname, value in self.locked.items():
-            jid = full.getJointId(jname)
-            kind = _kind(full.joints[jid])
-            if kind is None:  # a free or spherical joint above the chain: held at its neutral pose
-                continue
-            nq = full.joints[jid].nq
-            q_ref[full.idx_qs[jid] : full.idx_qs[jid] + nq] = _one_to_pin(kind, value)[:nq]
-        lock_ids = [full.getJointId(j) for j in self.locked]
-        self._full, self._lock_ids, self._q_ref = full, lock_ids, q_ref
-        try:
-            self.model = pin.buildReducedModel(full, lock_ids, q_ref) if lock_ids else full
-        except ValueError as exc:  # Pinocchio cannot fold a locked joint whose name a link also bears
-            raise ChainError(f"{self.name}: Pinocchio cannot lock the joints off the chain ({exc}); give "
-                             "another tool= or base=") from None
-        _check_data_size(self.model, self.name)
-        self.data = self.model.createData()
-        self.tool_frame_id = _frame_id(self.model, self.tool, self.name)
-        self.joints = self._joint_table()
-        if not self.joints:
-            raise ChainError(f"{self.name}: no movable joint between the base and frame {self.tool!r}")
+    @classmethod
+    def from_model(cls, model: pin.Model, *, tool: str | None = None, base: str | None = None,
+                   locked: dict[str, float] | None = None, name: str | None = None) -> Robot:
+        """A Robot from an in-memory Pinocchio model (what pink and mink take), reduced to base → tool.
+
+        Args:
+            model: the whole robot's ``pin.Model`` (copied; yours is left as it is).
+            tool: the tool frame (default: a frame named ``tool``, else the single leaf body).
+            base: the frame the chain starts from (default: the model's root); poses are in this frame.
+            locked: joints held fixed, name → value [rad or m]; joints off the chain are held at zero.
+            name: the robot's name (default: the model's).
+
+        Returns:
+            The Robot (no file behind it: ``source`` and ``urdf_path`` are None, the viewer draws a stick figure).
+
+        Raises:
+            ChainError, FrameNotFoundError, JointNotFoundError, ConfigurationError, JointLimitError: named.
+        """
+        return cls(build_model(model, tool=tool, locked=locked, name=name, base=base))
 
     def _index_joints(self) -> None:
         """Names, kinds, limits and the index maps between kinelab's q and Pinocchio's."""
@@ -308,7 +113,9 @@ class Robot:
 
     @property
     def source_format(self) -> str:
-        """The format of the file the robot was read from: "URDF", "xacro" or "MJCF"."""
+        """The format of the file the robot was read from: "URDF", "xacro" or "MJCF" ("pin.Model": none)."""
+        if self.source is None or self.urdf_path is None:
+            return "pin.Model"
         if xacro.is_xacro(self.source):
             return "xacro"
         return "MJCF" if is_mjcf(self.urdf_path) else "URDF"
@@ -319,70 +126,6 @@ class Robot:
         if key not in self._derived:
             self._derived[key] = build(self)
         return cast(T, self._derived[key])
-
-    # -- construction ------------------------------------------------------------------------
-    @staticmethod
-    def _default_tool(tree: UrdfTree, full: pin.Model) -> str:
-        if any(f.name == "tool" for f in full.frames):
-            return "tool"
-        if len(tree.leaves) == 1:
-            return tree.leaves[0]
-        raise ChainError(
-            f"the tool frame is ambiguous: {tree.root!r} branches into {len(tree.leaves)} leaf links "
-            f"({', '.join(tree.leaves[:12])}{', ...' if len(tree.leaves) > 12 else ''}); pass tool=NAME"
-        )
-
-    @staticmethod
-    def _check_chain(full: pin.Model, chain: list[int], tree: UrdfTree) -> None:
-        for jid in chain:
-            jname = full.names[jid]
-            if full.joints[jid].shortname() == "JointModelMimic":
-                continue  # follows its leader (Robot._with_mimics checked it is on the chain)
-            if _kind(full.joints[jid]) is None:
-                raise ChainError(
-                    f"joint {jname!r} is a {full.joints[jid].shortname()}: kinelab chains take revolute, "
-                    "continuous and prismatic joints only"
-                )
-
-    def _chain(self, full: pin.Model, base: str | None) -> list[int]:
-        """Joint ids from the base (or the root) to the tool frame."""
-        tool_id = _frame_id(full, self.tool, self.name)
-        chain = [j for j in full.supports[full.frames[tool_id].parentJoint] if j != 0]
-        return self._below_base(full, chain, base) if base is not None else chain
-
-    def _with_mimics(self, plain: pin.Model, chain: list[int], tree: UrdfTree,
-                     base: str | None) -> tuple[pin.Model, list[int]]:
-        """Pinocchio's model with its mimic joints (a follower has no coordinate of its own), the chain in it,
-        and ``self.mimics``; each leader's limits narrowed so that its followers stay within theirs."""
-        for jid in chain:
-            name = plain.names[jid]
-            if name in tree.mimic and plain.getJointId(tree.mimic[name]) not in chain:
-                raise ChainError(f"joint {name!r} mimics {tree.mimic[name]!r}, which is off the base-tool chain: "
-                                 f"hold it at a value (locked={{{name!r}: value}}) or choose another tool frame")
-        full = _build_full_model(self.urdf_path, mimic=True)
-        for jid in range(1, full.njoints):
-            follower = full.joints[jid].extract()
-            if full.joints[jid].shortname() == "JointModelMimic" and jid in self._chain(full, base):
-                name, leader = full.names[jid], tree.mimic[full.names[jid]]
-                iq = plain.idx_qs[plain.getJointId(name)]
-                self.mimics[name] = Mimic(name, leader, float(follower.scaling), float(follower.offset),
-                                          float(plain.lowerPositionLimit[iq]), float(plain.upperPositionLimit[iq]))
-        return full, self._chain(full, base)
-
-    @staticmethod
-    def _read_srdf(srdf: str | Path | None, tree: UrdfTree) -> Srdf | None:
-        if srdf is None:
-            return None
-        found = read_srdf(srdf)
-        found.check_joints(list(tree.joint_of.values()))
-        return found
-
-    def _group_frames(self, group: str, tree: UrdfTree, tool: str | None, base: str | None) -> tuple[str, str | None]:
-        """(tool, base) for an SRDF group: those given win over the group's."""
-        if self.srdf is None:
-            raise SRDFError(f"group={group!r} needs srdf= (the file that defines the group)")
-        g_tool, g_base = self.srdf.tool_and_base(group, {j: link for link, j in tree.joint_of.items()})
-        return tool or g_tool, base or g_base
 
     def named_q(self, name: str) -> np.ndarray:
         """The chain configuration [rad or m] of the SRDF's named configuration ``name`` (``group_state``).
@@ -400,67 +143,6 @@ class Robot:
                             f"{missing[0]!r}")
         return np.array([values[j] for j in self.joint_names])
 
-    def _below_base(self, full: pin.Model, chain: list[int], base: str) -> list[int]:
-        """The chain's joints between frame ``base`` and the tool; the base must lie on the root → tool path."""
-        base_id = _frame_id(full, base, self.name)
-        above = [j for j in full.supports[full.frames[base_id].parentJoint] if j != 0]
-        if any(j not in chain for j in above):
-            raise ChainError(f"{self.name}: base frame {base!r} is not on the path from the root to the tool "
-                             f"{self.tool!r} (a base must be an ancestor of the tool)")
-        return [j for j in chain if j not in above]
-
-    def _reroot(self, base: str) -> None:
-        """Express the reduced model in the ``base`` frame: every placement on the universe is premultiplied by
-        baseMworld (the joints above the base are locked, so the base is fixed in the world)."""
-        data = self.model.createData()
-        pin.framesForwardKinematics(self.model, data, pin.neutral(self.model))
-        bMw = self._bMw = data.oMf[_frame_id(self.model, base, self.name)].inverse()
-        for jid in range(1, self.model.njoints):
-            if self.model.parents[jid] == 0:
-                self.model.jointPlacements[jid] = bMw * self.model.jointPlacements[jid]
-        for fid in range(self.model.nframes):
-            frame = self.model.frames[fid]
-            if frame.parentJoint == 0:
-                frame.placement = bMw * frame.placement
-                self.model.frames[fid] = frame
-        self.data = self.model.createData()
-
-    @staticmethod
-    def _locked_values(full: pin.Model, chain: list[int], user: dict[str, float]) -> dict[str, float]:
-        names = [full.names[j] for j in range(1, full.njoints)]
-        for jname in user:
-            if jname not in names:
-                raise JointNotFoundError(jname, names)
-        locked = {}
-        for jid in range(1, full.njoints):
-            jname = full.names[jid]
-            if jname in user:
-                locked[jname] = _locked_value(full, jid, user[jname])
-            elif jid not in chain:
-                iq = full.idx_qs[jid]
-                lo, hi = full.lowerPositionLimit[iq], full.upperPositionLimit[iq]
-                locked[jname] = float(np.clip(0.0, lo, hi)) if full.joints[jid].nq == 1 else 0.0
-        return locked
-
-    def _joint_table(self) -> list[Joint]:
-        m = self.model
-        axes = _local_axes(m)
-        table = []
-        for jid in range(1, m.njoints):
-            jm = m.joints[jid]
-            if jm.nq == 0:  # a mimic joint: its leader's coordinate moves it
-                continue
-            kind = _kind(jm)
-            iq, iv = jm.idx_q, jm.idx_v
-            if kind == "continuous":
-                lo, hi = -np.pi, np.pi
-            else:
-                lo, hi = float(m.lowerPositionLimit[iq]), float(m.upperPositionLimit[iq])
-                lo, hi = _narrowed(m.names[jid], lo, hi, self.mimics.values())
-            ax, ay, az = (float(a) for a in axes[jid - 1])
-            table.append(Joint(m.names[jid], kind or "revolute", lo, hi, iq, iv, (ax, ay, az)))
-        return table
-
     # -- coordinates ---------------------------------------------------------------------------
     def joint_index(self, name: str) -> int:
         """Position of joint ``name`` in kinelab's q (raises JointNotFoundError with the valid names)."""
@@ -477,7 +159,7 @@ class Robot:
             arr = raw if raw.dtype == np.float64 else raw.astype(float)
         except (TypeError, ValueError):
             raise ConfigurationError(f"{what} must be {self.n} numbers (real), got {q!r}") from None
-        if arr.shape == (self.n,) and not limits and math.isfinite(sum(arr.tolist())):  # NaN, ±inf poison it
+        if arr.shape == (self.n,) and not limits and np.isfinite(sum(arr.tolist())):  # NaN, ±inf poison it
             return arr
         if arr.shape != (self.n,):
             raise ConfigurationError(
@@ -651,7 +333,7 @@ class Robot:
 
     def frame_placement(self, q: ArrayLike, frame: str) -> pin.SE3:
         """oMframe: pose of any frame of the reduced model in the base frame."""
-        fid = _frame_id(self.model, frame, self.name)
+        fid = frame_id(self.model, frame, self.name)
         self._forward(q)
         return pin.SE3(self.data.oMf[fid])
 
@@ -693,17 +375,20 @@ class Robot:
         ``ROS_PACKAGE_PATH``'s, then example-robot-data's); visuals whose mesh cannot be found are left out
         with a warning.
         """
-        if is_mjcf(self.urdf_path):
-            geom = pin.buildGeomFromMJCF(self._full, str(self.urdf_path), pin.GeometryType.VISUAL)
+        b = self._built
+        if b.urdf_path is None or b.full is None:
+            return pin.GeometryModel()  # an in-memory model brings no geometry: the viewer draws a stick figure
+        if is_mjcf(b.urdf_path):
+            geom = pin.buildGeomFromMJCF(b.full, str(b.urdf_path), pin.GeometryType.VISUAL)
         else:
-            geom = build_visual_model(self._full, self.urdf_path, package_dirs or self.package_dirs)
-        if self._lock_ids:
-            _, geom = pin.buildReducedModel(self._full, geom, self._lock_ids, self._q_ref)
-        if self._bMw is not None:  # re-rooted at the base frame, as the model was
+            geom = build_visual_model(b.full, b.urdf_path, package_dirs or self.package_dirs)
+        if b.lock_ids:
+            _, geom = pin.buildReducedModel(b.full, geom, list(b.lock_ids), b.q_ref)
+        if b.bMw is not None:  # re-rooted at the base frame, as the model was
             for gid in range(geom.ngeoms):
                 obj = geom.geometryObjects[gid]
                 if obj.parentJoint == 0:
-                    obj.placement = self._bMw * obj.placement
+                    obj.placement = b.bMw * obj.placement
                     geom.geometryObjects[gid] = obj
         return geom
 
@@ -731,7 +416,9 @@ class Robot:
         return f"Robot({self.name!r}, n={self.n}, tool={self.tool!r}, urdf={str(self.urdf_path)!r})"
 
 
-_AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
+def _read_only(arr: np.ndarray) -> np.ndarray:
+    arr.flags.writeable = False  # the checks derived from the limits would not see an edit
+    return arr
 
 
 def _best_conditioned(robot: Robot) -> np.ndarray:
@@ -750,22 +437,6 @@ def _best_conditioned(robot: Robot) -> np.ndarray:
         if ratio > best_ratio:
             best, best_ratio = q, ratio
     return best
-
-
-def _local_axes(model: pin.Model) -> list[np.ndarray]:
-    """Unit axis of every 1-DoF joint in its own frame, from the joint models themselves (no Data: a
-    Pinocchio Data holds nv³-sized tensors, so building one per joint made a load cubic in size)."""
-    axes = []
-    for jid in range(1, model.njoints):
-        joint = model.joints[jid]
-        if joint.nq == 0:  # a mimic joint has no axis of its own in kinelab's q
-            axes.append(np.zeros(3))
-            continue
-        axis = getattr(joint.extract(), "axis", None)
-        if axis is None:  # an aligned joint: JointModelRX, PY, RUBZ, ...
-            axis = _AXES[joint.shortname()[-1]]
-        axes.append(np.asarray(axis, dtype=float))
-    return axes
 
 
 def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, float] | None = None,
@@ -801,16 +472,17 @@ def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, fl
     """
     if str(name_or_path).startswith(descriptions.PREFIX):
         found = descriptions.resolve(str(name_or_path))
-        return Robot(found.path, tool=tool, locked=locked, name=found.name, base=base,
-                     package_dirs=[*(package_dirs or []), *found.package_dirs], srdf=srdf, group=group)
+        return Robot(build_file(found.path, tool=tool, locked=locked, name=found.name, base=base,
+                                package_dirs=[*(package_dirs or []), *found.package_dirs], srdf=srdf, group=group))
     path, entry = catalog.resolve(name_or_path)
     if entry is not None and not group:
         tool, base = tool or entry.tool, base or entry.base
         if entry.group and not (tool or base):
             group = entry.group
         srdf = srdf or catalog.srdf_path(entry)
-    robot = Robot(path, tool=tool, locked=locked, name=entry.name if entry else None, base=base,
-                  package_dirs=package_dirs, srdf=srdf, group=group, xacro_args=xacro_args, trust_xacro=trust_xacro)
+    robot = Robot(build_file(path, tool=tool, locked=locked, name=entry.name if entry else None, base=base,
+                             package_dirs=package_dirs, srdf=srdf, group=group, xacro_args=xacro_args,
+                             trust_xacro=trust_xacro))
     if entry is not None and entry.display is not None and robot.n == len(entry.display):
         robot.display_pose = np.array(entry.display)
     return robot

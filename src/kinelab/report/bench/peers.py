@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from kinelab.errors import KinelabError
 from kinelab.ik.chain import PRISMATIC, chain_model
 from kinelab.report.bench.protocol import TOL_POS, TOL_ROT, Case, Prepare, SolveFn
 from kinelab.robot import Robot
@@ -30,6 +31,8 @@ PEERS = {"rtb-ik_LM": "roboticstoolbox", "trac-ik": "pytracik", "ikpy": "ikpy", 
 
 def kinematic_urdf(robot: Robot) -> Path:
     """A copy of the robot's URDF without visual, collision, inertial, gazebo or transmission elements."""
+    if robot.urdf_path is None:
+        raise KinelabError(f"{robot.name} was made from an in-memory model: the peers read a URDF file")
     tree = ET.parse(robot.urdf_path)
     root = tree.getroot()
     for link in root.iter("link"):

@@ -21,6 +21,7 @@ from kinelab.ik.chain import chain_model
 from kinelab.ik.frdm import kernel
 from kinelab.report.bench import peers
 from kinelab.robot import Robot
+from kinelab.robot.build import build_file
 
 LENGTHS = (7, 15, 30, 60, 100)
 
@@ -51,7 +52,7 @@ def synthetic_urdf(n: int, seed: int = 0, link: float | None = None) -> str:
 def synthetic_robot(n: int, seed: int = 0) -> Robot:
     path = Path(tempfile.mkdtemp(prefix="kinelab-chain-")) / f"chain{n}.urdf"
     path.write_text(synthetic_urdf(n, seed))
-    return Robot(path, name=f"chain{n}")
+    return Robot(build_file(path, name=f"chain{n}"))
 
 
 def time_per_sweep(robot: Robot, sweeps: int = 500, repeats: int = 30) -> float:
