@@ -68,3 +68,19 @@ def test_a_free_joint_on_the_chain_is_refused_and_a_base_below_it_is_taken(tmp_p
     assert arm.joint_names == ["j1", "j2", "j3"] and arm.base == "base"
     expected = [0.0, 0.1 - 0.35 * np.sin(0.3), 0.5 + 0.35 * np.cos(0.3)]  # by hand: l2 tilted 0.3 rad about x
     np.testing.assert_allclose(arm.fk(np.zeros(3)).translation, expected, atol=1e-12)
+
+
+def test_the_default_tool_of_an_mjcf_is_its_tip_site(tmp_path):
+    """A site on the last body is the tool a MuJoCo user means (the tip site), 5 cm out along z here."""
+    tip = '<body name="hand" pos="0 0 0.1"><site name="tip" pos="0 0 0.05"/></body>'
+    path = tmp_path / "arm.xml"
+    path.write_text('<mujoco model="arm3"><compiler angle="radian"/><worldbody>'
+                    + BODIES.format(r1="-2 2", r2="-1.5 1.5", tilt="0.3", free="").replace('<body name="tool" '
+                                                                                              'pos="0 0 0.1"/>', tip)
+                    + "</worldbody></mujoco>")
+    (tmp_path / "plain").mkdir()
+    robot, plain = load(str(path)), load(str(write_mjcf(tmp_path / "plain")))
+    assert robot.tool == "tip" and plain.tool == "tool"
+    q = robot.random_q(3)
+    offset = plain.fk(q).rotation @ np.array([0.0, 0.0, 0.05])
+    np.testing.assert_allclose(robot.fk(q).translation, plain.fk(q).translation + offset, atol=1e-12)

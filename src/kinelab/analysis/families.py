@@ -61,6 +61,7 @@ class Relation:
     text: str
 
     def residual(self, q) -> float:
+        """How far q is from meeting the family's relations (0 on them)."""
         return abs(sum(s * q[i] for i, s in zip(self.index, self.sign, strict=True)) - self.value)
 
 
@@ -196,6 +197,7 @@ class Family:
                                         else ")")
 
     def to_dict(self) -> dict:
+        """The JSON form of the sweep (``kinelab singular --sweep --json``)."""
         return {"relations": [r.text for r in self.relations], "verified": self.verified, "text": self.text,
                 "count": self.count, "representative_q": self.representative.tolist(), "rank": self.rank,
                 "sigma_min_over_max": self.sigma_ratio}

@@ -41,9 +41,11 @@ class Analysis:
 
     @property
     def singular(self) -> bool:
+        """True when the rank is below the full rank."""
         return self.rank < self.full_rank
 
     def to_dict(self) -> dict:
+        """The JSON form (``kinelab singular --json``)."""
         return {
             "q": self.q.tolist(),
             "singular_values": self.singular_values.tolist(),

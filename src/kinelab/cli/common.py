@@ -26,6 +26,7 @@ class Parser(argparse.ArgumentParser):
     """An argument parser whose errors are one line and exit code 2, as for every user error."""
 
     def error(self, message: str) -> NoReturn:
+        """Print ``message`` on one line with the help hint and exit with code 2."""
         command = " ".join(self.prog.split()[1:])  # "" for the top parser, "ik" for a subcommand
         self.exit(2, f"kinelab: error: {message} (see 'kinelab {command + ' ' if command else ''}--help')\n")
 

@@ -33,6 +33,7 @@ def qmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def qconj(a: np.ndarray) -> np.ndarray:
+    """The conjugate of quaternion(s) ``a`` in (w, x, y, z) order."""
     return np.array([a[0], -a[1], -a[2], -a[3]])
 
 
@@ -54,6 +55,7 @@ class DualQuat:
     # -- construction -------------------------------------------------------------------------
     @classmethod
     def identity(cls) -> DualQuat:
+        """The unit biquaternion of the identity pose."""
         return cls(np.array([1.0, 0, 0, 0]), np.zeros(4))
 
     @classmethod
@@ -123,6 +125,7 @@ class DualQuat:
         return DualQuat(self.real_wxyz / r, self.dual_wxyz / r - self.real_wxyz * r0 / r**2)
 
     def is_unit(self, tol: float = 1e-9) -> bool:
+        """True when |λ| = 1 and λ·λ0 = 0 to ``tol``."""
         r = self.real_wxyz
         return abs(r @ r - 1.0) <= tol and abs(r @ self.dual_wxyz) <= tol
 
@@ -135,10 +138,12 @@ class DualQuat:
         return self.real_wxyz[1:].copy(), self.dual_wxyz[1:].copy()
 
     def as_array(self) -> np.ndarray:
+        """The eight numbers (real w, x, y, z, then dual w, x, y, z)."""
         return np.r_[self.real_wxyz, self.dual_wxyz]
 
     # -- poses --------------------------------------------------------------------------------
     def require_unit(self, what: str = "biquaternion", tol: float = 1e-6) -> DualQuat:
+        """This biquaternion, or a BiquaternionError naming ``what`` when it is not unit to ``tol``."""
         if not self.is_unit(tol):
             r = self.real_wxyz
             raise BiquaternionError(

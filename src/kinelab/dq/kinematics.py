@@ -37,6 +37,7 @@ def _constants(robot: Robot) -> tuple[list[DualQuat], DualQuat]:
 
 
 def tool_in_last_joint(robot: Robot) -> DualQuat:
+    """The constant tool placement in the last joint's frame, as a unit biquaternion."""
     return _constants(robot)[1]
 
 

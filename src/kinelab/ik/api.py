@@ -117,8 +117,15 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
         robot: the robot.
         targets: a sequence of ``pin.SE3`` or an (B, 4, 4) array of homogeneous matrices (oMtarget).
         positional: nothing: every argument after the targets is keyword-only.
-        solver, seed, tol_pos, tol_rot, max_restarts, options, task, axis, solver_options: as :func:`solve`
-            (``seed``: the base seed, row b uses seed + b; None draws one, reported in the result).
+        solver: as :func:`solve`.
+        seed: the base seed: row b uses seed + b; None draws one, reported in the result.
+        tol_pos: position tolerance [m].
+        tol_rot: rotation tolerance [rad].
+        max_restarts: random restarts per row after its first attempt.
+        options: the solver's options object.
+        task: the components to meet, as :func:`solve`.
+        axis: the tool axis of task "axis".
+        solver_options: the solver's option fields as keyword arguments.
         q0: starts: None (each row draws its own from its seed), one configuration for every row, or (B, n)
             [rad or m]; within the joint limits.
         time_budget: wall-clock budget [s] of the whole batch (None, the default: none); rows not started
@@ -151,7 +158,14 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "frdm",
         target: oMtarget (base frame).
         positional: nothing: every argument after the target is keyword-only.
         solver: "frdm" (one compiled batch per round of starts) or "dls".
-        seed, tol_pos, tol_rot, options, task, axis, solver_options: as :func:`solve`.
+        seed: base seed of the starts (None: fresh entropy); the same seed finds the same branches when the
+            budget allows the same number of rounds.
+        tol_pos: position tolerance [m].
+        tol_rot: rotation tolerance [rad].
+        options: the solver's options object.
+        task: the components to meet, as :func:`solve`.
+        axis: the tool axis of task "axis".
+        solver_options: the solver's option fields as keyword arguments.
         time_budget: wall-clock budget [s] of the search (default 0.05 s: every branch of a UR5 or Stanford
             target in 197 of 200 cases).
         q_ref: sort the solutions by distance to this configuration (rad or m; revolute joints modulo 2π).
@@ -191,12 +205,16 @@ def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
             is solved by :func:`solve` (with ``seed``) and the path starts there.
         solver: "frdm" (the only path follower).
         seed: seed of the first solve when ``q0`` is None.
-        tol_pos, tol_rot, task, axis: per sample, as :func:`solve`.
+        tol_pos: position tolerance per sample [m].
+        tol_rot: rotation tolerance per sample [rad].
+        task: the components to meet per sample, as :func:`solve`.
+        axis: the tool axis of task "axis".
         time_budget: wall-clock budget [s] of the whole path (None, the default: none); the monitored loop
             stops each attempt at it.
         options: an ``FRDMOptions`` (taken as it is), or its fields as keywords (``kicks``, ``intervals``,
             ``freeze``, ``policy``, ``order``, ``w_p``, ...) over the path's defaults (max_sweeps 2000,
             stall_window 100, stall_rel 1e-6).
+        solver_options: those fields as keyword arguments.
         jump_limit: largest joint step [rad or m] before the jump monitor fires (None: off).
         restrict: restrictions ("intervals", "freeze") held on every sample of the path.
         hold: samples a restriction stays on after the monitor switched it on.

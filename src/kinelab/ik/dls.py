@@ -91,10 +91,14 @@ def attempt(
     ``damping`` plus 1e-3 of the squared error, and an attempt whose error stops falling ends as stalled.
 
     Args:
-        robot: the robot; oMtarget: the wanted tool pose in the base frame; q0: the start [rad or m].
-        tol_pos: position tolerance [m]; tol_rot: rotation tolerance [rad].
+        robot: the robot.
+        oMtarget: the wanted tool pose in the base frame.
+        q0: the start [rad or m].
+        tol_pos: position tolerance [m].
+        tol_rot: rotation tolerance [rad].
         deadline: ``time.perf_counter()`` value after which the attempt stops.
-        options: a :class:`DLSOptions`, or its fields as keyword arguments.
+        options: a :class:`DLSOptions`.
+        kwargs: or its fields as keyword arguments.
 
     Returns:
         The attempt, before kinelab's Pinocchio check.

@@ -53,7 +53,12 @@ def restart_windows(cm: ChainModel, q_start: np.ndarray, pstar: np.ndarray) -> t
     a target it could reach.
 
     Args:
-        cm: the chain; q_start: the first start [rad or m]; pstar: the target point [m], base frame.
+        cm: the chain.
+        q_start: the first start [rad or m].
+        pstar: the target point [m], base frame.
+
+    Returns:
+        (lower, upper) of the restarts [rad or m].
     """
     lower, upper, L = cm.lower, cm.upper, cm.length
     rotary = np.flatnonzero(cm.kind != PRISMATIC)
@@ -104,6 +109,7 @@ class TypedKernel:
         self._entry: Callable[..., Any] | None = None
 
     def __call__(self, *args: Any) -> Any:
+        """Call the compiled entry point (the dispatcher on the first call)."""
         if self._entry is not None:
             return self._entry(*args)
         result = self.py_dispatcher(*args)

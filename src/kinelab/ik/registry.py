@@ -23,7 +23,8 @@ class SolverModule(Protocol):
     Options: Any
 
     def attempt(self, robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol_rot: float,
-                deadline: float, options: Any = None) -> Attempt: ...
+                deadline: float, options: Any = None) -> Attempt:
+        """One run from ``q0`` towards ``oMtarget``, before kinelab's Pinocchio check."""
 
 
 def register(name: str, module: Any) -> None:

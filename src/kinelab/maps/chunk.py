@@ -55,6 +55,7 @@ class MapSpec:
             raise KinelabError(f"chunk_voxels must be an integer ≥ 1, got {self.chunk_voxels!r}")
 
     def to_dict(self) -> dict:
+        """The JSON form stored with the map."""
         return asdict(self)
 
 

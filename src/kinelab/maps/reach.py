@@ -28,6 +28,7 @@ def reachability(robot: Robot, spec: MapSpec | None = None, out: str | None = No
         progress: show a progress bar over the chunks.
         client: a ``dask.distributed.Client``: the chunks run on its cluster (:mod:`kinelab.maps.cluster`);
             None: in this process, on all cores.
+        fields: the spec's fields as keyword arguments, instead of ``spec``.
 
     Returns:
         The :class:`~kinelab.maps.store.ReachabilityMap`.

@@ -23,6 +23,7 @@ class SingularityMap:
 
     @property
     def rank_deficient(self) -> np.ndarray:
+        """Per sample: the scaled Jacobian lost rank."""
         return self.sigma_ratio <= RANK_RTOL
 
 

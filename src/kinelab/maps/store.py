@@ -55,6 +55,7 @@ class ReachabilityMap:
 
     @property
     def chunks(self) -> int:
+        """How many chunks the map has."""
         return len(self.done)
 
     def write(self, index: int, values: dict[str, np.ndarray]) -> None:

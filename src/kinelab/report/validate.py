@@ -38,6 +38,7 @@ class Check:
 
     @property
     def passed(self) -> bool:
+        """True when the measured value is within the limit."""
         if not np.isfinite(self.value):
             return False
         return bool(self.value >= self.tolerance if self.at_least else self.value <= self.tolerance)
@@ -60,6 +61,7 @@ class Check:
 
 @dataclass
 class Report:
+    """The checks of one ``kinelab validate`` run, with what it ran on."""
     checks: list[Check] = field(default_factory=list)
     robots: list[str] = field(default_factory=list)
     n: int = DEFAULT_N
@@ -67,9 +69,11 @@ class Report:
 
     @property
     def passed(self) -> bool:
+        """True when every check passed."""
         return all(c.passed for c in self.checks)
 
     def to_dict(self) -> dict:
+        """The JSON form (``kinelab validate --json``, report.json)."""
         return {
             "passed": self.passed,
             "robots": self.robots,

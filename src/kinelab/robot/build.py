@@ -33,7 +33,7 @@ from kinelab.errors import (
 from kinelab.robot import xacro
 from kinelab.robot.joints import Joint, Mimic
 from kinelab.robot.meshes import mesh_package_dirs
-from kinelab.robot.mjcf import is_mjcf, read_mjcf
+from kinelab.robot.mjcf import body_tree, is_mjcf, read_mjcf
 from kinelab.robot.srdf import Srdf, read_srdf
 from kinelab.robot.urdf import UrdfTree, read_tree
 
@@ -113,24 +113,6 @@ def build_model(model: pin.Model, tool: str | None = None, locked: dict[str, flo
     return _Builder.from_model(pin.Model(model), tool, locked, name, base).built()
 
 
-def tree_of_model(model: pin.Model) -> UrdfTree:
-    """The link graph of a Pinocchio model (its BODY frames), as a URDF's would be."""
-    bodies = [f for f in model.frames if f.type == pin.FrameType.BODY]
-    by_joint: dict[int, str] = {}
-    for f in bodies:
-        by_joint.setdefault(f.parentJoint, f.name)
-    root = by_joint.get(0, "universe")
-    parent_of, joint_of = {}, {}
-    for jid in range(1, model.njoints):
-        child = by_joint.get(jid)
-        if child is not None:
-            parent_of[child] = by_joint.get(model.parents[jid], root)
-            joint_of[child] = model.names[jid]
-    links = [f.name for f in bodies] or [root]
-    parents = set(parent_of.values())
-    return UrdfTree(root, parent_of, joint_of, {}, links, [link for link in links if link not in parents])
-
-
 class _Builder:
     """The steps of one build; its attributes are the decisions made so far."""
 
@@ -164,7 +146,7 @@ class _Builder:
     @classmethod
     def from_model(cls, model: pin.Model, tool: str | None, locked: dict[str, float] | None, name: str | None,
                    base: str | None) -> _Builder:
-        b = cls(name or model.name or "robot", None, None, model, tree_of_model(model), [], {}, False)
+        b = cls(name or model.name or "robot", None, None, model, body_tree(model), [], {}, False)
         b.reduce(tool, base, locked)
         return b
 
@@ -218,10 +200,15 @@ class _Builder:
 
     @staticmethod
     def _default_tool(tree: UrdfTree, full: pin.Model) -> str:
+        """A frame named "tool"; else the single leaf body, or the one site on it (an MJCF tip site)."""
         if any(f.name == "tool" for f in full.frames):
             return "tool"
         if len(tree.leaves) == 1:
-            return tree.leaves[0]
+            leaf = tree.leaves[0]
+            ids = [i for i, f in enumerate(full.frames) if f.name == leaf and f.type == pin.FrameType.BODY]
+            sites = [f.name for f in full.frames if f.type == pin.FrameType.OP_FRAME and ids
+                     and f.parentFrame == ids[0]]
+            return sites[0] if len(sites) == 1 else leaf
         raise ChainError(
             f"the tool frame is ambiguous: {tree.root!r} branches into {len(tree.leaves)} leaf links "
             f"({', '.join(tree.leaves[:12])}{', ...' if len(tree.leaves) > 12 else ''}); pass tool=NAME"
@@ -254,7 +241,7 @@ class _Builder:
             if name in tree.mimic and plain.getJointId(tree.mimic[name]) not in chain:
                 raise ChainError(f"joint {name!r} mimics {tree.mimic[name]!r}, which is off the base-tool chain: "
                                  f"hold it at a value (locked={{{name!r}: value}}) or choose another tool frame")
-        assert self.urdf_path is not None  # an in-memory model has no mimic table (tree_of_model)
+        assert self.urdf_path is not None  # an in-memory model has no mimic table (body_tree)
         full = _build_full_model(self.urdf_path, mimic=True)
         for jid in range(1, full.njoints):
             follower = full.joints[jid].extract()

@@ -394,6 +394,7 @@ class Robot:
 
     @property
     def frame_names(self) -> list[str]:
+        """Every frame of the reduced model, by name."""
         return [f.name for f in self.model.frames]
 
     def characteristic_length(self) -> float:

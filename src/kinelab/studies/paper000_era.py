@@ -74,11 +74,13 @@ class Passage:
 
     @property
     def samples(self) -> int:
+        """Path samples."""
         return len(self.targets)
 
 
 @dataclass
 class PassageRun:
+    """One passage tracked without and with the paper's bypass."""
     passage: Passage
     without: TrackResult
     with_bypass: TrackResult
@@ -256,6 +258,7 @@ def tracking_bench(repeats: int = 3, robot: Robot | None = None) -> dict:
 
 
 def tracking_markdown(result: dict) -> str:
+    """The tracking bench as a Markdown table."""
     lines = ["| ERA passage | solver | reached | median per sample | p95 | worst error | largest joint step | "
              "lap change (after the 1st) |", "|---|---|---|---|---|---|---|---|"]
     for r in result["rows"]:

@@ -57,6 +57,7 @@ class Scene:
 
     @property
     def url(self) -> str:
+        """The address of the live meshcat page (127.0.0.1)."""
         return self.viewer.url()
 
     def node_paths(self) -> list[str]:
@@ -216,6 +217,7 @@ class Scene:
         return HTML(f'<iframe srcdoc="{page}" style="width:100%;height:{height}px;border:0"></iframe>')
 
     def save_html(self, path: str | Path) -> Path:
+        """Write the scene as one self-contained HTML page (its caption included); returns the path."""
         path = Path(path)
         path.write_text(self.static_html(), encoding="utf-8")
         return path

@@ -33,6 +33,7 @@ class Trajectory:
     U: list[np.ndarray] = field(default_factory=list)
 
     def append(self, t, q, M, U):
+        """Record one step: model time [s], Pinocchio q, M*, U."""
         self.t.append(float(t))
         self.q.append(np.array(q))
         self.M.append(np.array(M))

@@ -123,6 +123,7 @@ def _resume(mem, e, o, p, R):
 
 @njit(cache=True, inline="always")
 def objective(p, R, pstar, Rstar, w_p, w_ax):
+    """FRDM's weighted objective at tool pose (p, R) against (pstar, Rstar) (docs/methods.md §1.2)."""
     d0, d1, d2 = p[0] - pstar[0], p[1] - pstar[1], p[2] - pstar[2]
     E = w_p * (d0 * d0 + d1 * d1 + d2 * d2)
     for j in range(3):

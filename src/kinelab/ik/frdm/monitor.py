@@ -51,12 +51,14 @@ class Bypass:
     auto_kick: float = 1e-2
 
     def resolved_policy(self) -> tuple[str, ...]:
+        """The bypasses the monitor switches on, in order (the configured ones, or an automatic kick)."""
         if self.policy is not None:
             return tuple(self.policy)
         configured = tuple(k for k in ("kicks", "intervals", "freeze") if getattr(self, k))
         return configured or ("auto_kick",)
 
     def validate(self, robot: Robot) -> None:
+        """Refuse a bypass that names a joint the robot does not have (JointNotFoundError)."""
         for table in (self.kicks, self.intervals, self.freeze):
             for name in table:
                 robot.joint_index(name)
@@ -131,9 +133,11 @@ class Runner:
         return float(self.state[kernel.S_E])
 
     def trace_values(self) -> list[float]:
+        """The objective after every sweep so far."""
         return [float(v) for v in self.mem.trace[: self.sweeps]]
 
     def reset_history(self) -> None:
+        """Forget the window of objective values (after a bypass moved q)."""
         self.state[kernel.S_HISTORY] = 0.0
         self.state[kernel.S_E_WINDOW] = np.inf if self.sweeps == 0 else self.state[kernel.S_E] * (1 + 1e-12) + 1e-300
         self.state[kernel.S_WINDOW_START] = self.state[kernel.S_SWEEPS]

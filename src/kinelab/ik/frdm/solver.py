@@ -57,9 +57,11 @@ def attempt(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol
         robot: the robot.
         oMtarget: the wanted tool pose in the base frame.
         q0: start, one number per joint [rad or m].
-        tol_pos: position tolerance [m]; tol_rot: rotation tolerance [rad].
+        tol_pos: position tolerance [m].
+        tol_rot: rotation tolerance [rad].
         deadline: ``time.perf_counter()`` value after which the attempt stops.
-        options: an :class:`FRDMOptions`, or its fields as keyword arguments.
+        options: an :class:`FRDMOptions`.
+        kwargs: or its fields as keyword arguments.
 
     Returns:
         The attempt, before kinelab's Pinocchio check.

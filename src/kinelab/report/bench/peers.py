@@ -48,6 +48,7 @@ def kinematic_urdf(robot: Robot) -> Path:
 
 
 def tool_link(robot: Robot) -> str:
+    """The URDF link the tool frame sits on (the peers take a link, not a frame)."""
     from kinelab.analysis.oracles import tool_link as _tool_link
 
     return _tool_link(robot)

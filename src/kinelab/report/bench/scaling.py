@@ -50,6 +50,7 @@ def synthetic_urdf(n: int, seed: int = 0, link: float | None = None) -> str:
 
 
 def synthetic_robot(n: int, seed: int = 0) -> Robot:
+    """A synthetic n-link chain (every fourth joint prismatic), loaded from a temporary URDF."""
     path = Path(tempfile.mkdtemp(prefix="kinelab-chain-")) / f"chain{n}.urdf"
     path.write_text(synthetic_urdf(n, seed))
     return Robot(build_file(path, name=f"chain{n}"))
@@ -112,6 +113,7 @@ def linear_fit(x, y) -> tuple[float, float, float]:
 
 
 def run(lengths: tuple[int, ...] = LENGTHS, seed: int = 0, progress: bool = False, solves: int = 20) -> dict:
+    """FRDM's time per sweep and full solves (FRDM, DLS, ik_LM) on synthetic chains of each length."""
     rows = []
     for n in tqdm(lengths, desc="scaling", disable=not progress, unit="chain"):
         robot = synthetic_robot(n, seed)
@@ -129,6 +131,7 @@ def run(lengths: tuple[int, ...] = LENGTHS, seed: int = 0, progress: bool = Fals
 
 
 def markdown(result: dict) -> str:
+    """The scaling result as Markdown tables."""
     fit = result["fit_us_per_sweep"]
     lines = ["| links | FRDM µs per sweep | FRDM µs per solve | solved | DLS µs per solve | solved | "
              "ik_LM µs per solve | solved |", "|---|---|---|---|---|---|---|---|"]
