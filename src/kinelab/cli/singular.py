@@ -7,28 +7,19 @@ from typing import Any
 
 import numpy as np
 
-from kinelab.cli.common import (
-    json_flag,
-    load_robot,
-    plural,
-    print_json,
-    q_from_cli,
-    robot_arguments,
-    rounded,
-    seed_argument,
-)
+from kinelab.cli import common
 from kinelab.errors import KinelabError
 
 
 def add(sub: Any) -> None:
     """The ``singular`` subcommand."""
     s = sub.add_parser("singular", help="rank, singular values, lost directions; or a sweep for singular families")
-    robot_arguments(s, "one number per joint (rad and m; deg with --deg)")
+    common.robot_arguments(s, "one number per joint (rad and m; deg with --deg)")
     s.add_argument("--sweep", type=int, help="sample N configurations within the limits and report families")
     s.add_argument("--grid", action="store_true", help="sweep a stratified grid instead of uniform samples")
     s.add_argument("--force", action="store_true", help="run a sweep even when its memory estimate is over the limit")
-    seed_argument(s)
-    json_flag(s)
+    common.seed_argument(s)
+    common.json_flag(s)
     s.set_defaults(func=run)
 
 
@@ -36,17 +27,17 @@ def run(args: argparse.Namespace) -> int:
     """The analysis at one q, or the sweep's families."""
     from kinelab.analysis import singular
 
-    robot = load_robot(args)
+    robot = common.load_robot(args)
     if args.sweep is not None:
         if args.q:
             raise KinelabError("give either a configuration or --sweep N, not both")
         return _sweep(robot, args)
     if not args.q:
         raise KinelabError("give a configuration Q1 ... Qn or --sweep N")
-    q = q_from_cli(robot, args.q, args.deg)
+    q = common.q_from_cli(robot, args.q, args.deg)
     a = singular.analyze(robot, robot.check_q(q, limits=not args.ignore_limits))
     if args.json:
-        print_json({"robot": robot.name, **a.to_dict()})
+        common.print_json({"robot": robot.name, **a.to_dict()})
         return 0
     print(f"{robot.name}: rank {a.rank} of {a.full_rank}{' (SINGULAR)' if a.singular else ''}; "
           f"σ = {np.array2string(a.singular_values, precision=4)} (linear rows / L = {a.length:.4g} m)")
@@ -54,12 +45,12 @@ def run(args: argparse.Namespace) -> int:
     for d in a.lost_directions:
         parts = []
         if d.translation_axis is not None:
-            parts.append(f"translation {rounded(d.translation_axis, 3)} ({100 * d.translation_share:.0f} %)")
+            parts.append(f"translation {common.rounded(d.translation_axis, 3)} ({100 * d.translation_share:.0f} %)")
         if d.rotation_axis is not None:
-            parts.append(f"rotation about {rounded(d.rotation_axis, 3)} ({100 * d.rotation_share:.0f} %)")
+            parts.append(f"rotation about {common.rounded(d.rotation_axis, 3)} ({100 * d.rotation_share:.0f} %)")
         print(f"  lost tool motion (base axes, at the tool): {' + '.join(parts)}")
     for m in a.null_motions:
-        print(f"  joint motion that moves nothing: {rounded(m, 4)}")
+        print(f"  joint motion that moves nothing: {common.rounded(m, 4)}")
     return 0
 
 
@@ -71,12 +62,12 @@ def _sweep(robot: Any, args: argparse.Namespace) -> int:
                             method="grid" if args.grid else "random")
     out = {"robot": robot.name, **result.to_dict()}
     if args.json:
-        print_json(out)
+        common.print_json(out)
         return 0
     for note in result.notes:
         print(f"note: {note}")
     asked = f" (a grid of {args.sweep} asked for)" if result.samples != args.sweep else ""
-    print(f"{robot.name}: {plural(result.samples, 'sample')}{asked}, {out['near_singular']} near-singular "
+    print(f"{robot.name}: {common.plural(result.samples, 'sample')}{asked}, {out['near_singular']} near-singular "
           f"(σ_min/σ_max < {singular.NEAR_SINGULAR:g}), {out['refined']} refined, {out['singular']} singular "
           "after refinement")
     for f in result.families:
