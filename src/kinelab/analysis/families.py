@@ -14,6 +14,7 @@ from tqdm import tqdm
 
 from kinelab.analysis.singular import NEAR_SINGULAR, analyze, scaled_jacobian
 from kinelab.errors import KinelabError
+from kinelab.ik.request import check_seed
 from kinelab.robot import Robot
 
 RELATION_TOL = 1e-3  # [rad or m] a joint relation holds within this
@@ -284,6 +285,7 @@ def sweep(robot: Robot, samples: int = 5000, seed: int = 0, refine_top: int = 40
     lower, upper, notes = sweep_limits(robot)
     if method not in ("random", "grid"):
         raise KinelabError(f"unknown sweep method {method!r}; use 'random' or 'grid'")
+    check_seed(seed)
     rng = np.random.default_rng(seed)
     qs = rng.uniform(lower, upper, size=(samples, robot.n)) if method == "random" else grid(robot, samples, rng)
     L = robot.characteristic_length()

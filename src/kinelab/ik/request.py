@@ -120,6 +120,16 @@ def _plain_counts(max_restarts: Any, seed: Any) -> bool:
     return type(max_restarts) is int and max_restarts >= 0 and (seed is None or (type(seed) is int and seed >= 0))
 
 
+def check_seed(seed: Any, name: str = "seed") -> None:
+    """Refuse a seed that is not an integer ≥ 0 (numpy's generators take no other).
+
+    Raises:
+        OptionError: naming the value and what is valid.
+    """
+    if not count_ok(seed):
+        raise OptionError(name, seed, "an integer ≥ 0")
+
+
 def count_ok(value: Any) -> bool:
     """An integer ≥ 0 (a bool is not a count)."""
     return not isinstance(value, bool) and isinstance(value, numbers.Integral) and int(value) >= 0

@@ -16,11 +16,14 @@ import pinocchio as pin
 from kinelab.analysis.singular import conditioning_batch
 from kinelab.errors import KinelabError
 from kinelab.ik.api import solve_batch
+from kinelab.ik.request import check_seed
 from kinelab.ik.targets import as_target
 from kinelab.ik.workspace import reach_bound
 from kinelab.robot import Robot, load
 
 PLATFORM = ("platform_x", "platform_y", "platform_yaw")
+
+MAX_POSITIONS = 1_000_000  # platform positions of a base map's x-y grid
 
 
 @dataclass(frozen=True)
@@ -66,10 +69,18 @@ def base_map(robot: Robot, grasp: pin.SE3, step: float = 0.05, restarts: int = 1
                            f"{', '.join(PLATFORM)}")
     if not (isinstance(step, int | float) and np.isfinite(step) and step > 0):
         raise KinelabError(f"a base map needs a grid step > 0 [m], got {step!r}")
+    check_seed(seed)
+    check_seed(restarts, "restarts")
     grasp = as_target(grasp)
+    if robot.source is None:
+        raise KinelabError(f"{robot.name} was made from an in-memory model: a base map reloads it from its file")
     turning = load(str(robot.source), tool=robot.tool, base=robot.base, locked={j: 0.0 for j in PLATFORM[:2]})
     anchor, radius = reach_bound(turning)
     reach_xy = radius + float(np.hypot(anchor[0], anchor[1]))
+    if (2 * reach_xy / step + 1) ** 2 > MAX_POSITIONS:  # refused before the grid is built
+        raise KinelabError(f"a {step:g} m step over the {reach_xy:.3g} m the arm reaches is about "
+                           f"{(2 * reach_xy / step) ** 2:.3g} platform positions, over {MAX_POSITIONS}; take a "
+                           "larger step")
     ticks = np.arange(-np.ceil(reach_xy / step), np.ceil(reach_xy / step) + 1) * step
     xy = np.array([(grasp.translation[0] + a, grasp.translation[1] + b) for a in ticks for b in ticks
                    if np.hypot(a, b) <= reach_xy])

@@ -16,6 +16,7 @@ import numpy as np
 from kinelab.analysis.singular import conditioning_batch
 from kinelab.errors import KinelabError
 from kinelab.ik.api import solve_batch
+from kinelab.ik.request import check_seed
 from kinelab.maps import grid
 from kinelab.robot import Robot
 
@@ -53,6 +54,10 @@ class MapSpec:
             raise KinelabError(f"a reachability map takes task 'pose' or 'axis', got {self.task!r}")
         if not (isinstance(self.chunk_voxels, int) and self.chunk_voxels >= 1):
             raise KinelabError(f"chunk_voxels must be an integer ≥ 1, got {self.chunk_voxels!r}")
+        if not (isinstance(self.voxel, int | float) and np.isfinite(self.voxel) and self.voxel > 0):
+            raise KinelabError(f"the voxel side must be a positive length in metres, got {self.voxel!r}")
+        check_seed(self.seed)
+        check_seed(self.restarts, "restarts")
 
     def to_dict(self) -> dict:
         """The JSON form stored with the map."""

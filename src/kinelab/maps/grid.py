@@ -17,6 +17,14 @@ from kinelab.robot import Robot
 PHI = np.sqrt(2.0)
 PSI = 1.533751168755204288118041  # the root of ψ⁴ = ψ + 4 the spiral uses
 GOLDEN = (1.0 + np.sqrt(5.0)) / 2.0
+MAX_LATTICE = 20_000_000  # lattice points of a voxel grid (about 1.5 GB while the sphere is cut out of it)
+
+
+def estimated_voxels(robot: Robot, voxel: float) -> int:
+    """About how many voxels :func:`voxel_centres` returns (the reach sphere's volume over a voxel's), computed
+    without building the grid: the size guards run before anything is allocated."""
+    _, radius = reach_bound(robot)
+    return int(4.0 / 3.0 * np.pi * (radius + voxel * np.sqrt(3) / 2) ** 3 / voxel**3) + 1
 
 
 def voxel_centres(robot: Robot, voxel: float) -> np.ndarray:
@@ -29,6 +37,10 @@ def voxel_centres(robot: Robot, voxel: float) -> np.ndarray:
     if not (isinstance(voxel, int | float) and np.isfinite(voxel) and voxel > 0):
         raise KinelabError(f"the voxel side must be a positive length in metres, got {voxel!r}")
     anchor, radius = reach_bound(robot)
+    side = 2 * int(min(np.ceil(radius / voxel), 1e9)) + 1
+    if side**3 > MAX_LATTICE:
+        raise KinelabError(f"a {voxel:g} m voxel over {robot.name}'s reach ({radius:.3g} m) is a lattice of {side}³ = "
+                           f"{side**3:.3g} points, over the {MAX_LATTICE:.0e} kinelab allocates; take a larger voxel")
     steps = np.arange(-np.ceil(radius / voxel), np.ceil(radius / voxel) + 1) * voxel
     grid = np.stack(np.meshgrid(steps, steps, steps, indexing="ij"), axis=-1).reshape(-1, 3) + np.asarray(anchor)
     return grid[np.linalg.norm(grid - np.asarray(anchor), axis=1) <= radius + voxel * np.sqrt(3) / 2]

@@ -10,6 +10,7 @@ import numpy as np
 from kinelab.analysis import families
 from kinelab.analysis.singular import RANK_RTOL
 from kinelab.errors import KinelabError
+from kinelab.ik.request import check_seed
 from kinelab.robot import Robot
 
 
@@ -34,6 +35,7 @@ def singularity(robot: Robot, samples: int = 5000, seed: int = 0, method: str = 
     Raises:
         KinelabError: no sample, a sweep too large for memory, or an unknown method.
     """
+    check_seed(seed)
     families.check_sweep_size(robot, samples)
     if method not in ("random", "grid"):
         raise KinelabError(f"unknown sampling {method!r}; use 'random' or 'grid'")

@@ -16,6 +16,7 @@ from tqdm import tqdm
 from kinelab.analysis import oracles as checks
 from kinelab.errors import KinelabError
 from kinelab.geometry import quat_wxyz_from_matrix
+from kinelab.ik.request import check_seed
 from kinelab.robot import Robot, load
 from kinelab.studies import paper001_stanford as seed001
 
@@ -254,6 +255,7 @@ GENERAL_CHECKS = [model_checks, biquaternion_checks, solver_checks]
 
 def run(robots: list[str] | None = None, n: int | None = None, seed: int = 0, progress: bool = False) -> Report:
     """Run every check on ``robots`` (default: stanford, era, youbot, panda, ur5)."""
+    check_seed(seed)
     names = list(robots or DEFAULT_ROBOTS)
     n = DEFAULT_N if n is None else n
     if isinstance(n, bool) or not isinstance(n, int) or n < 1:

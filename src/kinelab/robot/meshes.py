@@ -33,33 +33,49 @@ def mesh_package_dirs(user: list[str] | None = None) -> list[str]:
     return dirs + ros + catalog.package_dirs()
 
 
-def _package_candidates(rest: str, dirs: list[str]) -> list[Path]:
-    """``NAME/path`` under each directory: DIR/NAME/path, DIR/path when DIR is the package NAME itself, and
-    DIR/*/NAME/path one level down (a workspace's src folder)."""
+MESH_SUFFIXES = {".stl", ".dae", ".obj", ".ply", ".glb", ".gltf", ".off", ".3ds", ".fbx", ".mesh"}
+
+
+def _package_candidates(rest: str, dirs: list[str]) -> list[tuple[Path, Path]]:
+    """(file, the folder it must stay in) for ``NAME/path`` under each directory: DIR/NAME/path, DIR/path when
+    DIR is the package NAME itself, and DIR/*/NAME/path one level down (a workspace's src folder)."""
     name, _, inner = rest.partition("/")
     out = []
     for d in map(Path, dirs):
-        out.append(d / rest)
+        out.append((d / rest, d))
         if d.name == name:
-            out.append(d / inner)
-        out += [package / inner for package in sorted(d.glob(f"*/{name}"))[:1]]
+            out.append((d / inner, d))
+        out += [(package / inner, package) for package in sorted(d.glob(f"*/{name}"))[:1]]
     return out
+
+
+def _within(path: Path, folder: Path) -> bool:
+    """``path`` (links and ``..`` resolved) lies inside ``folder``."""
+    try:
+        path.resolve().relative_to(folder.resolve())
+    except (ValueError, OSError):
+        return False
+    return True
 
 
 def resolve_uri(uri: str, urdf_dir: str | Path, package_dirs: list[str] | None = None) -> Path | None:
     """The file a URDF mesh URI names, or None if it cannot be found.
 
     ``package://NAME/rest`` is looked up under each of ``package_dirs`` (default: :func:`mesh_package_dirs`)
-    as described in :func:`_package_candidates`; ``file://`` and plain paths are taken relative to the URDF.
+    as described in :func:`_package_candidates`, and must stay inside the folder it was found under (a
+    ``package://../../`` URI reaches nothing); ``file://`` and plain paths are taken relative to the URDF, or
+    as they are when absolute (the file's author named them). Only mesh files count (by their suffix): a
+    URDF cannot make the viewer embed an arbitrary file.
     """
     dirs = mesh_package_dirs() if package_dirs is None else list(package_dirs)
     if uri.startswith("package://"):
         rest = uri[len("package://"):]
-        candidates = _package_candidates(rest, dirs) + [Path(urdf_dir) / rest.split("/", 1)[-1]]
+        candidates = _package_candidates(rest, dirs) + [(Path(urdf_dir) / rest.split("/", 1)[-1], Path(urdf_dir))]
+        found = [c for c, folder in candidates if _within(c, folder)]
     else:
         plain = uri[len("file://"):] if uri.startswith("file://") else uri
-        candidates = [Path(plain) if Path(plain).is_absolute() else Path(urdf_dir) / plain]
-    return next((c for c in candidates if c.is_file()), None)
+        found = [Path(plain) if Path(plain).is_absolute() else Path(urdf_dir) / plain]
+    return next((c for c in found if c.suffix.lower() in MESH_SUFFIXES and c.is_file()), None)
 
 
 def yourdfpy_filename_handler(urdf_path: str | Path, package_dirs: list[str] | None = None):

@@ -11,13 +11,15 @@ from __future__ import annotations
 import contextlib
 import html
 import io
+import os
+import tempfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
-from kinelab.errors import ConfigurationError
+from kinelab.errors import ConfigurationError, KinelabError
 from kinelab.robot import Robot
 from kinelab.view.caption import with_caption
 from kinelab.view.framing import frame_points
@@ -217,9 +219,25 @@ class Scene:
         return HTML(f'<iframe srcdoc="{page}" style="width:100%;height:{height}px;border:0"></iframe>')
 
     def save_html(self, path: str | Path) -> Path:
-        """Write the scene as one self-contained HTML page (its caption included); returns the path."""
+        """Write the scene as one self-contained HTML page (its caption included); returns the path.
+
+        The page is written beside its final name and renamed into place (never half a page).
+
+        Raises:
+            KinelabError: ``path`` is a folder, or its folder is missing or not writable.
+        """
         path = Path(path)
-        path.write_text(self.static_html(), encoding="utf-8")
+        if path.is_dir():
+            raise KinelabError(f"cannot write the page to {path}: it is a folder; give a file name such as "
+                               f"{path / 'view.html'}")
+        text = self.static_html()
+        try:
+            with tempfile.NamedTemporaryFile("w", encoding="utf-8", dir=path.parent, prefix=f".{path.name}.",
+                                             delete=False) as tmp:
+                tmp.write(text)
+            os.replace(tmp.name, path)
+        except OSError as exc:
+            raise KinelabError(f"cannot write the page to {path}: {exc.strerror or exc}") from None
         return path
 
     def close(self) -> None:

@@ -16,6 +16,7 @@ import numpy as np
 from tqdm import tqdm
 
 from kinelab.errors import KinelabError
+from kinelab.ik.request import check_seed
 from kinelab.ik.tasks import TASKS
 from kinelab.report.bench import fabrik, peers
 from kinelab.report.bench.adapters import KINELAB_SOLVERS
@@ -140,6 +141,7 @@ def run(robots: list[str] | None = None, n: int = 200, seed: int = 0, solvers: l
         budget: float = BUDGET, progress: bool = False, repeats: int = REPEATS, start: str = "random",
         sigma: float = 0.2, schedule: str = "blocked", task: str = "pose") -> dict[str, Any]:
     """Run the protocol; returns a JSON-ready dict with the rows, the machine and the versions."""
+    check_seed(seed)
     if n < 1 or repeats < 1 or not budget > 0:
         raise KinelabError(f"bench needs n ≥ 1, repeats ≥ 1 and a positive budget (got {n}, {repeats}, {budget} s)")
     if start not in STARTS or schedule not in SCHEDULES or not 0 < sigma < 10:

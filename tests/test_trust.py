@@ -1,0 +1,76 @@
+"""The defects a fault and fuzz run found (#23), each reproduced: raw errors, allocations sized by nonsense,
+files reached outside what the user pointed at. Each must now end in one clear error (a KinelabError, at the
+CLI one line and exit 2) or an honest result."""
+
+import numpy as np
+import pytest
+
+import kinelab
+from kinelab import KinelabError, cli, maps
+from kinelab.robot.meshes import resolve_uri
+
+
+@pytest.mark.parametrize("argv", [
+    ["singular", "ur5", "--sweep", "10", "--seed", "-1"],
+    ["validate", "--robots", "ur5", "--n", "2", "--seed", "-1", "--json"],
+    ["bench", "--robots", "ur5", "--n", "2", "--seed", "-1", "--json"],
+    ["map", "singular", "ur5", "--samples", "10", "--seed", "-1"],
+    ["map", "reach", "ur5", "--voxel", "1e-9"],
+    ["map", "reach", "ur5", "--voxel", "0.006"],
+    ["map", "base", "youbot", "--grasp", "1", "1", "0.3", "0", "0", "0", "--step", "1e-4"],
+    ["map", "reach", "ur5", "--scheduler", ""],
+    ["map", "reach", "ur5", "--scheduler", "abc"],
+])
+def test_nonsense_at_the_cli_is_one_line_and_exit_2_before_any_allocation(capsys, argv):
+    assert cli.main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("kinelab: error:"), err
+
+
+@pytest.mark.parametrize("where", ["folder", "missing"])
+def test_an_html_page_that_cannot_be_written_is_named(capsys, tmp_path, where):
+    out = tmp_path if where == "folder" else tmp_path / "no" / "such" / "view.html"
+    assert cli.main(["view", "ur5", "--html", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "cannot write the page" in err
+
+
+def test_map_guards_run_before_the_grid_is_built():
+    ur5 = kinelab.load("ur5")
+    with pytest.raises(KinelabError, match="about 1.28e\\+29 targets"):
+        maps.reachability(ur5, voxel=1e-9)
+    with pytest.raises(KinelabError, match="lattice"):  # even with force: the lattice itself is refused
+        maps.reachability(ur5, voxel=1e-4, force=True)
+
+
+def test_a_package_uri_cannot_climb_out_of_its_package_and_only_meshes_resolve(tmp_path):
+    package = tmp_path / "ws" / "arm"
+    (package / "meshes").mkdir(parents=True)
+    (package / "meshes" / "link.stl").write_text("solid x\nendsolid x\n")
+    secret = tmp_path / "secret.stl"
+    secret.write_text("solid secret\nendsolid secret\n")
+    dirs = [str(tmp_path / "ws")]
+    assert resolve_uri("package://arm/meshes/link.stl", package, dirs) == package / "meshes" / "link.stl"
+    assert resolve_uri("package://arm/../../secret.stl", package, dirs) is None
+    assert resolve_uri("package://arm/meshes/../../../secret.stl", package, dirs) is None
+    assert resolve_uri("/etc/passwd", package, dirs) is None  # an absolute path, but no mesh
+    assert resolve_uri(str(secret), package, dirs) == secret  # an absolute mesh the file's author named
+
+
+def test_an_unknown_solver_is_listed_once():
+    with pytest.raises(kinelab.SolverNotFoundError) as err:
+        kinelab.solve(kinelab.load("ur5"), kinelab.target_from_xyz_rpy([0.3, 0.1, 0.4]), solver="x")
+    assert str(err.value).count("frdm") == 1 and str(err.value).count("biquat") == 1
+
+
+def test_a_batch_keeps_its_budget_whatever_its_size():
+    """kinelab 0.1: a batch of ≤ 512 rows never looked at the clock (5 ms → 4.2 s). Behaviour, not speed:
+    an unattainable tolerance ends at the budget, with every row honest (the bench measures the overrun)."""
+    youbot = kinelab.load("youbot")
+    targets = youbot.fk_batch(youbot.random_qs(256, 0))
+    kinelab.solve_batch(youbot, targets[:2], time_budget=0.01)  # compile outside the measurement
+    res = kinelab.solve_batch(youbot, targets, seed=0, time_budget=0.02, tol_pos=1e-300, tol_rot=1e-300)
+    assert res.wall_time < 1.0 and not res.success.any()
+    assert set(res.status) == {"time_budget"}
+    started = ~np.isnan(res.q).any(axis=1)
+    assert youbot.within_limits_batch(res.q[started]).all()
