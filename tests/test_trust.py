@@ -74,3 +74,28 @@ def test_a_batch_keeps_its_budget_whatever_its_size():
     assert set(res.status) == {"time_budget"}
     started = ~np.isnan(res.q).any(axis=1)
     assert youbot.within_limits_batch(res.q[started]).all()
+
+
+def test_a_target_too_far_for_floating_point_gets_a_finite_answer_from_every_solver():
+    import pinocchio as pin
+
+    ur5 = kinelab.load("ur5")
+    target = pin.SE3(np.eye(3), np.array([1e200, 0.0, 0.0]))
+    for solver in ("frdm", "biquat", "dls"):
+        res = kinelab.solve(ur5, target, solver=solver, seed=0, time_budget=0.1)
+        assert not res.success and res.status.value == "unreachable" and np.all(np.isfinite(res.q)), solver
+        assert ur5.within_limits(res.q)
+
+
+def test_an_orientation_task_ignores_the_point_it_is_given():
+    """kinelab 0.1 declared task 'orientation' unreachable because of the ignored translation."""
+    import pinocchio as pin
+
+    ur5 = kinelab.load("ur5")
+    R = pin.rpy.rpyToMatrix(0.3, 0.2, 0.1)
+    target = pin.SE3(R, np.array([5.0, 0.0, 0.0]))  # 5 m out: beyond the UR5's reach, and irrelevant
+    for res in (kinelab.solve(ur5, target, task="orientation", seed=0),
+                kinelab.solve_batch(ur5, [target] * 2, task="orientation", seed=0)):
+        q = np.atleast_2d(res.q)[0]
+        assert bool(np.atleast_1d(res.success)[0])
+        assert np.linalg.norm(pin.log3(R.T @ ur5.fk(q).rotation)) <= 1e-6

@@ -99,7 +99,7 @@ def run_batch(robot: Robot, targets: Any, q0: Any, req: Request) -> BatchIKResul
     deadline = np.inf if req.time_budget is None else \
         t0 + req.time_budget - min(VERDICT_SECONDS_PER_ROW * points.shape[0], 0.5 * req.time_budget)
     if compiled:
-        attempts = np.where(_beyond(robot, points) > 0, 1, req.max_restarts + 1)
+        attempts = np.where(_beyond(robot, points, req) > 0, 1, req.max_restarts + 1)
         rows = frdm_batch.run(robot, points, rotations, starts, seed_states(seed, points.shape[0]), attempts,
                               req.tol_pos, req.tol_rot, deadline, req.options)
         mode = f"frdm (compiled batch, {numba.get_num_threads()} threads)"
@@ -131,8 +131,11 @@ def _starts(robot: Robot, q0: Any, count: int) -> np.ndarray | None:
     return np.array(arr, dtype=float)
 
 
-def _beyond(robot: Robot, points: np.ndarray) -> np.ndarray:
-    """Per target: how far [m] its position lies beyond the reach bound (≤ 0: maybe reachable)."""
+def _beyond(robot: Robot, points: np.ndarray, req: Request) -> np.ndarray:
+    """Per target: how far [m] its position lies beyond the reach bound (≤ 0: maybe reachable; always 0 for a
+    task that ignores the point)."""
+    if not req.task.position:
+        return np.zeros(points.shape[0])
     anchor, radius = reach_bound(robot)
     beyond: np.ndarray = np.linalg.norm(points - np.asarray(anchor), axis=1) - radius
     return beyond
@@ -163,13 +166,14 @@ def _judged(robot: Robot, rows: Rows, points: np.ndarray, rotations: np.ndarray,
     solved = np.flatnonzero(rows.status != Status.TIME_BUDGET.value)
     if solved.size:
         H_target = stack_homogeneous(points[solved], rotations[solved])
-        dp[solved], dr[solved] = task.errors_batch(H_target, robot.fk_batch(rows.Q[solved]))
+        with np.errstate(over="ignore"):  # a target 1e200 m away is far, not an error
+            dp[solved], dr[solved] = task.errors_batch(H_target, robot.fk_batch(rows.Q[solved]))
         within = robot.within_limits_batch(rows.Q[solved])
         success[solved] = task.met_batch(dp[solved], dr[solved], req.tol_pos, req.tol_rot) & within
     status = rows.status
     status[success] = Status.CONVERGED.value
     failed = ~success & (status != Status.TIME_BUDGET.value)
-    status[failed & (_beyond(robot, points) > 0)] = Status.UNREACHABLE.value
+    status[failed & (_beyond(robot, points, req) > 0)] = Status.UNREACHABLE.value
     status[failed & (status == Status.CONVERGED.value)] = Status.STALLED.value  # the solver's test passed only
     return BatchIKResult(rows.Q, success, rows.status, dp, dr, rows.iterations, rows.restarts, seed,
                          time.perf_counter() - t0, req.solver, mode)

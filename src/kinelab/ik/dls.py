@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import math
 import time
 from dataclasses import dataclass
 from typing import Any
@@ -118,11 +119,15 @@ def attempt(
             return Attempt(robot.from_pin_q(q), Status.CONVERGED, it)
         if time.perf_counter() > deadline:
             return Attempt(robot.from_pin_q(q), Status.TIME_BUDGET, it)
-        size = float(err @ err)
+        with np.errstate(over="ignore"):
+            size = float(err @ err)
         errors.append(size)
         if len(errors) > STALL_ITERATIONS and size > (1.0 - STALL_FALL) * errors[-1 - STALL_ITERATIONS]:
             return Attempt(robot.from_pin_q(q), Status.STALLED, it)  # held at a limit or a local minimum
-        v = J.T @ np.linalg.solve(J @ J.T + (opts.damping + ERROR_DAMPING * size) * np.eye(len(err)), err)
+        with np.errstate(over="ignore", invalid="ignore"):
+            v = J.T @ np.linalg.solve(J @ J.T + (opts.damping + ERROR_DAMPING * size) * np.eye(len(err)), err)
+        if not (math.isfinite(size) and np.all(np.isfinite(v))):  # a target too far for floating point
+            return Attempt(robot.from_pin_q(q), Status.STALLED, it)  # the last finite q, not a NaN one
         q = limits.project(pin.integrate(model, q, opts.step * v))
     return Attempt(robot.from_pin_q(q), Status.MAX_ITERATIONS, opts.max_iterations)
 

@@ -80,7 +80,8 @@ def solve_one(robot: Robot, target: Any, q0: Any, req: Request) -> IKResult:
     problem = _Problem(robot, target, req.solver, req.tol_pos, req.tol_rot, t_start, t_start + budget, req.seed,
                        req.task, req.task_label)
     max_restarts = req.max_restarts
-    beyond = out_of_reach(robot, target.translation)
+    # only a task that constrains the point can be out of reach (an orientation target's point is ignored)
+    beyond = out_of_reach(robot, target.translation) if req.task.position else 0.0
     if beyond > 0:
         max_restarts = 0  # proved out of reach: one attempt gives the best pose, restarts cannot help
     elif getattr(opts, "compiled", False) and hasattr(module, "multistart"):
