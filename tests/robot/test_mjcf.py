@@ -84,3 +84,42 @@ def test_the_default_tool_of_an_mjcf_is_its_tip_site(tmp_path):
     q = robot.random_q(3)
     offset = plain.fk(q).rotation @ np.array([0.0, 0.0, 0.05])
     np.testing.assert_allclose(robot.fk(q).translation, plain.fk(q).translation + offset, atol=1e-12)
+
+
+@pytest.mark.parametrize(("edit", "rule"), [
+    (('pos="0 0 0.3"', 'pos="0 0 1e308"'), "more than 10000 m"),
+    (('pos="0 0 0.3"', 'pos="0 nan 0.3"'), "pos must be 3 finite numbers"),
+    (('axis="0 0 1"', 'axis="0 0 0"'), "axis is zero"),
+    (('range="-2 2"', 'range="2 -2"'), "range lower 2 > upper -2"),
+    (('name="j2"', 'name="j1"'), "two joint elements are named 'j1'"),
+    (('<body name="l1" pos="0 0 0.3">', '<body name="l1" pos="0 0 0.3" quat="nan 0 0 1">'),
+     "quat must be 4 finite numbers"),
+    (('<body name="l1" pos="0 0 0.3">', '<body name="l1" pos="0 0 0.3" quat="0 0 0 0">'), "quat is zero"),
+    (('<worldbody>', '<include file="other.xml"/><worldbody>'), "<include> is not read"),
+])
+def test_an_mjcf_meets_the_rules_a_urdf_meets(tmp_path, edit, rule):
+    """kinelab 0.1 read MJCF without its model rules: inf positions, NaN quaternions, zero axes, lower > upper
+    (a raw ValueError in every solve), a duplicate joint name dropping a joint, an ignored include."""
+    path = write_mjcf(tmp_path)
+    path.write_text(path.read_text().replace(*edit, 1))
+    with pytest.raises(kinelab.URDFError, match=rule):
+        load(str(path))
+
+
+def test_a_huge_model_file_is_refused_before_pinocchio_parses_it(tmp_path):
+    """A URDF of 4000 links killed the process inside Pinocchio's parser; an MJCF of 2000 bodies ran it out of
+    memory: both are counted and refused first."""
+    from kinelab.robot.urdf import MAX_LINKS
+
+    links = "".join(f'<link name="l{i}"/>' for i in range(MAX_LINKS + 1))
+    joints = "".join(f'<joint name="j{i}" type="fixed"><parent link="l{i}"/><child link="l{i + 1}"/></joint>'
+                     for i in range(MAX_LINKS))
+    urdf = tmp_path / "long.urdf"
+    urdf.write_text(f'<robot name="long">{links}{joints}</robot>')
+    with pytest.raises(kinelab.URDFError, match=f"{MAX_LINKS + 1} links"):
+        load(str(urdf))
+    nested = "".join(f'<body name="b{i}">' for i in range(MAX_LINKS + 1)) + "</body>" * (MAX_LINKS + 1)
+    mjcf = tmp_path / "deep.xml"
+    mjcf.write_text(f"<mujoco><worldbody>{nested}</worldbody></mujoco>")
+    with pytest.raises(kinelab.URDFError, match=f"{MAX_LINKS + 1} bodies"):
+        load(str(mjcf))

@@ -92,3 +92,20 @@ def test_a_missing_package_directory_is_named(tmp_path):
     urdf = ros_package(tmp_path)
     with pytest.raises(URDFError, match="package directory .*nowhere.* does not exist"):
         load(urdf, package_dirs=[str(tmp_path / "nowhere")])
+
+
+def test_srdf_groups_that_include_each_other_and_non_finite_configurations_are_refused(tmp_path):
+    """kinelab 0.1: a group including itself hit Python's recursion limit; NaN named configurations loaded."""
+    from kinelab.robot.srdf import read_srdf
+
+    looped = tmp_path / "loop.srdf"
+    looped.write_text('<robot name="t"><group name="a"><group name="b"/></group>'
+                      '<group name="b"><group name="a"/></group></robot>')
+    with pytest.raises(kinelab.SRDFError, match="includes itself"):
+        read_srdf(looped).group_joints("a")
+    for value in ("nan", "inf"):
+        bad = tmp_path / f"{value}.srdf"
+        bad.write_text(f'<robot name="t"><group_state name="home" group="a"><joint name="j1" value="{value}"/>'
+                       "</group_state></robot>")
+        with pytest.raises(kinelab.SRDFError, match="not a finite number"):
+            read_srdf(bad)

@@ -8,13 +8,14 @@ angles are in degrees (MuJoCo's default): the parser converts every range to rad
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pinocchio as pin
 
 from kinelab.errors import URDFError
-from kinelab.robot.urdf import UrdfTree
+from kinelab.robot.urdf import MAX_OFFSET, UrdfTree, check_size
 
 
 def is_mjcf(path: Path) -> bool:
@@ -33,12 +34,76 @@ def read_mjcf(path: Path) -> tuple[pin.Model, UrdfTree]:
     Raises:
         URDFError: a file Pinocchio cannot read (the file and Pinocchio's reason named).
     """
+    check_mjcf(path)
     try:
         model = pin.buildModelFromMJCF(str(path))
     except (RuntimeError, ValueError) as exc:
         raise URDFError(f"Pinocchio cannot read the MJCF {path}: {exc}") from None
     _restore_slide_ranges(model, ET.parse(path).getroot())
     return model, body_tree(model)
+
+
+def check_mjcf(path: Path) -> None:
+    """The rules a URDF meets, for an MJCF file, before Pinocchio reads it: at most MAX_LINKS bodies, no
+    ``<include>`` (not read: merge the file), finite positions within MAX_OFFSET, finite non-zero quaternions
+    and axes, ranges with lower ≤ upper, unique body and joint names.
+
+    Raises:
+        URDFError: the file, the element and the rule named.
+    """
+    try:
+        root = ET.parse(path).getroot()
+    except (OSError, ET.ParseError) as exc:
+        raise URDFError(f"malformed MJCF {path}: {exc}") from None
+    bodies = list(root.iter("body"))
+    check_size(path, len(bodies), "bodies")
+    if root.find(".//include") is not None:
+        raise URDFError(f"{path}: <include> is not read by kinelab; merge the included file into {path.name}")
+    for kind, elements in (("body", bodies), ("joint", list(root.iter("joint")))):
+        names = [e.get("name", "") for e in elements if e.get("name")]
+        twice = sorted({n for n in names if names.count(n) > 1})
+        if twice:
+            raise URDFError(f"{path}: two {kind} elements are named {twice[0]!r}; names must be unique")
+    for body in bodies:
+        _check_body(path, body)
+    for joint in root.iter("joint"):
+        _check_joint(path, joint)
+
+
+def _numbers(path: Path, element: ET.Element, attribute: str, count: int) -> list[float] | None:
+    text = element.get(attribute)
+    if text is None:
+        return None
+    try:
+        values = [float(v) for v in text.split()]
+    except ValueError:
+        values = []
+    if len(values) != count or not all(math.isfinite(v) for v in values):
+        raise URDFError(f"{path}: {element.tag} {element.get('name', '?')!r} {attribute} must be {count} finite "
+                        f"numbers, got {text!r}")
+    return values
+
+
+def _check_body(path: Path, body: ET.Element) -> None:
+    name = body.get("name", "?")
+    pos = _numbers(path, body, "pos", 3)
+    if pos is not None and max(abs(v) for v in pos) > MAX_OFFSET:
+        raise URDFError(f"{path}: body {name!r} pos {pos} is more than {MAX_OFFSET:g} m from its parent")
+    for attribute, count, part in (("quat", 4, slice(0, 4)), ("axisangle", 4, slice(0, 3))):
+        values = _numbers(path, body, attribute, count)
+        if values is not None and math.hypot(*values[part]) < 1e-12:
+            raise URDFError(f"{path}: body {name!r} {attribute} is zero; give a non-zero {attribute}")
+    _numbers(path, body, "euler", 3)
+
+
+def _check_joint(path: Path, joint: ET.Element) -> None:
+    name = joint.get("name", "?")
+    axis = _numbers(path, joint, "axis", 3)
+    if axis is not None and math.hypot(*axis) < 1e-12:
+        raise URDFError(f"{path}: joint {name!r} axis is zero; an axis must be a non-zero direction")
+    span = _numbers(path, joint, "range", 2)
+    if span is not None and span[0] > span[1]:
+        raise URDFError(f"{path}: joint {name!r} range lower {span[0]:g} > upper {span[1]:g}")
 
 
 def _restore_slide_ranges(model: pin.Model, root: ET.Element) -> None:

@@ -6,6 +6,7 @@ Only what kinematics needs is read: ``<group>`` (with ``<chain>``, ``<joint>`` a
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -46,12 +47,19 @@ class Srdf:
                             f"{', '.join(self.states) or 'none'}")
         return self.states[name]
 
-    def group_joints(self, name: str) -> list[str]:
-        """The joints a group lists, its subgroups' included (a chain group lists none: see ``chain``)."""
+    def group_joints(self, name: str, _seen: tuple[str, ...] = ()) -> list[str]:
+        """The joints a group lists, its subgroups' included (a chain group lists none: see ``chain``).
+
+        Raises:
+            SRDFError: an unknown group, or groups that include each other (the cycle named).
+        """
+        if name in _seen:
+            raise SRDFError(f"{self.path.name}: group {name!r} includes itself "
+                            f"({' -> '.join((*_seen, name))}); a group may include only other groups")
         g = self.group(name)
         out = list(g.joints)
         for sub in g.subgroups:
-            out += [j for j in self.group_joints(sub) if j not in out]
+            out += [j for j in self.group_joints(sub, (*_seen, name)) if j not in out]
         return out
 
     def check_joints(self, known: list[str]) -> None:
@@ -120,7 +128,10 @@ def read_srdf(path: str | Path) -> Srdf:
 
 def _number(joint: ET.Element, path: Path) -> float:
     try:
-        return float(joint.get("value", "").split()[0])
+        value = float(joint.get("value", "").split()[0])
     except (ValueError, IndexError):
+        value = math.nan
+    if not math.isfinite(value):
         raise SRDFError(f"{path.name}: joint {joint.get('name')!r} of a group_state has value "
-                        f"{joint.get('value')!r}, not a number") from None
+                        f"{joint.get('value')!r}, not a finite number") from None
+    return value

@@ -24,6 +24,10 @@ from pathlib import Path
 from kinelab.errors import ChainError, URDFError
 
 MAX_OFFSET = 1e4  # [m] the largest joint or link offset a model may have (no robot is 10 km long)
+# links (or MJCF bodies) a file may have: checked before Pinocchio's parser, which crashes the process on a
+# URDF of 4000 links and runs out of memory on an MJCF of 2000 bodies; the longest chain kinelab can use is
+# far shorter (Pinocchio's Data limit, about 320 joints)
+MAX_LINKS = 1500
 
 
 @dataclass(frozen=True)
@@ -63,6 +67,7 @@ def read_tree(path: Path) -> UrdfTree:
     """
     xml = _parse(path)
     links = [link.get("name", "") for link in xml.findall("link")]
+    check_size(path, len(links), "links")
     parent_of: dict[str, str] = {}
     joint_of: dict[str, str] = {}
     mimic: dict[str, str] = {}
@@ -94,6 +99,17 @@ def read_tree(path: Path) -> UrdfTree:
     parents = set(parent_of.values())
     return UrdfTree(roots[0], parent_of, joint_of, mimic, links, [link for link in links if link not in parents],
                     broken)
+
+
+def check_size(path: Path, count: int, what: str) -> None:
+    """Refuse a file of more than MAX_LINKS links (bodies) before any parser allocates for it.
+
+    Raises:
+        URDFError: naming the count and the limit.
+    """
+    if count > MAX_LINKS:
+        raise URDFError(f"{path.name} has {count} {what}; kinelab reads files of at most {MAX_LINKS} (Pinocchio's "
+                        "parser fails on files far larger, and no chain longer than about 320 joints fits its Data)")
 
 
 def _parse(path: Path) -> ET.Element:
