@@ -75,6 +75,21 @@ def test_an_interrupted_map_resumes_to_the_same_arrays_as_one_run(ur5, tmp_path)
     np.testing.assert_array_equal(maps.load(tmp_path / "m.zarr").array("reachability"), whole.array("reachability"))
 
 
+def test_a_damaged_store_is_refused_on_load_and_recomputed_on_resume(ur5, tmp_path):
+    """kinelab 0.1 resumed a map whose chunk file was deleted and reported NaN voxels with exit 0."""
+    pytest.importorskip("zarr")
+    spec = reach.MapSpec(voxel=0.25, orientations=4, chunk_voxels=50, restarts=5)
+    out = tmp_path / "m.zarr"
+    whole = maps.reachability(ur5, spec, out=str(out))
+    (out / "reachability" / "1").unlink()  # a chunk file lost (a crash, a sync tool, a hand)
+    with pytest.raises(KinelabError, match=r"1 chunk\(s\) no longer match their checksums \(first: 1\)"):
+        maps.load(out)
+    with pytest.warns(UserWarning, match="computed again"):
+        again = maps.reachability(ur5, spec, out=str(out))
+    np.testing.assert_array_equal(again.array("reachability"), whole.array("reachability"))
+    assert not np.isnan(maps.load(out).array("reachability")).any()
+
+
 def test_bad_maps_are_refused_with_the_reason(ur5, tmp_path, monkeypatch):
     pytest.importorskip("zarr")
     with pytest.raises(KinelabError, match="voxel side must be a positive"):

@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import warnings
 
 from kinelab import __version__ as kinelab_version
 from kinelab.cli import bench, fk, ik, maps, robots, singular, validate, view
@@ -31,8 +32,15 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _one_line(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+              line: str | None = None) -> str:
+    """A warning as the CLI shows it: one line, no source path."""
+    return f"kinelab: warning: {' '.join(str(message).split())}\n"
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run one command; a user error prints one line and returns 2, Ctrl-C returns 130."""
+    warnings.formatwarning = _one_line
     args = build_parser().parse_args(argv)
     try:
         code: int = args.func(args)

@@ -42,7 +42,8 @@ def reachability(robot: Robot, spec: MapSpec | None = None, out: str | None = No
     spec.check()
     estimate = grid.estimated_voxels(robot, spec.voxel) * spec.orientations
     if estimate > 1.2 * MAX_TARGETS and not force:  # refused before the grid is built (a 1e-9 m voxel, say)
-        raise KinelabError(f"this map asks for about {estimate:.3g} targets; the limit is {MAX_TARGETS} without "
+        raise KinelabError(f"this map asks for about {estimate:.3g} targets (counted before any grid is built); the "
+                           f"limit is {MAX_TARGETS} without "
                            "force=True (--force): a larger voxel or fewer orientations make it smaller")
     centres = grid.voxel_centres(robot, spec.voxel)
     total = len(centres) * spec.orientations

@@ -9,6 +9,7 @@ file, the spec, the voxel count and the kinelab version. Zarr is the optional ex
 from __future__ import annotations
 
 import hashlib
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -52,6 +53,7 @@ class ReachabilityMap:
         self.meta, self.path = meta, path
         self.centres, self.done = arrays["centres"], arrays["done"]
         self.values = {k: arrays[k] for k in VALUES}
+        self.checksums = arrays.get("checksums")  # (chunks, 32) SHA-256 of each written chunk (on disk only)
 
     @property
     def chunks(self) -> int:
@@ -63,7 +65,26 @@ class ReachabilityMap:
         size = self.meta["spec"]["chunk_voxels"]
         for name in VALUES:
             self.values[name][index * size:index * size + len(values[name])] = values[name]
+        if self.checksums is not None:
+            self.checksums[index] = self._digest(index)
         self.done[index] = True
+
+    def _digest(self, index: int) -> np.ndarray:
+        """SHA-256 of chunk ``index``'s stored values, as 32 bytes."""
+        size = self.meta["spec"]["chunk_voxels"]
+        h = hashlib.sha256()
+        for name in VALUES:
+            h.update(np.ascontiguousarray(self.values[name][index * size:(index + 1) * size], dtype="<f8").tobytes())
+        return np.frombuffer(h.digest(), dtype=np.uint8)
+
+    def damaged(self) -> list[int]:
+        """The chunks marked done whose stored values no longer match the checksum written with them (a chunk
+        file deleted or altered); none for a map in memory."""
+        if self.checksums is None:
+            return []
+        done = np.flatnonzero(np.asarray(self.done[:]))
+        sums = np.asarray(self.checksums[:])
+        return [int(c) for c in done if not np.array_equal(sums[c], self._digest(int(c)))]
 
     def array(self, name: str) -> np.ndarray:
         """One of ``reachability``, ``manipulability``, ``sigma_ratio`` (or ``centres``) as a numpy array."""
@@ -84,23 +105,35 @@ def open_map(out: str | Path | None, robot: Robot, spec: Any, centres: np.ndarra
         return ReachabilityMap(meta, arrays)
     zarr, path = _zarr(), Path(out)
     if path.exists():
-        found = load(path)
+        found = load(path, check=False)
         _same(found.meta, meta, path)
+        damaged = found.damaged()
+        for c in damaged:
+            found.done[c] = False
+        if damaged:
+            warnings.warn(f"{path}: {len(damaged)} chunk(s) no longer match their checksums (first: {damaged[0]}); "
+                          "they are computed again", stacklevel=3)
         return found
     group = zarr.open_group(str(path), mode="w")
     group.attrs.update(meta)
     group.create_dataset("centres", data=centres, chunks=(spec.chunk_voxels, 3))
     for name in VALUES:
         group.create_dataset(name, shape=(len(centres),), chunks=(spec.chunk_voxels,), dtype="f8", fill_value=np.nan)
+    group.create_dataset("checksums", shape=(chunks, 32), chunks=(1, 32), dtype="u1", fill_value=0)
     group.create_dataset("done", shape=(chunks,), chunks=(1,), dtype=bool, fill_value=False)
-    return ReachabilityMap(meta, {k: group[k] for k in ("centres", "done", *VALUES)}, path)
+    return ReachabilityMap(meta, {k: group[k] for k in ("centres", "done", "checksums", *VALUES)}, path)
 
 
-def load(path: str | Path) -> ReachabilityMap:
+def load(path: str | Path, check: bool = True) -> ReachabilityMap:
     """Open a map written by :func:`kinelab.maps.reachability`.
 
+    Args:
+        path: the Zarr directory.
+        check: verify every finished chunk against its checksum.
+
     Raises:
-        KinelabError: no map there, or a map written by another kinelab version (named).
+        KinelabError: no map there, a map written by another kinelab version (named), or (with ``check``)
+            chunks whose values no longer match their checksums (running the same map again recomputes them).
     """
     from kinelab import __version__
 
@@ -108,13 +141,18 @@ def load(path: str | Path) -> ReachabilityMap:
     try:
         group = zarr.open_group(str(path), mode="r+")
         meta = dict(group.attrs)
-        arrays = {k: group[k] for k in ("centres", "done", *VALUES)}
+        arrays = {k: group[k] for k in ("centres", "done", "checksums", *VALUES)}
     except (KeyError, ValueError, FileNotFoundError, zarr.errors.GroupNotFoundError):
         raise KinelabError(f"{path} is not a kinelab reachability map") from None
     if meta.get("kinelab") != __version__:
         raise KinelabError(f"{path} was written by kinelab {meta.get('kinelab')}, this is {__version__}: "
                            "compute the map again")
-    return ReachabilityMap(meta, arrays, path)
+    found = ReachabilityMap(meta, arrays, path)
+    damaged = found.damaged() if check else []
+    if damaged:
+        raise KinelabError(f"{path}: {len(damaged)} chunk(s) no longer match their checksums (first: {damaged[0]}); "
+                           "run the same map again to compute them anew")
+    return found
 
 
 def _same(found: dict, wanted: dict, path: Path) -> None:
