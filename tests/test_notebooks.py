@@ -21,3 +21,13 @@ def test_every_notebook_has_a_rendered_page_in_the_docs():
     notebooks = sorted(p.stem for p in (ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))
     pages = sorted(p.stem for p in (ROOT / "docs" / "notebooks").glob("*.html"))
     assert notebooks and pages == notebooks
+
+
+def test_the_rendered_pages_carry_no_machine_path_and_no_warning():
+    """A committed page shows what a reader sees: no stderr output (a warning names the renderer's files) and no
+    path of the machine that rendered it."""
+    for page in sorted((ROOT / "docs" / "notebooks").glob("*.html")):
+        text = page.read_text()
+        assert "application/vnd.jupyter.stderr" not in text, page.name
+        for machine in ("/work/", "/root/", "/home/", "site-packages"):
+            assert machine not in text, (page.name, machine)

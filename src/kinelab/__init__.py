@@ -26,6 +26,7 @@ from kinelab.errors import (
 from kinelab.ik.api import solve, solve_all, solve_batch, track
 from kinelab.ik.batch import BatchIKResult
 from kinelab.ik.frdm.options import FRDMOptions
+from kinelab.ik.prepared import IK
 from kinelab.ik.result import Diagnostics, IKResult, Status, TrackResult
 from kinelab.ik.targets import from_xyz_quat_wxyz as target_from_xyz_quat_wxyz
 from kinelab.ik.targets import from_xyz_rpy as target_from_xyz_rpy
@@ -46,6 +47,7 @@ __all__ = [
     "Diagnostics",
     "FRDMOptions",
     "FrameNotFoundError",
+    "IK",
     "IKResult",
     "Joint",
     "JointLimitError",

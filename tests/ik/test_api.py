@@ -121,3 +121,27 @@ def test_one_request_feeds_every_entry_point():
     req = make_request(task="axis", axis="x", solver_options=kicks)
     assert req.task == Task("axis", 0) and req.options.mode == "axis" and req.options.tool_axis == "x"
     assert hash(req.options) == hash(make_request(task="axis", axis="x", solver_options=dict(kicks)).options)
+
+
+def test_the_prepared_solver_gives_kinelab_solve_s_answers(ur5):
+    """ik.solve equals kinelab.solve for the same seed and settings (one driver under both), and checks per call
+    only what changes."""
+    ik = kinelab.IK(ur5, tol_pos=1e-7, task="axis", axis="x")
+    rng = np.random.default_rng(9)
+    for k in range(5):
+        target = ur5.fk(ur5.random_q(rng))
+        a = ik.solve(target, seed=k)
+        b = kinelab.solve(ur5, target, seed=k, tol_pos=1e-7, task="axis", axis="x")
+        np.testing.assert_array_equal(a.q, b.q)
+        assert a.success == b.success and a.task == b.task == "axis x"
+    warm = ik.solve(target, q0=b.q)
+    assert warm.success and warm.restarts == 0
+    batch = ik.solve_batch([target] * 3, seed=4)
+    np.testing.assert_array_equal(batch.q, kinelab.solve_batch(ur5, [target] * 3, seed=4, tol_pos=1e-7,
+                                                               task="axis", axis="x").q)
+    with pytest.raises(OptionError, match="seed"):
+        ik.solve(target, seed=-1)
+    with pytest.raises(TypeError, match="by keyword"):
+        kinelab.IK(ur5, "dls")
+    with pytest.raises(OptionError, match="tol_pos"):
+        kinelab.IK(ur5, tol_pos=0.0)

@@ -98,6 +98,11 @@ def _prepare(module: Any, robot: Robot) -> None:
     prepare = getattr(module, "prepare", None)
     if prepare is not None:
         prepare(robot)
+    prepare_checks(robot)
+
+
+def prepare_checks(robot: Robot) -> None:
+    """Compile (or load) the target check and Pinocchio's verdict kernel, once per process."""
     if not _CHECKS_COMPILED:
         _compile_checks(robot)
 

@@ -37,12 +37,14 @@ class Task:
         Raises:
             OptionError: an unknown task or axis.
         """
+        if task == "pose" and axis == "z":
+            return POSE
+        if not isinstance(task, str) or task not in TASKS:
+            raise OptionError("task", task, f"one of {', '.join(TASKS)}")
+        if not isinstance(axis, str) or axis not in AXES:  # refused for every task: a typo is never ignored
+            raise OptionError("axis", axis, "'x', 'y' or 'z' (the tool axis to align)")
         if task == "pose":
             return POSE
-        if task not in TASKS:
-            raise OptionError("task", task, f"one of {', '.join(TASKS)}")
-        if axis not in AXES:
-            raise OptionError("axis", axis, "'x', 'y' or 'z' (the tool axis to align)")
         return cls(task, AXES.index(axis) if task == "axis" else -1)
 
     @property

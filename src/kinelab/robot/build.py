@@ -27,6 +27,7 @@ from kinelab.errors import (
     FrameNotFoundError,
     JointLimitError,
     JointNotFoundError,
+    OptionError,
     SRDFError,
     URDFError,
 )
@@ -129,6 +130,8 @@ class _Builder:
     def from_file(cls, source: Path, tool: str | None, locked: dict[str, float] | None, name: str | None,
                   base: str | None, package_dirs: list[str] | None, srdf: str | Path | None, group: str | None,
                   xacro_args: dict[str, str] | None, trust_xacro: bool) -> _Builder:
+        if xacro_args and not xacro.is_xacro(source):  # an argument that nothing reads is a mistake, said
+            raise OptionError("xacro_args", xacro_args, f"arguments of a .xacro source; {source.name} is not one")
         urdf_path = xacro.expand(source, xacro_args, trusted=trust_xacro) if xacro.is_xacro(source) else source
         if is_mjcf(urdf_path):
             full, tree = read_mjcf(urdf_path)

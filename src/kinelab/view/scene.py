@@ -216,7 +216,8 @@ class Scene:
         from IPython.display import HTML
 
         page = html.escape(self.static_html(), quote=True)
-        return HTML(f'<iframe srcdoc="{page}" style="width:100%;height:{height}px;border:0"></iframe>')
+        # in a <div>: IPython warns (on stderr, into the saved notebook) about markup that starts with <iframe>
+        return HTML(f'<div><iframe srcdoc="{page}" style="width:100%;height:{height}px;border:0"></iframe></div>')
 
     def save_html(self, path: str | Path) -> Path:
         """Write the scene as one self-contained HTML page (its caption included); returns the path.

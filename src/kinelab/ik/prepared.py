@@ -1,0 +1,119 @@
+"""The prepared solver: build once, call in the loop (what TRAC-IK's solver, pink's Configuration and rtb's
+``ets.ik_LM`` users already do).
+
+``IK(robot, solver=..., task=..., tol_pos=..., ...)`` checks every setting once and compiles the solver's
+kernels before it returns; ``ik.solve(target, q0=...)`` then checks only what changes per call (the target and
+the start) and goes straight to the driver, so a call pays no argument validation or option building. Its
+answers are those of :func:`kinelab.solve` with the same settings and seed (tested), and every one is judged
+by Pinocchio.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any
+
+from kinelab.ik.batch import BatchIKResult, run_batch
+from kinelab.ik.branches import find_all
+from kinelab.ik.driver import prepare_checks, solve_one
+from kinelab.ik.request import Request, check_seed, make_request
+from kinelab.ik.result import IKResult
+from kinelab.robot import Robot
+
+
+class IK:
+    """A solver prepared for one robot and one set of settings.
+
+    Args:
+        robot: the robot.
+        positional: nothing: every setting is keyword-only.
+        solver: "frdm", "biquat" or "dls".
+        tol_pos: position tolerance [m].
+        tol_rot: rotation tolerance [rad].
+        time_budget: wall-clock budget of each call [s] (None: none).
+        max_restarts: random restarts after the first attempt.
+        start_outside_limits: "project" (a start outside the limits is moved into them, with a warning) or
+            "refuse".
+        options: the solver's options object.
+        task: "pose", "position", "axis" or "orientation".
+        axis: the tool axis of task "axis".
+        solver_options: the solver's option fields as keyword arguments.
+
+    Raises:
+        TypeError: a setting given positionally.
+        SolverNotFoundError, OptionError: a bad setting, named (once, here).
+    """
+
+    def __init__(self, robot: Robot, *positional: Any, solver: str = "frdm", tol_pos: float = 1e-6,
+                 tol_rot: float = 1e-6, time_budget: float | None = 1.0, max_restarts: int = 1000,
+                 start_outside_limits: str = "project", options: Any = None, task: str = "pose", axis: str = "z",
+                 **solver_options: Any):
+        if positional:
+            raise TypeError("IK() takes the robot positionally and every setting by keyword: pass "
+                            f"solver={positional[0]!r}")
+        self.robot = robot
+        self.request: Request = make_request(solver, None, tol_pos, tol_rot, time_budget, max_restarts,
+                                             start_outside_limits, options, task, axis, solver_options)
+        prepare = getattr(self.request.module, "prepare", None)
+        if prepare is not None:
+            prepare(robot)  # compile (or load) the kernels now, not in the first call
+        prepare_checks(robot)
+        self._by_seed: dict[int | None, Request] = {None: self.request}
+
+    def _request(self, seed: int | None) -> Request:
+        found = self._by_seed.get(seed)
+        if found is None:
+            check_seed(seed)
+            found = self._by_seed[seed] = replace(self.request, seed=seed)
+        return found
+
+    def solve(self, target: Any, *, q0: Any = None, seed: int | None = None) -> IKResult:
+        """IK for one target (oMtarget in the base frame), as :func:`kinelab.solve` with these settings.
+
+        Args:
+            target: oMtarget (a ``pin.SE3``; three numbers [m] for task "position").
+            q0: the first start [rad or m] (None: a seeded random one).
+            seed: seed of the random starts (None: fresh entropy).
+
+        Returns:
+            The result, judged by Pinocchio on the task's components within the limits.
+
+        Raises:
+            TargetError, ConfigurationError, JointLimitError, OptionError: a bad target, start or seed.
+        """
+        return solve_one(self.robot, target, q0, self._request(seed))
+
+    def solve_batch(self, targets: Any, *, q0: Any = None, seed: int | None = None) -> BatchIKResult:
+        """Every target of a batch, as :func:`kinelab.solve_batch` with these settings (row b: seed + b).
+
+        Args:
+            targets: a sequence of ``pin.SE3`` or an (B, 4, 4) array.
+            q0: None, one start for every row, or (B, n) starts [rad or m].
+            seed: the base seed (None: one is drawn and reported).
+
+        Returns:
+            The batch result, every row judged by Pinocchio.
+
+        Raises:
+            TargetError, ConfigurationError, OptionError: named.
+        """
+        return run_batch(self.robot, targets, q0, replace(self._request(seed), start_outside_limits="refuse"))
+
+    def solve_all(self, target: Any, *, seed: int | None = None, q_ref: Any = None,
+                  max_solutions: int | None = None) -> list[IKResult]:
+        """The distinct branches of ``target`` found within the time budget, as :func:`kinelab.solve_all`.
+
+        Args:
+            target: oMtarget.
+            seed: base seed of the starts.
+            q_ref: sort the branches by distance to this configuration.
+            max_solutions: stop at this many branches.
+
+        Returns:
+            One result per distinct branch.
+
+        Raises:
+            TargetError, ConfigurationError, OptionError: named.
+        """
+        return find_all(self.robot, target, replace(self._request(seed), max_restarts=0), q_ref=q_ref,
+                        max_solutions=max_solutions)
