@@ -187,3 +187,14 @@ def test_task_protocols_judge_the_constrained_components_and_skip_solvers_withou
     result = runner.run(robots=["ur5"], n=3, solvers=["frdm", "biquat"], budget=0.05, repeats=1, task="position")
     assert [r["solver"] for r in result["rows"]] == ["frdm"] and "biquat" in result["not_run"]
     assert result["protocol"]["task"] == "position"
+
+
+def test_every_budgeted_path_runs_until_its_budget_and_is_reported():
+    """The loops protocol's budget rows cover every path (each solver, the batch, solve_all, prefer=); with a
+    tolerance no solver meets, each call runs at least its budget (behaviour: the figures belong to the bench)."""
+    from kinelab.report.bench import loops
+
+    rows = loops.budgets(kinelab.load("ur5"), budget=0.004, n=3)
+    assert [r["solver"] for r in rows] == ["frdm", "biquat", "dls", "frdm batch of 64", "frdm solve_all",
+                                           "frdm prefer="]
+    assert all(r["p50_ms"] >= 4.0 and r["max_ms"] >= r["p99_ms"] >= r["p50_ms"] for r in rows)

@@ -16,7 +16,7 @@ import numpy as np
 import pinocchio as pin
 from tqdm import tqdm
 
-from kinelab.ik.api import solve, solve_batch, track
+from kinelab.ik.api import solve, solve_all, solve_batch, track
 from kinelab.report.bench import peers
 from kinelab.report.bench.protocol import DEFAULT_ROBOTS, TOL_POS, TOL_ROT, cases, smooth_path
 from kinelab.robot import Robot, load
@@ -132,23 +132,41 @@ def tracking(robot: Robot, seed: int = 0, samples: int = 2000, repeats: int = 3)
 
 def budgets(robot: Robot, budget: float = 0.005, n: int = 200, seed: int = 0,
             solvers: tuple[str, ...] = ("frdm", "biquat", "dls")) -> list[dict[str, Any]]:
-    """How well each solver keeps ``time_budget`` [s]: n solves that cannot succeed (tolerances of 1e-300)
-    from random starts, solvers interleaved per problem; the wall time of each call, outside the solver."""
+    """How well every path keeps ``time_budget`` [s]: n calls that cannot succeed (tolerances of 1e-300) from
+    random starts, paths interleaved per problem; the wall time of each call, outside kinelab. The paths: each
+    solver's ``solve``, FRDM's ``solve_batch`` of 64 targets, ``solve_all`` and ``solve(prefer=)``."""
     problems = cases(robot, n, seed)
-    times: dict[str, list[float]] = {name: [] for name in solvers}
-    for name in solvers:  # warm-up: compilation
-        solve(robot, problems[0].oMtarget, solver=name, q0=problems[0].q_start, seed=seed, time_budget=budget)
+    paths = _budget_paths(robot, budget, solvers)
+    times: dict[str, list[float]] = {name: [] for name in paths}
+    for call in paths.values():  # warm-up: compilation
+        call(problems[0], seed, 1e-6)
+    names = list(paths)
     for k, case in enumerate(problems):
-        for name in solvers[k % len(solvers):] + solvers[:k % len(solvers)]:
+        for name in names[k % len(names):] + names[:k % len(names)]:
             t0 = time.perf_counter()
-            solve(robot, case.oMtarget, solver=name, q0=case.q_start, seed=seed + k, tol_pos=1e-300, tol_rot=1e-300,
-                  time_budget=budget)
+            paths[name](case, seed + k, 1e-300)
             times[name].append(time.perf_counter() - t0)
     allowed = budget * 1.05 + 1e-4
     return [{"robot": robot.name, "solver": name, "budget_ms": budget * 1e3,
              "p50_ms": float(np.percentile(t, 50) * 1e3), "p99_ms": float(np.percentile(t, 99) * 1e3),
              "max_ms": float(np.max(t) * 1e3), "kept": bool(np.percentile(t, 99) <= allowed)}
             for name, t in times.items()]
+
+
+def _budget_paths(robot: Robot, budget: float, solvers: tuple[str, ...]) -> dict[str, Callable[..., Any]]:
+    """One call per path, (case, seed, tolerance) → anything, each with ``budget``."""
+    def single(name: str) -> Callable[..., Any]:
+        return lambda case, seed, tol: solve(robot, case.oMtarget, solver=name, q0=case.q_start, seed=seed,
+                                             tol_pos=tol, tol_rot=tol, time_budget=budget)
+
+    paths = {name: single(name) for name in solvers}
+    paths["frdm batch of 64"] = lambda case, seed, tol: solve_batch(
+        robot, [case.oMtarget] * 64, seed=seed, tol_pos=tol, tol_rot=tol, time_budget=budget)
+    paths["frdm solve_all"] = lambda case, seed, tol: solve_all(robot, case.oMtarget, seed=seed, tol_pos=tol,
+                                                                tol_rot=tol, time_budget=budget)
+    paths["frdm prefer="] = lambda case, seed, tol: solve(robot, case.oMtarget, seed=seed, tol_pos=tol, tol_rot=tol,
+                                                         time_budget=budget, prefer=case.q_start)
+    return paths
 
 
 def run(robots: list[str] | None, seed: int = 0, repeats: int = 3, n: int = 2000, samples: int = 2000,
