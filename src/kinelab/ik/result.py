@@ -96,10 +96,10 @@ class BiquatTrajectory:
 
 @dataclass(frozen=True, repr=False)
 class Diagnostics:
-    """How a solve ran: each field is set by the solvers it applies to, None elsewhere.
+    """How a solve ran: each field is set by the solvers it applies to, None (or "") elsewhere.
 
     Attributes:
-        path: "compiled" (a compiled kernel ran the attempts) or None (the Python loop).
+        path: "compiled" (a compiled kernel ran the attempts) or "" (the Python loop).
         attempts: attempts run (the first start and its restarts); stalls: attempts that stalled.
         message: a solver's own note (a biquaternion run stopped by a singular matrix, say).
         sweeps, accelerated_sweeps: FRDM sweeps of the answer's run, and those Anderson's extrapolation kept.
@@ -115,13 +115,13 @@ class Diagnostics:
             starts: starts run (``solve_all``).
     """
 
-    path: str | None = None
+    path: str = ""
     attempts: int | None = None
     stalls: int | None = None
-    message: str | None = None
+    message: str = ""
     sweeps: int | None = None
     accelerated_sweeps: int | None = None
-    order: str | None = None
+    order: str = ""
     relax: float | None = None
     w_p: float | None = None
     objective: float | None = None
@@ -132,8 +132,8 @@ class Diagnostics:
     steps: int | None = None
     M0: float | None = None
     damping: float | None = None
-    law: str | None = None
-    integrator: str | None = None
+    law: str = ""
+    integrator: str = ""
     outside_limits: int | None = None
     trajectory: BiquatTrajectory | None = None
     answer_events: tuple[SingularEvent, ...] = ()
@@ -150,7 +150,7 @@ class Diagnostics:
         out: dict[str, Any] = {}
         for f in fields(self):
             value = getattr(self, f.name)
-            if value is None or f.name == "trajectory":
+            if value is None or value == "" or f.name == "trajectory":
                 continue
             if f.name in ("answer_events", "answer_bypasses"):
                 value = [v.to_dict() for v in value]
