@@ -67,7 +67,7 @@ def base_map(robot: Robot, grasp: pin.SE3, step: float = 0.05, restarts: int = 1
     if missing:
         raise KinelabError(f"{robot.name} has no platform joint {missing[0]!r}: a base map needs joints "
                            f"{', '.join(PLATFORM)}")
-    if not (isinstance(step, int | float) and np.isfinite(step) and step > 0):
+    if isinstance(step, bool) or not (isinstance(step, int | float) and np.isfinite(step) and step > 0):
         raise KinelabError(f"a base map needs a grid step > 0 [m], got {step!r}")
     check_seed(seed)
     check_seed(restarts, "restarts")

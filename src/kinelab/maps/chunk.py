@@ -48,13 +48,14 @@ class MapSpec:
 
     def check(self) -> None:
         """Raises KinelabError naming a bad field and what is valid."""
-        if not (isinstance(self.orientations, int) and self.orientations >= 1):
+        if isinstance(self.orientations, bool) or not (isinstance(self.orientations, int) and self.orientations >= 1):
             raise KinelabError(f"orientations must be an integer ≥ 1, got {self.orientations!r}")
         if self.task not in ("pose", "axis"):
             raise KinelabError(f"a reachability map takes task 'pose' or 'axis', got {self.task!r}")
-        if not (isinstance(self.chunk_voxels, int) and self.chunk_voxels >= 1):
+        if isinstance(self.chunk_voxels, bool) or not (isinstance(self.chunk_voxels, int) and self.chunk_voxels >= 1):
             raise KinelabError(f"chunk_voxels must be an integer ≥ 1, got {self.chunk_voxels!r}")
-        if not (isinstance(self.voxel, int | float) and np.isfinite(self.voxel) and self.voxel > 0):
+        if isinstance(self.voxel, bool) or not (isinstance(self.voxel, int | float) and np.isfinite(self.voxel)
+                                                and self.voxel > 0):
             raise KinelabError(f"the voxel side must be a positive length in metres, got {self.voxel!r}")
         check_seed(self.seed)
         check_seed(self.restarts, "restarts")

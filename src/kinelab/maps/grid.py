@@ -24,7 +24,9 @@ def estimated_voxels(robot: Robot, voxel: float) -> int:
     """About how many voxels :func:`voxel_centres` returns (the reach sphere's volume over a voxel's), computed
     without building the grid: the size guards run before anything is allocated."""
     _, radius = reach_bound(robot)
-    return int(4.0 / 3.0 * np.pi * (radius + voxel * np.sqrt(3) / 2) ** 3 / voxel**3) + 1
+    with np.errstate(over="ignore", divide="ignore"):
+        count = 4.0 / 3.0 * np.pi * (np.float64(radius) / voxel + np.sqrt(3) / 2) ** 3
+    return int(min(count, 1e30)) + 1
 
 
 def voxel_centres(robot: Robot, voxel: float) -> np.ndarray:
@@ -34,7 +36,7 @@ def voxel_centres(robot: Robot, voxel: float) -> np.ndarray:
     Raises:
         KinelabError: a voxel side that is not a positive finite number.
     """
-    if not (isinstance(voxel, int | float) and np.isfinite(voxel) and voxel > 0):
+    if isinstance(voxel, bool) or not (isinstance(voxel, int | float) and np.isfinite(voxel) and voxel > 0):
         raise KinelabError(f"the voxel side must be a positive length in metres, got {voxel!r}")
     anchor, radius = reach_bound(robot)
     side = 2 * int(min(np.ceil(radius / voxel), 1e9)) + 1

@@ -471,6 +471,7 @@ def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, fl
         RobotNotFoundError, DescriptionError, URDFError, SRDFError, ChainError, FrameNotFoundError: named.
         JointNotFoundError: a locked joint that does not exist (the valid names listed).
     """
+    _check_load_arguments(name_or_path, tool, locked, base, package_dirs, srdf, group, xacro_args, trust_xacro)
     if str(name_or_path).startswith(descriptions.PREFIX):
         found = descriptions.resolve(str(name_or_path))
         return Robot(build_file(found.path, tool=tool, locked=locked, name=found.name, base=base,
@@ -487,3 +488,28 @@ def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, fl
     if entry is not None and entry.display is not None and robot.n == len(entry.display):
         robot.display_pose = np.array(entry.display)
     return robot
+
+
+def _check_load_arguments(source: Any, tool: Any, locked: Any, base: Any, package_dirs: Any, srdf: Any,
+                          group: Any, xacro_args: Any, trust_xacro: Any) -> None:
+    """Refuse an argument of the wrong type, naming it and what it takes (before any file is read)."""
+    def refuse(name: str, value: Any, valid: str) -> None:
+        raise OptionError(name, value, valid)
+
+    if isinstance(source, bool) or not isinstance(source, str | Path):
+        refuse("name_or_path", source, "a registered name, a file path or 'rd:NAME'")
+    for name, value in (("tool", tool), ("base", base), ("group", group)):
+        if value is not None and not isinstance(value, str):
+            refuse(name, value, "a frame (or group) name, or None")
+    if srdf is not None and (isinstance(srdf, bool) or not isinstance(srdf, str | Path)):
+        refuse("srdf", srdf, "a path to an SRDF file, or None")
+    if package_dirs is not None and (isinstance(package_dirs, str | bytes) or not isinstance(package_dirs, list | tuple)
+                                     or not all(isinstance(d, str | Path) for d in package_dirs)):
+        refuse("package_dirs", package_dirs, "a list of folder paths, or None")
+    if locked is not None and (not isinstance(locked, dict) or not all(isinstance(k, str) for k in locked)):
+        refuse("locked", locked, "a dict joint name → value [rad or m], or None")
+    if xacro_args is not None and (not isinstance(xacro_args, dict) or not all(isinstance(k, str) for k in xacro_args)):
+        refuse("xacro_args", xacro_args, "a dict argument name → value, or None")
+    if not isinstance(trust_xacro, bool):
+        refuse("trust_xacro", trust_xacro, "True or False")
+
