@@ -83,6 +83,8 @@ NUMBERS = ["nan", "inf", "-inf", "1e308", "1e-320", "0", "-1", "1e6", "abc", "",
 def _mutate(root: ET.Element, rng: random.Random) -> str:
     """One random change of a URDF tree; returns what was done."""
     elements = [e for e in root.iter() if e is not root]
+    if not elements:  # everything was deleted already
+        return "none"
     target = rng.choice(elements)
     kind = rng.choice(["attribute", "attribute", "attribute", "delete", "duplicate", "relink", "swap_limits"])
     if kind == "attribute" and target.attrib:
@@ -268,8 +270,8 @@ def _check_successes(robot, out, target, kwargs) -> None:
         ok = np.atleast_1d(res.reached if hasattr(res, "reached") else res.success)
         for qb, good in zip(q, ok, strict=True):
             if good and kwargs.get("task", "pose") == "pose":
-                dp, dr = robot.tool_error(qb, target)
-                assert dp <= kwargs.get("tol_pos", 1e-6) and dr <= kwargs.get("tol_rot", 1e-6)
+                dp, dr = robot.tool_error(qb, target)  # log3 rounds at ~1e-16: a tolerance below that is met exactly
+                assert dp <= max(kwargs.get("tol_pos", 1e-6), 1e-15) and dr <= max(kwargs.get("tol_rot", 1e-6), 1e-15)
                 assert robot.within_limits(qb)
 
 
