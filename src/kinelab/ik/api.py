@@ -11,6 +11,7 @@ it to the driver (:mod:`kinelab.ik.driver`), the batch (:mod:`kinelab.ik.batch`)
 
 from __future__ import annotations
 
+import time
 from collections.abc import Sequence
 from dataclasses import replace
 from typing import Any
@@ -97,10 +98,14 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
         return solve_one(robot, target, q0, req)
     if q0 is not None:
         raise OptionError("q0", "given", "None with prefer= (the branch search draws its own starts)")
+    t0 = time.perf_counter()
     found = find_all(robot, target, req, q_ref=prefer)
     if found:
         return replace(found[0], diagnostics=replace(found[0].diagnostics, branches=len(found)))
-    return solve_one(robot, target, None, req)
+    # no branch met the tolerances: the best single answer, in what is left of the same budget
+    left = None if req.time_budget is None else max(req.time_budget - (time.perf_counter() - t0), 1e-4)
+    return solve_one(robot, target, None, replace(req, time_budget=left, max_restarts=0 if left == 1e-4 else
+                                                  req.max_restarts))
 
 
 def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frdm", q0: Any = None,

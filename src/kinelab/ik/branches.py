@@ -25,6 +25,7 @@ from kinelab.robot import Robot
 SAME = 1e-3  # [rad or m] two answers closer than this, joint by joint, are one solution (answers met to 1e-6 m
 # near a singular point differ by up to ~2e-4 rad; distinct branches by far more)
 ROUND = 64  # starts per round (one batch call)
+ROUND_SECONDS = 1e-3  # [s] a round's fixed cost (arrays, threads, the verdict of ROUND rows)
 
 
 def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None,
@@ -56,7 +57,9 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None,
     found: list[tuple[np.ndarray, float, float, int]] = []
     t0 = time.perf_counter()
     rounds = 0
-    while (left := budget - (time.perf_counter() - t0)) > 0 and (max_solutions is None or len(found) < max_solutions):
+    # a round costs about ROUND_SECONDS of set-up and verdict whatever its budget: none starts in less
+    while (left := budget - (time.perf_counter() - t0)) > ROUND_SECONDS and \
+            (max_solutions is None or len(found) < max_solutions):
         # each round gets what is left of the budget: the batch stops its rows there
         rnd = replace(req, seed=seed + rounds * ROUND, max_restarts=0, time_budget=left)
         batch = run_batch(robot, [target] * ROUND, None, rnd)
