@@ -354,7 +354,7 @@ def test_mixed_order_restarts_turn_the_sweep_direction(robots):
         last = {}
         for name in ("mixed", "base2tip", "tip2base"):
             q, best, stats = q0.copy(), q0.copy(), np.zeros(kernel.STATS_SIZE)
-            problem = kernel.Problem(vm.lower, vm.upper, np.ones(vm.n, dtype=np.bool_), target.translation,
+            problem = kernel.Objective(vm.lower, vm.upper, np.ones(vm.n, dtype=np.bool_), target.translation,
                                      target.rotation, 3.0 / vm.length**2, np.ones(3), 1e-6, 1e-6, True, True,
                                      np.zeros(vm.n), 0.0, -1)
             settings = kernel.Settings(1.0, 1e-10, 10, 0.1, 5, 0)  # no polish: both attempts run
@@ -378,7 +378,7 @@ def test_the_answer_does_not_depend_on_where_the_clock_chunks_end(chunk):
     settings = kernel.Settings(1.0, 1e-10, 10, 0.1, 5, 10)
     for _ in range(5):
         target, q0 = robot.fk(robot.random_q(rng)), robot.random_q(rng)
-        problem = kernel.Problem(vm.lower, vm.upper, np.ones(vm.n, dtype=np.bool_), target.translation,
+        problem = kernel.Objective(vm.lower, vm.upper, np.ones(vm.n, dtype=np.bool_), target.translation,
                                  target.rotation, 3.0 / vm.length**2, np.ones(3), 1e-9, 1e-9, True, True,
                                  np.zeros(vm.n), 0.0, -1)
         results = []

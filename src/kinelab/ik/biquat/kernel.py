@@ -21,7 +21,7 @@ T_ATTEMPTS, T_STEPS, T_MODEL_TIME, T_OUTSIDE, T_SINGULAR, T_CUT, T_ATTEMPT_STEPS
 STATS_SIZE = 8
 
 
-class Problem(NamedTuple):
+class Control(NamedTuple):
     """The target and the preset's settings."""
 
     pstar: np.ndarray  # (3,) target point [m], base frame
@@ -33,6 +33,9 @@ class Problem(NamedTuple):
     eps_rot: float  # stop when |m⃗| < eps_rot (half the rotation tolerance)
     eps_dual: float  # and |m0⃗| < eps_dual (half the position tolerance) [m]
     damping: float  # λ of the damped pseudo-inverse (0: exact solve when n = 6)
+
+
+Problem = Control  # its name before 0.2: numba caches written by 0.1 refer to it and must still load
 
 
 @njit(cache=True)

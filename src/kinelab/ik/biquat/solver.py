@@ -142,7 +142,7 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: 
     damping = opts.damping_for(robot.n)
     cm = chain_model(robot)
     max_steps = 30 if opts.max_time is None else max(1, int(np.ceil(float(opts.max_time) * k)))
-    prob = kernel.Problem(np.array(oMtarget.translation), np.ascontiguousarray(oMtarget.rotation), float(k), 1.0 / k,
+    prob = kernel.Control(np.array(oMtarget.translation), np.ascontiguousarray(oMtarget.rotation), float(k), 1.0 / k,
                           0.5, int(max_steps), 0.5 * float(tol_rot), 0.5 * float(tol_pos), float(damping))
     rng_state = restarts.seed_state(seed)
     q = restarts.first_start(q0, cm.kind, cm.lower, cm.upper, rng_state)

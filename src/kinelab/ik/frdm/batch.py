@@ -27,7 +27,7 @@ from kinelab.ik.frdm.kernel import (
     T_STALLS,
     T_SWEEPS,
     Memory,
-    Problem,
+    Objective,
 )
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.multistart import clock_chunk
@@ -168,7 +168,7 @@ def solve_rows(Q, draw_start, ch, lower, upper, free, pstars, Rstars, w_p, w_ax,
         q = Q[b].copy()
         if draw_start:
             random_configuration(q, ch.kind, lower, upper, rng_states[b])
-        pb = Problem(lower, upper, free, pstars[b], Rstars[b], w_p, w_ax, tol_pos, tol_rot, check_pos, check_rot,
+        pb = Objective(lower, upper, free, pstars[b], Rstars[b], w_p, w_ax, tol_pos, tol_rot, check_pos, check_rot,
                      rest, 0.0, rot_axis)
         best_q = q.copy()
         row_stats = np.zeros(STATS_SIZE)

@@ -7,7 +7,7 @@ point, R = tool rotation (columns u_x, u_y, u_z), starred = target. Objective
 
     E = w_p ‖p − p*‖² + Σ_j w_j ‖u_j − u*_j‖².
 
-Inputs travel as typed tuples: :class:`~kinelab.ik.chain.Chain` (the robot), :class:`Problem` (the
+Inputs travel as typed tuples: :class:`~kinelab.ik.chain.Chain` (the robot), :class:`Objective` (the
 target, weights, tolerances and windows of one solve), :class:`Settings` (the sweep and monitor
 settings) and :class:`Memory` (work arrays the caller keeps between calls). State and statistics are
 float arrays whose slots have names (``S_*``, ``T_*``).
@@ -47,7 +47,7 @@ T_ATTEMPTS, T_SWEEPS, T_STALLS, T_ACCEPTED, T_BEST_E, T_CUT, T_POLISHED = range(
 STATS_SIZE = 7
 
 
-class Problem(NamedTuple):
+class Objective(NamedTuple):
     """One solve: target, weights, tolerances, and the joint windows the bypasses may tighten."""
 
     lower: np.ndarray  # (n,) [rad or m]; −inf where unbounded
@@ -64,6 +64,9 @@ class Problem(NamedTuple):
     q_rest: np.ndarray  # (n,) rest configuration [rad or m] the rest term pulls towards
     w_rest: float  # weight of the rest term (0: none, the paper's objective)
     rot_axis: int  # rotation check: −1 the whole rotation; 0, 1, 2 only that tool axis (roll free)
+
+
+Problem = Objective  # its name before 0.2: numba caches written by 0.1 refer to it and must still load
 
 
 class Settings(NamedTuple):
@@ -479,7 +482,7 @@ def _count_sweep(state, trace, E):
 
 
 @njit(cache=True)
-def run(q: np.ndarray, ch: Chain, pb: Problem, st: Settings, order: int, max_sweeps: int,
+def run(q: np.ndarray, ch: Chain, pb: Objective, st: Settings, order: int, max_sweeps: int,
         mem: Memory) -> tuple[int, int]:
     """Sweep until converged, stalled or ``max_sweeps`` sweeps; q is updated in place. Returns (code,
     sweeps in this call); the state slots S_* carry the rest.
@@ -487,7 +490,7 @@ def run(q: np.ndarray, ch: Chain, pb: Problem, st: Settings, order: int, max_swe
     Args:
         q (np.ndarray): start, one number per joint [rad or m]; holds the result on return.
         ch (Chain): the chain.
-        pb (Problem): the target, weights, tolerances and windows.
+        pb (Objective): the target, weights, tolerances and windows.
         st (Settings): sweep and monitor settings.
         order (int): TIP_TO_BASE, BASE_TO_TIP or ALTERNATE.
         max_sweeps (int): sweeps allowed in this call.

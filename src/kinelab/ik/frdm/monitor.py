@@ -73,7 +73,7 @@ class Bypass:
                 raise KinelabError(f"unknown bypass {step!r} in policy; bypasses are: {', '.join(BYPASSES)}")
 
 
-class Problem:
+class Goal:
     """The arrays of one solve handed to the kernel, and the windows and free flags the bypasses change."""
 
     def __init__(self, cm: ChainModel, oMtarget: pin.SE3, options: FRDMOptions, tol_pos: float, tol_rot: float):
@@ -89,9 +89,9 @@ class Problem:
         self.base_lower, self.base_upper = self.lower.copy(), self.upper.copy()
         self.free = np.ones(cm.n, dtype=np.bool_)
 
-    def tuple(self) -> kernel.Problem:
+    def tuple(self) -> kernel.Objective:
         """The kernel's view of the problem (arrays shared, so bypasses show through)."""
-        return kernel.Problem(self.lower, self.upper, self.free, self.pstar, self.Rstar, self.w_p, self.w_ax,
+        return kernel.Objective(self.lower, self.upper, self.free, self.pstar, self.Rstar, self.w_p, self.w_ax,
                               self.tol_pos, self.tol_rot, self.check_pos, self.check_rot, no_rest(len(self.free)), 0.0,
                               self.rot_axis)
 
@@ -105,7 +105,7 @@ def _scaled_sigma_min(robot: Robot, q: np.ndarray, length: float) -> float:
 class Runner:
     """Runs the kernel in chunks, fires the monitor, applies bypasses and logs everything."""
 
-    def __init__(self, robot: Robot, cm: ChainModel, prob: Problem, options: FRDMOptions):
+    def __init__(self, robot: Robot, cm: ChainModel, prob: Goal, options: FRDMOptions):
         self.robot, self.vm, self.prob = robot, cm, prob
         self.order = ORDERS[options.order] if options.order != "mixed" else kernel.BASE_TO_TIP
         self.settings = options.settings()

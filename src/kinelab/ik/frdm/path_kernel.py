@@ -17,7 +17,7 @@ import numpy as np
 from numba import njit
 
 from kinelab.ik.frdm.attempts import lm_polish
-from kinelab.ik.frdm.kernel import CONVERGED, STATE_SIZE, Memory, Problem, run
+from kinelab.ik.frdm.kernel import CONVERGED, STATE_SIZE, Memory, Objective, run
 
 
 @njit(cache=True)
@@ -53,12 +53,12 @@ def follow(Q, q0, ch, lower, upper, free, pstars, Rstars, w_p, w_ax, tol_pos, to
         if w_rest > 0.0:
             for i in range(n):
                 rest[i] = q_prev[i] + _limit_pull(q_prev[i], lower[i], upper[i], pull) * (centre[i] - q_prev[i])
-            pb = Problem(lower, upper, free, pstars[k], Rstars[k], w_p, w_ax, tol_pos, tol_rot, check_pos, check_rot,
+            pb = Objective(lower, upper, free, pstars[k], Rstars[k], w_p, w_ax, tol_pos, tol_rot, check_pos, check_rot,
                          rest, w_rest, -1)
             mem.state[:] = 0.0
             code, spent = run(q, ch, pb, st, order, rest_sweeps, mem)
         if code != CONVERGED:
-            pb = Problem(lower, upper, free, pstars[k], Rstars[k], w_p, w_ax, tol_pos, tol_rot, check_pos, check_rot,
+            pb = Objective(lower, upper, free, pstars[k], Rstars[k], w_p, w_ax, tol_pos, tol_rot, check_pos, check_rot,
                          q_prev, 0.0, -1)
             mem.state[:] = 0.0
             code, more = run(q, ch, pb, st, order, max_sweeps, mem)

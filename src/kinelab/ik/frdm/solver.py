@@ -22,7 +22,7 @@ from kinelab.ik.chain import CONTINUOUS, ChainModel, chain_model
 from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm.attempts import multistart as compiled_multistart
 from kinelab.ik.frdm.kernel import no_rest
-from kinelab.ik.frdm.monitor import Bypass, Problem, Runner
+from kinelab.ik.frdm.monitor import Bypass, Goal, Runner
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.multistart import TypedKernel, clock_chunk
 from kinelab.ik.result import Attempt, Diagnostics, SingularEvent, Status
@@ -74,7 +74,7 @@ def attempt(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol
     if not opts.compiled:
         bypass.validate(robot)
     cm = chain_model(robot)
-    prob = Problem(cm, oMtarget, opts, tol_pos, tol_rot)
+    prob = Goal(cm, oMtarget, opts, tol_pos, tol_rot)
     run = Runner(robot, cm, prob, opts)
     q = np.array(q0, dtype=float)
     for step in bypass.active:
@@ -186,14 +186,14 @@ def _new_dict(_: Robot) -> dict:
 
 
 def _compiled_problem(cm: ChainModel, oMtarget: pin.SE3, opts: FRDMOptions, tol_pos: float,
-                      tol_rot: float) -> kernel.Problem:
+                      tol_rot: float) -> kernel.Objective:
     """The kernel's problem for the multistart: no bypass ever changes its windows, so the chain's own
     limit arrays and one shared all-free mask serve (no copies: the per-call cost is what a loop pays)."""
     if opts.use_limits:
         lower, upper = cm.lower, cm.upper
     else:
         lower, upper = _unbounded(cm.n), _unbounded(cm.n, 1.0)
-    return kernel.Problem(lower, upper, _all_free(cm.n), np.array(oMtarget.translation),
+    return kernel.Objective(lower, upper, _all_free(cm.n), np.array(oMtarget.translation),
                           np.array(oMtarget.rotation, order="C"),
                           opts.position_weight(cm.length), opts.axis_weights(), float(tol_pos), float(tol_rot),
                           opts.mode != "orientation", opts.mode != "position",

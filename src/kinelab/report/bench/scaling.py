@@ -61,7 +61,7 @@ def time_per_sweep(robot: Robot, sweeps: int = 500, repeats: int = 30) -> float:
     is what the code costs; a shared machine only ever adds to it)."""
     cm = chain_model(robot)
     far = pin.SE3(np.eye(3), np.array([100.0, 0.0, 0.0]))  # unreachable: the kernel never stops early
-    problem = kernel.Problem(cm.lower, cm.upper, np.ones(cm.n, dtype=np.bool_), far.translation.copy(),
+    problem = kernel.Objective(cm.lower, cm.upper, np.ones(cm.n, dtype=np.bool_), far.translation.copy(),
                              far.rotation.copy(), 1.0 / cm.length**2, np.ones(3), 1e-300, 1e-300, True, True,
                              np.zeros(cm.n), 0.0, -1)
     settings = kernel.Settings(1.0, -1.0, sweeps + 1, -1.0, 0, 0)
