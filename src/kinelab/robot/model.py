@@ -493,23 +493,28 @@ def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, fl
 def _check_load_arguments(source: Any, tool: Any, locked: Any, base: Any, package_dirs: Any, srdf: Any,
                           group: Any, xacro_args: Any, trust_xacro: Any) -> None:
     """Refuse an argument of the wrong type, naming it and what it takes (before any file is read)."""
-    def refuse(name: str, value: Any, valid: str) -> None:
-        raise OptionError(name, value, valid)
+    checks = (
+        ("name_or_path", source, _is_path(source), "a registered name, a file path or 'rd:NAME'"),
+        ("tool", tool, tool is None or isinstance(tool, str), "a frame name, or None"),
+        ("base", base, base is None or isinstance(base, str), "a frame name, or None"),
+        ("group", group, group is None or isinstance(group, str), "an SRDF group name, or None"),
+        ("srdf", srdf, srdf is None or _is_path(srdf), "a path to an SRDF file, or None"),
+        ("package_dirs", package_dirs, package_dirs is None or (isinstance(package_dirs, list | tuple)
+                                                                and all(map(_is_path, package_dirs))),
+         "a list of folder paths, or None"),
+        ("locked", locked, locked is None or _is_named_table(locked), "a dict joint name → value [rad or m], or None"),
+        ("xacro_args", xacro_args, xacro_args is None or _is_named_table(xacro_args),
+         "a dict argument name → value, or None"),
+        ("trust_xacro", trust_xacro, isinstance(trust_xacro, bool), "True or False"),
+    )
+    for name, value, ok, valid in checks:
+        if not ok:
+            raise OptionError(name, value, valid)
 
-    if isinstance(source, bool) or not isinstance(source, str | Path):
-        refuse("name_or_path", source, "a registered name, a file path or 'rd:NAME'")
-    for name, value in (("tool", tool), ("base", base), ("group", group)):
-        if value is not None and not isinstance(value, str):
-            refuse(name, value, "a frame (or group) name, or None")
-    if srdf is not None and (isinstance(srdf, bool) or not isinstance(srdf, str | Path)):
-        refuse("srdf", srdf, "a path to an SRDF file, or None")
-    if package_dirs is not None and (isinstance(package_dirs, str | bytes) or not isinstance(package_dirs, list | tuple)
-                                     or not all(isinstance(d, str | Path) for d in package_dirs)):
-        refuse("package_dirs", package_dirs, "a list of folder paths, or None")
-    if locked is not None and (not isinstance(locked, dict) or not all(isinstance(k, str) for k in locked)):
-        refuse("locked", locked, "a dict joint name → value [rad or m], or None")
-    if xacro_args is not None and (not isinstance(xacro_args, dict) or not all(isinstance(k, str) for k in xacro_args)):
-        refuse("xacro_args", xacro_args, "a dict argument name → value, or None")
-    if not isinstance(trust_xacro, bool):
-        refuse("trust_xacro", trust_xacro, "True or False")
 
+def _is_path(value: Any) -> bool:
+    return not isinstance(value, bool) and isinstance(value, str | Path)
+
+
+def _is_named_table(value: Any) -> bool:
+    return isinstance(value, dict) and all(isinstance(k, str) for k in value)
