@@ -103,3 +103,33 @@ def test_an_orientation_task_ignores_the_point_it_is_given():
         q = np.atleast_2d(res.q)[0]
         assert bool(np.atleast_1d(res.success)[0])
         assert np.linalg.norm(pin.log3(R.T @ ur5.fk(q).rotation)) <= 1e-6
+
+
+def test_each_round_of_solve_all_and_the_prefer_fallback_get_only_what_is_left(monkeypatch):
+    """kinelab 0.1: solve_all ran every round unbounded (a whole round past the budget) and solve(prefer=) then
+    started a fresh budget for its fallback (12× at 5 ms). Checked on the budgets handed down, not on a clock."""
+    import time
+
+    from kinelab.ik import api, branches
+
+    ur5 = kinelab.load("ur5")
+    target = ur5.fk(ur5.random_q(5))
+    kinelab.solve_all(ur5, target, time_budget=0.01, seed=0)  # compile and import outside the check
+    given: list[tuple[float, float]] = []  # (budget handed to a round, time left when it was handed)
+    t0 = time.perf_counter()
+    real_batch = branches.run_batch
+
+    def spy_batch(robot, targets, q0, req):
+        given.append((req.time_budget, 0.05 - (time.perf_counter() - t0)))
+        return real_batch(robot, targets, q0, req)
+
+    monkeypatch.setattr(branches, "run_batch", spy_batch)
+    kinelab.solve_all(ur5, target, time_budget=0.05, tol_pos=1e-300, tol_rot=1e-300, seed=0)
+    assert given and all(budget is not None and budget <= left + 1e-9 for budget, left in given)
+
+    fallback: list[float | None] = []
+    real_one = api.solve_one
+    monkeypatch.setattr(api, "solve_one", lambda robot, t, q0, req: fallback.append(req.time_budget)
+                        or real_one(robot, t, q0, req))
+    res = kinelab.solve(ur5, target, prefer=np.zeros(6), time_budget=0.05, tol_pos=1e-300, tol_rot=1e-300, seed=0)
+    assert not res.success and len(fallback) == 1 and fallback[0] is not None and fallback[0] < 0.05
