@@ -125,7 +125,8 @@ def test_each_round_of_solve_all_and_the_prefer_fallback_get_only_what_is_left(m
 
     monkeypatch.setattr(branches, "run_batch", spy_batch)
     kinelab.solve_all(ur5, target, time_budget=0.05, tol_pos=1e-300, tol_rot=1e-300, seed=0)
-    assert given and all(budget is not None and budget <= left + 1e-9 for budget, left in given)
+    # (the call's own set-up before its clock starts is allowed: 2 ms; kinelab 0.1 handed every round None)
+    assert given and all(budget is not None and budget <= left + 2e-3 for budget, left in given)
 
     fallback: list[float | None] = []
     real_one = api.solve_one
