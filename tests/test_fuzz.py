@@ -61,14 +61,21 @@ class Tally:
         self.counts["nonsense_accepted"] += bool(nonsense)
         return out
 
-    def close(self) -> None:
-        """Write the counts (when asked) and require no raw exception, hang or accepted nonsense."""
+    def close(self) -> dict[str, int]:
+        """Write the counts (when asked) and return them."""
         report = os.environ.get("KINELAB_FUZZ_REPORT")
         if report:
             with open(report, "a") as f:
                 f.write(json.dumps({"class": self.name, **self.counts}) + "\n")
-        assert self.counts["raw"] == 0, self.raw[:5]
-        assert self.counts["hangs"] == 0 and self.counts["nonsense_accepted"] == 0, self.counts
+        return self.counts
+
+
+def _clean(tally: Tally) -> None:
+    """No raw exception, hang or nonsense accepted, and the cases reached both sides (refused and answered)."""
+    counts = tally.close()
+    assert counts["raw"] == 0, tally.raw[:5]
+    assert counts["hangs"] == 0 and counts["nonsense_accepted"] == 0, counts
+    assert counts["clean"] > 0 and counts["accepted"] > 0, counts
 
 
 class _HangError(Exception):
@@ -247,7 +254,7 @@ def test_every_entry_point_counts_no_raw_error_hang_or_nonsense_accepted(entry):
         target = robot.fk(q)
         out = tally.run(functools.partial(_call_entry, entry, robot, target, q, kwargs), nonsense)
         _check_successes(robot, out, target, kwargs)
-    tally.close()
+    _clean(tally)
 
 
 def _call_entry(entry, robot, target, q, kwargs):
@@ -289,7 +296,7 @@ def test_load_variants_count_no_raw_error_hang_or_nonsense_accepted(tmp_path):
         robot = tally.run(lambda kw=kwargs: kinelab.load("ur5", **kw), nonsense)
         if robot is not None:
             _check_robot(robot)
-    tally.close()
+    _clean(tally)
 
 
 def test_map_functions_count_no_raw_error_hang_or_nonsense_accepted():
@@ -317,7 +324,7 @@ def test_map_functions_count_no_raw_error_hang_or_nonsense_accepted():
                                                                    if _count(kw["samples"]) else kw),
                  "base_map": lambda kw=kwargs: maps.base_map(youbot, grasp, **kw)}
         tally.run(calls[kind], nonsense=not valid)
-    tally.close()
+    _clean(tally)
 
 
 MJCF = """<mujoco model="m"><compiler angle="radian"/><worldbody>
@@ -352,4 +359,4 @@ def test_mutated_mjcf_and_srdf_files_count_no_raw_error_or_hang(tmp_path, kind):
             if robot is not None:
                 with contextlib.suppress(kinelab.KinelabError):
                     assert np.all(np.isfinite(robot.named_q("home")))
-    tally.close()
+    _clean(tally)

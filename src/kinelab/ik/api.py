@@ -19,6 +19,7 @@ from typing import Any
 import pinocchio as pin
 
 from kinelab.errors import OptionError
+from kinelab.geometry import stack_homogeneous
 from kinelab.ik.batch import BatchIKResult, run_batch
 from kinelab.ik.branches import find_all
 from kinelab.ik.driver import solve_one
@@ -102,10 +103,10 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
     found = find_all(robot, target, req, q_ref=prefer)
     if found:
         return replace(found[0], diagnostics=replace(found[0].diagnostics, branches=len(found)))
-    # no branch met the tolerances: the best single answer, in what is left of the same budget
+    # no branch met the tolerances: the best single answer, in what is left of the same budget (at least one
+    # attempt's worth, so that there is an answer to return)
     left = None if req.time_budget is None else max(req.time_budget - (time.perf_counter() - t0), 1e-4)
-    return solve_one(robot, target, None, replace(req, time_budget=left, max_restarts=0 if left == 1e-4 else
-                                                  req.max_restarts))
+    return solve_one(robot, target, None, replace(req, time_budget=left))
 
 
 def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frdm", q0: Any = None,
@@ -248,5 +249,6 @@ def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
             raise OptionError("q0", None, "a start configuration: the path's first target could not be solved "
                               f"({first.status.value}: {first.message})")
         q0 = first.q
-    return run_track(robot, targets, robot.check_q(q0, limits=True, what="q0"), req, settings)
+    return run_track(robot, stack_homogeneous(points, rotations), robot.check_q(q0, limits=True, what="q0"), req,
+                     settings)
 

@@ -58,14 +58,12 @@ class IK:
         if prepare is not None:
             prepare(robot)  # compile (or load) the kernels now, not in the first call
         prepare_checks(robot)
-        self._by_seed: dict[int | None, Request] = {None: self.request}
 
     def _request(self, seed: int | None) -> Request:
-        found = self._by_seed.get(seed)
-        if found is None:
-            check_seed(seed)
-            found = self._by_seed[seed] = replace(self.request, seed=seed)
-        return found
+        if seed is None:
+            return self.request
+        check_seed(seed)
+        return replace(self.request, seed=seed)
 
     def solve(self, target: Any, *, q0: Any = None, seed: int | None = None) -> IKResult:
         """IK for one target (oMtarget in the base frame), as :func:`kinelab.solve` with these settings.

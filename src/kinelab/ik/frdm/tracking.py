@@ -123,6 +123,7 @@ class _Path:
                  restrictions: list[str]):
         self.robot, self.req, self.opts, self.settings = robot, req, opts, settings
         self.restrictions = restrictions
+        self._by_active: dict[tuple[str, ...], FRDMOptions] = {}
         self.held: dict[str, int] = {}
         self.rows: list[np.ndarray] = []
         self.figures: list[tuple[float, float, str, int, float]] = []
@@ -132,8 +133,10 @@ class _Path:
         self.deadline = np.inf if budget is None else time.perf_counter() + budget
 
     def _solve(self, target: pin.SE3, q_start: np.ndarray, active: tuple[str, ...]) -> Attempt:
-        return solver.attempt(self.robot, target, q_start, self.req.tol_pos, self.req.tol_rot, self.deadline,
-                              replace(self.opts, active=active))
+        opts = self._by_active.get(active)
+        if opts is None:  # built (and checked) once per set of active restrictions, not once per sample
+            opts = self._by_active[active] = replace(self.opts, active=active)
+        return solver.attempt(self.robot, target, q_start, self.req.tol_pos, self.req.tol_rot, self.deadline, opts)
 
     def sample(self, k: int, target: pin.SE3, q_prev: np.ndarray) -> np.ndarray:
         """Solve sample k warm-started from q_prev, switching a restriction on if a monitor fires."""
