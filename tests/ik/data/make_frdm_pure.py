@@ -1,6 +1,7 @@
 """Record the answers of the paper's FRDM (kinelab 0.2, before the Newton finish) that the pure-FRDM option
-must keep bit for bit: ``python tests/ik/data/make_frdm_pure.py`` wrote frdm_pure.npz at commit 9a0c1f4+1
-(the commit before the Newton finish). Not to be rerun after it: the file pins what that code computed.
+must keep bit for bit: ``python tests/ik/data/make_frdm_pure.py`` wrote frdm_pure.npz with the code of the commit
+that added both files, before the Newton finish existed. Not to be rerun since: the file pins what that code
+computed (the test calls :func:`answers` with ``finish="none"``).
 """
 
 from __future__ import annotations
