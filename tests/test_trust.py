@@ -108,7 +108,6 @@ def test_an_orientation_task_ignores_the_point_it_is_given():
 def test_each_round_of_solve_all_and_the_prefer_fallback_get_only_what_is_left(monkeypatch):
     """kinelab 0.1: solve_all ran every round unbounded (a whole round past the budget) and solve(prefer=) then
     started a fresh budget for its fallback (12× at 5 ms). Checked on the budgets handed down, not on a clock."""
-    import time
 
     from kinelab.ik import api, branches
 

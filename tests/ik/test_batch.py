@@ -20,7 +20,7 @@ def test_every_row_is_the_single_solve_with_seed_plus_row(name, sigma):
     robot = load(name)
     _, targets, starts = problems(robot, 40, 1, sigma)
     batch = kinelab.solve_batch(robot, targets, q0=starts, seed=11)
-    assert batch.mode.startswith("frdm (compiled batch")
+    assert batch.mode.startswith("frdm+newton (compiled batch")
     for b in range(40):
         one = kinelab.solve(robot, targets[b], q0=None if starts is None else starts[b], seed=11 + b,
                             time_budget=60.0)

@@ -357,7 +357,7 @@ def test_mixed_order_restarts_turn_the_sweep_direction(robots):
             problem = kernel.Objective(vm.lower, vm.upper, np.ones(vm.n, dtype=np.bool_), target.translation,
                                      target.rotation, 3.0 / vm.length**2, np.ones(3), 1e-6, 1e-6, True, True,
                                      np.zeros(vm.n), 0.0, -1)
-            settings = kernel.Settings(1.0, 1e-10, 10, 0.1, 5, 0)  # no polish: both attempts run
+            settings = kernel.Settings(1.0, 1e-10, 10, 0.1, 5, 0, 0.0, 8)  # no polish: both attempts run
             code = attempts.multistart(q, vm.chain, problem, settings, ORDERS[name], 100, seed_state(7), 2, 1e9, best,
                                      stats, kernel.new_memory(vm.n, 5))
             last[name] = (q, stats[0], code)
@@ -375,7 +375,7 @@ def test_the_answer_does_not_depend_on_where_the_clock_chunks_end(chunk):
     robot = kinelab.load("panda")
     vm = vector_model(robot)
     rng = np.random.default_rng(11)
-    settings = kernel.Settings(1.0, 1e-10, 10, 0.1, 5, 10)
+    settings = kernel.Settings(1.0, 1e-10, 10, 0.1, 5, 10, 0.0, 8)
     for _ in range(5):
         target, q0 = robot.fk(robot.random_q(rng)), robot.random_q(rng)
         problem = kernel.Objective(vm.lower, vm.upper, np.ones(vm.n, dtype=np.bool_), target.translation,

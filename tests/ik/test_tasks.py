@@ -109,12 +109,13 @@ def test_a_stalled_attempt_is_finished_by_gauss_newton_steps_on_the_task_compone
         if q[2] > 0.02:  # targets with the boom nearly retracted
             continue
         target = pin.SE3(robot.fk(q).rotation @ pin.exp3(np.array([0.0, 0.0, 1.0])), robot.fk(q).translation)
-        pure = kinelab.solve(robot, target, task="axis", seed=0, max_restarts=0, stall_polish=0)
+        # the paper's FRDM, whose stalls the polish is for (the Newton finish would mostly pre-empt them)
+        pure = kinelab.solve(robot, target, task="axis", seed=0, max_restarts=0, stall_polish=0, finish="none")
         if pure.success:
             continue
         stalled += 1
         assert pure.diagnostics.polished == 0
-        res = kinelab.solve(robot, target, task="axis", seed=0, max_restarts=0)
+        res = kinelab.solve(robot, target, task="axis", seed=0, max_restarts=0, finish="none")
         if res.success:
             finished += 1
             assert res.diagnostics.polished == 1 and judged_here(robot, res.q, target, "axis")

@@ -33,7 +33,7 @@ def test_the_follower_reaches_every_sample_of_a_smooth_path(name, seed, options,
         assert dp <= 1e-6 and dr <= 1e-6 and robot.within_limits(res.q[k])
     path_step = np.abs(np.diff(Q, axis=0)).max()
     assert res.max_joint_step <= step_factor * path_step  # no branch jump
-    assert res.mode == ("frdm+lm (compiled follower)" if options else "frdm (compiled follower)")
+    assert res.mode == ("frdm+newton+lm (compiled follower)" if options else "frdm+newton (compiled follower)")
 
 
 def test_the_follower_reports_an_unreachable_sample_and_carries_on():

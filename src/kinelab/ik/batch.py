@@ -105,7 +105,7 @@ def run_batch(robot: Robot, targets: Any, q0: Any, req: Request) -> BatchIKResul
         attempts = np.where(_beyond(robot, points, req) > 0, 1, req.max_restarts + 1)
         rows = frdm_batch.run(robot, points, rotations, starts, seed_states(seed, points.shape[0]), attempts,
                               req.tol_pos, req.tol_rot, deadline, req.options)
-        mode = f"frdm (compiled batch, {numba.get_num_threads()} threads)"
+        mode = f"{req.options.label} (compiled batch, {numba.get_num_threads()} threads)"
     else:
         rows = _per_target(robot, points, rotations, starts, replace(req, seed=seed), deadline)
         mode = f"{req.solver} (per target)"

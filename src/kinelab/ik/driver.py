@@ -77,7 +77,7 @@ def solve_one(robot: Robot, target: Any, q0: Any, req: Request) -> IKResult:
     target = as_target(target, req.task.name)
     rng = _LazyRng(req.seed)
     budget = 1e9 if req.time_budget is None else req.time_budget
-    problem = _Call(robot, target, req.solver, req.tol_pos, req.tol_rot, t_start, t_start + budget, req.seed,
+    problem = Call(robot, target, req.solver, req.tol_pos, req.tol_rot, t_start, t_start + budget, req.seed,
                        req.task, req.task_label)
     max_restarts = req.max_restarts
     # only a task that constrains the point can be out of reach (an orientation target's point is ignored)
@@ -110,13 +110,13 @@ def prepare_checks(robot: Robot) -> None:
 def _compile_checks(robot: Robot) -> None:
     """Compile (or load) the target check and the verdict once per process, outside any solve's clock."""
     target = as_target(pin.SE3.Identity())
-    _Call(robot, target, "", 1.0, 1.0, 0.0, 0.0, None).judge(robot.neutral())
+    Call(robot, target, "", 1.0, 1.0, 0.0, 0.0, None).judge(robot.neutral())
     _CHECKS_COMPILED.append(True)
 
 
 @dataclass(slots=True)
-class _Call:
-    """What one solve is asked, handed between solve's helpers."""
+class Call:
+    """What one solve is asked, handed between the driver's helpers (and the prepared solver's lean path)."""
 
     robot: Robot
     target: pin.SE3
@@ -143,7 +143,7 @@ class _Call:
         return ok, dp, dr
 
 
-def _loop(module: Any, pb: _Call, start: np.ndarray, max_restarts: int, opts: Any, rng: _LazyRng,
+def _loop(module: Any, pb: Call, start: np.ndarray, max_restarts: int, opts: Any, rng: _LazyRng,
           beyond: float) -> IKResult:
     """Attempts from the start, then from seeded random starts, each judged by Pinocchio."""
     robot = pb.robot
@@ -182,11 +182,15 @@ def _loop(module: Any, pb: _Call, start: np.ndarray, max_restarts: int, opts: An
     )
 
 
-def _fast(module: Any, pb: _Call, start: np.ndarray | None, max_restarts: int, opts: Any) -> IKResult:
+def _fast(module: Any, pb: Call, start: np.ndarray | None, max_restarts: int, opts: Any) -> IKResult:
     """Restarts inside the solver's compiled kernel; the answer is then checked by Pinocchio."""
     att, restarts = module.multistart(pb.robot, pb.target, start, pb.tol_pos, pb.tol_rot, pb.deadline, pb.seed,
                                       max_restarts, opts)
-    success, dp, dr = pb.judge(att.q)
+    return compiled_result(pb, att, restarts, *pb.judge(att.q))
+
+
+def compiled_result(pb: Call, att: Attempt, restarts: int, success: bool, dp: float, dr: float) -> IKResult:
+    """The result of a compiled multistart's attempt, given Pinocchio's verdict on it (success, errors)."""
     status, message = att.status, ""
     if success:
         status = Status.CONVERGED
@@ -206,7 +210,7 @@ def _fast(module: Any, pb: _Call, start: np.ndarray | None, max_restarts: int, o
     )
 
 
-def _outside_limits(pb: _Call, q: np.ndarray, dp: float, dr: float, status: Status,
+def _outside_limits(pb: Call, q: np.ndarray, dp: float, dr: float, status: Status,
                     message: str) -> tuple[Status, str]:
     """A failed answer with a joint outside its limits: status OUTSIDE_LIMITS when the task's components are
     met (only the limits fail), the joint named either way."""
@@ -226,7 +230,7 @@ def _outside_limits(pb: _Call, q: np.ndarray, dp: float, dr: float, status: Stat
     return status, f"{message}; the best answer has {where}" if message else f"the best answer has {where}"
 
 
-def _explained(pb: _Call, status: Status, message: str) -> str:
+def _explained(pb: Call, status: Status, message: str) -> str:
     """The message, with the reason a short arm misses a whole pose and the tasks that fit it."""
     n = pb.robot.n
     if status in (Status.CONVERGED, Status.OUTSIDE_LIMITS) or n >= COMPONENTS[pb.task.name]:

@@ -3,7 +3,8 @@
 
 ``IK(robot, solver=..., task=..., tol_pos=..., ...)`` checks every setting once and compiles the solver's
 kernels before it returns; ``ik.solve(target, q0=...)`` then checks only what changes per call (the target and
-the start) and goes straight to the driver, so a call pays no argument validation or option building. Its
+the start): for compiled FRDM in one compiled check before the kernel (:mod:`kinelab.ik.lean`), otherwise
+straight to the driver, so a call pays no argument validation or option building. Its
 answers are those of :func:`kinelab.solve` with the same settings and seed (tested), and every one is judged
 by Pinocchio.
 """
@@ -16,6 +17,7 @@ from typing import Any
 from kinelab.ik.batch import BatchIKResult, run_batch
 from kinelab.ik.branches import find_all
 from kinelab.ik.driver import prepare_checks, solve_one
+from kinelab.ik.lean import LeanFRDM
 from kinelab.ik.request import Request, check_seed, make_request
 from kinelab.ik.result import IKResult
 from kinelab.robot import Robot
@@ -58,6 +60,8 @@ class IK:
         if prepare is not None:
             prepare(robot)  # compile (or load) the kernels now, not in the first call
         prepare_checks(robot)
+        req = self.request
+        self._lean = LeanFRDM(robot, req) if req.solver == "frdm" and req.options.compiled else None
 
     def _request(self, seed: int | None) -> Request:
         if seed is None:
@@ -79,6 +83,10 @@ class IK:
         Raises:
             TargetError, ConfigurationError, JointLimitError, OptionError: a bad target, start or seed.
         """
+        if self._lean is not None:
+            res = self._lean.solve(target, q0, seed)
+            if res is not None:
+                return res
         return solve_one(self.robot, target, q0, self._request(seed))
 
     def solve_batch(self, targets: Any, *, q0: Any = None, seed: int | None = None) -> BatchIKResult:

@@ -104,7 +104,8 @@ class Diagnostics:
         message: a solver's own note (a biquaternion run stopped by a singular matrix, say).
         sweeps, accelerated_sweeps: FRDM sweeps of the answer's run, and those Anderson's extrapolation kept.
         order, relax, w_p: FRDM's sweep order, relaxation and position weight [1/m²].
-        objective: FRDM's objective at the answer; polished: stalled attempts finished by Gauss–Newton steps;
+        objective: FRDM's objective at the answer; newton_steps: Gauss–Newton steps of FRDM's Newton finish
+            (every attempt); polished: stalled attempts finished by Gauss–Newton steps;
             polish_iterations: DLS steps after FRDM (``polish=True``); trace: the objective after every sweep.
         model_time: the biquaternion run's model time [s]; steps: its integration steps; M0: the scalar of
             N̄∘Λ at the end (±1 at the target); damping, law, integrator: how it ran; outside_limits: compiled
@@ -125,6 +126,7 @@ class Diagnostics:
     relax: float | None = None
     w_p: float | None = None
     objective: float | None = None
+    newton_steps: int | None = None
     polished: int | None = None
     polish_iterations: int | None = None
     trace: tuple[float, ...] | None = None
@@ -141,6 +143,14 @@ class Diagnostics:
     branches: int | None = None
     found: int | None = None
     starts: int | None = None
+
+    @classmethod
+    def quick(cls, **values: Any) -> Diagnostics:
+        """Diagnostics with these fields set (names and types the caller's own, unchecked): what a compiled
+        solve builds on every call, without the frozen dataclass's per-field setattr (≈ 1 µs, not ≈ 9)."""
+        made = object.__new__(cls)
+        made.__dict__.update(values)  # the other fields read their defaults from the class
+        return made
 
     def __repr__(self) -> str:
         return "Diagnostics(" + ", ".join(f"{k}={v!r}" for k, v in self.to_dict().items()) + ")"

@@ -32,10 +32,10 @@ def answers(finish: dict) -> dict[str, np.ndarray]:
         targets, starts = cases(robot)
         opts = dict(time_budget=None, **finish)
         out[f"{name}/warm"] = np.array([kinelab.solve(robot, t, q0=q, seed=3, **opts).q
-                                        for t, q in zip(targets, starts)])
+                                        for t, q in zip(targets, starts, strict=True)])
         out[f"{name}/random"] = np.array([kinelab.solve(robot, t, seed=k, **opts).q for k, t in enumerate(targets)])
         out[f"{name}/monitored"] = np.array([kinelab.solve(robot, t, q0=q, seed=3, policy=("auto_kick",), **opts).q
-                                             for t, q in zip(targets, starts)])
+                                             for t, q in zip(targets, starts, strict=True)])
         out[f"{name}/batch"] = kinelab.solve_batch(robot, targets, q0=starts, seed=5, **opts).q
         path = [robot.fk(starts[0] + s * (starts[1] - starts[0])) for s in np.linspace(0, 1, 40)]
         out[f"{name}/track"] = kinelab.track(robot, path, q0=starts[0], **finish).q

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from kinelab.ik.chain import PRISMATIC, chain_fk, random_configuration
+from kinelab.ik.chain import chain_fk, random_configuration
 from kinelab.ik.frdm.kernel import (
     BASE_TO_TIP,
     BUDGET,
@@ -21,6 +21,7 @@ from kinelab.ik.frdm.kernel import (
     MIXED,
     S_ACCEPTED,
     S_E,
+    S_NEWTON,
     S_SWEEPS,
     STALL_STEP,
     STALL_WINDOW,
@@ -28,14 +29,15 @@ from kinelab.ik.frdm.kernel import (
     T_ATTEMPTS,
     T_BEST_E,
     T_CUT,
+    T_NEWTON,
     T_POLISHED,
     T_STALLS,
     T_SWEEPS,
     TIP_TO_BASE,
-    _within,
     run,
     total_objective,
 )
+from kinelab.ik.frdm.newton import lm_polish
 
 
 @njit(cache=True)
@@ -69,6 +71,7 @@ def multistart(q, ch, pb, st, order, max_sweeps, rng_state, max_attempts, sweep_
             stats[T_BEST_E] = best
             return BUDGET
         stats[T_ATTEMPTS] += 1.0
+        stats[T_NEWTON] += mem.state[S_NEWTON]
         done += 1
         stats[T_ACCEPTED] += mem.state[S_ACCEPTED]
         if mem.state[S_E] < best:
@@ -106,68 +109,3 @@ def _polished(q, ch, pb, iterations, stats, mem):
         return True
     q[:] = q_stalled
     return False
-
-
-@njit(cache=True)
-def lm_polish(q, ch, pb, iterations):
-    """Levenberg–Marquardt on the world-frame error of the constrained components, steps kept in the windows:
-    [p* − p; log(R* Rᵀ)], or for task "axis" [p* − p; a* − a] with a the tool axis (da/dq_i = e_i × a).
-
-    Returns (CONVERGED or −1, iterations spent); q is updated in place.
-    """
-    n = q.shape[0]
-    e, o, p, R = np.empty((n, 3)), np.empty((n, 3)), np.empty(3), np.empty((3, 3))
-    J = np.empty((6, n))
-    err = np.empty(6)
-    for it in range(iterations):
-        chain_fk(ch, q, e, o, p, R)
-        if _within(p, R, pb.pstar, pb.Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot, pb.rot_axis):
-            return CONVERGED, it
-        _world_error(p, R, pb, err)
-        _world_jacobian(e, o, p, R, ch.kind, pb, J)
-        A = J.T @ J
-        damping = 1e-9 + 1e-3 * (err @ err)
-        for i in range(n):
-            A[i, i] += damping
-        dq = np.linalg.solve(A, J.T @ err)
-        for i in range(n):
-            q[i] = min(max(q[i] + dq[i], pb.lower[i]), pb.upper[i])
-    chain_fk(ch, q, e, o, p, R)
-    if _within(p, R, pb.pstar, pb.Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot, pb.rot_axis):
-        return CONVERGED, iterations
-    return -1, iterations
-
-
-@njit(cache=True)
-def _world_jacobian(e, o, p, R, kind, pb, J):
-    """J ← the error's Jacobian rows (position; rotation, or the tool axis of task "axis"); unchecked rows 0."""
-    for i in range(e.shape[0]):
-        if kind[i] == PRISMATIC:
-            J[0:3, i] = e[i]
-            J[3:6, i] = 0.0
-        else:
-            J[0:3, i] = np.cross(e[i], p - o[i])
-            J[3:6, i] = e[i] if pb.rot_axis < 0 else np.cross(e[i], R[:, pb.rot_axis])
-        if not pb.check_pos:
-            J[0:3, i] = 0.0
-        if not pb.check_rot:
-            J[3:6, i] = 0.0
-
-
-@njit(cache=True)
-def _world_error(p, R, pb, err):
-    """err = [p* − p; log(R* Rᵀ) or a* − a] with the constrained components only (an unchecked component
-    must not pull)."""
-    for k in range(3):
-        err[k] = pb.pstar[k] - p[k] if pb.check_pos else 0.0
-    if pb.rot_axis >= 0:
-        for k in range(3):
-            err[3 + k] = pb.Rstar[k, pb.rot_axis] - R[k, pb.rot_axis] if pb.check_rot else 0.0
-        return
-    M = pb.Rstar @ R.T
-    cos_a = min(1.0, max(-1.0, (M[0, 0] + M[1, 1] + M[2, 2] - 1.0) / 2.0))
-    angle = np.arccos(cos_a)
-    scale = 0.5 if angle < 1e-8 else angle / (2.0 * np.sin(angle))
-    w = (M[2, 1] - M[1, 2], M[0, 2] - M[2, 0], M[1, 0] - M[0, 1])
-    for k in range(3):
-        err[3 + k] = scale * w[k] if pb.check_rot else 0.0

@@ -67,6 +67,6 @@ def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: 
     events = [SingularEvent("stall", "not diagnosed (compiled follower)", sample=k)
               for k in range(count) if codes[k] in (kernel.STALL_STEP, kernel.STALL_WINDOW)]
     return TrackResult(Q, dp, dr, status, sweeps, np.full(count, per_sample), events, [],
-                       mode="frdm+lm (compiled follower)" if opts.polish else "frdm (compiled follower)")
+                       mode=opts.label + ("+lm" if opts.polish else "") + " (compiled follower)")
 
 

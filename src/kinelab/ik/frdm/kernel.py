@@ -29,9 +29,10 @@ from kinelab.ik.chain import (
     chain_fk,
     rotate_about,
     rotate_rows,
-    rotation_angle,
     rotm,
 )
+from kinelab.ik.frdm.newton import lm_polish
+from kinelab.ik.frdm.newton import within as _within
 
 REFRESH_SWEEPS = 8  # sweeps carried incrementally before the chain FK is recomputed
 TIP_TO_BASE, BASE_TO_TIP, ALTERNATE, MIXED = 0, 1, 2, 3  # sweep order codes (MIXED: per restart, in turn)
@@ -39,12 +40,14 @@ TIP_TO_BASE, BASE_TO_TIP, ALTERNATE, MIXED = 0, 1, 2, 3  # sweep order codes (MI
 # run() return codes
 CONVERGED, STALL_STEP, STALL_WINDOW, BUDGET = 0, 1, 2, 3
 
-# slots of an attempt's state array
-S_HISTORY, S_SWEEPS, S_E_WINDOW, S_WINDOW_START, S_ACCEPTED, S_E, S_KICKED, S_HELD, S_SINCE_FK = range(9)
-STATE_SIZE = 9
-# slots of a multistart's statistics array
-T_ATTEMPTS, T_SWEEPS, T_STALLS, T_ACCEPTED, T_BEST_E, T_CUT, T_POLISHED = range(7)
-STATS_SIZE = 7
+# slots of an attempt's state array (S_FINISH: 0 the Newton finish not tried, 1 tried and fell short, 2 converged;
+# S_NEWTON: its Gauss–Newton steps)
+S_HISTORY, S_SWEEPS, S_E_WINDOW, S_WINDOW_START, S_ACCEPTED, S_E, S_KICKED, S_HELD, S_SINCE_FK, S_FINISH, \
+    S_NEWTON = range(11)
+STATE_SIZE = 11
+# slots of a multistart's statistics array (T_NEWTON: Gauss–Newton steps of the finish, every attempt)
+T_ATTEMPTS, T_SWEEPS, T_STALLS, T_ACCEPTED, T_BEST_E, T_CUT, T_POLISHED, T_NEWTON = range(8)
+STATS_SIZE = 8
 
 
 class Objective(NamedTuple):
@@ -78,6 +81,8 @@ class Settings(NamedTuple):
     window_rel: float
     accel_m: int  # Anderson memory (0: plain FRDM)
     polish: int  # Gauss–Newton steps tried on a stalled attempt before the restart (0: none)
+    finish_below: float  # the Newton finish starts once the objective is below this (0: never, the paper's FRDM)
+    finish_steps: int  # Gauss–Newton steps of the finish
 
 
 class Memory(NamedTuple):
@@ -153,25 +158,6 @@ def rest_term(q, kind, q_rest, w_rest):
 def total_objective(q, kind, p, R, pb):
     """The objective E plus the rest term of the problem."""
     return objective(p, R, pb.pstar, pb.Rstar, pb.w_p, pb.w_ax) + rest_term(q, kind, pb.q_rest, pb.w_rest)
-
-
-@njit(cache=True, inline="always")
-def _within(p, R, pstar, Rstar, tol_pos, tol_rot, check_pos, check_rot, rot_axis):
-    """Both tolerances met (those checked): position [m] and rotation angle [rad] (of R*ᵀR, or with
-    ``rot_axis`` ≥ 0 between that tool axis and the target's)."""
-    dp = np.sqrt((p[0] - pstar[0]) ** 2 + (p[1] - pstar[1]) ** 2 + (p[2] - pstar[2]) ** 2)
-    if check_pos and not dp <= tol_pos:
-        return False
-    if not check_rot:
-        return True
-    if rot_axis < 0:
-        return rotation_angle(R, Rstar) <= tol_rot
-    k = rot_axis
-    c0 = R[1, k] * Rstar[2, k] - R[2, k] * Rstar[1, k]
-    c1 = R[2, k] * Rstar[0, k] - R[0, k] * Rstar[2, k]
-    c2 = R[0, k] * Rstar[1, k] - R[1, k] * Rstar[0, k]
-    dot = R[0, k] * Rstar[0, k] + R[1, k] * Rstar[1, k] + R[2, k] * Rstar[2, k]
-    return np.arctan2(np.sqrt(c0 * c0 + c1 * c1 + c2 * c2), dot) <= tol_rot
 
 
 @njit(cache=True, inline="always")
@@ -456,6 +442,31 @@ def _fk_converged(q, ch, pb, e, o, p, R, since_fk):
 
 
 @njit(cache=True, inline="always")
+def _near(state):
+    """The objective at the current q: the last sweep's, or the start's before the first sweep."""
+    return state[S_E_WINDOW] if state[S_SWEEPS] == 0.0 else state[S_E]
+
+
+@njit(cache=True)
+def _finished(q, ch, pb, steps, state):
+    """The Newton finish, tried once per attempt: True (q converged, its objective in state) if Gauss–Newton
+    steps from q meet the tolerances, else q is left exactly as it was and the sweeps go on."""
+    q_kept = q.copy()
+    code, spent = lm_polish(q, ch, pb, steps)
+    state[S_NEWTON] += spent
+    if code == CONVERGED:
+        state[S_FINISH] = 2.0
+        n = q.shape[0]
+        e, o, p, R = np.empty((n, 3)), np.empty((n, 3)), np.empty(3), np.empty((3, 3))
+        chain_fk(ch, q, e, o, p, R)
+        state[S_E] = total_objective(q, ch.kind, p, R, pb)
+        return True
+    state[S_FINISH] = 1.0
+    q[:] = q_kept
+    return False
+
+
+@njit(cache=True, inline="always")
 def _window_stalled(state, st, E1):
     """The monitor's window test: True when E fell by less than window_rel over the last window."""
     if state[S_SWEEPS] - state[S_WINDOW_START] >= st.window:
@@ -515,6 +526,9 @@ def run(q: np.ndarray, ch: Chain, pb: Objective, st: Settings, order: int, max_s
         if _within(p, R, pstar, Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot, pb.rot_axis) and \
                 _fk_converged(q, ch, pb, e, o, p, R, since_fk):  # converged only on an exact FK
             state[S_E] = total_objective(q, kind, p, R, pb)
+            return CONVERGED, s
+        if st.finish_below > 0.0 and state[S_FINISH] == 0.0 and _near(state) < st.finish_below and \
+                _finished(q, ch, pb, st.finish_steps, state):
             return CONVERGED, s
         x_old[:] = q
         base_to_tip = _base_to_tip(order, state)

@@ -128,6 +128,11 @@ class Runner:
         return int(self.state[kernel.S_ACCEPTED])
 
     @property
+    def newton_steps(self) -> int:
+        """Gauss–Newton steps of the finish so far."""
+        return int(self.state[kernel.S_NEWTON])
+
+    @property
     def E(self) -> float:
         """The objective at the current q."""
         return float(self.state[kernel.S_E])
@@ -141,6 +146,7 @@ class Runner:
         self.state[kernel.S_HISTORY] = 0.0
         self.state[kernel.S_E_WINDOW] = np.inf if self.sweeps == 0 else self.state[kernel.S_E] * (1 + 1e-12) + 1e-300
         self.state[kernel.S_WINDOW_START] = self.state[kernel.S_SWEEPS]
+        self.state[kernel.S_FINISH] = 0.0  # a bypass moved q: the Newton finish may be tried again
 
     def kernel_run(self, q: np.ndarray, budget: int) -> tuple[int, int]:
         """Up to ``budget`` sweeps of the compiled kernel from q (in place)."""

@@ -16,8 +16,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from kinelab.ik.frdm.attempts import lm_polish
 from kinelab.ik.frdm.kernel import CONVERGED, STATE_SIZE, Memory, Objective, run
+from kinelab.ik.frdm.newton import lm_polish
 
 
 @njit(cache=True)

@@ -81,9 +81,10 @@ def attempt(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol
         q = run.apply(bypass, step, q)
     status = run.solve(q, deadline, bypass, opts.max_bypass_events)
     diag = Diagnostics(sweeps=run.sweeps, accelerated_sweeps=run.accepted, order=opts.order, w_p=prob.w_p,
-                       relax=opts.relax, objective=run.E, trace=tuple(run.trace_values()) if opts.trace else None)
+                       relax=opts.relax, objective=run.E, newton_steps=run.newton_steps,
+                       trace=tuple(run.trace_values()) if opts.trace else None)
     att = Attempt(robot.wrap_continuous(run.q), status, run.sweeps, run.events, run.bypass_log, diag,
-                  "frdm" + (" (plain)" if opts.plain else ""))
+                  opts.label)
     if opts.polish and status != Status.CONVERGED:
         pol = dls.attempt(robot, oMtarget, run.q, tol_pos, tol_rot, deadline, max_iterations=20)
         att = Attempt(pol.q, pol.status, run.sweeps + pol.iterations, run.events, run.bypass_log,
@@ -102,20 +103,8 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: 
     """
     opts = options or FRDMOptions()
     ctx = _context(robot, opts, float(tol_pos), float(tol_rot))
-    code, q, stats = ctx.run(oMtarget, q0, seed, max_restarts + 1, deadline)
-    if code == kernel.CONVERGED:
-        status = Status.CONVERGED
-    elif time.perf_counter() > deadline:
-        status = Status.TIME_BUDGET
-    else:
-        status = Status.STALLED if stats[kernel.T_STALLS] > 0 else Status.MAX_ITERATIONS
-    sweeps, stalls, attempts = int(stats[kernel.T_SWEEPS]), int(stats[kernel.T_STALLS]), int(stats[kernel.T_ATTEMPTS])
-    diag = Diagnostics(sweeps=sweeps, accelerated_sweeps=int(stats[kernel.T_ACCEPTED]), order=opts.order,
-                       w_p=ctx.problem.w_p, objective=float(stats[kernel.T_BEST_E]), attempts=attempts, stalls=stalls,
-                       polished=int(stats[kernel.T_POLISHED]), path="compiled")
-    events = [SingularEvent("stall", "not diagnosed (compiled multistart: restarted)", count=stalls)] if stalls else []
-    return Attempt(robot.wrap_continuous(q) if ctx.continuous else q, status, sweeps, events, [], diag, ctx.mode), \
-        max(0, attempts - 1)
+    code, q, stats = ctx.run(oMtarget.homogeneous, q0, seed, max_restarts + 1, deadline)
+    return ctx.attempt(code, q, stats, deadline), max(0, int(stats[kernel.T_ATTEMPTS]) - 1)
 
 
 class _Context:
@@ -125,22 +114,29 @@ class _Context:
 
     def __init__(self, robot: Robot, opts: FRDMOptions, tol_pos: float, tol_rot: float):
         cm = chain_model(robot)
+        self.robot, self.order_name = robot, opts.order
         self.cm, self.n, self.continuous = cm, cm.n, bool((cm.kind == CONTINUOUS).any())
         self.problem = _compiled_problem(cm, pin.SE3.Identity(), opts, tol_pos, tol_rot)
         self.pstar, self.Rstar = self.problem.pstar, self.problem.Rstar
         self.settings, self.order, self.cap = opts.settings(), ORDERS[opts.order], opts.sweep_cap
         self.chunk = float(clock_chunk(JOINT_SWEEPS_PER_LOOK, cm.n))
         self.later_chunk = float(clock_chunk(JOINT_SWEEPS_PER_LATER_LOOK, cm.n))
-        self.mode = "frdm" + (" (plain)" if opts.plain else "")
+        self.mode = opts.label
         self.memory = kernel.new_memory(cm.n, opts.accel_m)  # reused: every attempt resets what it reads
         self.seed: int | None = None
         self.seed_value = np.zeros(1, dtype=np.uint64)  # the generator state of ``self.seed``
 
-    def run(self, oMtarget: pin.SE3, q0: np.ndarray | None, seed: int | None, attempts: int,
+    def run(self, H: np.ndarray, q0: np.ndarray | None, seed: int | None, attempts: int,
             deadline: float) -> tuple[int, np.ndarray, np.ndarray]:
-        """(code, kept q (a new array), stats) of attempts from q0 (None: drawn) and seeded restarts."""
-        self.pstar[:] = oMtarget.translation
-        self.Rstar[:] = oMtarget.rotation
+        """(code, kept q (a new array), stats) of attempts towards the target H (oMtarget as a 4 × 4 matrix)
+        from q0 (None: drawn) and seeded restarts."""
+        self.pstar[:] = H[:3, 3]
+        self.Rstar[:] = H[:3, :3]
+        return self.run_aimed(q0, seed, attempts, deadline)
+
+    def run_aimed(self, q0: np.ndarray | None, seed: int | None, attempts: int,
+                  deadline: float) -> tuple[int, np.ndarray, np.ndarray]:
+        """:meth:`run` with the target already in ``pstar`` and ``Rstar``."""
         if seed is None or seed != self.seed:  # a loop usually passes one seed: its state is made once
             self.seed_value = restarts.seed_state(seed)
             self.seed = seed
@@ -160,6 +156,29 @@ class _Context:
 
             code = restarts.run_in_chunks(chunk, attempts, stats, deadline, kernel.CONVERGED)
         return code, best_q, stats
+
+    def attempt(self, code: int, q: np.ndarray, stats: np.ndarray, deadline: float) -> Attempt:
+        """The :class:`Attempt` of a :meth:`run` (status, diagnostics, q with continuous joints wrapped)."""
+        if code == kernel.CONVERGED:
+            status = Status.CONVERGED
+        elif time.perf_counter() > deadline:
+            status = Status.TIME_BUDGET
+        else:
+            status = Status.STALLED if stats[kernel.T_STALLS] > 0 else Status.MAX_ITERATIONS
+        st = stats.tolist()  # one conversion, then Python floats
+        sweeps, stalls = int(st[kernel.T_SWEEPS]), int(st[kernel.T_STALLS])
+        diag = Diagnostics.quick(sweeps=sweeps, accelerated_sweeps=int(st[kernel.T_ACCEPTED]),
+                                 order=self.order_name, w_p=self.problem.w_p, objective=st[kernel.T_BEST_E],
+                                 attempts=int(st[kernel.T_ATTEMPTS]), stalls=stalls,
+                                 polished=int(st[kernel.T_POLISHED]), newton_steps=int(st[kernel.T_NEWTON]),
+                                 path="compiled")
+        return Attempt(self.robot.wrap_continuous(q) if self.continuous else q, status, sweeps,
+                       self.stall_events(stalls) if stalls else [], [], diag, self.mode)
+
+    @staticmethod
+    def stall_events(stalls: int) -> list[SingularEvent]:
+        """The one event a compiled multistart reports: how many attempts stalled (each was restarted)."""
+        return [SingularEvent("stall", "not diagnosed (compiled multistart: restarted)", count=stalls)]
 
 
 def _context(robot: Robot, opts: FRDMOptions, tol_pos: float, tol_rot: float) -> _Context:

@@ -1,0 +1,142 @@
+"""The prepared solver's lean call: compiled FRDM for one target with nothing checked twice.
+
+:class:`kinelab.IK` checks its settings once; per call only the target and the start change. For the usual
+call — a ``pin.SE3`` target, a float64 start of the right length (or none), an integer seed or none — one
+compiled function checks both (finite, a proper rotation, the start within the limits, the target within
+the reach bound), the compiled multistart solves, Pinocchio's FK of the answer is judged by the compiled
+verdict, and the result is built directly. Anything else (a point target, a list start, a start outside the
+limits, a target beyond reach) returns None and the caller takes the general driver, which names the
+problem, warns or answers UNREACHABLE exactly as :func:`kinelab.solve` does: the lean call changes the cost,
+never the answer.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+from numba import njit
+
+from kinelab.ik.driver import Call, compiled_result, prepare_checks
+from kinelab.ik.frdm import kernel
+from kinelab.ik.frdm import solver as frdm
+from kinelab.ik.multistart import TypedKernel
+from kinelab.ik.request import Request
+from kinelab.ik.result import Diagnostics, IKResult, Status
+from kinelab.ik.verdict import pose_defect, pose_verdict
+from kinelab.ik.workspace import reach_bound
+from kinelab.robot import Robot
+
+SEED_LIMIT = 1 << 64
+OK, NOT_USUAL = 0, 1
+
+
+@njit(cache=True)
+def usual_inputs(H: np.ndarray, q0: np.ndarray, n: int, lower: np.ndarray, upper: np.ndarray,
+                 anchor: np.ndarray, radius: float, pstar: np.ndarray, Rstar: np.ndarray) -> int:
+    """OK when H is a proper pose whose point lies within ``radius`` [m] of ``anchor`` and q0 is empty (no start)
+    or n finite values within [lower, upper]: then H's point and rotation are copied into pstar and Rstar (the
+    kernel's target). NOT_USUAL otherwise (the general path then names what is wrong)."""
+    if pose_defect(H) != 0:
+        return NOT_USUAL
+    d = np.sqrt((H[0, 3] - anchor[0]) ** 2 + (H[1, 3] - anchor[1]) ** 2 + (H[2, 3] - anchor[2]) ** 2)
+    if not d <= radius:
+        return NOT_USUAL
+    if q0.shape[0] != 0:
+        if q0.shape[0] != n:
+            return NOT_USUAL
+        for i in range(n):
+            if not lower[i] <= q0[i] <= upper[i]:  # also False for NaN; ±inf never lies within finite limits
+                return NOT_USUAL
+    for i in range(3):
+        pstar[i] = H[i, 3]
+        for j in range(3):
+            Rstar[i, j] = H[i, j]
+    return OK
+
+
+_USUAL = TypedKernel(usual_inputs)
+_VERDICT = TypedKernel(pose_verdict)
+
+
+class LeanFRDM:
+    """The lean call of a prepared compiled-FRDM solver (see the module's docstring).
+
+    Args:
+        robot: the robot.
+        req: the prepared solver's request (solver "frdm" with options the compiled multistart serves).
+    """
+
+    def __init__(self, robot: Robot, req: Request):
+        self.robot, self.req = robot, req
+        self.ctx = frdm._context(robot, req.options, float(req.tol_pos), float(req.tol_rot))
+        self.lower, self.upper = robot.check_bounds
+        anchor, radius = reach_bound(robot)
+        self.anchor = np.array(anchor, dtype=float)
+        self.radius = float(radius) if req.task.position else np.inf  # an ignored point is never out of reach
+        self.none = np.empty(0)
+        self.budget = np.inf if req.time_budget is None else float(req.time_budget)
+        self.attempts = req.max_restarts + 1
+        self.axis, self.n = req.task.axis, robot.n
+        self.check_pos, self.check_rot = req.task.position, req.task.rotation
+        self.tol_pos, self.tol_rot, self.task_label = req.tol_pos, req.tol_rot, req.task_label
+        self.order, self.w_p = req.options.order, self.ctx.problem.w_p
+        prepare_checks(robot)
+        self._compile()
+
+    def _compile(self) -> None:
+        """Load (or compile) the input check before any call's clock starts."""
+        H = pin.SE3.Identity().homogeneous
+        _USUAL(H, self.none, self.n, self.lower, self.upper, self.anchor, self.radius, np.zeros(3), np.zeros((3, 3)))
+
+    def solve(self, target: Any, q0: Any, seed: Any) -> IKResult | None:
+        """The result for the usual call, or None for the general driver (see the module's docstring)."""
+        t_start = time.perf_counter()
+        if type(target) is not pin.SE3:
+            return None
+        if q0 is None:
+            start = self.none
+        elif type(q0) is np.ndarray and q0.dtype == np.float64 and q0.ndim == 1 and q0.flags.c_contiguous:
+            start = q0
+        else:
+            return None
+        if seed is None:
+            seed = int.from_bytes(os.urandom(8), "little")  # fresh entropy, as the general path draws
+        elif type(seed) is not int or not 0 <= seed < SEED_LIMIT:
+            return None
+        H = target.homogeneous
+        ctx = self.ctx
+        if _USUAL(H, start, self.n, self.lower, self.upper, self.anchor, self.radius, ctx.pstar, ctx.Rstar) != OK:
+            return None
+        deadline = t_start + self.budget
+        code, q, stats = ctx.run_aimed(None if q0 is None else start, seed, self.attempts, deadline)
+        if ctx.continuous:
+            q = self.robot.wrap_continuous(q)
+        dp, dr, within = _VERDICT(H, self.robot.tool_pose_of_float_q(q).homogeneous, q, self.lower, self.upper,
+                                  self.axis)
+        ok = within and (not self.check_pos or dp <= self.tol_pos) and (not self.check_rot or dr <= self.tol_rot)
+        if ok and code == kernel.CONVERGED:  # the usual outcome, built without the general path's bookkeeping
+            return self._converged(q, stats, dp, dr, t_start)
+        att = ctx.attempt(code, q, stats, deadline)
+        req = self.req
+        call = Call(self.robot, target, req.solver, req.tol_pos, req.tol_rot, t_start, deadline, seed, req.task,
+                    req.task_label)
+        return compiled_result(call, att, max(0, int(stats[kernel.T_ATTEMPTS]) - 1), ok, dp, dr)
+
+    def _converged(self, q: np.ndarray, stats: np.ndarray, dp: float, dr: float, t_start: float) -> IKResult:
+        """The result of a converged solve that Pinocchio confirmed (what :meth:`FRDMContext.attempt` and the
+        driver would build, fewer steps)."""
+        st = stats.tolist()
+        sweeps, stalls = int(st[kernel.T_SWEEPS]), int(st[kernel.T_STALLS])
+        diag = Diagnostics.quick(sweeps=sweeps, accelerated_sweeps=int(st[kernel.T_ACCEPTED]), order=self.order,
+                                 w_p=self.w_p, objective=st[kernel.T_BEST_E], attempts=int(st[kernel.T_ATTEMPTS]),
+                                 stalls=stalls, polished=int(st[kernel.T_POLISHED]),
+                                 newton_steps=int(st[kernel.T_NEWTON]), path="compiled")
+        events = self.ctx.stall_events(stalls) if stalls else []
+        return IKResult(q=q, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr,
+                        iterations=sweeps, restarts=max(0, int(st[kernel.T_ATTEMPTS]) - 1),
+                        wall_time=time.perf_counter() - t_start, solver="frdm", mode=self.ctx.mode,
+                        singular_events=events, diagnostics=diag, task=self.task_label)

@@ -1,0 +1,89 @@
+"""The prepared solver's lean call (kinelab.ik.lean) gives kinelab.solve's results: same q, verdict, status,
+counts and diagnostics for the same seed, on the usual call and on every input it hands to the general path."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import kinelab
+
+
+@pytest.fixture(scope="module")
+def ur5():
+    return kinelab.load("ur5")
+
+
+SAME = ("success", "status", "position_error", "rotation_error", "iterations", "restarts", "solver", "mode",
+        "message", "task")
+
+
+def _same(a: kinelab.IKResult, b: kinelab.IKResult) -> None:
+    np.testing.assert_array_equal(a.q, b.q)
+    for name in SAME:
+        assert getattr(a, name) == getattr(b, name), name
+    assert a.diagnostics.to_dict() == b.diagnostics.to_dict()
+    assert [e.to_dict() for e in a.singular_events] == [e.to_dict() for e in b.singular_events]
+
+
+@pytest.mark.parametrize("name", ["ur5", "kinova", "stanford", "youbot"])
+@pytest.mark.parametrize("task", ["pose", "position", "axis"])
+def test_the_lean_call_equals_kinelab_solve(name, task):
+    robot = kinelab.load(name)
+    settings = dict(task=task, time_budget=None, max_restarts=30)
+    ik = kinelab.IK(robot, **settings)
+    rng = np.random.default_rng(3)
+    for k in range(8):
+        q = robot.random_q(rng)
+        target = robot.fk(q)
+        warm = np.clip(q + rng.normal(0, 0.1, q.size), robot.lower, robot.upper)
+        for q0 in (warm, None):
+            _same(ik.solve(target, q0=q0, seed=k), kinelab.solve(robot, target, q0=q0, seed=k, **settings))
+    assert ik._lean is not None  # the lean path served these calls (pose-like targets, float starts)
+
+
+def test_every_unusual_input_gets_the_general_path_s_answer_or_error(ur5):
+    ik = kinelab.IK(ur5, time_budget=None, max_restarts=5)
+    q = ur5.random_q(1)
+    target = ur5.fk(q)
+    outside = q.copy()
+    outside[0] = ur5.upper[0] + 0.5
+    far = pin.SE3(target.rotation, np.array([9.0, 0.0, 0.0]))  # beyond the UR5's reach: UNREACHABLE
+    cases = [(target, list(q)), (target, outside), (far, q), (target, q.astype(np.float32))]
+    for t, q0 in cases:
+        with warnings.catch_warnings(record=True) as lean_warned:
+            warnings.simplefilter("always")
+            a = ik.solve(t, q0=q0, seed=2)
+        with warnings.catch_warnings(record=True) as plain_warned:
+            warnings.simplefilter("always")
+            b = kinelab.solve(ur5, t, q0=q0, seed=2, time_budget=None, max_restarts=5)
+        _same(a, b)
+        assert [str(w.message) for w in lean_warned] == [str(w.message) for w in plain_warned]
+    assert ik.solve(far, q0=q).status.value == "unreachable"
+    bad = pin.SE3(target.rotation, np.array([np.nan, 0.0, 0.0]))
+    with pytest.raises(kinelab.TargetError, match="NaN"):
+        ik.solve(bad, q0=q)
+    nan_start = q.copy()
+    nan_start[2] = np.nan
+    with pytest.raises(kinelab.ConfigurationError, match="finite"):
+        ik.solve(target, q0=nan_start)
+    with pytest.raises(kinelab.ConfigurationError, match="6 numbers"):
+        ik.solve(target, q0=np.zeros(5))
+    _same(ik.solve(target, q0=q, seed=2**64 + 5), kinelab.solve(ur5, target, q0=q, seed=2**64 + 5, time_budget=None,
+                                                                max_restarts=5))  # numpy takes any size
+    for seed in (-1, 1.5, True):
+        with pytest.raises(kinelab.OptionError, match="seed"):
+            ik.solve(target, q0=q, seed=seed)
+
+
+def test_a_lean_failure_reports_as_the_general_path_does(ur5):
+    """A target met only outside the limits: the lean call builds the failure through the driver's helpers."""
+    ik = kinelab.IK(ur5, time_budget=None, max_restarts=3, tol_pos=1e-12, tol_rot=1e-12, finish="none")
+    target = ur5.fk(ur5.random_q(4))
+    a = ik.solve(target, q0=ur5.random_q(5), seed=1)
+    b = kinelab.solve(ur5, target, q0=ur5.random_q(5), seed=1, time_budget=None, max_restarts=3, tol_pos=1e-12,
+                      tol_rot=1e-12, finish="none")
+    _same(a, b)
