@@ -210,7 +210,8 @@ def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
         q0: the configuration at the start of the path [rad or m], within the limits; None: the first target
             is solved by :func:`solve` (with ``seed``) and the path starts there.
         solver: "frdm" (the only path follower).
-        seed: seed of the first solve when ``q0`` is None.
+        seed: seed of the first solve when ``q0`` is None, and of the restarts that recover a missed sample
+            (None: fresh entropy).
         tol_pos: position tolerance per sample [m].
         tol_rot: rotation tolerance per sample [rad].
         task: the components to meet per sample, as :func:`solve`.

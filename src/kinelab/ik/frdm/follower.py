@@ -11,6 +11,7 @@ from kinelab.geometry import stack_homogeneous
 from kinelab.ik.chain import chain_model
 from kinelab.ik.frdm import kernel, path_kernel
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
+from kinelab.ik.multistart import seed_state
 from kinelab.ik.result import SingularEvent, Status, TrackResult
 from kinelab.ik.targets import as_target_arrays
 from kinelab.ik.tasks import POSE, Task
@@ -25,7 +26,7 @@ _STATUS = {kernel.STALL_STEP: Status.STALLED, kernel.STALL_WINDOW: Status.STALLE
 
 
 def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: float, max_sweeps: int,
-           rest_weight: float | None, opts: FRDMOptions, task: Task = POSE) -> TrackResult:
+           rest_weight: float | None, opts: FRDMOptions, task: Task = POSE, seed: int | None = None) -> TrackResult:
     """Solve every sample of a path in the compiled follower; each answer judged by Pinocchio.
 
     Args:
@@ -38,6 +39,7 @@ def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: 
         rest_weight: weight of the rest term (None: :data:`REST_WEIGHT` on arms with more than six joints).
         opts: FRDM options (order, weights, stall window).
         task: the components judged (FRDM's mode in ``opts`` is the same task).
+        seed: seed of the recovery's restarts (None: fresh entropy).
 
     Returns:
         A :class:`~kinelab.ik.frdm.tracking.TrackResult` with mode "frdm (compiled follower)". Continuous
@@ -58,7 +60,7 @@ def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: 
                        rotations, opts.position_weight(cm.length), opts.axis_weights(), float(tol_pos),
                        float(tol_rot), opts.mode != "orientation", opts.mode != "position", opts.settings(), order,
                        int(max_sweeps), float(rest_weight), REST_SWEEPS, centre, CENTRE_PULL,
-                       LM_ITERATIONS if opts.polish else 0, codes, sweeps)
+                       LM_ITERATIONS if opts.polish else 0, seed_state(seed), codes, sweeps)
     dp, dr = task.errors_batch(stack_homogeneous(points, rotations), robot.fk_batch(Q))
     ok = task.met_batch(dp, dr, tol_pos, tol_rot) & robot.within_limits_batch(Q) & np.isfinite(Q).all(axis=1)
     status = [Status.CONVERGED.value if ok[k] else _STATUS.get(int(codes[k]), Status.MAX_ITERATIONS).value

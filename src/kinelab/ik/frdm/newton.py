@@ -36,9 +36,11 @@ def within(p, R, pstar, Rstar, tol_pos, tol_rot, check_pos, check_rot, rot_axis)
 
 
 @njit(cache=True)
-def lm_polish(q, ch, pb, iterations):
+def lm_polish(q, ch, pb, iterations, max_step=np.inf):
     """Levenberg–Marquardt on the world-frame error of the constrained components, steps kept in the windows:
     [p* − p; log(R* Rᵀ)], or for task "axis" [p* − p; a* − a] with a the tool axis (da/dq_i = e_i × a).
+    ``max_step`` [rad or m] caps every step's largest joint change (a trust region: near a singular
+    configuration a Gauss–Newton step can throw the arm onto another branch).
 
     Returns (CONVERGED or −1, iterations spent); q is updated in place.
     """
@@ -50,13 +52,17 @@ def lm_polish(q, ch, pb, iterations):
         chain_fk(ch, q, e, o, p, R)
         if within(p, R, pb.pstar, pb.Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot, pb.rot_axis):
             return CONVERGED, it
-        _world_error(p, R, pb, err)
-        _world_jacobian(e, o, p, R, ch.kind, pb, J)
+        world_error(p, R, pb, err)
+        world_jacobian(e, o, p, R, ch.kind, pb, J)
         A = J.T @ J
         damping = 1e-9 + 1e-3 * (err @ err)
         for i in range(n):
             A[i, i] += damping
         dq = np.linalg.solve(A, J.T @ err)
+        if max_step < np.inf:
+            largest = np.max(np.abs(dq))
+            if largest > max_step:
+                dq *= max_step / largest
         for i in range(n):
             q[i] = min(max(q[i] + dq[i], pb.lower[i]), pb.upper[i])
     chain_fk(ch, q, e, o, p, R)
@@ -66,7 +72,7 @@ def lm_polish(q, ch, pb, iterations):
 
 
 @njit(cache=True)
-def _world_jacobian(e, o, p, R, kind, pb, J):
+def world_jacobian(e, o, p, R, kind, pb, J):
     """J ← the error's Jacobian rows (position; rotation, or the tool axis of task "axis"); unchecked rows 0."""
     for i in range(e.shape[0]):
         if kind[i] == PRISMATIC:
@@ -82,7 +88,7 @@ def _world_jacobian(e, o, p, R, kind, pb, J):
 
 
 @njit(cache=True)
-def _world_error(p, R, pb, err):
+def world_error(p, R, pb, err):
     """err = [p* − p; log(R* Rᵀ) or a* − a] with the constrained components only (an unchecked component
     must not pull)."""
     for k in range(3):

@@ -92,7 +92,7 @@ def run_track(robot: Robot, targets: Any, q0: np.ndarray, req: Request, settings
     _check_restrict(settings.restrict, opts.intervals, opts.freeze)
     if _followable(opts) and not settings.restrict:
         return follow(robot, targets, q0, req.tol_pos, req.tol_rot, opts.sweep_cap, settings.rest_weight, opts,
-                      req.task)
+                      req.task, req.seed)
     policy = opts.policy or ()
     attempt_opts = replace(opts, policy=tuple(s for s in policy if s not in RESTRICTIONS))
     path = _Path(robot, req, attempt_opts, settings, [s for s in policy if s in RESTRICTIONS])

@@ -97,3 +97,21 @@ def smooth_path(robot: Robot, seed: int, samples: int = 2000, amplitude: float =
     phase, rate = rng.uniform(0, 2 * np.pi, robot.n), rng.uniform(0.5, 1.5, robot.n)
     t = np.linspace(0, 2 * np.pi, samples)
     return (lo + hi) / 2 + amplitude * (hi - lo) / 2 * np.sin(np.outer(t, rate) + phase)
+
+
+def blend_path(robot: Robot, seed: int, samples: int = 200, amplitude: float = 0.6) -> np.ndarray:
+    """A smooth joint-space path (samples × n) from one seeded configuration to another, both drawn within
+    ± ``amplitude`` of each joint's range about mid-range (continuous joints: of [−π, π]), blended by a cosine
+    (zero joint speed at both ends)."""
+    rng = np.random.default_rng(seed)
+    lo, hi = np.maximum(robot.lower, -np.pi), np.minimum(robot.upper, np.pi)
+    mid, half = (lo + hi) / 2, amplitude * (hi - lo) / 2
+    qa, qb = mid + half * rng.uniform(-1, 1, robot.n), mid + half * rng.uniform(-1, 1, robot.n)
+    s = (1 - np.cos(np.linspace(0, np.pi, samples))) / 2
+    return qa + np.outer(s, qb - qa)
+
+
+def path_set(robot: Robot, seed: int, count: int, samples: int = 200) -> list[np.ndarray]:
+    """``count`` seeded joint-space paths, cosine blends and sinusoids in turn (path k from seed + k): the set
+    the tracking protocol and its test follow."""
+    return [(blend_path if k % 2 == 0 else smooth_path)(robot, seed + k, samples) for k in range(count)]

@@ -1,0 +1,52 @@
+"""Tracking reaches every sample of generated smooth paths without a branch jump (#24 goal 4), and reaches
+every reachable sample of the ERA passages; the recovery's pose interpolation against Pinocchio."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import kinelab
+from kinelab.ik.frdm.path_kernel import pose_between
+from kinelab.ik.workspace import out_of_reach
+from kinelab.report.bench.protocol import path_set
+from kinelab.studies import paper000_era as ep
+
+
+@pytest.mark.parametrize("name", ["ur5", "stanford"])
+def test_every_sample_of_generated_paths_is_reached_without_a_branch_jump(name):
+    robot = kinelab.load(name)
+    for Q_path in path_set(robot, seed=100, count=8):  # cosine blends and sinusoids, 200 samples each
+        targets = [robot.fk(q) for q in Q_path]
+        res = kinelab.track(robot, targets, q0=Q_path[0], seed=0)
+        dp = np.array([robot.tool_error(q, t)[0] for q, t in zip(res.q, targets, strict=True)])  # the oracle's
+        dr = np.array([robot.tool_error(q, t)[1] for q, t in zip(res.q, targets, strict=True)])
+        assert res.reached.all() and (dp <= 1e-6).all() and (dr <= 1e-6).all()
+        assert all(robot.within_limits(q) for q in res.q)
+        path_step = np.abs(np.diff(Q_path, axis=0)).max()
+        steps = np.abs(np.diff(np.vstack([Q_path[0], res.q]), axis=0)).max()
+        assert steps <= 3 * path_step, "a branch jump"
+
+
+def test_the_era_passages_reach_every_reachable_sample_and_the_paper_s_frdm_still_stops_at_the_elbow():
+    era = kinelab.load("era")
+    for passage in (ep.elbow_passage(era), ep.wrist_passage(era), ep.shoulder_passage(era)):
+        reachable = np.array([out_of_reach(era, t.translation) <= 0 for t in passage.targets])
+        res = kinelab.track(era, passage.targets, q0=passage.q0, seed=0)
+        assert (res.reached == reachable).all(), passage.name
+    elbow = ep.elbow_passage(era)
+    pure = kinelab.track(era, elbow.targets, q0=elbow.q0, finish="none")
+    assert pure.reached.sum() < len(elbow.targets) // 2 + 1  # the paper's stop at the straight arm, kept
+
+
+def test_pose_between_follows_the_segment_and_the_rotation_geodesic():
+    rng = np.random.default_rng(5)
+    for _ in range(50):
+        a, b = pin.SE3.Random(), pin.SE3.Random()
+        s = rng.uniform()
+        p, R = np.empty(3), np.empty((3, 3))
+        pose_between(a.translation, a.rotation, b.translation, b.rotation, s, p, R)
+        np.testing.assert_allclose(p, a.translation + s * (b.translation - a.translation), atol=1e-12)
+        expected = a.rotation @ pin.exp3(s * pin.log3(a.rotation.T @ b.rotation))
+        np.testing.assert_allclose(R, expected, atol=1e-9)
