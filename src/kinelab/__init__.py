@@ -6,6 +6,7 @@ errors every call raises on bad input (all :class:`KinelabError`).
 """
 
 from importlib.metadata import PackageNotFoundError, version
+from typing import TYPE_CHECKING
 
 from kinelab.errors import (
     BiquaternionError,
@@ -23,15 +24,38 @@ from kinelab.errors import (
     TargetError,
     URDFError,
 )
-from kinelab.ik.api import solve, solve_all, solve_batch, track
-from kinelab.ik.batch import BatchIKResult
-from kinelab.ik.frdm.options import FRDMOptions
-from kinelab.ik.prepared import IK
-from kinelab.ik.result import Diagnostics, IKResult, Status, TrackResult
-from kinelab.ik.targets import from_xyz_quat_wxyz as target_from_xyz_quat_wxyz
-from kinelab.ik.targets import from_xyz_rpy as target_from_xyz_rpy
+from kinelab.lazy import loader
 from kinelab.robot import Joint, Robot, load
 from kinelab.robot.catalog import names as robots
+
+# the solvers load on first use (kinelab.lazy)
+_LAZY = {
+    "solve": ("kinelab.ik.api", "solve"),
+    "solve_all": ("kinelab.ik.api", "solve_all"),
+    "solve_batch": ("kinelab.ik.api", "solve_batch"),
+    "track": ("kinelab.ik.api", "track"),
+    "BatchIKResult": ("kinelab.ik.batch", "BatchIKResult"),
+    "FRDMOptions": ("kinelab.ik.frdm.options", "FRDMOptions"),
+    "IK": ("kinelab.ik.prepared", "IK"),
+    "Diagnostics": ("kinelab.ik.result", "Diagnostics"),
+    "IKResult": ("kinelab.ik.result", "IKResult"),
+    "Status": ("kinelab.ik.result", "Status"),
+    "TrackResult": ("kinelab.ik.result", "TrackResult"),
+    "target_from_xyz_quat_wxyz": ("kinelab.ik.targets", "from_xyz_quat_wxyz"),
+    "target_from_xyz_rpy": ("kinelab.ik.targets", "from_xyz_rpy"),
+}
+
+
+__getattr__ = loader(__name__, globals(), _LAZY)
+
+if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and editors
+    from kinelab.ik.api import solve, solve_all, solve_batch, track
+    from kinelab.ik.batch import BatchIKResult
+    from kinelab.ik.frdm.options import FRDMOptions
+    from kinelab.ik.prepared import IK
+    from kinelab.ik.result import Diagnostics, IKResult, Status, TrackResult
+    from kinelab.ik.targets import from_xyz_quat_wxyz as target_from_xyz_quat_wxyz
+    from kinelab.ik.targets import from_xyz_rpy as target_from_xyz_rpy
 
 try:
     __version__ = version("kinelab")

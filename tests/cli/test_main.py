@@ -9,7 +9,6 @@ import pytest
 
 import kinelab
 from kinelab import cli
-from kinelab.cli.common import compiling_notice
 from kinelab.cli.common import plural as _plural
 from kinelab.studies import paper001_stanford as seed001
 
@@ -192,7 +191,6 @@ def test_bad_values_end_in_one_line_and_exit_2_before_any_work(argv, needle):
 
 def test_ctrl_c_stops_a_long_command_with_one_line_and_130():
     import signal
-    import time
 
     proc = subprocess.Popen([sys.executable, "-m", "kinelab.cli", "singular", "ur5", "--sweep", "1000000", "--json"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
@@ -221,14 +219,20 @@ def test_a_failed_report_leaves_the_previous_one_whole(tmp_path, monkeypatch):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]  # no temporary folder left behind
 
 
-def test_a_slow_compilation_is_announced_on_stderr_and_a_quick_one_is_not(capsys):
-    with compiling_notice(after=0.01):
-        time.sleep(0.2)
-    assert "compiling its solver kernels" in capsys.readouterr().err
-    with compiling_notice(after=5.0):
-        pass
-    time.sleep(0.05)
-    assert capsys.readouterr().err == ""
+def test_a_first_compilation_is_announced_once_per_path_in_one_line(capsys, monkeypatch):
+    """As if nothing were cached (a fresh install): each path the command runs says so once, as news."""
+    from kinelab.ik import compiling
+
+    monkeypatch.setattr(compiling, "_cached", lambda kernel: False)
+    monkeypatch.setattr(compiling, "_SAID", set())
+    for _ in range(2):
+        code, _, err = run(capsys, "ik", "ur5", "--target-xyz", "0.4", "0.2", "0.5")
+        assert code == 0
+        if _ == 0:
+            lines = err.strip().splitlines()
+            assert lines and all(line.startswith("kinelab: compiling ") and "warning" not in line for line in lines)
+            assert any("the monitored FRDM loop" in line and " s, once" in line for line in lines)
+    assert "compiling" not in err  # the second run in the same process says nothing
 
 
 PANDA_SRDF = str(kinelab.robot.catalog.erd_share_dir() / "example-robot-data" / "robots" / "panda_description"
@@ -350,3 +354,13 @@ def test_a_sweep_prints_the_samples_it_ran_and_representatives_that_paste_back(c
     q = line.split("e.g. q = ")[1].split()
     code, out, _ = run(capsys, "singular", "ur5", *q)
     assert code == 0 and "(SINGULAR)" in out  # full precision: still singular when pasted back
+
+
+def test_warmup_runs_every_compiled_path_and_reports_each(capsys):
+    code, _, err = run(capsys, "warmup")
+    lines = err.strip().splitlines()
+    assert code == 0 and lines[0].startswith("kinelab: compiling every solver path")
+    assert [line.split(":")[0].strip() for line in lines[1:-1]] == [
+        "FRDM (single solves, the prepared solver)", "FRDM's monitored loop (bypasses, policies)", "the FRDM batch",
+        "the path follower", "the biquaternion solver"]
+    assert all(line.endswith(" s)") for line in lines[1:-1]) and lines[-1].startswith("kinelab: every path is ready")

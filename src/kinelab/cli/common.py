@@ -7,11 +7,7 @@ continuous joints only (prismatic joints stay in metres).
 from __future__ import annotations
 
 import argparse
-import contextlib
 import json
-import sys
-import threading
-from collections.abc import Iterator
 from typing import Any, NoReturn
 
 import numpy as np
@@ -136,18 +132,3 @@ def rounded(values: Any, digits: int) -> list[float]:
 def plural(count: int, word: str, plural_form: str | None = None) -> str:
     """"1 sample", "2 samples" (or the plural form given)."""
     return f"{count} {word}" if count == 1 else f"{count} {plural_form or word + 's'}"
-
-
-@contextlib.contextmanager
-def compiling_notice(after: float = 1.0) -> Iterator[None]:
-    """Say on stderr that the kernels are being compiled when the block takes longer than ``after`` [s]:
-    the first run on a machine compiles them (numba) and keeps them for the next runs."""
-    timer = threading.Timer(after, lambda: print(
-        "kinelab: compiling its solver kernels for this machine (once; later runs load them) ...",
-        file=sys.stderr, flush=True))
-    timer.daemon = True
-    timer.start()
-    try:
-        yield
-    finally:
-        timer.cancel()

@@ -9,7 +9,6 @@ from typing import Any
 import numpy as np
 
 from kinelab.cli.common import (
-    compiling_notice,
     json_flag,
     load_robot,
     plural,
@@ -20,7 +19,7 @@ from kinelab.cli.common import (
     source_arguments,
 )
 from kinelab.errors import KinelabError
-from kinelab.ik.frdm.options import SWITCHABLE, bypass_plan
+from kinelab.ik.frdm.policy import SWITCHABLE, bypass_plan
 from kinelab.ik.result import IKResult, Status
 from kinelab.ik.tasks import AXES, TASKS
 from kinelab.robot import Robot
@@ -67,7 +66,6 @@ def add(sub: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Solve, print the result (or its JSON form); exit 0 when reached, 1 when not."""
     from kinelab.ik import solve
-    from kinelab.ik.registry import solver_module
 
     robot = load_robot(args)
     target, options = _target(robot, args)
@@ -78,10 +76,6 @@ def run(args: argparse.Namespace) -> int:
     if args.solver == "biquat":
         options.update({k: v for k, v in (("law", args.law), ("integrator", args.integrator), ("step", args.step),
                                           ("k", args.gain)) if v is not None})
-    prepare = getattr(solver_module(args.solver), "prepare", None)
-    if prepare is not None:
-        with compiling_notice():
-            prepare(robot)
     result = solve(robot, target, solver=args.solver, q0=q0, seed=args.seed, tol_pos=args.tol_pos,
                    tol_rot=args.tol_rot, time_budget=args.time_budget, task=args.task, axis=args.axis, **options)
     if args.json:

@@ -13,12 +13,30 @@
 - :mod:`~kinelab.ik.frdm` (paper 000) and :mod:`~kinelab.ik.biquat` (paper 001).
 """
 
+from typing import TYPE_CHECKING
+
 from kinelab.errors import TargetError
-from kinelab.ik.api import solve, solve_all, solve_batch, track
-from kinelab.ik.registry import register
-from kinelab.ik.result import Diagnostics, IKResult, Status
-from kinelab.ik.targets import from_xyz_quat_wxyz as target_from_xyz_quat_wxyz
-from kinelab.ik.targets import from_xyz_rpy as target_from_xyz_rpy
+from kinelab.lazy import loader
+
+__getattr__ = loader(__name__, globals(), {
+    "solve": ("kinelab.ik.api", "solve"),
+    "solve_all": ("kinelab.ik.api", "solve_all"),
+    "solve_batch": ("kinelab.ik.api", "solve_batch"),
+    "track": ("kinelab.ik.api", "track"),
+    "register": ("kinelab.ik.registry", "register"),
+    "Diagnostics": ("kinelab.ik.result", "Diagnostics"),
+    "IKResult": ("kinelab.ik.result", "IKResult"),
+    "Status": ("kinelab.ik.result", "Status"),
+    "target_from_xyz_quat_wxyz": ("kinelab.ik.targets", "from_xyz_quat_wxyz"),
+    "target_from_xyz_rpy": ("kinelab.ik.targets", "from_xyz_rpy"),
+})
+
+if TYPE_CHECKING:  # the names the loader serves, for type checkers and editors
+    from kinelab.ik.api import solve, solve_all, solve_batch, track
+    from kinelab.ik.registry import register
+    from kinelab.ik.result import Diagnostics, IKResult, Status
+    from kinelab.ik.targets import from_xyz_quat_wxyz as target_from_xyz_quat_wxyz
+    from kinelab.ik.targets import from_xyz_rpy as target_from_xyz_rpy
 
 __all__ = ["Diagnostics", "IKResult", "Status", "TargetError", "register", "solve", "solve_all", "solve_batch",
            "target_from_xyz_quat_wxyz", "target_from_xyz_rpy", "track"]

@@ -16,13 +16,14 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from kinelab.ik.compiling import announce
 from kinelab.ik.limits import wrap_q
 from kinelab.ik.multistart import TypedKernel
 from kinelab.ik.request import Request
 from kinelab.ik.result import Attempt, BypassRecord, IKResult, SingularEvent, Status
 from kinelab.ik.targets import as_target
 from kinelab.ik.tasks import COMPONENTS, POSE, Task
-from kinelab.ik.verdict import pose_verdict
+from kinelab.ik.verdict import pose_defect, pose_verdict
 from kinelab.ik.workspace import out_of_reach
 from kinelab.robot import Robot
 
@@ -72,7 +73,7 @@ def solve_one(robot: Robot, target: Any, q0: Any, req: Request) -> IKResult:
         TargetError, ConfigurationError, JointLimitError: bad target or start, named.
     """
     module, opts = req.module, req.options
-    _prepare(module, robot)
+    _prepare(module, robot, opts)
     t_start = time.perf_counter()
     target = as_target(target, req.task.name)
     rng = _LazyRng(req.seed)
@@ -93,17 +94,18 @@ def solve_one(robot: Robot, target: Any, q0: Any, req: Request) -> IKResult:
 _CHECKS_COMPILED: list[bool] = []
 
 
-def _prepare(module: Any, robot: Robot) -> None:
+def _prepare(module: Any, robot: Robot, options: Any) -> None:
     """Compilation and model building, which are not a solve's time: the solver's, and the checks'."""
     prepare = getattr(module, "prepare", None)
     if prepare is not None:
-        prepare(robot)
+        prepare(robot, options)
     prepare_checks(robot)
 
 
 def prepare_checks(robot: Robot) -> None:
     """Compile (or load) the target check and Pinocchio's verdict kernel, once per process."""
     if not _CHECKS_COMPILED:
+        announce("the verdict", [pose_verdict, pose_defect])
         _compile_checks(robot)
 
 

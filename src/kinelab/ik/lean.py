@@ -20,6 +20,7 @@ import numpy as np
 import pinocchio as pin
 from numba import njit
 
+from kinelab.ik.compiling import announce
 from kinelab.ik.driver import Call, compiled_result, prepare_checks
 from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm import solver as frdm
@@ -89,6 +90,7 @@ class LeanFRDM:
 
     def _compile(self) -> None:
         """Load (or compile) the input check before any call's clock starts."""
+        announce("the prepared solver's input check", [usual_inputs])
         H = pin.SE3.Identity().homogeneous
         _USUAL(H, self.none, self.n, self.lower, self.upper, self.anchor, self.radius, np.zeros(3), np.zeros((3, 3)))
 

@@ -58,7 +58,7 @@ class IK:
                                              start_outside_limits, options, task, axis, solver_options)
         prepare = getattr(self.request.module, "prepare", None)
         if prepare is not None:
-            prepare(robot)  # compile (or load) the kernels now, not in the first call
+            prepare(robot, self.request.options)  # compile (or load) the kernels now, not in the first call
         prepare_checks(robot)
         req = self.request
         self._lean = LeanFRDM(robot, req) if req.solver == "frdm" and req.options.compiled else None

@@ -18,7 +18,8 @@ SOLVERS: dict[str, Any] = {}
 
 class SolverModule(Protocol):
     """What a solver provides: an options class with ``of(options, **kwargs)``, and ``attempt``; optionally
-    ``prepare(robot)`` (compilation, outside the timed region) and a compiled ``multistart``."""
+    ``prepare(robot, options)`` (compilation of what those options run, outside the timed region) and a compiled
+    ``multistart``."""
 
     Options: Any
 

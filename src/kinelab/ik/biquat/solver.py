@@ -23,6 +23,7 @@ from kinelab.ik.biquat import kernel, laws
 from kinelab.ik.biquat.integrators import Stop, System, Trajectory, adaptive, fixed
 from kinelab.ik.biquat.options import LAWS, BiquatOptions
 from kinelab.ik.chain import chain_model
+from kinelab.ik.compiling import announce
 from kinelab.ik.limits import wrap_q
 from kinelab.ik.multistart import TypedKernel, clock_chunk
 from kinelab.ik.result import Attempt, Diagnostics, Status
@@ -174,10 +175,12 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: 
 _COMPILED: list[bool] = []
 
 
-def prepare(robot: Robot) -> None:
-    """Compile (or load) the kernels before a solve's clock starts (once per process)."""
+def prepare(robot: Robot, options: BiquatOptions | None = None) -> None:
+    """Compile (or load) the kernels before a solve's clock starts (once per process), announced when it
+    compiles; ``options`` (the solves' options) make no difference: every path is loaded."""
     chain_model(robot)
     if not _COMPILED:
+        announce("the biquaternion solver", [kernel.multistart, kernel.integrate, laws.simple_law])
         target = pin.SE3.Identity()
         multistart(robot, target, robot.neutral(), 1e-6, 1e-6, np.inf, 0, 0)
         for law in LAWS:  # the laws the Python integrators call are compiled too, outside any budget

@@ -28,7 +28,13 @@ Modules: ``options`` (FRDMOptions), ``kernel`` (compiled), ``reference`` (readab
 ``monitor`` (monitor and bypasses), ``solver`` (attempt, multistart), ``tracking`` (paths).
 """
 
-from kinelab.ik.frdm import solver
-from kinelab.ik.frdm.options import FRDMOptions
+from typing import TYPE_CHECKING
 
-__all__ = ["FRDMOptions", "solver"]
+from kinelab.lazy import loader
+
+__getattr__ = loader(__name__, globals(), {"FRDMOptions": ("kinelab.ik.frdm.options", "FRDMOptions")})
+
+if TYPE_CHECKING:
+    from kinelab.ik.frdm.options import FRDMOptions
+
+__all__ = ["FRDMOptions"]

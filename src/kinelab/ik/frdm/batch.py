@@ -17,6 +17,7 @@ from numba import njit, prange
 
 from kinelab.geometry import wrap_to_pi
 from kinelab.ik.chain import CONTINUOUS, chain_model, random_configuration
+from kinelab.ik.compiling import announce
 from kinelab.ik.frdm import solver
 from kinelab.ik.frdm.attempts import multistart
 from kinelab.ik.frdm.kernel import (
@@ -54,9 +55,10 @@ class Rows:
 
 
 def prepare(robot: Robot) -> None:
-    """Compile (or load) the single-solve and the batch kernels: outside the batch's clock."""
-    solver.prepare(robot)
+    """Compile (or load) the batch kernel: outside the batch's clock, announced when it compiles."""
+    chain_model(robot)
     if not _COMPILED:
+        announce("the FRDM batch", [solve_rows])
         one = np.ones(1, dtype=np.int64)
         run(robot, np.zeros((1, 3)), np.eye(3)[None], None, np.ones((1, 1), dtype=np.uint64), one, 1e-6, 1e-6,
             np.inf, FRDMOptions())

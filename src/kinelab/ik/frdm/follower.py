@@ -9,6 +9,7 @@ import numpy as np
 
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.chain import chain_model
+from kinelab.ik.compiling import announce
 from kinelab.ik.frdm import kernel, path_kernel
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.multistart import seed_state
@@ -55,6 +56,7 @@ def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: 
     bounded = np.isfinite(cm.lower) & np.isfinite(cm.upper)
     centre = np.where(bounded, (np.where(bounded, cm.lower, 0.0) + np.where(bounded, cm.upper, 0.0)) / 2, q0)
     lower, upper = (cm.lower, cm.upper) if opts.use_limits else (np.full(cm.n, -np.inf), np.full(cm.n, np.inf))
+    announce("the path follower", [path_kernel.follow])
     t0 = time.perf_counter()
     path_kernel.follow(Q, np.array(q0, dtype=float), cm.chain, lower, upper, np.ones(cm.n, dtype=np.bool_), points,
                        rotations, opts.position_weight(cm.length), opts.axis_weights(), float(tol_pos),

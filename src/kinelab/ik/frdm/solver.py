@@ -19,6 +19,7 @@ import pinocchio as pin
 from kinelab.ik import dls
 from kinelab.ik import multistart as restarts
 from kinelab.ik.chain import CONTINUOUS, ChainModel, chain_model
+from kinelab.ik.compiling import announce
 from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm.attempts import multistart as compiled_multistart
 from kinelab.ik.frdm.kernel import no_rest
@@ -36,17 +37,28 @@ JOINT_SWEEPS_PER_LOOK = 256
 JOINT_SWEEPS_PER_LATER_LOOK = 64
 
 
-def prepare(robot: Robot) -> None:
-    """Build the chain model and compile (or load) both kernels: done before a solve's clock starts."""
+def prepare(robot: Robot, options: FRDMOptions | None = None) -> None:
+    """Build the chain model and compile (or load) the kernels ``options`` run (None: both the compiled
+    multistart and the monitored loop): done before a solve's clock starts, announced when it compiles.
+
+    Args:
+        robot: the robot.
+        options: the options of the solves to come.
+    """
     chain_model(robot)
-    if not _COMPILED:
-        target = pin.SE3.Identity()
-        attempt(robot, target, robot.neutral(), 1e-6, 1e-6, np.inf, max_sweeps=2, policy=())
+    target = pin.SE3.Identity()
+    compiled = options is None or options.compiled
+    if compiled and "multistart" not in _COMPILED:
+        announce("FRDM", [compiled_multistart])
         multistart(robot, target, robot.neutral(), 1e-6, 1e-6, np.inf, 0, 0)
-        _COMPILED.append(True)
+        _COMPILED.add("multistart")
+    if (options is None or not compiled) and "monitored" not in _COMPILED:
+        announce("the monitored FRDM loop", [kernel.run])
+        attempt(robot, target, robot.neutral(), 1e-6, 1e-6, np.inf, max_sweeps=2, policy=())
+        _COMPILED.add("monitored")
 
 
-_COMPILED: list[bool] = []  # one compilation per process, whatever the robot
+_COMPILED: set[str] = set()  # the paths compiled (or loaded) in this process, whatever the robot
 
 
 def attempt(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol_rot: float, deadline: float,

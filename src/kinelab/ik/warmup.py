@@ -1,0 +1,38 @@
+"""Compile every compiled path ahead of use (``kinelab warmup``): after an install, or an update of kinelab or
+numba, each path's first call compiles its numba kernels (about a minute each on a 2-core machine); warming up
+pays that once, with progress, so that no later solve, batch, path or notebook waits silently."""
+
+from __future__ import annotations
+
+import time
+import warnings
+from collections.abc import Callable, Iterator
+
+from kinelab.ik.compiling import CompileNotice
+from kinelab.robot import Robot
+
+
+def paths(robot: Robot) -> list[tuple[str, Callable[[], object]]]:
+    """(name, a call that runs the path once on ``robot``) for every compiled path."""
+    from kinelab.ik.api import solve, solve_batch, track
+    from kinelab.ik.prepared import IK
+
+    q = robot.random_q(0)
+    target = robot.fk(q)
+    return [
+        ("FRDM (single solves, the prepared solver)", lambda: IK(robot).solve(target, q0=q)),
+        ("FRDM's monitored loop (bypasses, policies)", lambda: solve(robot, target, policy=("auto_kick",))),
+        ("the FRDM batch", lambda: solve_batch(robot, [target] * 2, seed=0)),
+        ("the path follower", lambda: track(robot, [target] * 2, q0=q)),
+        ("the biquaternion solver", lambda: solve(robot, target, solver="biquat", seed=0)),
+    ]
+
+
+def run(robot: Robot) -> Iterator[tuple[str, float]]:
+    """Run every path once (compiling what is not cached), yielding (name, seconds) as each finishes."""
+    for name, call in paths(robot):
+        t0 = time.perf_counter()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", CompileNotice)  # the caller reports progress itself
+            call()
+        yield name, time.perf_counter() - t0
