@@ -169,11 +169,25 @@ def test_the_loops_protocols_judge_every_answer_with_pinocchio():
     by_loop = {r["loop"]: r for r in rows}
     assert {"frdm solve() loop", "frdm solve_batch"} <= set(by_loop)
     assert by_loop["frdm solve_batch"]["success_pct"] == 100.0 and by_loop["frdm solve_batch"]["spread"] >= 1.0
-    tracked = {r["tracker"]: r for r in loops.tracking(ur5, seed=2, samples=200, repeats=1)}
-    assert tracked["frdm+lm track"]["reached"] == 200
-    assert 0 < tracked["frdm track"]["max_step_over_path_step"] < 10
+    tracked = {r["tracker"]: r for r in loops.tracking(ur5, seed=2, paths=2, samples=100, repeats=1)}
+    assert tracked["frdm track"]["reached"] == 200 and tracked["frdm track"]["paths_with_jump"] == 0
     text = loops.markdown(rows, list(tracked.values()))
-    assert "| ur5 | frdm solve_batch | warm σ=0.02 |" in text and "| ur5 | frdm+lm track | 200/200 |" in text
+    assert "| ur5 | frdm solve_batch | warm σ=0.02 |" in text and "| ur5 | frdm track | 200/200 | 0/2 |" in text
+
+
+def test_the_versus_protocol_times_both_calls_and_judges_every_answer():
+    from kinelab.report.bench import versus
+
+    ur5 = kinelab.load("ur5")
+    contenders = versus.solvers(ur5)
+    cases = versus.problems(ur5, 6, 3, "warm", 0.2)
+    result = versus.rounds(ur5, cases, {k: contenders[k] for k in ("IK.solve", "kinelab.solve")}, 2, 0)
+    for name in ("IK.solve", "kinelab.solve"):
+        assert len(result[name]) == 2 and all(ok.all() and (t > 0).all() for t, ok in result[name])
+    wrong = {"wrong": lambda t, q0, seed: q0 + 0.5}  # a solver whose answers miss: judged here, not trusted
+    assert not versus.rounds(ur5, cases, wrong, 1, 0)["wrong"][0][1].any()
+    floor = versus.problems(ur5, 3, 4, "floor", 0.0)
+    assert all(np.allclose(ur5.fk(q0).homogeneous, t.homogeneous) for t, q0 in floor)
 
 
 def test_task_protocols_judge_the_constrained_components_and_skip_solvers_without_the_task(ur5):

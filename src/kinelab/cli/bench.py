@@ -34,6 +34,9 @@ def add(sub: Any) -> None:
     s.add_argument("--tracking", action="store_true", help="also time tracking along the ERA passages (FRDM, DLS)")
     s.add_argument("--loops", action="store_true",
                    help="also the loops users run: throughput (solve loop, solve_batch, ik_LM) and path tracking")
+    s.add_argument("--versus", action="store_true",
+                   help="also kinelab.IK(...).solve and kinelab.solve against ik_LM: floor, warm (sigma 0.02, 0.2) "
+                        "and random starts, interleaved and blocked rounds, ratios with their spread")
     s.add_argument("--out", help="write bench.json, bench.md and bench.png here")
     s.add_argument("--json", action="store_true", help="print the results as JSON instead of tables")
     s.set_defaults(func=run)
@@ -64,6 +67,11 @@ def run(args: argparse.Namespace) -> int:
         from kinelab.report.bench import loops
 
         result["loops"] = loops.run(args.robots, seed=args.seed, repeats=args.repeats, progress=not args.json)
+    if args.versus:
+        from kinelab.report.bench import versus
+
+        result["versus"] = versus.run(args.robots, seed=args.seed, repeats=max(args.repeats, 2),
+                                      progress=not args.json)
     if args.out:
         render.write_bench(result, args.out)
     if args.json:
@@ -91,3 +99,7 @@ def _print_tables(result: dict[str, Any]) -> None:
         from kinelab.report.bench import loops
 
         print(loops.markdown(result["loops"]["throughput"], result["loops"]["tracking"], result["loops"]["budgets"]))
+    if "versus" in result:
+        from kinelab.report.bench import versus
+
+        print(versus.markdown(result["versus"]))

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from kinelab.report.bench import loops, scaling
+from kinelab.report.bench import loops, scaling, versus
 from kinelab.report.outfolder import atomic_folder
 from kinelab.report.page import CAPTIONS, validate_html
 from kinelab.report.validate import Report
@@ -131,6 +131,8 @@ def _write_bench_files(result: dict[str, Any], folder: Path) -> None:
     if "loops" in result:
         sections.append(loops.markdown(result["loops"]["throughput"], result["loops"]["tracking"],
                                        result["loops"]["budgets"]))
+    if "versus" in result:
+        sections.append(versus.markdown(result["versus"]))
     (folder / "bench.md").write_text("\n\n".join(sections) + "\n")
     bench_figure(result, folder / "bench.png")
 
