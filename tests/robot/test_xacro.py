@@ -100,3 +100,32 @@ def test_a_map_worker_gets_the_user_s_trust_and_arguments(tmp_path):
     path.write_text(XACRO)
     how = recipe(load(path, xacro_args={"reach": "0.5"}))
     assert how["trust_xacro"] is False and how["xacro_args"] == {"reach": "0.5"}
+
+
+def test_no_temporary_folder_outlives_what_uses_it(tmp_path):
+    """kinelab 0.2 left a kinelab-* folder in the temporary directory per xacro load, viewer scene and bench
+    run. Checked in a process of its own with a private TMPDIR."""
+    import os
+    import subprocess
+    import sys
+
+    private = tmp_path / "tmp"
+    private.mkdir()
+    (tmp_path / "arm.urdf.xacro").write_text(XACRO)
+    script = f"""
+import gc, os, kinelab
+from kinelab.report.bench import peers
+robot = kinelab.load({str(tmp_path / "arm.urdf.xacro")!r})
+assert len(os.listdir({str(private)!r})) == 1, "the expansion lives while its robot does"
+del robot
+gc.collect()
+assert os.listdir({str(private)!r}) == [], "gone with its robot"
+ur5 = kinelab.load("ur5")
+ur5.visual_model()
+assert os.listdir({str(private)!r}) == [], "the mesh-resolved copy is read once and removed"
+peers.kinematic_urdf(ur5)
+"""
+    done = subprocess.run([sys.executable, "-c", script], env={**os.environ, "TMPDIR": str(private)},
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert os.listdir(private) == []  # the bench's stripped URDF went with the process

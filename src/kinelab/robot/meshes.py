@@ -97,7 +97,7 @@ def missing_meshes(urdf_path: str | Path, package_dirs: list[str] | None = None)
     return [u for u in uris if resolve_uri(u, urdf_dir, package_dirs) is None]
 
 
-def _with_resolved_meshes(urdf_path: Path, package_dirs: list[str]) -> Path:
+def _with_resolved_meshes(urdf_path: Path, package_dirs: list[str], folder: Path) -> Path:
     """A copy of the URDF whose visual meshes name the files kinelab resolved (absolute paths), and without
     the visuals whose mesh cannot be found: Pinocchio then reads exactly what kinelab found."""
     tree = ET.parse(urdf_path)
@@ -111,7 +111,7 @@ def _with_resolved_meshes(urdf_path: Path, package_dirs: list[str]) -> Path:
                 link.remove(vis)
             else:
                 mesh.set("filename", str(found.resolve()))
-    out = Path(tempfile.mkdtemp(prefix="kinelab-")) / urdf_path.name
+    out = folder / urdf_path.name
     tree.write(out)
     return out
 
@@ -128,5 +128,6 @@ def build_visual_model(
         warnings.warn(f"{len(missing)} mesh(es) of {urdf_path} not found (first: {missing[0]}; searched "
                       f"{', '.join(dirs) or 'no package directory'}); those visuals are left out: pass "
                       "package_dirs= (CLI --package-dir) or set ROS_PACKAGE_PATH", stacklevel=2)
-    resolved = _with_resolved_meshes(urdf_path, dirs)
-    return pin.buildGeomFromUrdf(model, str(resolved), pin.GeometryType.VISUAL, package_dirs=dirs)
+    with tempfile.TemporaryDirectory(prefix="kinelab-") as folder:  # Pinocchio reads it once, here
+        resolved = _with_resolved_meshes(urdf_path, dirs, Path(folder))
+        return pin.buildGeomFromUrdf(model, str(resolved), pin.GeometryType.VISUAL, package_dirs=dirs)

@@ -30,6 +30,7 @@ from kinelab.robot.build import LIMIT_SLACK, Built, build_file, build_model, fra
 from kinelab.robot.joints import Joint, Mimic
 from kinelab.robot.meshes import build_visual_model
 from kinelab.robot.mjcf import is_mjcf
+from kinelab.scratch import own
 
 T = TypeVar("T")
 SAMPLE_TURNS = 4  # random configurations keep revolute joints within ±4 turns (see Robot.random_q)
@@ -59,6 +60,8 @@ class Robot:
         self.srdf, self.package_dirs = built.srdf, built.package_dirs
         self.xacro_args, self.trust_xacro = built.xacro_args, built.trust_xacro
         self._built = built
+        if built.source is not None and built.urdf_path is not None and built.urdf_path != built.source:
+            own(self, built.urdf_path.parent)  # a xacro expansion: it lives as long as this robot
         self.data = self.model.createData()
         self.tool_frame_id = frame_id(self.model, self.tool, self.name)
         self._index_joints()

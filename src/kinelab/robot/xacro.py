@@ -15,13 +15,13 @@ from __future__ import annotations
 
 import contextlib
 import re
-import tempfile
 import threading
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
 from kinelab.errors import URDFError
+from kinelab.scratch import scratch_dir
 
 INSTALL_HINT = "pip install 'kinelab[xacro]' (xacrodoc)"
 # what an untrusted file may not use, and how to find it in the text to name its line
@@ -78,7 +78,7 @@ def expand(path: Path, args: dict[str, str] | None = None, trusted: bool = False
                             "it") from None
         reason = " ".join(str(exc).split())  # one line: xacro's messages span several
         raise URDFError(f"xacro cannot expand {path}: {reason}") from None
-    out = Path(tempfile.mkdtemp(prefix="kinelab-xacro-")) / (path.name.removesuffix(".xacro") or "robot.urdf")
+    out = scratch_dir("kinelab-xacro-") / (path.name.removesuffix(".xacro") or "robot.urdf")
     out.write_text(text)
     return out
 

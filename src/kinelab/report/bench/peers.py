@@ -12,7 +12,6 @@ limits; its answer is re-checked by :func:`kinelab.report.bench.protocol.check_s
 from __future__ import annotations
 
 import importlib.util
-import tempfile
 import time
 import warnings
 import xml.etree.ElementTree as ET
@@ -25,6 +24,7 @@ from kinelab.errors import KinelabError
 from kinelab.ik.chain import PRISMATIC, chain_model
 from kinelab.report.bench.protocol import TOL_POS, TOL_ROT, Case, Prepare, SolveFn
 from kinelab.robot import Robot
+from kinelab.scratch import scratch_dir
 
 PEERS = {"rtb-ik_LM": "roboticstoolbox", "trac-ik": "pytracik", "ikpy": "ikpy", "pink": "pink"}
 
@@ -42,7 +42,7 @@ def kinematic_urdf(robot: Robot) -> Path:
     for tag in ("gazebo", "transmission"):
         for el in list(root.findall(tag)):
             root.remove(el)
-    out = Path(tempfile.mkdtemp(prefix="kinelab-bench-")) / f"{robot.name}.urdf"
+    out = scratch_dir("kinelab-bench-") / f"{robot.name}.urdf"
     tree.write(out)
     return out
 

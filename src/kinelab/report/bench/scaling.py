@@ -7,10 +7,8 @@ line is fitted to time per sweep against the number of links and its R² reporte
 
 from __future__ import annotations
 
-import tempfile
 import time
 from collections.abc import Callable
-from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -22,6 +20,7 @@ from kinelab.ik.frdm import kernel
 from kinelab.report.bench import peers
 from kinelab.robot import Robot
 from kinelab.robot.build import build_file
+from kinelab.scratch import scratch_dir
 
 LENGTHS = (7, 15, 30, 60, 100)
 
@@ -51,7 +50,7 @@ def synthetic_urdf(n: int, seed: int = 0, link: float | None = None) -> str:
 
 def synthetic_robot(n: int, seed: int = 0) -> Robot:
     """A synthetic n-link chain (every fourth joint prismatic), loaded from a temporary URDF."""
-    path = Path(tempfile.mkdtemp(prefix="kinelab-chain-")) / f"chain{n}.urdf"
+    path = scratch_dir("kinelab-chain-") / f"chain{n}.urdf"
     path.write_text(synthetic_urdf(n, seed))
     return Robot(build_file(path, name=f"chain{n}"))
 
