@@ -96,6 +96,9 @@ def test_ik_beyond_reach_is_unreachable_with_exit_1(capsys):
     (["ik", "era", "--target-xyz", "4", "2", "6", "--kick", "joint4"], "--kick wants JOINT=DELTA"),
     (["ik", "era", "--target-xyz", "4", "2", "6", "--interval", "joint5=80"], "wants JOINT=LOWER:UPPER"),
     (["ik", "era", "--target-xyz", "4", "2", "6", "--interval", "joint5=1:-1"], "is empty"),
+    (["ik", "panda", "--target-xyz", "0.4", "0.2", "0.5", "--target-rpy", "180", "0", "0"], "looks like degrees"),
+    (["ik", "panda", "--target-q", "0", "30", "0", "-90", "0", "90", "45"], "add --deg"),
+    (["fk", "panda", "0", "30", "0", "-90", "0", "90", "45"], "30 for panda_joint2 looks like degrees"),
     (["ik", "era", "--target-xyz", "4", "2", "6", "--freeze", "joint1=x"], "is not a number"),
     (["ik", "era", "--solver", "dls", "--target-xyz", "4", "2", "6", "--freeze", "joint1"], "FRDM's bypasses"),
 ])

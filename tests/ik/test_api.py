@@ -145,3 +145,11 @@ def test_the_prepared_solver_gives_kinelab_solve_s_answers(ur5):
         kinelab.IK(ur5, "dls")
     with pytest.raises(OptionError, match="tol_pos"):
         kinelab.IK(ur5, tol_pos=0.0)
+
+
+def test_roll_pitch_yaw_in_degrees_are_taken_by_name_and_caught_when_given_as_radians():
+    deg = kinelab.target_from_xyz_rpy([0.4, 0.2, 0.5], [180, 0, 90], degrees=True)
+    rad = kinelab.target_from_xyz_rpy([0.4, 0.2, 0.5], [np.pi, 0, np.pi / 2])
+    np.testing.assert_allclose(deg.homogeneous, rad.homogeneous, atol=1e-12)
+    with pytest.raises(kinelab.TargetError, match="looks like degrees.*degrees=True"):
+        kinelab.target_from_xyz_rpy([0.4, 0.2, 0.5], [180, 0, 0])

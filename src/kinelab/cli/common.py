@@ -42,9 +42,14 @@ def q_from_cli(robot: Robot, values: list[str], deg: bool, what: str = "q") -> n
                                      "configuration name with --srdf)")
         numbers.append(float(v))
     q = robot.check_q(numbers, what=what)
+    angular = np.array([k != "prismatic" for k in robot.joint_kinds])
     if deg:
-        angular = np.array([k != "prismatic" for k in robot.joint_kinds])
-        q = np.where(angular, np.deg2rad(q), q)
+        return np.where(angular, np.deg2rad(q), q)
+    for i in np.flatnonzero(angular & (np.abs(q) > 2 * np.pi + 1e-9)):
+        j = robot.joints[i]
+        if not j.lower <= q[i] <= j.upper:  # a joint whose limits allow it may turn that far in radians
+            raise ConfigurationError(f"{what}: {q[i]:g} for {j.name} looks like degrees (beyond ±2π rad and "
+                                     "outside its limits): add --deg, or give radians")
     return q
 
 

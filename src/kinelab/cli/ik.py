@@ -88,13 +88,17 @@ def run(args: argparse.Namespace) -> int:
 def _target(robot: Robot, args: argparse.Namespace) -> tuple[Any, dict[str, Any]]:
     """The target pose, and the biquaternion solver's signed target when it is given as a configuration."""
     from kinelab.ik import target_from_xyz_rpy
+    from kinelab.ik.targets import DEGREES_LIKELY
 
     if (args.target_q is None) == (args.target_xyz is None):
         raise KinelabError("give the target as --target-q Q... or as --target-xyz X Y Z [--target-rpy R P Y]")
     options: dict[str, Any] = {}
     if args.target_q is None:
         rpy = np.array(args.target_rpy if args.target_rpy is not None else [0.0, 0.0, 0.0])
-        return target_from_xyz_rpy(args.target_xyz, np.deg2rad(rpy) if args.deg else rpy), options
+        if not args.deg and np.abs(rpy).max() > DEGREES_LIKELY:
+            raise KinelabError(f"--target-rpy {' '.join(f'{v:g}' for v in rpy)} looks like degrees (an angle beyond "
+                               "±2π rad): add --deg, or give radians")
+        return target_from_xyz_rpy(args.target_xyz, rpy, degrees=args.deg), options
     q_target = robot.check_q(q_from_cli(robot, args.target_q, args.deg, "--target-q"), limits=True,
                              what="--target-q")
     if args.solver == "biquat":

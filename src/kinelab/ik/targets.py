@@ -16,10 +16,28 @@ from kinelab.ik.verdict import NOT_A_ROTATION, NOT_FINITE, pose_defect
 _POSE_DEFECT = TypedKernel(pose_defect)
 
 
-def from_xyz_rpy(xyz: ArrayLike, rpy: ArrayLike = (0.0, 0.0, 0.0)) -> pin.SE3:
-    """oMtarget from a position [m] and roll-pitch-yaw angles [rad] (R = Rz(yaw) Ry(pitch) Rx(roll))."""
+def from_xyz_rpy(xyz: ArrayLike, rpy: ArrayLike = (0.0, 0.0, 0.0), *, degrees: bool = False) -> pin.SE3:
+    """oMtarget from a position [m] and roll-pitch-yaw angles (R = Rz(yaw) Ry(pitch) Rx(roll)).
+
+    Args:
+        xyz: the position [m], base frame.
+        rpy: roll, pitch, yaw [rad; degrees with ``degrees=True``].
+        degrees: the angles are in degrees.
+
+    Raises:
+        TargetError: not three finite numbers each, or radians beyond ±2π (degrees given as radians, most
+            likely: said, with ``degrees=True`` named).
+    """
     xyz, rpy = _finite(xyz, 3, "xyz"), _finite(rpy, 3, "rpy")
+    if degrees:
+        rpy = np.deg2rad(rpy)
+    elif np.abs(rpy).max() > DEGREES_LIKELY:
+        raise TargetError(f"rpy {rpy.tolist()} looks like degrees (an angle beyond ±2π rad): pass degrees=True, or "
+                          "give radians")
     return pin.SE3(pin.rpy.rpyToMatrix(*rpy), xyz)
+
+
+DEGREES_LIKELY = 2 * np.pi + 1e-9  # [rad] an angle beyond this, where radians are expected, was meant in degrees
 
 
 def from_xyz_quat_wxyz(xyz: ArrayLike, quat_wxyz: ArrayLike) -> pin.SE3:
