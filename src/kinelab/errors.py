@@ -2,11 +2,34 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+import difflib
+from collections.abc import Iterable, Mapping
 
 
 class KinelabError(Exception):
     """Base class of every error kinelab raises on bad input or an impossible request."""
+
+
+def did_you_mean(name: str, valid: Iterable[str], words: Mapping[str, str] | None = None) -> str:
+    """" (did you mean 'x'?)" for the valid name closest to ``name`` — the same letters in another case, a close
+    spelling, or a name whose description holds ``name`` as a word (``words``: word → name) — else "".
+
+    Args:
+        name: what the user gave.
+        valid: the valid names.
+        words: lower-case words that stand for a valid name (a robot's maker, say).
+
+    Returns:
+        The suggestion, with a leading space, or "".
+    """
+    names = list(valid)
+    folded = {n.lower(): n for n in names}
+    key = str(name).strip().lower()
+    found = folded.get(key) or (words or {}).get(key)
+    if found is None:
+        close = difflib.get_close_matches(key, list(folded), n=1, cutoff=0.75)
+        found = folded[close[0]] if close else None
+    return f" (did you mean {found!r}?)" if found is not None and found != name else ""
 
 
 def _listing(options: Iterable[str], most: int = 40) -> str:
@@ -18,12 +41,12 @@ def _listing(options: Iterable[str], most: int = 40) -> str:
 class RobotNotFoundError(KinelabError):
     """A robot name that is neither registered nor an existing URDF file."""
 
-    def __init__(self, name: str, valid: Iterable[str]):
+    def __init__(self, name: str, valid: Iterable[str], words: Mapping[str, str] | None = None):
         self.name = name
         self.valid = list(valid)
         super().__init__(
-            f"unknown robot {name!r}: not a registered name and no such file; "
-            f"registered robots are: {_listing(self.valid)}"
+            f"unknown robot {name!r}{did_you_mean(name, self.valid, words)}: not a registered name and no such "
+            f"file; registered robots are: {_listing(self.valid)}"
         )
 
 
@@ -51,7 +74,8 @@ class FrameNotFoundError(KinelabError):
         self.name = name
         self.valid = list(valid)
         where = f" in robot {robot!r}" if robot else ""
-        super().__init__(f"unknown frame {name!r}{where}; frames are: {_listing(self.valid, 60)}")
+        super().__init__(f"unknown frame {name!r}{where}{did_you_mean(name, self.valid)}; frames are: "
+                         f"{_listing(self.valid, 60)}")
 
 
 class JointNotFoundError(KinelabError):
@@ -60,7 +84,8 @@ class JointNotFoundError(KinelabError):
     def __init__(self, name: str, valid: Iterable[str]):
         self.name = name
         self.valid = list(valid)
-        super().__init__(f"unknown joint {name!r}; joints are: {_listing(self.valid)}")
+        super().__init__(f"unknown joint {name!r}{did_you_mean(name, self.valid)}; joints are: "
+                         f"{_listing(self.valid)}")
 
 
 class ConfigurationError(KinelabError):
@@ -100,4 +125,5 @@ class SolverNotFoundError(KinelabError):
     def __init__(self, name: str, valid: Iterable[str]):
         self.name = name
         self.valid = sorted(valid)
-        super().__init__(f"unknown solver {name!r}; solvers are: {', '.join(self.valid)}")
+        super().__init__(f"unknown solver {name!r}{did_you_mean(name, self.valid)}; solvers are: "
+                         f"{', '.join(self.valid)}")

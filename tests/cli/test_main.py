@@ -371,3 +371,18 @@ def test_warmup_runs_every_compiled_path_and_reports_each(capsys):
         "FRDM (single solves, the prepared solver)", "FRDM's monitored loop (bypasses, policies)", "the FRDM batch",
         "the path follower", "the biquaternion solver"]
     assert all(line.endswith(" s)") for line in lines[1:-1]) and lines[-1].startswith("kinelab: every path is ready")
+
+
+def test_close_names_are_suggested_and_printed_numbers_have_no_minus_zero(capsys):
+    for name, meant in (("pandaa", "panda"), ("UR5", "ur5"), ("franka", "panda")):
+        code, _, err = run(capsys, "info", name)
+        assert code == 2 and f"(did you mean {meant!r}?)" in err
+    code, _, err = run(capsys, "ik", "ur5", "--target-xyz", "0.4", "0.2", "0.5", "--solver", "frdn")
+    assert code == 2 and "(did you mean 'frdm'?)" in err
+    code, _, err = run(capsys, "fk", "ur5", "0", "0", "0", "0", "0", "0", "--tool", "tool1")
+    assert code == 2 and "(did you mean 'tool0'?)" in err
+    code, out, _ = run(capsys, "fk", "stanford", "0", "0", "0", "0", "0", "0")
+    assert code == 0 and "-0." not in out and "e-1" not in out  # no −0, no 1e-17 rounding noise
+    code, out, _ = run(capsys, "ik", "era", "--target-xyz", "4", "2", "6", "--deg")
+    assert code == 0 and len([line for line in out.splitlines() if line.startswith("  q")]) == 1
+    assert out.splitlines()[1].count("]") == 2 and out.splitlines()[2].startswith("  position error")  # one line

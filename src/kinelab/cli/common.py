@@ -137,3 +137,10 @@ def rounded(values: Any, digits: int) -> list[float]:
 def plural(count: int, word: str, plural_form: str | None = None) -> str:
     """"1 sample", "2 samples" (or the plural form given)."""
     return f"{count} {word}" if count == 1 else f"{count} {plural_form or word + 's'}"
+
+
+def shown(values: Any, precision: int = 6, prefix: str = "") -> str:
+    """Numbers as the CLI prints them: ``precision`` digits, rounding noise below 1e-12 as 0, no "-0", one line
+    per row however many joints (``prefix``: the text before the array, for the rows after the first)."""
+    clean = np.round(np.asarray(values, dtype=float), precision) + 0.0  # + 0.0 turns the −0 of rounding into 0
+    return np.array2string(clean, precision=precision, suppress_small=True, max_line_width=10_000, prefix=prefix)

@@ -5,9 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-import numpy as np
-
-from kinelab.cli.common import json_flag, load_robot, pose_dict, print_json, q_from_cli, robot_arguments
+from kinelab.cli.common import json_flag, load_robot, pose_dict, print_json, q_from_cli, robot_arguments, shown
 
 
 def add(sub: Any) -> None:
@@ -32,8 +30,8 @@ def run(args: argparse.Namespace) -> int:
     print(f"{robot.name}: pose of {robot.tool!r} in {robot.base!r}")
     for note in outside:
         print(f"  note: {note} (the pose is computed all the same)")
-    print(f"  position [m]   {np.array2string(oMtool.translation, precision=6)}")
-    print(f"  quat_wxyz      {np.array2string(np.array(out['quat_wxyz']), precision=6)}")
-    print(f"  rpy [rad]      {np.array2string(np.array(out['rpy_rad']), precision=6)}")
-    print("  rotation       " + np.array2string(oMtool.rotation, precision=6, prefix="  rotation       "))
+    print(f"  position [m]   {shown(oMtool.translation)}")
+    print(f"  quat_wxyz      {shown(out['quat_wxyz'])}")
+    print(f"  rpy [rad]      {shown(out['rpy_rad'])}")
+    print("  rotation       " + shown(oMtool.rotation, prefix="  rotation       "))
     return 0

@@ -16,6 +16,7 @@ from kinelab.cli.common import (
     print_json,
     q_from_cli,
     seed_argument,
+    shown,
     source_arguments,
 )
 from kinelab.errors import KinelabError
@@ -157,7 +158,7 @@ def _print_ik(robot: Robot, args: argparse.Namespace, result: IKResult) -> None:
     q_show = np.where([k != "prismatic" for k in robot.joint_kinds], np.rad2deg(result.q), result.q) \
         if args.deg else result.q
     print(f"{robot.name} {args.solver}, task {result.task}: {result.status.value} (success: {result.success})")
-    print(f"  q{' [deg, m]' if args.deg else ' [rad, m]'}  {np.array2string(q_show, precision=6)}")
+    print(f"  q{' [deg, m]' if args.deg else ' [rad, m]'}  {shown(q_show)}")
     free = {"position": (False, True), "orientation": (True, False)}.get(args.task, (False, False))
     print(f"  position error {result.position_error:.3e} m{' (free)' if free[0] else ''}, "
           f"{'axis' if args.task == 'axis' else 'rotation'} error {result.rotation_error:.3e} rad"

@@ -5,8 +5,6 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-import numpy as np
-
 from kinelab.cli import common
 from kinelab.errors import KinelabError
 
@@ -40,7 +38,7 @@ def run(args: argparse.Namespace) -> int:
         common.print_json({"robot": robot.name, **a.to_dict()})
         return 0
     print(f"{robot.name}: rank {a.rank} of {a.full_rank}{' (SINGULAR)' if a.singular else ''}; "
-          f"σ = {np.array2string(a.singular_values, precision=4)} (linear rows / L = {a.length:.4g} m)")
+          f"σ = {common.shown(a.singular_values, precision=4)} (linear rows / L = {a.length:.4g} m)")
     print(f"  manipulability {a.manipulability:.4g}, condition {a.condition:.4g}")
     for d in a.lost_directions:
         parts = []

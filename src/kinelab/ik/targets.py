@@ -30,7 +30,7 @@ def from_xyz_rpy(xyz: ArrayLike, rpy: ArrayLike = (0.0, 0.0, 0.0), *, degrees: b
     """
     xyz, rpy = _finite(xyz, 3, "xyz"), _finite(rpy, 3, "rpy")
     if degrees:
-        rpy = np.deg2rad(rpy)
+        rpy = np.asarray(np.deg2rad(rpy), dtype=float)
     elif np.abs(rpy).max() > DEGREES_LIKELY:
         raise TargetError(f"rpy {rpy.tolist()} looks like degrees (an angle beyond ±2π rad): pass degrees=True, or "
                           "give radians")

@@ -137,6 +137,15 @@ def srdf_path(entry: Entry) -> Path | None:
     return None if root is None else root / entry.srdf
 
 
+def _maker_words() -> dict[str, str]:
+    """Words of the descriptions that name one robot alone ("franka", "jaco", "xarm7") → that robot."""
+    seen: dict[str, set[str]] = {}
+    for e in ENTRIES.values():
+        for word in e.description.replace(",", " ").lower().split():
+            seen.setdefault(word, set()).add(e.name)
+    return {word: next(iter(robots)) for word, robots in seen.items() if len(robots) == 1 and len(word) > 3}
+
+
 def names() -> list[str]:
     """All registered robot names, bundled ones first."""
     return list(ENTRIES)
@@ -155,4 +164,4 @@ def resolve(name_or_path: str | Path) -> tuple[Path, Entry | None]:
     path = Path(key)
     if path.suffix.lower() in {".urdf", ".xml"} or path.exists() or "/" in key:
         return path, None
-    raise RobotNotFoundError(key, names())
+    raise RobotNotFoundError(key, names(), _maker_words())
