@@ -172,10 +172,28 @@ def test_an_interrupted_cli_run_resumes_to_the_identical_map(ur5, tmp_path):
         if done >= 3:
             proc.send_signal(signal.SIGINT)
             break
-    proc.communicate(timeout=60)
+    _, err = proc.communicate(timeout=60)
     interrupted = maps.load(out)
-    assert proc.returncode == 130 and 3 <= int(np.sum(interrupted.done[:])) < interrupted.chunks
-    assert subprocess.run(argv, capture_output=True, text=True, env=env, timeout=600).returncode == 0
+    kept = int(np.sum(interrupted.done[:]))
+    assert proc.returncode == 130 and 3 <= kept < interrupted.chunks
+    # one line: what was kept, and the command that resumes (kinelab 0.2 said only "kinelab: interrupted")
+    assert err.strip().splitlines()[-1] == (f"kinelab: interrupted; {kept} of {interrupted.chunks} chunks are saved "
+                                            f"in {out}; the same command resumes: kinelab {' '.join(argv[3:])}")
+    rerun = subprocess.run(argv[:-1], capture_output=True, text=True, env=env, timeout=600)  # the bar shows
+    assert rerun.returncode == 0 and f"resumed: {kept} chunks already in {out}" in rerun.stderr
     whole = maps.reachability(ur5, reach.MapSpec(voxel=0.15, orientations=4, restarts=3, chunk_voxels=16))
     for name in ("reachability", "manipulability", "sigma_ratio"):
         np.testing.assert_array_equal(maps.load(out).array(name), whole.array(name))
+
+
+def test_progress_shows_by_default_where_someone_watches_and_not_in_a_pipe(ur5, capsys, monkeypatch):
+    """kinelab 0.2's maps.reachability printed nothing for 82 s by default (progress=False)."""
+    import sys
+
+    spec = reach.MapSpec(voxel=0.3, orientations=1, restarts=0, chunk_voxels=8)
+    maps.reachability(ur5, spec)
+    assert capsys.readouterr().err == ""  # a pipe or a log: quiet
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True, raising=False)
+    maps.reachability(ur5, spec)
+    err = capsys.readouterr().err
+    assert "map: 100%" in err and "chunk" in err

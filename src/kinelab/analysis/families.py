@@ -10,11 +10,11 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
-from tqdm import tqdm
 
 from kinelab.analysis.singular import NEAR_SINGULAR, analyze, scaled_jacobian
 from kinelab.errors import KinelabError
 from kinelab.ik.request import check_seed
+from kinelab.progress import bar
 from kinelab.robot import Robot
 
 RELATION_TOL = 1e-3  # [rad or m] a joint relation holds within this
@@ -22,12 +22,13 @@ SPECIAL_VALUES = (0.0, np.pi / 2, -np.pi / 2, np.pi, -np.pi, 2 * np.pi, -2 * np.
 FAMILY_MARGIN = 0.1  # [rad] a sample this close to every relation of a known family is explained by it
 
 
-def sigma_ratio_batch(robot: Robot, qs: np.ndarray, length: float | None = None, progress: bool = False) -> np.ndarray:
+def sigma_ratio_batch(robot: Robot, qs: np.ndarray, length: float | None = None,
+                      progress: bool | None = False) -> np.ndarray:
     """σ_min/σ_max of the scaled Jacobian for each row of ``qs`` (one batched SVD)."""
     L = length or robot.characteristic_length()
     model, data, fid = robot.model, robot.data, robot.tool_frame_id
     Js = np.empty((len(qs), 6, robot.nv))
-    for i, q in enumerate(tqdm(qs, desc="jacobians", disable=not progress, unit="q", leave=False)):
+    for i, q in enumerate(bar(qs, progress=progress, desc="jacobians", unit="q", leave=False)):
         Js[i] = pin.computeFrameJacobian(model, data, robot.to_pin_q(q), fid, pin.LOCAL_WORLD_ALIGNED).reshape(6, -1)
     Js[:, :3] /= L
     s = np.linalg.svd(Js, compute_uv=False)
@@ -310,7 +311,7 @@ def _refine_samples(robot: Robot, qs: np.ndarray, order: list[int], lower: np.nd
     """
     groups: dict[tuple[tuple[Relation, ...], bool], list[np.ndarray]] = {}
     refined = singular_count = 0
-    with tqdm(total=refine_top, desc="refine", disable=not progress, unit="q", leave=False) as bar:
+    with bar(total=refine_top, progress=progress, desc="refine", unit="q", leave=False) as shown:
         while refined < refine_top and order:
             known = [rel for rel, verified in groups if rel and verified]
             pick = next((i for i in order if not any(all(r.residual(qs[i]) < FAMILY_MARGIN for r in rel)
@@ -320,7 +321,7 @@ def _refine_samples(robot: Robot, qs: np.ndarray, order: list[int], lower: np.nd
             order.remove(pick)
             q = refine(robot, qs[pick], lower, upper, L)
             refined += 1
-            bar.update()
+            shown.update()
             if analyze(robot, q, L).singular:
                 singular_count += 1
                 relations, verified = characterise(robot, q, L)

@@ -144,3 +144,11 @@ def shown(values: Any, precision: int = 6, prefix: str = "") -> str:
     per row however many joints (``prefix``: the text before the array, for the rows after the first)."""
     clean = np.round(np.asarray(values, dtype=float), precision) + 0.0  # + 0.0 turns the −0 of rounding into 0
     return np.array2string(clean, precision=precision, suppress_small=True, max_line_width=10_000, prefix=prefix)
+
+
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C on a command that kept its work: ``note`` says what was kept and how to go on."""
+
+    def __init__(self, note: str):
+        super().__init__(note)
+        self.note = note

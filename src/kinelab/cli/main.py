@@ -43,14 +43,16 @@ def main(argv: list[str] | None = None) -> int:
     """Run one command; a user error prints one line and returns 2, Ctrl-C returns 130."""
     warnings.formatwarning = _one_line
     args = build_parser().parse_args(argv)
+    args.command_line = list(sys.argv[1:] if argv is None else argv)  # what resumes an interrupted command
     try:
         code: int = args.func(args)
         return code
     except KinelabError as exc:
         print(f"kinelab: error: {exc}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("kinelab: interrupted", file=sys.stderr)
+    except KeyboardInterrupt as stop:
+        note = getattr(stop, "note", "")
+        print(f"kinelab: interrupted{'; ' + note if note else ''}", file=sys.stderr)
         return 130
     except BrokenPipeError:  # the reader went away (| head): say nothing more
         devnull = os.open(os.devnull, os.O_WRONLY)

@@ -3,12 +3,21 @@
 from __future__ import annotations
 
 import argparse
+import shlex
 import time
 from typing import Any
 
 import numpy as np
 
-from kinelab.cli.common import Parser, load_robot, plural, print_json, seed_argument, source_arguments
+from kinelab.cli.common import (
+    Interrupted,
+    Parser,
+    load_robot,
+    plural,
+    print_json,
+    seed_argument,
+    source_arguments,
+)
 from kinelab.errors import KinelabError
 
 
@@ -108,6 +117,20 @@ def run_singular(args: argparse.Namespace) -> int:
     return 0
 
 
+def _kept(args: argparse.Namespace) -> str:
+    """What an interrupted map kept, and the command that resumes it."""
+    if not args.out:
+        return "nothing was kept (no --out): give --out DIR to keep the chunks and resume"
+    from kinelab.maps import store
+
+    try:
+        done = store.load(args.out, check=False).done[:]
+    except KinelabError:
+        return f"no chunk was written to {args.out} yet"
+    return (f"{int(sum(done))} of {len(done)} chunks are saved in {args.out}; the same command resumes: "
+            f"kinelab {shlex.join(args.command_line)}")
+
+
 def run_reach(args: argparse.Namespace) -> int:
     """Build (or resume) the reachability map and print its summary."""
     from kinelab import maps
@@ -127,6 +150,8 @@ def run_reach(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     try:
         result = maps.reachability(robot, spec, out=args.out, force=args.force, progress=not args.json, client=client)
+    except KeyboardInterrupt:
+        raise Interrupted(_kept(args)) from None
     finally:
         if client is not None:
             client.close()

@@ -172,17 +172,20 @@ def _local_client(workers: int | None) -> Any:
 
 
 def run_chunks(client: Any, robot: Robot, spec: Any, centres: np.ndarray, todo: list[int], target: Any,
-               progress: bool = False) -> None:
+               progress: bool | None = None) -> None:
     """Submit the chunks ``todo`` and write each into ``target`` as it arrives."""
     from dask.distributed import as_completed
-    from tqdm import tqdm
+
+    from kinelab.progress import bar
 
     how = recipe(robot)
     scattered = client.scatter(centres, broadcast=True)
     futures = [client.submit(chunk_task, how, spec, scattered, c, key=f"kinelab-map-{how['sha256'][:8]}-{c}")
                for c in todo]
-    with tqdm(total=len(todo), desc="map (dask)", disable=not progress, unit="chunk") as bar:
+    resumed = target.chunks - len(todo)
+    with bar(total=target.chunks, initial=resumed, progress=progress, unit="chunk",
+             desc=f"map (dask; resumed: {resumed} chunks already written)" if resumed else "map (dask)") as shown:
         for future in as_completed(futures):
             index, values = future.result()
             target.write(index, values)
-            bar.update()
+            shown.update()

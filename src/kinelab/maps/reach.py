@@ -10,13 +10,14 @@ from typing import Any
 from kinelab.errors import KinelabError
 from kinelab.maps import cluster, grid, store
 from kinelab.maps.chunk import MAX_TARGETS, MapSpec, compute_chunk
+from kinelab.progress import bar
 from kinelab.robot import Robot
 
 __all__ = ["MAX_TARGETS", "MapSpec", "compute_chunk", "reachability"]
 
 
 def reachability(robot: Robot, spec: MapSpec | None = None, out: str | None = None, force: bool = False,
-                 progress: bool = False, client: Any = None, **fields) -> Any:
+                 progress: bool | None = None, client: Any = None, **fields) -> Any:
     """The reachability map of ``robot``, computed in this process chunk by chunk (written to ``out`` as they
     finish when given: an interrupted run resumes from the chunks already there).
 
@@ -25,7 +26,8 @@ def reachability(robot: Robot, spec: MapSpec | None = None, out: str | None = No
         spec: the map's parameters (:class:`MapSpec`), or its fields as keyword arguments.
         out: a Zarr directory to write (None: in memory only).
         force: run a map of more than MAX_TARGETS targets.
-        progress: show a progress bar over the chunks.
+        progress: show a bar over the chunks (None: in a terminal or Jupyter, not in a pipe or a log); a resumed
+            map's bar starts at the chunks already written.
         client: a ``dask.distributed.Client``: the chunks run on its cluster (:mod:`kinelab.maps.cluster`);
             None: in this process, on all cores.
         fields: the spec's fields as keyword arguments, instead of ``spec``.
@@ -36,8 +38,6 @@ def reachability(robot: Robot, spec: MapSpec | None = None, out: str | None = No
     Raises:
         KinelabError: a bad spec, a map too large without ``force``, or ``out`` holding another map.
     """
-    from tqdm import tqdm
-
     spec = spec or MapSpec(**fields)
     spec.check()
     estimate = grid.estimated_voxels(robot, spec.voxel) * spec.orientations
@@ -56,6 +56,10 @@ def reachability(robot: Robot, spec: MapSpec | None = None, out: str | None = No
     if client is not None:
         cluster.run_chunks(client, robot, spec, centres, todo, target, progress)
         return target
-    for c in tqdm(todo, desc="map", disable=not progress, unit="chunk"):
-        target.write(c, compute_chunk(robot, spec, centres, c))
+    resumed = target.chunks - len(todo)
+    with bar(total=target.chunks, initial=resumed, progress=progress, unit="chunk",
+             desc=f"map (resumed: {resumed} chunks already in {out})" if resumed else "map") as shown:
+        for c in todo:
+            target.write(c, compute_chunk(robot, spec, centres, c))
+            shown.update()
     return target

@@ -29,7 +29,7 @@ class SingularityMap:
 
 
 def singularity(robot: Robot, samples: int = 5000, seed: int = 0, method: str = "random",
-                progress: bool = False) -> SingularityMap:
+                progress: bool | None = None) -> SingularityMap:
     """σ_min/σ_max over ``samples`` configurations within the limits.
 
     Raises:

@@ -1,0 +1,28 @@
+"""Progress bars that show where someone is watching: ``progress=None`` (the default of every long call) shows a
+bar in a terminal and in Jupyter (tqdm's notebook bar when ipywidgets is installed, its text bar otherwise) and
+stays quiet when the output goes to a file or a pipe; True and False force it."""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Iterable
+from typing import Any
+
+
+def interactive() -> bool:
+    """True in a Jupyter kernel or when stderr is a terminal."""
+    shell = sys.modules.get("IPython")
+    if shell is not None:
+        ipython = getattr(shell, "get_ipython", lambda: None)()
+        if ipython is not None and getattr(ipython, "kernel", None) is not None:
+            return True
+    return bool(getattr(sys.stderr, "isatty", lambda: False)())
+
+
+def bar(iterable: Iterable[Any] | None = None, *, progress: bool | None, **options: Any) -> Any:
+    """A tqdm bar over ``iterable`` (or a manual one with ``total=``), shown as ``progress`` says (None: when
+    :func:`interactive`); ``options`` go to tqdm (desc, unit, total, initial, leave)."""
+    from tqdm.auto import tqdm
+
+    show = interactive() if progress is None else bool(progress)
+    return tqdm(iterable, disable=not show, **options)
