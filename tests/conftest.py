@@ -31,3 +31,15 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(pytest.mark.notebooks)
         if item.nodeid in _SLOW:
             item.add_marker(pytest.mark.slow)
+
+
+def pytest_unconfigure(config):
+    """Say last, in one line, when tests were skipped for want of Chromium (a green run that checked no page is
+    not the same as one that did)."""
+    reporter = config.pluginmanager.get_plugin("terminalreporter")
+    if reporter is None:
+        return
+    skipped = [r for r in reporter.stats.get("skipped", []) if "chromium" in str(r.longrepr).lower()]
+    if skipped:
+        reporter.write_line(f"kinelab: {len(skipped)} browser test(s) skipped: Debian's chromium is not installed "
+                            "here (apt install chromium; .ci/run installs it)", yellow=True)
