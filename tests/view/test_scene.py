@@ -156,3 +156,39 @@ def test_the_singular_overlay_explains_its_marks_in_the_caption():
     caption = html[html.index('id="kinelab-caption"'):]
     assert "σ_min/σ_max = " in caption and "rank 5 of 6" in caption
     assert "magenta line: a tool direction the arm cannot move in" in caption
+
+
+def test_a_mobile_robot_far_from_the_origin_is_framed_where_it_stands():
+    """kinelab 0.2 framed a youBot at x = 7, y = −9 m together with its rails' origins: a speck on a 20 m grid."""
+    from kinelab.view.framing import frame_points
+
+    youbot = kinelab.load("youbot")
+    q = youbot.display_q().copy()
+    q[0], q[1] = 7.0, -9.0
+    scene = viz.Scene(youbot)
+    try:
+        view = frame_points(scene._points(q), floor_z=0.0, margin=0.0)
+    finally:
+        scene.close()
+    platform = youbot.joint_placements(q)["platform_yaw"].translation  # the base's turning joint, at (7, −9)
+    assert np.linalg.norm(view.centre[:2] - platform[:2]) < 0.6 and view.radius < 1.0 and view.cell <= 0.2
+
+
+@pytest.mark.browser
+@needs_browser
+def test_a_branch_grid_is_readable_at_1280_by_900(tmp_path):
+    """kinelab 0.2 drew eight UR5 branches as thin sticks in the middle of a wide floor (0.26 % of the picture
+    changed; measured); thick figures, closer together, framed to the page: 1.9 %."""
+    if CHROMIUM is None:
+        pytest.fail("CI must have chromium: .ci/run installs Debian's chromium")
+    ur5 = kinelab.load("ur5")
+    branches = kinelab.solve_all(ur5, ur5.fk(ur5.random_q(3)), seed=0, time_budget=0.2)
+    s = viz.side_by_side(ur5, [b.q for b in branches])
+    page = s.save_html(tmp_path / "branches.html")
+    s.viewer["branches"].delete()
+    (tmp_path / "empty.html").write_text(s.static_html())
+    s.close()
+    size = (1280, 900)
+    share = browser.changed_share(browser.screenshot(page, tmp_path / "b.png", size=size),
+                                  browser.screenshot(tmp_path / "empty.html", tmp_path / "e.png", size=size))
+    assert len(branches) >= 4 and share > 0.012, f"the branches cover only {share:.2%} of the picture"

@@ -26,6 +26,8 @@ class Framing:
     centre: np.ndarray  # (3,) [m]: moved to the viewer's origin
     radius: float  # [m]
     floor_z: float  # [m]: the base's height (the floor is drawn there)
+    fill: float = FILL  # share of the frame's height the sphere spans (> 1 for a flat spread of copies, whose
+    # sphere is mostly empty above the floor)
 
     @property
     def cell(self) -> float:
@@ -52,20 +54,20 @@ class Framing:
         """The camera's position in meshcat's camera frame (three.js axes: y up), distance chosen so that
         the sphere fills FILL of the height (or of the width, on a narrow page)."""
         half = FOV / 2 if aspect >= 1 else np.arctan(np.tan(FOV / 2) * aspect)
-        distance = self.radius / np.sin(half) / FILL
+        distance = self.radius / np.sin(half) / self.fill
         x = distance * np.cos(ELEVATION) * np.cos(AZIMUTH)
         y = distance * np.cos(ELEVATION) * np.sin(AZIMUTH)
         return [float(x), float(distance * np.sin(ELEVATION)), float(y)]  # (x, up, −y) of the base frame
 
 
-def frame_points(points: np.ndarray, floor_z: float, margin: float) -> Framing:
+def frame_points(points: np.ndarray, floor_z: float, margin: float, fill: float = FILL) -> Framing:
     """The framing of a robot occupying ``points`` (rows, base frame) standing on the floor at ``floor_z``:
     the centre of their bounding box, the radius of the sphere about it that holds them plus ``margin``
     (the links' thickness)."""
     pts = np.asarray(points, dtype=float)
     centre = (pts.min(axis=0) + pts.max(axis=0)) / 2
     radius = float(np.max(np.linalg.norm(pts - centre, axis=1))) + margin
-    return Framing(centre, max(radius, 0.05), float(floor_z))
+    return Framing(centre, max(radius, 0.05), float(floor_z), fill)
 
 
 def _translation(t: np.ndarray) -> np.ndarray:

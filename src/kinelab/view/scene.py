@@ -22,8 +22,10 @@ import pinocchio as pin
 from kinelab.errors import ConfigurationError, KinelabError
 from kinelab.robot import Robot
 from kinelab.view.caption import with_caption
-from kinelab.view.framing import frame_points
+from kinelab.view.framing import FILL, frame_points
 from kinelab.view.server import Server
+
+SPREAD_FILL = 1.1  # side-by-side copies stand on a wide flat patch: its sphere may overfill the frame's height
 
 AXIS_COLORS = (0xE6194B, 0x3CB44B, 0x4363D8)  # x red, y green, z blue
 
@@ -66,6 +68,15 @@ class Scene:
         """The meshcat paths of the robot's visual geometries (one per URDF visual)."""
         return [self.pinviz.getViewerNodeName(g, pin.GeometryType.VISUAL) for g in self.geom.geometryObjects]
 
+    def _rails(self) -> int:
+        """How many joints lead the chain as a mobile base's rails (prismatic, over 2 m of travel)."""
+        count = 0
+        for j in self.robot.joints:
+            if j.kind != "prismatic" or j.upper - j.lower <= 2:
+                break
+            count += 1
+        return count
+
     def _arm_reach(self) -> float:
         q = self.robot.neutral()
         points = chain_points(self.robot, q)
@@ -80,18 +91,20 @@ class Scene:
         return self._aim(self._points(self.robot.display_q() if q is None else q))
 
     def _points(self, q) -> np.ndarray:
-        """Points the robot occupies at q: its joint origins, its tool point and its visuals' origins [m]."""
-        chain = chain_points(self.robot, q)  # leaves the robot's own Data at q
+        """Points the robot occupies at q: its joint origins, its tool point and its visuals' origins [m]; a
+        mobile base's rails (prismatic joints over 2 m ahead of the arm) are where the robot can go, not where it
+        is, so their joint origins are left out (a youBot at x = 7, y = −9 m is framed where it stands)."""
+        chain = chain_points(self.robot, q)[self._rails():]  # leaves the robot's own Data at q
         gdata = pin.GeometryData(self.geom)
         pin.updateGeometryPlacements(self.robot.model, self.robot.data, self.geom, gdata)
         return np.array([*chain, *(M.translation for M in gdata.oMg)])
 
-    def _aim(self, points: np.ndarray) -> Scene:
+    def _aim(self, points: np.ndarray, fill: float = FILL) -> Scene:
         """Frame ``points`` (base frame): meshcat turns its camera about the viewer's origin, so the scene
         moves to put their centre there, the grid under the base, the camera at the framing distance."""
         import meshcat.geometry as g
 
-        view = frame_points(points, floor_z=0.0, margin=0.05 * self.robot.characteristic_length())
+        view = frame_points(points, floor_z=0.0, margin=0.05 * self.robot.characteristic_length(), fill=fill)
         self.viewer.set_transform(view.scene_shift())
         self.viewer["/Grid"].set_property("visible", False)
         self.viewer["floor"].set_object(g.LineSegments(g.PointsGeometry(view.floor_segments()),
@@ -258,7 +271,7 @@ def side_by_side(robot: Robot, qs: list, spacing: float | None = None, viewer: A
     Args:
         robot: the robot.
         qs: the configurations (one number per joint each, rad or m), at least one.
-        spacing: distance between neighbouring copies [m]; default 1.2 × the arm's reach.
+        spacing: distance between neighbouring copies [m]; default 0.9 × the arm's reach.
         viewer: a meshcat viewer to draw in (default: a new one on 127.0.0.1).
 
     Returns:
@@ -273,7 +286,7 @@ def side_by_side(robot: Robot, qs: list, spacing: float | None = None, viewer: A
     scene = Scene(robot, viewer=viewer)
     scene.viewer[scene.root].delete()
     scene.viewer["frames"].delete()
-    spacing = spacing or 1.2 * scene._reach
+    spacing = spacing or 0.9 * scene._reach
     columns = int(np.ceil(np.sqrt(len(checked))))
     occupied = []
     for k, q in enumerate(checked):
@@ -285,7 +298,7 @@ def side_by_side(robot: Robot, qs: list, spacing: float | None = None, viewer: A
     scene.title = f"{robot.name}: {len(checked)} configurations side by side"
     scene.legend = {"figures": "joints: blue spheres; links: grey cylinders; copies in rows along the base x axis",
                     "tool": "tool frames: x red, y green, z blue"}
-    return scene._aim(np.array(occupied))
+    return scene._aim(np.array(occupied), fill=SPREAD_FILL if len(checked) > 1 else FILL)
 
 
 def chain_points(robot: Robot, q: Any) -> list[np.ndarray]:
@@ -297,7 +310,7 @@ def _stick_figure(node, points: list[np.ndarray], size: float) -> None:
     """Spheres at the points and cylinders between consecutive distinct ones, under the meshcat ``node``."""
     import meshcat.geometry as g
 
-    radius = 0.08 * size
+    radius = 0.16 * size  # links as thick as an arm's: readable when a page holds a grid of copies
     for k, p in enumerate(points):
         node[f"joint{k}"].set_object(g.Sphere(1.6 * radius), g.MeshLambertMaterial(color=0x4363D8))
         node[f"joint{k}"].set_transform(pin.SE3(np.eye(3), p).homogeneous)
