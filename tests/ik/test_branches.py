@@ -147,3 +147,29 @@ def test_solve_with_prefer_returns_the_branch_nearest_the_reference():
     beyond = kinelab.target_from_xyz_rpy([5.0, 0.0, 0.0], [0.0, 0.0, 0.0])
     res = kinelab.solve(robot, beyond, seed=0, time_budget=0.02, prefer=q_ref)
     assert not res.success and res.status is kinelab.Status.UNREACHABLE
+
+
+def test_the_good_turing_estimate_counts_the_branches_reached_once():
+    from kinelab.ik.branches import unseen
+
+    assert unseen([]) == 1.0  # nothing found yet: a start may find anything
+    assert unseen([5, 5, 5]) == pytest.approx(1 / 15)  # none reached once: (0 + 1) / 15
+    assert unseen([1, 3]) == pytest.approx(2 / 4)  # one branch reached once
+
+
+def test_the_search_stops_by_its_rule_with_every_closed_form_branch():
+    """kinelab 0.2 spent the whole budget on every target; with a generous budget the rule stops the search
+    once another start is unlikely to add a branch, and the branches are still all the closed form's."""
+    ur5 = load("ur5")
+    rng = np.random.default_rng(4)
+    complete = stopped = 0
+    for k in range(20):
+        target = ur5.fk(ur5.random_q(rng))
+        analytic = [q for q in ur_inverse(BASE @ target.homogeneous, *UR_DH["ur5"]) if ur5.within_limits(q)]
+        found = kinelab.solve_all(ur5, target, seed=k, time_budget=2.0)
+        d = found[0].diagnostics
+        stopped += d.unseen < 0.01 and found[0].wall_time < 1.0
+        complete += all(min(distance(ur5, s.q, q) for s in found) < 1e-2 for q in analytic)
+    assert stopped == 20 and complete >= 19
+    with pytest.raises(OptionError, match="stop_below"):
+        kinelab.solve_all(ur5, target, stop_below=1.5)

@@ -21,7 +21,7 @@ import pinocchio as pin
 from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.batch import BatchIKResult, run_batch
-from kinelab.ik.branches import find_all
+from kinelab.ik.branches import UNSEEN, find_all
 from kinelab.ik.driver import solve_one
 from kinelab.ik.frdm.tracking import PathSettings, path_options, run_track
 from kinelab.ik.registry import solver_module
@@ -156,8 +156,10 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
 def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", seed: int | None = None,
               tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float = 0.05, options: Any = None,
               task: str = "pose", axis: str = "z", q_ref: Any = None, max_solutions: int | None = None,
-              **solver_options: Any) -> list[IKResult]:
-    """The distinct solutions (branches) of ``target`` that seeded starts find within ``time_budget``.
+              stop_below: float | None = UNSEEN, **solver_options: Any) -> list[IKResult]:
+    """The distinct solutions (branches) of ``target`` that seeded starts find, in rounds of 64, until the
+    estimated chance that one more start finds a new branch falls below ``stop_below`` or ``time_budget`` is
+    spent.
 
     Args:
         robot: the robot.
@@ -175,7 +177,9 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "frdm",
         time_budget: wall-clock budget [s] of the search (default 0.05 s: every branch of a UR5 or Stanford
             target in 197 of 200 cases).
         q_ref: sort the solutions by distance to this configuration (rad or m; revolute joints modulo 2π).
-        max_solutions: stop once this many distinct solutions are found (None: use the whole budget).
+        max_solutions: stop once this many distinct solutions are found (None: no such limit).
+        stop_below: the stopping rule (:func:`kinelab.ik.branches.unseen`, a Good–Turing estimate from how many
+            starts reached each branch; checked after two rounds); None: spend the whole budget.
 
     Returns:
         One :class:`IKResult` per distinct solution, nearest ``q_ref`` first when given.
@@ -188,7 +192,7 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "frdm",
         refuse_positional("solve_all", positional)
     req = make_request(solver, seed, tol_pos, tol_rot, time_budget, 0, "refuse", options, task, axis,
                        solver_options)
-    return find_all(robot, target, req, q_ref=q_ref, max_solutions=max_solutions)
+    return find_all(robot, target, req, q_ref=q_ref, max_solutions=max_solutions, stop_below=stop_below)
 
 
 def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any = None, solver: str = "frdm",

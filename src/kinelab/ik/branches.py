@@ -26,10 +26,21 @@ SAME = 1e-3  # [rad or m] two answers closer than this, joint by joint, are one 
 # near a singular point differ by up to ~2e-4 rad; distinct branches by far more)
 ROUND = 64  # starts per round (one batch call)
 ROUND_SECONDS = 1e-3  # [s] a round's fixed cost (arrays, threads, the verdict of ROUND rows)
+UNSEEN = 0.01  # the search stops once a further start is estimated this unlikely to find a new branch
+MIN_ROUNDS = 2  # rounds before the rule may stop the search (a single round's counts are too few to judge)
 
 
-def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None,
-             max_solutions: int | None = None) -> list[IKResult]:
+def unseen(counts: list[int]) -> float:
+    """The chance that one more successful start lands on a branch not found yet, estimated from how many
+    successful starts reached each branch found (Good–Turing: the share of starts whose branch was reached only
+    once, n₁/n, estimates the mass of the unseen branches; (n₁ + 1)/n keeps it above 0 when every branch was
+    reached twice or more, so that a rarely reached branch still asks for starts). 1 before any success."""
+    n = sum(counts)
+    return 1.0 if n == 0 else min(1.0, (sum(1 for c in counts if c == 1) + 1) / n)
+
+
+def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_solutions: int | None = None,
+             stop_below: float | None = UNSEEN) -> list[IKResult]:
     """The distinct solutions found for ``target`` within the request's time budget, each checked by Pinocchio.
 
     Args:
@@ -40,10 +51,14 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None,
             when the budget allows the same number of rounds.
         q_ref: sort the solutions by distance to this configuration (rad or m; revolute joints modulo 2π);
             default: by the order found.
-        max_solutions: stop once this many distinct solutions are found (None: use the whole budget).
+        max_solutions: stop once this many distinct solutions are found (None: no such limit).
+        stop_below: stop once the estimated chance that one more start finds a new branch (:func:`unseen`) is
+            below this, after MIN_ROUNDS rounds (None: spend the whole budget).
 
     Returns:
-        One :class:`IKResult` per distinct solution (``diagnostics.found``: how many starts reached it).
+        One :class:`IKResult` per distinct solution (``diagnostics.found``: how many starts reached it;
+        ``diagnostics.unseen``: the estimated chance, when the search stopped, that one more start would have
+        found a new branch).
 
     Raises:
         TargetError, ConfigurationError, OptionError: bad input, named.
@@ -51,6 +66,9 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None,
     target = as_target(target, req.task.name)
     if max_solutions is not None and (not count_ok(max_solutions) or max_solutions < 1):
         raise OptionError("max_solutions", max_solutions, "an integer ≥ 1, or None")
+    if stop_below is not None and not (isinstance(stop_below, float | int) and not isinstance(stop_below, bool)
+                                       and 0.0 < stop_below < 1.0):
+        raise OptionError("stop_below", stop_below, "a chance in (0, 1), or None to spend the whole budget")
     ref = None if q_ref is None else robot.check_q(q_ref, what="q_ref")
     seed = fresh_seed() if req.seed is None else req.seed
     budget = 0.05 if req.time_budget is None else req.time_budget
@@ -59,7 +77,8 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None,
     rounds = 0
     # a round costs about ROUND_SECONDS of set-up and verdict whatever its budget: none starts in less
     while (left := budget - (time.perf_counter() - t0)) > ROUND_SECONDS and \
-            (max_solutions is None or len(found) < max_solutions):
+            (max_solutions is None or len(found) < max_solutions) and \
+            (stop_below is None or rounds < MIN_ROUNDS or unseen([f[3] for f in found]) >= stop_below):
         # each round gets what is left of the budget: the batch stops its rows there
         rnd = replace(req, seed=seed + rounds * ROUND, max_restarts=0, time_budget=left)
         batch = run_batch(robot, [target] * ROUND, None, rnd)
@@ -69,10 +88,11 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None,
     elapsed = time.perf_counter() - t0
     if ref is not None:
         found.sort(key=lambda f: distance(robot, f[0], ref))
+    missing = unseen([f[3] for f in found])
     return [IKResult(q=q, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr, iterations=0,
                      restarts=rounds * ROUND - 1, wall_time=elapsed, solver=req.solver,
-                     mode=f"{req.solver} (all branches)", diagnostics=Diagnostics(found=count, starts=rounds * ROUND),
-                     task=req.task_label)
+                     mode=f"{req.solver} (all branches, multistart)",
+                     diagnostics=Diagnostics(found=count, starts=rounds * ROUND, unseen=missing), task=req.task_label)
             for q, dp, dr, count in found[:max_solutions]]
 
 

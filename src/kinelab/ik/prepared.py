@@ -15,7 +15,7 @@ from dataclasses import replace
 from typing import Any
 
 from kinelab.ik.batch import BatchIKResult, run_batch
-from kinelab.ik.branches import find_all
+from kinelab.ik.branches import UNSEEN, find_all
 from kinelab.ik.driver import prepare_checks, solve_one
 from kinelab.ik.lean import LeanFRDM
 from kinelab.ik.request import Request, check_seed, make_request
@@ -106,7 +106,7 @@ class IK:
         return run_batch(self.robot, targets, q0, replace(self._request(seed), start_outside_limits="refuse"))
 
     def solve_all(self, target: Any, *, seed: int | None = None, q_ref: Any = None,
-                  max_solutions: int | None = None) -> list[IKResult]:
+                  max_solutions: int | None = None, stop_below: float | None = UNSEEN) -> list[IKResult]:
         """The distinct branches of ``target`` found within the time budget, as :func:`kinelab.solve_all`.
 
         Args:
@@ -114,6 +114,7 @@ class IK:
             seed: base seed of the starts.
             q_ref: sort the branches by distance to this configuration.
             max_solutions: stop at this many branches.
+            stop_below: the stopping rule's threshold, as :func:`kinelab.solve_all` (None: the whole budget).
 
         Returns:
             One result per distinct branch.
@@ -122,4 +123,4 @@ class IK:
             TargetError, ConfigurationError, OptionError: named.
         """
         return find_all(self.robot, target, replace(self._request(seed), max_restarts=0), q_ref=q_ref,
-                        max_solutions=max_solutions)
+                        max_solutions=max_solutions, stop_below=stop_below)

@@ -112,8 +112,9 @@ class Diagnostics:
             attempts restarted because their answer left the limits; trajectory: the recorded run.
         answer_events, answer_bypasses: the monitor events and bypasses of the answer's own attempt (the
             result's ``singular_events``/``bypasses`` cover every attempt).
-        branches: distinct solutions found (``solve(prefer=)``); found: starts that reached this solution and
-            starts: starts run (``solve_all``).
+        branches: distinct solutions found (``solve(prefer=)``); found: starts that reached this solution,
+            starts: starts run and unseen: the estimated chance that one more start would find a new branch
+            (``solve_all``).
     """
 
     path: str = ""
@@ -143,6 +144,7 @@ class Diagnostics:
     branches: int | None = None
     found: int | None = None
     starts: int | None = None
+    unseen: float | None = None
 
     @classmethod
     def quick(cls, **values: Any) -> Diagnostics:
