@@ -10,7 +10,7 @@ import re
 from kinelab.cli.main import build_parser
 
 SOURCE = ("[--tool TOOL] [--base BASE] [--srdf SRDF] [--group GROUP] [--package-dir PACKAGE_DIR] "
-          "[--xacro-arg NAME=VALUE] [--trust-xacro]")
+          "[--xacro-arg NAME=VALUE] [--lock JOINT=VALUE] [--trust-xacro]")
 
 
 def usages(parser: argparse.ArgumentParser, prefix: str = "kinelab") -> list[str]:

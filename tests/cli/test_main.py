@@ -386,3 +386,13 @@ def test_close_names_are_suggested_and_printed_numbers_have_no_minus_zero(capsys
     code, out, _ = run(capsys, "ik", "era", "--target-xyz", "4", "2", "6", "--deg")
     assert code == 0 and len([line for line in out.splitlines() if line.startswith("  q")]) == 1
     assert out.splitlines()[1].count("]") == 2 and out.splitlines()[2].startswith("  position error")  # one line
+
+
+def test_lock_holds_a_joint_from_the_command_line(capsys):
+    code, out, _ = run(capsys, "info", "panda", "--lock", "panda_joint7=0.5", "--json")
+    info = json.loads(out)
+    assert code == 0 and info["dof"] == 6 and info["locked"]["panda_joint7"] == 0.5
+    code, _, err = run(capsys, "info", "panda", "--lock", "panda_joint7=x")
+    assert code == 2 and "--lock panda_joint7=x" in err
+    code, _, err = run(capsys, "info", "panda", "--lock", "panda_joint77=0.1")
+    assert code == 2 and "panda_joint77" in err

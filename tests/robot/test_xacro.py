@@ -129,3 +129,15 @@ peers.kinematic_urdf(ur5)
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     assert os.listdir(private) == []  # the bench's stripped URDF went with the process
+
+
+def test_an_argument_the_file_does_not_declare_is_refused_by_name(tmp_path, capsys):
+    """kinelab 0.2 passed --xacro-arg nosuch=1 to xacro, which ignored it."""
+    path = tmp_path / "arm.urdf.xacro"
+    path.write_text(XACRO)
+    with pytest.raises(kinelab.OptionError, match="declares no xacro argument 'nosuch'.*declares: reach"):
+        load(path, xacro_args={"nosuch": "1"})
+    assert load(path, xacro_args={"reach": "0.4"}).n == 2
+    code = kinelab.cli.main(["info", str(path), "--xacro-arg", "nosuch=1"])
+    err = capsys.readouterr().err
+    assert code == 2 and "declares no xacro argument 'nosuch'" in err and len(err.strip().splitlines()) == 1

@@ -65,17 +65,29 @@ def load_robot(args: argparse.Namespace) -> Robot:
     """The robot a per-robot command names, with its --tool, --base, --srdf, --group, --package-dir and
     --xacro-arg."""
     return load(args.robot, tool=args.tool, base=args.base, srdf=args.srdf, group=args.group,
-                package_dirs=args.package_dir, xacro_args=_xacro_args(args.xacro_arg), trust_xacro=args.trust_xacro)
+                package_dirs=args.package_dir, xacro_args=_pairs(args.xacro_arg, "--xacro-arg"),
+                trust_xacro=args.trust_xacro, locked=_locked(args.lock))
 
 
-def _xacro_args(items: list[str] | None) -> dict[str, str] | None:
-    """--xacro-arg NAME=VALUE flags as a dict (a flag without '=' is refused)."""
+def _pairs(items: list[str] | None, flag: str) -> dict[str, str] | None:
+    """NAME=VALUE flags as a dict (a flag without '=' is refused)."""
     if not items:
         return None
     bad = [item for item in items if "=" not in item]
     if bad:
-        raise KinelabError(f"--xacro-arg takes NAME=VALUE, got {bad[0]!r}")
+        raise KinelabError(f"{flag} takes NAME=VALUE, got {bad[0]!r}")
     return dict(item.split("=", 1) for item in items)
+
+
+def _locked(items: list[str] | None) -> dict[str, float] | None:
+    """--lock JOINT=VALUE flags as load()'s ``locked`` (rad or m)."""
+    pairs = _pairs(items, "--lock")
+    if pairs is None:
+        return None
+    bad = [f"{name}={value}" for name, value in pairs.items() if not _is_number(value)]
+    if bad:
+        raise KinelabError(f"--lock {bad[0]}: the value is not a number (rad or m)")
+    return {name: float(value) for name, value in pairs.items()}
 
 
 def robot_arguments(s: argparse.ArgumentParser, q_help: str | None = None, limits: bool = True) -> None:
@@ -99,6 +111,8 @@ def source_arguments(s: argparse.ArgumentParser) -> None:
     s.add_argument("--group", help="SRDF group whose chain gives base and tool")
     s.add_argument("--package-dir", action="append", help="where package:// meshes resolve (repeatable)")
     s.add_argument("--xacro-arg", action="append", metavar="NAME=VALUE", help="an argument of a .xacro robot")
+    s.add_argument("--lock", action="append", metavar="JOINT=VALUE",
+                   help="hold a joint at a value (rad or m) and leave it out of the chain (repeatable)")
     s.add_argument("--trust-xacro", action="store_true",
                    help="let a .xacro robot run what xacro runs ($(eval), $(env), load_yaml); refused without it")
 

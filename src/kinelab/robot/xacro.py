@@ -20,7 +20,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
-from kinelab.errors import URDFError
+from kinelab.errors import OptionError, URDFError
 from kinelab.scratch import scratch_dir
 
 INSTALL_HINT = "pip install 'kinelab[xacro]' (xacrodoc)"
@@ -60,6 +60,7 @@ def expand(path: Path, args: dict[str, str] | None = None, trusted: bool = False
             (named, with its file and line), or a file xacro cannot expand (xacro's reason: a missing argument,
             an undefined property or macro).
     """
+    _check_declared(path, args or {})
     try:
         from xacrodoc import XacroDoc  # optional extra: imported only for a xacro file
     except ImportError:
@@ -147,3 +148,34 @@ def _guarded() -> Iterator[None]:
         symbols.update(plain_symbols)
         if namespace is not None:
             namespace["load_yaml"] = plain_ns
+
+
+_ARG = re.compile(r"<xacro:arg\s[^>]*name\s*=\s*[\"']([^\"']+)[\"']")
+_INCLUDE = re.compile(r"<xacro:include\s[^>]*filename\s*=\s*[\"']([^\"']+)[\"']")
+
+
+def _check_declared(path: Path, args: dict[str, str]) -> None:
+    """Refuse an argument that the file does not declare (``<xacro:arg name=...>``): xacro would ignore it
+    silently. Includes given as plain relative paths are read too; when the file includes one kinelab cannot
+    read without expanding it (``$(find pkg)/...``), an argument may be declared there and none is refused."""
+    if not args or not path.is_file():
+        return
+    declared: set[str] = set()
+    todo, seen = [path], set()
+    while todo:
+        current = todo.pop()
+        if current in seen:
+            continue
+        seen.add(current)
+        text = current.read_text(errors="replace")
+        declared.update(_ARG.findall(text))
+        for name in _INCLUDE.findall(text):
+            if "$" in name:
+                return  # an include only xacro can resolve: its arguments are unknown here
+            todo.append((current.parent / name).resolve())
+    unknown = sorted(set(args) - declared)
+    if unknown:
+        raise OptionError("xacro_args", {k: args[k] for k in unknown},
+                          f"arguments {path.name} declares: {', '.join(sorted(declared)) or 'none'}",
+                          f"{path.name} declares no xacro argument {unknown[0]!r} (xacro would ignore it); it "
+                          f"declares: {', '.join(sorted(declared)) or 'none'}")
