@@ -12,6 +12,7 @@ error.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -39,6 +40,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("prefixes", nargs="*", help="notebook numbers to render (default: all)")
     parser.add_argument("--out", default=str(ROOT / "docs" / "notebooks"), help="folder for the HTML pages")
     args = parser.parse_args(argv)
+    os.environ["KINELAB_PROGRESS"] = "0"  # a page shows results, not the bars of the run that made them
     notebooks = sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))
     chosen = [nb for nb in notebooks if not args.prefixes or nb.name[:2] in args.prefixes]
     if not chosen:

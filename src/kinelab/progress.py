@@ -1,16 +1,21 @@
 """Progress bars that show where someone is watching: ``progress=None`` (the default of every long call) shows a
 bar in a terminal and in Jupyter (tqdm's notebook bar when ipywidgets is installed, its text bar otherwise) and
-stays quiet when the output goes to a file or a pipe; True and False force it."""
+stays quiet when the output goes to a file or a pipe, or when the environment sets ``KINELAB_PROGRESS=0`` (a
+notebook rendered to a page, a batch job); True and False force it."""
 
 from __future__ import annotations
 
+import importlib.util
+import os
 import sys
 from collections.abc import Iterable
 from typing import Any
 
 
 def interactive() -> bool:
-    """True in a Jupyter kernel or when stderr is a terminal."""
+    """True in a Jupyter kernel or when stderr is a terminal, unless ``KINELAB_PROGRESS=0``."""
+    if os.environ.get("KINELAB_PROGRESS") == "0":
+        return False
     shell = sys.modules.get("IPython")
     if shell is not None:
         ipython = getattr(shell, "get_ipython", lambda: None)()
@@ -22,7 +27,10 @@ def interactive() -> bool:
 def bar(iterable: Iterable[Any] | None = None, *, progress: bool | None, **options: Any) -> Any:
     """A tqdm bar over ``iterable`` (or a manual one with ``total=``), shown as ``progress`` says (None: when
     :func:`interactive`); ``options`` go to tqdm (desc, unit, total, initial, leave)."""
-    from tqdm.auto import tqdm
+    if importlib.util.find_spec("ipywidgets") is not None:
+        from tqdm.auto import tqdm
+    else:  # tqdm.auto would warn in Jupyter that it has no widgets: the text bar is the one to show
+        from tqdm import tqdm
 
     show = interactive() if progress is None else bool(progress)
     return tqdm(iterable, disable=not show, **options)
