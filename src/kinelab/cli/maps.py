@@ -9,15 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from kinelab.cli.common import (
-    Interrupted,
-    Parser,
-    load_robot,
-    plural,
-    print_json,
-    seed_argument,
-    source_arguments,
-)
+from kinelab.cli.common import Interrupted, Parser, load_robot, plural, print_json, seed_argument, source_arguments
 from kinelab.errors import KinelabError
 
 
