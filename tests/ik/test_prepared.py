@@ -80,10 +80,11 @@ def test_every_unusual_input_gets_the_general_path_s_answer_or_error(ur5):
 
 
 def test_a_lean_failure_reports_as_the_general_path_does(ur5):
-    """A target met only outside the limits: the lean call builds the failure through the driver's helpers."""
-    ik = kinelab.IK(ur5, time_budget=None, max_restarts=3, tol_pos=1e-12, tol_rot=1e-12, finish="none")
+    """Tolerances no answer meets (1e-300): the lean call builds the failure through the driver's helpers."""
+    ik = kinelab.IK(ur5, time_budget=None, max_restarts=3, tol_pos=1e-300, tol_rot=1e-300, finish="none")
     target = ur5.fk(ur5.random_q(4))
     a = ik.solve(target, q0=ur5.random_q(5), seed=1)
-    b = kinelab.solve(ur5, target, q0=ur5.random_q(5), seed=1, time_budget=None, max_restarts=3, tol_pos=1e-12,
-                      tol_rot=1e-12, finish="none")
+    b = kinelab.solve(ur5, target, q0=ur5.random_q(5), seed=1, time_budget=None, max_restarts=3, tol_pos=1e-300,
+                      tol_rot=1e-300, finish="none")
+    assert not a.success and a.restarts == 3 and "none of 4 starts" in a.message
     _same(a, b)
