@@ -16,6 +16,7 @@ from collections.abc import Sequence
 from dataclasses import replace
 from typing import Any
 
+import numpy as np
 import pinocchio as pin
 
 from kinelab.errors import OptionError
@@ -25,7 +26,7 @@ from kinelab.ik.branches import UNSEEN, find_all
 from kinelab.ik.driver import solve_one
 from kinelab.ik.frdm.tracking import PathSettings, path_options, run_track
 from kinelab.ik.registry import solver_module
-from kinelab.ik.request import make_request
+from kinelab.ik.request import Request, make_request
 from kinelab.ik.result import IKResult, TrackResult
 from kinelab.ik.targets import as_target_arrays
 from kinelab.robot import Robot
@@ -248,12 +249,18 @@ def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
                        path_options(options, solver_options))
     points, rotations = as_target_arrays(targets)
     if q0 is None:
-        first = solve(robot, pin.SE3(rotations[0], points[0]), seed=seed, tol_pos=tol_pos, tol_rot=tol_rot,
-                      task=task, axis=axis)
-        if not first.success:
-            raise OptionError("q0", None, "a start configuration: the path's first target could not be solved "
-                              f"({first.status.value}: {first.message})")
-        q0 = first.q
+        q0 = _first_answer(robot, pin.SE3(rotations[0], points[0]), req)
     return run_track(robot, stack_homogeneous(points, rotations), robot.check_q(q0, limits=True, what="q0"), req,
                      settings)
+
+
+def _first_answer(robot: Robot, target: pin.SE3, req: Request) -> np.ndarray:
+    """Where a path without q0 starts: the answer to its first target, with the path's seed, tolerances and task."""
+    first = solve(robot, target, seed=req.seed, tol_pos=req.tol_pos, tol_rot=req.tol_rot, task=req.task.name,
+                  axis="xyz"[req.task.axis] if req.task.axis >= 0 else "z")
+    if not first.success:
+        raise OptionError("q0", None, "a start configuration: the path's first target could not be solved "
+                          f"({first.status.value}: {first.message})")
+    q: np.ndarray = first.q
+    return q
 

@@ -26,7 +26,7 @@ from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm import solver as frdm
 from kinelab.ik.multistart import TypedKernel
 from kinelab.ik.request import Request
-from kinelab.ik.result import Diagnostics, IKResult, Status
+from kinelab.ik.result import IKResult, Status
 from kinelab.ik.verdict import pose_defect, pose_verdict
 from kinelab.ik.workspace import reach_bound
 from kinelab.robot import Robot
@@ -84,7 +84,6 @@ class LeanFRDM:
         self.axis, self.n = req.task.axis, robot.n
         self.check_pos, self.check_rot = req.task.position, req.task.rotation
         self.tol_pos, self.tol_rot, self.task_label = req.tol_pos, req.tol_rot, req.task_label
-        self.order, self.w_p = req.options.order, self.ctx.problem.w_p
         prepare_checks(robot)
         self._compile()
 
@@ -129,14 +128,11 @@ class LeanFRDM:
         return compiled_result(call, att, max(0, int(stats[kernel.T_ATTEMPTS]) - 1), ok, dp, dr)
 
     def _converged(self, q: np.ndarray, stats: np.ndarray, dp: float, dr: float, t_start: float) -> IKResult:
-        """The result of a converged solve that Pinocchio confirmed (what :meth:`FRDMContext.attempt` and the
+        """The result of a converged solve that Pinocchio confirmed (what the context's ``attempt`` and the
         driver would build, fewer steps)."""
         st = stats.tolist()
         sweeps, stalls = int(st[kernel.T_SWEEPS]), int(st[kernel.T_STALLS])
-        diag = Diagnostics.quick(sweeps=sweeps, accelerated_sweeps=int(st[kernel.T_ACCEPTED]), order=self.order,
-                                 w_p=self.w_p, objective=st[kernel.T_BEST_E], attempts=int(st[kernel.T_ATTEMPTS]),
-                                 stalls=stalls, polished=int(st[kernel.T_POLISHED]),
-                                 newton_steps=int(st[kernel.T_NEWTON]), path="compiled")
+        diag = self.ctx.diagnostics(st)
         events = self.ctx.stall_events(stalls) if stalls else []
         return IKResult(q=q, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr,
                         iterations=sweeps, restarts=max(0, int(st[kernel.T_ATTEMPTS]) - 1),

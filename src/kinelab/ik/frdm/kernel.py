@@ -442,9 +442,22 @@ def _fk_converged(q, ch, pb, e, o, p, R, since_fk):
 
 
 @njit(cache=True, inline="always")
-def _near(state):
-    """The objective at the current q: the last sweep's, or the start's before the first sweep."""
-    return state[S_E_WINDOW] if state[S_SWEEPS] == 0.0 else state[S_E]
+def _converged_here(q, ch, pb, e, o, p, R, since_fk, state):
+    """Both tolerances met at q, on an exact FK (the carried state only says where to look); then the
+    objective goes into state[S_E]."""
+    if _within(p, R, pb.pstar, pb.Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot, pb.rot_axis) and \
+            _fk_converged(q, ch, pb, e, o, p, R, since_fk):
+        state[S_E] = total_objective(q, ch.kind, p, R, pb)
+        return True
+    return False
+
+
+@njit(cache=True, inline="always")
+def _finish_due(st, state):
+    """The Newton finish is on, not yet tried in this attempt, and the objective at q (the last sweep's, or the
+    start's before the first sweep) is below its threshold."""
+    now = state[S_E_WINDOW] if state[S_SWEEPS] == 0.0 else state[S_E]
+    return st.finish_below > 0.0 and state[S_FINISH] == 0.0 and now < st.finish_below
 
 
 @njit(cache=True)
@@ -523,12 +536,9 @@ def run(q: np.ndarray, ch: Chain, pb: Objective, st: Settings, order: int, max_s
             since_fk = 0
         if state[S_SWEEPS] == 0.0:
             state[S_E_WINDOW] = total_objective(q, kind, p, R, pb)
-        if _within(p, R, pstar, Rstar, pb.tol_pos, pb.tol_rot, pb.check_pos, pb.check_rot, pb.rot_axis) and \
-                _fk_converged(q, ch, pb, e, o, p, R, since_fk):  # converged only on an exact FK
-            state[S_E] = total_objective(q, kind, p, R, pb)
+        if _converged_here(q, ch, pb, e, o, p, R, since_fk, state):
             return CONVERGED, s
-        if st.finish_below > 0.0 and state[S_FINISH] == 0.0 and _near(state) < st.finish_below and \
-                _finished(q, ch, pb, st.finish_steps, state):
+        if _finish_due(st, state) and _finished(q, ch, pb, st.finish_steps, state):
             return CONVERGED, s
         x_old[:] = q
         base_to_tip = _base_to_tip(order, state)

@@ -87,21 +87,11 @@ def follow(Q, q0, ch, lower, upper, free, pstars, Rstars, w_p, w_ax, tol_pos, to
     trust = TRUST_FLOOR
     velocity = np.zeros(n)  # the last reached sample's joint step: the predictor's
     for k in range(Q.shape[0]):
-        code, spent = -1, 0
         if recover:
-            code, spent = _predicted(q, q_good, velocity, ch, pb, fw, trust, pstars[k], Rstars[k])
-            if code != CONVERGED:
-                q[:] = q_good
-        if code != CONVERGED:
-            code, more = _sample(q, ch, pb, fw, trust, pstars[k], Rstars[k], rest, mem)
-            spent += more
-        if code != CONVERGED and recover:
-            first = q.copy()
-            code, more = _recover(q, q_good, p_good, R_good, ch, pb, fw, trust, pstars[k], Rstars[k], rest, mem,
-                                  rng_state)
-            spent += more
-            if code != CONVERGED:
-                q[:] = first  # the first answer, the nearest to the last reached one
+            code, spent = _tracked(q, q_good, p_good, R_good, velocity, ch, pb, fw, trust, pstars[k], Rstars[k], rest,
+                                   mem, rng_state)
+        else:
+            code, spent = _sample(q, ch, pb, fw, trust, pstars[k], Rstars[k], rest, mem)
         velocity[:] = 0.0
         if code == CONVERGED:
             velocity[:] = q - q_good
@@ -145,6 +135,26 @@ def redundant_newton(q, ch, pb, iterations, max_step, centre, pull):
         for i in range(n):
             q[i] = min(max(q[i] + dq[i], pb.lower[i]), pb.upper[i])
     return -1, iterations
+
+
+@njit(cache=True)
+def _tracked(q, q_good, p_good, R_good, velocity, ch, pb, fw, trust, pstar, Rstar, rest, mem, rng_state):
+    """One sample with the Newton finish on: the predictor, then the sample's phases from the last reached
+    configuration, then the recovery; a sample none of them reaches keeps the phases' answer, the nearest to the
+    last reached one. Returns (code, sweeps and steps); q holds the answer."""
+    code, spent = _predicted(q, q_good, velocity, ch, pb, fw, trust, pstar, Rstar)
+    if code == CONVERGED:
+        return code, spent
+    q[:] = q_good
+    code, more = _sample(q, ch, pb, fw, trust, pstar, Rstar, rest, mem)
+    spent += more
+    if code == CONVERGED:
+        return code, spent
+    first = q.copy()
+    code, more = _recover(q, q_good, p_good, R_good, ch, pb, fw, trust, pstar, Rstar, rest, mem, rng_state)
+    if code != CONVERGED:
+        q[:] = first
+    return code, spent + more
 
 
 @njit(cache=True)

@@ -179,13 +179,17 @@ class _Context:
             status = Status.STALLED if stats[kernel.T_STALLS] > 0 else Status.MAX_ITERATIONS
         st = stats.tolist()  # one conversion, then Python floats
         sweeps, stalls = int(st[kernel.T_SWEEPS]), int(st[kernel.T_STALLS])
-        diag = Diagnostics.quick(sweeps=sweeps, accelerated_sweeps=int(st[kernel.T_ACCEPTED]),
-                                 order=self.order_name, w_p=self.problem.w_p, objective=st[kernel.T_BEST_E],
-                                 attempts=int(st[kernel.T_ATTEMPTS]), stalls=stalls,
-                                 polished=int(st[kernel.T_POLISHED]), newton_steps=int(st[kernel.T_NEWTON]),
-                                 path="compiled")
+        diag = self.diagnostics(st)
         return Attempt(self.robot.wrap_continuous(q) if self.continuous else q, status, sweeps,
                        self.stall_events(stalls) if stalls else [], [], diag, self.mode)
+
+    def diagnostics(self, st: list[float]) -> Diagnostics:
+        """The diagnostics of a run from its statistics (``stats.tolist()``: slots T_*)."""
+        return Diagnostics.quick(sweeps=int(st[kernel.T_SWEEPS]), accelerated_sweeps=int(st[kernel.T_ACCEPTED]),
+                                 order=self.order_name, w_p=self.problem.w_p, objective=st[kernel.T_BEST_E],
+                                 attempts=int(st[kernel.T_ATTEMPTS]), stalls=int(st[kernel.T_STALLS]),
+                                 polished=int(st[kernel.T_POLISHED]), newton_steps=int(st[kernel.T_NEWTON]),
+                                 path="compiled")
 
     @staticmethod
     def stall_events(stalls: int) -> list[SingularEvent]:
