@@ -369,7 +369,7 @@ def test_warmup_runs_every_compiled_path_and_reports_each(capsys):
     assert code == 0 and lines[0].startswith("kinelab: compiling every solver path")
     assert [line.split(":")[0].strip() for line in lines[1:-1]] == [
         "FRDM (single solves, the prepared solver)", "FRDM's monitored loop (bypasses, policies)", "the FRDM batch",
-        "the path follower", "the biquaternion solver"]
+        "the path follower", "the biquaternion solver", "the closed form (every branch, one pose and a batch)"]
     assert all(line.endswith(" s)") for line in lines[1:-1]) and lines[-1].startswith("kinelab: every path is ready")
 
 

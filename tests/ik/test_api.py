@@ -109,7 +109,7 @@ def test_results_carry_typed_diagnostics(ur5):
     loop = kinelab.solve(ur5, _target(ur5), seed=0, policy=("auto_kick",))
     assert loop.diagnostics.path == "" and isinstance(loop.diagnostics.answer_events, tuple)
     json.dumps(res.to_dict()) and json.dumps(loop.to_dict())
-    found = kinelab.solve_all(ur5, _target(ur5), seed=0, time_budget=0.01)
+    found = kinelab.solve_all(ur5, _target(ur5), solver="frdm", seed=0, time_budget=0.01)
     assert sum(f.diagnostics.found for f in found) <= found[0].diagnostics.starts
 
 

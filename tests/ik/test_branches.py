@@ -1,57 +1,17 @@
-"""solve_all against the UR arms' closed-form inverse (up to 8 solutions), written here from the standard
-derivation (wrist centre → θ1, θ5, θ6, then the planar 2R for θ2, θ3 and θ4) and itself checked by
-Pinocchio's FK."""
+"""solve_all against the UR arms' closed-form inverse (up to 8 solutions, tests/closed_forms.py: wrist centre →
+θ1, θ5, θ6, then the planar 2R for θ2, θ3 and θ4), itself checked by Pinocchio's FK."""
 
 import numpy as np
 import pytest
+from closed_forms import BASE, UR_DH, ur_inverse
 
 import kinelab
 from kinelab import OptionError, load
 from kinelab.ik.branches import distance
 
-UR_DH = {"ur5": (0.089159, -0.425, -0.39225, 0.10915, 0.09465, 0.0823),
-         "ur10": (0.1273, -0.612, -0.5723, 0.163941, 0.1157, 0.0922)}
-BASE = np.diag([-1.0, -1.0, 1.0, 1.0])  # ur_description's base_link is the DH base turned by π about z
-
-
-def dh(d, a, alpha, theta):
-    ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
-    return np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, d], [0, 0, 0, 1]])
-
-
-def ur_inverse(T, d1, a2, a3, d4, d5, d6):
-    """Every real solution (angles in (−π, π]) for the flange pose T in the DH base frame."""
-    p5 = T[:3, 3] - d6 * T[:3, 2]  # the wrist centre
-    r = np.hypot(p5[0], p5[1])
-    out = []
-    for s1 in (1, -1):
-        if r < abs(d4):
-            break
-        t1 = np.arctan2(p5[1], p5[0]) + s1 * np.arccos(d4 / r) + np.pi / 2
-        c5 = (T[0, 3] * np.sin(t1) - T[1, 3] * np.cos(t1) - d4) / d6
-        for s5 in (1, -1):
-            if abs(c5) > 1 or abs(np.sin(np.arccos(np.clip(c5, -1, 1)))) < 1e-9:
-                continue
-            t5 = s5 * np.arccos(c5)
-            t6 = np.arctan2((-T[0, 1] * np.sin(t1) + T[1, 1] * np.cos(t1)) / np.sin(t5),
-                            (T[0, 0] * np.sin(t1) - T[1, 0] * np.cos(t1)) / np.sin(t5))
-            T14 = np.linalg.inv(dh(d1, 0, np.pi / 2, t1)) @ T @ np.linalg.inv(
-                dh(d5, 0, -np.pi / 2, t5) @ dh(d6, 0, 0, t6))
-            x, y = T14[0, 3], T14[1, 3]
-            c3 = (x * x + y * y - a2 * a2 - a3 * a3) / (2 * a2 * a3)
-            for s3 in (1, -1):
-                if abs(c3) > 1:
-                    continue
-                t3 = s3 * np.arccos(c3)
-                t2 = np.arctan2(y, x) - np.arctan2(a3 * np.sin(t3), a2 + a3 * np.cos(t3))
-                T34 = np.linalg.inv(dh(0, a2, 0, t2) @ dh(0, a3, 0, t3)) @ T14
-                q = np.array([t1, t2, t3, np.arctan2(T34[1, 0], T34[0, 0]), t5, t6])
-                out.append(np.arctan2(np.sin(q), np.cos(q)))
-    return out
-
 
 @pytest.mark.parametrize("name", ["ur5", "ur10"])
-def test_solve_all_finds_every_closed_form_solution_and_no_other(name):
+def test_the_multistart_finds_every_closed_form_solution_and_no_other(name):
     robot = load(name)
     rng = np.random.default_rng(1)
     complete = 0
@@ -61,7 +21,7 @@ def test_solve_all_finds_every_closed_form_solution_and_no_other(name):
         for q in analytic:  # the oracle is itself exact
             dp, dr = robot.tool_error(q, target)
             assert dp < 1e-9 and dr < 1e-9
-        found = kinelab.solve_all(robot, target, seed=k, time_budget=0.05)
+        found = kinelab.solve_all(robot, target, solver="frdm", seed=k, time_budget=0.05)
         for sol in found:  # every answer is a closed-form solution, and checked by Pinocchio
             assert min(distance(robot, sol.q, q) for q in analytic) < 1e-2  # ill-conditioned near a singularity
             assert robot.tool_error(sol.q, target)[0] <= 1e-6
@@ -72,7 +32,7 @@ def test_solve_all_finds_every_closed_form_solution_and_no_other(name):
 def test_solutions_sort_by_distance_to_a_reference_and_bad_arguments_are_named():
     robot = load("ur5")
     q_ref = robot.random_q(4)
-    found = kinelab.solve_all(robot, robot.fk(q_ref), seed=0, time_budget=0.05, q_ref=q_ref)
+    found = kinelab.solve_all(robot, robot.fk(q_ref), solver="frdm", seed=0, time_budget=0.05, q_ref=q_ref)
     distances = [distance(robot, s.q, q_ref) for s in found]
     assert distances == sorted(distances) and distances[0] < 1e-3  # the reference's own branch comes first
     with pytest.raises(OptionError, match="max_solutions"):
@@ -125,7 +85,7 @@ def test_solve_all_finds_every_closed_form_solution_of_the_stanford_arm():
         for q in analytic:  # the oracle is itself exact
             dp, dr = robot.tool_error(q, target)
             assert dp < 1e-9 and dr < 1e-9
-        found = kinelab.solve_all(robot, target, seed=k, time_budget=0.05)
+        found = kinelab.solve_all(robot, target, solver="frdm", seed=k, time_budget=0.05)
         for sol in found:
             assert min(distance(robot, sol.q, q) for q in analytic) < 1e-2
         complete += all(min(distance(robot, s.q, q) for s in found) < 1e-2 for q in analytic)
@@ -166,7 +126,7 @@ def test_the_search_stops_by_its_rule_with_every_closed_form_branch():
     for k in range(20):
         target = ur5.fk(ur5.random_q(rng))
         analytic = [q for q in ur_inverse(BASE @ target.homogeneous, *UR_DH["ur5"]) if ur5.within_limits(q)]
-        found = kinelab.solve_all(ur5, target, seed=k, time_budget=2.0)
+        found = kinelab.solve_all(ur5, target, solver="frdm", seed=k, time_budget=2.0)
         d = found[0].diagnostics
         stopped += d.unseen < 0.01 and found[0].wall_time < 1.0
         complete += all(min(distance(ur5, s.q, q) for s in found) < 1e-2 for q in analytic)

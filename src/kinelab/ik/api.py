@@ -154,19 +154,22 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
     return run_batch(robot, targets, q0, req)
 
 
-def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", seed: int | None = None,
+def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto", seed: int | None = None,
               tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float = 0.05, options: Any = None,
               task: str = "pose", axis: str = "z", q_ref: Any = None, max_solutions: int | None = None,
               stop_below: float | None = UNSEEN, **solver_options: Any) -> list[IKResult]:
-    """The distinct solutions (branches) of ``target`` that seeded starts find, in rounds of 64, until the
-    estimated chance that one more start finds a new branch falls below ``stop_below`` or ``time_budget`` is
-    spent.
+    """The distinct solutions (branches) of ``target``: every one in closed form where the chain's geometry
+    allows it (docs/analytic.md), else those that seeded starts find, in rounds of 64, until the estimated
+    chance that one more start finds a new branch falls below ``stop_below`` or ``time_budget`` is spent.
 
     Args:
         robot: the robot.
         target: oMtarget (base frame).
         positional: nothing: every argument after the target is keyword-only.
-        solver: "frdm" (one compiled batch per round of starts) or "dls".
+        solver: "auto" (the closed form when the chain is in an analytic class and the task is "pose", else
+            "frdm"), "analytic" (refused, with the reason, where there is no closed form), or a multistart
+            solver: "frdm" (one compiled batch per round of starts) or "dls". The results' ``solver`` and
+            ``mode`` say which ran.
         seed: base seed of the starts (None: fresh entropy); the same seed finds the same branches when the
             budget allows the same number of rounds.
         tol_pos: position tolerance [m].
@@ -175,8 +178,8 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "frdm",
         task: the components to meet, as :func:`solve`.
         axis: the tool axis of task "axis".
         solver_options: the solver's option fields as keyword arguments.
-        time_budget: wall-clock budget [s] of the search (default 0.05 s: every branch of a UR5 or Stanford
-            target in 197 of 200 cases).
+        time_budget: wall-clock budget [s] of the multistart search (default 0.05 s: every branch of a
+            Stanford target in 197 of 200 cases); the closed form takes microseconds and no budget.
         q_ref: sort the solutions by distance to this configuration (rad or m; revolute joints modulo 2π).
         max_solutions: stop once this many distinct solutions are found (None: no such limit).
         stop_below: the stopping rule (:func:`kinelab.ik.branches.unseen`, a Good–Turing estimate from how many
@@ -191,9 +194,15 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "frdm",
     """
     if positional:
         refuse_positional("solve_all", positional)
-    req = make_request(solver, seed, tol_pos, tol_rot, time_budget, 0, "refuse", options, task, axis,
-                       solver_options)
-    return find_all(robot, target, req, q_ref=q_ref, max_solutions=max_solutions, stop_below=stop_below)
+    method = solver if solver in ("auto", "analytic") else "multistart"
+    if method != "multistart" and (options is not None or solver_options):
+        if method == "analytic":  # the closed form has no options: refusing says so rather than ignoring them
+            raise OptionError("options", options or solver_options, "none with solver='analytic'")
+        method = "multistart"  # options name a multistart solver's settings: "auto" runs FRDM with them
+    req = make_request("frdm" if method != "multistart" else solver, seed, tol_pos, tol_rot, time_budget, 0,
+                       "refuse", options, task, axis, solver_options)
+    return find_all(robot, target, req, q_ref=q_ref, max_solutions=max_solutions, stop_below=stop_below,
+                    method=method)
 
 
 def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any = None, solver: str = "frdm",

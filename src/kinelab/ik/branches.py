@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from kinelab.errors import OptionError
+from kinelab.ik.analytic.branches import analytic_all, has_closed_form
 from kinelab.ik.batch import fresh_seed, run_batch
 from kinelab.ik.request import Request, count_ok
 from kinelab.ik.result import Diagnostics, IKResult, Status
@@ -27,6 +28,7 @@ SAME = 1e-3  # [rad or m] two answers closer than this, joint by joint, are one 
 ROUND = 64  # starts per round (one batch call)
 ROUND_SECONDS = 1e-3  # [s] a round's fixed cost (arrays, threads, the verdict of ROUND rows)
 UNSEEN = 0.01  # the search stops once a further start is estimated this unlikely to find a new branch
+METHODS = ("multistart", "analytic", "auto")
 MIN_ROUNDS = 2  # rounds before the rule may stop the search (a single round's counts are too few to judge)
 
 
@@ -40,8 +42,10 @@ def unseen(counts: list[int]) -> float:
 
 
 def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_solutions: int | None = None,
-             stop_below: float | None = UNSEEN) -> list[IKResult]:
-    """The distinct solutions found for ``target`` within the request's time budget, each checked by Pinocchio.
+             stop_below: float | None = UNSEEN, method: str = "multistart") -> list[IKResult]:
+    """The distinct solutions of ``target``, each checked by Pinocchio: every branch in closed form where the
+    chain's class allows it (:mod:`kinelab.ik.analytic`), else those seeded starts find within the request's
+    time budget.
 
     Args:
         robot: the robot.
@@ -54,15 +58,21 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
         max_solutions: stop once this many distinct solutions are found (None: no such limit).
         stop_below: stop once the estimated chance that one more start finds a new branch (:func:`unseen`) is
             below this, after MIN_ROUNDS rounds (None: spend the whole budget).
+        method: "multistart"; "analytic" (the closed form, refused by name where the chain or the task has
+            none); "auto" (the closed form where there is one and the task is "pose", else the multistart).
 
     Returns:
-        One :class:`IKResult` per distinct solution (``diagnostics.found``: how many starts reached it;
-        ``diagnostics.unseen``: the estimated chance, when the search stopped, that one more start would have
-        found a new branch).
+        One :class:`IKResult` per distinct solution. Multistart: ``diagnostics.found``, how many starts reached
+        it; ``diagnostics.unseen``, the estimated chance, when the search stopped, that one more start would
+        have found a new branch. Closed form (``solver`` "analytic"): ``diagnostics.branches``, how many
+        branches the pose has within the limits (all of them are returned); ``diagnostics.found``, the roots
+        merged into the answer (2 at a double root); ``unseen`` 0.
 
     Raises:
         TargetError, ConfigurationError, OptionError: bad input, named.
     """
+    if method not in METHODS:
+        raise OptionError("method", method, " or ".join(map(repr, METHODS)))
     target = as_target(target, req.task.name)
     if max_solutions is not None and (not count_ok(max_solutions) or max_solutions < 1):
         raise OptionError("max_solutions", max_solutions, "an integer ≥ 1, or None")
@@ -70,6 +80,8 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
                                        and 0.0 < stop_below < 1.0):
         raise OptionError("stop_below", stop_below, "a chance in (0, 1), or None to spend the whole budget")
     ref = None if q_ref is None else robot.check_q(q_ref, what="q_ref")
+    if method == "analytic" or (method == "auto" and has_closed_form(robot, req)):
+        return analytic_all(robot, target, req, q_ref=ref, max_solutions=max_solutions)
     seed = fresh_seed() if req.seed is None else req.seed
     budget = 0.05 if req.time_budget is None else req.time_budget
     found: list[tuple[np.ndarray, float, float, int]] = []

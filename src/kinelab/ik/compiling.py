@@ -14,7 +14,8 @@ from typing import Any
 # [s] each path's first compilation on the 2-core development machine, numba's own start included (a process
 # that compiles two paths pays that start once): what the notice says it takes "about"
 SECONDS = {"FRDM": 60, "the monitored FRDM loop": 55, "the FRDM batch": 90, "the path follower": 75,
-           "the biquaternion solver": 35, "the verdict": 10, "the prepared solver's input check": 5}
+           "the biquaternion solver": 35, "the closed form": 15, "the closed form's batch": 5, "the verdict": 10,
+           "the prepared solver's input check": 5}
 
 
 class CompileNotice(UserWarning):

@@ -25,7 +25,22 @@ def paths(robot: Robot) -> list[tuple[str, Callable[[], object]]]:
         ("the FRDM batch", lambda: solve_batch(robot, [target] * 2, seed=0)),
         ("the path follower", lambda: track(robot, [target] * 2, q0=q)),
         ("the biquaternion solver", lambda: solve(robot, target, solver="biquat", seed=0)),
+        ("the closed form (every branch, one pose and a batch)", lambda: _closed_form(robot)),
     ]
+
+
+def _closed_form(robot: Robot) -> None:
+    """Every branch of one pose and of a batch, on ``robot`` if its chain has a closed form, else on the UR5
+    (the compiled code is the same for every arm)."""
+    from kinelab.ik.analytic.branches import all_branches_batch
+    from kinelab.ik.analytic.classify import classify
+    from kinelab.ik.api import solve_all
+    from kinelab.robot import load
+
+    arm = robot if classify(robot).arm is not None else load("ur5")
+    target = arm.fk(arm.random_q(0))
+    solve_all(arm, target, solver="analytic")
+    all_branches_batch(arm, [target])
 
 
 def run(robot: Robot) -> Iterator[tuple[str, float]]:

@@ -165,8 +165,8 @@ def _budget_paths(robot: Robot, budget: float, solvers: tuple[str, ...]) -> dict
     paths = {name: single(name) for name in solvers}
     paths["frdm batch of 64"] = lambda case, seed, tol: solve_batch(
         robot, [case.oMtarget] * 64, seed=seed, tol_pos=tol, tol_rot=tol, time_budget=budget)
-    paths["frdm solve_all"] = lambda case, seed, tol: solve_all(robot, case.oMtarget, seed=seed, tol_pos=tol,
-                                                                tol_rot=tol, time_budget=budget)
+    paths["frdm solve_all"] = lambda case, seed, tol: solve_all(robot, case.oMtarget, solver="frdm", seed=seed,
+                                                                tol_pos=tol, tol_rot=tol, time_budget=budget)
     paths["frdm prefer="] = lambda case, seed, tol: solve(robot, case.oMtarget, seed=seed, tol_pos=tol, tol_rot=tol,
                                                          time_budget=budget, prefer=case.q_start)
     return paths

@@ -1,0 +1,181 @@
+"""Every branch of a pose in closed form, each confirmed by Pinocchio within the joint limits.
+
+The kernel (:mod:`kinelab.ik.analytic.kernel`) returns the raw roots in (−π, π]; here each joint's angle is
+moved to the copy (θ + 2πk) inside its limits, nearest the reference when one is given (a joint whose range
+spans more than 2π has several copies: one branch, one answer), roots that coincide (a double root at a
+workspace boundary or an elbow stretched straight) are merged and counted, and every answer is judged by
+Pinocchio's FK. An answer short of the tolerance (geometry within the class tolerance but not exact) is
+finished by a warm-started solve from it; one that still misses is dropped.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from kinelab.errors import OptionError
+from kinelab.geometry import pose_errors, stack_homogeneous
+from kinelab.ik.analytic.classify import ArmClass, classify
+from kinelab.ik.analytic.kernel import MAX_ROWS, branches, branches_batch
+from kinelab.ik.compiling import announce
+from kinelab.ik.multistart import TypedKernel
+from kinelab.ik.request import Request, make_request
+from kinelab.ik.result import Diagnostics, IKResult, Status
+from kinelab.ik.targets import as_target_arrays
+from kinelab.robot import Robot
+
+SAME = 1e-5  # [rad] roots closer than this joint by joint are one branch (a double root split by rounding:
+# the two roots of arccos(1 − ε) are √(2ε) apart, 1.4e-6 rad at ε = 1e-12)
+LIMIT_SLACK = 1e-9  # [rad] a root this close outside a limit is the limit (a pose taken at the limit)
+CONTINUUM = "one of a continuum: a singular pose, another angle of the free joint serves too"
+_KERNEL = TypedKernel(branches)
+_NO_REF = {n: np.zeros(n) for n in (5, 6)}
+
+
+def arm_of(robot: Robot, req: Request) -> ArmClass:
+    """The robot's analytic class for a pose request.
+
+    Raises:
+        OptionError: the chain is in no analytic class (the tests it failed named), or the task is not "pose".
+    """
+    found = classify(robot)
+    if found.arm is None:
+        raise OptionError("solver", "analytic", "a chain in an analytic class (docs/analytic.md); "
+                          f"{robot.name}'s is not: {found.reason}")
+    if req.task.name != "pose":
+        raise OptionError("task", req.task_label, "'pose' with solver='analytic' (other tasks: solver='frdm')")
+    return found.arm
+
+
+def has_closed_form(robot: Robot, req: Request) -> bool:
+    """True when the chain is in an analytic class and the request asks for the whole pose."""
+    return req.task.name == "pose" and classify(robot).arm is not None
+
+
+def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | None = None,
+                 max_solutions: int | None = None) -> list[IKResult]:
+    """Every branch of the pose ``target`` (oMtarget, base frame) that Pinocchio confirms within the limits.
+
+    Args:
+        robot: a robot whose chain is in an analytic class.
+        target: oMtarget (``pin.SE3``), already checked.
+        req: the validated request (task "pose"; tol_pos [m], tol_rot [rad]).
+        q_ref: sort the answers by distance to this configuration and pick each angle's copy nearest it.
+        max_solutions: at most this many answers (the nearest ``q_ref`` first when given).
+
+    Returns:
+        One :class:`IKResult` per branch (``diagnostics.branches``: how many the pose has within the limits;
+        ``diagnostics.found``: the roots merged into this answer, 2 at a double root; ``message`` says when the
+        answer is one of a continuum).
+
+    Raises:
+        OptionError: the chain is in no analytic class, or the task is not "pose".
+    """
+    t0 = time.perf_counter()
+    arm = arm_of(robot, req)
+    q, found, free = roots(robot, arm, target.homogeneous, q_ref)
+    answers = []
+    for k in range(q.shape[0]):
+        judged = _judged(robot, q[k], target, req)
+        if judged is not None:
+            answers.append((*judged, int(found[k]), bool(free[k])))
+    if q_ref is not None:
+        from kinelab.ik.branches import distance  # the multistart's module imports this one
+
+        answers.sort(key=lambda a: distance(robot, a[0], q_ref))
+    elapsed = time.perf_counter() - t0
+    mode = f"analytic ({arm.name})"
+    return [IKResult(q=q, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr, iterations=0,
+                     restarts=0, wall_time=elapsed, solver="analytic", mode=mode, message=CONTINUUM if loose else "",
+                     diagnostics=Diagnostics(path="compiled", branches=len(answers), found=count, unseen=0.0),
+                     task=req.task_label)
+            for q, dp, dr, count, loose in answers[:max_solutions]]
+
+
+def roots(robot: Robot, arm: ArmClass, H: np.ndarray, q_ref: np.ndarray | None) -> tuple[np.ndarray, ...]:
+    """The compiled branches of the pose H (4 × 4, base frame): (q (m, n) within the limits, roots merged into
+    each, one-of-a-continuum flags), before Pinocchio's word."""
+    announce("the closed form", [branches])
+    n = arm.n
+    out, found, free = np.empty((MAX_ROWS, n)), np.zeros(MAX_ROWS, dtype=np.int64), np.zeros(MAX_ROWS, dtype=np.bool_)
+    ref = _NO_REF[n] if q_ref is None else np.ascontiguousarray(q_ref, dtype=float)
+    m = _KERNEL(n == 6, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, np.ascontiguousarray(H, dtype=float),
+                robot.lower, robot.upper, ref, q_ref is not None, SAME, LIMIT_SLACK, out, found, free)
+    return out[:m], found[:m], free[:m]
+
+
+def _judged(robot: Robot, q: np.ndarray, target: Any, req: Request) -> tuple[np.ndarray, float, float] | None:
+    """(q, position error, rotation error) when Pinocchio's FK of q meets the tolerances, after a warm-started
+    finish if the closed form fell short; None when it still does not."""
+    dp, dr = robot.tool_error(q, target)
+    if dp <= req.tol_pos and dr <= req.tol_rot:
+        return q, dp, dr
+    if dp > 1e3 * req.tol_pos + 1e-6 or dr > 1e3 * req.tol_rot + 1e-6:
+        return None  # not this pose's root (a 5R arm's candidate for the other shoulder side, say)
+    from kinelab.ik.driver import solve_one  # the driver's import chain reaches this module
+
+    finish = make_request("frdm", seed=0, tol_pos=req.tol_pos, tol_rot=req.tol_rot, max_restarts=0)
+    done = solve_one(robot, target, q, finish)
+    return (done.q, done.position_error, done.rotation_error) if done.success else None
+
+
+@dataclass(frozen=True, eq=False)
+class BranchBatch:
+    """Every branch of each pose of a batch, each confirmed by Pinocchio within the limits.
+
+    Attributes:
+        q: (B, MAX_ROWS, n) branches [rad], the first ``count[b]`` rows of pose b; NaN after them.
+        count: (B,) branches per pose.
+        found: (B, MAX_ROWS) roots merged into each branch (2 at a double root); 0 after ``count``.
+        free: (B, MAX_ROWS) the branch is one of a continuum (a singular pose).
+    """
+
+    q: np.ndarray
+    count: np.ndarray
+    found: np.ndarray
+    free: np.ndarray
+
+
+def all_branches_batch(robot: Robot, targets: Any, tol_pos: float = 1e-6, tol_rot: float = 1e-6) -> BranchBatch:
+    """Every branch of each pose in ``targets``, the closed form run in threads over the batch.
+
+    Each joint takes the copy of its angle within the limits nearest 0; every branch is then judged by
+    Pinocchio's FK (one call per branch) and kept only when it meets both tolerances. Unlike
+    :func:`analytic_all` an answer that falls short is dropped, not finished (the classes' geometry is exact to
+    rounding; a chain within the class tolerance but not exact should use :func:`analytic_all`).
+
+    Args:
+        robot: a robot whose chain is in an analytic class.
+        targets: a sequence of ``pin.SE3`` or a (B, 4, 4) array of oMtarget, base frame.
+        tol_pos: position tolerance [m].
+        tol_rot: rotation tolerance [rad].
+
+    Returns:
+        The :class:`BranchBatch`.
+
+    Raises:
+        TargetError: a bad target, its index named.
+        OptionError: the chain is in no analytic class.
+    """
+    arm = arm_of(robot, make_request("frdm", tol_pos=tol_pos, tol_rot=tol_rot))
+    H = stack_homogeneous(*as_target_arrays(targets))
+    announce("the closed form's batch", [branches_batch])
+    B, n = H.shape[0], arm.n
+    out = np.full((B, MAX_ROWS, n), np.nan)
+    found, free = np.zeros((B, MAX_ROWS), dtype=np.int64), np.zeros((B, MAX_ROWS), dtype=np.bool_)
+    count = np.zeros(B, dtype=np.int64)
+    branches_batch(n == 6, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, H, robot.lower, robot.upper, SAME,
+                   LIMIT_SLACK, out, found, free, count)
+    pose, row = np.nonzero(np.arange(MAX_ROWS)[None, :] < count[:, None])
+    dp, dr = pose_errors(H[pose], robot.fk_batch(out[pose, row]))
+    ok = (dp <= tol_pos) & (dr <= tol_rot)
+    kept = np.bincount(pose[ok], minlength=B)
+    rank = np.arange(int(ok.sum())) - np.concatenate([[0], np.cumsum(kept)[:-1]])[pose[ok]]
+    q = np.full_like(out, np.nan)
+    q[pose[ok], rank] = out[pose[ok], row[ok]]
+    f, loose = np.zeros_like(found), np.zeros_like(free)
+    f[pose[ok], rank], loose[pose[ok], rank] = found[pose[ok], row[ok]], free[pose[ok], row[ok]]
+    return BranchBatch(q, kept, f, loose)

@@ -1,0 +1,138 @@
+"""Which arms the subproblems solve: the chain's class, read from its joint axes and points at q = 0.
+
+Two classes are solved in closed form (docs/analytic.md), each also in its mirror image (the chain read from
+the tool back to the base, which solves the inverse pose):
+
+- **6R, h₂ ∥ h₃ ∥ h₄, axes 5 and 6 meeting** (the UR arms, the Unitree Z1): up to 8 branches;
+- **5R, h₂ ∥ h₃ ∥ h₄** (the SO-101): up to 4 candidates, of which a pose keeps those that meet it.
+
+Axes count as parallel when their angle is below AXIS_TOL and as meeting when their distance is below
+POINT_TOL; a chain that misses a test by more gets the numeric path, with the tests it failed named.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from kinelab.errors import ChainError
+from kinelab.ik.chain import PRISMATIC, chain_model
+from kinelab.robot import Robot
+
+AXIS_TOL = 1e-6  # [rad] axes closer to parallel than this are parallel
+POINT_TOL = 1e-6  # [m] axes closer than this meet
+
+
+@dataclass(frozen=True, eq=False)
+class ArmClass:
+    """An arm the subproblems solve, in the orientation they solve it.
+
+    Attributes:
+        name: the class, in words; mirrored: the chain is solved read from the tool back (inverse pose,
+            joints reversed and negated).
+        h, o: (n, 3) unit axes and points on them at q = 0 [m], in the solved orientation's base frame.
+        R0, N0: the tool's rotation and point at q = 0 in that frame.
+    """
+
+    name: str
+    mirrored: bool
+    h: np.ndarray
+    o: np.ndarray
+    R0: np.ndarray
+    N0: np.ndarray
+
+    @property
+    def n(self) -> int:
+        """Number of joints."""
+        return int(self.h.shape[0])
+
+
+@dataclass(frozen=True, eq=False)
+class Classification:
+    """The chain's class (``arm``), or None with ``reason`` naming the tests it failed."""
+
+    arm: ArmClass | None
+    reason: str
+
+
+def classify(robot: Robot) -> Classification:
+    """The analytic class of ``robot``'s chain, built once per Robot (see the module's docstring)."""
+    return robot.derived("analytic_class", _classify)
+
+
+def _classify(robot: Robot) -> Classification:
+    try:
+        cm = chain_model(robot)
+    except ChainError as err:
+        return Classification(None, str(err))
+    if (cm.kind == PRISMATIC).any():
+        return Classification(None, "a prismatic joint (the subproblems here solve revolute chains)")
+    if cm.n not in (5, 6):
+        return Classification(None, f"{cm.n} joints (the subproblems here solve 5R and 6R chains)")
+    v = cm.vectors(np.zeros(cm.n))
+    h, o, R0, N0 = v["e"].copy(), v["o"].copy(), v["R"].copy(), v["N"].copy()
+    failed = []
+    for mirrored in (False, True):
+        hh, oo, RR, NN = reverse(h, o, R0, N0) if mirrored else (h, o, R0, N0)
+        misses = _misses(hh, oo)
+        if not misses:
+            if cm.n == 6:
+                oo = oo.copy()
+                oo[4] = oo[5] = meeting_point(oo[4], hh[4], oo[5], hh[5])
+            name = ("6R, axes 2, 3, 4 parallel, axes 5 and 6 meeting" if cm.n == 6 else "5R, axes 2, 3, 4 parallel")
+            if mirrored:
+                name += " (mirrored: read from the tool)"
+            return Classification(ArmClass(name, mirrored, hh, oo, RR, NN), "")
+        failed.append(("read from the tool: " if mirrored else "") + "; ".join(misses))
+    return Classification(None, " | ".join(failed))
+
+
+def _misses(h: np.ndarray, o: np.ndarray) -> list[str]:
+    """The class tests these axes fail, in words (empty: in the class)."""
+    misses = []
+    for i, j in ((1, 2), (1, 3)):
+        angle = _angle(h[i], h[j])
+        if angle > AXIS_TOL:
+            misses.append(f"axes {i + 1} and {j + 1} are {angle:.2g} rad from parallel (tolerance {AXIS_TOL:g})")
+    if _angle(h[0], h[1]) <= AXIS_TOL:
+        misses.append("axes 1 and 2 are parallel (joint 1 would not fix the plane of the elbow)")
+    if h.shape[0] == 6:
+        gap = line_distance(o[4], h[4], o[5], h[5])
+        if gap > POINT_TOL:
+            misses.append(f"axes 5 and 6 are {gap:.2g} m apart (tolerance {POINT_TOL:g})")
+        if _angle(h[4], h[5]) <= AXIS_TOL:
+            misses.append("axes 5 and 6 are parallel")
+    elif _angle(h[4], h[1]) <= AXIS_TOL:
+        misses.append("axis 5 is parallel to axis 2 (the wrist could not turn the tool out of the arm's plane)")
+    return misses
+
+
+def _angle(a: np.ndarray, b: np.ndarray) -> float:
+    """The angle between two lines' directions [rad], in [0, π/2]."""
+    return float(np.arctan2(np.linalg.norm(np.cross(a, b)), abs(np.dot(a, b))))
+
+
+def line_distance(p: np.ndarray, a: np.ndarray, q: np.ndarray, b: np.ndarray) -> float:
+    """The distance [m] between the line through p along a and the line through q along b (unit a, b)."""
+    n = np.cross(a, b)
+    if np.linalg.norm(n) < AXIS_TOL:
+        d = q - p
+        return float(np.linalg.norm(d - a * np.dot(a, d)))
+    return float(abs(np.dot(q - p, n)) / np.linalg.norm(n))
+
+
+def meeting_point(p: np.ndarray, a: np.ndarray, q: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The midpoint of the closest points of two non-parallel lines (their meeting point when they meet)."""
+    w = p - q
+    A, B, C = float(np.dot(a, a)), float(np.dot(a, b)), float(np.dot(b, b))
+    D, E = float(np.dot(a, w)), float(np.dot(b, w))
+    den = A * C - B * B
+    s, t = (B * E - C * D) / den, (A * E - B * D) / den
+    return np.asarray(0.5 * ((p + s * a) + (q + t * b)), dtype=float)
+
+
+def reverse(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The chain read from the tool back: T(q)⁻¹ = T'(q') with q' = −q reversed, axes R0ᵀ·h and points
+    R0ᵀ·(o − N0) in reverse order, and tool pose at q' = 0 the inverse of T(0)."""
+    return (h[::-1] @ R0, (o[::-1] - N0) @ R0, R0.T.copy(), -R0.T @ N0)

@@ -1,0 +1,257 @@
+"""Every branch in closed form (kinelab.ik.analytic) against two references per arm, as sets, on 1000 poses per
+arm including singular and joint-limit ones: the UR arms' closed form of tests/closed_forms.py, and EAIK
+(Ostermeier et al., an independent implementation of the subproblems, built here from Pinocchio's own axes
+and points, not from kinelab's chain model); for the SO-101 EAIK and FRDM's dense multistart. Every answer is
+confirmed by Pinocchio within the limits. Mirrored and re-rooted chains are written as URDF files here."""
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from closed_forms import BASE, UR_DH, ur_inverse
+from eaik.IK_HP import HPRobot
+from helpers import write_urdf
+
+import kinelab
+from kinelab import OptionError, load
+from kinelab.ik.analytic.classify import classify
+
+SAME = 1e-4  # [rad] two answers this close joint by joint (modulo 2π) are one branch (double roots split by rounding)
+POSES = 1000
+
+
+def wrapped(d):
+    return np.arctan2(np.sin(d), np.cos(d))
+
+
+def merged(qs):
+    out = []
+    for q in qs:
+        if all(np.max(np.abs(wrapped(q - o))) > SAME for o in out):
+            out.append(np.asarray(q, dtype=float))
+    return out
+
+
+def has_copy_within(robot, q):
+    """Some θ + 2πk of every joint lies within its limits (the test's own reading of the limits)."""
+    k = np.arange(-3, 4)[:, None] * 2 * np.pi
+    return all(((q[j] + k >= robot.lower[j] - 1e-9) & (q[j] + k <= robot.upper[j] + 1e-9)).any()
+               for j in range(robot.n))
+
+
+def confirmed(robot, target, qs, tol=1e-9):
+    """The references' answers that Pinocchio confirms and that have a copy within the limits, merged."""
+    keep = []
+    for q in qs:
+        placed = q + 2 * np.pi * np.round((np.clip(q, robot.lower, robot.upper) - q) / (2 * np.pi))
+        if has_copy_within(robot, q) and max(robot.tool_error(placed, target)) <= tol:
+            keep.append(q)
+    return merged(keep)
+
+
+def same_set(a, b, tol=SAME):
+    return all(any(np.max(np.abs(wrapped(x - y))) <= tol for y in b) for x in a) and \
+        all(any(np.max(np.abs(wrapped(x - y))) <= tol for x in a) for y in b)
+
+
+def pinocchio_axes(robot):
+    """Unit axes, points on them and the tool pose at q = 0, read from Pinocchio's model and Jacobians."""
+    model, data = robot.model, robot.model.createData()
+    q0 = pin.neutral(model)
+    pin.computeJointJacobians(model, data, q0)
+    pin.framesForwardKinematics(model, data, q0)
+    h = np.array([pin.getJointJacobian(model, data, j, pin.WORLD)[3:, model.joints[j].idx_v]
+                  for j in range(1, model.njoints)])
+    o = np.array([data.oMi[j].translation for j in range(1, model.njoints)])
+    return h, o, data.oMf[robot.tool_frame_id]
+
+
+class Eaik:
+    """EAIK's solver for a robot, fed Pinocchio's axes; its tool frame at q = 0 is the base's orientation."""
+
+    def __init__(self, robot):
+        h, o, M = pinocchio_axes(robot)
+        self.R0 = M.rotation
+        self.bot = HPRobot(h, np.vstack([o[0], np.diff(o, axis=0), M.translation - o[-1]]))
+
+    def __call__(self, target):
+        H = target.homogeneous.copy()
+        H[:3, :3] = H[:3, :3] @ self.R0.T
+        return list(self.bot.IK(H).Q)  # least-squares answers too: at a double root Pinocchio confirms them
+
+
+def poses(robot, singular, seed):
+    """POSES configurations: 80 % random, 10 % with ``singular`` joints set to 0 (a singular pose), 10 % with
+    one or two joints at a limit."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for k in range(POSES):
+        q = robot.random_q(rng)
+        if k % 10 == 8:
+            q[singular[k // 10 % len(singular)]] = 0.0
+        elif k % 10 == 9:
+            for j in rng.choice(robot.n, size=1 + k % 2, replace=False):
+                q[j] = robot.lower[j] if rng.random() < 0.5 else robot.upper[j]
+        out.append(q)
+    return out
+
+
+def continuum(found):
+    return any("continuum" in s.message for s in found)
+
+
+@pytest.mark.parametrize("name", ["ur5", "ur10"])
+def test_the_ur_branches_are_the_closed_form_and_eaik_as_sets(name):
+    robot = load(name)
+    eaik = Eaik(robot)
+    agree_closed, agree_eaik, compared = 0, 0, 0
+    for q in poses(robot, singular=[[4], [2], [2, 4]], seed=7):
+        target = robot.fk(q)
+        found = kinelab.solve_all(robot, target, solver="analytic")
+        assert found and all(s.success and s.solver == "analytic" for s in found)
+        for s in found:  # Pinocchio confirms each, within the limits
+            assert robot.within_limits(s.q) and max(robot.tool_error(s.q, target)) <= 1e-6
+        assert any(np.max(np.abs(wrapped(s.q - q))) <= 1e-6 for s in found) or continuum(found)
+        if continuum(found):  # a wrist at q5 = 0: a circle of answers, not a finite set to compare
+            continue
+        compared += 1
+        ours = [s.q for s in found]
+        agree_closed += same_set(ours, confirmed(robot, target, ur_inverse(BASE @ target.homogeneous,
+                                                                        *UR_DH[name])))
+        agree_eaik += same_set(ours, confirmed(robot, target, eaik(target)))
+    print(name, compared, agree_closed, agree_eaik)
+    assert compared >= 0.85 * POSES  # the q5 = 0 poses (and q5 at ±2π) are continua
+    assert agree_closed >= 0.999 * compared and agree_eaik >= 0.999 * compared
+
+
+def test_the_so101_branches_are_eaik_and_the_dense_multistart_as_sets():
+    robot = load("so101")
+    eaik = Eaik(robot)
+    agree_eaik, agree_search, searched = 0, 0, 0
+    for k, q in enumerate(poses(robot, singular=[[2], [3], [1, 2]], seed=8)):
+        target = robot.fk(q)
+        found = kinelab.solve_all(robot, target, solver="analytic")
+        assert all(robot.within_limits(s.q) and max(robot.tool_error(s.q, target)) <= 1e-6 for s in found)
+        assert any(np.max(np.abs(wrapped(s.q - q))) <= 1e-6 for s in found)
+        ours = [s.q for s in found]
+        agree_eaik += same_set(ours, confirmed(robot, target, eaik(target)))
+        if k % 50 == 0:  # a dense search (rounds of 64 seeded starts for 0.5 s), one pose in fifty
+            searched += 1
+            dense = kinelab.solve_all(robot, target, solver="frdm", seed=k, time_budget=0.5, stop_below=None)
+            # a search's answers met to 1e-6 m scatter by up to ~1e-2 rad near a double root (test_branches.py)
+            agree_search += same_set(ours, [s.q for s in dense], tol=1e-2)
+    assert agree_eaik >= 0.999 * POSES
+    assert agree_search == searched
+
+
+def test_arms_are_classified_by_their_axes_and_others_are_refused_by_name():
+    assert {n: classify(load(n)).arm is not None for n in ("ur3", "ur5", "ur10", "z1", "so101", "kinova", "panda",
+                                                           "stanford")} == \
+        {"ur3": True, "ur5": True, "ur10": True, "z1": True, "so101": True, "kinova": False, "panda": False,
+         "stanford": False}
+    kinova = load("kinova")
+    target = kinova.fk(kinova.random_q(0))
+    with pytest.raises(OptionError, match="kinova's is not: axes 2 and 4 are 1.6 rad from parallel"):
+        kinelab.solve_all(kinova, target, solver="analytic")
+    auto = kinelab.solve_all(kinova, target, seed=0)  # the numeric search instead, saying so
+    assert auto and all(s.solver == "frdm" and "multistart" in s.mode for s in auto)
+    ur5 = load("ur5")
+    with pytest.raises(OptionError, match="task"):
+        kinelab.solve_all(ur5, ur5.fk(ur5.random_q(0)), solver="analytic", task="position")
+    with pytest.raises(OptionError, match="options"):
+        kinelab.solve_all(ur5, ur5.fk(ur5.random_q(0)), solver="analytic", relax=1.2)
+
+
+def chain_urdf(h, o, M, lower, upper, mount=None):
+    """A URDF of revolute joints with axes h_i through points o_i (base frame, q = 0) and the tool at M; links
+    are frames without rotation. ``mount``: (xyz, rpy) of the base under a "world" link."""
+    rows = ['<link name="base"/>']
+    if mount is not None:
+        rows += ['<link name="world"/>', f'<joint name="mount" type="fixed"><parent link="world"/><child link="base"/>'
+                 f'<origin xyz="{" ".join(map(repr, mount[0]))}" rpy="{" ".join(map(repr, mount[1]))}"/></joint>']
+    parent, at = "base", np.zeros(3)
+    for i in range(len(h)):
+        rows += [f'<link name="l{i + 1}"/>',
+                 f'<joint name="j{i + 1}" type="revolute"><parent link="{parent}"/><child link="l{i + 1}"/>'
+                 f'<origin xyz="{" ".join(map(repr, (o[i] - at).tolist()))}"/>'
+                 f'<axis xyz="{" ".join(map(repr, h[i].tolist()))}"/>'
+                 f'<limit lower="{float(lower[i])!r}" upper="{float(upper[i])!r}" effort="1" velocity="1"/></joint>']
+        parent, at = f"l{i + 1}", o[i]
+    rpy = pin.rpy.matrixToRpy(M.rotation)
+    rows += ['<link name="tool"/>', f'<joint name="tool_joint" type="fixed"><parent link="{parent}"/>'
+             f'<child link="tool"/><origin xyz="{" ".join(map(repr, (M.translation - at).tolist()))}" '
+             f'rpy="{" ".join(map(repr, rpy.tolist()))}"/></joint>']
+    return "\n".join(rows)
+
+
+def test_a_mirrored_ur5_read_from_its_tool_classifies_and_solves_the_inverse_pose(tmp_path):
+    """The UR5 written tool first: its base is the UR5's tool, joint k is the UR5's joint 7 − k turning the other
+    way (q'_k = −q_{7−k}), so its FK at q' is the UR5's at q inverted."""
+    ur5 = load("ur5")
+    h, o, M = pinocchio_axes(ur5)
+    R0, N0 = M.rotation, M.translation
+    mirror_file = write_urdf(tmp_path, chain_urdf((h[::-1] @ R0), (o[::-1] - N0) @ R0, M.inverse(),
+                                                  -ur5.upper[::-1], -ur5.lower[::-1]))
+    mirror = load(mirror_file, tool="tool")
+    arm = classify(mirror).arm
+    assert arm is not None and arm.mirrored
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        q = ur5.random_q(rng)
+        target = mirror.fk(-q[::-1])
+        assert target.isApprox(ur5.fk(q).inverse(), 1e-9)  # the file is the mirror image
+        found = kinelab.solve_all(mirror, target, solver="analytic")
+        assert all(max(mirror.tool_error(s.q, target)) <= 1e-6 for s in found)
+        closed = confirmed(ur5, ur5.fk(q), ur_inverse(BASE @ ur5.fk(q).homogeneous, *UR_DH["ur5"]))
+        assert same_set([-s.q[::-1] for s in found], closed)
+
+
+def test_a_chain_re_rooted_at_a_tilted_mount_keeps_its_class_and_its_branches(tmp_path):
+    ur5 = load("ur5")
+    h, o, M = pinocchio_axes(ur5)
+    mount = ((0.4, -0.1, 0.8), (0.3, -0.2, 0.5))
+    path = write_urdf(tmp_path, chain_urdf(h, o, M, ur5.lower, ur5.upper, mount=mount))
+    on_mount, on_world = load(path, tool="tool", base="base"), load(path, tool="tool", base="world")
+    wMb = pin.SE3(pin.rpy.rpyToMatrix(*mount[1]), np.array(mount[0]))
+    assert classify(on_world).arm is not None and not classify(on_world).arm.mirrored
+    rng = np.random.default_rng(6)
+    for _ in range(200):
+        q = ur5.random_q(rng)
+        assert on_mount.fk(q).isApprox(ur5.fk(q), 1e-9)
+        target = on_world.fk(q)
+        in_world = kinelab.solve_all(on_world, target, solver="analytic")
+        in_base = kinelab.solve_all(on_mount, wMb.inverse() * target, solver="analytic")
+        assert all(max(on_world.tool_error(s.q, target)) <= 1e-6 for s in in_world)
+        assert same_set([s.q for s in in_world], [s.q for s in in_base])
+        assert same_set([s.q for s in in_base], confirmed(ur5, ur5.fk(q), ur_inverse(BASE @ ur5.fk(q).homogeneous,
+                                                                                    *UR_DH["ur5"])))
+
+
+def test_a_double_root_is_one_branch_and_a_reference_picks_the_copies():
+    robot = load("ur5")
+    q = np.array([0.3, -1.0, 0.0, 0.4, 0.9, -0.2])  # the elbow stretched straight: θ3's two roots coincide
+    found = kinelab.solve_all(robot, robot.fk(q), solver="analytic")
+    straight = [s for s in found if abs(wrapped(s.q[2])) < 1e-6]
+    assert len(straight) == 1 and straight[0].diagnostics.found == 2  # two roots, one answer
+    assert all(s.diagnostics.branches == len(found) for s in found)
+    ref = q + np.array([-2 * np.pi, 0, 0, -2 * np.pi, 0, 2 * np.pi])  # the same pose, other copies in limits
+    near = kinelab.solve_all(robot, robot.fk(q), solver="analytic", q_ref=ref)
+    assert np.allclose(near[0].q, ref, atol=1e-9)
+
+
+def test_the_batch_gives_each_pose_the_branches_of_a_single_call_and_drops_what_pinocchio_refuses():
+    from kinelab.ik.analytic.branches import all_branches_batch
+
+    robot = load("ur10")
+    rng = np.random.default_rng(9)
+    Q = np.array([robot.random_q(rng) for _ in range(300)])
+    H = robot.fk_batch(Q)
+    H[7, 0, 3] += 5.0  # beyond reach: no branch
+    batch = all_branches_batch(robot, H)
+    assert batch.count[7] == 0 and np.isnan(batch.q[7]).all()
+    for b in range(0, 300, 7):
+        single = kinelab.solve_all(robot, pin.SE3(H[b]), solver="analytic")
+        assert batch.count[b] == len(single)
+        assert same_set(list(batch.q[b, :batch.count[b]]), [s.q for s in single], tol=1e-12)
+        assert np.isnan(batch.q[b, batch.count[b]:]).all()
+    for b, r in zip(*np.nonzero(~np.isnan(batch.q[:, :, 0])), strict=True):
+        assert robot.within_limits(batch.q[b, r]) and max(robot.tool_error(batch.q[b, r], pin.SE3(H[b]))) <= 1e-6
