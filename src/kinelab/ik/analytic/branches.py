@@ -68,7 +68,8 @@ def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | No
 
     Returns:
         One :class:`IKResult` per branch (``diagnostics.branches``: how many the pose has within the limits;
-        ``diagnostics.found``: the roots merged into this answer, 2 at a double root; ``message`` says when the
+        ``diagnostics.found``: the roots merged into this answer, 2 at a double root; ``diagnostics.polished``: 1
+        when the closed form fell short and a warm-started FRDM solve finished it; ``message`` says when the
         answer is one of a continuum).
 
     Raises:
@@ -90,9 +91,10 @@ def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | No
     mode = f"analytic ({arm.name})"
     return [IKResult(q=q, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr, iterations=0,
                      restarts=0, wall_time=elapsed, solver="analytic", mode=mode, message=CONTINUUM if loose else "",
-                     diagnostics=Diagnostics(path="compiled", branches=len(answers), found=count, unseen=0.0),
+                     diagnostics=Diagnostics(path="compiled", branches=len(answers), found=count, unseen=0.0,
+                                             polished=1 if finished else None),
                      task=req.task_label)
-            for q, dp, dr, count, loose in answers[:max_solutions]]
+            for q, dp, dr, finished, count, loose in answers[:max_solutions]]
 
 
 def roots(robot: Robot, arm: ArmClass, H: np.ndarray, q_ref: np.ndarray | None) -> tuple[np.ndarray, ...]:
@@ -107,19 +109,19 @@ def roots(robot: Robot, arm: ArmClass, H: np.ndarray, q_ref: np.ndarray | None) 
     return out[:m], found[:m], free[:m]
 
 
-def _judged(robot: Robot, q: np.ndarray, target: Any, req: Request) -> tuple[np.ndarray, float, float] | None:
-    """(q, position error, rotation error) when Pinocchio's FK of q meets the tolerances, after a warm-started
-    finish if the closed form fell short; None when it still does not."""
+def _judged(robot: Robot, q: np.ndarray, target: Any, req: Request) -> tuple[np.ndarray, float, float, bool] | None:
+    """(q, position error, rotation error, finished) when Pinocchio's FK of q meets the tolerances, after a
+    warm-started finish (``finished``) if the closed form fell short; None when it still does not."""
     dp, dr = robot.tool_error(q, target)
     if dp <= req.tol_pos and dr <= req.tol_rot:
-        return q, dp, dr
+        return q, dp, dr, False
     if dp > 1e3 * req.tol_pos + 1e-6 or dr > 1e3 * req.tol_rot + 1e-6:
         return None  # not this pose's root (a 5R arm's candidate for the other shoulder side, say)
     from kinelab.ik.driver import solve_one  # the driver's import chain reaches this module
 
     finish = make_request("frdm", seed=0, tol_pos=req.tol_pos, tol_rot=req.tol_rot, max_restarts=0)
     done = solve_one(robot, target, q, finish)
-    return (done.q, done.position_error, done.rotation_error) if done.success else None
+    return (done.q, done.position_error, done.rotation_error, True) if done.success else None
 
 
 @dataclass(frozen=True, eq=False)
