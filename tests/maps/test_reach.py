@@ -42,7 +42,7 @@ def test_fk_points_are_reachable_and_points_beyond_the_reach_are_not(ur5):
 
 
 def test_a_reached_target_is_pinocchio_checked(ur5):
-    spec = reach.MapSpec(orientations=8, restarts=10)
+    spec = reach.MapSpec(orientations=8, restarts=10, method="numeric")
     centre = ur5.fk(ur5.random_q(3)).translation[None]
     H = reach.targets_of(centre, grid.rotations(8))
     res = kinelab.solve_batch(ur5, H, seed=spec.seed, max_restarts=spec.restarts)
@@ -51,6 +51,24 @@ def test_a_reached_target_is_pinocchio_checked(ur5):
             dp, dr = ur5.tool_error(q, kinelab.target_from_xyz_quat_wxyz(T[:3, 3], _quat(T[:3, :3])))
             assert dp <= 1e-6 and dr <= 1e-6 and ur5.within_limits(q)
     assert reach.compute_chunk(ur5, spec, centre, 0)["reachability"][0] == res.success.mean()
+
+
+def test_an_analytic_arm_s_map_counts_every_branch_and_reaches_all_the_numeric_map_reaches(ur5):
+    """The closed-form map: a voxel's branch count is the mean of solve_all's counts over its orientations, each
+    branch checked by Pinocchio; wherever the numeric batch reached a pose, the closed form reached it too."""
+    rng = np.random.default_rng(2)
+    centres = np.vstack([[ur5.fk(ur5.random_q(rng)).translation for _ in range(24)], [[2.0, 0.0, 0.0]]])
+    closed = reach.compute_chunk(ur5, reach.MapSpec(orientations=8), centres, 0)
+    numeric = reach.compute_chunk(ur5, reach.MapSpec(orientations=8, restarts=20, method="numeric"), centres, 0)
+    assert np.isnan(numeric["branches"]).all() and closed["reachability"][-1] == 0 == closed["branches"][-1]
+    assert (closed["reachability"] >= numeric["reachability"]).all() and closed["reachability"].mean() > 0.3
+    H = reach.targets_of(centres[:6], grid.rotations(8))
+    counts = [len(kinelab.solve_all(ur5, kinelab.target_from_xyz_quat_wxyz(T[:3, 3], _quat(T[:3, :3])),
+                                    solver="analytic")) for T in H]
+    assert np.allclose(closed["branches"][:6], np.reshape(counts, (6, 8)).mean(axis=1))
+    assert reach.MapSpec().closed_form(ur5) and not reach.MapSpec().closed_form(kinelab.load("panda"))
+    with pytest.raises(KinelabError, match="method is one of auto, numeric"):
+        reach.MapSpec(method="fast").check()
 
 
 def _quat(R):

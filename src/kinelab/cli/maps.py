@@ -38,6 +38,9 @@ def _add_reach(kinds: Any) -> None:
                    help="pose (default), or axis: the tool z axis along spread directions, the roll free")
     r.add_argument("--restarts", type=int, default=20, help="random restarts per target (default 20)")
     seed_argument(r)
+    r.add_argument("--method", choices=("auto", "numeric"), default="auto",
+                   help="auto: every branch in closed form where the arm has one (task pose), else the numeric batch; "
+                        "numeric: the numeric batch everywhere (default auto)")
     r.add_argument("--chunk", type=int, default=64, help="voxels per chunk, the unit of work and storage (default 64)")
     r.add_argument("--out", help="a Zarr directory: written chunk by chunk, resumed if it holds this map unfinished")
     r.add_argument("--force", action="store_true", help="run a map of more than 2 million targets")
@@ -129,7 +132,7 @@ def run_reach(args: argparse.Namespace) -> int:
 
     robot = load_robot(args)
     spec = maps.MapSpec(voxel=args.voxel, orientations=args.orientations, task=args.task, restarts=args.restarts,
-                        seed=args.seed, chunk_voxels=args.chunk)
+                        seed=args.seed, chunk_voxels=args.chunk, method=args.method)
     if args.scheduler and args.workers:
         raise KinelabError("give --scheduler ADDRESS or --workers N, not both")
     if args.workers is not None and args.workers < 1:
@@ -147,15 +150,22 @@ def run_reach(args: argparse.Namespace) -> int:
     finally:
         if client is not None:
             client.close()
-    reach = result.array("reachability")
+    reach, branches = result.array("reachability"), result.array("branches")
     summary = {"robot": robot.name, "voxels": int(len(reach)), "targets": int(len(reach) * spec.orientations),
                "reached_voxels": int((reach > 0).sum()), "mean_reachability": float(np.nanmean(reach)),
+               "solver": result.meta["solver"],
+               "mean_branches": None if np.isnan(branches).all() or not (reach > 0).any()
+               else float(np.mean(branches[reach > 0])),
                "seconds": time.perf_counter() - t0, "out": args.out}
     if args.json:
         print_json(summary)
     else:
         print(f"{robot.name}: {plural(summary['voxels'], 'voxel')} of {args.voxel:g} m × {spec.orientations} "
               f"orientations; {summary['reached_voxels']} voxels reached, mean reachability "
-              f"{summary['mean_reachability']:.3f}; {summary['seconds']:.1f} s"
+              f"{summary['mean_reachability']:.3f}"
+              + (f"; every branch in closed form: {summary['mean_branches']:.2f} per pose within the limits in the "
+                 "reached voxels"
+                 if summary["mean_branches"] is not None else "")
+              + f"; {summary['seconds']:.1f} s"
               + (f"; written to {args.out}" if args.out else ""))
     return 0

@@ -1,10 +1,14 @@
 """One chunk of a reachability map: a pure function of (robot, spec, chunk index), and the map's spec.
 
 In every voxel the map asks for K tool poses (the voxel's centre, K orientations spread over SO(3), or K
-tool-axis directions for task "axis"), solves them with :func:`kinelab.solve_batch` (every answer checked
-by Pinocchio), and keeps per voxel the reachability index (the share of the K poses reached), the best
-manipulability among the answers and the smallest σ_min/σ_max. A chunk's seeds are fixed by its index and
-no wall-clock budget cuts it, so the map is the same whatever runs it and in whatever order.
+tool-axis directions for task "axis") and keeps per voxel the reachability index (the share of the K poses
+reached), the best manipulability among the answers and the smallest σ_min/σ_max. Where the arm has a
+closed form (:mod:`kinelab.ik.analytic`) and the task is "pose", every branch of every pose is computed
+(:func:`~kinelab.ik.analytic.branches.all_branches_batch`), the voxel also keeps the mean number of branches
+within the limits, and a pose's σ ratio is its best branch's; elsewhere :func:`kinelab.solve_batch` finds one
+answer per pose (the branch count is then unknown: NaN). Every answer is checked by Pinocchio. A chunk's
+seeds are fixed by its index and no wall-clock budget cuts it, so the map is the same whatever runs it and in
+whatever order.
 """
 
 from __future__ import annotations
@@ -15,11 +19,14 @@ import numpy as np
 
 from kinelab.analysis.singular import conditioning_batch
 from kinelab.errors import KinelabError
+from kinelab.ik.analytic.branches import all_branches_batch
+from kinelab.ik.analytic.classify import classify
 from kinelab.ik.api import solve_batch
 from kinelab.ik.request import check_seed
 from kinelab.maps import grid
 from kinelab.robot import Robot
 
+METHODS = ("auto", "numeric")
 MAX_TARGETS = 2_000_000  # a map asking for more needs force=True (about an hour per million on one core)
 
 
@@ -35,6 +42,8 @@ class MapSpec:
         restarts: random restarts per target after its first attempt.
         seed: base seed; chunk c's targets use seed + c · chunk_voxels · orientations + row.
         chunk_voxels: voxels per chunk (the unit of work and of storage).
+        method: "auto" (every branch in closed form where the arm has one and the task is "pose", else the
+            numeric batch) or "numeric" (the FRDM batch everywhere).
     """
 
     voxel: float = 0.1
@@ -45,6 +54,7 @@ class MapSpec:
     restarts: int = 20
     seed: int = 0
     chunk_voxels: int = 64
+    method: str = "auto"
 
     def check(self) -> None:
         """Raises KinelabError naming a bad field and what is valid."""
@@ -57,8 +67,14 @@ class MapSpec:
         if isinstance(self.voxel, bool) or not (isinstance(self.voxel, int | float) and np.isfinite(self.voxel)
                                                 and self.voxel > 0):
             raise KinelabError(f"the voxel side must be a positive length in metres, got {self.voxel!r}")
+        if self.method not in METHODS:
+            raise KinelabError(f"a reachability map's method is one of {', '.join(METHODS)}, got {self.method!r}")
         check_seed(self.seed)
         check_seed(self.restarts, "restarts")
+
+    def closed_form(self, robot: Robot) -> bool:
+        """True when this map of ``robot`` is computed with every branch in closed form."""
+        return self.method == "auto" and self.task == "pose" and classify(robot).arm is not None
 
     def to_dict(self) -> dict:
         """The JSON form stored with the map."""
@@ -78,11 +94,15 @@ def targets_of(centres: np.ndarray, rotations: np.ndarray) -> np.ndarray:
 def compute_chunk(robot: Robot, spec: MapSpec, centres: np.ndarray, index: int) -> dict[str, np.ndarray]:
     """The map's values for chunk ``index`` (voxels index·chunk_voxels onwards): reachability (share of the
     orientations reached), best manipulability (Yoshikawa, of the Jacobian with linear rows / L; 0 where
-    nothing is reached) and smallest σ_min/σ_max (1 where nothing is reached)."""
+    nothing is reached), smallest σ_min/σ_max (1 where nothing is reached) and the mean number of branches per
+    orientation (closed form only; NaN otherwise)."""
     lo = index * spec.chunk_voxels
     chunk = centres[lo:lo + spec.chunk_voxels]
     R = grid.axis_rotations(spec.orientations) if spec.task == "axis" else grid.rotations(spec.orientations)
-    res = solve_batch(robot, targets_of(chunk, R), seed=spec.seed + lo * spec.orientations, task=spec.task,
+    targets = targets_of(chunk, R)
+    if spec.closed_form(robot):
+        return _every_branch(robot, spec, targets, len(chunk))
+    res = solve_batch(robot, targets, seed=spec.seed + lo * spec.orientations, task=spec.task,
                       tol_pos=spec.tol_pos, tol_rot=spec.tol_rot, max_restarts=spec.restarts)
     ok = res.success.reshape(len(chunk), spec.orientations)
     manip = np.zeros(len(chunk) * spec.orientations)
@@ -91,6 +111,24 @@ def compute_chunk(robot: Robot, spec: MapSpec, centres: np.ndarray, index: int) 
         J = robot.jacobian_batch(res.q[res.success], frame="local_world_aligned")
         manip[res.success], ratio[res.success] = conditioning_batch(J, robot.characteristic_length())
     return {"reachability": ok.mean(axis=1), "manipulability": manip.reshape(ok.shape).max(axis=1),
-            "sigma_ratio": ratio.reshape(ok.shape).min(axis=1)}
+            "sigma_ratio": ratio.reshape(ok.shape).min(axis=1), "branches": np.full(len(chunk), np.nan)}
+
+
+def _every_branch(robot: Robot, spec: MapSpec, targets: np.ndarray, voxels: int) -> dict[str, np.ndarray]:
+    """The chunk's values from every branch of every pose: a pose is reached when it has a branch, its
+    manipulability and σ ratio are its best branch's."""
+    batch = all_branches_batch(robot, targets, tol_pos=spec.tol_pos, tol_rot=spec.tol_rot)
+    pose, row = np.nonzero(~np.isnan(batch.q[:, :, 0]))
+    manip, ratio = np.zeros(len(targets)), np.zeros(len(targets))
+    if len(pose):
+        J = robot.jacobian_batch(batch.q[pose, row], frame="local_world_aligned")
+        m, r = conditioning_batch(J, robot.characteristic_length())
+        np.maximum.at(manip, pose, m)
+        np.maximum.at(ratio, pose, r)
+    ok = (batch.count > 0).reshape(voxels, spec.orientations)
+    ratio[batch.count == 0] = 1.0  # an unreached pose does not lower the voxel's smallest ratio
+    return {"reachability": ok.mean(axis=1), "manipulability": manip.reshape(ok.shape).max(axis=1),
+            "sigma_ratio": ratio.reshape(ok.shape).min(axis=1),
+            "branches": batch.count.reshape(ok.shape).mean(axis=1).astype(float)}
 
 

@@ -19,7 +19,7 @@ from kinelab.errors import KinelabError
 from kinelab.robot import Robot
 
 INSTALL_HINT = "pip install 'kinelab[maps]' (zarr)"
-VALUES = ("reachability", "manipulability", "sigma_ratio")
+VALUES = ("reachability", "manipulability", "sigma_ratio", "branches")
 
 
 def _zarr() -> Any:
@@ -42,7 +42,8 @@ def metadata(robot: Robot, spec: Any, voxels: int) -> dict:
     from kinelab import __version__
 
     return {"robot": robot.name, "source_sha256": model_sha256(robot),
-            "spec": spec.to_dict(), "solver": "frdm", "voxels": int(voxels), "kinelab": __version__,
+            "spec": spec.to_dict(), "solver": "analytic" if spec.closed_form(robot) else "frdm",
+            "voxels": int(voxels), "kinelab": __version__,
             "base": robot.base, "tool": robot.tool}
 
 
@@ -87,7 +88,8 @@ class ReachabilityMap:
         return [int(c) for c in done if not np.array_equal(sums[c], self._digest(int(c)))]
 
     def array(self, name: str) -> np.ndarray:
-        """One of ``reachability``, ``manipulability``, ``sigma_ratio`` (or ``centres``) as a numpy array."""
+        """One of ``reachability``, ``manipulability``, ``sigma_ratio``, ``branches`` (or ``centres``) as a numpy
+        array."""
         return np.asarray(self.centres[:] if name == "centres" else self.values[name][:])
 
 
