@@ -114,3 +114,21 @@ def test_a_browser_shows_the_verdict_banner_at_the_top_of_the_report(tmp_path):
     tint = (np.abs(rgb - (0xFD, 0xEC, 0xEA)).max(axis=2) < 6)
     assert red[:160].sum() > 5000  # the banner, first thing on the page
     assert tint.sum() > 2000  # the failed check's row
+
+
+def test_the_closed_form_checks_hold_on_ur5_and_fail_when_a_branch_is_missing(monkeypatch):
+    """Every solver's answer from a random start is one of the closed form's branches; hide one branch of each
+    pose and the check must fail for the answers that landed on it."""
+    import kinelab
+    import kinelab.ik as ik
+
+    ur5 = kinelab.load("ur5")
+    rows = validate.analytic_checks(ur5, 40, 0)
+    assert [r.name for r in rows] == ["closed form: every branch met (Pinocchio-checked)",
+                                      *(f"{s}: every answer is one of the closed form's branches"
+                                        for s in ("frdm", "biquat", "dls"))]
+    assert all(r.passed for r in rows) and "on the branch nearest its start" in rows[1].detail
+    assert validate.analytic_checks(kinelab.load("panda"), 40, 0) == []  # no closed form: no such check
+    real = ik.solve_all
+    monkeypatch.setattr(ik, "solve_all", lambda *a, **kw: real(*a, **kw)[1:])
+    assert not all(r.passed for r in validate.analytic_checks(ur5, 40, 0)[1:])

@@ -148,6 +148,41 @@ def solver_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     return rows
 
 
+def analytic_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+    """Where the arm has a closed form: its branches confirmed by Pinocchio, and every FRDM, biquaternion and DLS
+    answer from a random start is one of them (with the share of FRDM answers on the branch nearest the start)."""
+    from kinelab.ik import solve, solve_all
+    from kinelab.ik.analytic.classify import classify
+    from kinelab.ik.branches import SAME, distance
+
+    if classify(robot).arm is None:
+        return []
+    count = max(10, n // 4)
+    rng = np.random.default_rng(seed + 5)
+    targets = [robot.fk(robot.random_q(rng)) for _ in range(count)]
+    branches = [solve_all(robot, t, solver="analytic") for t in targets]
+    worst = max(max(robot.tool_error(b.q, t)) for t, found in zip(targets, branches, strict=True) for b in found)
+    rows = [Check(robot.name, "closed form: every branch met (Pinocchio-checked)", worst, 1e-6, "m or rad",
+                  f"{count} targets, {np.mean([len(b) for b in branches]):.2f} branches each within the limits")]
+    for solver in ("frdm", "biquat", "dls"):
+        on_branch = nearest = solved = 0
+        for k, (target, found) in enumerate(zip(targets, branches, strict=True)):
+            start = robot.random_q(np.random.default_rng(seed + 1000 + k))
+            res = solve(robot, target, solver=solver, q0=start, seed=k, time_budget=0.2)
+            if not res.success:
+                continue
+            solved += 1
+            gaps = [distance(robot, res.q, b.q) for b in found]
+            on_branch += min(gaps) <= SAME  # answers met to 1e-6 lie up to ~2e-4 rad off a branch near a singularity
+            nearest += int(np.argmin(gaps)) == int(np.argmin([distance(robot, start, b.q) for b in found]))
+        detail = f"{solved} of {count} solved from random starts"
+        if solver == "frdm" and solved:
+            detail += f"; on the branch nearest its start in {100 * nearest / solved:.0f} %"
+        rows.append(Check(robot.name, f"{solver}: every answer is one of the closed form's branches",
+                          on_branch / max(solved, 1), 1.0, "%", detail, at_least=True))
+    return rows
+
+
 def seed001_run_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     """Seed 001's run: from the paper's start to its target with K = 1, h = 0.01 s."""
     run = seed001.reproduce(robot, record=True)
@@ -253,7 +288,7 @@ PAPER_CHECKS: dict[str, list[Callable[[Robot, int, int], list[Check]]]] = {
     "youbot": [youbot_checks],
     "era": [era_checks],
 }
-GENERAL_CHECKS = [model_checks, biquaternion_checks, solver_checks]
+GENERAL_CHECKS = [model_checks, biquaternion_checks, solver_checks, analytic_checks]
 
 
 def run(robots: list[str] | None = None, n: int | None = None, seed: int = 0, progress: bool = False) -> Report:
