@@ -216,3 +216,17 @@ def test_every_budgeted_path_runs_until_its_budget_and_is_reported():
     kept_back = {"frdm batch of 64": (CALL_SECONDS + 64 * VERDICT_SECONDS_PER_ROW) * 1e3}
     assert all(r["p50_ms"] >= 4.0 - kept_back.get(r["solver"], 0.0) and r["max_ms"] >= r["p99_ms"] >= r["p50_ms"]
                for r in rows), rows
+
+
+def test_the_branches_bench_reports_each_arm_and_its_multistart_completeness():
+    """Behaviour only (the figures belong to the bench): the closed form's arm gets its times, the multistart's
+    completeness against it and the batch's rates; an arm without one gets the multistart against a dense search."""
+    from kinelab.report.bench import branches
+
+    rows = branches.run(["so101", "kinova"], n=10, repeats=2)
+    closed, numeric = rows
+    assert closed["class"].startswith("5R") and {"closed form", "multistart"} <= set(closed["us"])
+    assert 0.0 <= closed["multistart_complete"] <= 1.0 and closed["batch_kernel_per_s"] > 0
+    assert numeric["class"].startswith("none: ") and set(numeric["us"]) == {"multistart"}
+    table = branches.markdown(rows)
+    assert table.count("\n") == 3 and "| so101 |" in table and "(vs dense)" in table

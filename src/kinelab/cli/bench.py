@@ -37,6 +37,9 @@ def add(sub: Any) -> None:
     s.add_argument("--versus", action="store_true",
                    help="also kinelab.IK(...).solve and kinelab.solve against ik_LM: floor, warm (sigma 0.02, 0.2) "
                         "and random starts, interleaved and blocked rounds, ratios with their spread")
+    s.add_argument("--branches", action="store_true",
+                   help="also every branch of a pose: the closed form against the multistart and EAIK, the batch's "
+                        "poses per second (the arms with a closed form, then kinova)")
     s.add_argument("--out", help="write bench.json, bench.md and bench.png here")
     s.add_argument("--json", action="store_true", help="print the results as JSON instead of tables")
     s.set_defaults(func=run)
@@ -72,6 +75,10 @@ def run(args: argparse.Namespace) -> int:
 
         result["versus"] = versus.run(args.robots, seed=args.seed, repeats=max(args.repeats, 2),
                                       progress=not args.json)
+    if args.branches:
+        from kinelab.report.bench import branches
+
+        result["branches"] = branches.run(None, seed=args.seed, repeats=max(args.repeats, 2), progress=not args.json)
     if args.out:
         render.write_bench(result, args.out)
     if args.json:
@@ -103,3 +110,7 @@ def _print_tables(result: dict[str, Any]) -> None:
         from kinelab.report.bench import versus
 
         print(versus.markdown(result["versus"]))
+    if "branches" in result:
+        from kinelab.report.bench import branches
+
+        print(branches.markdown(result["branches"]))
