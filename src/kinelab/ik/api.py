@@ -78,10 +78,12 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
         task: "pose" (all), "position", "axis" (the tool point and tool axis ``axis``, roll free) or
             "orientation" (:mod:`kinelab.ik.tasks`); the biquaternion solver takes "pose" only.
         axis: the tool axis of task "axis": "x", "y" or "z".
-        prefer: a reference configuration (rad or m): search every branch within ``time_budget`` and return
-            the one nearest it (revolute joints compared modulo 2π); None (default): the first answer found.
-            The search spends the whole budget; solvers "frdm" and "dls"; ``q0`` and ``max_restarts`` do
-            not apply to it (given with ``prefer``, they are refused).
+        prefer: a reference configuration (rad or m): return the branch nearest it (revolute joints compared
+            modulo 2π, each angle's copy in the limits nearest it) among every branch — in closed form where
+            the chain has one, the task is "pose" and FRDM runs without options (the result's ``solver`` is
+            then "analytic"), else those :func:`solve_all`'s multistart finds within ``time_budget`` (solvers
+            "frdm" and "dls"); None (default): the first answer found. ``q0`` and ``max_restarts`` do not
+            apply to it (given with ``prefer``, they are refused).
         solver_options: the solver's option fields as keyword arguments (instead of ``options``).
 
     Returns:
@@ -101,7 +103,8 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
     if q0 is not None:
         raise OptionError("q0", "given", "None with prefer= (the branch search draws its own starts)")
     t0 = time.perf_counter()
-    found = find_all(robot, target, req, q_ref=prefer)
+    closed = solver == "frdm" and options is None and not solver_options
+    found = find_all(robot, target, req, q_ref=prefer, method="auto" if closed else "multistart")
     if found:
         return replace(found[0], diagnostics=replace(found[0].diagnostics, branches=len(found)))
     # no branch met the tolerances: the best single answer, in what is left of the same budget (at least one
