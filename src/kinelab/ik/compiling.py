@@ -22,19 +22,22 @@ class CompileNotice(UserWarning):
     """kinelab compiles a path's kernels now (once per machine and version); the message says about how long."""
 
 
-_SAID: set[str] = set()
+_SAID: set[str] = set()  # the paths looked at in this process (announced or found cached)
 
 
 def announce(path: str, kernels: Iterable[Any]) -> None:
     """Warn once per process that ``path`` compiles, if any of its numba ``kernels`` has no cached machine code.
+    The cache is looked at on the path's first call only (reading its index costs tens of microseconds).
 
     Args:
         path: the path's name, a key of :data:`SECONDS`.
         kernels: its numba dispatchers (the entry points its first call compiles).
     """
-    if path in _SAID or all(_cached(k) for k in kernels):
+    if path in _SAID:
         return
     _SAID.add(path)
+    if all(_cached(k) for k in kernels):
+        return
     warnings.warn(f"compiling {path} for this machine: about {SECONDS.get(path, 60)} s on 2 cores, once (later "
                   "runs load the cached code; `kinelab warmup` compiles every path ahead)", CompileNotice,
                   stacklevel=2)
