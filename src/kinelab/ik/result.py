@@ -96,55 +96,67 @@ class BiquatTrajectory:
 
 @dataclass(frozen=True, repr=False)
 class Diagnostics:
-    """How a solve ran: each field is set by the solvers it applies to, None (or "") elsewhere.
-
-    Attributes:
-        path: "compiled" (a compiled kernel ran the attempts) or "" (the Python loop).
-        attempts: attempts run (the first start and its restarts); stalls: attempts that stalled.
-        message: a solver's own note (a biquaternion run stopped by a singular matrix, say).
-        sweeps, accelerated_sweeps: FRDM sweeps of the answer's run, and those Anderson's extrapolation kept.
-        order, relax, w_p: FRDM's sweep order, relaxation and position weight [1/m²].
-        objective: FRDM's objective at the answer; newton_steps: Gauss–Newton steps of FRDM's Newton finish
-            (every attempt); polished: stalled attempts finished by Gauss–Newton steps;
-            polish_iterations: DLS steps after FRDM (``polish=True``); trace: the objective after every sweep.
-        model_time: the biquaternion run's model time [s]; steps: its integration steps; M0: the scalar of
-            N̄∘Λ at the end (±1 at the target); damping, law, integrator: how it ran; outside_limits: compiled
-            attempts restarted because their answer left the limits; trajectory: the recorded run.
-        answer_events, answer_bypasses: the monitor events and bypasses of the answer's own attempt (the
-            result's ``singular_events``/``bypasses`` cover every attempt).
-        branches: distinct solutions found (``solve(prefer=)``); found: starts that reached this solution,
-            starts: starts run and unseen: the estimated chance that one more start would find a new branch
-            (``solve_all``).
-    """
+    """How a solve ran: each field is set by the solvers it applies to, None (or "") elsewhere."""
 
     path: str = ""
+    """"compiled" (a compiled kernel ran the attempts) or "" (the Python loop)."""
     attempts: int | None = None
+    """Attempts run: the first start and its restarts."""
     stalls: int | None = None
+    """Attempts that stalled."""
     message: str = ""
+    """A solver's own note (a biquaternion run stopped by a singular matrix, say)."""
     sweeps: int | None = None
+    """FRDM sweeps of the answer's run."""
     accelerated_sweeps: int | None = None
+    """FRDM sweeps whose Anderson extrapolation was kept."""
     order: str = ""
+    """FRDM's sweep order."""
     relax: float | None = None
+    """FRDM's relaxation factor."""
     w_p: float | None = None
+    """FRDM's position weight [1/m²]."""
     objective: float | None = None
+    """FRDM's objective at the answer."""
     newton_steps: int | None = None
+    """Gauss–Newton steps of FRDM's Newton finish, over every attempt."""
     polished: int | None = None
+    """Attempts finished by Gauss–Newton steps after a stall (FRDM), or 1 when a closed-form answer was finished
+    by a warm-started FRDM solve."""
     polish_iterations: int | None = None
+    """DLS steps after FRDM (``polish=True``)."""
     trace: tuple[float, ...] | None = None
+    """FRDM's objective after every sweep."""
     model_time: float | None = None
+    """The biquaternion run's model time [s]."""
     steps: int | None = None
+    """The biquaternion run's integration steps."""
     M0: float | None = None
+    """The scalar of N̄∘Λ at the end of a biquaternion run (±1 at the target)."""
     damping: float | None = None
+    """The biquaternion run's damping."""
     law: str = ""
+    """The biquaternion control law that ran."""
     integrator: str = ""
+    """The biquaternion run's integrator."""
     outside_limits: int | None = None
+    """Compiled attempts restarted because their answer left the limits."""
     trajectory: BiquatTrajectory | None = None
+    """The recorded biquaternion run (``record=True``)."""
     answer_events: tuple[SingularEvent, ...] = ()
+    """The monitor events of the answer's own attempt (the result's ``singular_events`` cover every attempt)."""
     answer_bypasses: tuple[BypassRecord, ...] = ()
+    """The bypasses of the answer's own attempt (the result's ``bypasses`` cover every attempt)."""
     branches: int | None = None
+    """Distinct solutions: found by the search (``solve(prefer=)``), or that exist within the limits (closed
+    form, ``solver == "analytic"``)."""
     found: int | None = None
+    """Starts that reached this solution (multistart), or the roots merged into it (closed form: 2 at a double
+    root)."""
     starts: int | None = None
+    """Starts run (``solve_all``'s multistart)."""
     unseen: float | None = None
+    """The estimated chance that one more start would find a new branch (multistart; 0 for the closed form)."""
 
     @classmethod
     def quick(cls, **values: Any) -> Diagnostics:
