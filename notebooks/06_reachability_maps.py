@@ -2,6 +2,11 @@
 # jupyter:
 #   jupytext:
 #     formats: ipynb,py:percent
+#     text_representation:
+#       extension: .py
+#       format_name: percent
+#       format_version: '1.3'
+#       jupytext_version: 1.19.6
 #   kernelspec:
 #     display_name: Python 3
 #     language: python
@@ -15,7 +20,9 @@
 # mobile manipulator: where must the platform stand to reach a grasp? `kinelab.maps` answers both, every
 # reached target checked by Pinocchio. The maps are computed chunk by chunk (each chunk a pure function of
 # the robot, the spec and its index), so the same map comes out of one process, a resumed run or a Dask
-# cluster (`kinelab map reach ur5 --workers 2`, extra `kinelab[cluster]`).
+# cluster (`kinelab map reach ur5 --workers 2`, extra `kinelab[cluster]`). The UR5 has a closed form
+# (docs/analytic.md), so its map solves every branch of every pose and also counts, per voxel, the branches
+# within the limits; arms without one get the FRDM batch, one answer per pose.
 #
 # Units: metres and radians; every position is in the robot's base frame.
 
@@ -31,8 +38,10 @@ ur5 = kinelab.load("ur5")
 spec = maps.MapSpec(voxel=0.1, orientations=8, restarts=5)
 ur5_map = maps.reachability(ur5, spec)
 reach = ur5_map.array("reachability")
+branches = ur5_map.array("branches")
 print(f"{len(reach)} voxels of {spec.voxel} m inside the reach bound, {spec.orientations} orientations each; "
-      f"{(reach > 0).sum()} reached, {(reach == 1).sum()} in every orientation")
+      f"{(reach > 0).sum()} reached, {(reach == 1).sum()} in every orientation ({ur5_map.meta['solver']}); "
+      f"{branches[reach > 0].mean():.2f} branches per pose within the limits in the reached voxels")
 
 # %% [markdown]
 # ## The map in 3-D
