@@ -18,6 +18,7 @@ import numpy as np
 from kinelab.errors import OptionError
 from kinelab.ik.analytic.branches import analytic_all, has_closed_form
 from kinelab.ik.batch import fresh_seed, run_batch
+from kinelab.ik.limits import distance
 from kinelab.ik.request import Request, count_ok
 from kinelab.ik.result import Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target
@@ -106,14 +107,6 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
                      mode=f"{req.solver} (all branches, multistart)",
                      diagnostics=Diagnostics(found=count, starts=rounds * ROUND, unseen=missing), task=req.task_label)
             for q, dp, dr, count in found[:max_solutions]]
-
-
-def distance(robot: Robot, q: np.ndarray, ref: np.ndarray) -> float:
-    """max |q_i − ref_i| over the joints [rad or m], revolute and continuous joints modulo 2π."""
-    d = np.asarray(q, dtype=float) - np.asarray(ref, dtype=float)
-    revolute = np.array([k != "prismatic" for k in robot.joint_kinds])
-    d[revolute] = np.arctan2(np.sin(d[revolute]), np.cos(d[revolute]))
-    return float(np.max(np.abs(d)))
 
 
 def _merge(robot: Robot, found: list[tuple[np.ndarray, float, float, int]], q: np.ndarray, dp: float,

@@ -38,3 +38,11 @@ def wrap_q(robot: Robot, q: np.ndarray) -> np.ndarray:
     outside = revolute & ((q < robot.lower) | (q > robot.upper))
     lowest = q + TWO_PI * np.ceil((robot.lower - q) / TWO_PI)  # the first turn of q at or above the lower limit
     return np.where(outside & (lowest <= robot.upper), lowest, q)
+
+
+def distance(robot: Robot, q: np.ndarray, ref: np.ndarray) -> float:
+    """max |q_i − ref_i| over the joints [rad or m], revolute and continuous joints modulo 2π."""
+    d = np.asarray(q, dtype=float) - np.asarray(ref, dtype=float)
+    revolute = np.array([k != "prismatic" for k in robot.joint_kinds])
+    d[revolute] = np.arctan2(np.sin(d[revolute]), np.cos(d[revolute]))
+    return float(np.max(np.abs(d)))

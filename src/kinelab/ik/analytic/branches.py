@@ -21,6 +21,8 @@ from kinelab.geometry import pose_errors, stack_homogeneous
 from kinelab.ik.analytic.classify import ArmClass, classify
 from kinelab.ik.analytic.kernel import MAX_ROWS, branches, branches_batch
 from kinelab.ik.compiling import announce
+from kinelab.ik.driver import solve_one
+from kinelab.ik.limits import distance
 from kinelab.ik.multistart import TypedKernel
 from kinelab.ik.request import Request, make_request
 from kinelab.ik.result import Diagnostics, IKResult, Status
@@ -84,8 +86,6 @@ def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | No
         if judged is not None:
             answers.append((*judged, int(found[k]), bool(free[k])))
     if q_ref is not None:
-        from kinelab.ik.branches import distance  # the multistart's module imports this one
-
         answers.sort(key=lambda a: distance(robot, a[0], q_ref))
     elapsed = time.perf_counter() - t0
     mode = f"analytic ({arm.name})"
@@ -117,8 +117,6 @@ def _judged(robot: Robot, q: np.ndarray, target: Any, req: Request) -> tuple[np.
         return q, dp, dr, False
     if dp > 1e3 * req.tol_pos + 1e-6 or dr > 1e3 * req.tol_rot + 1e-6:
         return None  # not this pose's root (a 5R arm's candidate for the other shoulder side, say)
-    from kinelab.ik.driver import solve_one  # the driver's import chain reaches this module
-
     finish = make_request("frdm", seed=0, tol_pos=req.tol_pos, tol_rot=req.tol_rot, max_restarts=0)
     done = solve_one(robot, target, q, finish)
     return (done.q, done.position_error, done.rotation_error, True) if done.success else None
