@@ -18,7 +18,7 @@ import numpy as np
 from kinelab.errors import OptionError
 from kinelab.ik.analytic.branches import analytic_all, has_closed_form
 from kinelab.ik.batch import fresh_seed, run_batch
-from kinelab.ik.limits import distance
+from kinelab.ik.limits import distance as distance  # exported: the branch distance users sort by
 from kinelab.ik.request import Request, count_ok
 from kinelab.ik.result import Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target

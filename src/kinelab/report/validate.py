@@ -153,7 +153,8 @@ def analytic_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     answer from a random start is one of them (with the share of FRDM answers on the branch nearest the start)."""
     from kinelab.ik import solve, solve_all
     from kinelab.ik.analytic.classify import classify
-    from kinelab.ik.branches import SAME, distance
+    from kinelab.ik.branches import SAME
+    from kinelab.ik.limits import distance
 
     if classify(robot).arm is None:
         return []

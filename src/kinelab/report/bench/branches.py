@@ -25,7 +25,8 @@ from kinelab.ik.analytic.branches import SAME as CLOSED_SAME
 from kinelab.ik.analytic.branches import all_branches_batch
 from kinelab.ik.analytic.classify import classify
 from kinelab.ik.api import solve_all
-from kinelab.ik.branches import SAME, distance
+from kinelab.ik.branches import SAME
+from kinelab.ik.limits import distance
 from kinelab.robot import Robot, load
 
 ANALYTIC_ROBOTS = ("ur3", "ur5", "ur10", "z1", "so101")
