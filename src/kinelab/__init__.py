@@ -43,12 +43,17 @@ _LAZY = {
     "TrackResult": ("kinelab.ik.result", "TrackResult"),
     "target_from_xyz_quat_wxyz": ("kinelab.ik.targets", "from_xyz_quat_wxyz"),
     "target_from_xyz_rpy": ("kinelab.ik.targets", "from_xyz_rpy"),
+    "Collisions": ("kinelab.collision.model", "Collisions"),
+    "Environment": ("kinelab.collision.obstacles", "Environment"),
+    "Obstacle": ("kinelab.collision.obstacles", "Obstacle"),
 }
 
 
 __getattr__ = loader(__name__, globals(), _LAZY)
 
 if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and editors
+    from kinelab.collision.model import Collisions
+    from kinelab.collision.obstacles import Environment, Obstacle
     from kinelab.ik.api import solve, solve_all, solve_batch, track
     from kinelab.ik.batch import BatchIKResult
     from kinelab.ik.frdm.options import FRDMOptions
@@ -66,9 +71,11 @@ __all__ = [
     "BatchIKResult",
     "BiquaternionError",
     "ChainError",
+    "Collisions",
     "ConfigurationError",
     "DescriptionError",
     "Diagnostics",
+    "Environment",
     "FRDMOptions",
     "FrameNotFoundError",
     "IK",
@@ -77,6 +84,7 @@ __all__ = [
     "JointLimitError",
     "JointNotFoundError",
     "KinelabError",
+    "Obstacle",
     "OptionError",
     "Robot",
     "RobotNotFoundError",

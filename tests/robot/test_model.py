@@ -227,7 +227,7 @@ def test_missing_meshes_leave_kinematics_intact_and_drop_only_those_visuals(tmp_
                              "</link>"))
     robot = kinelab.load(write_urdf(tmp_path, body))
     np.testing.assert_allclose(robot.fk([0, 0]).translation, [0, 0, 1.3])
-    with pytest.warns(UserWarning, match="1 mesh.*package://nowhere/m.stl"):
+    with pytest.warns(UserWarning, match="1 visual mesh.*package://nowhere/m.stl"):
         geom = robot.visual_model()
     assert geom.ngeoms == 1
 

@@ -19,10 +19,12 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from kinelab.collision.model import CollisionModel, as_collisions, collision_model
 from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.batch import BatchIKResult, run_batch
 from kinelab.ik.branches import UNSEEN, find_all
+from kinelab.ik.clear import mark_colliding, solve_clear
 from kinelab.ik.driver import solve_one
 from kinelab.ik.frdm.tracking import PathSettings, path_options, run_track
 from kinelab.ik.registry import solver_module
@@ -57,7 +59,8 @@ def refuse_positional(function: str, extra: tuple[Any, ...]) -> None:
 def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0: Any = None,
           seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float = 1.0,
           max_restarts: int = 1000, start_outside_limits: str = "project", options: Any = None,
-          task: str = "pose", axis: str = "z", prefer: Any = None, **solver_options: Any) -> IKResult:
+          task: str = "pose", axis: str = "z", prefer: Any = None, collisions: Any = None,
+          **solver_options: Any) -> IKResult:
     """Solve IK for the tool pose ``target`` (``pin.SE3`` in the robot's base frame).
 
     Args:
@@ -84,6 +87,10 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
             then "analytic"), else those :func:`solve_all`'s multistart finds within ``time_budget`` (solvers
             "frdm" and "dls"); None (default): the first answer found. ``q0`` and ``max_restarts`` do not
             apply to it (given with ``prefer``, they are refused).
+        collisions: None (no check), "self", a :class:`kinelab.Environment` (itself and the obstacles) or a
+            :class:`kinelab.Collisions` (with a margin [m]): a colliding answer is never a success; the solve
+            runs again from new starts within ``time_budget`` (:mod:`kinelab.ik.clear`) and fails with status
+            ``collision``, naming the pair, when every answer collides.
         solver_options: the solver's option fields as keyword arguments (instead of ``options``).
 
     Returns:
@@ -98,19 +105,29 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
         refuse_positional("solve", positional)
     req = make_request(solver, seed, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options,
                        task, axis, solver_options)
+    check = _collision_model(robot, collisions)
     if prefer is None:
-        return solve_one(robot, target, q0, req)
+        return solve_one(robot, target, q0, req) if check is None else solve_clear(robot, target, q0, req, check)
     if q0 is not None:
         raise OptionError("q0", "given", "None with prefer= (the branch search draws its own starts)")
     t0 = time.perf_counter()
     closed = solver == "frdm" and options is None and not solver_options
     found = find_all(robot, target, req, q_ref=prefer, method="auto" if closed else "multistart")
+    if check is not None:
+        found = mark_colliding(found, check, drop=True)
     if found:
         return replace(found[0], diagnostics=replace(found[0].diagnostics, branches=len(found)))
-    # no branch met the tolerances: the best single answer, in what is left of the same budget (at least one
-    # attempt's worth, so that there is an answer to return)
+    # no (clear) branch met the tolerances: the best single answer, in what is left of the same budget (at
+    # least one attempt's worth, so that there is an answer to return)
     left = None if req.time_budget is None else max(req.time_budget - (time.perf_counter() - t0), 1e-4)
-    return solve_one(robot, target, None, replace(req, time_budget=left))
+    rest = replace(req, time_budget=left)
+    return solve_one(robot, target, None, rest) if check is None else solve_clear(robot, target, None, rest, check)
+
+
+def _collision_model(robot: Robot, collisions: Any) -> CollisionModel | None:
+    """The collision model for ``collisions=`` (None: no check)."""
+    spec = as_collisions(collisions)
+    return None if spec is None else collision_model(robot, spec)
 
 
 def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frdm", q0: Any = None,
@@ -160,7 +177,8 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
 def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto", seed: int | None = None,
               tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float = 0.05, options: Any = None,
               task: str = "pose", axis: str = "z", q_ref: Any = None, max_solutions: int | None = None,
-              stop_below: float | None = UNSEEN, **solver_options: Any) -> list[IKResult]:
+              stop_below: float | None = UNSEEN, collisions: Any = None, drop_colliding: bool = False,
+              **solver_options: Any) -> list[IKResult]:
     """The distinct solutions (branches) of ``target``: every one in closed form where the chain's geometry
     allows it (docs/analytic.md), else those that seeded starts find, in rounds of 64, until the estimated
     chance that one more start finds a new branch falls below ``stop_below`` or ``time_budget`` is spent.
@@ -187,6 +205,9 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
         max_solutions: stop once this many distinct solutions are found (None: no such limit).
         stop_below: the stopping rule (:func:`kinelab.ik.branches.unseen`, a Good–Turing estimate from how many
             starts reached each branch; checked after two rounds); None: spend the whole budget.
+        collisions: as :func:`solve`: a branch that collides is marked (``success`` False, status
+            ``collision``, ``diagnostics.contact`` naming the pair), or left out with ``drop_colliding``.
+        drop_colliding: leave colliding branches out instead of marking them.
 
     Returns:
         One :class:`IKResult` per distinct solution, nearest ``q_ref`` first when given.
@@ -204,8 +225,10 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
         method = "multistart"  # options name a multistart solver's settings: "auto" runs FRDM with them
     req = make_request("frdm" if method != "multistart" else solver, seed, tol_pos, tol_rot, time_budget, 0,
                        "refuse", options, task, axis, solver_options)
-    return find_all(robot, target, req, q_ref=q_ref, max_solutions=max_solutions, stop_below=stop_below,
-                    method=method)
+    check = _collision_model(robot, collisions)
+    found = find_all(robot, target, req, q_ref=q_ref, max_solutions=max_solutions, stop_below=stop_below,
+                     method=method)
+    return found if check is None else mark_colliding(found, check, drop=bool(drop_colliding))
 
 
 def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any = None, solver: str = "frdm",

@@ -19,6 +19,7 @@ class Status(str, Enum):
     MAX_ITERATIONS = "max_iterations"
     TIME_BUDGET = "time_budget"
     OUTSIDE_LIMITS = "outside_limits"  # the pose is met, but only with a joint outside its limits
+    COLLISION = "collision"  # the pose is met, but every answer found collides (``collisions=``)
 
 
 @dataclass(frozen=True)
@@ -157,6 +158,12 @@ class Diagnostics:
     """Starts run (``solve_all``'s multistart)."""
     unseen: float | None = None
     """The estimated chance that one more start would find a new branch (multistart; 0 for the closed form)."""
+    contact: Any = None
+    """With ``collisions=``: the colliding pair of the answer (a :class:`kinelab.collision.Contact`: the two
+    objects' names and their distance [m]), or None when it is clear."""
+    clear_after: int | None = None
+    """With ``collisions=``: the answers found that collided before this one (each a full solve from new
+    starts)."""
 
     @classmethod
     def quick(cls, **values: Any) -> Diagnostics:
@@ -178,6 +185,8 @@ class Diagnostics:
                 continue
             if f.name in ("answer_events", "answer_bypasses"):
                 value = [v.to_dict() for v in value]
+            elif f.name == "contact":
+                value = asdict(value)
             elif isinstance(value, tuple):
                 value = list(value)
             out[f.name] = value

@@ -89,20 +89,21 @@ def yourdfpy_filename_handler(urdf_path: str | Path, package_dirs: list[str] | N
     return handler
 
 
-def missing_meshes(urdf_path: str | Path, package_dirs: list[str] | None = None) -> list[str]:
-    """Mesh URIs of ``<visual>`` elements that cannot be resolved."""
+def missing_meshes(urdf_path: str | Path, package_dirs: list[str] | None = None, kind: str = "visual") -> list[str]:
+    """Mesh URIs of the ``<visual>`` (or ``<collision>``, ``kind``) elements that cannot be resolved."""
     root = ET.parse(urdf_path).getroot()
     urdf_dir = Path(urdf_path).parent
-    uris = [m.get("filename", "") for m in root.iter("mesh")]
+    uris = [m.get("filename", "") for el in root.iter(kind) for m in el.iter("mesh")]
     return [u for u in uris if resolve_uri(u, urdf_dir, package_dirs) is None]
 
 
-def _with_resolved_meshes(urdf_path: Path, package_dirs: list[str], folder: Path) -> Path:
-    """A copy of the URDF whose visual meshes name the files kinelab resolved (absolute paths), and without
-    the visuals whose mesh cannot be found: Pinocchio then reads exactly what kinelab found."""
+def _with_resolved_meshes(urdf_path: Path, package_dirs: list[str], folder: Path, kind: str = "visual") -> Path:
+    """A copy of the URDF whose ``kind`` ("visual" or "collision") meshes name the files kinelab resolved
+    (absolute paths), and without the elements whose mesh cannot be found: Pinocchio then reads exactly what
+    kinelab found."""
     tree = ET.parse(urdf_path)
     for link in tree.getroot().iter("link"):
-        for vis in list(link.findall("visual")):
+        for vis in list(link.findall(kind)):
             mesh = vis.find("geometry/mesh")
             if mesh is None:
                 continue
@@ -117,17 +118,19 @@ def _with_resolved_meshes(urdf_path: Path, package_dirs: list[str], folder: Path
 
 
 def build_visual_model(
-    model: pin.Model, urdf_path: str | Path, package_dirs: list[str] | None = None
+    model: pin.Model, urdf_path: str | Path, package_dirs: list[str] | None = None, kind: str = "visual"
 ) -> pin.GeometryModel:
-    """Pinocchio's VISUAL geometry of ``model`` (the full, unreduced model of the URDF), its meshes found
-    as :func:`resolve_uri` finds them; a visual whose mesh cannot be found is left out with a warning."""
+    """Pinocchio's VISUAL (or, ``kind="collision"``, COLLISION) geometry of ``model`` (the full, unreduced
+    model of the URDF), its meshes found as :func:`resolve_uri` finds them; an element whose mesh cannot be
+    found is left out with a warning naming the directories searched."""
     urdf_path = Path(urdf_path)
     dirs = mesh_package_dirs() if package_dirs is None else list(package_dirs)
-    missing = missing_meshes(urdf_path, dirs)
+    missing = missing_meshes(urdf_path, dirs, kind)
     if missing:
-        warnings.warn(f"{len(missing)} mesh(es) of {urdf_path} not found (first: {missing[0]}; searched "
-                      f"{', '.join(dirs) or 'no package directory'}); those visuals are left out: pass "
+        warnings.warn(f"{len(missing)} {kind} mesh(es) of {urdf_path} not found (first: {missing[0]}; searched "
+                      f"{', '.join(dirs) or 'no package directory'}); those {kind} elements are left out: pass "
                       "package_dirs= (CLI --package-dir) or set ROS_PACKAGE_PATH", stacklevel=2)
+    geometry_type = pin.GeometryType.COLLISION if kind == "collision" else pin.GeometryType.VISUAL
     with tempfile.TemporaryDirectory(prefix="kinelab-") as folder:  # Pinocchio reads it once, here
-        resolved = _with_resolved_meshes(urdf_path, dirs, Path(folder))
-        return pin.buildGeomFromUrdf(model, str(resolved), pin.GeometryType.VISUAL, package_dirs=dirs)
+        resolved = _with_resolved_meshes(urdf_path, dirs, Path(folder), kind)
+        return pin.buildGeomFromUrdf(model, str(resolved), geometry_type, package_dirs=dirs)

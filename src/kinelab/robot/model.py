@@ -371,20 +371,22 @@ class Robot:
         """q1 ⊖ q0 through ``pin.difference``: the n velocities that take q0 to q1 in 1 s."""
         return np.asarray(pin.difference(self.model, self.to_pin_q(q0), self.to_pin_q(q1)), dtype=float)
 
-    def visual_model(self, package_dirs: list[str] | None = None) -> pin.GeometryModel:
-        """Visual geometry matched to ``self.model`` (locked joints folded in), meshes resolved.
+    def visual_model(self, package_dirs: list[str] | None = None, kind: str = "visual") -> pin.GeometryModel:
+        """Visual (or, ``kind="collision"``, collision) geometry matched to ``self.model`` (locked joints
+        folded in, re-rooted as the model is), meshes resolved.
 
         ``package://`` URIs resolve under ``package_dirs`` (default: those given to :func:`load`, then
-        ``ROS_PACKAGE_PATH``'s, then example-robot-data's); visuals whose mesh cannot be found are left out
-        with a warning.
+        ``ROS_PACKAGE_PATH``'s, then example-robot-data's); elements whose mesh cannot be found are left out
+        with a warning naming the directories searched.
         """
         b = self._built
         if b.urdf_path is None or b.full is None:
             return pin.GeometryModel()  # an in-memory model brings no geometry: the viewer draws a stick figure
+        geometry_type = pin.GeometryType.COLLISION if kind == "collision" else pin.GeometryType.VISUAL
         if is_mjcf(b.urdf_path):
-            geom = pin.buildGeomFromMJCF(b.full, str(b.urdf_path), pin.GeometryType.VISUAL)
+            geom = pin.buildGeomFromMJCF(b.full, str(b.urdf_path), geometry_type)
         else:
-            geom = build_visual_model(b.full, b.urdf_path, package_dirs or self.package_dirs)
+            geom = build_visual_model(b.full, b.urdf_path, package_dirs or self.package_dirs, kind)
         if b.lock_ids:
             _, geom = pin.buildReducedModel(b.full, geom, list(b.lock_ids), b.q_ref)
         if b.bMw is not None:  # re-rooted at the base frame, as the model was

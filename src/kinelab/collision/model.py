@@ -1,0 +1,230 @@
+"""A robot's collision model: its URDF's ``<collision>`` geometry on the reduced chain, the obstacles around
+it, the pairs worth checking, and a conservative sphere per object for a cheap first test.
+
+Pairs: every two robot objects on different joints, except those on adjacent joints (a link and its parent
+touch at their joint by design), those the robot's SRDF disables (``disable_collisions``) and those that do
+not move relative to each other; and every moving robot object against every obstacle (the base's own
+geometry stands where it is mounted). The exact test is Pinocchio's (coal's GJK/EPA on meshes and
+primitives), with ``margin`` as coal's security margin.
+
+The first test: each object's axis-aligned box in its own frame, turned into the sphere around it (centre
+and half-diagonal, in its joint's frame); a pair whose spheres are farther apart than ``margin`` cannot
+collide, so the exact test runs only on the others. A plane's test is the sphere's height above it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab.collision.obstacles import Environment
+from kinelab.errors import KinelabError
+from kinelab.robot import Robot
+
+PLANE = -1.0  # radius marker of a plane obstacle (its test is a height, not a distance)
+
+
+class CollisionError(KinelabError):
+    """Collisions asked of a robot that has no collision geometry, or a bad collision setting; says which."""
+
+
+@dataclass(frozen=True)
+class Collisions:
+    """What a solve must avoid.
+
+    Attributes:
+        self_collisions: the robot against itself.
+        environment: the obstacles (base frame), or None.
+        margin: a clearance every pair must keep [m] (≥ 0).
+    """
+
+    self_collisions: bool = True
+    environment: Environment | None = None
+    margin: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.margin, int | float) and not isinstance(self.margin, bool)
+                and np.isfinite(self.margin) and self.margin >= 0):
+            raise CollisionError(f"the collision margin is a clearance ≥ 0 m, got {self.margin!r}")
+        if self.environment is not None and not isinstance(self.environment, Environment):
+            raise CollisionError(f"environment must be a kinelab.Environment, got {type(self.environment).__name__}")
+        if not self.self_collisions and self.environment is None:
+            raise CollisionError("collisions with neither self_collisions nor an environment check nothing")
+
+
+def as_collisions(value: Any) -> Collisions | None:
+    """A :class:`Collisions` from what entry points accept: None (no check), "self", an Environment (itself
+    and the obstacles) or a Collisions.
+
+    Raises:
+        CollisionError: anything else, named.
+    """
+    if value is None or isinstance(value, Collisions):
+        return value
+    if isinstance(value, str) and value == "self":
+        return Collisions()
+    if isinstance(value, Environment):
+        return Collisions(environment=value)
+    raise CollisionError(f"collisions={value!r} is not valid: None, 'self', a kinelab.Environment or a "
+                         "kinelab.Collisions(self_collisions=, environment=, margin=)")
+
+
+@dataclass(frozen=True)
+class Contact:
+    """The first colliding pair found: the two objects' names and their distance [m] (≤ margin; negative:
+    penetration depth, as coal reports it)."""
+
+    first: str
+    second: str
+    distance: float
+
+    def __str__(self) -> str:
+        return f"{self.first} and {self.second} ({self.distance * 1e3:+.1f} mm)"
+
+
+@dataclass(eq=False)
+class CollisionModel:
+    """The geometry, the pairs and the first-test spheres of one robot and one :class:`Collisions`.
+
+    Objects on joint 0 (the base's geometry, the obstacles) stand still; a plane obstacle's first test uses its
+    point ``centres`` and unit ``normals`` (base frame).
+    """
+
+    robot: Robot
+    geom: pin.GeometryModel
+    pairs: np.ndarray  # (P, 2) object indices, the moving object first
+    centres: np.ndarray  # (G, 3) sphere centres in each object's joint frame [m]
+    radii: np.ndarray  # (G,) [m]; PLANE for a plane
+    normals: np.ndarray  # (G, 3) a plane's unit normal; zero elsewhere
+    joints: np.ndarray  # (G,) each object's parent joint
+    margin: float
+    summary: str
+    data: Any = field(default=None)
+    gdata: Any = field(default=None)
+
+    def __post_init__(self) -> None:
+        self.data, self.gdata = self.robot.model.createData(), pin.GeometryData(self.geom)
+        for req in self.gdata.collisionRequests:
+            req.security_margin = self.margin
+
+    def contact(self, q: Any, first_test: bool = True) -> Contact | None:
+        """The first pair at q (rad or m, one number per joint) closer than the margin, with its distance, or
+        None.
+
+        Args:
+            q: the configuration.
+            first_test: skip the pairs whose spheres are apart (False: the exact test on every pair).
+
+        Raises:
+            ConfigurationError: q not n finite numbers.
+        """
+        k = self.colliding_pair(q, first_test)
+        return None if k is None else self.contact_of(k)
+
+    def colliding_pair(self, q: Any, first_test: bool = True) -> int | None:
+        """The index of the first pair at q closer than the margin, or None (no distance computed: cheaper
+        than :meth:`contact`)."""
+        q = self.robot.check_q(q)
+        model = self.robot.model
+        pin.forwardKinematics(model, self.data, self.robot.to_pin_q(q))
+        candidates = self.candidates() if first_test else np.arange(len(self.pairs))
+        if candidates.size == 0:
+            return None
+        pin.updateGeometryPlacements(model, self.data, self.geom, self.gdata)
+        for k in candidates:
+            if pin.computeCollision(self.geom, self.gdata, int(k)):
+                return int(k)
+        return None
+
+    def candidates(self) -> np.ndarray:
+        """The pairs whose spheres the first test cannot separate (the data's joint placements current)."""
+        R = np.array([m.rotation for m in self.data.oMi])
+        t = np.array([m.translation for m in self.data.oMi])
+        world = np.einsum("gij,gj->gi", R[self.joints], self.centres) + t[self.joints]
+        a, b = self.pairs[:, 0], self.pairs[:, 1]
+        gap = np.linalg.norm(world[a] - world[b], axis=1) - self.radii[a] - self.radii[b]
+        plane = self.radii[b] == PLANE
+        gap[plane] = np.einsum("pi,pi->p", world[a[plane]] - world[b[plane]], self.normals[b[plane]]) \
+            - self.radii[a[plane]]
+        return np.flatnonzero(gap <= self.margin)
+
+    def contact_of(self, k: int) -> Contact:
+        """Pair k as a :class:`Contact`, its distance computed at the placements of the last check."""
+        pair = self.geom.collisionPairs[k]
+        distance = pin.computeDistance(self.geom, self.gdata, k).min_distance
+        return Contact(self.geom.geometryObjects[pair.first].name, self.geom.geometryObjects[pair.second].name,
+                       float(distance))
+
+
+def collision_model(robot: Robot, collisions: Collisions) -> CollisionModel:
+    """The robot's collision model for ``collisions``, built once per Robot and setting.
+
+    Raises:
+        CollisionError: the robot has no collision geometry (an in-memory model, or a file without
+            ``<collision>`` elements).
+    """
+    return robot.derived(f"collision model {collisions!r}", lambda r: _build(r, collisions))
+
+
+def _build(robot: Robot, collisions: Collisions) -> CollisionModel:
+    geom = robot.visual_model(kind="collision")
+    if geom.ngeoms == 0:
+        raise CollisionError(f"{robot.name} has no collision geometry (no <collision> element in its file, or a "
+                             "model built in memory): collisions cannot be checked")
+    own = geom.ngeoms
+    obstacles = collisions.environment.obstacles if collisions.environment is not None else ()
+    for k, obstacle in enumerate(obstacles):
+        geom.addGeometryObject(pin.GeometryObject(obstacle.name or f"{obstacle.shape} {k}", 0, 0,
+                                                  obstacle.placement, obstacle.geometry()))
+    objects = list(geom.geometryObjects)
+    joints = np.array([o.parentJoint for o in objects], dtype=int)
+    pairs, left_out = _self_pairs(robot, objects, own) if collisions.self_collisions else ([], (0, 0))
+    pairs += [(i, own + k) for i in range(own) if joints[i] != 0 for k in range(len(obstacles))]
+    for i, j in pairs:
+        geom.addCollisionPair(pin.CollisionPair(int(i), int(j)))
+    centres, radii, normals = _spheres(objects, own, obstacles)
+    summary = (f"{own} collision object(s) of {robot.name}, {len(obstacles)} obstacle(s); {len(pairs)} pairs "
+               f"checked ({left_out[0]} on adjacent links and {left_out[1]} disabled by the SRDF left out), "
+               f"margin {collisions.margin:g} m")
+    return CollisionModel(robot, geom, np.array(pairs, dtype=int).reshape(-1, 2), centres, radii, normals, joints,
+                          float(collisions.margin), summary)
+
+
+def _self_pairs(robot: Robot, objects: list[Any], own: int) -> tuple[list[tuple[int, int]], tuple[int, int]]:
+    """The robot's own pairs worth checking, and how many were left out as adjacent and as SRDF-disabled."""
+    parents = robot.model.parents
+    link = [robot.model.frames[o.parentFrame].name for o in objects[:own]]
+    disabled = {frozenset(p) for p in (robot.srdf.disabled_collisions if robot.srdf is not None else ())}
+    pairs, adjacent, by_srdf = [], 0, 0
+    for i in range(own):
+        for j in range(i + 1, own):
+            a, b = objects[i].parentJoint, objects[j].parentJoint
+            if a == b:
+                continue  # no relative motion
+            if parents[a] == b or parents[b] == a:
+                adjacent += 1
+            elif frozenset((link[i], link[j])) in disabled:
+                by_srdf += 1
+            else:
+                pairs.append((i, j))
+    return pairs, (adjacent, by_srdf)
+
+
+def _spheres(objects: list[Any], own: int, obstacles: tuple[Any, ...]) -> tuple[np.ndarray, ...]:
+    """Per object: the centre (its joint's frame) and radius of the sphere around its box, and a plane's normal."""
+    G = len(objects)
+    centres, radii, normals = np.zeros((G, 3)), np.zeros(G), np.zeros((G, 3))
+    for g, obj in enumerate(objects):
+        if g >= own and obstacles[g - own].shape == "plane":
+            centres[g], radii[g] = obj.placement.translation, PLANE
+            normals[g] = obj.placement.rotation[:, 2]
+            continue
+        obj.geometry.computeLocalAABB()
+        box = obj.geometry.aabb_local
+        lo, hi = np.asarray(box.min_), np.asarray(box.max_)
+        centres[g] = obj.placement.act(0.5 * (lo + hi))
+        radii[g] = 0.5 * float(np.linalg.norm(hi - lo))
+    return centres, radii, normals

@@ -1,0 +1,128 @@
+"""Obstacles around a robot: planes, boxes, spheres, cylinders and capsules placed in its base frame.
+
+An :class:`Environment` is a tuple of :class:`Obstacle` built in Python or read from a JSON file::
+
+    {"obstacles": [
+        {"shape": "plane", "xyz": [0, 0, 0], "name": "floor"},
+        {"shape": "box", "size": [0.8, 1.2, 0.05], "xyz": [0.6, 0, 0.3], "rpy": [0, 0, 0.2], "name": "table"}
+    ]}
+
+Sizes in metres: a box's full side lengths (x, y, z); a sphere's radius; a cylinder's and a capsule's radius and
+length along their z axis. A plane is the boundary of the solid half-space below it: the points whose height
+along the plane's z axis (its ``rpy`` turned) is below its ``xyz`` are inside the obstacle.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab.errors import KinelabError
+
+SIZES = {"plane": 0, "box": 3, "sphere": 1, "cylinder": 2, "capsule": 2}
+
+
+class ObstacleError(KinelabError):
+    """An obstacle or an obstacle file that cannot be used; names the obstacle and what is valid."""
+
+
+@dataclass(frozen=True)
+class Obstacle:
+    """One obstacle, placed in the robot's base frame.
+
+    Attributes:
+        shape: "plane", "box", "sphere", "cylinder" or "capsule".
+        size: the shape's dimensions [m] (see the module's docstring); () for a plane.
+        xyz: its position [m]; rpy: its orientation (roll, pitch, yaw [rad], Pinocchio's convention).
+        name: a name for messages (default: the shape and its index).
+    """
+
+    shape: str
+    size: tuple[float, ...] = ()
+    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        label = self.name or self.shape
+        if self.shape not in SIZES:
+            raise ObstacleError(f"obstacle {label!r}: unknown shape {self.shape!r}; shapes are {', '.join(SIZES)}")
+        size, xyz, rpy = _numbers(label, "size", self.size), _numbers(label, "xyz", self.xyz), \
+            _numbers(label, "rpy", self.rpy)
+        if len(size) != SIZES[self.shape]:
+            raise ObstacleError(f"obstacle {label!r}: a {self.shape} takes {SIZES[self.shape]} size number(s) "
+                                f"[m], got {len(size)}")
+        if any(s <= 0 for s in size):
+            raise ObstacleError(f"obstacle {label!r}: sizes must be > 0 m, got {list(size)}")
+        if len(xyz) != 3 or len(rpy) != 3:
+            raise ObstacleError(f"obstacle {label!r}: xyz and rpy take 3 numbers each")
+        object.__setattr__(self, "size", size)
+        object.__setattr__(self, "xyz", xyz)
+        object.__setattr__(self, "rpy", rpy)
+
+    @property
+    def placement(self) -> pin.SE3:
+        """bMobstacle: the obstacle's frame in the base frame."""
+        return pin.SE3(pin.rpy.rpyToMatrix(*self.rpy), np.array(self.xyz))
+
+    def geometry(self) -> Any:
+        """The obstacle as a coal shape, in its own frame."""
+        import coal
+
+        if self.shape == "plane":
+            return coal.Halfspace(np.array([0.0, 0.0, 1.0]), 0.0)
+        if self.shape == "box":
+            return coal.Box(*self.size)
+        if self.shape == "sphere":
+            return coal.Sphere(self.size[0])
+        return (coal.Cylinder if self.shape == "cylinder" else coal.Capsule)(self.size[0], self.size[1])
+
+
+def _numbers(label: str, what: str, values: Any) -> tuple[float, ...]:
+    try:
+        out = tuple(float(v) for v in values)
+    except (TypeError, ValueError):
+        raise ObstacleError(f"obstacle {label!r}: {what} must be numbers, got {values!r}") from None
+    if not all(math.isfinite(v) for v in out):
+        raise ObstacleError(f"obstacle {label!r}: {what} must be finite numbers, got {list(out)}")
+    return out
+
+
+@dataclass(frozen=True)
+class Environment:
+    """The obstacles around a robot (base frame)."""
+
+    obstacles: tuple[Obstacle, ...] = ()
+
+    def __post_init__(self) -> None:
+        if not all(isinstance(o, Obstacle) for o in self.obstacles):
+            raise ObstacleError("an Environment holds Obstacle objects")
+        object.__setattr__(self, "obstacles", tuple(self.obstacles))
+
+    @classmethod
+    def from_file(cls, path: str | Path) -> Environment:
+        """Read an obstacle file (JSON, see the module's docstring): data only, nothing in it runs.
+
+        Raises:
+            ObstacleError: a missing or malformed file, or a bad obstacle (its index named).
+        """
+        path = Path(path)
+        try:
+            data = json.loads(path.read_text())
+        except (OSError, ValueError) as exc:
+            raise ObstacleError(f"cannot read the obstacle file {path}: {exc}") from None
+        rows = data.get("obstacles") if isinstance(data, dict) else None
+        if not isinstance(rows, list):
+            raise ObstacleError(f"{path}: an obstacle file is a JSON object with a list 'obstacles'")
+        out = []
+        for k, row in enumerate(rows):
+            if not isinstance(row, dict) or set(row) - {"shape", "size", "xyz", "rpy", "name"}:
+                raise ObstacleError(f"{path}: obstacle {k} must be an object with keys shape, size, xyz, rpy, name")
+            out.append(Obstacle(**{"name": f"{row.get('shape', '?')} {k}", **row}))
+        return cls(tuple(out))

@@ -1,0 +1,84 @@
+"""Answers a real arm can take: a solve whose answer collides starts again from new starts, and the branches
+of ``solve_all`` that collide are marked (or dropped).
+
+A solve with ``collisions=`` runs the driver as usual, then checks the answer (:mod:`kinelab.collision`: the
+sphere test, then Pinocchio's exact test). A colliding answer is never a success: the solve runs again from
+fresh seeded starts (the first run from ``q0``, the next ones from random configurations) until an answer
+is clear, the time budget is spent or ``max_restarts`` runs have collided; it then fails with status
+``collision``, naming the colliding pair and its distance.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+from typing import Any
+
+from kinelab.collision.model import CollisionModel
+from kinelab.ik.batch import fresh_seed
+from kinelab.ik.driver import solve_one
+from kinelab.ik.request import Request
+from kinelab.ik.result import IKResult, Status
+from kinelab.robot import Robot
+
+STRIDE = 1_000_003  # seeds between two runs: a run's restarts use seed, seed + 1, ... within one run
+
+
+def solve_clear(robot: Robot, target: Any, q0: Any, req: Request, model: CollisionModel) -> IKResult:
+    """The first answer that meets the target and collides with nothing ``model`` checks.
+
+    Args:
+        robot: the robot.
+        target: oMtarget (base frame).
+        q0: the first run's start (None: seeded random).
+        req: the validated request; its time budget covers every run, ``max_restarts`` bounds the runs.
+        model: the collision model (:func:`kinelab.collision.collision_model`).
+
+    Returns:
+        The clear answer (``diagnostics.clear_after``: the colliding answers before it), or the solver's own
+        failure, or a failure with status ``collision`` (``diagnostics.contact`` and the message name the pair).
+    """
+    t0 = time.perf_counter()
+    seed = fresh_seed() if req.seed is None else req.seed
+    collided: IKResult | None = None
+    runs = 0
+    while runs <= req.max_restarts:
+        left = None if req.time_budget is None else req.time_budget - (time.perf_counter() - t0)
+        if left is not None and left <= 0 and runs:
+            break
+        res = solve_one(robot, target, q0 if runs == 0 else None,
+                        replace(req, seed=seed + runs * STRIDE, time_budget=left))
+        runs += 1
+        if not res.success:
+            return res if collided is None else collided
+        pair = model.colliding_pair(res.q)
+        if pair is None:
+            return _with(res, t0, runs - 1, None)
+        collided = _collided(res, t0, runs, model, pair)
+    assert collided is not None
+    return collided
+
+
+def _with(res: IKResult, t0: float, before: int, contact: Any) -> IKResult:
+    return replace(res, wall_time=time.perf_counter() - t0,
+                   diagnostics=replace(res.diagnostics, clear_after=before, contact=contact))
+
+
+def _collided(res: IKResult, t0: float, runs: int, model: CollisionModel, pair: int) -> IKResult:
+    contact = model.contact_of(pair)  # the geometry's placements are still those of res.q
+    return replace(_with(res, t0, runs, contact), success=False, status=Status.COLLISION,
+                   message=f"the pose is met, but every answer of {runs} run(s) collides; the last: {contact}")
+
+
+def mark_colliding(found: list[IKResult], model: CollisionModel, drop: bool) -> list[IKResult]:
+    """``solve_all``'s branches with those that collide marked (success False, status ``collision``,
+    ``diagnostics.contact`` set), or left out with ``drop``."""
+    out = []
+    for res in found:
+        contact = model.contact(res.q)
+        if contact is None:
+            out.append(res)
+        elif not drop:
+            out.append(replace(res, success=False, status=Status.COLLISION, message=f"collides: {contact}",
+                               diagnostics=replace(res.diagnostics, contact=contact)))
+    return out
