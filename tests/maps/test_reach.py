@@ -215,3 +215,27 @@ def test_progress_shows_by_default_where_someone_watches_and_not_in_a_pipe(ur5, 
     maps.reachability(ur5, spec)
     err = capsys.readouterr().err
     assert "map: 100%" in err and "chunk" in err
+
+
+def test_a_map_with_a_table_differs_from_one_without_exactly_where_the_exact_check_says(ur5):
+    """The same voxels with and without the floor and a table: a pose is reached with them when one of its
+    branches (solve_all, every branch) is clear by Pinocchio's exact test on every pair, checked here."""
+    from kinelab.collision import Collisions, Environment, Obstacle, collision_model
+
+    env = Environment((Obstacle("plane", name="floor"),
+                       Obstacle("box", size=(0.6, 0.8, 0.05), xyz=(0.5, 0.0, 0.2), name="table")))
+    rng = np.random.default_rng(5)
+    centres = np.array([ur5.fk(ur5.random_q(rng)).translation for _ in range(16)])
+    spec = reach.MapSpec(orientations=8, collisions=Collisions(environment=env))
+    free = reach.compute_chunk(ur5, reach.MapSpec(orientations=8), centres, 0)
+    walled = reach.compute_chunk(ur5, spec, centres, 0)
+    exact = collision_model(ur5, Collisions(environment=env))
+    expected = np.zeros((16, 8))
+    for k, T in enumerate(reach.targets_of(centres, grid.rotations(8))):
+        target = kinelab.target_from_xyz_quat_wxyz(T[:3, 3], _quat(T[:3, :3]))
+        expected.flat[k] = any(exact.contact(s.q, first_test=False) is None
+                               for s in kinelab.solve_all(ur5, target, solver="analytic"))
+    assert np.array_equal(walled["reachability"], expected.mean(axis=1))
+    assert (walled["reachability"] <= free["reachability"]).all()
+    assert (walled["reachability"] < free["reachability"]).any()  # the table and floor take poses away
+    assert spec.to_dict()["collisions"]["environment"]["obstacles"][1]["name"] == "table"

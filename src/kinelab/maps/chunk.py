@@ -13,13 +13,15 @@ whatever order.
 
 from __future__ import annotations
 
+import json
 from dataclasses import asdict, dataclass
 
 import numpy as np
 
 from kinelab.analysis.singular import conditioning_batch
+from kinelab.collision.model import CollisionModel, Collisions, collision_model
 from kinelab.errors import KinelabError
-from kinelab.ik.analytic.branches import all_branches_batch
+from kinelab.ik.analytic.branches import BranchBatch, all_branches_batch
 from kinelab.ik.analytic.classify import classify
 from kinelab.ik.api import solve_batch
 from kinelab.ik.request import check_seed
@@ -44,6 +46,9 @@ class MapSpec:
         chunk_voxels: voxels per chunk (the unit of work and of storage).
         method: "auto" (every branch in closed form where the arm has one and the task is "pose", else the
             numeric batch) or "numeric" (the FRDM batch everywhere).
+        collisions: None, or what answers must not collide with (:class:`kinelab.Collisions`): a pose counts
+            as reached only through a clear answer — any clear branch in closed form; the batch's one answer
+            otherwise (a pose whose answer collides counts as unreached even if another branch is clear).
     """
 
     voxel: float = 0.1
@@ -55,6 +60,7 @@ class MapSpec:
     seed: int = 0
     chunk_voxels: int = 64
     method: str = "auto"
+    collisions: Collisions | None = None
 
     def check(self) -> None:
         """Raises KinelabError naming a bad field and what is valid."""
@@ -67,6 +73,8 @@ class MapSpec:
         if isinstance(self.voxel, bool) or not (isinstance(self.voxel, int | float) and np.isfinite(self.voxel)
                                                 and self.voxel > 0):
             raise KinelabError(f"the voxel side must be a positive length in metres, got {self.voxel!r}")
+        if self.collisions is not None and not isinstance(self.collisions, Collisions):
+            raise KinelabError(f"a map's collisions is a kinelab.Collisions or None, got {self.collisions!r}")
         if self.method not in METHODS:
             raise KinelabError(f"a reachability map's method is one of {', '.join(METHODS)}, got {self.method!r}")
         check_seed(self.seed)
@@ -77,8 +85,8 @@ class MapSpec:
         return self.method == "auto" and self.task == "pose" and classify(robot).arm is not None
 
     def to_dict(self) -> dict:
-        """The JSON form stored with the map."""
-        return asdict(self)
+        """The JSON form stored with the map (tuples as lists, as the store gives them back)."""
+        return dict(json.loads(json.dumps(asdict(self))))
 
 
 def targets_of(centres: np.ndarray, rotations: np.ndarray) -> np.ndarray:
@@ -104,6 +112,9 @@ def compute_chunk(robot: Robot, spec: MapSpec, centres: np.ndarray, index: int) 
         return _every_branch(robot, spec, targets, len(chunk))
     res = solve_batch(robot, targets, seed=spec.seed + lo * spec.orientations, task=spec.task,
                       tol_pos=spec.tol_pos, tol_rot=spec.tol_rot, max_restarts=spec.restarts)
+    if spec.collisions is not None:
+        model = collision_model(robot, spec.collisions)
+        res.success[res.success] = [model.colliding_pair(q) is None for q in res.q[res.success]]
     ok = res.success.reshape(len(chunk), spec.orientations)
     manip = np.zeros(len(chunk) * spec.orientations)
     ratio = np.ones(len(chunk) * spec.orientations)
@@ -118,6 +129,8 @@ def _every_branch(robot: Robot, spec: MapSpec, targets: np.ndarray, voxels: int)
     """The chunk's values from every branch of every pose: a pose is reached when it has a branch, its
     manipulability and σ ratio are its best branch's."""
     batch = all_branches_batch(robot, targets, tol_pos=spec.tol_pos, tol_rot=spec.tol_rot)
+    if spec.collisions is not None:
+        _drop_colliding(batch, collision_model(robot, spec.collisions))
     pose, row = np.nonzero(~np.isnan(batch.q[:, :, 0]))
     manip, ratio = np.zeros(len(targets)), np.zeros(len(targets))
     if len(pose):
@@ -132,3 +145,11 @@ def _every_branch(robot: Robot, spec: MapSpec, targets: np.ndarray, voxels: int)
             "branches": batch.count.reshape(ok.shape).mean(axis=1).astype(float)}
 
 
+
+
+def _drop_colliding(batch: BranchBatch, model: CollisionModel) -> None:
+    """Set the branches that collide to NaN and recount each pose's clear branches (in place)."""
+    for b, r in zip(*np.nonzero(~np.isnan(batch.q[:, :, 0])), strict=True):
+        if model.colliding_pair(batch.q[b, r]) is not None:
+            batch.q[b, r] = np.nan
+    batch.count[:] = (~np.isnan(batch.q[:, :, 0])).sum(axis=1)
