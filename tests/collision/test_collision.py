@@ -120,3 +120,35 @@ def test_obstacles_and_settings_are_checked_by_name(tmp_path):
     model_only = kinelab.Robot.from_model(kinelab.load("ur5").model, tool="tool0")
     with pytest.raises(CollisionError, match="no collision geometry"):
         collision_model(model_only, Collisions())
+
+
+def test_missing_collision_meshes_are_named_and_the_robot_still_loads(tmp_path):
+    from helpers import write_urdf
+
+    body = ('<link name="base"/><link name="l1"><collision><geometry><mesh filename="package://nowhere/arm.stl"/>'
+            '</geometry></collision></link><link name="l2"><collision><geometry><box size="0.1 0.1 0.1"/>'
+            '</geometry></collision></link>'
+            '<joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>'
+            '<limit lower="-3" upper="3" effort="1" velocity="1"/></joint>'
+            '<joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0 0 0.3"/>'
+            '<axis xyz="0 1 0"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>')
+    robot = kinelab.load(write_urdf(tmp_path, body), tool="l2")
+    assert robot.fk(np.zeros(2)).translation[2] == pytest.approx(0.3)  # the kinematics are intact
+    with pytest.raises(CollisionError, match=r"1 collision mesh\(es\) not found \(first: package://nowhere/arm.stl; "
+                                             "searched"):
+        kinelab.solve(robot, robot.fk(np.zeros(2)), collisions="self")
+
+
+def test_the_srdf_disables_pairs_and_a_pair_naming_a_missing_link_is_reported(tmp_path):
+    srdf = tmp_path / "panda.srdf"
+    srdf.write_text('<?xml version="1.0"?><robot name="panda">'
+                    '<disable_collisions link1="panda_link5" link2="panda_link7" reason="Default"/>'
+                    '<disable_collisions link1="panda_link5" link2="panda_hand" reason="Default"/>'
+                    '<disable_collisions link1="panda_link0" link2="panda_link99" reason="Never"/></robot>')
+    plain = collision_model(kinelab.load("panda"), Collisions())
+    robot = kinelab.load("panda", srdf=srdf)
+    with pytest.warns(UserWarning, match="names link\\(s\\) panda_link99"):
+        pruned = collision_model(robot, Collisions())
+    assert "2 disabled by the SRDF" in pruned.summary and len(pruned.pairs) == len(plain.pairs) - 2
+    q = np.zeros(7)  # at zero, link 5 touches link 7 and the hand: only the SRDF's pairs say so
+    assert plain.contact(q) is not None and pruned.contact(q) is None

@@ -14,7 +14,9 @@ collide, so the exact test runs only on the others. A plane's test is the sphere
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -23,6 +25,8 @@ import pinocchio as pin
 from kinelab.collision.obstacles import Environment
 from kinelab.errors import KinelabError
 from kinelab.robot import Robot
+from kinelab.robot.meshes import mesh_package_dirs, missing_meshes
+from kinelab.robot.mjcf import is_mjcf
 
 PLANE = -1.0  # radius marker of a plane obstacle (its test is a height, not a distance)
 
@@ -170,7 +174,10 @@ def collision_model(robot: Robot, collisions: Collisions) -> CollisionModel:
 
 
 def _build(robot: Robot, collisions: Collisions) -> CollisionModel:
-    geom = robot.visual_model(kind="collision")
+    _check_meshes(robot)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)  # missing meshes were refused above, by name
+        geom = robot.visual_model(kind="collision")
     if geom.ngeoms == 0:
         raise CollisionError(f"{robot.name} has no collision geometry (no <collision> element in its file, or a "
                              "model built in memory): collisions cannot be checked")
@@ -191,6 +198,25 @@ def _build(robot: Robot, collisions: Collisions) -> CollisionModel:
                f"margin {collisions.margin:g} m")
     return CollisionModel(robot, geom, np.array(pairs, dtype=int).reshape(-1, 2), centres, radii, normals, joints,
                           float(collisions.margin), summary)
+
+
+def _check_meshes(robot: Robot) -> None:
+    """Refuse a robot whose collision meshes cannot all be found (a missing mesh would be a hole in the check);
+    report SRDF pairs that name links the model does not have."""
+    path = robot.urdf_path
+    if path is not None and not is_mjcf(Path(path)):
+        dirs = mesh_package_dirs() if robot.package_dirs is None else list(robot.package_dirs)
+        missing = missing_meshes(path, dirs, "collision")
+        if missing:
+            raise CollisionError(f"{robot.name}: {len(missing)} collision mesh(es) not found (first: {missing[0]}; "
+                                 f"searched {', '.join(dirs) or 'no package directory'}): collisions cannot be "
+                                 "checked; pass package_dirs= to kinelab.load (CLI --package-dir)")
+    if robot.srdf is not None:
+        links = {f.name for f in robot.model.frames}
+        unknown = sorted({n for pair in robot.srdf.disabled_collisions for n in pair if n not in links})
+        if unknown:
+            warnings.warn(f"{robot.srdf.path}: disable_collisions names link(s) {', '.join(unknown)} that "
+                          f"{robot.name}'s model does not have; those pairs are ignored", stacklevel=3)
 
 
 def _self_pairs(robot: Robot, objects: list[Any], own: int) -> tuple[list[tuple[int, int]], tuple[int, int]]:
