@@ -152,3 +152,50 @@ def test_the_srdf_disables_pairs_and_a_pair_naming_a_missing_link_is_reported(tm
     assert "2 disabled by the SRDF" in pruned.summary and len(pruned.pairs) == len(plain.pairs) - 2
     q = np.zeros(7)  # at zero, link 5 touches link 7 and the hand: only the SRDF's pairs say so
     assert plain.contact(q) is not None and pruned.contact(q) is None
+
+
+def test_a_batch_and_a_path_never_count_a_colliding_answer():
+    """solve_batch solves a colliding row again and fails it with status collision when no answer is clear;
+    track marks the samples whose answer collides, by sample."""
+    ur5 = kinelab.load("ur5")
+    model = collision_model(ur5, Collisions(environment=FLOOR_AND_TABLE))
+    rng = np.random.default_rng(14)
+    Q = [q for q in (ur5.random_q(rng) for _ in range(400)) if model.colliding_pair(q) is None][:40]
+    targets = ur5.fk_batch(np.array(Q))  # reachable without a collision
+    plain = kinelab.solve_batch(ur5, targets, seed=0)
+    clear = kinelab.solve_batch(ur5, targets, seed=0, collisions=FLOOR_AND_TABLE, time_budget=5.0)
+    assert any(model.colliding_pair(q) is not None for q in plain.q[plain.success])  # the plain batch collides
+    for q, ok, status in zip(clear.q, clear.success, clear.status, strict=True):
+        assert not ok or model.contact(q, first_test=False) is None
+        assert ok or status in ("collision", "time_budget")
+    assert clear.success.sum() >= 0.95 * len(targets)
+    start = np.array([0.0, -1.0, 1.2, -0.2, 0.4, 0.0])
+    line = [ur5.fk(start + np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.0]))]
+    down = [pin_shift(line[0], dz) for dz in np.linspace(0.0, -1.2, 25)]  # the tool driven through the table
+    path = kinelab.track(ur5, down, q0=start, collisions=FLOOR_AND_TABLE)
+    hit = [k for k, s in enumerate(path.status) if s == "collision"]
+    assert hit and [k for k, _ in path.contacts] == hit
+    assert all(model.contact(path.q[k], first_test=False) is not None for k in hit)
+    assert all(model.contact(path.q[k], first_test=False) is None for k in np.flatnonzero(path.reached))
+
+
+def pin_shift(T, dz):
+    import pinocchio as pin
+
+    return pin.SE3(T.rotation, T.translation + np.array([0.0, 0.0, dz]))
+
+
+def test_the_prepared_solver_checks_every_call_against_the_model_it_built_once():
+    ur5 = kinelab.load("ur5")
+    ik = kinelab.IK(ur5, collisions=FLOOR_AND_TABLE, time_budget=0.5)
+    model = collision_model(ur5, Collisions(environment=FLOOR_AND_TABLE))
+    assert ik.collisions is model  # built once, shared with the plain calls
+    rng = np.random.default_rng(15)
+    clear = [q for q in (ur5.random_q(rng) for _ in range(300)) if model.colliding_pair(q) is None][:20]
+    for k, q in enumerate(clear):
+        res = ik.solve(ur5.fk(q), seed=k)
+        assert res.success and model.contact(res.q, first_test=False) is None
+    batch = ik.solve_batch(ur5.fk_batch(np.array(clear)), seed=0)
+    assert all(model.contact(q, first_test=False) is None for q in batch.q[batch.success])
+    branches = ik.solve_all(ur5.fk(clear[0]), seed=0)
+    assert all(b.success == (model.contact(b.q, first_test=False) is None) for b in branches)

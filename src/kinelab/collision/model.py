@@ -106,6 +106,7 @@ class CollisionModel:
     joints: np.ndarray  # (G,) each object's parent joint
     margin: float
     summary: str
+    spec: Collisions | None = None
     data: Any = field(default=None)
     gdata: Any = field(default=None)
 
@@ -197,7 +198,7 @@ def _build(robot: Robot, collisions: Collisions) -> CollisionModel:
                f"checked ({left_out[0]} on adjacent links and {left_out[1]} disabled by the SRDF left out), "
                f"margin {collisions.margin:g} m")
     return CollisionModel(robot, geom, np.array(pairs, dtype=int).reshape(-1, 2), centres, radii, normals, joints,
-                          float(collisions.margin), summary)
+                          float(collisions.margin), summary, collisions)
 
 
 def _check_meshes(robot: Robot) -> None:

@@ -24,7 +24,7 @@ from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.batch import BatchIKResult, run_batch
 from kinelab.ik.branches import UNSEEN, find_all
-from kinelab.ik.clear import mark_colliding, solve_clear
+from kinelab.ik.clear import clear_batch, clear_track, mark_colliding, solve_clear
 from kinelab.ik.driver import solve_one
 from kinelab.ik.frdm.tracking import PathSettings, path_options, run_track
 from kinelab.ik.registry import solver_module
@@ -133,7 +133,8 @@ def _collision_model(robot: Robot, collisions: Any) -> CollisionModel | None:
 def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frdm", q0: Any = None,
                 seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6,
                 time_budget: float | None = None, max_restarts: int = 1000, start_outside_limits: str = "refuse",
-                options: Any = None, task: str = "pose", axis: str = "z", **solver_options: Any) -> BatchIKResult:
+                options: Any = None, task: str = "pose", axis: str = "z", collisions: Any = None,
+                **solver_options: Any) -> BatchIKResult:
     """Solve IK for every target of a batch: row b is what :func:`solve` gives for ``targets[b]`` alone with
     ``seed = seed + b`` and start ``q0[b]``, when neither runs out of time.
 
@@ -158,6 +159,8 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
         time_budget: wall-clock budget [s] of the whole batch (None, the default: none); rows not started
             when it runs out are left unsolved with status ``time_budget`` and NaN in q.
         start_outside_limits: "refuse" (the default here: a batch of starts is data, checked row by row).
+        collisions: as :func:`solve`: a row whose answer collides is solved again from fresh seeds within what
+            is left of ``time_budget``, and fails with status ``collision`` when every answer collides.
 
     Returns:
         The :class:`~kinelab.ik.batch.BatchIKResult`, every row judged by Pinocchio's FK.
@@ -171,7 +174,12 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
         refuse_positional("solve_batch", positional)
     req = make_request(solver, seed, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options,
                        task, axis, solver_options)
-    return run_batch(robot, targets, q0, req)
+    check = _collision_model(robot, collisions)
+    t0 = time.perf_counter()
+    res = run_batch(robot, targets, q0, req)
+    if check is None:
+        return res
+    return clear_batch(robot, stack_homogeneous(*as_target_arrays(targets)), res, req, check, t0)
 
 
 def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto", seed: int | None = None,
@@ -235,7 +243,7 @@ def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
           seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float | None = None,
           options: Any = None, task: str = "pose", axis: str = "z", jump_limit: float | None = 0.2,
           restrict: tuple[str, ...] = (), hold: int = 10, rest_weight: float | None = None,
-          **solver_options: Any) -> TrackResult:
+          collisions: Any = None, **solver_options: Any) -> TrackResult:
     """Follow a path: solve each target in turn, warm-started from the previous answer (no restarts).
 
     With no bypass, policy or restriction named, the whole path runs in the compiled follower; otherwise
@@ -266,6 +274,8 @@ def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
         restrict: restrictions ("intervals", "freeze") held on every sample of the path.
         hold: samples a restriction stays on after the monitor switched it on.
         rest_weight: compiled follower only: weight of the rest term (None: 0.01 beyond six joints, else 0).
+        collisions: as :func:`solve`: a sample whose answer collides is not reached (status ``collision``);
+            ``contacts`` lists (sample, pair) for each; without ``q0`` the first target is solved clear.
 
     Returns:
         One row of q per sample, Pinocchio's errors, statuses, the monitor log (:class:`TrackResult`).
@@ -283,16 +293,20 @@ def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
     req = make_request(solver, seed, tol_pos, tol_rot, time_budget, 0, "refuse", options, task, axis,
                        path_options(options, solver_options))
     points, rotations = as_target_arrays(targets)
+    check = _collision_model(robot, collisions)
     if q0 is None:
-        q0 = _first_answer(robot, pin.SE3(rotations[0], points[0]), req)
-    return run_track(robot, stack_homogeneous(points, rotations), robot.check_q(q0, limits=True, what="q0"), req,
+        q0 = _first_answer(robot, pin.SE3(rotations[0], points[0]), req, check)
+    path = run_track(robot, stack_homogeneous(points, rotations), robot.check_q(q0, limits=True, what="q0"), req,
                      settings)
+    return path if check is None else clear_track(path, check)
 
 
-def _first_answer(robot: Robot, target: pin.SE3, req: Request) -> np.ndarray:
-    """Where a path without q0 starts: the answer to its first target, with the path's seed, tolerances and task."""
+def _first_answer(robot: Robot, target: pin.SE3, req: Request, check: CollisionModel | None) -> np.ndarray:
+    """Where a path without q0 starts: the answer to its first target, with the path's seed, tolerances and task
+    (clear of collisions when the path checks them)."""
     first = solve(robot, target, seed=req.seed, tol_pos=req.tol_pos, tol_rot=req.tol_rot, task=req.task.name,
-                  axis="xyz"[req.task.axis] if req.task.axis >= 0 else "z")
+                  axis="xyz"[req.task.axis] if req.task.axis >= 0 else "z",
+                  collisions=None if check is None else check.spec)
     if not first.success:
         raise OptionError("q0", None, "a start configuration: the path's first target could not be solved "
                           f"({first.status.value}: {first.message})")

@@ -14,13 +14,18 @@ import time
 from dataclasses import replace
 from typing import Any
 
+import numpy as np
+import pinocchio as pin
+
 from kinelab.collision.model import CollisionModel
-from kinelab.ik.batch import fresh_seed
+from kinelab.ik.batch import BatchIKResult, fresh_seed
 from kinelab.ik.driver import solve_one
 from kinelab.ik.request import Request
-from kinelab.ik.result import IKResult, Status
+from kinelab.ik.result import IKResult, Status, TrackResult
 from kinelab.robot import Robot
 
+ROW_RUNS = 20  # runs a colliding batch row gets (each a full solve): a row with no clear answer must not take the
+# whole batch's budget
 STRIDE = 1_000_003  # seeds between two runs: a run's restarts use seed, seed + 1, ... within one run
 
 
@@ -82,3 +87,35 @@ def mark_colliding(found: list[IKResult], model: CollisionModel, drop: bool) -> 
             out.append(replace(res, success=False, status=Status.COLLISION, message=f"collides: {contact}",
                                diagnostics=replace(res.diagnostics, contact=contact)))
     return out
+
+
+def clear_batch(robot: Robot, H: np.ndarray, res: BatchIKResult, req: Request, model: CollisionModel,
+                t0: float) -> BatchIKResult:
+    """The batch with every colliding row solved again by :func:`solve_clear` (fresh seeds, what is left of the
+    budget); a row with no clear answer fails with status ``collision``."""
+    q, success, status = res.q.copy(), res.success.copy(), res.status.copy()
+    dp, dr = res.position_error.copy(), res.rotation_error.copy()
+    for b in np.flatnonzero(success):
+        if model.colliding_pair(q[b]) is None:
+            continue
+        left = None if req.time_budget is None else max(req.time_budget - (time.perf_counter() - t0), 1e-4)
+        again = solve_clear(robot, pin.SE3(H[b, :3, :3], H[b, :3, 3]), None,
+                            replace(req, seed=res.seed + b + STRIDE, time_budget=left,
+                                    max_restarts=min(req.max_restarts, ROW_RUNS)), model)
+        q[b], success[b], status[b] = again.q, again.success, again.status.value
+        dp[b], dr[b] = again.position_error, again.rotation_error
+    return replace(res, q=q, success=success, status=status, position_error=dp, rotation_error=dr,
+                   wall_time=time.perf_counter() - t0)
+
+
+def clear_track(res: TrackResult, model: CollisionModel) -> TrackResult:
+    """The path with every reached sample whose answer collides marked ``collision`` (not reached), the
+    contacts listed by sample."""
+    status, contacts = list(res.status), []
+    for k, (q, s) in enumerate(zip(res.q, res.status, strict=True)):
+        if s == Status.CONVERGED.value:
+            contact = model.contact(q)
+            if contact is not None:
+                status[k] = Status.COLLISION.value
+                contacts.append((k, contact))
+    return replace(res, status=status, contacts=contacts)

@@ -11,15 +11,20 @@ by Pinocchio.
 
 from __future__ import annotations
 
+import time
 from dataclasses import replace
 from typing import Any
 
+from kinelab.collision.model import as_collisions, collision_model
+from kinelab.geometry import stack_homogeneous
 from kinelab.ik.batch import BatchIKResult, run_batch
 from kinelab.ik.branches import UNSEEN, find_all
+from kinelab.ik.clear import clear_batch, mark_colliding, solve_clear
 from kinelab.ik.driver import prepare_checks, solve_one
 from kinelab.ik.lean import LeanFRDM
 from kinelab.ik.request import Request, check_seed, make_request
 from kinelab.ik.result import IKResult
+from kinelab.ik.targets import as_target_arrays
 from kinelab.robot import Robot
 
 
@@ -39,6 +44,8 @@ class IK:
         options: the solver's options object.
         task: "pose", "position", "axis" or "orientation".
         axis: the tool axis of task "axis".
+        collisions: as :func:`kinelab.solve` (None, "self", an Environment or a Collisions): every answer of
+            every call must be clear; the collision model is built here, once.
         solver_options: the solver's option fields as keyword arguments.
 
     Raises:
@@ -49,7 +56,7 @@ class IK:
     def __init__(self, robot: Robot, *positional: Any, solver: str = "frdm", tol_pos: float = 1e-6,
                  tol_rot: float = 1e-6, time_budget: float | None = 1.0, max_restarts: int = 1000,
                  start_outside_limits: str = "project", options: Any = None, task: str = "pose", axis: str = "z",
-                 **solver_options: Any):
+                 collisions: Any = None, **solver_options: Any):
         if positional:
             raise TypeError("IK() takes the robot positionally and every setting by keyword: pass "
                             f"solver={positional[0]!r}")
@@ -62,6 +69,8 @@ class IK:
         prepare_checks(robot)
         req = self.request
         self._lean = LeanFRDM(robot, req) if req.solver == "frdm" and req.options.compiled else None
+        spec = as_collisions(collisions)
+        self.collisions = None if spec is None else collision_model(robot, spec)
 
     def _request(self, seed: int | None) -> Request:
         if seed is None:
@@ -83,6 +92,8 @@ class IK:
         Raises:
             TargetError, ConfigurationError, JointLimitError, OptionError: a bad target, start or seed.
         """
+        if self.collisions is not None:
+            return solve_clear(self.robot, target, q0, self._request(seed), self.collisions)
         if self._lean is not None:
             res = self._lean.solve(target, q0, seed)
             if res is not None:
@@ -103,7 +114,12 @@ class IK:
         Raises:
             TargetError, ConfigurationError, OptionError: named.
         """
-        return run_batch(self.robot, targets, q0, replace(self._request(seed), start_outside_limits="refuse"))
+        req = replace(self._request(seed), start_outside_limits="refuse")
+        t0 = time.perf_counter()
+        res = run_batch(self.robot, targets, q0, req)
+        if self.collisions is None:
+            return res
+        return clear_batch(self.robot, stack_homogeneous(*as_target_arrays(targets)), res, req, self.collisions, t0)
 
     def solve_all(self, target: Any, *, seed: int | None = None, q_ref: Any = None,
                   max_solutions: int | None = None, stop_below: float | None = UNSEEN) -> list[IKResult]:
@@ -122,5 +138,6 @@ class IK:
         Raises:
             TargetError, ConfigurationError, OptionError: named.
         """
-        return find_all(self.robot, target, replace(self._request(seed), max_restarts=0), q_ref=q_ref,
-                        max_solutions=max_solutions, stop_below=stop_below)
+        found = find_all(self.robot, target, replace(self._request(seed), max_restarts=0), q_ref=q_ref,
+                         max_solutions=max_solutions, stop_below=stop_below)
+        return found if self.collisions is None else mark_colliding(found, self.collisions, drop=False)

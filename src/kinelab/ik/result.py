@@ -271,6 +271,7 @@ class TrackResult:
     events: list[SingularEvent] = field(default_factory=list)
     bypasses: list[BypassRecord] = field(default_factory=list)
     mode: str = "frdm (monitored)"
+    contacts: list[tuple[int, Any]] = field(default_factory=list)  # (sample, Contact) with collisions=
 
     @property
     def joint_steps(self) -> np.ndarray:
