@@ -19,16 +19,20 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import coal
 import numpy as np
 import pinocchio as pin
 
 from kinelab.collision.obstacles import Environment
+from kinelab.collision.spheres import PLANE, Frames
+from kinelab.collision.spheres import candidates as sphere_candidates
+from kinelab.dispatch import TypedKernel
 from kinelab.errors import KinelabError
 from kinelab.robot import Robot
 from kinelab.robot.meshes import mesh_package_dirs, missing_meshes
 from kinelab.robot.mjcf import is_mjcf
 
-PLANE = -1.0  # radius marker of a plane obstacle (its test is a height, not a distance)
+_SPHERES = TypedKernel(sphere_candidates)
 
 
 class CollisionError(KinelabError):
@@ -107,12 +111,18 @@ class CollisionModel:
     margin: float
     summary: str
     spec: Collisions | None = None
+    frames: Frames | None = None
+    hulls: Any = field(default=None)
     data: Any = field(default=None)
     gdata: Any = field(default=None)
+    hdata: Any = field(default=None)
 
     def __post_init__(self) -> None:
         self.data, self.gdata = self.robot.model.createData(), pin.GeometryData(self.geom)
-        for req in self.gdata.collisionRequests:
+        self.hulls = _hulls(self.geom)
+        self.hdata = pin.GeometryData(self.hulls)
+        self._found = np.empty(len(self.pairs), dtype=np.int64)
+        for req in (*self.gdata.collisionRequests, *self.hdata.collisionRequests):
             req.security_margin = self.margin
 
     def contact(self, q: Any, first_test: bool = True) -> Contact | None:
@@ -134,18 +144,30 @@ class CollisionModel:
         than :meth:`contact`)."""
         q = self.robot.check_q(q)
         model = self.robot.model
-        pin.forwardKinematics(model, self.data, self.robot.to_pin_q(q))
-        candidates = self.candidates() if first_test else np.arange(len(self.pairs))
-        if candidates.size == 0:
+        spheres = self.candidates(q) if first_test else np.arange(len(self.pairs))
+        if spheres.size == 0:
             return None
+        pin.forwardKinematics(model, self.data, self.robot.to_pin_q(q))
+        candidates = [int(k) for k in spheres]
+        if first_test:  # the convex hulls next: a pair whose hulls are apart cannot collide
+            pin.updateGeometryPlacements(model, self.data, self.hulls, self.hdata)
+            candidates = [k for k in candidates if pin.computeCollision(self.hulls, self.hdata, k)]
+            if not candidates:
+                return None
         pin.updateGeometryPlacements(model, self.data, self.geom, self.gdata)
         for k in candidates:
             if pin.computeCollision(self.geom, self.gdata, int(k)):
                 return int(k)
         return None
 
-    def candidates(self) -> np.ndarray:
-        """The pairs whose spheres the first test cannot separate (the data's joint placements current)."""
+    def candidates(self, q: np.ndarray) -> np.ndarray:
+        """The pairs whose spheres the first test cannot separate at q (checked n floats)."""
+        f = self.frames
+        if f is not None:
+            count = _SPHERES(q, f.parents, f.place_R, f.place_t, f.axis, f.kind, f.q_index, self.joints,
+                                      self.centres, self.radii, self.normals, self.pairs, self.margin, self._found)
+            return self._found[:count]
+        pin.forwardKinematics(self.robot.model, self.data, self.robot.to_pin_q(q))
         R = np.array([m.rotation for m in self.data.oMi])
         t = np.array([m.translation for m in self.data.oMi])
         world = np.einsum("gij,gj->gi", R[self.joints], self.centres) + t[self.joints]
@@ -197,8 +219,43 @@ def _build(robot: Robot, collisions: Collisions) -> CollisionModel:
     summary = (f"{own} collision object(s) of {robot.name}, {len(obstacles)} obstacle(s); {len(pairs)} pairs "
                f"checked ({left_out[0]} on adjacent links and {left_out[1]} disabled by the SRDF left out), "
                f"margin {collisions.margin:g} m")
-    return CollisionModel(robot, geom, np.array(pairs, dtype=int).reshape(-1, 2), centres, radii, normals, joints,
-                          float(collisions.margin), summary, collisions)
+    return CollisionModel(robot, geom, np.array(pairs, dtype=np.int64).reshape(-1, 2), centres, radii, normals,
+                          joints.astype(np.int64), float(collisions.margin), summary, collisions, _frames(robot))
+
+
+def _frames(robot: Robot) -> Frames | None:
+    """The model's joints as the compiled sphere test reads them; None when a joint is not one of the chain's
+    (a mimic follower): the test then reads Pinocchio's frames."""
+    model = robot.model
+    index = {j.name: i for i, j in enumerate(robot.joints)}
+    if robot.mimics or any(model.names[j] not in index for j in range(1, model.njoints)):
+        return None
+    J = model.njoints
+    axis = np.zeros((J, 3))
+    for j in range(1, J):
+        axis[j] = robot.joints[index[model.names[j]]].axis_local
+    return Frames(np.array(model.parents, dtype=np.int64),
+                  np.array([m.rotation for m in model.jointPlacements]),
+                  np.array([m.translation for m in model.jointPlacements]), axis,
+                  np.array([0] + [int(robot.joints[index[model.names[j]]].kind == "prismatic") for j in range(1, J)],
+                           dtype=np.int64),
+                  np.array([0] + [index[model.names[j]] for j in range(1, J)], dtype=np.int64))
+
+
+def _hulls(geom: pin.GeometryModel) -> pin.GeometryModel:
+    """The geometry with every mesh replaced by its convex hull (qhull, computed once): a hull contains its
+    mesh, so hulls that do not meet are a proof that the meshes do not."""
+    hulls = geom.copy()
+    for k, obj in enumerate(geom.geometryObjects):
+        if isinstance(obj.geometry, coal.BVHModelBase):
+            mesh = obj.geometry.clone()
+            mesh.buildConvexHull(True, "Qt")
+            convex = mesh.convex
+            convex.computeLocalAABB()
+            hull = pin.GeometryObject(obj)
+            hull.geometry = convex
+            hulls.geometryObjects[k] = hull
+    return hulls
 
 
 def _check_meshes(robot: Robot) -> None:

@@ -4,11 +4,10 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from typing import Any
 
-import numba
 import numpy as np
 
+from kinelab.dispatch import TypedKernel as TypedKernel  # exported: the solvers' kernels are called through it
 from kinelab.ik.chain import PRISMATIC, ChainModel, random_configuration
 
 
@@ -91,28 +90,3 @@ def clock_chunk(joint_steps: int, n: int) -> int:
     """Iterations of an n-joint kernel between two looks at the clock: the work of ``joint_steps`` single-joint
     steps, so that a budget is overrun by about the same time whatever the chain's length (at least 4)."""
     return max(4, joint_steps // max(1, n))
-
-
-class TypedKernel:
-    """A numba kernel called through the compiled entry point of the argument types it first saw.
-
-    numba types every argument on every call, and a NamedTuple argument is typed in Python: 2–3 µs per
-    call for kinelab's kernel tuples, as much as a converged solve costs. kinelab builds every argument
-    of its kernels itself, with fixed dtypes, layouts and scalar types (``float``, ``int``, ``bool``), so
-    after the first call (which compiles or loads the kernel through the dispatcher, with numba's own
-    type check) the same compiled function serves every later call. A call whose argument types could
-    differ must go through the dispatcher (``kernel.py_dispatcher``) instead.
-    """
-
-    def __init__(self, dispatcher: Any):
-        self.py_dispatcher = dispatcher
-        self._entry: Callable[..., Any] | None = None
-
-    def __call__(self, *args: Any) -> Any:
-        """Call the compiled entry point (the dispatcher on the first call)."""
-        if self._entry is not None:
-            return self._entry(*args)
-        result = self.py_dispatcher(*args)
-        signature = tuple(numba.typeof(a) for a in args)
-        self._entry = self.py_dispatcher.overloads[signature].entry_point
-        return result
