@@ -199,3 +199,26 @@ def test_the_prepared_solver_checks_every_call_against_the_model_it_built_once()
     assert all(model.contact(q, first_test=False) is None for q in batch.q[batch.success])
     branches = ik.solve_all(ur5.fk(clear[0]), seed=0)
     assert all(b.success == (model.contact(b.q, first_test=False) is None) for b in branches)
+
+
+def test_the_command_line_checks_collisions_with_an_obstacle_file(tmp_path, capsys):
+    from kinelab import cli
+
+    scene = tmp_path / "scene.json"
+    scene.write_text(json.dumps({"obstacles": [{"shape": "plane", "name": "floor"}]}))
+    code = cli.main(["fk", "ur5", "0", "0", "0", "0", "0", "0", "--obstacles", str(scene), "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0 and out["collision"]["second"] == "floor" and out["collision"]["distance"] < 0
+    code = cli.main(["ik", "ur5", "--target-xyz", "0.4", "0.2", "0.5", "--target-rpy", "3.14", "0", "0",
+                     "--obstacles", str(scene), "--json"])
+    res = json.loads(capsys.readouterr().out)
+    ur5 = kinelab.load("ur5")
+    floor = collision_model(ur5, Collisions(environment=Environment.from_file(scene)))
+    assert code == 0 and res["success"] and floor.contact(res["q"], first_test=False) is None
+    assert res["info"]["clear_after"] is not None
+    for argv, said in ((["fk", "ur5", "0", "0", "0", "0", "0", "0", "--margin", "0.1"], "--margin is a collision"),
+                       (["fk", "ur5", "0", "0", "0", "0", "0", "0", "--obstacles", str(tmp_path / "none.json")],
+                        "cannot read the obstacle file")):
+        assert cli.main(argv) == 2
+        err = capsys.readouterr().err
+        assert said in err and err.count("\n") == 1

@@ -117,6 +117,27 @@ def source_arguments(s: argparse.ArgumentParser) -> None:
                    help="let a .xacro robot run what xacro runs ($(eval), $(env), load_yaml); refused without it")
 
 
+def collision_arguments(s: argparse.ArgumentParser) -> None:
+    """--collisions, --obstacles FILE and --margin: what answers must not collide with."""
+    s.add_argument("--collisions", action="store_true", help="the robot must not collide with itself")
+    s.add_argument("--obstacles", metavar="FILE",
+                   help="an obstacle file (JSON: planes, boxes, spheres, cylinders, capsules in the base frame); "
+                        "implies --collisions")
+    s.add_argument("--margin", type=float, default=0.0, help="clearance every pair must keep [m] (default 0)")
+
+
+def collisions_of(args: argparse.Namespace) -> Any:
+    """The :class:`kinelab.Collisions` the collision flags ask for, or None."""
+    if not args.collisions and args.obstacles is None:
+        if args.margin:
+            raise KinelabError("--margin is a collision clearance: give --collisions or --obstacles FILE")
+        return None
+    from kinelab.collision import Collisions, Environment
+
+    env = None if args.obstacles is None else Environment.from_file(args.obstacles)
+    return Collisions(environment=env, margin=args.margin)
+
+
 def json_flag(s: argparse.ArgumentParser, what: str = "the result") -> None:
     """The --json flag of a command that prints results."""
     s.add_argument("--json", action="store_true", help=f"print {what} as JSON")

@@ -5,13 +5,24 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from kinelab.cli.common import json_flag, load_robot, pose_dict, print_json, q_from_cli, robot_arguments, shown
+from kinelab.cli.common import (
+    collision_arguments,
+    collisions_of,
+    json_flag,
+    load_robot,
+    pose_dict,
+    print_json,
+    q_from_cli,
+    robot_arguments,
+    shown,
+)
 
 
 def add(sub: Any) -> None:
     """The ``fk`` subcommand."""
     s = sub.add_parser("fk", help="tool pose at a configuration")
     robot_arguments(s, "one number per joint (rad and m; deg with --deg)")
+    collision_arguments(s)
     json_flag(s)
     s.set_defaults(func=run)
 
@@ -24,6 +35,14 @@ def run(args: argparse.Namespace) -> int:
     oMtool = robot.fk(q)  # FK is defined at any q: a q outside the limits is computed and said, not refused
     out = {"robot": robot.name, "base": robot.base, "tool": robot.tool, "q": q.tolist(), **pose_dict(oMtool),
            "outside_limits": outside}
+    spec = collisions_of(args)
+    if spec is not None:
+        from dataclasses import asdict
+
+        from kinelab.collision import collision_model
+
+        contact = collision_model(robot, spec).contact(q)
+        out["collision"] = None if contact is None else asdict(contact)
     if args.json:
         print_json(out)
         return 0
@@ -34,4 +53,10 @@ def run(args: argparse.Namespace) -> int:
     print(f"  quat_wxyz      {shown(out['quat_wxyz'])}")
     print(f"  rpy [rad]      {shown(out['rpy_rad'])}")
     print("  rotation       " + shown(oMtool.rotation, prefix="  rotation       "))
+    if "collision" in out:
+        print(f"  collision      {'none' if out['collision'] is None else _said(out['collision'])}")
     return 0
+
+
+def _said(contact: dict[str, Any]) -> str:
+    return f"{contact['first']} and {contact['second']} ({contact['distance'] * 1e3:+.1f} mm)"

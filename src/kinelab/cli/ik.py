@@ -9,6 +9,8 @@ from typing import Any
 import numpy as np
 
 from kinelab.cli.common import (
+    collision_arguments,
+    collisions_of,
     json_flag,
     load_robot,
     plural,
@@ -59,6 +61,7 @@ def add(sub: Any) -> None:
     s.add_argument("--integrator", choices=["euler", "rk4", "adaptive"], help="biquat: integrator")
     s.add_argument("--step", type=float, help="biquat: fixed step h [s] (the paper: 0.01; default 1/k)")
     s.add_argument("--gain", type=float, help="biquat: gain k [1/s] (default 1)")
+    collision_arguments(s)
     source_arguments(s)
     json_flag(s)
     s.set_defaults(func=run)
@@ -78,7 +81,8 @@ def run(args: argparse.Namespace) -> int:
         options.update({k: v for k, v in (("law", args.law), ("integrator", args.integrator), ("step", args.step),
                                           ("k", args.gain)) if v is not None})
     result = solve(robot, target, solver=args.solver, q0=q0, seed=args.seed, tol_pos=args.tol_pos,
-                   tol_rot=args.tol_rot, time_budget=args.time_budget, task=args.task, axis=args.axis, **options)
+                   tol_rot=args.tol_rot, time_budget=args.time_budget, task=args.task, axis=args.axis,
+                   collisions=collisions_of(args), **options)
     if args.json:
         print_json({"robot": robot.name, "target": pose_dict(target), **result.to_dict()})
     else:
@@ -170,6 +174,8 @@ def _print_ik(robot: Robot, args: argparse.Namespace, result: IKResult) -> None:
         print(f"  model time {result.diagnostics.model_time:.4g} s, final M0 = "
               + (f"{m0:+.6f}" if m0 is not None else "n/a (give --target-q for the sign of N)"))
     _print_events(result)
+    if result.success and result.diagnostics.clear_after is not None:
+        print(f"  clear of collisions ({plural(result.diagnostics.clear_after, 'colliding answer')} found before)")
     if result.message:
         print("  " + re.sub(r"task='(\w+)'", r"--task \1", result.message))
     if not result.success and result.status is not Status.OUTSIDE_LIMITS and args.task != "position" \
