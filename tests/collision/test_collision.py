@@ -222,3 +222,29 @@ def test_the_command_line_checks_collisions_with_an_obstacle_file(tmp_path, caps
         assert cli.main(argv) == 2
         err = capsys.readouterr().err
         assert said in err and err.count("\n") == 1
+
+
+def test_a_scene_draws_the_obstacles_and_the_links_in_contact():
+    from kinelab.view import scene as viz
+    from kinelab.view.collisions import draw_collisions
+
+    ur5 = kinelab.load("ur5")
+    model = collision_model(ur5, Collisions(environment=FLOOR_AND_TABLE))
+    q = np.array([0.0, -0.3, 0.9, 0.0, 0.0, 0.0])  # the arm laid through the table onto the floor
+    s = viz.Scene(ur5)
+    try:
+        contacts = draw_collisions(s, model, q)
+        names = {n for c in contacts for n in (c.first, c.second)}
+        assert {"floor", "table"} <= names and all(c.distance <= 0 for c in contacts)
+        assert [str(c) for c in contacts] == [str(c) for c in model.contacts(q)]
+        from browser import scene_paths
+
+        paths = scene_paths(s.static_html())
+        red = {p for p in paths if p.startswith("/meshcat/contacts/")}
+        assert len(red) == len(names - {"floor", "table"}) and {"/meshcat/obstacles/0", "/meshcat/obstacles/1"} <= paths
+        assert "red links: in contact" in s.legend["collisions"] and "floor, table" in s.legend["obstacles"]
+        clear = draw_collisions(s, model, np.array([0.0, -1.57, 0.0, -1.57, 0.0, 0.0]))
+        assert clear == [] and "no contact" in s.legend["collisions"]
+        assert not {p for p in scene_paths(s.static_html()) if p.startswith("/meshcat/contacts/")}
+    finally:
+        s.close()

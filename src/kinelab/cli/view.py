@@ -7,7 +7,7 @@ import math
 import sys
 from typing import Any
 
-from kinelab.cli.common import load_robot, plural, q_from_cli, robot_arguments
+from kinelab.cli.common import collision_arguments, collisions_of, load_robot, plural, q_from_cli, robot_arguments
 from kinelab.errors import KinelabError
 from kinelab.robot import load
 
@@ -19,6 +19,7 @@ def add(sub: Any) -> None:
     s = sub.add_parser("view", help="show a robot in meshcat (live on 127.0.0.1, or --html for a static page)")
     robot_arguments(s, "configuration (default: the robot's display pose)")
     s.add_argument("--singular", action="store_true", help="draw the lost directions and σ_min at q")
+    collision_arguments(s)
     s.add_argument("--html", help="write a self-contained HTML page instead of serving")
     s.set_defaults(func=run_view)
     s = sub.add_parser("animate", help="animate a solver run in meshcat (the ERA passages)")
@@ -41,6 +42,13 @@ def run_view(args: argparse.Namespace) -> int:
     scene = viz.Scene(robot).show(q)
     if args.singular:
         scene.singular_directions(q)
+    spec = collisions_of(args)
+    if spec is not None:
+        from kinelab.collision import collision_model
+        from kinelab.view.collisions import draw_collisions
+
+        contacts = draw_collisions(scene, collision_model(robot, spec), q)
+        print(f"{len(contacts)} contact(s)" + "".join(f"\n  {c}" for c in contacts))
     return _publish(scene, args.html)
 
 

@@ -139,6 +139,15 @@ class CollisionModel:
         k = self.colliding_pair(q, first_test)
         return None if k is None else self.contact_of(k)
 
+    def contacts(self, q: Any) -> list[Contact]:
+        """Every pair at q closer than the margin, each with its distance (the exact test on the pairs the first
+        tests leave)."""
+        q = self.robot.check_q(q)
+        spheres = self.candidates(q)
+        pin.forwardKinematics(self.robot.model, self.data, self.robot.to_pin_q(q))
+        pin.updateGeometryPlacements(self.robot.model, self.data, self.geom, self.gdata)
+        return [self.contact_of(int(k)) for k in spheres if pin.computeCollision(self.geom, self.gdata, int(k))]
+
     def colliding_pair(self, q: Any, first_test: bool = True) -> int | None:
         """The index of the first pair at q closer than the margin, or None (no distance computed: cheaper
         than :meth:`contact`)."""

@@ -1,0 +1,91 @@
+"""Collisions in a scene: the obstacles drawn where they stand, and the links in contact coloured red."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab.collision.model import CollisionModel, Contact
+from kinelab.collision.obstacles import Obstacle
+
+OBSTACLE_COLOR = 0x9A9A9A
+CONTACT_COLOR = 0xE6194B
+PLANE_SIDE = 4.0  # [m] the square drawn for an (unbounded) plane
+
+
+def draw_collisions(scene: Any, model: CollisionModel, q: Any) -> list[Contact]:
+    """Draw ``model``'s obstacles in ``scene`` and colour red the robot's visuals on the links in contact at q
+    (the robot drawn at q first); returns the contacts, which the caption lists."""
+    import meshcat.geometry as g
+
+    scene.show(q)
+    obstacles = model.spec.environment.obstacles if model.spec and model.spec.environment else ()
+    for k, obstacle in enumerate(obstacles):
+        node = scene.viewer["obstacles"][f"{k}"]
+        opacity = 0.25 if obstacle.shape == "plane" else 0.6
+        material = g.MeshLambertMaterial(color=OBSTACLE_COLOR, opacity=opacity, transparent=True)
+        node.set_object(_shape(obstacle), material)
+        node.set_transform(_placement(obstacle).homogeneous)
+    contacts = model.contacts(q)
+    _overlay(scene, model, {n for c in contacts for n in (c.first, c.second)})
+    if obstacles:
+        named = ", ".join(o.name or o.shape for o in obstacles)
+        scene.legend["obstacles"] = f"grey: {len(obstacles)} obstacle(s) ({named})"
+    scene.legend["collisions"] = ("red links: in contact — " + "; ".join(str(c) for c in contacts)) if contacts \
+        else "no contact at this q (margin " + f"{model.margin:g} m)"
+    return contacts
+
+
+def _overlay(scene: Any, model: CollisionModel, names: set[str]) -> None:
+    """The robot's collision objects in contact, drawn red over its visuals at the placements of the last check
+    (unlit: a mesh without normals would draw black under a lit material)."""
+    import meshcat.geometry as g
+
+    scene.viewer["contacts"].delete()  # the contacts of an earlier q
+    for k, obj in enumerate(model.geom.geometryObjects):
+        if obj.name not in names or obj.parentJoint == 0:
+            continue
+        shape = _mesh(obj.geometry)
+        if shape is None:
+            continue
+        node = scene.viewer["contacts"][f"{k}"]
+        node.set_object(shape, g.MeshBasicMaterial(color=CONTACT_COLOR, opacity=0.55, transparent=True))
+        node.set_transform(model.gdata.oMg[k].homogeneous)
+
+
+def _mesh(geometry: Any) -> Any:
+    """A coal geometry as a meshcat one (meshes as triangles; boxes, spheres, cylinders as such), else None."""
+    import coal
+    import meshcat.geometry as g
+
+    if isinstance(geometry, coal.BVHModelBase):
+        tris = [geometry.tri_indices(i) for i in range(geometry.num_tris)]
+        return g.TriangularMeshGeometry(np.asarray(geometry.vertices()),
+                                        np.array([[t[0], t[1], t[2]] for t in tris], dtype=np.uint32))
+    if isinstance(geometry, coal.Box):
+        return g.Box(list(2 * np.asarray(geometry.halfSide)))
+    if isinstance(geometry, coal.Sphere):
+        return g.Sphere(geometry.radius)
+    return None
+
+
+def _shape(obstacle: Obstacle) -> Any:
+    import meshcat.geometry as g
+
+    s = obstacle.size
+    if obstacle.shape == "plane":
+        return g.Box([PLANE_SIDE, PLANE_SIDE, 1e-3])
+    if obstacle.shape == "box":
+        return g.Box(list(s))
+    if obstacle.shape == "sphere":
+        return g.Sphere(s[0])
+    return g.Cylinder(s[1] + (2 * s[0] if obstacle.shape == "capsule" else 0.0), s[0])
+
+
+def _placement(obstacle: Obstacle) -> pin.SE3:
+    """Where meshcat's shape stands: its cylinders run along y, kinelab's (coal's) along z."""
+    if obstacle.shape in ("cylinder", "capsule"):
+        return obstacle.placement * pin.SE3(pin.rpy.rpyToMatrix(np.pi / 2, 0.0, 0.0), np.zeros(3))
+    return obstacle.placement
