@@ -132,3 +132,17 @@ def test_the_closed_form_checks_hold_on_ur5_and_fail_when_a_branch_is_missing(mo
     real = ik.solve_all
     monkeypatch.setattr(ik, "solve_all", lambda *a, **kw: real(*a, **kw)[1:])
     assert not all(r.passed for r in validate.analytic_checks(ur5, 40, 0)[1:])
+
+
+def test_the_collision_checks_hold_on_panda_and_fail_when_the_check_sees_nothing(monkeypatch):
+    import kinelab
+    from kinelab.collision.model import CollisionModel
+
+    panda = kinelab.load("panda")
+    rows = validate.collision_checks(panda, 40, 0)
+    assert [r.name for r in rows] == ["collisions: the check agrees with Pinocchio's distances",
+                                      "collisions: no success collides"]
+    assert all(r.passed for r in rows)
+    assert validate.collision_checks(kinelab.load("stanford"), 40, 0) == []  # no collision geometry: no check
+    monkeypatch.setattr(CollisionModel, "colliding_pair", lambda self, q, first_test=True: None)
+    assert not validate.collision_checks(panda, 40, 0)[0].passed

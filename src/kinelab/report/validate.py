@@ -184,6 +184,48 @@ def analytic_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     return rows
 
 
+FLOOR_AND_TABLE = (("plane", (), (0.0, 0.0, 0.0), "floor"), ("box", (0.6, 0.8, 0.05), (0.5, 0.0, 0.2), "table"))
+
+
+def collision_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+    """Where the robot has collision geometry: the check (sphere, hull and exact tests) agrees with Pinocchio's
+    distance computation on every pair, and no success of a solve with collisions= collides (a floor and a
+    table around it)."""
+    import pinocchio as pin
+
+    from kinelab.collision import CollisionError, Collisions, Environment, Obstacle, collision_model
+    from kinelab.ik import solve
+
+    env = Environment(tuple(Obstacle(s, size, xyz, name=name) for s, size, xyz, name in FLOOR_AND_TABLE))
+    try:
+        model = collision_model(robot, Collisions(environment=env))
+    except CollisionError:
+        return []
+    rng = np.random.default_rng(seed + 6)
+    count = max(20, n)
+    agree = 0
+    for _ in range(count):
+        q = robot.random_q(rng)
+        found = model.colliding_pair(q) is not None
+        pin.forwardKinematics(robot.model, model.data, robot.to_pin_q(q))
+        pin.updateGeometryPlacements(robot.model, model.data, model.geom, model.gdata)
+        pin.computeDistances(model.geom, model.gdata)
+        closest = min(r.min_distance for r in model.gdata.distanceResults)
+        agree += found == (closest <= model.margin)
+    solved = clear = 0
+    for k in range(max(10, n // 4)):
+        q = robot.random_q(rng)
+        if model.colliding_pair(q, first_test=False) is not None:
+            continue
+        res = solve(robot, robot.fk(q), seed=k, collisions=env, time_budget=0.5)
+        solved += res.success
+        clear += res.success and model.contact(res.q, first_test=False) is None
+    return [Check(robot.name, "collisions: the check agrees with Pinocchio's distances", agree / count, 1.0, "%",
+                  f"{count} random configurations, floor and table; {model.summary}", at_least=True),
+            Check(robot.name, "collisions: no success collides", clear / max(solved, 1), 1.0, "%",
+                  f"{solved} targets solved clear of the floor and table", at_least=True)]
+
+
 def seed001_run_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     """Seed 001's run: from the paper's start to its target with K = 1, h = 0.01 s."""
     run = seed001.reproduce(robot, record=True)
@@ -289,7 +331,7 @@ PAPER_CHECKS: dict[str, list[Callable[[Robot, int, int], list[Check]]]] = {
     "youbot": [youbot_checks],
     "era": [era_checks],
 }
-GENERAL_CHECKS = [model_checks, biquaternion_checks, solver_checks, analytic_checks]
+GENERAL_CHECKS = [model_checks, biquaternion_checks, solver_checks, analytic_checks, collision_checks]
 
 
 def run(robots: list[str] | None = None, n: int | None = None, seed: int = 0, progress: bool = False) -> Report:
