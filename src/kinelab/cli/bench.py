@@ -40,6 +40,9 @@ def add(sub: Any) -> None:
     s.add_argument("--branches", action="store_true",
                    help="also every branch of a pose: the closed form against the multistart and EAIK, the batch's "
                         "poses per second (the arms with a closed form, then kinova)")
+    s.add_argument("--collisions", action="store_true",
+                   help="also solve with and without collisions= around a floor and a table (panda, ur5, kinova): "
+                        "time ratio with its spread, clear success, the check's own cost")
     s.add_argument("--out", help="write bench.json, bench.md and bench.png here")
     s.add_argument("--json", action="store_true", help="print the results as JSON instead of tables")
     s.set_defaults(func=run)
@@ -79,6 +82,11 @@ def run(args: argparse.Namespace) -> int:
         from kinelab.report.bench import branches
 
         result["branches"] = branches.run(None, seed=args.seed, repeats=max(args.repeats, 2), progress=not args.json)
+    if args.collisions:
+        from kinelab.report.bench import collisions
+
+        result["collisions"] = collisions.run(None, seed=args.seed, repeats=max(args.repeats, 2),
+                                              progress=not args.json)
     if args.out:
         render.write_bench(result, args.out)
     if args.json:
@@ -114,3 +122,7 @@ def _print_tables(result: dict[str, Any]) -> None:
         from kinelab.report.bench import branches
 
         print(branches.markdown(result["branches"]))
+    if "collisions" in result:
+        from kinelab.report.bench import collisions
+
+        print(collisions.markdown(result["collisions"]))

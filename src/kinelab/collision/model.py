@@ -202,7 +202,10 @@ def collision_model(robot: Robot, collisions: Collisions) -> CollisionModel:
         CollisionError: the robot has no collision geometry (an in-memory model, or a file without
             ``<collision>`` elements).
     """
-    return robot.derived(f"collision model {collisions!r}", lambda r: _build(r, collisions))
+    models: dict[Collisions, CollisionModel] = robot.derived("collision models", lambda r: {})
+    if collisions not in models:
+        models[collisions] = _build(robot, collisions)
+    return models[collisions]
 
 
 def _build(robot: Robot, collisions: Collisions) -> CollisionModel:

@@ -55,13 +55,12 @@ def solve_clear(robot: Robot, target: Any, q0: Any, req: Request, model: Collisi
                         replace(req, seed=seed + runs * STRIDE, time_budget=left))
         runs += 1
         if not res.success:
-            return res if collided is None else collided
-        pair = model.colliding_pair(res.q)
-        if pair is None:
+            return res if collided is None else _collided(collided, t0, runs - 1, model)
+        if model.colliding_pair(res.q) is None:
             return _with(res, t0, runs - 1, None)
-        collided = _collided(res, t0, runs, model, pair)
+        collided = res
     assert collided is not None
-    return collided
+    return _collided(collided, t0, runs, model)
 
 
 def _with(res: IKResult, t0: float, before: int, contact: Any) -> IKResult:
@@ -69,8 +68,9 @@ def _with(res: IKResult, t0: float, before: int, contact: Any) -> IKResult:
                    diagnostics=replace(res.diagnostics, clear_after=before, contact=contact))
 
 
-def _collided(res: IKResult, t0: float, runs: int, model: CollisionModel, pair: int) -> IKResult:
-    contact = model.contact_of(pair)  # the geometry's placements are still those of res.q
+def _collided(res: IKResult, t0: float, runs: int, model: CollisionModel) -> IKResult:
+    """The last colliding answer as the failure, its pair and distance computed now (once)."""
+    contact = model.contact(res.q)
     return replace(_with(res, t0, runs, contact), success=False, status=Status.COLLISION,
                    message=f"the pose is met, but every answer of {runs} run(s) collides; the last: {contact}")
 

@@ -57,7 +57,7 @@ def _eaik(robot: Robot) -> Call | None:
     return call
 
 
-def _rounds(poses: list[pin.SE3], calls: dict[str, Call], repeats: int) -> dict[str, list[float]]:
+def rounds(poses: list[pin.SE3], calls: dict[str, Call], repeats: int) -> dict[str, list[float]]:
     """Per solver, the median time per call [s] of each round; rounds alternate interleaved and blocked."""
     medians: dict[str, list[float]] = {name: [] for name in calls}
     names = list(calls)
@@ -90,7 +90,7 @@ def analytic_arm(robot: Robot, n: int, seed: int, repeats: int) -> dict[str, Any
         calls["EAIK (unchecked)"] = peer
     for name in calls:  # warm-up: compilation
         calls[name](poses[0], 0)
-    medians = _rounds(poses, calls, repeats)
+    medians = rounds(poses, calls, repeats)
     closed = [solve_all(robot, t) for t in poses]
     searched = [solve_all(robot, t, solver="frdm", seed=seed + k) for k, t in enumerate(poses)]
     complete = sum(_complete(robot, s, c, SAME) for s, c in zip(searched, closed, strict=True))
@@ -133,7 +133,7 @@ def numeric_arm(robot: Robot, n: int, seed: int, repeats: int) -> dict[str, Any]
     poses = [robot.fk(robot.random_q(rng)) for _ in range(n)]
     calls: dict[str, Call] = {"multistart": lambda t, s: solve_all(robot, t, seed=s)}
     calls["multistart"](poses[0], 0)
-    medians = _rounds(poses, calls, repeats)
+    medians = rounds(poses, calls, repeats)
     complete = 0
     for k, target in enumerate(poses):
         dense = solve_all(robot, target, seed=10_000 + k, time_budget=0.5, stop_below=None)
