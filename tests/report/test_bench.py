@@ -230,3 +230,15 @@ def test_the_branches_bench_reports_each_arm_and_its_multistart_completeness():
     assert numeric["class"].startswith("none: ") and set(numeric["us"]) == {"multistart"}
     table = branches.markdown(rows)
     assert table.count("\n") == 3 and "| so101 |" in table and "(vs dense)" in table
+
+
+def test_the_collisions_bench_reports_each_arm_with_and_without_the_check():
+    """Behaviour only (the figures belong to the bench): both calls timed on the same clear targets, the ratio,
+    the clear success and the check's cost are reported."""
+    from kinelab.report.bench import collisions
+
+    (row,) = collisions.run(["panda"], n=6, repeats=2)
+    assert row["targets"] == 6 and set(row["us"]) == {"plain", "collisions"} and row["ratio"] > 0
+    assert row["clear_success"] == 1.0 and 0 < row["random_colliding"] < 1 and row["check_clear_us"] > 0
+    table = collisions.markdown([row])
+    assert table.count("\n") == 2 and "| panda | 107 |" in table
