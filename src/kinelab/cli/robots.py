@@ -52,7 +52,7 @@ def run_info(args: argparse.Namespace) -> int:
     info = {"robot": robot.name, "urdf": str(robot.urdf_path), "base": robot.base, "tool": robot.tool,
             "dof": robot.n, "nq": robot.nq, "nv": robot.nv, "joints": [_joint_row(j) for j in robot.joints],
             "locked": robot.locked, "mimics": {name: m.leader for name, m in robot.mimics.items()},
-            "format": robot.source_format}
+            "format": robot.source_format, "collisions": _collision_summary(robot)}
     if args.json:
         print_json(info)
         return 0
@@ -69,4 +69,15 @@ def run_info(args: argparse.Namespace) -> int:
         print(f"mimic: {name} follows {m.leader}")
     if robot.locked:
         print(f"locked: {', '.join(f'{k}={v:g}' for k, v in robot.locked.items())}")
+    print(f"collisions: {info['collisions']}")
     return 0
+
+
+def _collision_summary(robot: Any) -> str:
+    """What a self-collision check of this robot uses, or why it cannot run."""
+    from kinelab.collision import CollisionError, Collisions, collision_model
+
+    try:
+        return collision_model(robot, Collisions()).summary
+    except CollisionError as err:
+        return f"none ({err})"
