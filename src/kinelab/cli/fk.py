@@ -5,37 +5,27 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from kinelab.cli.common import (
-    collision_arguments,
-    collisions_of,
-    json_flag,
-    load_robot,
-    pose_dict,
-    print_json,
-    q_from_cli,
-    robot_arguments,
-    shown,
-)
+from kinelab.cli import common
 
 
 def add(sub: Any) -> None:
     """The ``fk`` subcommand."""
     s = sub.add_parser("fk", help="tool pose at a configuration")
-    robot_arguments(s, "one number per joint (rad and m; deg with --deg)")
-    collision_arguments(s)
-    json_flag(s)
+    common.robot_arguments(s, "one number per joint (rad and m; deg with --deg)")
+    common.collision_arguments(s)
+    common.json_flag(s)
     s.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Print oMtool at q: position, quaternion (w, x, y, z), roll-pitch-yaw and the rotation matrix."""
-    robot = load_robot(args)
-    q = q_from_cli(robot, args.q, args.deg)
+    robot = common.load_robot(args)
+    q = common.q_from_cli(robot, args.q, args.deg)
     outside = [] if args.ignore_limits else robot.outside_limits(q)
     oMtool = robot.fk(q)  # FK is defined at any q: a q outside the limits is computed and said, not refused
-    out = {"robot": robot.name, "base": robot.base, "tool": robot.tool, "q": q.tolist(), **pose_dict(oMtool),
+    out = {"robot": robot.name, "base": robot.base, "tool": robot.tool, "q": q.tolist(), **common.pose_dict(oMtool),
            "outside_limits": outside}
-    spec = collisions_of(args)
+    spec = common.collisions_of(args)
     if spec is not None:
         from dataclasses import asdict
 
@@ -44,15 +34,15 @@ def run(args: argparse.Namespace) -> int:
         contact = collision_model(robot, spec).contact(q)
         out["collision"] = None if contact is None else asdict(contact)
     if args.json:
-        print_json(out)
+        common.print_json(out)
         return 0
     print(f"{robot.name}: pose of {robot.tool!r} in {robot.base!r}")
     for note in outside:
         print(f"  note: {note} (the pose is computed all the same)")
-    print(f"  position [m]   {shown(oMtool.translation)}")
-    print(f"  quat_wxyz      {shown(out['quat_wxyz'])}")
-    print(f"  rpy [rad]      {shown(out['rpy_rad'])}")
-    print("  rotation       " + shown(oMtool.rotation, prefix="  rotation       "))
+    print(f"  position [m]   {common.shown(oMtool.translation)}")
+    print(f"  quat_wxyz      {common.shown(out['quat_wxyz'])}")
+    print(f"  rpy [rad]      {common.shown(out['rpy_rad'])}")
+    print("  rotation       " + common.shown(oMtool.rotation, prefix="  rotation       "))
     if "collision" in out:
         print(f"  collision      {'none' if out['collision'] is None else _said(out['collision'])}")
     return 0
