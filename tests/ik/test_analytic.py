@@ -288,3 +288,35 @@ def test_near_parallel_axes_are_classified_by_the_stated_tolerance_and_never_ans
         assert any(np.max(np.abs(wrapped(s.q - q))) <= 1e-3 for s in found)
         finished += sum(s.diagnostics.polished == 1 for s in found)
     assert finished > 0  # 9e-7 rad off parallel leaves some answers short of 1e-6 rad: they needed the finish
+
+
+def test_solve_with_the_closed_form_returns_the_branch_nearest_the_start():
+    from kinelab.collision import Collisions, Environment, Obstacle, collision_model
+
+    ur10 = load("ur10")
+    rng = np.random.default_rng(16)
+    scene = Environment((Obstacle("plane", name="floor"),))
+    floor = collision_model(ur10, Collisions(environment=scene))
+    for _ in range(30):
+        q = ur10.random_q(rng)
+        start = np.clip(q + rng.normal(0.0, 0.3, 6), ur10.lower, ur10.upper)
+        target = ur10.fk(q)
+        res = kinelab.solve(ur10, target, solver="analytic", q0=start)
+        every = kinelab.solve_all(ur10, target, solver="analytic", q_ref=start)
+        assert res.success and res.solver == "analytic" and np.allclose(res.q, every[0].q)
+        assert max(ur10.tool_error(res.q, target)) <= 1e-6 and res.diagnostics.branches == len(every)
+        clear = kinelab.solve(ur10, target, solver="analytic", q0=start, collisions=scene)
+        marked = kinelab.solve_all(ur10, target, solver="analytic", q_ref=start, collisions=scene)
+        first_clear = next((b for b in marked if b.success), None)
+        if first_clear is None:
+            assert clear.status == kinelab.Status.COLLISION and clear.diagnostics.contact is not None
+        else:
+            assert clear.success and np.allclose(clear.q, first_clear.q)
+            assert floor.contact(clear.q, first_test=False) is None
+    far = kinelab.target_from_xyz_rpy([3.0, 0.0, 0.0], [0.0, 0.0, 0.0])
+    beyond = kinelab.solve(ur10, far, solver="analytic")
+    assert not beyond.success and beyond.status == kinelab.Status.UNREACHABLE and "beyond" in beyond.message
+    with pytest.raises(OptionError, match="panda's is not"):
+        kinelab.solve(load("panda"), far, solver="analytic")
+    with pytest.raises(OptionError, match="the closed form has no settings"):
+        kinelab.solve(ur10, far, solver="analytic", relax=1.3)

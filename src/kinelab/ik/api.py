@@ -22,6 +22,7 @@ import pinocchio as pin
 from kinelab.collision.model import CollisionModel, as_collisions, collision_model
 from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
+from kinelab.ik.analytic.branches import analytic_one
 from kinelab.ik.batch import BatchIKResult, run_batch
 from kinelab.ik.branches import UNSEEN, find_all
 from kinelab.ik.clear import clear_batch, clear_track, mark_colliding, solve_clear
@@ -30,7 +31,7 @@ from kinelab.ik.frdm.tracking import PathSettings, path_options, run_track
 from kinelab.ik.registry import solver_module
 from kinelab.ik.request import Request, make_request
 from kinelab.ik.result import IKResult, TrackResult
-from kinelab.ik.targets import as_target_arrays
+from kinelab.ik.targets import as_target, as_target_arrays
 from kinelab.robot import Robot
 
 # The order of the arguments after (robot, target) in kinelab 0.1's positional signatures: a call that still
@@ -68,7 +69,9 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
         target: oMtarget, the wanted tool pose in the base frame (a point, three numbers [m], for task
             "position").
         positional: nothing: every argument after the target is keyword-only.
-        solver: "frdm", "biquat" or "dls" (the Pinocchio reference).
+        solver: "frdm", "biquat" or "dls" (the Pinocchio reference); or "analytic": the branch nearest ``q0``
+            (without it the first) from the closed form, where the chain has one (docs/analytic.md), refused by
+            name elsewhere.
         q0: first start (one number per joint, rad or m); default a seeded random configuration.
         seed: seed of the random starts, an int ≥ 0 (None: fresh entropy). A solve that does not run out of
             budget returns the same answer for the same seed in any process; one that does depends on speed.
@@ -103,6 +106,10 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
     """
     if positional:
         refuse_positional("solve", positional)
+    if solver == "analytic":
+        return _closed_form_one(robot, target, q0, prefer, collisions, options or solver_options,
+                                make_request("frdm", seed, tol_pos, tol_rot, time_budget, max_restarts,
+                                             start_outside_limits, None, task, axis, None))
     req = make_request(solver, seed, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options,
                        task, axis, solver_options)
     check = _collision_model(robot, collisions)
@@ -122,6 +129,18 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
     left = None if req.time_budget is None else max(req.time_budget - (time.perf_counter() - t0), 1e-4)
     rest = replace(req, time_budget=left)
     return solve_one(robot, target, None, rest) if check is None else solve_clear(robot, target, None, rest, check)
+
+
+def _closed_form_one(robot: Robot, target: Any, q0: Any, prefer: Any, collisions: Any, options: Any,
+                     req: Request) -> IKResult:
+    """``solve(solver="analytic")``: the branch nearest q0 (or ``prefer``), from the closed form."""
+    if options:
+        raise OptionError("options", options, "none with solver='analytic' (the closed form has no settings)")
+    if q0 is not None and prefer is not None:
+        raise OptionError("prefer", "given with q0", "one reference: q0 or prefer, with solver='analytic'")
+    ref = q0 if q0 is not None else prefer
+    return analytic_one(robot, as_target(target, req.task.name), req,
+                        None if ref is None else robot.check_q(ref, what="q0"), _collision_model(robot, collisions))
 
 
 def _collision_model(robot: Robot, collisions: Any) -> CollisionModel | None:

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from kinelab.collision.model import CollisionModel
 from kinelab.errors import OptionError
 from kinelab.geometry import pose_errors, stack_homogeneous
 from kinelab.ik.analytic.classify import ArmClass, classify
@@ -179,3 +180,66 @@ def all_branches_batch(robot: Robot, targets: Any, tol_pos: float = 1e-6, tol_ro
     f, loose = np.zeros_like(found), np.zeros_like(free)
     f[pose[ok], rank], loose[pose[ok], rank] = found[pose[ok], row[ok]], free[pose[ok], row[ok]]
     return BranchBatch(q, kept, f, loose)
+
+
+def analytic_one(robot: Robot, target: Any, req: Request, q0: np.ndarray | None,
+                 model: CollisionModel | None = None) -> IKResult:
+    """The branch nearest ``q0`` (each angle's copy in the limits nearest it; without q0 the first branch) that
+    Pinocchio confirms — and, with a collision ``model``, the nearest that is clear.
+
+    Args:
+        robot: a robot whose chain is in an analytic class.
+        target: oMtarget (``pin.SE3``), already checked.
+        req: the validated request (task "pose").
+        q0: the reference configuration [rad], checked, or None.
+        model: a collision model, or None.
+
+    Returns:
+        The answer (``diagnostics.branches``: the branches the pose has within the limits), or a failure:
+        status ``unreachable`` when no branch meets the pose within the limits, ``collision`` when every branch
+        collides (``diagnostics.contact``: the nearest one's pair).
+
+    Raises:
+        OptionError: the chain is in no analytic class, or the task is not "pose".
+    """
+    t0 = time.perf_counter()
+    arm = arm_of(robot, req)
+    q, found, free = roots(robot, arm, target.homogeneous, q0)
+    order = range(q.shape[0]) if q0 is None else np.argsort(np.abs(np.angle(np.exp(1j * (q - q0)))).max(axis=1))
+    mode, collided = f"analytic ({arm.name})", None
+    for k in order:
+        judged = _judged(robot, q[k], target, req)
+        if judged is None:
+            continue
+        if model is not None and model.colliding_pair(judged[0]) is not None:
+            collided = collided or judged
+            continue
+        answer, dp, dr, finished = judged
+        return IKResult(q=answer, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr,
+                        iterations=0, restarts=0, wall_time=time.perf_counter() - t0, solver="analytic", mode=mode,
+                        message=CONTINUUM if free[k] else "", task=req.task_label,
+                        diagnostics=Diagnostics(path="compiled", branches=q.shape[0], found=int(found[k]),
+                                                polished=1 if finished else None,
+                                                clear_after=None if model is None else 0))
+    contact = None if collided is None or model is None else model.contact(collided[0])
+    return _no_branch(robot, target, req, q0, q.shape[0], (collided, contact), mode, t0)
+
+
+def _no_branch(robot: Robot, target: Any, req: Request, q0: np.ndarray | None, count: int, collided: Any, mode: str,
+               t0: float) -> IKResult:
+    """The failure of :func:`analytic_one`: the nearest colliding branch, or the reference (or zero) when the
+    closed form has no branch within the limits."""
+    if collided[0] is not None:
+        (answer, dp, dr, _), contact = collided
+        return IKResult(q=answer, success=False, status=Status.COLLISION, position_error=dp, rotation_error=dr,
+                        iterations=0, restarts=0, wall_time=time.perf_counter() - t0, solver="analytic", mode=mode,
+                        message=f"the pose is met, but every one of its {count} branch(es) collides; the nearest: "
+                                f"{contact}", task=req.task_label,
+                        diagnostics=Diagnostics(path="compiled", branches=count, contact=contact))
+    q = np.zeros(robot.n) if q0 is None else np.array(q0, dtype=float)
+    dp, dr = robot.tool_error(np.clip(q, robot.lower, robot.upper), target)
+    return IKResult(q=q, success=False, status=Status.UNREACHABLE, position_error=dp, rotation_error=dr,
+                    iterations=0, restarts=0, wall_time=time.perf_counter() - t0, solver="analytic", mode=mode,
+                    message="no branch of the closed form meets the pose within the joint limits: the pose is beyond "
+                            "the arm's reach, or only reached with a joint outside its limits",
+                    task=req.task_label, diagnostics=Diagnostics(path="compiled", branches=0))

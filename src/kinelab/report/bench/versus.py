@@ -20,6 +20,7 @@ import numpy as np
 import pinocchio as pin
 from tqdm import tqdm
 
+from kinelab.ik.analytic.classify import classify
 from kinelab.ik.api import solve
 from kinelab.ik.prepared import IK
 from kinelab.report.bench import peers
@@ -47,12 +48,15 @@ def problems(robot: Robot, n: int, seed: int, start: str, sigma: float) -> list[
 
 
 def solvers(robot: Robot) -> dict[str, Solver]:
-    """The contenders: the prepared call, the plain call and (if installed) ik_LM."""
+    """The contenders: the prepared call, the plain call, the closed form where the arm has one (the branch
+    nearest the start) and (if installed) ik_LM."""
     ik = IK(robot, time_budget=BUDGET)
     out: dict[str, Solver] = {
         "IK.solve": lambda t, q0, seed: ik.solve(t, q0=q0, seed=seed).q,
         "kinelab.solve": lambda t, q0, seed: solve(robot, t, q0=q0, seed=seed, time_budget=BUDGET).q,
     }
+    if classify(robot).arm is not None:
+        out["solve analytic"] = lambda t, q0, seed: solve(robot, t, solver="analytic", q0=q0).q
     try:
         ets = peers.rtb_ets(robot)
     except (ImportError, ValueError, peers.KinelabError):
@@ -100,7 +104,7 @@ def compare(robot: Robot, n: int = 60, seed: int = 0, repeats: int = 4) -> list[
         cases = problems(robot, n, seed, start, sigma)
         result = rounds(robot, cases, contenders, repeats, seed)
         lm = result.get("ik_LM")
-        for name in ("IK.solve", "kinelab.solve"):
+        for name in [c for c in contenders if c != "ik_LM"]:
             med = np.array([np.median(t) for t, _ in result[name]])
             p95 = np.array([np.percentile(t, 95) for t, _ in result[name]])
             row = {"robot": robot.name, "protocol": start + (f" σ={sigma}" if start == "warm" else ""),
