@@ -248,3 +248,33 @@ def test_a_scene_draws_the_obstacles_and_the_links_in_contact():
         assert not {p for p in scene_paths(s.static_html()) if p.startswith("/meshcat/contacts/")}
     finally:
         s.close()
+
+
+def test_a_mesh_obstacle_collides_where_the_same_box_does(tmp_path):
+    """A 0.3 m cube written here as an STL file and the box of the same size and place give the same verdicts;
+    an obstacle file may name a mesh beside it, not outside its folder."""
+    import trimesh
+
+    trimesh.creation.box(extents=(0.3, 0.3, 0.3)).export(tmp_path / "cube.stl")
+    ur5 = kinelab.load("ur5")
+    place = {"xyz": (0.4, 0.1, 0.3), "rpy": (0.0, 0.0, 0.4)}
+    as_box = collision_model(ur5, Collisions(self_collisions=False,
+                                             environment=Environment((Obstacle("box", (0.3, 0.3, 0.3), **place),))))
+    as_mesh = collision_model(ur5, Collisions(self_collisions=False, environment=Environment(
+        (Obstacle("mesh", mesh=str(tmp_path / "cube.stl"), **place),))))
+    rng = np.random.default_rng(17)
+    hits = 0
+    for _ in range(400):
+        q = ur5.random_q(rng)
+        box_hit = as_box.colliding_pair(q, first_test=False) is not None
+        hits += box_hit
+        assert box_hit == (as_mesh.colliding_pair(q) is not None)
+    assert hits > 20
+    scene = tmp_path / "scene.json"
+    scene.write_text(json.dumps({"obstacles": [{"shape": "mesh", "mesh": "cube.stl", "xyz": [0.4, 0.1, 0.3]}]}))
+    assert Environment.from_file(scene).obstacles[0].mesh == str((tmp_path / "cube.stl").resolve())
+    scene.write_text(json.dumps({"obstacles": [{"shape": "mesh", "mesh": "../elsewhere/cube.stl"}]}))
+    with pytest.raises(ObstacleError, match="outside the file's folder"):
+        Environment.from_file(scene)
+    with pytest.raises(ObstacleError, match="names its file"):
+        Obstacle("mesh")

@@ -8,8 +8,11 @@ An :class:`Environment` is a tuple of :class:`Obstacle` built in Python or read 
     ]}
 
 Sizes in metres: a box's full side lengths (x, y, z); a sphere's radius; a cylinder's and a capsule's radius and
-length along their z axis. A plane is the boundary of the solid half-space below it: the points whose height
-along the plane's z axis (its ``rpy`` turned) is below its ``xyz`` are inside the obstacle.
+length along their z axis; a mesh's scale (one number, default 1) with ``mesh`` its file (STL, OBJ, DAE, ...;
+in an obstacle file, a path relative to that file's folder and inside it; a mesh is its surface: a link
+wholly inside a closed mesh that touches none of its triangles is not a contact). A plane is the boundary of the
+solid half-space below it: the points whose height along the plane's z axis (its ``rpy`` turned) is below its
+``xyz`` are inside the obstacle.
 """
 
 from __future__ import annotations
@@ -25,7 +28,7 @@ import pinocchio as pin
 
 from kinelab.errors import KinelabError
 
-SIZES = {"plane": 0, "box": 3, "sphere": 1, "cylinder": 2, "capsule": 2}
+SIZES = {"plane": 0, "box": 3, "sphere": 1, "cylinder": 2, "capsule": 2, "mesh": 1}
 
 
 class ObstacleError(KinelabError):
@@ -37,10 +40,11 @@ class Obstacle:
     """One obstacle, placed in the robot's base frame.
 
     Attributes:
-        shape: "plane", "box", "sphere", "cylinder" or "capsule".
-        size: the shape's dimensions [m] (see the module's docstring); () for a plane.
+        shape: "plane", "box", "sphere", "cylinder", "capsule" or "mesh".
+        size: the shape's dimensions [m] (see the module's docstring); () for a plane; a mesh's scale (default 1).
         xyz: its position [m]; rpy: its orientation (roll, pitch, yaw [rad], Pinocchio's convention).
         name: a name for messages (default: the shape and its index).
+        mesh: a mesh obstacle's file (read when the obstacle is checked).
     """
 
     shape: str
@@ -48,13 +52,18 @@ class Obstacle:
     xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
     rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
     name: str = ""
+    mesh: str = ""
 
     def __post_init__(self) -> None:
         label = self.name or self.shape
         if self.shape not in SIZES:
             raise ObstacleError(f"obstacle {label!r}: unknown shape {self.shape!r}; shapes are {', '.join(SIZES)}")
-        size, xyz, rpy = _numbers(label, "size", self.size), _numbers(label, "xyz", self.xyz), \
-            _numbers(label, "rpy", self.rpy)
+        if (self.shape == "mesh") != bool(self.mesh):
+            raise ObstacleError(f"obstacle {label!r}: a mesh obstacle names its file (mesh=...), and only a mesh does")
+        if self.shape == "mesh" and not Path(self.mesh).is_file():
+            raise ObstacleError(f"obstacle {label!r}: mesh file {self.mesh} not found")
+        size, xyz, rpy = _numbers(label, "size", self.size or ((1.0,) if self.shape == "mesh" else ())), \
+            _numbers(label, "xyz", self.xyz), _numbers(label, "rpy", self.rpy)
         if len(size) != SIZES[self.shape]:
             raise ObstacleError(f"obstacle {label!r}: a {self.shape} takes {SIZES[self.shape]} size number(s) "
                                 f"[m], got {len(size)}")
@@ -81,6 +90,11 @@ class Obstacle:
             return coal.Box(*self.size)
         if self.shape == "sphere":
             return coal.Sphere(self.size[0])
+        if self.shape == "mesh":
+            try:
+                return coal.MeshLoader().load(self.mesh, np.full(3, self.size[0]))
+            except Exception as exc:  # coal's loader raises its own error types for unreadable files
+                raise ObstacleError(f"obstacle {self.name or 'mesh'!r}: cannot read mesh {self.mesh}: {exc}") from None
         return (coal.Cylinder if self.shape == "cylinder" else coal.Capsule)(self.size[0], self.size[1])
 
 
@@ -122,7 +136,21 @@ class Environment:
             raise ObstacleError(f"{path}: an obstacle file is a JSON object with a list 'obstacles'")
         out = []
         for k, row in enumerate(rows):
-            if not isinstance(row, dict) or set(row) - {"shape", "size", "xyz", "rpy", "name"}:
-                raise ObstacleError(f"{path}: obstacle {k} must be an object with keys shape, size, xyz, rpy, name")
+            if not isinstance(row, dict) or set(row) - {"shape", "size", "xyz", "rpy", "name", "mesh"}:
+                raise ObstacleError(f"{path}: obstacle {k} must be an object with keys shape, size, xyz, rpy, name "
+                                    "(and mesh)")
+            if "mesh" in row:
+                row = {**row, "mesh": _inside(path, row["mesh"], k)}
             out.append(Obstacle(**{"name": f"{row.get('shape', '?')} {k}", **row}))
         return cls(tuple(out))
+
+
+def _inside(path: Path, mesh: Any, k: int) -> str:
+    """A mesh path of an obstacle file, resolved against the file's folder; refused outside it (a file is data:
+    it reads nothing beyond what the user pointed at)."""
+    folder = path.resolve().parent
+    found = (folder / str(mesh)).resolve()
+    if not found.is_relative_to(folder):
+        raise ObstacleError(f"{path}: obstacle {k}'s mesh {mesh!r} lies outside the file's folder {folder}; put the "
+                            "mesh beside the obstacle file")
+    return str(found)

@@ -81,6 +81,8 @@ def _shape(obstacle: Obstacle) -> Any:
         return g.Box(list(s))
     if obstacle.shape == "sphere":
         return g.Sphere(s[0])
+    if obstacle.shape == "mesh":
+        return _mesh(obstacle.geometry())
     return g.Cylinder(s[1] + (2 * s[0] if obstacle.shape == "capsule" else 0.0), s[0])
 
 
