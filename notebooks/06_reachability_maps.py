@@ -69,11 +69,12 @@ plt.tight_layout()
 # The same map with the arm standing on a floor beside a table (a 0.6 m × 0.8 m top, 5 cm thick, 0.2 m up and
 # 0.5 m in front), and the arm kept clear of itself: a pose counts only through a branch that collides with
 # nothing (`MapSpec(collisions=...)`, docs/collisions.md). The floor removes everything below the base's
-# height, the table the voxels it occupies and the poses that would reach through it; the difference slice
-# shows where.
+# height, the table the voxels it occupies and the poses that would reach through it: the 3-D view draws the
+# two (grey) with the voxels still reached, and the slice above the table shows where orientations are lost.
 
 # %%
 from kinelab import Collisions, Environment, Obstacle
+from kinelab.view.collisions import draw_obstacles
 
 scene = Environment((Obstacle("plane", name="floor"),
                      Obstacle("box", size=(0.6, 0.8, 0.05), xyz=(0.5, 0.0, 0.2), name="table")))
@@ -81,6 +82,10 @@ walled_map = maps.reachability(ur5, maps.MapSpec(voxel=0.1, orientations=8, coll
 walled = walled_map.array("reachability")
 print(f"with the floor and the table: {(walled > 0).sum()} voxels reached of {(reach > 0).sum()}; "
       f"mean reachability {walled.mean():.3f} against {reach.mean():.3f}")
+walled_cloud = draw_obstacles(view_maps.reachability_cloud(ur5, walled_map, meshes=False), scene)
+walled_cloud.notebook_html()
+
+# %%
 fig, axes = plt.subplots(1, 2, figsize=(10, 4.2))
 view_maps.reachability_slice(ur5_map, value=0.25, ax=axes[0])
 axes[0].set_title("free, layer z ≈ 0.25 m")
@@ -122,3 +127,4 @@ plt.xlabel("platform x [m]"); plt.ylabel("platform y [m]"); plt.legend(fontsize=
 
 # %%
 cloud.close()
+walled_cloud.close()

@@ -8,7 +8,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.collision.model import CollisionModel, Contact
-from kinelab.collision.obstacles import Obstacle
+from kinelab.collision.obstacles import Environment, Obstacle
 
 OBSTACLE_COLOR = 0x9A9A9A
 CONTACT_COLOR = 0xE6194B
@@ -18,24 +18,31 @@ PLANE_SIDE = 4.0  # [m] the square drawn for an (unbounded) plane
 def draw_collisions(scene: Any, model: CollisionModel, q: Any) -> list[Contact]:
     """Draw ``model``'s obstacles in ``scene`` and colour red the robot's visuals on the links in contact at q
     (the robot drawn at q first); returns the contacts, which the caption lists."""
+    scene.show(q)
+    if model.spec is not None and model.spec.environment is not None:
+        draw_obstacles(scene, model.spec.environment)
+    contacts = model.contacts(q)
+    _overlay(scene, model, {n for c in contacts for n in (c.first, c.second)})
+    scene.legend["collisions"] = ("red links: in contact — " + "; ".join(str(c) for c in contacts)) if contacts \
+        else "no contact at this q (margin " + f"{model.margin:g} m)"
+    return contacts
+
+
+def draw_obstacles(scene: Any, environment: Environment) -> Any:
+    """Draw the obstacles (grey, translucent; a plane as a 4 m square) in ``scene``; returns the scene."""
     import meshcat.geometry as g
 
-    scene.show(q)
-    obstacles = model.spec.environment.obstacles if model.spec and model.spec.environment else ()
+    obstacles = environment.obstacles
     for k, obstacle in enumerate(obstacles):
         node = scene.viewer["obstacles"][f"{k}"]
         opacity = 0.25 if obstacle.shape == "plane" else 0.6
         material = g.MeshLambertMaterial(color=OBSTACLE_COLOR, opacity=opacity, transparent=True)
         node.set_object(_shape(obstacle), material)
         node.set_transform(_placement(obstacle).homogeneous)
-    contacts = model.contacts(q)
-    _overlay(scene, model, {n for c in contacts for n in (c.first, c.second)})
     if obstacles:
         named = ", ".join(o.name or o.shape for o in obstacles)
         scene.legend["obstacles"] = f"grey: {len(obstacles)} obstacle(s) ({named})"
-    scene.legend["collisions"] = ("red links: in contact — " + "; ".join(str(c) for c in contacts)) if contacts \
-        else "no contact at this q (margin " + f"{model.margin:g} m)"
-    return contacts
+    return scene
 
 
 def _overlay(scene: Any, model: CollisionModel, names: set[str]) -> None:
