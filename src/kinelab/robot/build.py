@@ -8,13 +8,9 @@ reduced model and its re-rooting at the base frame. The result is a frozen :clas
 
 from __future__ import annotations
 
-import contextlib
 import math
-import os
-import sys
-import tempfile
 import warnings
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -33,7 +29,7 @@ from kinelab.errors import (
 )
 from kinelab.robot import xacro
 from kinelab.robot.joints import Joint, Mimic
-from kinelab.robot.meshes import mesh_package_dirs
+from kinelab.robot.meshes import c_stderr_captured, mesh_package_dirs
 from kinelab.robot.mjcf import body_tree, is_mjcf, read_mjcf
 from kinelab.robot.srdf import Srdf, read_srdf
 from kinelab.robot.urdf import UrdfTree, read_tree
@@ -347,7 +343,7 @@ def _narrowed(leader: str, lo: float, hi: float, mimics: Iterable[Mimic]) -> tup
 def _build_full_model(path: Path, mimic: bool = False) -> pin.Model:
     said: list[str] = []
     try:
-        with _c_stderr_captured(said):  # urdfdom prints its complaints on the process's stderr
+        with c_stderr_captured(said):  # urdfdom prints its complaints on the process's stderr
             model = pin.buildModelFromUrdf(str(path), mimic=mimic)
     except (RuntimeError, ValueError, UnicodeDecodeError) as exc:
         detail = " ".join([str(exc), *said]).strip()
@@ -355,22 +351,6 @@ def _build_full_model(path: Path, mimic: bool = False) -> pin.Model:
     if said:
         warnings.warn(f"Pinocchio's URDF parser on {path.name}: {' '.join(said)}", stacklevel=3)
     return model
-
-
-@contextlib.contextmanager
-def _c_stderr_captured(said: list[str]) -> Iterator[None]:
-    """File descriptor 2 redirected to a temporary file for the block; its lines appended to ``said``."""
-    sys.stderr.flush()
-    saved = os.dup(2)
-    with tempfile.TemporaryFile(mode="w+b") as sink:
-        os.dup2(sink.fileno(), 2)
-        try:
-            yield
-        finally:
-            os.dup2(saved, 2)
-            os.close(saved)
-            sink.seek(0)
-            said.extend(line.strip() for line in sink.read().decode("utf-8", "replace").splitlines() if line.strip())
 
 
 def frame_id(model: pin.Model, name: str, robot: str) -> int:

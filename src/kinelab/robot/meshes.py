@@ -6,10 +6,13 @@ dropped with a warning (the robot still loads and still draws its primitive shap
 
 from __future__ import annotations
 
+import contextlib
 import os
+import sys
 import tempfile
 import warnings
 import xml.etree.ElementTree as ET
+from collections.abc import Iterator
 from pathlib import Path
 
 import pinocchio as pin
@@ -131,6 +134,28 @@ def build_visual_model(
                       f"{', '.join(dirs) or 'no package directory'}); those {kind} elements are left out: pass "
                       "package_dirs= (CLI --package-dir) or set ROS_PACKAGE_PATH", stacklevel=2)
     geometry_type = pin.GeometryType.COLLISION if kind == "collision" else pin.GeometryType.VISUAL
+    said: list[str] = []
     with tempfile.TemporaryDirectory(prefix="kinelab-") as folder:  # Pinocchio reads it once, here
         resolved = _with_resolved_meshes(urdf_path, dirs, Path(folder), kind)
-        return pin.buildGeomFromUrdf(model, str(resolved), geometry_type, package_dirs=dirs)
+        with c_stderr_captured(said):  # urdfdom prints its complaints on the process's stderr
+            geom = pin.buildGeomFromUrdf(model, str(resolved), geometry_type, package_dirs=dirs)
+    if said:
+        warnings.warn(f"Pinocchio's URDF parser on {urdf_path.name} ({kind} geometry): {' '.join(said)}",
+                      stacklevel=2)
+    return geom
+
+
+@contextlib.contextmanager
+def c_stderr_captured(said: list[str]) -> Iterator[None]:
+    """File descriptor 2 redirected to a temporary file for the block; its lines appended to ``said``."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile(mode="w+b") as sink:
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            sink.seek(0)
+            said.extend(line.strip() for line in sink.read().decode("utf-8", "replace").splitlines() if line.strip())
