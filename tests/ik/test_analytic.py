@@ -320,3 +320,25 @@ def test_solve_with_the_closed_form_returns_the_branch_nearest_the_start():
         kinelab.solve(load("panda"), far, solver="analytic")
     with pytest.raises(OptionError, match="the closed form has no settings"):
         kinelab.solve(ur10, far, solver="analytic", relax=1.3)
+
+
+def test_the_prepared_closed_form_gives_what_the_plain_calls_give():
+    ur5 = load("ur5")
+    ik = kinelab.IK(ur5, solver="analytic")
+    rng = np.random.default_rng(18)
+    Q = np.array([ur5.random_q(rng) for _ in range(12)])
+    starts = np.clip(Q + rng.normal(0.0, 0.2, Q.shape), ur5.lower, ur5.upper)
+    H = ur5.fk_batch(Q)
+    batch = ik.solve_batch(H, q0=starts)
+    for b in range(len(Q)):
+        target = ur5.fk(Q[b])
+        one = ik.solve(target, q0=starts[b])
+        plain = kinelab.solve(ur5, target, solver="analytic", q0=starts[b])
+        assert one.success and np.array_equal(one.q, plain.q) and np.array_equal(batch.q[b], one.q)
+        assert [s.q.tolist() for s in ik.solve_all(target)] == \
+            [s.q.tolist() for s in kinelab.solve_all(ur5, target, solver="analytic")]
+    assert batch.success.all() and batch.solver == "analytic"
+    with pytest.raises(OptionError, match="panda's is not"):
+        kinelab.IK(load("panda"), solver="analytic")
+    with pytest.raises(OptionError, match="none with solver='analytic'"):
+        kinelab.IK(ur5, solver="analytic", relax=1.2)

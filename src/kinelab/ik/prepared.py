@@ -15,8 +15,13 @@ import time
 from dataclasses import replace
 from typing import Any
 
+import numpy as np
+import pinocchio as pin
+
 from kinelab.collision.model import as_collisions, collision_model
+from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
+from kinelab.ik.analytic.branches import analytic_one, arm_of
 from kinelab.ik.batch import BatchIKResult, run_batch
 from kinelab.ik.branches import UNSEEN, find_all
 from kinelab.ik.clear import clear_batch, mark_colliding, solve_clear
@@ -24,7 +29,7 @@ from kinelab.ik.driver import prepare_checks, solve_one
 from kinelab.ik.lean import LeanFRDM
 from kinelab.ik.request import Request, check_seed, make_request
 from kinelab.ik.result import IKResult
-from kinelab.ik.targets import as_target_arrays
+from kinelab.ik.targets import as_target, as_target_arrays
 from kinelab.robot import Robot
 
 
@@ -34,7 +39,8 @@ class IK:
     Args:
         robot: the robot.
         positional: nothing: every setting is keyword-only.
-        solver: "frdm", "biquat" or "dls".
+        solver: "frdm", "biquat" or "dls"; or "analytic" (the closed form, docs/analytic.md: ``solve`` returns the
+            branch nearest ``q0``, ``solve_all`` every branch; refused here, by name, for a chain without one).
         tol_pos: position tolerance [m].
         tol_rot: rotation tolerance [rad].
         time_budget: wall-clock budget of each call [s] (None: none).
@@ -61,14 +67,22 @@ class IK:
             raise TypeError("IK() takes the robot positionally and every setting by keyword: pass "
                             f"solver={positional[0]!r}")
         self.robot = robot
-        self.request: Request = make_request(solver, None, tol_pos, tol_rot, time_budget, max_restarts,
-                                             start_outside_limits, options, task, axis, solver_options)
-        prepare = getattr(self.request.module, "prepare", None)
-        if prepare is not None:
-            prepare(robot, self.request.options)  # compile (or load) the kernels now, not in the first call
+        self.analytic = solver == "analytic"
+        if self.analytic and (options is not None or solver_options):
+            raise OptionError("options", options or solver_options, "none with solver='analytic'")
+        self.request: Request = make_request("frdm" if self.analytic else solver, None, tol_pos, tol_rot,
+                                             time_budget, max_restarts, start_outside_limits, options, task, axis,
+                                             solver_options)
+        if self.analytic:
+            arm_of(robot, self.request)  # a chain without a closed form is refused here, by name
+        else:
+            prepare = getattr(self.request.module, "prepare", None)
+            if prepare is not None:
+                prepare(robot, self.request.options)  # compile (or load) the kernels now, not in the first call
         prepare_checks(robot)
         req = self.request
-        self._lean = LeanFRDM(robot, req) if req.solver == "frdm" and req.options.compiled else None
+        self._lean = LeanFRDM(robot, req) if not self.analytic and req.solver == "frdm" and req.options.compiled \
+            else None
         spec = as_collisions(collisions)
         self.collisions = None if spec is None else collision_model(robot, spec)
 
@@ -92,6 +106,9 @@ class IK:
         Raises:
             TargetError, ConfigurationError, JointLimitError, OptionError: a bad target, start or seed.
         """
+        if self.analytic:
+            return analytic_one(self.robot, as_target(target, self.request.task.name), self.request,
+                                None if q0 is None else self.robot.check_q(q0, what="q0"), self.collisions)
         if self.collisions is not None:
             return solve_clear(self.robot, target, q0, self._request(seed), self.collisions)
         if self._lean is not None:
@@ -116,6 +133,8 @@ class IK:
         """
         req = replace(self._request(seed), start_outside_limits="refuse")
         t0 = time.perf_counter()
+        if self.analytic:
+            return self._closed_form_batch(targets, q0, t0)
         res = run_batch(self.robot, targets, q0, req)
         if self.collisions is None:
             return res
@@ -139,5 +158,20 @@ class IK:
             TargetError, ConfigurationError, OptionError: named.
         """
         found = find_all(self.robot, target, replace(self._request(seed), max_restarts=0), q_ref=q_ref,
-                         max_solutions=max_solutions, stop_below=stop_below)
+                         max_solutions=max_solutions, stop_below=stop_below,
+                         method="analytic" if self.analytic else "multistart")
         return found if self.collisions is None else mark_colliding(found, self.collisions, drop=False)
+
+    def _closed_form_batch(self, targets: Any, q0: Any, t0: float) -> BatchIKResult:
+        """Every row by :meth:`solve` (the branch nearest its start; q0: None, one start, or (B, n) starts)."""
+        H = stack_homogeneous(*as_target_arrays(targets))
+        starts = None if q0 is None else np.broadcast_to(self.robot.check_qs(np.atleast_2d(q0)), (len(H), self.robot.n))
+        rows = [self.solve(pin.SE3(H[b, :3, :3], H[b, :3, 3]), q0=None if starts is None else starts[b])
+                for b in range(len(H))]
+        return BatchIKResult(q=np.array([r.q for r in rows]), success=np.array([r.success for r in rows]),
+                             status=np.array([r.status.value for r in rows]),
+                             position_error=np.array([r.position_error for r in rows]),
+                             rotation_error=np.array([r.rotation_error for r in rows]),
+                             iterations=np.zeros(len(rows), dtype=int), restarts=np.zeros(len(rows), dtype=int),
+                             seed=0, wall_time=time.perf_counter() - t0, solver="analytic",
+                             mode=rows[0].mode if rows else "analytic")
