@@ -330,6 +330,8 @@ def test_the_prepared_closed_form_gives_what_the_plain_calls_give():
     starts = np.clip(Q + rng.normal(0.0, 0.2, Q.shape), ur5.lower, ur5.upper)
     H = ur5.fk_batch(Q)
     batch = ik.solve_batch(H, q0=starts)
+    plain_batch = kinelab.solve_batch(ur5, H, solver="analytic", q0=starts)
+    assert np.array_equal(plain_batch.q, batch.q) and plain_batch.solver == "analytic"
     for b in range(len(Q)):
         target = ur5.fk(Q[b])
         one = ik.solve(target, q0=starts[b])

@@ -22,7 +22,7 @@ import pinocchio as pin
 from kinelab.collision.model import CollisionModel, as_collisions, collision_model
 from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
-from kinelab.ik.analytic.branches import analytic_one
+from kinelab.ik.analytic.branches import analytic_one, nearest_batch
 from kinelab.ik.batch import BatchIKResult, run_batch
 from kinelab.ik.branches import UNSEEN, find_all
 from kinelab.ik.clear import clear_batch, clear_track, mark_colliding, solve_clear
@@ -164,7 +164,7 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
         robot: the robot.
         targets: a sequence of ``pin.SE3`` or an (B, 4, 4) array of homogeneous matrices (oMtarget).
         positional: nothing: every argument after the targets is keyword-only.
-        solver: as :func:`solve`.
+        solver: as :func:`solve` ("analytic": each row the closed form's branch nearest its start).
         seed: the base seed: row b uses seed + b; None draws one, reported in the result.
         tol_pos: position tolerance [m].
         tol_rot: rotation tolerance [rad].
@@ -191,6 +191,12 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
     """
     if positional:
         refuse_positional("solve_batch", positional)
+    if solver == "analytic":
+        if options is not None or solver_options:
+            raise OptionError("options", options or solver_options, "none with solver='analytic'")
+        return nearest_batch(robot, targets, q0, make_request("frdm", seed, tol_pos, tol_rot, time_budget,
+                                                              max_restarts, start_outside_limits, None, task, axis,
+                                                              None), _collision_model(robot, collisions))
     req = make_request(solver, seed, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options,
                        task, axis, solver_options)
     check = _collision_model(robot, collisions)

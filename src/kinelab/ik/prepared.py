@@ -15,13 +15,10 @@ import time
 from dataclasses import replace
 from typing import Any
 
-import numpy as np
-import pinocchio as pin
-
 from kinelab.collision.model import as_collisions, collision_model
 from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
-from kinelab.ik.analytic.branches import analytic_one, arm_of
+from kinelab.ik.analytic.branches import analytic_one, arm_of, nearest_batch
 from kinelab.ik.batch import BatchIKResult, run_batch
 from kinelab.ik.branches import UNSEEN, find_all
 from kinelab.ik.clear import clear_batch, mark_colliding, solve_clear
@@ -134,7 +131,7 @@ class IK:
         req = replace(self._request(seed), start_outside_limits="refuse")
         t0 = time.perf_counter()
         if self.analytic:
-            return self._closed_form_batch(targets, q0, t0)
+            return nearest_batch(self.robot, targets, q0, self.request, self.collisions)
         res = run_batch(self.robot, targets, q0, req)
         if self.collisions is None:
             return res
@@ -161,17 +158,3 @@ class IK:
                          max_solutions=max_solutions, stop_below=stop_below,
                          method="analytic" if self.analytic else "multistart")
         return found if self.collisions is None else mark_colliding(found, self.collisions, drop=False)
-
-    def _closed_form_batch(self, targets: Any, q0: Any, t0: float) -> BatchIKResult:
-        """Every row by :meth:`solve` (the branch nearest its start; q0: None, one start, or (B, n) starts)."""
-        H = stack_homogeneous(*as_target_arrays(targets))
-        starts = None if q0 is None else np.broadcast_to(self.robot.check_qs(np.atleast_2d(q0)), (len(H), self.robot.n))
-        rows = [self.solve(pin.SE3(H[b, :3, :3], H[b, :3, 3]), q0=None if starts is None else starts[b])
-                for b in range(len(H))]
-        return BatchIKResult(q=np.array([r.q for r in rows]), success=np.array([r.success for r in rows]),
-                             status=np.array([r.status.value for r in rows]),
-                             position_error=np.array([r.position_error for r in rows]),
-                             rotation_error=np.array([r.rotation_error for r in rows]),
-                             iterations=np.zeros(len(rows), dtype=int), restarts=np.zeros(len(rows), dtype=int),
-                             seed=0, wall_time=time.perf_counter() - t0, solver="analytic",
-                             mode=rows[0].mode if rows else "analytic")

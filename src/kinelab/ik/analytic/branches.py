@@ -15,12 +15,14 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+import pinocchio as pin
 
 from kinelab.collision.model import CollisionModel
 from kinelab.errors import OptionError
 from kinelab.geometry import pose_errors, stack_homogeneous
 from kinelab.ik.analytic.classify import ArmClass, classify
 from kinelab.ik.analytic.kernel import MAX_ROWS, branches, branches_batch
+from kinelab.ik.batch import BatchIKResult
 from kinelab.ik.compiling import announce
 from kinelab.ik.driver import solve_one
 from kinelab.ik.limits import distance
@@ -243,3 +245,24 @@ def _no_branch(robot: Robot, target: Any, req: Request, q0: np.ndarray | None, c
                     message="no branch of the closed form meets the pose within the joint limits: the pose is beyond "
                             "the arm's reach, or only reached with a joint outside its limits",
                     task=req.task_label, diagnostics=Diagnostics(path="compiled", branches=0))
+
+
+def nearest_batch(robot: Robot, targets: Any, q0: Any, req: Request, model: CollisionModel | None) -> BatchIKResult:
+    """:func:`analytic_one` for every target of a batch (q0: None, one start for every row, or (B, n) starts).
+
+    Raises:
+        TargetError, ConfigurationError: a bad target or start, its index named.
+        OptionError: the chain is in no analytic class, or the task is not "pose".
+    """
+    t0 = time.perf_counter()
+    H = stack_homogeneous(*as_target_arrays(targets))
+    starts = None if q0 is None else np.broadcast_to(robot.check_qs(np.atleast_2d(q0), what="q0"), (len(H), robot.n))
+    rows = [analytic_one(robot, pin.SE3(H[b, :3, :3], H[b, :3, 3]), req, None if starts is None else starts[b], model)
+            for b in range(len(H))]
+    return BatchIKResult(q=np.array([r.q for r in rows]), success=np.array([r.success for r in rows]),
+                         status=np.array([r.status.value for r in rows]),
+                         position_error=np.array([r.position_error for r in rows]),
+                         rotation_error=np.array([r.rotation_error for r in rows]),
+                         iterations=np.zeros(len(rows), dtype=int), restarts=np.zeros(len(rows), dtype=int),
+                         seed=0, wall_time=time.perf_counter() - t0, solver="analytic",
+                         mode=rows[0].mode if rows else "analytic")
