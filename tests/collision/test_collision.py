@@ -278,3 +278,17 @@ def test_a_mesh_obstacle_collides_where_the_same_box_does(tmp_path):
         Environment.from_file(scene)
     with pytest.raises(ObstacleError, match="names its file"):
         Obstacle("mesh")
+
+
+def test_the_map_command_counts_only_clear_answers_with_an_obstacle_file(tmp_path, capsys):
+    from kinelab import cli
+
+    scene = tmp_path / "scene.json"
+    scene.write_text(json.dumps({"obstacles": [{"shape": "plane", "name": "floor"}]}))
+    argv = ["map", "reach", "ur5", "--voxel", "0.3", "--orientations", "4", "--json"]
+    assert cli.main(argv) == 0
+    free = json.loads(capsys.readouterr().out)
+    assert cli.main([*argv, "--obstacles", str(scene)]) == 0
+    walled = json.loads(capsys.readouterr().out)
+    assert walled["voxels"] == free["voxels"] and walled["reached_voxels"] < free["reached_voxels"]
+    assert walled["mean_reachability"] < free["mean_reachability"]

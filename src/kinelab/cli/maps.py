@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from kinelab.cli import common
 from kinelab.cli.common import Interrupted, Parser, load_robot, plural, print_json, seed_argument, source_arguments
 from kinelab.errors import KinelabError
 
@@ -41,6 +42,7 @@ def _add_reach(kinds: Any) -> None:
     r.add_argument("--method", choices=("auto", "numeric"), default="auto",
                    help="auto: every branch in closed form where the arm has one (task pose), else the numeric batch; "
                         "numeric: the numeric batch everywhere (default auto)")
+    common.collision_arguments(r)
     r.add_argument("--chunk", type=int, default=64, help="voxels per chunk, the unit of work and storage (default 64)")
     r.add_argument("--out", help="a Zarr directory: written chunk by chunk, resumed if it holds this map unfinished")
     r.add_argument("--force", action="store_true", help="run a map of more than 2 million targets")
@@ -132,7 +134,8 @@ def run_reach(args: argparse.Namespace) -> int:
 
     robot = load_robot(args)
     spec = maps.MapSpec(voxel=args.voxel, orientations=args.orientations, task=args.task, restarts=args.restarts,
-                        seed=args.seed, chunk_voxels=args.chunk, method=args.method)
+                        seed=args.seed, chunk_voxels=args.chunk, method=args.method,
+                        collisions=common.collisions_of(args))
     if args.scheduler and args.workers:
         raise KinelabError("give --scheduler ADDRESS or --workers N, not both")
     if args.workers is not None and args.workers < 1:
