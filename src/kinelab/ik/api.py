@@ -22,7 +22,7 @@ import pinocchio as pin
 from kinelab.collision.model import CollisionModel, as_collisions, collision_model
 from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
-from kinelab.ik.analytic.branches import analytic_one, nearest_batch
+from kinelab.ik.analytic.branches import analytic_one, nearest_batch, refuse_options
 from kinelab.ik.batch import BatchIKResult, run_batch
 from kinelab.ik.branches import UNSEEN, find_all
 from kinelab.ik.clear import clear_batch, clear_track, mark_colliding, solve_clear
@@ -84,12 +84,10 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
         task: "pose" (all), "position", "axis" (the tool point and tool axis ``axis``, roll free) or
             "orientation" (:mod:`kinelab.ik.tasks`); the biquaternion solver takes "pose" only.
         axis: the tool axis of task "axis": "x", "y" or "z".
-        prefer: a reference configuration (rad or m): return the branch nearest it (revolute joints compared
-            modulo 2π, each angle's copy in the limits nearest it) among every branch — in closed form where
-            the chain has one, the task is "pose" and FRDM runs without options (the result's ``solver`` is
-            then "analytic"), else those :func:`solve_all`'s multistart finds within ``time_budget`` (solvers
-            "frdm" and "dls"); None (default): the first answer found. ``q0`` and ``max_restarts`` do not
-            apply to it (given with ``prefer``, they are refused).
+        prefer: a reference configuration (rad or m): the branch nearest it (modulo 2π) among :func:`solve_all`'s
+            — in closed form where the chain has one and FRDM runs without options (``solver`` "analytic"),
+            else the multistart's within ``time_budget``; None (default): the first answer found. ``q0`` is
+            refused with it.
         collisions: None (no check), "self", a :class:`kinelab.Environment` (itself and the obstacles) or a
             :class:`kinelab.Collisions` (with a margin [m]): a colliding answer is never a success; the solve
             runs again from new starts within ``time_budget`` (:mod:`kinelab.ik.clear`) and fails with status
@@ -107,19 +105,30 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
     if positional:
         refuse_positional("solve", positional)
     if solver == "analytic":
-        return _closed_form_one(robot, target, q0, prefer, collisions, options or solver_options,
-                                make_request("frdm", seed, tol_pos, tol_rot, time_budget, max_restarts,
-                                             start_outside_limits, None, task, axis, None))
+        req = make_request("frdm", seed, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, None,
+                           task, axis, None)
+        return _closed_form_one(robot, target, q0, prefer, collisions, options or solver_options, req)
     req = make_request(solver, seed, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options,
                        task, axis, solver_options)
     check = _collision_model(robot, collisions)
     if prefer is None:
-        return solve_one(robot, target, q0, req) if check is None else solve_clear(robot, target, q0, req, check)
+        return _one_answer(robot, target, q0, req, check)
     if q0 is not None:
         raise OptionError("q0", "given", "None with prefer= (the branch search draws its own starts)")
-    t0 = time.perf_counter()
     closed = solver == "frdm" and options is None and not solver_options
-    found = find_all(robot, target, req, q_ref=prefer, method="auto" if closed else "multistart")
+    return _preferred(robot, target, req, prefer, check, "auto" if closed else "multistart")
+
+
+def _one_answer(robot: Robot, target: Any, q0: Any, req: Request, check: CollisionModel | None) -> IKResult:
+    """One solve through the driver, clear of collisions when ``check`` is given."""
+    return solve_one(robot, target, q0, req) if check is None else solve_clear(robot, target, q0, req, check)
+
+
+def _preferred(robot: Robot, target: Any, req: Request, prefer: Any, check: CollisionModel | None,
+               method: str) -> IKResult:
+    """``solve(prefer=)``: the (clear) branch nearest ``prefer`` among every branch found."""
+    t0 = time.perf_counter()
+    found = find_all(robot, target, req, q_ref=prefer, method=method)
     if check is not None:
         found = mark_colliding(found, check, drop=True)
     if found:
@@ -127,15 +136,13 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
     # no (clear) branch met the tolerances: the best single answer, in what is left of the same budget (at
     # least one attempt's worth, so that there is an answer to return)
     left = None if req.time_budget is None else max(req.time_budget - (time.perf_counter() - t0), 1e-4)
-    rest = replace(req, time_budget=left)
-    return solve_one(robot, target, None, rest) if check is None else solve_clear(robot, target, None, rest, check)
+    return _one_answer(robot, target, None, replace(req, time_budget=left), check)
 
 
 def _closed_form_one(robot: Robot, target: Any, q0: Any, prefer: Any, collisions: Any, options: Any,
                      req: Request) -> IKResult:
     """``solve(solver="analytic")``: the branch nearest q0 (or ``prefer``), from the closed form."""
-    if options:
-        raise OptionError("options", options, "none with solver='analytic' (the closed form has no settings)")
+    refuse_options(options)
     if q0 is not None and prefer is not None:
         raise OptionError("prefer", "given with q0", "one reference: q0 or prefer, with solver='analytic'")
     ref = q0 if q0 is not None else prefer
@@ -192,8 +199,7 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
     if positional:
         refuse_positional("solve_batch", positional)
     if solver == "analytic":
-        if options is not None or solver_options:
-            raise OptionError("options", options or solver_options, "none with solver='analytic'")
+        refuse_options(options or solver_options)
         return nearest_batch(robot, targets, q0, make_request("frdm", seed, tol_pos, tol_rot, time_budget,
                                                               max_restarts, start_outside_limits, None, task, axis,
                                                               None), _collision_model(robot, collisions))
@@ -253,8 +259,8 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
         refuse_positional("solve_all", positional)
     method = solver if solver in ("auto", "analytic") else "multistart"
     if method != "multistart" and (options is not None or solver_options):
-        if method == "analytic":  # the closed form has no options: refusing says so rather than ignoring them
-            raise OptionError("options", options or solver_options, "none with solver='analytic'")
+        if method == "analytic":  # refusing says so rather than ignoring them
+            refuse_options(options or solver_options)
         method = "multistart"  # options name a multistart solver's settings: "auto" runs FRDM with them
     req = make_request("frdm" if method != "multistart" else solver, seed, tol_pos, tol_rot, time_budget, 0,
                        "refuse", options, task, axis, solver_options)

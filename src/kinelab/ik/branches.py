@@ -83,10 +83,27 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
     ref = None if q_ref is None else robot.check_q(q_ref, what="q_ref")
     if method == "analytic" or (method == "auto" and has_closed_form(robot, req)):
         return analytic_all(robot, target, req, q_ref=ref, max_solutions=max_solutions)
+    t0 = time.perf_counter()
+    found, rounds = _search(robot, target, req, max_solutions, stop_below, t0)
+    elapsed = time.perf_counter() - t0
+    if ref is not None:
+        found.sort(key=lambda f: distance(robot, f[0], ref))
+    missing = unseen([f[3] for f in found])
+    return [IKResult(q=q, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr, iterations=0,
+                     restarts=rounds * ROUND - 1, wall_time=elapsed, solver=req.solver,
+                     mode=f"{req.solver} (all branches, multistart)",
+                     diagnostics=Diagnostics(found=count, starts=rounds * ROUND, unseen=missing), task=req.task_label)
+            for q, dp, dr, count in found[:max_solutions]]
+
+
+def _search(robot: Robot, target: Any, req: Request, max_solutions: int | None, stop_below: float | None,
+            t0: float) -> tuple[list[tuple[np.ndarray, float, float, int]], int]:
+    """Rounds of ROUND seeded starts until the budget (counted from t0), ``max_solutions`` or the stopping rule
+    ends them: the distinct solutions (q, position error, rotation error, starts that reached it) and the rounds
+    run."""
     seed = fresh_seed() if req.seed is None else req.seed
     budget = 0.05 if req.time_budget is None else req.time_budget
     found: list[tuple[np.ndarray, float, float, int]] = []
-    t0 = time.perf_counter()
     rounds = 0
     # a round costs about ROUND_SECONDS of set-up and verdict whatever its budget: none starts in less
     while (left := budget - (time.perf_counter() - t0)) > ROUND_SECONDS and \
@@ -98,15 +115,7 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
         for b in np.flatnonzero(batch.success):
             _merge(robot, found, batch.q[b], batch.position_error[b], batch.rotation_error[b])
         rounds += 1
-    elapsed = time.perf_counter() - t0
-    if ref is not None:
-        found.sort(key=lambda f: distance(robot, f[0], ref))
-    missing = unseen([f[3] for f in found])
-    return [IKResult(q=q, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr, iterations=0,
-                     restarts=rounds * ROUND - 1, wall_time=elapsed, solver=req.solver,
-                     mode=f"{req.solver} (all branches, multistart)",
-                     diagnostics=Diagnostics(found=count, starts=rounds * ROUND, unseen=missing), task=req.task_label)
-            for q, dp, dr, count in found[:max_solutions]]
+    return found, rounds
 
 
 def _merge(robot: Robot, found: list[tuple[np.ndarray, float, float, int]], q: np.ndarray, dp: float,
