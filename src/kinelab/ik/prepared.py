@@ -16,9 +16,8 @@ from dataclasses import replace
 from typing import Any
 
 from kinelab.collision.model import as_collisions, collision_model
-from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
-from kinelab.ik.analytic.branches import analytic_one, arm_of, nearest_batch
+from kinelab.ik.analytic.branches import analytic_one, arm_of, nearest_batch, refuse_options
 from kinelab.ik.batch import BatchIKResult, run_batch
 from kinelab.ik.branches import UNSEEN, find_all
 from kinelab.ik.clear import clear_batch, mark_colliding, solve_clear
@@ -65,8 +64,8 @@ class IK:
                             f"solver={positional[0]!r}")
         self.robot = robot
         self.analytic = solver == "analytic"
-        if self.analytic and (options is not None or solver_options):
-            raise OptionError("options", options or solver_options, "none with solver='analytic'")
+        if self.analytic:
+            refuse_options(options or solver_options)
         self.request: Request = make_request("frdm" if self.analytic else solver, None, tol_pos, tol_rot,
                                              time_budget, max_restarts, start_outside_limits, options, task, axis,
                                              solver_options)

@@ -18,6 +18,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.collision.model import CollisionModel
+from kinelab.dispatch import TypedKernel
 from kinelab.errors import OptionError
 from kinelab.geometry import pose_errors, stack_homogeneous
 from kinelab.ik.analytic.classify import ArmClass, classify
@@ -26,7 +27,6 @@ from kinelab.ik.batch import BatchIKResult
 from kinelab.ik.compiling import announce
 from kinelab.ik.driver import solve_one
 from kinelab.ik.limits import distance
-from kinelab.ik.multistart import TypedKernel
 from kinelab.ik.request import Request, make_request
 from kinelab.ik.result import Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target_arrays
@@ -53,6 +53,16 @@ def arm_of(robot: Robot, req: Request) -> ArmClass:
     if req.task.name != "pose":
         raise OptionError("task", req.task_label, "'pose' with solver='analytic' (other tasks: solver='frdm')")
     return found.arm
+
+
+def refuse_options(options: Any) -> None:
+    """The closed form has no settings: options given with solver="analytic" are refused by name.
+
+    Raises:
+        OptionError: ``options`` (an options object or option keywords) is not empty.
+    """
+    if options:
+        raise OptionError("options", options, "none with solver='analytic' (the closed form has no settings)")
 
 
 def has_closed_form(robot: Robot, req: Request) -> bool:
