@@ -170,22 +170,14 @@ class CollisionModel:
         return None
 
     def candidates(self, q: np.ndarray) -> np.ndarray:
-        """The pairs whose spheres the first test cannot separate at q (checked n floats)."""
+        """The pairs whose spheres the first test cannot separate at q (checked n floats); every pair when the
+        compiled test cannot read the chain's joints (:func:`_frames`)."""
         f = self.frames
-        if f is not None:
-            count = _SPHERES(q, f.parents, f.place_R, f.place_t, f.axis, f.kind, f.q_index, self.joints,
-                                      self.centres, self.radii, self.normals, self.pairs, self.margin, self._found)
-            return self._found[:count]
-        pin.forwardKinematics(self.robot.model, self.data, self.robot.to_pin_q(q))
-        R = np.array([m.rotation for m in self.data.oMi])
-        t = np.array([m.translation for m in self.data.oMi])
-        world = np.einsum("gij,gj->gi", R[self.joints], self.centres) + t[self.joints]
-        a, b = self.pairs[:, 0], self.pairs[:, 1]
-        gap = np.linalg.norm(world[a] - world[b], axis=1) - self.radii[a] - self.radii[b]
-        plane = self.radii[b] == PLANE
-        gap[plane] = np.einsum("pi,pi->p", world[a[plane]] - world[b[plane]], self.normals[b[plane]]) \
-            - self.radii[a[plane]]
-        return np.flatnonzero(gap <= self.margin)
+        if f is None:  # a mimic follower in the chain: no sphere test, the hulls take every pair
+            return np.arange(len(self.pairs))
+        count = _SPHERES(q, f.parents, f.place_R, f.place_t, f.axis, f.kind, f.q_index, self.joints, self.centres,
+                         self.radii, self.normals, self.pairs, self.margin, self._found)
+        return self._found[:count]
 
     def contact_of(self, k: int) -> Contact:
         """Pair k as a :class:`Contact`, its distance computed at the placements of the last check."""
@@ -237,7 +229,7 @@ def _build(robot: Robot, collisions: Collisions) -> CollisionModel:
 
 def _frames(robot: Robot) -> Frames | None:
     """The model's joints as the compiled sphere test reads them; None when a joint is not one of the chain's
-    (a mimic follower): the test then reads Pinocchio's frames."""
+    (a mimic follower): the sphere test is then skipped."""
     model = robot.model
     index = {j.name: i for i, j in enumerate(robot.joints)}
     if robot.mimics or any(model.names[j] not in index for j in range(1, model.njoints)):
