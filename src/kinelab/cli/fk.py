@@ -25,7 +25,7 @@ def run(args: argparse.Namespace) -> int:
     oMtool = robot.fk(q)  # FK is defined at any q: a q outside the limits is computed and said, not refused
     out = {"robot": robot.name, "base": robot.base, "tool": robot.tool, "q": q.tolist(), **common.pose_dict(oMtool),
            "outside_limits": outside}
-    spec = common.collisions_of(args)
+    spec, contact = common.collisions_of(args), None
     if spec is not None:
         from dataclasses import asdict
 
@@ -44,9 +44,5 @@ def run(args: argparse.Namespace) -> int:
     print(f"  rpy [rad]      {common.shown(out['rpy_rad'])}")
     print("  rotation       " + common.shown(oMtool.rotation, prefix="  rotation       "))
     if "collision" in out:
-        print(f"  collision      {'none' if out['collision'] is None else _said(out['collision'])}")
+        print(f"  collision      {contact or 'none'}")
     return 0
-
-
-def _said(contact: dict[str, Any]) -> str:
-    return f"{contact['first']} and {contact['second']} ({contact['distance'] * 1e3:+.1f} mm)"

@@ -184,19 +184,17 @@ def analytic_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     return rows
 
 
-FLOOR_AND_TABLE = (("plane", (), (0.0, 0.0, 0.0), "floor"), ("box", (0.6, 0.8, 0.05), (0.5, 0.0, 0.2), "table"))
-
-
 def collision_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     """Where the robot has collision geometry: the check (sphere, hull and exact tests) agrees with Pinocchio's
     distance computation on every pair, and no success of a solve with collisions= collides (a floor and a
     table around it)."""
     import pinocchio as pin
 
-    from kinelab.collision import CollisionError, Collisions, Environment, Obstacle, collision_model
+    from kinelab.collision import CollisionError, Collisions, collision_model
     from kinelab.ik import solve
+    from kinelab.report.bench.collisions import FLOOR_AND_TABLE
 
-    env = Environment(tuple(Obstacle(s, size, xyz, name=name) for s, size, xyz, name in FLOOR_AND_TABLE))
+    env = FLOOR_AND_TABLE
     try:
         model = collision_model(robot, Collisions(environment=env))
     except CollisionError:

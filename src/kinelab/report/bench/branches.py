@@ -27,6 +27,7 @@ from kinelab.ik.analytic.classify import classify
 from kinelab.ik.api import solve_all
 from kinelab.ik.branches import SAME
 from kinelab.ik.limits import distance
+from kinelab.report.bench.protocol import round_plan
 from kinelab.robot import Robot, load
 
 ANALYTIC_ROBOTS = ("ur3", "ur5", "ur10", "z1", "so101")
@@ -58,14 +59,13 @@ def _eaik(robot: Robot) -> Call | None:
 
 
 def rounds(poses: list[pin.SE3], calls: dict[str, Call], repeats: int) -> dict[str, list[float]]:
-    """Per solver, the median time per call [s] of each round; rounds alternate interleaved and blocked."""
+    """Per solver, the median time per call [s] of each round (:func:`~kinelab.report.bench.protocol.round_plan`:
+    interleaved and blocked rounds alternating)."""
     medians: dict[str, list[float]] = {name: [] for name in calls}
     names = list(calls)
     for r in range(repeats):
         times: dict[str, list[float]] = {name: [] for name in calls}
-        order = ([(k, name) for k in range(len(poses)) for name in names[k % len(names):] + names[:k % len(names)]]
-                 if r % 2 == 0 else [(k, name) for name in names for k in range(len(poses))])
-        for k, name in order:
+        for k, name in round_plan(len(poses), names, r):
             t0 = time.perf_counter()
             calls[name](poses[k], r * len(poses) + k)
             times[name].append(time.perf_counter() - t0)

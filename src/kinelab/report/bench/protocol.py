@@ -42,6 +42,15 @@ class Case:
     task: str = "pose"  # the components judged (kinelab.ik.tasks); the tool axis of "axis" is z
 
 
+def round_plan(count: int, names: list[str], r: int) -> list[tuple[int, str]]:
+    """The order of round r over ``count`` problems and the solvers ``names``: (problem, solver) pairs. Even
+    rounds interleaved (every solver on each problem in turn), odd rounds blocked (each solver over the whole
+    set); the solvers' order rotates with the round, so that each goes first as often as the others."""
+    order = names[r % len(names):] + names[:r % len(names)]
+    return ([(k, name) for k in range(count) for name in order] if r % 2 == 0 else
+            [(k, name) for name in order for k in range(count)])
+
+
 def cases(robot: Robot, n: int, seed: int, start: str = "random", sigma: float = 0.2,
           task: str = "pose") -> list[Case]:
     """``n`` seeded problems: targets drawn uniformly within the joint limits; starts drawn uniformly

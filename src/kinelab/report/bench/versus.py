@@ -24,7 +24,7 @@ from kinelab.ik.analytic.classify import classify
 from kinelab.ik.api import solve
 from kinelab.ik.prepared import IK
 from kinelab.report.bench import peers
-from kinelab.report.bench.protocol import DEFAULT_ROBOTS, TOL_POS, TOL_ROT
+from kinelab.report.bench.protocol import DEFAULT_ROBOTS, TOL_POS, TOL_ROT, round_plan
 from kinelab.robot import Robot, load
 
 PROTOCOLS = (("floor", 0.0), ("warm", 0.02), ("warm", 0.2), ("random", 0.0))
@@ -82,10 +82,7 @@ def rounds(robot: Robot, cases: list[tuple[pin.SE3, np.ndarray]], contenders: di
     for r in range(repeats):
         times = {name: np.zeros(len(cases)) for name in names}
         ok = {name: np.zeros(len(cases), dtype=bool) for name in names}
-        order = names[r % len(names):] + names[:r % len(names)]
-        plan = ([(k, name) for k in range(len(cases)) for name in order] if r % 2 == 0 else
-                [(k, name) for name in order for k in range(len(cases))])
-        for k, name in plan:
+        for k, name in round_plan(len(cases), names, r):
             target, q0 = cases[k]
             times[name][k], ok[name][k] = _timed(robot, contenders[name], target, q0, seed + r * len(cases) + k)
         for name in names:
