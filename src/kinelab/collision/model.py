@@ -119,11 +119,19 @@ class CollisionModel:
 
     def __post_init__(self) -> None:
         self.data, self.gdata = self.robot.model.createData(), pin.GeometryData(self.geom)
-        self.hulls = _hulls(self.geom)
-        self.hdata = pin.GeometryData(self.hulls)
         self._found = np.empty(len(self.pairs), dtype=np.int64)
-        for req in (*self.gdata.collisionRequests, *self.hdata.collisionRequests):
+        for req in self.gdata.collisionRequests:
             req.security_margin = self.margin
+
+    def _hull_data(self) -> Any:
+        """The convex hulls' geometry data, the hulls computed on the first check (a model built only to say
+        what it holds, as ``kinelab info`` does, never runs qhull)."""
+        if self.hdata is None:
+            self.hulls = _hulls(self.geom)
+            self.hdata = pin.GeometryData(self.hulls)
+            for req in self.hdata.collisionRequests:
+                req.security_margin = self.margin
+        return self.hdata
 
     def contact(self, q: Any, first_test: bool = True) -> Contact | None:
         """The first pair at q (rad or m, one number per joint) closer than the margin, with its distance, or
@@ -159,8 +167,9 @@ class CollisionModel:
         pin.forwardKinematics(model, self.data, self.robot.to_pin_q(q))
         candidates = [int(k) for k in spheres]
         if first_test:  # the convex hulls next: a pair whose hulls are apart cannot collide
-            pin.updateGeometryPlacements(model, self.data, self.hulls, self.hdata)
-            candidates = [k for k in candidates if pin.computeCollision(self.hulls, self.hdata, k)]
+            hdata = self._hull_data()
+            pin.updateGeometryPlacements(model, self.data, self.hulls, hdata)
+            candidates = [k for k in candidates if pin.computeCollision(self.hulls, hdata, k)]
             if not candidates:
                 return None
         pin.updateGeometryPlacements(model, self.data, self.geom, self.gdata)
