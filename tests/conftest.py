@@ -14,6 +14,15 @@ def robots():
 
 
 @pytest.fixture
+def no_tolerance_floor(monkeypatch):
+    """Tolerances below kinelab's floor (1e-12) accepted, for tests that need one no answer can meet: the
+    budget or the restart count must then end the solve."""
+    from kinelab.ik import request
+
+    monkeypatch.setattr(request, "TOL_FLOOR", 0.0)
+
+
+@pytest.fixture
 def rng():
     return np.random.default_rng(12345)
 

@@ -63,7 +63,7 @@ def test_an_unknown_solver_is_listed_once():
     assert str(err.value).count("frdm") == 1 and str(err.value).count("biquat") == 1
 
 
-def test_a_batch_keeps_its_budget_whatever_its_size():
+def test_a_batch_keeps_its_budget_whatever_its_size(no_tolerance_floor):
     """kinelab 0.1: a batch of ≤ 512 rows never looked at the clock (5 ms → 4.2 s). Behaviour, not speed:
     an unattainable tolerance ends at the budget, with every row honest (the bench measures the overrun)."""
     youbot = kinelab.load("youbot")
@@ -105,7 +105,7 @@ def test_an_orientation_task_ignores_the_point_it_is_given():
         assert np.linalg.norm(pin.log3(R.T @ ur5.fk(q).rotation)) <= 1e-6
 
 
-def test_each_round_of_solve_all_and_the_prefer_fallback_get_only_what_is_left(monkeypatch):
+def test_each_round_of_solve_all_and_the_prefer_fallback_get_only_what_is_left(monkeypatch, no_tolerance_floor):
     """kinelab 0.1: solve_all ran every round unbounded (a whole round past the budget) and solve(prefer=) then
     started a fresh budget for its fallback (12× at 5 ms). Checked on the budgets handed down, not on a clock."""
 
@@ -137,7 +137,8 @@ def test_each_round_of_solve_all_and_the_prefer_fallback_get_only_what_is_left(m
     kinelab.solve_all(ur5, target, solver="frdm", time_budget=0.05, tol_pos=1e-300, tol_rot=1e-300, seed=0)
     # kinelab 0.1 handed every round None; 0.05 s at 7.5 ms per reading leaves room for 6 rounds
     assert len(given) == 6 and all(budget is not None and budget <= left + 1e-12 for budget, left in given)
-    monkeypatch.undo()
+    monkeypatch.setattr(branches, "time", __import__("time"))
+    monkeypatch.setattr(branches, "run_batch", real_batch)
 
     fallback: list[float | None] = []
     real_one = api.solve_one

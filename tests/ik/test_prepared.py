@@ -79,7 +79,7 @@ def test_every_unusual_input_gets_the_general_path_s_answer_or_error(ur5):
             ik.solve(target, q0=q, seed=seed)
 
 
-def test_a_lean_failure_reports_as_the_general_path_does(ur5):
+def test_a_lean_failure_reports_as_the_general_path_does(ur5, no_tolerance_floor):
     """Tolerances no answer meets (1e-300): the lean call builds the failure through the driver's helpers."""
     ik = kinelab.IK(ur5, time_budget=None, max_restarts=3, tol_pos=1e-300, tol_rot=1e-300, finish="none")
     target = ur5.fk(ur5.random_q(4))

@@ -48,7 +48,7 @@ def test_numpy_integers_are_fine_as_seed_and_restarts(ur5):
 
 @pytest.mark.parametrize("solver", ["frdm", "biquat", "dls"])
 @pytest.mark.parametrize("links", [6, 150])
-def test_an_unattainable_tolerance_ends_at_the_budget(solver, links):
+def test_an_unattainable_tolerance_ends_at_the_budget(solver, links, no_tolerance_floor):
     """A tolerance no solver reaches: the answer comes back once the budget is spent, not much later (the
     compiled kernels look at the clock after a fixed amount of joint work, whatever the chain's length)."""
     from kinelab.report.bench import scaling
@@ -89,3 +89,20 @@ def test_an_options_object_and_keyword_options_together_are_refused(ur5, solver,
     with pytest.raises(kinelab.OptionError, match="not both"):
         kinelab.solve(ur5, ur5.fk(ur5.random_q(0)), solver=solver, options=opts, max_restarts=1, **{
             "frdm": {"relax": 1.0}, "dls": {"damping": 1e-6}, "biquat": {"k": 1.0}}[solver])
+
+
+@pytest.mark.parametrize("name", ["tol_pos", "tol_rot"])
+def test_a_tolerance_finer_than_double_precision_can_check_is_refused(name):
+    """1e-320 once came back as a success whose error, measured by pin.log3 instead of the verdict's atan2,
+    was 2.3e-16 on one machine and 0 on another: below 1e-12 no verdict is trustworthy, so none is given."""
+    robot = kinelab.load("ur5")
+    target = robot.fk(robot.random_q(1))
+    for solve_call in (lambda **kw: kinelab.solve(robot, target, **kw),
+                       lambda **kw: kinelab.solve_batch(robot, [target], **kw),
+                       lambda **kw: kinelab.solve_all(robot, target, **kw),
+                       lambda **kw: kinelab.IK(robot, **kw)):
+        with pytest.raises(kinelab.OptionError, match=rf"{name}=1e-13 .*≥ 1e-12"):
+            solve_call(**{name: 1e-13})
+    res = kinelab.solve(robot, target, seed=0, **{name: 1e-12})
+    dp, dr = robot.tool_error(res.q, target)
+    assert res.success and (dp if name == "tol_pos" else dr) <= 1e-12

@@ -19,6 +19,11 @@ from kinelab.ik.registry import solver_module
 from kinelab.ik.tasks import POSE, Task
 
 START_POLICIES = ("project", "refuse")
+TOL_FLOOR = 1e-12
+"""The smallest tolerance accepted [m or rad]: Pinocchio's FK in double precision rounds a tool pose by
+~1e-16 per metre of chain, and two correct ways of measuring the same error (``pin.log3`` and the
+atan2 angle) differ by that much; a finer tolerance could not be checked, so a success against it
+would be a guess."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -95,6 +100,7 @@ def check_arguments(tol_pos: Any, tol_rot: Any, time_budget: Any, max_restarts: 
         OptionError: the first bad argument.
     """
     if _plain_positive(tol_pos, tol_rot, 1.0 if time_budget is None else time_budget) \
+            and tol_pos >= TOL_FLOOR and tol_rot >= TOL_FLOOR \
             and _plain_counts(max_restarts, seed) and start_outside_limits in START_POLICIES:
         return  # the common case, checked fast
     for name, value in (("tol_pos", tol_pos), ("tol_rot", tol_rot), ("time_budget", time_budget)):
@@ -102,6 +108,9 @@ def check_arguments(tol_pos: Any, tol_rot: Any, time_budget: Any, max_restarts: 
             continue
         if isinstance(value, bool) or not isinstance(value, numbers.Real) or not 0 < float(value) < math.inf:
             raise OptionError(name, value, "a finite number > 0" + (" or None" if name == "time_budget" else ""))
+        if name != "time_budget" and float(value) < TOL_FLOOR:
+            raise OptionError(name, value, f"a finite number ≥ {TOL_FLOOR:g} (a finer error is below the rounding "
+                              "of Pinocchio's double-precision FK and could not be checked)")
     if not count_ok(max_restarts):
         raise OptionError("max_restarts", max_restarts, "an integer ≥ 0")
     if seed is not None and not count_ok(seed):
