@@ -14,12 +14,13 @@ def robots():
 
 
 @pytest.fixture
-def no_tolerance_floor(monkeypatch):
+def no_tolerance_floor():
     """Tolerances below kinelab's floor (1e-12) accepted, for tests that need one no answer can meet: the
     budget or the restart count must then end the solve."""
-    from kinelab.ik import request
+    from kinelab.ik.request import unmeetable_tolerances
 
-    monkeypatch.setattr(request, "TOL_FLOOR", 0.0)
+    with unmeetable_tolerances():
+        yield
 
 
 @pytest.fixture

@@ -137,8 +137,7 @@ def test_each_round_of_solve_all_and_the_prefer_fallback_get_only_what_is_left(m
     kinelab.solve_all(ur5, target, solver="frdm", time_budget=0.05, tol_pos=1e-300, tol_rot=1e-300, seed=0)
     # kinelab 0.1 handed every round None; 0.05 s at 7.5 ms per reading leaves room for 6 rounds
     assert len(given) == 6 and all(budget is not None and budget <= left + 1e-12 for budget, left in given)
-    monkeypatch.setattr(branches, "time", __import__("time"))
-    monkeypatch.setattr(branches, "run_batch", real_batch)
+    monkeypatch.undo()
 
     fallback: list[float | None] = []
     real_one = api.solve_one

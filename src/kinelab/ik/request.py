@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import math
 import numbers
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
@@ -24,6 +26,19 @@ TOL_FLOOR = 1e-12
 ~1e-16 per metre of chain, and two correct ways of measuring the same error (``pin.log3`` and the
 atan2 angle) differ by that much; a finer tolerance could not be checked, so a success against it
 would be a guess."""
+
+
+@contextmanager
+def unmeetable_tolerances() -> Iterator[None]:
+    """Within the block, accept tolerances below :data:`TOL_FLOOR` (down to any number > 0): for measurements
+    that need calls no answer can end, such as how well a solve keeps its ``time_budget``. Not thread-safe
+    (it changes the module's floor for the block)."""
+    global TOL_FLOOR
+    kept, TOL_FLOOR = TOL_FLOOR, 0.0
+    try:
+        yield
+    finally:
+        TOL_FLOOR = kept
 
 
 @dataclass(frozen=True, slots=True)

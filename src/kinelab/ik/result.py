@@ -97,7 +97,12 @@ class BiquatTrajectory:
 
 @dataclass(frozen=True, repr=False)
 class Diagnostics:
-    """How a solve ran: each field is set by the solvers it applies to, None (or "") elsewhere."""
+    """How a solve ran: each field is set by the solvers it applies to, None (or "") elsewhere.
+
+    The fields come in groups: every solver's (path to message, outside_limits), FRDM's (order to
+    polish_iterations), the biquaternion run's (law to trajectory), the answer's own attempt (answer_events,
+    answer_bypasses), the search for branches (branches to unseen) and collisions (contact, clear_after).
+    """
 
     path: str = ""
     """"compiled" (a compiled kernel ran the attempts) or "" (the Python loop)."""
@@ -107,10 +112,8 @@ class Diagnostics:
     """Attempts that stalled."""
     message: str = ""
     """A solver's own note (a biquaternion run stopped by a singular matrix, say)."""
-    sweeps: int | None = None
-    """FRDM sweeps of the answer's run."""
-    accelerated_sweeps: int | None = None
-    """FRDM sweeps whose Anderson extrapolation was kept."""
+    outside_limits: int | None = None
+    """Compiled attempts restarted because their answer left the limits."""
     order: str = ""
     """FRDM's sweep order."""
     relax: float | None = None
@@ -119,6 +122,12 @@ class Diagnostics:
     """FRDM's position weight [1/m²]."""
     objective: float | None = None
     """FRDM's objective at the answer."""
+    trace: tuple[float, ...] | None = None
+    """FRDM's objective after every sweep."""
+    sweeps: int | None = None
+    """FRDM sweeps of the answer's run."""
+    accelerated_sweeps: int | None = None
+    """FRDM sweeps whose Anderson extrapolation was kept."""
     newton_steps: int | None = None
     """Gauss–Newton steps of FRDM's Newton finish, over every attempt."""
     polished: int | None = None
@@ -126,22 +135,18 @@ class Diagnostics:
     by a warm-started FRDM solve."""
     polish_iterations: int | None = None
     """DLS steps after FRDM (``polish=True``)."""
-    trace: tuple[float, ...] | None = None
-    """FRDM's objective after every sweep."""
+    law: str = ""
+    """The biquaternion control law that ran."""
     model_time: float | None = None
     """The biquaternion run's model time [s]."""
     steps: int | None = None
     """The biquaternion run's integration steps."""
+    integrator: str = ""
+    """The biquaternion run's integrator."""
     M0: float | None = None
     """The scalar of N̄∘Λ at the end of a biquaternion run (±1 at the target)."""
     damping: float | None = None
     """The biquaternion run's damping."""
-    law: str = ""
-    """The biquaternion control law that ran."""
-    integrator: str = ""
-    """The biquaternion run's integrator."""
-    outside_limits: int | None = None
-    """Compiled attempts restarted because their answer left the limits."""
     trajectory: BiquatTrajectory | None = None
     """The recorded biquaternion run (``record=True``)."""
     answer_events: tuple[SingularEvent, ...] = ()

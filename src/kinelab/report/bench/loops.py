@@ -17,6 +17,7 @@ import pinocchio as pin
 from tqdm import tqdm
 
 from kinelab.ik.api import solve, solve_all, solve_batch, track
+from kinelab.ik.request import unmeetable_tolerances
 from kinelab.report.bench import peers
 from kinelab.report.bench.protocol import DEFAULT_ROBOTS, TOL_POS, TOL_ROT, cases, path_set
 from kinelab.robot import Robot, load
@@ -144,11 +145,12 @@ def budgets(robot: Robot, budget: float = 0.005, n: int = 200, seed: int = 0,
     for call in paths.values():  # warm-up: compilation
         call(problems[0], seed, 1e-6)
     names = list(paths)
-    for k, case in enumerate(problems):
-        for name in names[k % len(names):] + names[:k % len(names)]:
-            t0 = time.perf_counter()
-            paths[name](case, seed + k, 1e-300)
-            times[name].append(time.perf_counter() - t0)
+    with unmeetable_tolerances():
+        for k, case in enumerate(problems):
+            for name in names[k % len(names):] + names[:k % len(names)]:
+                t0 = time.perf_counter()
+                paths[name](case, seed + k, 1e-300)
+                times[name].append(time.perf_counter() - t0)
     allowed = budget * 1.05 + 1e-4
     return [{"robot": robot.name, "solver": name, "budget_ms": budget * 1e3,
              "p50_ms": float(np.percentile(t, 50) * 1e3), "p99_ms": float(np.percentile(t, 99) * 1e3),
