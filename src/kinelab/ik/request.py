@@ -115,23 +115,28 @@ def check_arguments(tol_pos: Any, tol_rot: Any, time_budget: Any, max_restarts: 
         OptionError: the first bad argument.
     """
     if _plain_positive(tol_pos, tol_rot, 1.0 if time_budget is None else time_budget) \
-            and tol_pos >= TOL_FLOOR and tol_rot >= TOL_FLOOR \
-            and _plain_counts(max_restarts, seed) and start_outside_limits in START_POLICIES:
+            and min(tol_pos, tol_rot) >= TOL_FLOOR and _plain_counts(max_restarts, seed) \
+            and start_outside_limits in START_POLICIES:
         return  # the common case, checked fast
-    for name, value in (("tol_pos", tol_pos), ("tol_rot", tol_rot), ("time_budget", time_budget)):
-        if name == "time_budget" and value is None:
-            continue
-        if isinstance(value, bool) or not isinstance(value, numbers.Real) or not 0 < float(value) < math.inf:
-            raise OptionError(name, value, "a finite number > 0" + (" or None" if name == "time_budget" else ""))
-        if name != "time_budget" and float(value) < TOL_FLOOR:
-            raise OptionError(name, value, f"a finite number ≥ {TOL_FLOOR:g} (a finer error is below the rounding "
-                              "of Pinocchio's double-precision FK and could not be checked)")
+    _check_positive("tol_pos", tol_pos, TOL_FLOOR)
+    _check_positive("tol_rot", tol_rot, TOL_FLOOR)
+    if time_budget is not None:
+        _check_positive("time_budget", time_budget, 0.0)
     if not count_ok(max_restarts):
         raise OptionError("max_restarts", max_restarts, "an integer ≥ 0")
     if seed is not None and not count_ok(seed):
         raise OptionError("seed", seed, "an integer ≥ 0, or None for fresh entropy")
     if not isinstance(start_outside_limits, str) or start_outside_limits not in START_POLICIES:
         raise OptionError("start_outside_limits", start_outside_limits, "'project' or 'refuse'")
+
+
+def _check_positive(name: str, value: Any, floor: float) -> None:
+    """Refuse a value that is not a finite real > 0 and ≥ floor (a tolerance's floor: :data:`TOL_FLOOR`)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not 0 < float(value) < math.inf:
+        raise OptionError(name, value, "a finite number > 0" + (" or None" if name == "time_budget" else ""))
+    if float(value) < floor:
+        raise OptionError(name, value, f"a finite number ≥ {floor:g} (a finer error is below the rounding of "
+                          "Pinocchio's double-precision FK and could not be checked)")
 
 
 def _plain_positive(a: Any, b: Any, c: Any) -> bool:
