@@ -217,7 +217,7 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
               tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float = 0.05, options: Any = None,
               task: str = "pose", axis: str = "z", q_ref: Any = None, max_solutions: int | None = None,
               stop_below: float | None = UNSEEN, collisions: Any = None, drop_colliding: bool = False,
-              **solver_options: Any) -> list[IKResult]:
+              redundancy: int | None = None, **solver_options: Any) -> list[IKResult]:
     """The distinct solutions (branches) of ``target``: every one in closed form where the chain's geometry
     allows it (docs/analytic.md), else those that seeded starts find, in rounds of 64, until the estimated
     chance that one more start finds a new branch falls below ``stop_below`` or ``time_budget`` is spent.
@@ -247,6 +247,9 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
         collisions: as :func:`solve`: a branch that collides is marked (``success`` False, status
             ``collision``, ``diagnostics.contact`` naming the pair), or left out with ``drop_colliding``.
         drop_colliding: leave colliding branches out instead of marking them.
+        redundancy: K, for a 7R arm that is analytic with its first or last joint held (the ERA): every
+            branch at K values of that joint, evenly spread over its range (docs/analytic.md); solver "auto" or
+            "analytic". None: a 7R arm gets the multistart.
 
     Returns:
         One :class:`IKResult` per distinct solution, nearest ``q_ref`` first when given.
@@ -264,9 +267,12 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
         method = "multistart"  # options name a multistart solver's settings: "auto" runs FRDM with them
     req = make_request("frdm" if method != "multistart" else solver, seed, tol_pos, tol_rot, time_budget, 0,
                        "refuse", options, task, axis, solver_options)
+    if redundancy is not None and method == "multistart":
+        raise OptionError("redundancy", redundancy, f"None with solver={solver!r} and options (redundancy= "
+                          "sweeps a joint of the closed form: solver 'auto' or 'analytic', no options)")
     check = _collision_model(robot, collisions)
     found = find_all(robot, target, req, q_ref=q_ref, max_solutions=max_solutions, stop_below=stop_below,
-                     method=method)
+                     method=method, redundancy=redundancy)
     return found if check is None else mark_colliding(found, check, drop=bool(drop_colliding))
 
 

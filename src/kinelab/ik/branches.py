@@ -17,6 +17,7 @@ import numpy as np
 
 from kinelab.errors import OptionError
 from kinelab.ik.analytic.branches import analytic_all, has_closed_form
+from kinelab.ik.analytic.redundancy import check_redundancy, redundant_all
 from kinelab.ik.batch import fresh_seed, run_batch
 from kinelab.ik.limits import distance as distance  # exported: the branch distance users sort by
 from kinelab.ik.request import Request, count_ok
@@ -43,7 +44,8 @@ def unseen(counts: list[int]) -> float:
 
 
 def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_solutions: int | None = None,
-             stop_below: float | None = UNSEEN, method: str = "multistart") -> list[IKResult]:
+             stop_below: float | None = UNSEEN, method: str = "multistart",
+             redundancy: int | None = None) -> list[IKResult]:
     """The distinct solutions of ``target``, each checked by Pinocchio: every branch in closed form where the
     chain's class allows it (:mod:`kinelab.ik.analytic`), else those seeded starts find within the request's
     time budget.
@@ -61,6 +63,8 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
             below this, after MIN_ROUNDS rounds (None: spend the whole budget).
         method: "multistart"; "analytic" (the closed form, refused by name where the chain or the task has
             none); "auto" (the closed form where there is one and the task is "pose", else the multistart).
+        redundancy: K samples of a 7R arm's swept end joint (:mod:`kinelab.ik.analytic.redundancy`), with
+            method "analytic" or "auto"; None: no sweep.
 
     Returns:
         One :class:`IKResult` per distinct solution. Multistart: ``diagnostics.found``, how many starts reached
@@ -81,6 +85,8 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
                                        and 0.0 < stop_below < 1.0):
         raise OptionError("stop_below", stop_below, "a chance in (0, 1), or None to spend the whole budget")
     ref = None if q_ref is None else robot.check_q(q_ref, what="q_ref")
+    if redundancy is not None:
+        return redundant_all(robot, target, req, check_redundancy(redundancy), ref, max_solutions)
     if method == "analytic" or (method == "auto" and has_closed_form(robot, req)):
         return analytic_all(robot, target, req, q_ref=ref, max_solutions=max_solutions)
     t0 = time.perf_counter()

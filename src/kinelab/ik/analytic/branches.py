@@ -95,9 +95,9 @@ def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | No
     q, found, free = roots(robot, arm, target.homogeneous, q_ref)
     answers = []
     for k in range(q.shape[0]):
-        judged = _judged(robot, q[k], target, req)
-        if judged is not None:
-            answers.append((*judged, int(found[k]), bool(free[k])))
+        verdict = judged(robot, q[k], target, req)
+        if verdict is not None:
+            answers.append((*verdict, int(found[k]), bool(free[k])))
     if q_ref is not None:
         answers.sort(key=lambda a: distance(robot, a[0], q_ref))
     elapsed = time.perf_counter() - t0
@@ -113,16 +113,23 @@ def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | No
 def roots(robot: Robot, arm: ArmClass, H: np.ndarray, q_ref: np.ndarray | None) -> tuple[np.ndarray, ...]:
     """The compiled branches of the pose H (4 × 4, base frame): (q (m, n) within the limits, roots merged into
     each, one-of-a-continuum flags), before Pinocchio's word."""
+    return arm_roots(arm, H, robot.lower, robot.upper, q_ref)
+
+
+def arm_roots(arm: ArmClass, H: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+              q_ref: np.ndarray | None) -> tuple[np.ndarray, ...]:
+    """:func:`roots` of the arm ``arm`` with joint limits ``lower``, ``upper`` (arm.n each, rad)."""
     announce("the closed form", [branches])
     n = arm.n
     out, found, free = np.empty((MAX_ROWS, n)), np.zeros(MAX_ROWS, dtype=np.int64), np.zeros(MAX_ROWS, dtype=np.bool_)
     ref = _NO_REF[n] if q_ref is None else np.ascontiguousarray(q_ref, dtype=float)
     m = _KERNEL(n == 6, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, np.ascontiguousarray(H, dtype=float),
-                robot.lower, robot.upper, ref, q_ref is not None, SAME, LIMIT_SLACK, out, found, free)
+                np.ascontiguousarray(lower), np.ascontiguousarray(upper), ref, q_ref is not None, SAME,
+                LIMIT_SLACK, out, found, free)
     return out[:m], found[:m], free[:m]
 
 
-def _judged(robot: Robot, q: np.ndarray, target: Any, req: Request) -> tuple[np.ndarray, float, float, bool] | None:
+def judged(robot: Robot, q: np.ndarray, target: Any, req: Request) -> tuple[np.ndarray, float, float, bool] | None:
     """(q, position error, rotation error, finished) when Pinocchio's FK of q meets the tolerances, after a
     warm-started finish (``finished``) if the closed form fell short; None when it still does not."""
     dp, dr = robot.tool_error(q, target)
@@ -220,13 +227,13 @@ def analytic_one(robot: Robot, target: Any, req: Request, q0: np.ndarray | None,
     order = range(q.shape[0]) if q0 is None else np.argsort(np.abs(np.angle(np.exp(1j * (q - q0)))).max(axis=1))
     mode, collided = f"analytic ({arm.name})", None
     for k in order:
-        judged = _judged(robot, q[k], target, req)
-        if judged is None:
+        verdict = judged(robot, q[k], target, req)
+        if verdict is None:
             continue
-        if model is not None and model.colliding_pair(judged[0]) is not None:
-            collided = collided or judged
+        if model is not None and model.colliding_pair(verdict[0]) is not None:
+            collided = collided or verdict
             continue
-        answer, dp, dr, finished = judged
+        answer, dp, dr, finished = verdict
         return IKResult(q=answer, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr,
                         iterations=0, restarts=0, wall_time=time.perf_counter() - t0, solver="analytic", mode=mode,
                         message=CONTINUUM if free[k] else "", task=req.task_label,

@@ -71,16 +71,22 @@ def _classify(robot: Robot) -> Classification:
     if cm.n not in (5, 6):
         return Classification(None, f"{cm.n} joints (the subproblems here solve 5R and 6R chains)")
     v = cm.vectors(np.zeros(cm.n))
-    h, o, R0, N0 = v["e"].copy(), v["o"].copy(), v["R"].copy(), v["N"].copy()
+    return classify_vectors(v["e"].copy(), v["o"].copy(), v["R"].copy(), v["N"].copy())
+
+
+def classify_vectors(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray) -> Classification:
+    """The analytic class of a revolute chain given by its (n, 3) unit axes h and points o at q = 0 and its
+    tool's rotation R0 and point N0 there (base frame, metres), n = 5 or 6."""
     failed = []
+    n = h.shape[0]
     for mirrored in (False, True):
         hh, oo, RR, NN = reverse(h, o, R0, N0) if mirrored else (h, o, R0, N0)
         misses = _misses(hh, oo)
         if not misses:
-            if cm.n == 6:
+            if n == 6:
                 oo = oo.copy()
                 oo[4] = oo[5] = meeting_point(oo[4], hh[4], oo[5], hh[5])
-            name = ("6R, axes 2, 3, 4 parallel, axes 5 and 6 meeting" if cm.n == 6 else "5R, axes 2, 3, 4 parallel")
+            name = ("6R, axes 2, 3, 4 parallel, axes 5 and 6 meeting" if n == 6 else "5R, axes 2, 3, 4 parallel")
             if mirrored:
                 name += " (mirrored: read from the tool)"
             return Classification(ArmClass(name, mirrored, hh, oo, RR, NN), "")

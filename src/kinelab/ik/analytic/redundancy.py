@@ -1,0 +1,165 @@
+"""7R arms by their redundancy parameter: one end joint swept over K samples, the other six in closed form.
+
+A 7R arm has a one-parameter family of answers per pose. When holding its first (or last) joint at a value
+leaves six joints in an analytic class (:mod:`kinelab.ik.analytic.classify`), every branch at that value
+comes from the closed form: with the first joint at θ, the rest must reach M(θ)⁻¹·oMtarget, M(θ) the
+rotation by θ about the first joint's line (base frame); with the last joint at θ, oMtarget·S(θ)⁻¹, S(θ) the
+rotation about the last joint's line seen from the tool at θ = 0. The first joint is tried first. Every
+answer is judged by Pinocchio's FK of the whole chain within all of its limits.
+
+The ERA (the FRDM paper's arm) is such an arm; the Panda, the xArm7 and the Kinova 7-DoF arms are not (with
+any one joint held, the remaining axes meet no class's tests), and are refused with those tests named.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab.errors import ChainError, OptionError
+from kinelab.ik.analytic.branches import CONTINUUM, arm_roots, judged
+from kinelab.ik.analytic.classify import ArmClass, classify_vectors
+from kinelab.ik.chain import PRISMATIC, chain_model
+from kinelab.ik.limits import distance
+from kinelab.ik.request import Request
+from kinelab.ik.result import Diagnostics, IKResult, Status
+from kinelab.robot import Robot
+
+
+@dataclass(frozen=True, eq=False)
+class SweptArm:
+    """A 7R chain whose joint ``joint`` (0: the first, 6: the last) is swept and the other six solved.
+
+    Attributes:
+        joint: index of the swept joint in the chain.
+        arm: the class of the other six joints, with the swept one at 0.
+        axis, point: the swept joint's unit axis and a point on it [m]: in the base frame for the first
+            joint, in the tool frame (at θ = 0) for the last.
+    """
+
+    joint: int
+    arm: ArmClass
+    axis: np.ndarray
+    point: np.ndarray
+
+    def sub_target(self, H: np.ndarray, theta: float) -> np.ndarray:
+        """The 4 × 4 pose the six other joints must reach when the swept joint is at ``theta`` [rad]."""
+        R = pin.exp3(theta * self.axis)
+        M = np.eye(4)
+        M[:3, :3], M[:3, 3] = R, self.point - R @ self.point
+        M_inv = np.eye(4)
+        M_inv[:3, :3], M_inv[:3, 3] = R.T, -R.T @ M[:3, 3]
+        return M_inv @ H if self.joint == 0 else H @ M_inv
+
+
+def swept_arm(robot: Robot, k: int | None = None) -> SweptArm:
+    """The robot's swept form, built once per Robot.
+
+    Raises:
+        OptionError: the chain is not 7R, or holding neither end joint leaves an analytic class (the tests
+            each failed named).
+    """
+    found = robot.derived("analytic_swept", _swept)
+    if isinstance(found, str):
+        raise OptionError("redundancy", k, f"a 7R chain that is analytic with its first or last joint held "
+                          f"(docs/analytic.md); {robot.name}'s is not: {found}")
+    return found
+
+
+def _swept(robot: Robot) -> SweptArm | str:
+    try:
+        cm = chain_model(robot)
+    except ChainError as err:
+        return str(err)
+    if cm.n != 7 or (cm.kind == PRISMATIC).any():
+        return f"{cm.n} joints{', one prismatic' if (cm.kind == PRISMATIC).any() else ''} (a 7R chain is swept)"
+    v = cm.vectors(np.zeros(7))
+    reasons = []
+    for joint in (0, 6):
+        found = holding(v["e"], v["o"], v["R"], v["N"], joint)
+        if isinstance(found, SweptArm):
+            return found
+        reasons.append(f"joint {joint + 1} held (the other six's axes numbered 1 to 6): {found}")
+    return "; ".join(reasons)
+
+
+def holding(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray, joint: int) -> SweptArm | str:
+    """The 7R chain (axes h, points o at q = 0, tool R0, N0; base frame) swept at its end joint ``joint``
+    (0 or 6), or why the other six are in no class."""
+    keep = slice(1, 7) if joint == 0 else slice(0, 6)
+    c = classify_vectors(h[keep].copy(), o[keep].copy(), R0.copy(), N0.copy())
+    if c.arm is None:
+        return c.reason
+    if joint == 0:
+        return SweptArm(0, c.arm, h[0].copy(), o[0].copy())
+    return SweptArm(6, c.arm, R0.T @ h[6], R0.T @ (o[6] - N0))
+
+
+def samples(lower: float, upper: float, k: int) -> np.ndarray:
+    """K values of the swept joint [rad]: the midpoints of K equal cells of its range, the range cut to one
+    turn (−π, π] when it spans more (θ and θ + 2π are one configuration)."""
+    lo, hi = lower, upper
+    if hi - lo >= 2 * math.pi:
+        lo, hi = -math.pi, math.pi
+    return lo + (np.arange(k) + 0.5) * (hi - lo) / k
+
+
+def check_redundancy(k: object) -> int:
+    """K as an int.
+
+    Raises:
+        OptionError: K is not an integer in [1, 4096].
+    """
+    if isinstance(k, bool) or not isinstance(k, int | np.integer) or not 1 <= k <= 4096:
+        raise OptionError("redundancy", k, "an integer in [1, 4096]: the samples of the swept joint, or None")
+    return int(k)
+
+
+def redundant_all(robot: Robot, target: pin.SE3, req: Request, k: int, q_ref: np.ndarray | None = None,
+                  max_solutions: int | None = None) -> list[IKResult]:
+    """Every branch of ``target`` (oMtarget, base frame) at K values of the swept joint, each judged by
+    Pinocchio within the limits.
+
+    Args:
+        robot: a 7R robot that :func:`swept_arm` accepts.
+        target: the pose.
+        req: the validated request (task "pose").
+        k: samples of the swept joint (:func:`samples`).
+        q_ref: sort the answers by distance to this configuration; each angle's copy is picked nearest it.
+        max_solutions: at most this many answers (the nearest ``q_ref`` first when given).
+
+    Returns:
+        One :class:`IKResult` per answer; ``diagnostics.branches`` counts them all.
+
+    Raises:
+        OptionError: the chain cannot be swept, or the task is not "pose".
+    """
+    t0 = time.perf_counter()
+    if req.task.name != "pose":
+        raise OptionError("task", req.task_label, "'pose' with redundancy= (other tasks: solver='frdm')")
+    sw = swept_arm(robot, k)
+    j = sw.joint
+    keep = np.arange(7) != j
+    lower, upper = robot.lower[keep], robot.upper[keep]
+    ref = None if q_ref is None else q_ref[keep]
+    answers = []
+    for theta in samples(float(robot.lower[j]), float(robot.upper[j]), k):
+        q6, found, free = arm_roots(sw.arm, sw.sub_target(target.homogeneous, float(theta)), lower, upper, ref)
+        for r in range(q6.shape[0]):
+            verdict = judged(robot, np.insert(q6[r], j, theta), target, req)
+            if verdict is not None:
+                answers.append((*verdict, int(found[r]), bool(free[r])))
+    if q_ref is not None:
+        answers.sort(key=lambda a: distance(robot, a[0], q_ref))
+    mode = f"analytic ({sw.arm.name}; joint {j + 1} swept over {k} samples)"
+    elapsed = time.perf_counter() - t0
+    return [IKResult(q=q, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr, iterations=0,
+                     restarts=0, wall_time=elapsed, solver="analytic", mode=mode, message=CONTINUUM if loose else "",
+                     diagnostics=Diagnostics(path="compiled", branches=len(answers), found=count,
+                                             polished=1 if finished else None),
+                     task=req.task_label)
+            for q, dp, dr, finished, count, loose in answers[:max_solutions]]

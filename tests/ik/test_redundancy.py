@@ -1,0 +1,99 @@
+"""7R arms by their redundancy parameter (kinelab.ik.analytic.redundancy), against Pinocchio and against the
+closed form of the 6R arm Pinocchio builds with the swept joint locked."""
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import kinelab
+from kinelab.ik.analytic.redundancy import samples, swept_arm
+
+
+@pytest.fixture(scope="module")
+def era():
+    return kinelab.load("era")
+
+
+def _same_sets(a: np.ndarray, b: np.ndarray, tol: float = 1e-6) -> bool:
+    """Each row of a has a row of b within tol (joint by joint, modulo 2π), and the other way round."""
+    def covered(x, y):
+        return all(np.min(np.max(np.abs(np.angle(np.exp(1j * (y - row)))), axis=1)) < tol for row in x)
+    return len(a) == len(b) and covered(a, b) and covered(b, a)
+
+
+def _contains(rows: np.ndarray, q: np.ndarray, tol: float = 1e-6) -> bool:
+    """One of rows is q within tol [rad], joint by joint modulo 2π."""
+    return bool(np.min(np.max(np.abs(np.angle(np.exp(1j * (rows - q)))), axis=1)) < tol)
+
+
+def test_every_answer_meets_the_pose_within_the_limits_at_the_sampled_values(era):
+    thetas = samples(float(era.lower[0]), float(era.upper[0]), 16)
+    for seed in range(20):
+        target = era.fk(era.random_q(seed))
+        found = kinelab.solve_all(era, target, redundancy=16)
+        assert found and all(r.success and r.diagnostics.branches == len(found) for r in found)
+        for r in found:
+            dp, dr = era.tool_error(r.q, target)  # Pinocchio's FK of the whole 7R chain
+            assert dp <= 1e-6 and dr <= 1e-6 and era.within_limits(r.q)
+            assert np.min(np.abs(thetas - r.q[0])) < 1e-12  # joint 1 is one of its 16 samples
+
+
+def test_the_branches_at_each_sample_are_those_of_the_arm_with_that_joint_locked(era):
+    """The reference: Pinocchio reduces the model with joint 1 locked at θ, kinelab classifies that 6R arm
+    from scratch and returns its branches; the sweep's answers with q1 = θ must be the same set."""
+    thetas = samples(float(era.lower[0]), float(era.upper[0]), 4)
+    compared = 0
+    for seed in range(6):
+        target = era.fk(era.random_q(100 + seed))
+        swept = np.array([r.q for r in kinelab.solve_all(era, target, redundancy=4)])
+        for theta in thetas:
+            locked = kinelab.load("era", locked={"joint1": float(theta)})
+            reference = np.array([r.q for r in kinelab.solve_all(locked, target, solver="analytic")]).reshape(-1, 6)
+            mine = swept[np.abs(swept[:, 0] - theta) < 1e-12][:, 1:] if len(swept) else np.zeros((0, 6))
+            assert _same_sets(mine, reference), (seed, theta)
+            compared += len(reference)
+    assert compared > 20  # the comparison covered answers, not only empty sets
+
+
+def test_the_configuration_a_pose_came_from_is_found_when_its_joint_is_a_sample(era):
+    thetas = samples(float(era.lower[0]), float(era.upper[0]), 8)
+    rng = np.random.default_rng(5)
+    for k in range(20):
+        q = era.random_q(200 + k)
+        q[0] = thetas[rng.integers(8)]
+        assert _contains(np.array([r.q for r in kinelab.solve_all(era, era.fk(q), redundancy=8)]), q)
+
+
+def test_holding_the_last_joint_solves_the_same_poses(era):
+    """The ERA is analytic with either end held; the sweep uses the first. Held at its last joint instead,
+    the six others' branches at the pose's own q7 contain the q the pose came from, and all meet the pose."""
+    from kinelab.ik.analytic import redundancy
+    from kinelab.ik.chain import chain_model
+
+    v = chain_model(era).vectors(np.zeros(7))
+    end = redundancy.holding(v["e"], v["o"], v["R"], v["N"], 6)
+    assert isinstance(end, redundancy.SweptArm) and swept_arm(era).joint == 0
+    for seed in range(20):
+        q = era.random_q(300 + seed)
+        target = era.fk(q)
+        q6, _, _ = redundancy.arm_roots(end.arm, end.sub_target(target.homogeneous, float(q[6])), era.lower[:6],
+                                        era.upper[:6], None)
+        answers = np.array([np.append(r, q[6]) for r in q6])
+        assert len(answers) and all(max(era.tool_error(a, target)) < 1e-6 for a in answers)
+        assert _contains(answers, q)
+
+
+def test_arms_that_cannot_be_swept_are_refused_by_name(era):
+    panda, ur5 = kinelab.load("panda"), kinelab.load("ur5")
+    with pytest.raises(kinelab.OptionError, match=r"panda's is not: joint 1 held .*joint 7 held"):
+        kinelab.solve_all(panda, panda.fk(panda.random_q(1)), redundancy=8)
+    with pytest.raises(kinelab.OptionError, match="6 joints"):
+        kinelab.solve_all(ur5, ur5.fk(ur5.random_q(1)), redundancy=8)
+    target = era.fk(era.random_q(1))
+    for bad in (0, -1, True, 2.0, "8", 10**6):
+        with pytest.raises(kinelab.OptionError, match="redundancy"):
+            kinelab.solve_all(era, target, redundancy=bad)
+    with pytest.raises(kinelab.OptionError, match="solver='frdm'"):
+        kinelab.solve_all(era, target, redundancy=8, solver="frdm")
+    with pytest.raises(kinelab.OptionError, match="task"):
+        kinelab.solve_all(era, pin.SE3(np.eye(3), np.array([1.0, 2.0, 6.0])), redundancy=8, task="position")
