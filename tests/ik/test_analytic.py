@@ -79,15 +79,15 @@ class Eaik:
         return list(self.bot.IK(H).Q)  # least-squares answers too: at a double root Pinocchio confirms them
 
 
-def poses(robot, singular, seed):
-    """POSES configurations: 80 % random, 10 % with ``singular`` joints set to 0 (a singular pose), 10 % with
-    one or two joints at a limit."""
+def poses(robot, singular, seed, at=0.0):
+    """POSES configurations: 80 % random, 10 % with ``singular`` joints set to ``at`` (a singular pose), 10 %
+    with one or two joints at a limit."""
     rng = np.random.default_rng(seed)
     out = []
     for k in range(POSES):
         q = robot.random_q(rng)
         if k % 10 == 8:
-            q[singular[k // 10 % len(singular)]] = 0.0
+            q[singular[k // 10 % len(singular)]] = at
         elif k % 10 == 9:
             for j in rng.choice(robot.n, size=1 + k % 2, replace=False):
                 q[j] = robot.lower[j] if rng.random() < 0.5 else robot.upper[j]
@@ -123,6 +123,29 @@ def test_the_ur_branches_are_the_closed_form_and_eaik_as_sets(name):
     assert agree_closed >= 0.999 * compared and agree_eaik >= 0.999 * compared
 
 
+def test_the_spherical_wrist_branches_of_kinova_are_eaik_s_as_sets():
+    """The Jaco 2 (j2s6s200): axes 2 ∥ 3, a spherical wrist. Its wrist is singular at q5 = π (axes 4 and 6 in
+    line) and its arm stretched at q3 = π; EAIK classifies it the same way (6R-SPHERICAL_SECOND_TWO_PARALLEL)."""
+    robot = load("kinova")
+    eaik = Eaik(robot)
+    assert eaik.bot.getKinematicFamily() == "6R-SPHERICAL_SECOND_TWO_PARALLEL"
+    agree, compared = 0, 0
+    for q in poses(robot, singular=[[4], [2], [2, 4]], seed=8, at=np.pi):
+        target = robot.fk(q)
+        found = kinelab.solve_all(robot, target, solver="analytic")
+        assert found and all(s.success and "spherical wrist" in s.mode for s in found)
+        for s in found:
+            assert robot.within_limits(s.q) and max(robot.tool_error(s.q, target)) <= 1e-6
+        # at q3 = π the elbow's two roots nearly meet: axes 2 and 3 are 2e-13 rad from parallel in this file,
+        # which moves a double root by √(2e-13) ≈ 1e-6 rad; roots within SAME are one branch
+        assert any(np.max(np.abs(wrapped(s.q - q))) <= SAME for s in found) or continuum(found)
+        if continuum(found):  # q5 = π: q4 and q6 turn about one line, a circle of answers
+            continue
+        compared += 1
+        agree += same_set([s.q for s in found], confirmed(robot, target, eaik(target)))
+    assert compared >= 0.85 * POSES and agree >= 0.999 * compared
+
+
 def test_the_so101_branches_are_eaik_and_the_dense_multistart_as_sets():
     robot = load("so101")
     eaik = Eaik(robot)
@@ -143,16 +166,22 @@ def test_the_so101_branches_are_eaik_and_the_dense_multistart_as_sets():
     assert agree_search == searched
 
 
-def test_arms_are_classified_by_their_axes_and_others_are_refused_by_name():
+def test_arms_are_classified_by_their_axes_and_others_are_refused_by_name(tmp_path):
     assert {n: classify(load(n)).arm is not None for n in ("ur3", "ur5", "ur10", "z1", "so101", "kinova", "panda",
                                                            "stanford")} == \
-        {"ur3": True, "ur5": True, "ur10": True, "z1": True, "so101": True, "kinova": False, "panda": False,
+        {"ur3": True, "ur5": True, "ur10": True, "z1": True, "so101": True, "kinova": True, "panda": False,
          "stanford": False}
+    # a 6R in no class: the kinova with its wrist point moved 3 cm off axis 6
     kinova = load("kinova")
-    target = kinova.fk(kinova.random_q(0))
-    with pytest.raises(OptionError, match="kinova's is not: axes 2 and 4 are 1.6 rad from parallel"):
-        kinelab.solve_all(kinova, target, solver="analytic")
-    auto = kinelab.solve_all(kinova, target, seed=0)  # the numeric search instead, saying so
+    h, o, M = pinocchio_axes(kinova)
+    o = o.copy()
+    o[5] += 0.03 * np.cross(h[5], h[4])
+    off = load(write_urdf(tmp_path, chain_urdf(h, o, M, kinova.lower, kinova.upper)), tool="tool")
+    target = off.fk(off.random_q(0))
+    with pytest.raises(OptionError, match="is not: .*axes 5 and 6 are 0.03 m apart .*axes 4, 5 and 6 miss a "
+                                          "common point by 0.03 m"):
+        kinelab.solve_all(off, target, solver="analytic")
+    auto = kinelab.solve_all(off, target, seed=0)  # the numeric search instead, saying so
     assert auto and all(s.solver == "frdm" and "multistart" in s.mode for s in auto)
     ur5 = load("ur5")
     with pytest.raises(OptionError, match="task"):
@@ -203,6 +232,25 @@ def test_a_mirrored_ur5_read_from_its_tool_classifies_and_solves_the_inverse_pos
         assert all(max(mirror.tool_error(s.q, target)) <= 1e-6 for s in found)
         closed = confirmed(ur5, ur5.fk(q), ur_inverse(BASE @ ur5.fk(q).homogeneous, *UR_DH["ur5"]))
         assert same_set([-s.q[::-1] for s in found], closed)
+
+
+def test_a_mirrored_kinova_a_spherical_shoulder_classifies_and_solves_the_inverse_pose(tmp_path):
+    """The kinova written tool first (axes 1, 2, 3 meeting, 4 ∥ 5): the spherical-wrist class, mirrored."""
+    kinova = load("kinova")
+    h, o, M = pinocchio_axes(kinova)
+    R0, N0 = M.rotation, M.translation
+    mirror = load(write_urdf(tmp_path, chain_urdf((h[::-1] @ R0), (o[::-1] - N0) @ R0, M.inverse(),
+                                                  -kinova.upper[::-1], -kinova.lower[::-1])), tool="tool")
+    arm = classify(mirror).arm
+    assert arm is not None and arm.mirrored and "spherical wrist" in arm.name
+    eaik = Eaik(kinova)
+    rng = np.random.default_rng(9)
+    for _ in range(200):
+        q = kinova.random_q(rng)
+        target = mirror.fk(-q[::-1])
+        found = kinelab.solve_all(mirror, target, solver="analytic")
+        assert all(max(mirror.tool_error(s.q, target)) <= 1e-6 for s in found)
+        assert same_set([-s.q[::-1] for s in found], confirmed(kinova, kinova.fk(q), eaik(kinova.fk(q))))
 
 
 def test_a_chain_re_rooted_at_a_tilted_mount_keeps_its_class_and_its_branches(tmp_path):

@@ -223,13 +223,15 @@ def test_the_branches_bench_reports_each_arm_and_its_multistart_completeness():
     completeness against it and the batch's rates; an arm without one gets the multistart against a dense search."""
     from kinelab.report.bench import branches
 
-    rows = branches.run(["so101", "kinova"], n=10, repeats=2)
-    closed, numeric = rows
+    rows = branches.run(["so101", "stanford", "era"], n=10, repeats=2)
+    closed, numeric, swept = rows
     assert closed["class"].startswith("5R") and {"closed form", "multistart"} <= set(closed["us"])
     assert 0.0 <= closed["multistart_complete"] <= 1.0 and closed["batch_kernel_per_s"] > 0
     assert numeric["class"].startswith("none: ") and set(numeric["us"]) == {"multistart"}
+    assert "joint 1 swept over 16 samples" in swept["class"] and swept["branches_mean"] > 1
+    assert set(swept["us"]) == {"closed form", "multistart"}
     table = branches.markdown(rows)
-    assert table.count("\n") == 3 and "| so101 |" in table and "(vs dense)" in table
+    assert table.count("\n") == 4 and "| so101 |" in table and "(vs dense)" in table and "at 16 samples" in table
 
 
 def test_the_collisions_bench_reports_each_arm_with_and_without_the_check():

@@ -123,7 +123,7 @@ def arm_roots(arm: ArmClass, H: np.ndarray, lower: np.ndarray, upper: np.ndarray
     n = arm.n
     out, found, free = np.empty((MAX_ROWS, n)), np.zeros(MAX_ROWS, dtype=np.int64), np.zeros(MAX_ROWS, dtype=np.bool_)
     ref = _NO_REF[n] if q_ref is None else np.ascontiguousarray(q_ref, dtype=float)
-    m = _KERNEL(n == 6, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, np.ascontiguousarray(H, dtype=float),
+    m = _KERNEL(arm.kind, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, np.ascontiguousarray(H, dtype=float),
                 np.ascontiguousarray(lower), np.ascontiguousarray(upper), ref, q_ref is not None, SAME,
                 LIMIT_SLACK, out, found, free)
     return out[:m], found[:m], free[:m]
@@ -187,7 +187,7 @@ def all_branches_batch(robot: Robot, targets: Any, tol_pos: float = 1e-6, tol_ro
     out = np.full((B, MAX_ROWS, n), np.nan)
     found, free = np.zeros((B, MAX_ROWS), dtype=np.int64), np.zeros((B, MAX_ROWS), dtype=np.bool_)
     count = np.zeros(B, dtype=np.int64)
-    branches_batch(n == 6, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, H, robot.lower, robot.upper, SAME,
+    branches_batch(arm.kind, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, H, robot.lower, robot.upper, SAME,
                    LIMIT_SLACK, out, found, free, count)
     pose, row = np.nonzero(np.arange(MAX_ROWS)[None, :] < count[:, None])
     dp, dr = pose_errors(H[pose], robot.fk_batch(out[pose, row]))

@@ -1,9 +1,10 @@
 """Which arms the subproblems solve: the chain's class, read from its joint axes and points at q = 0.
 
-Two classes are solved in closed form (docs/analytic.md), each also in its mirror image (the chain read from
-the tool back to the base, which solves the inverse pose):
+Three classes are solved in closed form (docs/analytic.md), each also in its mirror image (the chain read
+from the tool back to the base, which solves the inverse pose):
 
 - **6R, h₂ ∥ h₃ ∥ h₄, axes 5 and 6 meeting** (the UR arms, the Unitree Z1): up to 8 branches;
+- **6R, h₂ ∥ h₃, axes 4, 5 and 6 meeting** (a spherical wrist: the Kinova Jaco 2 j2s6s200): up to 8;
 - **5R, h₂ ∥ h₃ ∥ h₄** (the SO-101): up to 4 candidates, of which a pose keeps those that meet it.
 
 Axes count as parallel when their angle is below AXIS_TOL and as meeting when their distance is below
@@ -17,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinelab.errors import ChainError
+from kinelab.ik.analytic.kernel import PARALLEL_5R, PARALLEL_6R, SPHERICAL_6R
 from kinelab.ik.chain import PRISMATIC, chain_model
 from kinelab.robot import Robot
 
@@ -29,13 +31,14 @@ class ArmClass:
     """An arm the subproblems solve, in the orientation they solve it.
 
     Attributes:
-        name: the class, in words; mirrored: the chain is solved read from the tool back (inverse pose,
-            joints reversed and negated).
+        name: the class, in words; kind: its kernel code (:mod:`kinelab.ik.analytic.kernel`); mirrored: the
+            chain is solved read from the tool back (inverse pose, joints reversed and negated).
         h, o: (n, 3) unit axes and points on them at q = 0 [m], in the solved orientation's base frame.
         R0, N0: the tool's rotation and point at q = 0 in that frame.
     """
 
     name: str
+    kind: int
     mirrored: bool
     h: np.ndarray
     o: np.ndarray
@@ -78,20 +81,56 @@ def classify_vectors(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarra
     """The analytic class of a revolute chain given by its (n, 3) unit axes h and points o at q = 0 and its
     tool's rotation R0 and point N0 there (base frame, metres), n = 5 or 6."""
     failed = []
-    n = h.shape[0]
     for mirrored in (False, True):
         hh, oo, RR, NN = reverse(h, o, R0, N0) if mirrored else (h, o, R0, N0)
-        misses = _misses(hh, oo)
-        if not misses:
-            if n == 6:
-                oo = oo.copy()
-                oo[4] = oo[5] = meeting_point(oo[4], hh[4], oo[5], hh[5])
-            name = ("6R, axes 2, 3, 4 parallel, axes 5 and 6 meeting" if n == 6 else "5R, axes 2, 3, 4 parallel")
-            if mirrored:
-                name += " (mirrored: read from the tool)"
-            return Classification(ArmClass(name, mirrored, hh, oo, RR, NN), "")
-        failed.append(("read from the tool: " if mirrored else "") + "; ".join(misses))
+        misses = []
+        for kind, name, test in CLASSES[h.shape[0]]:
+            missed = test(hh, oo)
+            if isinstance(missed, np.ndarray):  # in the class: the points it solves with
+                name += " (mirrored: read from the tool)" if mirrored else ""
+                return Classification(ArmClass(name, kind, mirrored, hh, missed, RR, NN), "")
+            misses.append(missed)
+        failed.append(("read from the tool: " if mirrored else "") + " / ".join(misses))
     return Classification(None, " | ".join(failed))
+
+
+def _parallel(h: np.ndarray, o: np.ndarray) -> np.ndarray | str:
+    """The points the class h₂ ∥ h₃ ∥ h₄ (axes 5 and 6 meeting, in 6R) solves with, or the tests failed."""
+    misses = _misses(h, o)
+    if misses:
+        return "; ".join(misses)
+    oo: np.ndarray = o.copy()
+    if h.shape[0] == 6:
+        oo[4] = oo[5] = meeting_point(oo[4], h[4], oo[5], h[5])
+    return oo
+
+
+def _spherical(h: np.ndarray, o: np.ndarray) -> np.ndarray | str:
+    """The points the class h₂ ∥ h₃, axes 4, 5, 6 meeting solves with (o[3..5] the wrist point), or the tests
+    failed."""
+    misses = []
+    angle = _angle(h[1], h[2])
+    if angle > AXIS_TOL:
+        misses.append(f"axes 2 and 3 are {angle:.2g} rad from parallel (tolerance {AXIS_TOL:g})")
+    if _angle(h[0], h[1]) <= AXIS_TOL:
+        misses.append("axes 1 and 2 are parallel (joint 1 would not fix the plane of the elbow)")
+    if _angle(h[3], h[4]) <= AXIS_TOL or _angle(h[4], h[5]) <= AXIS_TOL:
+        misses.append("axis 5 is parallel to axis 4 or 6")
+        return "; ".join(misses)
+    w = meeting_point(o[3], h[3], o[4], h[4])
+    gap = max(line_distance(o[3], h[3], o[4], h[4]), line_distance(w, h[5], o[5], h[5]))
+    if gap > POINT_TOL:
+        misses.append(f"axes 4, 5 and 6 miss a common point by {gap:.2g} m (tolerance {POINT_TOL:g})")
+    if misses:
+        return "; ".join(misses)
+    oo: np.ndarray = o.copy()
+    oo[3] = oo[4] = oo[5] = w
+    return oo
+
+
+CLASSES = {6: ((PARALLEL_6R, "6R, axes 2, 3, 4 parallel, axes 5 and 6 meeting", _parallel),
+               (SPHERICAL_6R, "6R, axes 2, 3 parallel, axes 4, 5, 6 meeting (spherical wrist)", _spherical)),
+           5: ((PARALLEL_5R, "5R, axes 2, 3, 4 parallel", _parallel),)}
 
 
 def _misses(h: np.ndarray, o: np.ndarray) -> list[str]:

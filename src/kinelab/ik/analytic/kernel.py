@@ -1,4 +1,4 @@
-"""All the branches of one pose, compiled, for the arms whose axes 2, 3 and 4 are parallel (docs/analytic.md).
+"""All the branches of one pose, compiled, for the arms of the three classes of docs/analytic.md.
 
 The chain is written as a product of exponentials at q = 0, everything in the base frame: unit axes h_i,
 points o_i on them, the tool's rotation R0 and point N0. With R = R_target·R0ᵀ and v the target point less
@@ -9,6 +9,11 @@ angles follow from the orientation (subproblems 4 and 1), the sum θ₂ + θ₃ 
 Rows are written into ``out`` (angles in (−π, π], one row per root combination; coincident roots are
 written twice and merged by the caller); ``free`` marks rows where a subproblem was degenerate and its
 angle was set to 0 (a continuum of answers: a wrist or shoulder singularity).
+
+A spherical wrist (axes 4, 5, 6 meeting at w) with h₂ ∥ h₃ is solved the classical way: the target fixes
+the wrist point, which joints 1–3 alone move (joint 1 from its component along h₂, subproblem 4; joint 3
+from its distance to axis 2's point, subproblem 3; joint 2 by subproblem 1); the rotation left for the wrist
+gives joint 5 (subproblem 4), then joints 4 and 6 (subproblem 1 each).
 """
 
 from __future__ import annotations
@@ -37,6 +42,7 @@ from kinelab.ik.analytic.subproblems import (
 )
 
 MAX_ROWS = 8
+PARALLEL_5R, PARALLEL_6R, SPHERICAL_6R = 0, 1, 2  # the classes' kernel codes (ArmClass.kind)
 SINGULAR_WRIST = 1e-6  # [rad] q5's two roots closer than twice this are the singular wrist's double root
 
 
@@ -175,6 +181,53 @@ def parallel_5r(h, o, R0, N0, Rt, pt, out, free):
 
 
 @njit(cache=True)
+def spherical_6r(h, o, R0, N0, Rt, pt, out, free):
+    """Every branch of a 6R arm with h₂ ∥ h₃ and axes 4, 5, 6 meeting at o[3] = o[4] = o[5]; returns the row
+    count. Arguments as :func:`parallel_6r`."""
+    R06 = mm(Rt, transpose(R0))
+    w0 = row3(o, 3)
+    v = sub3(sub3(pt, row3(o, 0)), mv(R06, sub3(N0, w0)))
+    n1, a1, b1, free1 = _shoulder(h, o, v)
+    h2, h3 = row3(h, 1), row3(h, 2)
+    p12, p23, p3w = sub3(row3(o, 1), row3(o, 0)), sub3(row3(o, 2), row3(o, 1)), sub3(w0, row3(o, 2))
+    row = 0
+    for i1 in range(max(n1, 0)):
+        q1 = a1 if i1 == 0 else b1
+        R1 = rotation(row3(h, 0), q1)
+        c = sub3(mtv(R1, v), p12)  # the wrist point seen from axis 2's point, before joint 1
+        n3, a3, b3 = sp4(p23, h3, p3w, 0.5 * (dot3(c, c) - dot3(p23, p23) - dot3(p3w, p3w)))
+        if n3 <= 0:
+            continue
+        for i3 in range(2):
+            q3 = a3 if i3 == 0 else b3
+            R3 = rotation(h3, q3)
+            m2, q2 = sp1(h2, add3(p23, mv(R3, p3w)), c)
+            Rw = mm(transpose(mm(mm(R1, rotation(h2, q2)), R3)), R06)
+            row = _spherical_wrist(h, Rw, q1, q2, q3, out, free, row, free1 or m2 == DEGENERATE)
+    return row
+
+
+@njit(cache=True)
+def _spherical_wrist(h, Rw, q1, q2, q3, out, free, row, flag):
+    """Rows for joints 4–6 turning the rotation Rw = R₄R₅R₆ (after q1, q2, q3); returns the next row. With the
+    wrist singular (h₆ turned onto h₄: q5's double root) q4 + q6 is a continuum: q4 = 0 and the row is flagged."""
+    h4, h5, h6 = row3(h, 3), row3(h, 4), row3(h, 5)
+    n5, a5, b5 = sp4(h4, h5, h6, dot3(h4, mv(Rw, h6)))
+    if n5 == 2 and abs(wrap(a5 - b5)) < 2.0 * SINGULAR_WRIST:
+        n5, a5 = 1, a5 - 0.5 * wrap(a5 - b5)
+    for i5 in range(max(n5, 0)):
+        q5 = a5 if i5 == 0 else b5
+        R5 = rotation(h5, q5)
+        m4, q4 = sp1(h4, mv(R5, h6), mv(Rw, h6))
+        _, q6 = sp1(h6, h5, mtv(mm(rotation(h4, q4), R5), mv(Rw, h5)))
+        out[row, 0], out[row, 1], out[row, 2] = wrap(q1), wrap(q2), wrap(q3)
+        out[row, 3], out[row, 4], out[row, 5] = wrap(q4), wrap(q5), wrap(q6)
+        free[row] = flag or m4 == DEGENERATE or n5 == 1
+        row += 1
+    return row
+
+
+@njit(cache=True)
 def _placed(row, lower, upper, ref, use_ref, slack, out):
     """Each angle's copy θ + 2πk within [lower, upper] (slack allowed, then clipped), nearest ``ref`` (else
     nearest 0, the copy in (−π, π] when it is inside), into ``out``; False when a joint has no copy inside."""
@@ -192,7 +245,7 @@ def _placed(row, lower, upper, ref, use_ref, slack, out):
 
 
 @njit(cache=True)
-def branches(six, mirrored, h, o, R0, N0, H, lower, upper, ref, use_ref, same, slack, out, found, free):
+def branches(kind, mirrored, h, o, R0, N0, H, lower, upper, ref, use_ref, same, slack, out, found, free):
     """Every distinct branch of the pose H (4 × 4, base frame) within the limits, in the robot's joint order.
 
     Roots closer than ``same`` [rad] joint by joint (modulo 2π) are one branch (``found`` counts them); each
@@ -209,8 +262,10 @@ def branches(six, mirrored, h, o, R0, N0, H, lower, upper, ref, use_ref, same, s
         Rt = transpose(Rt)
     R0t, N0t = mat9(R0), (N0[0], N0[1], N0[2])
     raw, loose = np.empty((MAX_ROWS, n)), np.zeros(MAX_ROWS, dtype=np.bool_)
-    if six:
+    if kind == PARALLEL_6R:
         count = parallel_6r(h, o, R0t, N0t, Rt, pt, raw, loose)
+    elif kind == SPHERICAL_6R:
+        count = spherical_6r(h, o, R0t, N0t, Rt, pt, raw, loose)
     else:
         count = parallel_5r(h, o, R0t, N0t, Rt, pt, raw, loose)
     m = 0
@@ -241,11 +296,11 @@ def _close(a, b, same):
 
 
 @njit(cache=True, parallel=True)
-def branches_batch(six, mirrored, h, o, R0, N0, H, lower, upper, same, slack, out, found, free, count):
+def branches_batch(kind, mirrored, h, o, R0, N0, H, lower, upper, same, slack, out, found, free, count):
     """:func:`branches` for every pose of the (B, 4, 4) stack H, in threads (copies nearest 0).
 
     Args:
-        six: a 6R class (else 5R).
+        kind: the class's kernel code (PARALLEL_5R, PARALLEL_6R or SPHERICAL_6R).
         mirrored: the class is solved read from the tool back.
         h: (n, 3) unit axes at q = 0 in the solved orientation.
         o: (n, 3) points on them [m].
@@ -264,5 +319,5 @@ def branches_batch(six, mirrored, h, o, R0, N0, H, lower, upper, same, slack, ou
     n = h.shape[0]
     zero = np.zeros(n)
     for b in prange(H.shape[0]):
-        count[b] = branches(six, mirrored, h, o, R0, N0, H[b], lower, upper, zero, False, same, slack, out[b],
+        count[b] = branches(kind, mirrored, h, o, R0, N0, H[b], lower, upper, zero, False, same, slack, out[b],
                             found[b], free[b])

@@ -70,6 +70,11 @@ def swept_arm(robot: Robot, k: int | None = None) -> SweptArm:
     return found
 
 
+def has_swept_form(robot: Robot) -> bool:
+    """True when :func:`swept_arm` accepts the robot."""
+    return isinstance(robot.derived("analytic_swept", _swept), SweptArm)
+
+
 def _swept(robot: Robot) -> SweptArm | str:
     try:
         cm = chain_model(robot)

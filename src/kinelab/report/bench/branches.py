@@ -7,8 +7,10 @@ closed form, unchecked). Rounds alternate interleaved (each solver on each pose 
 and blocked schedules; the multistart's seeds change with the round. Figures: the median time per call per
 round, reported as the median over rounds with the spread (lowest, highest round); how often the multistart
 found every closed-form branch; the batch's poses per second on all cores, with and without Pinocchio's check.
-Arms without a closed form (kinova by default) get the multistart against a dense reference: the same search
-without its stopping rule for 0.5 s.
+Arms without a closed form (the Stanford arm by default) get the multistart against a dense reference: the
+same search without its stopping rule for 0.5 s. A 7R arm with a swept closed form (the ERA) gets
+``solve_all(..., redundancy=K)`` against the multistart, timed alike (its answers are a continuum: no
+completeness).
 """
 
 from __future__ import annotations
@@ -24,14 +26,17 @@ from tqdm import tqdm
 from kinelab.ik.analytic.branches import SAME as CLOSED_SAME
 from kinelab.ik.analytic.branches import all_branches_batch
 from kinelab.ik.analytic.classify import classify
+from kinelab.ik.analytic.redundancy import has_swept_form
 from kinelab.ik.api import solve_all
 from kinelab.ik.branches import SAME
 from kinelab.ik.limits import distance
 from kinelab.report.bench.protocol import round_plan
 from kinelab.robot import Robot, load
 
-ANALYTIC_ROBOTS = ("ur3", "ur5", "ur10", "z1", "so101")
-NUMERIC_ROBOTS = ("kinova",)
+ANALYTIC_ROBOTS = ("ur3", "ur5", "ur10", "z1", "kinova", "so101")
+NUMERIC_ROBOTS = ("stanford",)
+REDUNDANT_ROBOTS = ("era",)
+K = 16  # samples of a 7R arm's swept joint
 Call = Callable[[pin.SE3, int], Any]
 
 
@@ -121,7 +126,7 @@ def _throughput(robot: Robot, rng: np.random.Generator, count: int = 20_000) -> 
     best = np.inf
     for _ in range(3):
         t0 = time.perf_counter()
-        branches_batch(arm.n == 6, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, H, robot.lower, robot.upper,
+        branches_batch(arm.kind, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, H, robot.lower, robot.upper,
                        CLOSED_SAME, LIMIT_SLACK, out, found, free, rows)
         best = min(best, time.perf_counter() - t0)
     return {"batch_checked_per_s": checked, "batch_kernel_per_s": count / best}
@@ -144,15 +149,33 @@ def numeric_arm(robot: Robot, n: int, seed: int, repeats: int) -> dict[str, Any]
             "multistart_complete": complete / n}
 
 
+def redundant_arm(robot: Robot, n: int, seed: int, repeats: int) -> dict[str, Any]:
+    """A 7R arm with a swept closed form: its time and answer count at K samples against the multistart's."""
+    rng = np.random.default_rng(seed)
+    poses = [robot.fk(robot.random_q(rng)) for _ in range(n)]
+    calls: dict[str, Call] = {"closed form": lambda t, s: solve_all(robot, t, redundancy=K),
+                              "multistart": lambda t, s: solve_all(robot, t, solver="frdm", seed=s)}
+    for name in calls:
+        calls[name](poses[0], 0)
+    medians = rounds(poses, calls, repeats)
+    found = [solve_all(robot, t, redundancy=K) for t in poses]
+    return {"robot": robot.name, "class": f"{found[0][0].mode if found[0] else 'swept'}", "poses": n,
+            "branches_mean": float(np.mean([len(f) for f in found])), "samples": K,
+            "us": {k: 1e6 * float(np.median(v)) for k, v in medians.items()},
+            "spread_us": {k: (1e6 * min(v), 1e6 * max(v)) for k, v in medians.items()}}
+
+
 def run(robots: list[str] | None = None, n: int = 100, seed: int = 0, repeats: int = 4,
         progress: bool = False) -> list[dict[str, Any]]:
-    """Every arm asked for (default: the arms with a closed form, then kinova), a row each."""
-    names = list(robots or (*ANALYTIC_ROBOTS, *NUMERIC_ROBOTS))
+    """Every arm asked for (default: the arms with a closed form, the Stanford arm, the ERA), a row each."""
+    names = list(robots or (*ANALYTIC_ROBOTS, *NUMERIC_ROBOTS, *REDUNDANT_ROBOTS))
     rows = []
     for name in tqdm(names, desc="bench --branches", disable=not progress, unit="arm"):
         robot = load(name)
         if classify(robot).arm is not None:
             rows.append(analytic_arm(robot, n, seed, repeats))
+        elif robot.n == 7 and has_swept_form(robot):
+            rows.append(redundant_arm(robot, max(10, n // 5), seed, repeats))
         else:
             rows.append(numeric_arm(robot, max(10, n // 5), seed, repeats))
     return rows
@@ -169,6 +192,11 @@ def markdown(rows: list[dict[str, Any]]) -> str:
     lines = ["| arm | branches | closed form | multistart | EAIK (unchecked) | multistart complete | batch checked "
              "| batch kernel |", "|---|---|---|---|---|---|---|---|"]
     for r in rows:
+        if "samples" in r:
+            lines.append(f"| {r['robot']} | {r['branches_mean']:.1f} at {r['samples']} samples | "
+                         f"{shown(r, 'closed form', 1e3, 'ms')} | {shown(r, 'multistart', 1e3, 'ms')} "
+                         "| – | – | – | – |")
+            continue
         closed = "closed form" in r["us"]
         lines.append(
             f"| {r['robot']} | {r['branches_mean']:.2f} | {shown(r, 'closed form', 1, 'µs')} | "
