@@ -97,3 +97,39 @@ def test_arms_that_cannot_be_swept_are_refused_by_name(era):
         kinelab.solve_all(era, target, redundancy=8, solver="frdm")
     with pytest.raises(kinelab.OptionError, match="task"):
         kinelab.solve_all(era, pin.SE3(np.eye(3), np.array([1.0, 2.0, 6.0])), redundancy=8, task="position")
+
+
+def test_frdm_answers_on_the_era_are_closed_form_branches_and_the_kick_does_not_pick_the_elbow(era):
+    """The FRDM paper (seed 000) calls its answer unique and bends the ERA's straight elbow with a signed kick
+    (δq4 < 0). Against the swept closed form: every FRDM answer is one of the branches at its own q1 (FRDM
+    returns one of several, chosen by its start) and, started from the target's own configuration with the
+    elbow straightened, the kick's sign gives the answer's elbow sign about as often as a coin would.
+
+    An answer within the tolerances may sit at (or 1e-6 rad inside) a joint limit whose exact root lies beyond
+    it (up to 3e-5 rad here, near a singular wrist, where the other joints make up the difference to 1e-7):
+    such an answer is no exact branch, and the test names that as the only way to miss one."""
+    from kinelab.ik.analytic.redundancy import at_value
+    from kinelab.ik.request import make_request
+
+    rng = np.random.default_rng(1)
+    req = make_request("frdm")
+    solved, agree, counts, at_limit = 0, 0, [], 0
+    for k in range(150):
+        q = era.random_q(rng)
+        if abs(q[3]) < 0.3:  # an elbow clearly bent one way or the other
+            continue
+        target, q0 = era.fk(q), q.copy()
+        q0[3] = 0.0
+        for kick in (-0.01, 0.01):
+            res = kinelab.solve(era, target, q0=q0, seed=k, max_restarts=0, kicks={"joint4": kick})
+            if not res.success:
+                continue
+            solved += 1
+            agree += int(np.sign(res.q[3]) == np.sign(kick))
+            branches = np.array([a[0] for a in at_value(era, target, req, float(res.q[0]))])
+            counts.append(len(branches))
+            if not (len(branches) and _contains(branches, res.q, 1e-4)):
+                assert np.min(np.minimum(res.q - era.lower, era.upper - res.q)) < 1e-4, res.q
+                at_limit += 1
+    assert solved >= 150 and at_limit <= 0.03 * solved and 0.35 <= agree / solved <= 0.65
+    assert np.mean(counts) > 2  # several branches at each answer's own q1

@@ -35,6 +35,14 @@ from kinelab.robot import Robot
 SAME = 1e-5  # [rad] roots closer than this joint by joint are one branch (a double root split by rounding:
 # the two roots of arccos(1 − ε) are √(2ε) apart, 1.4e-6 rad at ε = 1e-12)
 LIMIT_SLACK = 1e-9  # [rad] a root this close outside a limit is the limit (a pose taken at the limit)
+
+
+def limit_slack(tol_rot: float) -> float:
+    """How far [rad] a root may lie outside a limit and still be tried at the limit: tol_rot. An answer within
+    the tolerances can sit at a limit while the exact root lies just beyond it (FRDM found such answers on the
+    ERA 3.5e-7 rad past a wrist limit); Pinocchio then judges the clipped root, which a warm-started solve
+    finishes when it falls short."""
+    return max(LIMIT_SLACK, tol_rot)
 CONTINUUM = "one of a continuum: a singular pose, another angle of the free joint serves too"
 _KERNEL = TypedKernel(branches)
 _NO_REF = {n: np.zeros(n) for n in (5, 6)}
@@ -92,7 +100,7 @@ def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | No
     """
     t0 = time.perf_counter()
     arm = arm_of(robot, req)
-    q, found, free = roots(robot, arm, target.homogeneous, q_ref)
+    q, found, free = roots(robot, arm, target.homogeneous, q_ref, limit_slack(req.tol_rot))
     answers = []
     for k in range(q.shape[0]):
         verdict = judged(robot, q[k], target, req)
@@ -110,14 +118,16 @@ def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | No
             for q, dp, dr, finished, count, loose in answers[:max_solutions]]
 
 
-def roots(robot: Robot, arm: ArmClass, H: np.ndarray, q_ref: np.ndarray | None) -> tuple[np.ndarray, ...]:
-    """The compiled branches of the pose H (4 × 4, base frame): (q (m, n) within the limits, roots merged into
-    each, one-of-a-continuum flags), before Pinocchio's word."""
-    return arm_roots(arm, H, robot.lower, robot.upper, q_ref)
+def roots(robot: Robot, arm: ArmClass, H: np.ndarray, q_ref: np.ndarray | None,
+          slack: float = LIMIT_SLACK) -> tuple[np.ndarray, ...]:
+    """The compiled branches of the pose H (4 × 4, base frame): (q (m, n) within the limits, a root up to
+    ``slack`` [rad] outside one clipped to it; roots merged into each; one-of-a-continuum flags), before
+    Pinocchio's word."""
+    return arm_roots(arm, H, robot.lower, robot.upper, q_ref, slack)
 
 
 def arm_roots(arm: ArmClass, H: np.ndarray, lower: np.ndarray, upper: np.ndarray,
-              q_ref: np.ndarray | None) -> tuple[np.ndarray, ...]:
+              q_ref: np.ndarray | None, slack: float = LIMIT_SLACK) -> tuple[np.ndarray, ...]:
     """:func:`roots` of the arm ``arm`` with joint limits ``lower``, ``upper`` (arm.n each, rad)."""
     announce("the closed form", [branches])
     n = arm.n
@@ -125,7 +135,7 @@ def arm_roots(arm: ArmClass, H: np.ndarray, lower: np.ndarray, upper: np.ndarray
     ref = _NO_REF[n] if q_ref is None else np.ascontiguousarray(q_ref, dtype=float)
     m = _KERNEL(arm.kind, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, np.ascontiguousarray(H, dtype=float),
                 np.ascontiguousarray(lower), np.ascontiguousarray(upper), ref, q_ref is not None, SAME,
-                LIMIT_SLACK, out, found, free)
+                slack, out, found, free)
     return out[:m], found[:m], free[:m]
 
 
@@ -188,7 +198,7 @@ def all_branches_batch(robot: Robot, targets: Any, tol_pos: float = 1e-6, tol_ro
     found, free = np.zeros((B, MAX_ROWS), dtype=np.int64), np.zeros((B, MAX_ROWS), dtype=np.bool_)
     count = np.zeros(B, dtype=np.int64)
     branches_batch(arm.kind, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, H, robot.lower, robot.upper, SAME,
-                   LIMIT_SLACK, out, found, free, count)
+                   limit_slack(tol_rot), out, found, free, count)
     pose, row = np.nonzero(np.arange(MAX_ROWS)[None, :] < count[:, None])
     dp, dr = pose_errors(H[pose], robot.fk_batch(out[pose, row]))
     ok = (dp <= tol_pos) & (dr <= tol_rot)
@@ -223,7 +233,7 @@ def analytic_one(robot: Robot, target: Any, req: Request, q0: np.ndarray | None,
     """
     t0 = time.perf_counter()
     arm = arm_of(robot, req)
-    q, found, free = roots(robot, arm, target.homogeneous, q0)
+    q, found, free = roots(robot, arm, target.homogeneous, q0, limit_slack(req.tol_rot))
     order = range(q.shape[0]) if q0 is None else np.argsort(np.abs(np.angle(np.exp(1j * (q - q0)))).max(axis=1))
     mode, collided = f"analytic ({arm.name})", None
     for k in order:

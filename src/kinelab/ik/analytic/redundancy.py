@@ -21,7 +21,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.errors import ChainError, OptionError
-from kinelab.ik.analytic.branches import CONTINUUM, arm_roots, judged
+from kinelab.ik.analytic.branches import CONTINUUM, arm_roots, judged, limit_slack
 from kinelab.ik.analytic.classify import ArmClass, classify_vectors
 from kinelab.ik.chain import PRISMATIC, chain_model
 from kinelab.ik.limits import distance
@@ -124,6 +124,27 @@ def check_redundancy(k: object) -> int:
     return int(k)
 
 
+def at_value(robot: Robot, target: pin.SE3, req: Request, theta: float,
+             q_ref: np.ndarray | None = None) -> list[tuple[np.ndarray, float, float, bool, int, bool]]:
+    """Every branch of ``target`` with the swept joint at ``theta`` [rad] that Pinocchio confirms within the
+    limits: (q, position error [m], rotation error [rad], finished by FRDM, roots merged, one of a continuum).
+
+    Raises:
+        OptionError: the chain cannot be swept.
+    """
+    sw = swept_arm(robot)
+    keep = np.arange(7) != sw.joint
+    ref = None if q_ref is None else q_ref[keep]
+    q6, found, free = arm_roots(sw.arm, sw.sub_target(target.homogeneous, theta), robot.lower[keep],
+                                robot.upper[keep], ref, limit_slack(req.tol_rot))
+    answers = []
+    for r in range(q6.shape[0]):
+        verdict = judged(robot, np.insert(q6[r], sw.joint, theta), target, req)
+        if verdict is not None:
+            answers.append((*verdict, int(found[r]), bool(free[r])))
+    return answers
+
+
 def redundant_all(robot: Robot, target: pin.SE3, req: Request, k: int, q_ref: np.ndarray | None = None,
                   max_solutions: int | None = None) -> list[IKResult]:
     """Every branch of ``target`` (oMtarget, base frame) at K values of the swept joint, each judged by
@@ -148,16 +169,9 @@ def redundant_all(robot: Robot, target: pin.SE3, req: Request, k: int, q_ref: np
         raise OptionError("task", req.task_label, "'pose' with redundancy= (other tasks: solver='frdm')")
     sw = swept_arm(robot, k)
     j = sw.joint
-    keep = np.arange(7) != j
-    lower, upper = robot.lower[keep], robot.upper[keep]
-    ref = None if q_ref is None else q_ref[keep]
     answers = []
     for theta in samples(float(robot.lower[j]), float(robot.upper[j]), k):
-        q6, found, free = arm_roots(sw.arm, sw.sub_target(target.homogeneous, float(theta)), lower, upper, ref)
-        for r in range(q6.shape[0]):
-            verdict = judged(robot, np.insert(q6[r], j, theta), target, req)
-            if verdict is not None:
-                answers.append((*verdict, int(found[r]), bool(free[r])))
+        answers += at_value(robot, target, req, float(theta), q_ref)
     if q_ref is not None:
         answers.sort(key=lambda a: distance(robot, a[0], q_ref))
     mode = f"analytic ({sw.arm.name}; joint {j + 1} swept over {k} samples)"
