@@ -53,3 +53,21 @@ def test_finish_options_are_checked():
     for bad in ({"finish": "lm"}, {"finish_below": -1.0}, {"finish_steps": 0}, {"finish_steps": 2.5}):
         with pytest.raises(kinelab.OptionError, match=next(iter(bad))):
             kinelab.solve(ur5, target, **bad)
+
+
+def test_a_frozen_joint_stays_frozen_through_the_newton_finish():
+    """kinelab 0.2: the Gauss–Newton finish moved every joint, a joint the freeze bypass held too (the answer
+    met the pose with joint 7 moved by 8e-3 rad). Held from the first sweep, it now stays at its value."""
+    xarm7 = kinelab.load("xarm7")
+    held = 0
+    for seed in range(20):
+        q = xarm7.random_q(seed)
+        target, start = xarm7.fk(q), q + 0.01
+        value = float(q[6])
+        res = kinelab.solve(xarm7, target, q0=start, max_restarts=0, freeze={"joint7": value}, active=("freeze",))
+        assert res.mode == "frdm+newton"
+        if res.success:
+            held += 1
+            assert res.q[6] == value
+            assert max(xarm7.tool_error(res.q, target)) <= 1e-6
+    assert held >= 15

@@ -39,7 +39,8 @@ def add(sub: Any) -> None:
                         "and random starts, interleaved and blocked rounds, ratios with their spread")
     s.add_argument("--branches", action="store_true",
                    help="also every branch of a pose: the closed form against the multistart and EAIK, the batch's "
-                        "poses per second (the arms with a closed form, the Stanford arm's multistart, the ERA swept)")
+                        "poses per second (the arms with a closed form, the Stanford arm's multistart, the ERA and "
+                        "the Panda swept)")
     s.add_argument("--collisions", action="store_true",
                    help="also solve with and without collisions= around a floor and a table (panda, ur5, kinova): "
                         "time ratio with its spread, clear success, the check's own cost")

@@ -139,15 +139,19 @@ def arm_roots(arm: ArmClass, H: np.ndarray, lower: np.ndarray, upper: np.ndarray
     return out[:m], found[:m], free[:m]
 
 
-def judged(robot: Robot, q: np.ndarray, target: Any, req: Request) -> tuple[np.ndarray, float, float, bool] | None:
+def judged(robot: Robot, q: np.ndarray, target: Any, req: Request,
+           held: dict[str, float] | None = None) -> tuple[np.ndarray, float, float, bool] | None:
     """(q, position error, rotation error, finished) when Pinocchio's FK of q meets the tolerances, after a
-    warm-started finish (``finished``) if the closed form fell short; None when it still does not."""
+    warm-started finish (``finished``; the joints of ``held`` frozen at their values [rad]) if the closed form
+    fell short; None when it still does not."""
     dp, dr = robot.tool_error(q, target)
     if dp <= req.tol_pos and dr <= req.tol_rot:
         return q, dp, dr, False
     if dp > 1e3 * req.tol_pos + 1e-6 or dr > 1e3 * req.tol_rot + 1e-6:
         return None  # not this pose's root (a 5R arm's candidate for the other shoulder side, say)
-    finish = make_request("frdm", seed=0, tol_pos=req.tol_pos, tol_rot=req.tol_rot, max_restarts=0)
+    frozen = {} if held is None else {"freeze": held, "active": ("freeze",)}
+    finish = make_request("frdm", seed=0, tol_pos=req.tol_pos, tol_rot=req.tol_rot, max_restarts=0,
+                          solver_options=frozen)
     done = solve_one(robot, target, q, finish)
     return (done.q, done.position_error, done.rotation_error, True) if done.success else None
 

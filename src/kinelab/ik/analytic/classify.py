@@ -5,6 +5,8 @@ from the tool back to the base, which solves the inverse pose):
 
 - **6R, h₂ ∥ h₃ ∥ h₄, axes 5 and 6 meeting** (the UR arms, the Unitree Z1): up to 8 branches;
 - **6R, h₂ ∥ h₃, axes 4, 5 and 6 meeting** (a spherical wrist: the Kinova Jaco 2 j2s6s200): up to 8;
+- **6R, axes 1 and 2 meeting, axes 4, 5 and 6 meeting**: up to 8 (mirrored: a spherical shoulder and axes 5
+  and 6 meeting — the Panda's and the xArm7's first six joints);
 - **5R, h₂ ∥ h₃ ∥ h₄** (the SO-101): up to 4 candidates, of which a pose keeps those that meet it.
 
 Axes count as parallel when their angle is below AXIS_TOL and as meeting when their distance is below
@@ -18,12 +20,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinelab.errors import ChainError
-from kinelab.ik.analytic.kernel import PARALLEL_5R, PARALLEL_6R, SPHERICAL_6R
+from kinelab.ik.analytic.kernel import MEETING_6R, PARALLEL_5R, PARALLEL_6R, SPHERICAL_6R
 from kinelab.ik.chain import PRISMATIC, chain_model
 from kinelab.robot import Robot
 
-AXIS_TOL = 1e-6  # [rad] axes closer to parallel than this are parallel
-POINT_TOL = 1e-6  # [m] axes closer than this meet
+AXIS_TOL = 1e-5  # [rad] axes closer to parallel are parallel (URDF numbers are rounded: 1.5708 is π/2 + 3.7e-6)
+POINT_TOL = 1e-5  # [m] axes closer than this meet
 
 
 @dataclass(frozen=True, eq=False)
@@ -114,6 +116,25 @@ def _spherical(h: np.ndarray, o: np.ndarray) -> np.ndarray | str:
         misses.append(f"axes 2 and 3 are {angle:.2g} rad from parallel (tolerance {AXIS_TOL:g})")
     if _angle(h[0], h[1]) <= AXIS_TOL:
         misses.append("axes 1 and 2 are parallel (joint 1 would not fix the plane of the elbow)")
+    return _with_wrist(h, o, misses)
+
+
+def _meeting(h: np.ndarray, o: np.ndarray) -> np.ndarray | str:
+    """The points the class axes 1, 2 meeting, axes 4, 5, 6 meeting solves with (o[0..1] the shoulder point,
+    o[3..5] the wrist point), or the tests failed."""
+    if _angle(h[0], h[1]) <= AXIS_TOL:
+        return "axes 1 and 2 are parallel"
+    gap = line_distance(o[0], h[0], o[1], h[1])
+    if gap > POINT_TOL:
+        return f"axes 1 and 2 are {gap:.2g} m apart (tolerance {POINT_TOL:g})"
+    found = _with_wrist(h, o, [])
+    if isinstance(found, np.ndarray):
+        found[0] = found[1] = meeting_point(o[0], h[0], o[1], h[1])
+    return found
+
+
+def _with_wrist(h: np.ndarray, o: np.ndarray, misses: list[str]) -> np.ndarray | str:
+    """o with o[3..5] moved to the point where axes 4, 5, 6 meet, or ``misses`` and the wrist's failed tests."""
     if _angle(h[3], h[4]) <= AXIS_TOL or _angle(h[4], h[5]) <= AXIS_TOL:
         misses.append("axis 5 is parallel to axis 4 or 6")
         return "; ".join(misses)
@@ -129,7 +150,8 @@ def _spherical(h: np.ndarray, o: np.ndarray) -> np.ndarray | str:
 
 
 CLASSES = {6: ((PARALLEL_6R, "6R, axes 2, 3, 4 parallel, axes 5 and 6 meeting", _parallel),
-               (SPHERICAL_6R, "6R, axes 2, 3 parallel, axes 4, 5, 6 meeting (spherical wrist)", _spherical)),
+               (SPHERICAL_6R, "6R, axes 2, 3 parallel, axes 4, 5, 6 meeting (spherical wrist)", _spherical),
+               (MEETING_6R, "6R, axes 1, 2 meeting, axes 4, 5, 6 meeting (spherical wrist)", _meeting)),
            5: ((PARALLEL_5R, "5R, axes 2, 3, 4 parallel", _parallel),)}
 
 

@@ -13,7 +13,9 @@ angle was set to 0 (a continuum of answers: a wrist or shoulder singularity).
 A spherical wrist (axes 4, 5, 6 meeting at w) with h₂ ∥ h₃ is solved the classical way: the target fixes
 the wrist point, which joints 1–3 alone move (joint 1 from its component along h₂, subproblem 4; joint 3
 from its distance to axis 2's point, subproblem 3; joint 2 by subproblem 1); the rotation left for the wrist
-gives joint 5 (subproblem 4), then joints 4 and 6 (subproblem 1 each).
+gives joint 5 (subproblem 4), then joints 4 and 6 (subproblem 1 each). With axes 1 and 2 meeting at s
+instead, the wrist point's distance from s fixes joint 3 (subproblem 3) and the turn of joints 1 and 2 onto
+it is subproblem 2 (here subproblem 4 for joint 1, then subproblem 1 for joint 2).
 """
 
 from __future__ import annotations
@@ -42,7 +44,7 @@ from kinelab.ik.analytic.subproblems import (
 )
 
 MAX_ROWS = 8
-PARALLEL_5R, PARALLEL_6R, SPHERICAL_6R = 0, 1, 2  # the classes' kernel codes (ArmClass.kind)
+PARALLEL_5R, PARALLEL_6R, SPHERICAL_6R, MEETING_6R = 0, 1, 2, 3  # the classes' kernel codes (ArmClass.kind)
 SINGULAR_WRIST = 1e-6  # [rad] q5's two roots closer than twice this are the singular wrist's double root
 
 
@@ -208,6 +210,34 @@ def spherical_6r(h, o, R0, N0, Rt, pt, out, free):
 
 
 @njit(cache=True)
+def meeting_6r(h, o, R0, N0, Rt, pt, out, free):
+    """Every branch of a 6R arm with axes 1 and 2 meeting at o[0] = o[1] and axes 4, 5, 6 meeting at
+    o[3] = o[4] = o[5]; returns the row count. Arguments as :func:`parallel_6r`."""
+    R06 = mm(Rt, transpose(R0))
+    s, w0 = row3(o, 0), row3(o, 3)
+    v = sub3(sub3(pt, mv(R06, sub3(N0, w0))), s)  # the wrist point seen from the shoulder point
+    a, b = sub3(row3(o, 2), s), sub3(w0, row3(o, 2))
+    h1, h2, h3 = row3(h, 0), row3(h, 1), row3(h, 2)
+    n3, a3, b3 = sp4(a, h3, b, 0.5 * (dot3(v, v) - dot3(a, a) - dot3(b, b)))
+    row = 0
+    if n3 <= 0:
+        return row
+    for i3 in range(2):
+        q3 = a3 if i3 == 0 else b3
+        R3 = rotation(h3, q3)
+        u = add3(a, mv(R3, b))
+        n1, a1, b1 = sp4(v, h1, h2, dot3(h2, u))  # joint 2 keeps the component of u along h2
+        free1 = n1 == DEGENERATE
+        for i1 in range(max(n1, 0) if not free1 else 1):
+            q1 = (a1 if i1 == 0 else b1) if not free1 else 0.0
+            R1 = rotation(h1, q1)
+            m2, q2 = sp1(h2, u, mtv(R1, v))
+            Rw = mm(transpose(mm(mm(R1, rotation(h2, q2)), R3)), R06)
+            row = _spherical_wrist(h, Rw, q1, q2, q3, out, free, row, free1 or m2 == DEGENERATE)
+    return row
+
+
+@njit(cache=True)
 def _spherical_wrist(h, Rw, q1, q2, q3, out, free, row, flag):
     """Rows for joints 4–6 turning the rotation Rw = R₄R₅R₆ (after q1, q2, q3); returns the next row. With the
     wrist singular (h₆ turned onto h₄: q5's double root) q4 + q6 is a continuum: q4 = 0 and the row is flagged."""
@@ -266,6 +296,8 @@ def branches(kind, mirrored, h, o, R0, N0, H, lower, upper, ref, use_ref, same, 
         count = parallel_6r(h, o, R0t, N0t, Rt, pt, raw, loose)
     elif kind == SPHERICAL_6R:
         count = spherical_6r(h, o, R0t, N0t, Rt, pt, raw, loose)
+    elif kind == MEETING_6R:
+        count = meeting_6r(h, o, R0t, N0t, Rt, pt, raw, loose)
     else:
         count = parallel_5r(h, o, R0t, N0t, Rt, pt, raw, loose)
     m = 0
@@ -300,7 +332,7 @@ def branches_batch(kind, mirrored, h, o, R0, N0, H, lower, upper, same, slack, o
     """:func:`branches` for every pose of the (B, 4, 4) stack H, in threads (copies nearest 0).
 
     Args:
-        kind: the class's kernel code (PARALLEL_5R, PARALLEL_6R or SPHERICAL_6R).
+        kind: the class's kernel code (PARALLEL_5R, PARALLEL_6R, SPHERICAL_6R or MEETING_6R).
         mirrored: the class is solved read from the tool back.
         h: (n, 3) unit axes at q = 0 in the solved orientation.
         o: (n, 3) points on them [m].

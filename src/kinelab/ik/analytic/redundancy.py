@@ -139,7 +139,7 @@ def at_value(robot: Robot, target: pin.SE3, req: Request, theta: float,
                                 robot.upper[keep], ref, limit_slack(req.tol_rot))
     answers = []
     for r in range(q6.shape[0]):
-        verdict = judged(robot, np.insert(q6[r], sw.joint, theta), target, req)
+        verdict = judged(robot, np.insert(q6[r], sw.joint, theta), target, req, {robot.joints[sw.joint].name: theta})
         if verdict is not None:
             answers.append((*verdict, int(found[r]), bool(free[r])))
     return answers

@@ -73,9 +73,12 @@ def lm_polish(q, ch, pb, iterations, max_step=np.inf):
 
 @njit(cache=True)
 def world_jacobian(e, o, p, R, kind, pb, J):
-    """J ← the error's Jacobian rows (position; rotation, or the tool axis of task "axis"); unchecked rows 0."""
+    """J ← the error's Jacobian rows (position; rotation, or the tool axis of task "axis"); unchecked rows 0, and
+    the columns of frozen joints (``pb.free`` False) 0: a step never moves a joint a bypass holds."""
     for i in range(e.shape[0]):
-        if kind[i] == PRISMATIC:
+        if not pb.free[i]:
+            J[:, i] = 0.0
+        elif kind[i] == PRISMATIC:
             J[0:3, i] = e[i]
             J[3:6, i] = 0.0
         else:

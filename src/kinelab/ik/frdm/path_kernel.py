@@ -127,7 +127,8 @@ def redundant_newton(q, ch, pb, iterations, max_step, centre, pull):
         for r in range(6):
             A[r, r] += damping
         for i in range(n):  # the pull acts on the first step only: the later ones converge as Gauss–Newton does
-            z[i] = _limit_pull(q[i], pb.lower[i], pb.upper[i], pull) * (centre[i] - q[i]) if it == 0 else 0.0
+            z[i] = _limit_pull(q[i], pb.lower[i], pb.upper[i], pull) * (centre[i] - q[i]) \
+                if it == 0 and pb.free[i] else 0.0
         dq = J.T @ np.linalg.solve(A, err) + z - J.T @ np.linalg.solve(A, J @ z)
         largest = np.max(np.abs(dq))
         if largest > max_step:

@@ -35,7 +35,7 @@ from kinelab.robot import Robot, load
 
 ANALYTIC_ROBOTS = ("ur3", "ur5", "ur10", "z1", "kinova", "so101")
 NUMERIC_ROBOTS = ("stanford",)
-REDUNDANT_ROBOTS = ("era",)
+REDUNDANT_ROBOTS = ("era", "panda")
 K = 16  # samples of a 7R arm's swept joint
 Call = Callable[[pin.SE3, int], Any]
 
@@ -167,7 +167,8 @@ def redundant_arm(robot: Robot, n: int, seed: int, repeats: int) -> dict[str, An
 
 def run(robots: list[str] | None = None, n: int = 100, seed: int = 0, repeats: int = 4,
         progress: bool = False) -> list[dict[str, Any]]:
-    """Every arm asked for (default: the arms with a closed form, the Stanford arm, the ERA), a row each."""
+    """Every arm asked for (default: the arms with a closed form, the Stanford arm, the ERA and the Panda), a row
+    each."""
     names = list(robots or (*ANALYTIC_ROBOTS, *NUMERIC_ROBOTS, *REDUNDANT_ROBOTS))
     rows = []
     for name in tqdm(names, desc="bench --branches", disable=not progress, unit="arm"):
