@@ -146,3 +146,19 @@ def test_the_collision_checks_hold_on_panda_and_fail_when_the_check_sees_nothing
     assert validate.collision_checks(kinelab.load("stanford"), 40, 0) == []  # no collision geometry: no check
     monkeypatch.setattr(CollisionModel, "colliding_pair", lambda self, q, first_test=True: None)
     assert not validate.collision_checks(panda, 40, 0)[0].passed
+
+
+def test_the_swept_closed_form_checks_hold_on_the_era_and_fail_when_its_branches_are_wrong(monkeypatch):
+    """The ERA has no closed form as a whole but one with joint 1 held: validate checks its branches and that
+    FRDM's and DLS's answers are among them at their own joint-1 angle; branches moved off the answers fail it."""
+    import kinelab
+    from kinelab.ik.analytic import redundancy
+
+    era = kinelab.load("era")
+    rows = validate.analytic_checks(era, 40, 0)
+    assert [r.name.split(":")[0] for r in rows] == ["closed form, joint 1 swept", "frdm", "dls"]
+    assert all(r.passed for r in rows)
+    real = redundancy.at_value
+    monkeypatch.setattr(redundancy, "at_value", lambda *a, **k: [(q + 0.01, *rest) for q, *rest in real(*a, **k)])
+    rows = validate.analytic_checks(era, 40, 0)
+    assert not any(r.passed for r in rows)  # the moved branches miss the pose, and every answer misses them
