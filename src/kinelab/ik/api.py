@@ -267,9 +267,6 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
         method = "multistart"  # options name a multistart solver's settings: "auto" runs FRDM with them
     req = make_request("frdm" if method != "multistart" else solver, seed, tol_pos, tol_rot, time_budget, 0,
                        "refuse", options, task, axis, solver_options)
-    if redundancy is not None and method == "multistart":
-        raise OptionError("redundancy", redundancy, f"None with solver={solver!r} and options (redundancy= "
-                          "sweeps a joint of the closed form: solver 'auto' or 'analytic', no options)")
     check = _collision_model(robot, collisions)
     found = find_all(robot, target, req, q_ref=q_ref, max_solutions=max_solutions, stop_below=stop_below,
                      method=method, redundancy=redundancy)

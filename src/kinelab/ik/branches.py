@@ -86,6 +86,9 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
         raise OptionError("stop_below", stop_below, "a chance in (0, 1), or None to spend the whole budget")
     ref = None if q_ref is None else robot.check_q(q_ref, what="q_ref")
     if redundancy is not None:
+        if method == "multistart":
+            raise OptionError("redundancy", redundancy, f"None with solver={req.solver!r} and options (redundancy= "
+                              "sweeps a joint of the closed form: solver 'auto' or 'analytic', no options)")
         return redundant_all(robot, target, req, check_redundancy(redundancy), ref, max_solutions)
     if method == "analytic" or (method == "auto" and has_closed_form(robot, req)):
         return analytic_all(robot, target, req, q_ref=ref, max_solutions=max_solutions)
