@@ -37,3 +37,34 @@ def test_a_path_is_announced_once_per_process(monkeypatch):
         compiling.announce("FRDM", [None])
         compiling.announce("FRDM", [None])
     assert len(said) == 1 and "about 60 s" in str(said[0].message)
+
+
+def test_a_helper_changed_in_another_module_drops_the_cached_kernel(tmp_path):
+    """numba keys a kernel's cache on its own file: change a helper it calls elsewhere and the cached kernel
+    keeps the old arithmetic. drop_stale_cache removes the package's cache files when a module with kernels
+    changed, so the next process compiles the new code."""
+    import subprocess
+
+    package = tmp_path / "pkg"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    (package / "helper.py").write_text("from numba import njit\n\n\n@njit(cache=True)\ndef scale(x):\n"
+                                       "    return 2 * x\n")
+    (package / "kernel.py").write_text("from numba import njit\n\nfrom pkg.helper import scale\n\n\n"
+                                       "@njit(cache=True)\ndef run(x):\n    return scale(x) + 1\n")
+    call = ("import sys; from pathlib import Path; from kinelab.ik.compiling import drop_stale_cache; "
+            "dropped = drop_stale_cache(Path(sys.argv[1])); from pkg.kernel import run; print(dropped, run(10))")
+
+    def fresh_process() -> str:
+        env = {**__import__("os").environ, "PYTHONPATH": str(tmp_path)}
+        done = subprocess.run([sys.executable, "-c", call, str(package)], capture_output=True, text=True, env=env,
+                              timeout=300)
+        assert done.returncode == 0, done.stderr[-2000:]
+        return done.stdout.strip()
+
+    assert fresh_process() == "False 21"  # nothing cached yet: the stamp is written, the kernel compiled
+    assert fresh_process() == "False 21"  # unchanged: the cache serves
+    (package / "helper.py").write_text("from numba import njit\n\n\n@njit(cache=True)\ndef scale(x):\n"
+                                       "    return 3 * x\n")
+    assert fresh_process() == "True 31"  # the helper changed: the cache is dropped and the new code runs
+    assert fresh_process() == "False 31"
