@@ -47,6 +47,18 @@ def test_info_json_is_stable(capsys):
     assert json.loads(out)["collisions"].startswith("17 collision object(s) of panda, 0 obstacle(s); 75 pairs")
 
 
+def test_info_names_the_closed_form_or_the_joint_a_7r_arm_holds(capsys):
+    lines = {}
+    for name in ("ur5", "kinova", "panda", "youbot"):
+        code, out, _ = run(capsys, "info", name)
+        assert code == 0
+        lines[name] = next(line for line in out.splitlines() if line.startswith("closed form: "))
+    assert lines["ur5"] == "closed form: 6R, axes 2, 3, 4 parallel, axes 5 and 6 meeting: every branch in closed form"
+    assert "spherical wrist" in lines["kinova"] and lines["kinova"].endswith("every branch in closed form")
+    assert lines["panda"].startswith("closed form: with joint 7 (panda_joint7) held: ")
+    assert "redundancy=K" in lines["panda"] and lines["youbot"].startswith("closed form: none")
+
+
 def test_fk_stanford_matches_the_papers_rotation(capsys):
     code, out, _ = run(capsys, "fk", "stanford", "20", "40", "0.3", "-35", "60", "-45", "--deg", "--json")
     pose = json.loads(out)

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from kinelab.cli.common import json_flag, load_robot, print_json, robot_arguments
+from kinelab.ik.analytic.redundancy import closed_form_summary
 from kinelab.robot import Joint, catalog
 
 
@@ -52,7 +53,8 @@ def run_info(args: argparse.Namespace) -> int:
     info = {"robot": robot.name, "urdf": str(robot.urdf_path), "base": robot.base, "tool": robot.tool,
             "dof": robot.n, "nq": robot.nq, "nv": robot.nv, "joints": [_joint_row(j) for j in robot.joints],
             "locked": robot.locked, "mimics": {name: m.leader for name, m in robot.mimics.items()},
-            "format": robot.source_format, "collisions": _collision_summary(robot)}
+            "format": robot.source_format, "collisions": _collision_summary(robot),
+            "closed_form": closed_form_summary(robot)}
     if args.json:
         print_json(info)
         return 0
@@ -69,6 +71,7 @@ def run_info(args: argparse.Namespace) -> int:
         print(f"mimic: {name} follows {m.leader}")
     if robot.locked:
         print(f"locked: {', '.join(f'{k}={v:g}' for k, v in robot.locked.items())}")
+    print(f"closed form: {info['closed_form']}")
     print(f"collisions: {info['collisions']}")
     return 0
 

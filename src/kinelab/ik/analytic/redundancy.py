@@ -182,3 +182,18 @@ def redundant_all(robot: Robot, target: pin.SE3, req: Request, k: int, q_ref: np
                                              polished=1 if finished else None),
                      task=req.task_label)
             for q, dp, dr, finished, count, loose in answers[:max_solutions]]
+
+
+def closed_form_summary(robot: Robot) -> str:
+    """One line on the robot's closed form (``kinelab info``): its class, the joint a 7R arm holds, or none."""
+    from kinelab.ik.analytic.classify import classify
+
+    arm = classify(robot).arm
+    if arm is not None:
+        return f"{arm.name}: every branch in closed form"
+    if robot.n == 7 and has_swept_form(robot):
+        sw = swept_arm(robot)
+        return (f"with joint {sw.joint + 1} ({robot.joints[sw.joint].name}) held: {sw.arm.name} "
+                "(solve_all(..., redundancy=K))")
+    return "none (the numeric multistart; solver='analytic' names the failed tests)"
+
