@@ -77,6 +77,41 @@ def test_a_success_is_clear_of_the_arm_and_the_obstacles(arm):
     assert successes >= 20 and colliding_targets >= 10
 
 
+def test_a_colliding_answer_of_an_arm_with_a_closed_form_restarts_at_its_nearest_clear_branch():
+    """ur5 (closed form): where the plain answer hits the floor or the table, the solve with collisions= runs
+    once more from the clear branch nearest that answer and returns it; with a box through the shoulder every
+    branch collides, which the solve says at once, counting the branches."""
+    from kinelab.ik.limits import distance
+
+    ur5 = kinelab.load("ur5")
+    model = collision_model(ur5, Collisions(environment=FLOOR_AND_TABLE))
+    rng = np.random.default_rng(11)
+    checked = 0
+    for seed in range(200):
+        q = ur5.random_q(rng)
+        if model.colliding_pair(q) is not None:
+            continue
+        target = ur5.fk(q)
+        plain = kinelab.solve(ur5, target, seed=seed)
+        if not plain.success or model.colliding_pair(plain.q) is None:
+            continue
+        res = kinelab.solve(ur5, target, seed=seed, collisions=FLOOR_AND_TABLE)
+        assert res.success and res.diagnostics.clear_after == 1 and model.colliding_pair(res.q) is None
+        clear = [b.q for b in kinelab.solve_all(ur5, target) if model.colliding_pair(b.q) is None]
+        gaps = [distance(ur5, b, plain.q) for b in clear]  # the distance the branches are sorted by
+        assert min(distance(ur5, b, res.q) for b in clear) < 1e-6  # one of the clear branches
+        assert distance(ur5, res.q, plain.q) <= min(gaps) + 1e-9  # a nearest one (ties happen: q1 ± π)
+        checked += 1
+        if checked == 10:
+            break
+    assert checked == 10
+    shoulder = Environment((Obstacle("box", size=(0.3, 0.3, 0.3), xyz=(0.0, 0.0, 0.1), name="post"),))
+    target = ur5.fk(ur5.random_q(2))
+    res = kinelab.solve(ur5, target, seed=0, collisions=Collisions(self_collisions=False, environment=shoulder))
+    assert res.status.value == "collision" and "each of its" in res.message and "post" in res.message
+    assert res.diagnostics.clear_after == 1 and res.wall_time < 0.5
+
+
 def test_solve_all_marks_or_drops_the_branches_that_collide():
     ur5 = kinelab.load("ur5")
     model = collision_model(ur5, Collisions(environment=FLOOR_AND_TABLE))
