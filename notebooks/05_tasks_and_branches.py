@@ -150,6 +150,35 @@ for k, b in enumerate(axis_branches):
 view_so101 = viz.side_by_side(so101, [b.q for b in axis_branches])
 view_so101.notebook_html()
 
+# %% [markdown]
+# ## A 7R arm's branches along its redundancy
+#
+# A 7-joint arm meets a pose along a one-parameter family of configurations. The Panda's first six joints
+# have a spherical shoulder and axes 5 and 6 meeting: with joint 7 held at a value they have a closed form
+# (docs/analytic.md), so `solve_all(..., redundancy=K)` returns every branch at K values of joint 7, each
+# checked by Pinocchio on the whole arm. Plotted against the held joint, the answers trace the self-motion
+# curves of the pose: where a curve ends, a joint limit (or the reach) cuts it.
+
+# %%
+import matplotlib.pyplot as plt  # noqa: E402
+
+panda = kinelab.load("panda")
+oMpanda = panda.fk(panda.random_q(np.random.default_rng(7)))
+swept = kinelab.solve_all(panda, oMpanda, redundancy=64)
+print(f"{len(swept)} answers at 64 values of joint 7: {swept[0].mode}")
+print(f"worst error: {max(max(panda.tool_error(s.q, oMpanda)) for s in swept):.1e} (m or rad)")
+Q = np.array([s.q for s in swept])
+fig, axes = plt.subplots(2, 3, figsize=(11, 5.5), sharex=True)
+for j, ax in enumerate(axes.flat):
+    ax.scatter(Q[:, 6], Q[:, j], s=6)
+    ax.axhline(panda.lower[j], color="0.6", lw=0.8)
+    ax.axhline(panda.upper[j], color="0.6", lw=0.8)
+    ax.set_ylabel(f"q{j + 1} [rad]")
+for ax in axes[1]:
+    ax.set_xlabel("q7, held [rad]")
+fig.suptitle("Every branch of one Panda pose at 64 values of joint 7 (grey: joint limits)")
+fig.tight_layout()
+
 # %%
 view.close()
 view_so101.close()
