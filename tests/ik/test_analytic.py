@@ -146,6 +146,28 @@ def test_the_spherical_wrist_branches_of_kinova_are_eaik_s_as_sets():
     assert compared >= 0.85 * POSES and agree >= 0.999 * compared
 
 
+def test_the_youbot_heading_and_arm_branches_meet_every_pose_and_are_the_dense_multistart_s():
+    """The youBot's platform heading and arm (its x and y held): axes 1 ∥ 2, axes 3 ∥ 4 ∥ 5, a class of its own
+    (no EAIK class): every answer confirmed by Pinocchio, the configuration the pose came from found, and on
+    one pose in fifty the same set as a dense FRDM search (0.5 s without its stopping rule)."""
+    youbot = load("youbot")
+    turning = load(str(youbot.source), tool=youbot.tool, base=youbot.base,
+                   locked={"platform_x": 0.0, "platform_y": 0.0})
+    assert classify(turning).arm.name == "6R, axes 1, 2 parallel, axes 3, 4, 5 parallel"
+    searched = agree = 0
+    for k, q in enumerate(poses(turning, singular=[[3], [4]], seed=12)):
+        target = turning.fk(q)
+        found = kinelab.solve_all(turning, target, solver="analytic")
+        for s in found:
+            assert turning.within_limits(s.q) and max(turning.tool_error(s.q, target)) <= 1e-6
+        assert any(np.max(np.abs(wrapped(s.q - q))) <= SAME for s in found) or continuum(found)
+        if k % 50 == 0:
+            searched += 1
+            dense = kinelab.solve_all(turning, target, solver="frdm", seed=k, time_budget=0.5, stop_below=None)
+            agree += same_set([s.q for s in found], [s.q for s in dense], tol=1e-2)
+    assert agree == searched == POSES // 50
+
+
 def test_the_so101_branches_are_eaik_and_the_dense_multistart_as_sets():
     robot = load("so101")
     eaik = Eaik(robot)

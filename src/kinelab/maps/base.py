@@ -4,6 +4,11 @@ platform's x and y held there (the heading and the arm free: six coordinates on 
 six components of the grasp) is asked for the grasp, every answer checked by Pinocchio; the reachable
 positions are ranked by the arm's manipulability there. (A grid over the heading as well would ask a
 5-joint arm for a full pose from a fixed platform, which it meets only by chance.)
+
+The heading and the arm are a 6R chain; where it is in a closed-form class (the youBot's: heading ∥ joint 1,
+joints 2, 3, 4 parallel; docs/analytic.md) every branch of every position comes from the closed form in one
+batch and the position keeps its best-conditioned branch; otherwise a seeded numeric batch with restarts finds
+one answer per position.
 """
 
 from __future__ import annotations
@@ -15,6 +20,8 @@ import pinocchio as pin
 
 from kinelab.analysis.singular import conditioning_batch
 from kinelab.errors import KinelabError
+from kinelab.ik.analytic.branches import all_branches_batch
+from kinelab.ik.analytic.classify import classify
 from kinelab.ik.api import solve_batch
 from kinelab.ik.request import check_seed
 from kinelab.ik.targets import as_target
@@ -85,11 +92,37 @@ def base_map(robot: Robot, grasp: pin.SE3, step: float = 0.05, restarts: int = 1
     xy = np.array([(grasp.translation[0] + a, grasp.translation[1] + b) for a in ticks for b in ticks
                    if np.hypot(a, b) <= reach_xy])
     targets = np.array([(pin.SE3(np.eye(3), np.array([-x, -y, 0.0])) * grasp).homogeneous for x, y in xy])
-    res = solve_batch(turning, targets, seed=seed, max_restarts=restarts)
-    manip = np.zeros(len(xy))
-    if res.success.any():
-        J = turning.jacobian_batch(res.q[res.success], frame="local_world_aligned")[:, :, 1:]  # the arm's columns
-        manip[res.success] = conditioning_batch(J, turning.characteristic_length())[0]
-    yaw = np.where(res.success, res.q[:, 0], np.nan)
-    q = np.where(res.success[:, None], res.q[:, 1:], np.nan)
-    return BaseMap(np.column_stack([xy, yaw]), res.success.copy(), manip, q)
+    if classify(turning).arm is not None:
+        success, answers, manip = _best_branches(turning, targets)
+    else:
+        res = solve_batch(turning, targets, seed=seed, max_restarts=restarts)
+        success, answers, manip = res.success.copy(), res.q, np.zeros(len(xy))
+        if success.any():
+            manip[success] = _manipulability(turning, res.q[success])
+    yaw = np.where(success, answers[:, 0], np.nan)
+    q = np.where(success[:, None], answers[:, 1:], np.nan)
+    return BaseMap(np.column_stack([xy, yaw]), success, manip, q)
+
+
+def _manipulability(turning: Robot, q: np.ndarray) -> np.ndarray:
+    """Yoshikawa's measure of the arm's columns of the Jacobian (linear rows / L) at each row of q."""
+    J = turning.jacobian_batch(q, frame="local_world_aligned")[:, :, 1:]  # the arm's columns
+    return np.asarray(conditioning_batch(J, turning.characteristic_length())[0])
+
+
+def _best_branches(turning: Robot, targets: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(reached, the best-conditioned branch (P, 6), its manipulability) per target from the closed form's batch
+    (every branch confirmed by Pinocchio)."""
+    batch = all_branches_batch(turning, targets)
+    success = batch.count > 0
+    answers = np.full((len(targets), turning.n), np.nan)
+    manip = np.zeros(len(targets))
+    pose, row = np.nonzero(np.arange(batch.q.shape[1])[None, :] < batch.count[:, None])
+    if pose.size:
+        scores = _manipulability(turning, batch.q[pose, row])
+        order = np.lexsort((scores, pose))  # by position, best branch last
+        last = np.r_[pose[order][1:] != pose[order][:-1], True]
+        best = order[last]
+        answers[pose[best]] = batch.q[pose[best], row[best]]
+        manip[pose[best]] = scores[best]
+    return success, answers, manip

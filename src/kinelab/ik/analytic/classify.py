@@ -7,6 +7,8 @@ from the tool back to the base, which solves the inverse pose):
 - **6R, h₂ ∥ h₃, axes 4, 5 and 6 meeting** (a spherical wrist: the Kinova Jaco 2 j2s6s200): up to 8;
 - **6R, axes 1 and 2 meeting, axes 4, 5 and 6 meeting**: up to 8 (mirrored: a spherical shoulder and axes 5
   and 6 meeting — the Panda's and the xArm7's first six joints);
+- **6R, h₁ ∥ h₂, h₃ ∥ h₄ ∥ h₅** (a turning platform carrying a planar arm: the youBot's heading and arm):
+  up to 8;
 - **5R, h₂ ∥ h₃ ∥ h₄** (the SO-101): up to 4 candidates, of which a pose keeps those that meet it.
 
 Axes count as parallel when their angle is below AXIS_TOL and as meeting when their distance is below
@@ -20,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinelab.errors import ChainError
-from kinelab.ik.analytic.kernel import MEETING_6R, PARALLEL_5R, PARALLEL_6R, SPHERICAL_6R
+from kinelab.ik.analytic.kernel import MEETING_6R, PARALLEL_5R, PARALLEL_6R, SPHERICAL_6R, TWO_THREE_6R
 from kinelab.ik.chain import PRISMATIC, chain_model
 from kinelab.robot import Robot
 
@@ -133,6 +135,20 @@ def _meeting(h: np.ndarray, o: np.ndarray) -> np.ndarray | str:
     return found
 
 
+def _two_three(h: np.ndarray, o: np.ndarray) -> np.ndarray | str:
+    """The points the class h₁ ∥ h₂, h₃ ∥ h₄ ∥ h₅ solves with (as given), or the tests failed."""
+    misses = []
+    for i, j in ((0, 1), (2, 3), (2, 4)):
+        angle = _angle(h[i], h[j])
+        if angle > AXIS_TOL:
+            misses.append(f"axes {i + 1} and {j + 1} are {angle:.2g} rad from parallel (tolerance {AXIS_TOL:g})")
+    if _angle(h[0], h[2]) <= AXIS_TOL or _angle(h[2], h[5]) <= AXIS_TOL:
+        misses.append("axis 3 is parallel to axis 1 or 6")
+    if not misses and line_distance(o[0], h[0], o[1], h[1]) <= POINT_TOL:
+        misses.append("axes 1 and 2 are one line")
+    return "; ".join(misses) if misses else o.copy()
+
+
 def _with_wrist(h: np.ndarray, o: np.ndarray, misses: list[str]) -> np.ndarray | str:
     """o with o[3..5] moved to the point where axes 4, 5, 6 meet, or ``misses`` and the wrist's failed tests."""
     if _angle(h[3], h[4]) <= AXIS_TOL or _angle(h[4], h[5]) <= AXIS_TOL:
@@ -151,7 +167,8 @@ def _with_wrist(h: np.ndarray, o: np.ndarray, misses: list[str]) -> np.ndarray |
 
 CLASSES = {6: ((PARALLEL_6R, "6R, axes 2, 3, 4 parallel, axes 5 and 6 meeting", _parallel),
                (SPHERICAL_6R, "6R, axes 2, 3 parallel, axes 4, 5, 6 meeting (spherical wrist)", _spherical),
-               (MEETING_6R, "6R, axes 1, 2 meeting, axes 4, 5, 6 meeting (spherical wrist)", _meeting)),
+               (MEETING_6R, "6R, axes 1, 2 meeting, axes 4, 5, 6 meeting (spherical wrist)", _meeting),
+               (TWO_THREE_6R, "6R, axes 1, 2 parallel, axes 3, 4, 5 parallel", _two_three)),
            5: ((PARALLEL_5R, "5R, axes 2, 3, 4 parallel", _parallel),)}
 
 

@@ -16,6 +16,11 @@ from its distance to axis 2's point, subproblem 3; joint 2 by subproblem 1); the
 gives joint 5 (subproblem 4), then joints 4 and 6 (subproblem 1 each). With axes 1 and 2 meeting at s
 instead, the wrist point's distance from s fixes joint 3 (subproblem 3) and the turn of joints 1 and 2 onto
 it is subproblem 2 (here subproblem 4 for joint 1, then subproblem 1 for joint 2).
+
+With h₁ ∥ h₂ and h₃ ∥ h₄ ∥ h₅ (a turning platform carrying a planar arm, the youBot's heading and arm), the
+rotation is R(h₁, θ₁)·R(h₃, θ₃)·R(h₆, q₆) with θ₁ = q₁ ± q₂ and θ₃ = q₃ ± q₄ ± q₅: θ₃ by subproblem 4, θ₁
+and q₆ by subproblem 1; the point then fixes q₂ through the component along h₃ that the planar joints keep
+(subproblem 4), and the planar elbow gives q₄ (subproblem 3) and q₃ (subproblem 1).
 """
 
 from __future__ import annotations
@@ -44,7 +49,7 @@ from kinelab.ik.analytic.subproblems import (
 )
 
 MAX_ROWS = 8
-PARALLEL_5R, PARALLEL_6R, SPHERICAL_6R, MEETING_6R = 0, 1, 2, 3  # the classes' kernel codes (ArmClass.kind)
+PARALLEL_5R, PARALLEL_6R, SPHERICAL_6R, MEETING_6R, TWO_THREE_6R = 0, 1, 2, 3, 4  # kernel codes (ArmClass.kind)
 SINGULAR_WRIST = 1e-6  # [rad] q5's two roots closer than twice this are the singular wrist's double root
 
 
@@ -238,6 +243,57 @@ def meeting_6r(h, o, R0, N0, Rt, pt, out, free):
 
 
 @njit(cache=True)
+def two_three_6r(h, o, R0, N0, Rt, pt, out, free):
+    """Every branch of a 6R arm with h₁ ∥ h₂ and h₃ ∥ h₄ ∥ h₅; returns the row count. Arguments as
+    :func:`parallel_6r`."""
+    R06 = mm(Rt, transpose(R0))
+    h1, h3, h6 = row3(h, 0), row3(h, 2), row3(h, 5)
+    s2 = 1.0 if dot3(row3(h, 1), h1) > 0 else -1.0
+    p12, p56 = sub3(row3(o, 1), row3(o, 0)), sub3(row3(o, 5), row3(o, 4))
+    rest = sub3(sub3(pt, row3(o, 0)), mv(R06, sub3(N0, row3(o, 5))))
+    n3, a3, b3 = sp4(h1, h3, h6, dot3(h1, mv(R06, h6)))
+    if n3 == 2 and abs(wrap(a3 - b3)) < 2.0 * SINGULAR_WRIST:
+        n3, a3 = 1, a3 - 0.5 * wrap(a3 - b3)
+    row = 0
+    for i3 in range(max(n3, 0)):
+        t3 = a3 if i3 == 0 else b3
+        R3s = rotation(h3, t3)
+        m1, t1 = sp1(h1, mv(R3s, h6), mv(R06, h6))
+        R15 = mm(rotation(h1, t1), R3s)
+        _, q6 = sp1(h6, h3, mtv(R15, mv(R06, h3)))
+        w = mtv(rotation(h1, t1), sub3(rest, mv(R15, p56)))
+        n2, a2, b2 = sp4(h3, h1, p12, dot3(h3, w) - dot3(h3, sub3(row3(o, 4), row3(o, 1))))
+        for i2 in range(max(n2, 0)):
+            phi = a2 if i2 == 0 else b2  # the turn about h1 of joint 1 against the sum θ₁: q₂ = ∓φ
+            v = sub3(sub3(w, mv(rotation(h1, phi), p12)), sub3(row3(o, 2), row3(o, 1)))
+            row = _planar_three(h, o, v, t3, (t1 + phi, -s2 * phi, q6), out, free, row,
+                                m1 == DEGENERATE or n3 == 1)
+    return row
+
+
+@njit(cache=True)
+def _planar_three(h, o, v, t3, outer, out, free, row, flag):
+    """Rows for joints 3–5 (parallel) reaching v = R₃(p₃₄ + R₄ p₄₅) with q₃ ± q₄ ± q₅ = t3, after (q1, q2, q6) in
+    ``outer``; returns the next row."""
+    h3, h4 = row3(h, 2), row3(h, 3)
+    s4 = 1.0 if dot3(h4, h3) > 0 else -1.0
+    s5 = 1.0 if dot3(row3(h, 4), h3) > 0 else -1.0
+    p34, p45 = sub3(row3(o, 3), row3(o, 2)), sub3(row3(o, 4), row3(o, 3))
+    n4, a4, b4 = sp4(p34, h4, p45, 0.5 * (dot3(v, v) - dot3(p34, p34) - dot3(p45, p45)))
+    if n4 <= 0:
+        return row
+    for i4 in range(2):
+        q4 = a4 if i4 == 0 else b4
+        _, q3 = sp1(h3, add3(p34, mv(rotation(h4, q4), p45)), v)
+        q5 = s5 * (t3 - q3 - s4 * q4)
+        out[row, 0], out[row, 1], out[row, 2] = wrap(outer[0]), wrap(outer[1]), wrap(q3)
+        out[row, 3], out[row, 4], out[row, 5] = wrap(q4), wrap(q5), wrap(outer[2])
+        free[row] = flag
+        row += 1
+    return row
+
+
+@njit(cache=True)
 def _spherical_wrist(h, Rw, q1, q2, q3, out, free, row, flag):
     """Rows for joints 4–6 turning the rotation Rw = R₄R₅R₆ (after q1, q2, q3); returns the next row. With the
     wrist singular (h₆ turned onto h₄: q5's double root) q4 + q6 is a continuum: q4 = 0 and the row is flagged."""
@@ -298,6 +354,8 @@ def branches(kind, mirrored, h, o, R0, N0, H, lower, upper, ref, use_ref, same, 
         count = spherical_6r(h, o, R0t, N0t, Rt, pt, raw, loose)
     elif kind == MEETING_6R:
         count = meeting_6r(h, o, R0t, N0t, Rt, pt, raw, loose)
+    elif kind == TWO_THREE_6R:
+        count = two_three_6r(h, o, R0t, N0t, Rt, pt, raw, loose)
     else:
         count = parallel_5r(h, o, R0t, N0t, Rt, pt, raw, loose)
     m = 0
@@ -332,7 +390,7 @@ def branches_batch(kind, mirrored, h, o, R0, N0, H, lower, upper, same, slack, o
     """:func:`branches` for every pose of the (B, 4, 4) stack H, in threads (copies nearest 0).
 
     Args:
-        kind: the class's kernel code (PARALLEL_5R, PARALLEL_6R, SPHERICAL_6R or MEETING_6R).
+        kind: the class's kernel code (PARALLEL_5R, PARALLEL_6R, SPHERICAL_6R, MEETING_6R or TWO_THREE_6R).
         mirrored: the class is solved read from the tool back.
         h: (n, 3) unit axes at q = 0 in the solved orientation.
         o: (n, 3) points on them [m].
