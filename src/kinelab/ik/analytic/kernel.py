@@ -84,13 +84,9 @@ def _elbow(h, o, q1, R1, R06, v, R_rest, wrist, spin, out, free, row, flag):
         last += spin * (t234 - chosen)
         t234 = chosen
         R234 = rotation(h2, t234)
-    delta = sub3(c, mv(R234, p45))
-    n3, a3, b3 = sp4(p23, h3, p34, 0.5 * (dot3(delta, delta) - dot3(p34, p34) - dot3(p23, p23)))
-    if n3 <= 0:
-        return row
-    for i3 in range(2):
-        q3 = a3 if i3 == 0 else b3
-        _, q2 = sp1(h2, add3(p23, mv(rotation(h3, q3), p34)), delta)
+    n, q2a, q3a, q2b, q3b = _planar_pair(h2, h3, p23, p34, sub3(c, mv(R234, p45)))
+    for i in range(n):
+        q2, q3 = (q2a, q3a) if i == 0 else (q2b, q3b)
         q4 = s4 * (t234 - q2 - s3 * q3)
         out[row, 0], out[row, 1], out[row, 2], out[row, 3] = wrap(q1), wrap(q2), wrap(q3), wrap(q4)
         out[row, 4] = wrap(wrist[0])
@@ -101,6 +97,18 @@ def _elbow(h, o, q1, R1, R06, v, R_rest, wrist, spin, out, free, row, flag):
         free[row] = flag
         row += 1
     return row
+
+
+@njit(cache=True)
+def _planar_pair(ha, hb, pa, pb, v):
+    """The two (qa, qb) with R(ha, qa)·(pa + R(hb, qb)·pb) = v, ha ∥ hb (a planar elbow): qb by subproblem 3,
+    then qa by subproblem 1; (count, qa₁, qb₁, qa₂, qb₂), count 0 when ‖v‖ is out of the elbow's reach."""
+    n, a, b = sp4(pa, hb, pb, 0.5 * (dot3(v, v) - dot3(pa, pa) - dot3(pb, pb)))
+    if n <= 0:
+        return 0, 0.0, 0.0, 0.0, 0.0
+    _, qa1 = sp1(ha, add3(pa, mv(rotation(hb, a), pb)), v)
+    _, qa2 = sp1(ha, add3(pa, mv(rotation(hb, b), pb)), v)
+    return 2, qa1, a, qa2, b
 
 
 @njit(cache=True)
@@ -279,12 +287,9 @@ def _planar_three(h, o, v, t3, outer, out, free, row, flag):
     s4 = 1.0 if dot3(h4, h3) > 0 else -1.0
     s5 = 1.0 if dot3(row3(h, 4), h3) > 0 else -1.0
     p34, p45 = sub3(row3(o, 3), row3(o, 2)), sub3(row3(o, 4), row3(o, 3))
-    n4, a4, b4 = sp4(p34, h4, p45, 0.5 * (dot3(v, v) - dot3(p34, p34) - dot3(p45, p45)))
-    if n4 <= 0:
-        return row
-    for i4 in range(2):
-        q4 = a4 if i4 == 0 else b4
-        _, q3 = sp1(h3, add3(p34, mv(rotation(h4, q4), p45)), v)
+    n, q3a, q4a, q3b, q4b = _planar_pair(h3, h4, p34, p45, v)
+    for i in range(n):
+        q3, q4 = (q3a, q4a) if i == 0 else (q3b, q4b)
         q5 = s5 * (t3 - q3 - s4 * q4)
         out[row, 0], out[row, 1], out[row, 2] = wrap(outer[0]), wrap(outer[1]), wrap(q3)
         out[row, 3], out[row, 4], out[row, 5] = wrap(q4), wrap(q5), wrap(outer[2])
