@@ -4,6 +4,8 @@ arm including singular and joint-limit ones: the UR arms' closed form of tests/c
 and points, not from kinelab's chain model); for the SO-101 EAIK and FRDM's dense multistart. Every answer is
 confirmed by Pinocchio within the limits. Mirrored and re-rooted chains are written as URDF files here."""
 
+import zlib
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -414,3 +416,61 @@ def test_the_prepared_closed_form_gives_what_the_plain_calls_give():
         kinelab.IK(load("panda"), solver="analytic")
     with pytest.raises(OptionError, match="none with solver='analytic'"):
         kinelab.IK(ur5, solver="analytic", relax=1.2)
+
+
+def _unit(rng):
+    v = rng.normal(size=3)
+    return v / np.linalg.norm(v)
+
+
+def random_arm(kind, rng):
+    """Axes h (n, 3) and points o (n, 3) of a random chain of the class ``kind``, in general position otherwise
+    (axes at random angles, not only at right angles; link lengths 0.1–0.5 m)."""
+    h = np.array([_unit(rng) for _ in range(6)])
+    o = rng.uniform(-0.5, 0.5, size=(6, 3))
+    if kind in ("parallel 6R", "parallel 5R"):
+        h[2], h[3] = h[1], -h[1]  # the parallel triple, one of them reversed
+        if kind == "parallel 6R":
+            meet = rng.uniform(-0.5, 0.5, 3)
+            o[4], o[5] = meet + 0.2 * h[4], meet - 0.1 * h[5]
+        return (h[:5], o[:5]) if kind == "parallel 5R" else (h, o)
+    if kind in ("spherical wrist", "meeting"):
+        w = rng.uniform(-0.5, 0.5, 3)
+        o[3], o[4], o[5] = w + 0.3 * h[3], w - 0.2 * h[4], w + 0.1 * h[5]
+        if kind == "spherical wrist":
+            h[2] = -h[1]
+        else:
+            s = rng.uniform(-0.5, 0.5, 3)
+            o[0], o[1] = s + 0.2 * h[0], s - 0.1 * h[1]
+        return h, o
+    h[1], h[3], h[4] = -h[0], h[2], -h[2]  # "two three": 1 ∥ 2, 3 ∥ 4 ∥ 5
+    return h, o
+
+
+@pytest.mark.parametrize("kind, name", [("parallel 6R", "6R, axes 2, 3, 4 parallel, axes 5 and 6 meeting"),
+                                        ("parallel 5R", "5R, axes 2, 3, 4 parallel"),
+                                        ("spherical wrist", "6R, axes 2, 3 parallel, axes 4, 5, 6 meeting"),
+                                        ("meeting", "6R, axes 1, 2 meeting, axes 4, 5, 6 meeting"),
+                                        ("two three", "6R, axes 1, 2 parallel, axes 3, 4, 5 parallel")])
+def test_random_arms_of_each_class_find_the_configuration_each_pose_came_from(tmp_path, kind, name):
+    """Arms generated here, ten per class, their axes at random angles (the registered arms have right angles
+    only): each classifies, every answer meets its pose (Pinocchio) and the configuration the pose came from is
+    among them (to SAME, or the pose is singular and its answer flagged one of a continuum), on 30 poses each."""
+    rng = np.random.default_rng(zlib.crc32(kind.encode()))
+    found_all = 0
+    for k in range(10):
+        h, o = random_arm(kind, rng)
+        n = h.shape[0]
+        tool = pin.SE3(pin.exp3(rng.normal(size=3)), o[-1] + rng.uniform(-0.3, 0.3, 3))
+        path = write_urdf(tmp_path, chain_urdf(h, o, tool, -np.pi * np.ones(n), np.pi * np.ones(n)), f"a{k}.urdf")
+        arm = load(path, tool="tool")
+        assert classify(arm).arm is not None and classify(arm).arm.name.startswith(name), classify(arm).reason
+        for _ in range(30):
+            q = arm.random_q(rng)
+            target = arm.fk(q)
+            answers = kinelab.solve_all(arm, target, solver="analytic")
+            assert all(max(arm.tool_error(s.q, target)) <= 1e-6 and arm.within_limits(s.q) for s in answers)
+            hit = any(np.max(np.abs(wrapped(s.q - q))) <= SAME for s in answers)
+            assert hit or continuum(answers) or (n == 5 and answers), (k, q)
+            found_all += hit
+    assert found_all >= 0.99 * 300
