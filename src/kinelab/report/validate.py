@@ -195,7 +195,7 @@ def _swept_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     from kinelab.ik.limits import distance
     from kinelab.ik.request import make_request
 
-    if robot.n != 7 or not has_swept_form(robot):
+    if not has_swept_form(robot):
         return []
     held = swept_arm(robot).joint
     count = max(10, n // 4)

@@ -108,11 +108,16 @@ def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | No
             answers.append((*verdict, int(found[k]), bool(free[k])))
     if q_ref is not None:
         answers.sort(key=lambda a: distance(robot, a[0], q_ref))
-    elapsed = time.perf_counter() - t0
-    mode = f"analytic ({arm.name})"
+    return branch_results(answers, req, f"analytic ({arm.name})", time.perf_counter() - t0, max_solutions, 0.0)
+
+
+def branch_results(answers: list[tuple[Any, ...]], req: Request, mode: str, elapsed: float,
+                   max_solutions: int | None, unseen: float | None) -> list[IKResult]:
+    """The closed form's answers — (q, position error, rotation error, finished, roots merged, one of a
+    continuum) each — as IKResults, the first ``max_solutions``; ``diagnostics.branches`` counts them all."""
     return [IKResult(q=q, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr, iterations=0,
                      restarts=0, wall_time=elapsed, solver="analytic", mode=mode, message=CONTINUUM if loose else "",
-                     diagnostics=Diagnostics(path="compiled", branches=len(answers), found=count, unseen=0.0,
+                     diagnostics=Diagnostics(path="compiled", branches=len(answers), found=count, unseen=unseen,
                                              polished=1 if finished else None),
                      task=req.task_label)
             for q, dp, dr, finished, count, loose in answers[:max_solutions]]

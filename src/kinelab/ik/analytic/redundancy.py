@@ -7,8 +7,8 @@ rotation by θ about the first joint's line (base frame); with the last joint at
 rotation about the last joint's line seen from the tool at θ = 0. The first joint is tried first. Every
 answer is judged by Pinocchio's FK of the whole chain within all of its limits.
 
-The ERA (the FRDM paper's arm) is such an arm; the Panda, the xArm7 and the Kinova 7-DoF arms are not (with
-any one joint held, the remaining axes meet no class's tests), and are refused with those tests named.
+The ERA (the FRDM paper's arm, joint 1 held), the Panda and the xArm7 (joint 7 held), the PR2, TALOS and
+TIAGo arms are such arms; Baxter's and TIAGo Pro's are not, and are refused with the tests each end failed.
 """
 
 from __future__ import annotations
@@ -21,12 +21,12 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.errors import ChainError, OptionError
-from kinelab.ik.analytic.branches import CONTINUUM, arm_roots, judged, limit_slack
-from kinelab.ik.analytic.classify import ArmClass, classify_vectors
+from kinelab.ik.analytic.branches import arm_roots, branch_results, judged, limit_slack
+from kinelab.ik.analytic.classify import ArmClass, classify, classify_vectors
 from kinelab.ik.chain import PRISMATIC, chain_model
 from kinelab.ik.limits import distance
 from kinelab.ik.request import Request
-from kinelab.ik.result import Diagnostics, IKResult, Status
+from kinelab.ik.result import IKResult
 from kinelab.robot import Robot
 
 
@@ -47,13 +47,12 @@ class SweptArm:
     point: np.ndarray
 
     def sub_target(self, H: np.ndarray, theta: float) -> np.ndarray:
-        """The 4 × 4 pose the six other joints must reach when the swept joint is at ``theta`` [rad]."""
-        R = pin.exp3(theta * self.axis)
-        M = np.eye(4)
-        M[:3, :3], M[:3, 3] = R, self.point - R @ self.point
-        M_inv = np.eye(4)
-        M_inv[:3, :3], M_inv[:3, 3] = R.T, -R.T @ M[:3, 3]
-        return M_inv @ H if self.joint == 0 else H @ M_inv
+        """The 4 × 4 pose the six other joints must reach when the swept joint is at ``theta`` [rad]: H turned by
+        −θ about the joint's line (on the left for the first joint, on the right for the last)."""
+        back = np.eye(4)
+        back[:3, :3] = pin.exp3(-theta * self.axis)
+        back[:3, 3] = self.point - back[:3, :3] @ self.point
+        return back @ H if self.joint == 0 else H @ back
 
 
 def swept_arm(robot: Robot, k: int | None = None) -> SweptArm:
@@ -175,23 +174,15 @@ def redundant_all(robot: Robot, target: pin.SE3, req: Request, k: int, q_ref: np
     if q_ref is not None:
         answers.sort(key=lambda a: distance(robot, a[0], q_ref))
     mode = f"analytic ({sw.arm.name}; joint {j + 1} swept over {k} samples)"
-    elapsed = time.perf_counter() - t0
-    return [IKResult(q=q, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr, iterations=0,
-                     restarts=0, wall_time=elapsed, solver="analytic", mode=mode, message=CONTINUUM if loose else "",
-                     diagnostics=Diagnostics(path="compiled", branches=len(answers), found=count,
-                                             polished=1 if finished else None),
-                     task=req.task_label)
-            for q, dp, dr, finished, count, loose in answers[:max_solutions]]
+    return branch_results(answers, req, mode, time.perf_counter() - t0, max_solutions, None)
 
 
 def closed_form_summary(robot: Robot) -> str:
     """One line on the robot's closed form (``kinelab info``): its class, the joint a 7R arm holds, or none."""
-    from kinelab.ik.analytic.classify import classify
-
     arm = classify(robot).arm
     if arm is not None:
         return f"{arm.name}: every branch in closed form"
-    if robot.n == 7 and has_swept_form(robot):
+    if has_swept_form(robot):
         sw = swept_arm(robot)
         return (f"with joint {sw.joint + 1} ({robot.joints[sw.joint].name}) held: {sw.arm.name} "
                 "(solve_all(..., redundancy=K))")

@@ -175,7 +175,7 @@ def run(robots: list[str] | None = None, n: int = 100, seed: int = 0, repeats: i
         robot = load(name)
         if classify(robot).arm is not None:
             rows.append(analytic_arm(robot, n, seed, repeats))
-        elif robot.n == 7 and has_swept_form(robot):
+        elif has_swept_form(robot):
             rows.append(redundant_arm(robot, max(10, n // 5), seed, repeats))
         else:
             rows.append(numeric_arm(robot, max(10, n // 5), seed, repeats))
