@@ -20,10 +20,9 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.collision.model import CollisionModel
-from kinelab.ik.analytic.branches import arm_of, has_closed_form, limit_slack, roots
+from kinelab.ik.analytic.branches import arm_of, has_closed_form, nearest_roots
 from kinelab.ik.batch import BatchIKResult, fresh_seed
 from kinelab.ik.driver import solve_one
-from kinelab.ik.limits import distance
 from kinelab.ik.request import Request
 from kinelab.ik.result import Diagnostics, IKResult, Status, TrackResult
 from kinelab.robot import Robot
@@ -75,8 +74,7 @@ def _from_branches(robot: Robot, target: Any, collided: IKResult, q0: Any, req: 
     """The solver run again from the pose's clear branches (closed form), nearest ``q0`` or the colliding answer
     first; a failure with status ``collision`` when every branch within the limits collides."""
     ref = collided.q if q0 is None else np.asarray(q0, dtype=float)  # q0 passed the first run's checks
-    q, _, _ = roots(robot, arm_of(robot, req), target.homogeneous, ref, limit_slack(req.tol_rot))
-    order = np.argsort([distance(robot, row, ref) for row in q])
+    q, _, _, order = nearest_roots(robot, arm_of(robot, req), target, req, ref)
     for k in order:
         if model.colliding_pair(q[k]) is not None:
             continue

@@ -123,6 +123,15 @@ def branch_results(answers: list[tuple[Any, ...]], req: Request, mode: str, elap
             for q, dp, dr, finished, count, loose in answers[:max_solutions]]
 
 
+def nearest_roots(robot: Robot, arm: ArmClass, target: Any, req: Request,
+                  ref: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any]:
+    """:func:`roots` of the pose ``target`` (copies nearest ``ref``, roots up to ``tol_rot`` past a limit tried at
+    it) and the order to try them in: nearest ``ref`` first (joint by joint, modulo 2π), as found without it."""
+    q, found, free = roots(robot, arm, target.homogeneous, ref, limit_slack(req.tol_rot))
+    order = range(q.shape[0]) if ref is None else np.argsort(np.abs(np.angle(np.exp(1j * (q - ref)))).max(axis=1))
+    return q, found, free, order
+
+
 def roots(robot: Robot, arm: ArmClass, H: np.ndarray, q_ref: np.ndarray | None,
           slack: float = LIMIT_SLACK) -> tuple[np.ndarray, ...]:
     """The compiled branches of the pose H (4 × 4, base frame): (q (m, n) within the limits, a root up to
@@ -242,8 +251,7 @@ def analytic_one(robot: Robot, target: Any, req: Request, q0: np.ndarray | None,
     """
     t0 = time.perf_counter()
     arm = arm_of(robot, req)
-    q, found, free = roots(robot, arm, target.homogeneous, q0, limit_slack(req.tol_rot))
-    order = range(q.shape[0]) if q0 is None else np.argsort(np.abs(np.angle(np.exp(1j * (q - q0)))).max(axis=1))
+    q, found, free, order = nearest_roots(robot, arm, target, req, q0)
     mode, collided = f"analytic ({arm.name})", None
     for k in order:
         verdict = judged(robot, q[k], target, req)
