@@ -151,32 +151,26 @@ def solver_checks(robot: Robot, n: int, seed: int) -> list[Check]:
 def analytic_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     """Where the arm has a closed form: its branches confirmed by Pinocchio, and every FRDM, biquaternion and DLS
     answer from a random start is one of them (with the share of FRDM answers on the branch nearest the start)."""
-    from kinelab.ik import solve, solve_all
+    from kinelab.ik import solve_all
     from kinelab.ik.analytic.classify import classify
     from kinelab.ik.branches import SAME
     from kinelab.ik.limits import distance
 
     if classify(robot).arm is None:
         return _swept_checks(robot, n, seed)
-    count = max(10, n // 4)
-    rng = np.random.default_rng(seed + 5)
-    targets = [robot.fk(robot.random_q(rng)) for _ in range(count)]
+    targets = _closed_form_targets(robot, n, seed)
     branches = [solve_all(robot, t, solver="analytic") for t in targets]
-    worst = max(max(robot.tool_error(b.q, t)) for t, found in zip(targets, branches, strict=True) for b in found)
-    rows = [Check(robot.name, "closed form: every branch met (Pinocchio-checked)", worst, 1e-6, "m or rad",
-                  f"{count} targets, {np.mean([len(b) for b in branches]):.2f} branches each within the limits")]
+    rows = [Check(robot.name, "closed form: every branch met (Pinocchio-checked)", _worst(robot, targets, branches),
+                  1e-6, "m or rad", f"{len(targets)} targets, {np.mean([len(b) for b in branches]):.2f} branches "
+                  "each within the limits")]
     for solver in ("frdm", "biquat", "dls"):
         on_branch = nearest = solved = 0
-        for k, (target, found) in enumerate(zip(targets, branches, strict=True)):
-            start = robot.random_q(np.random.default_rng(seed + 1000 + k))
-            res = solve(robot, target, solver=solver, q0=start, seed=k, time_budget=0.2)
-            if not res.success:
-                continue
+        for k, start, res in _solved_from_random_starts(robot, targets, solver, seed):
             solved += 1
-            gaps = [distance(robot, res.q, b.q) for b in found]
+            gaps = [distance(robot, res.q, b.q) for b in branches[k]]
             on_branch += min(gaps) <= SAME  # answers met to 1e-6 lie up to ~2e-4 rad off a branch near a singularity
-            nearest += int(np.argmin(gaps)) == int(np.argmin([distance(robot, start, b.q) for b in found]))
-        detail = f"{solved} of {count} solved from random starts"
+            nearest += int(np.argmin(gaps)) == int(np.argmin([distance(robot, start, b.q) for b in branches[k]]))
+        detail = f"{solved} of {len(targets)} solved from random starts"
         if solver == "frdm" and solved:
             detail += f"; on the branch nearest its start in {100 * nearest / solved:.0f} %"
         rows.append(Check(robot.name, f"{solver}: every answer is one of the closed form's branches",
@@ -189,7 +183,7 @@ def _swept_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     confirmed by Pinocchio, and every FRDM and DLS answer from a random start one of the branches at its own
     value of that joint, to SAME (95 % at least: an answer within the tolerances can sit at a limit whose exact
     root lies just beyond it, or near a singular shoulder several 1e-3 rad along the near-continuum)."""
-    from kinelab.ik import solve, solve_all
+    from kinelab.ik import solve_all
     from kinelab.ik.analytic.redundancy import at_value, has_swept_form, swept_arm
     from kinelab.ik.branches import SAME
     from kinelab.ik.limits import distance
@@ -198,29 +192,47 @@ def _swept_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     if not has_swept_form(robot):
         return []
     held = swept_arm(robot).joint
-    count = max(10, n // 4)
-    rng = np.random.default_rng(seed + 5)
-    targets = [robot.fk(robot.random_q(rng)) for _ in range(count)]
+    targets = _closed_form_targets(robot, n, seed)
     found = [solve_all(robot, t, redundancy=16) for t in targets]
-    worst = max(max(robot.tool_error(b.q, t)) for t, answers in zip(targets, found, strict=True) for b in answers)
-    rows = [Check(robot.name, f"closed form, joint {held + 1} swept: every branch met (Pinocchio-checked)", worst,
-                  1e-6, "m or rad", f"{count} targets, {np.mean([len(f) for f in found]):.1f} answers each at 16 "
-                  "samples")]
+    rows = [Check(robot.name, f"closed form, joint {held + 1} swept: every branch met (Pinocchio-checked)",
+                  _worst(robot, targets, found), 1e-6, "m or rad",
+                  f"{len(targets)} targets, {np.mean([len(f) for f in found]):.1f} answers each at 16 samples")]
     req = make_request("frdm")
     for solver in ("frdm", "dls"):
         on_branch = solved = 0
-        for k, target in enumerate(targets):
-            start = robot.random_q(np.random.default_rng(seed + 1000 + k))
-            res = solve(robot, target, solver=solver, q0=start, seed=k, time_budget=0.2)
-            if not res.success:
-                continue
+        for k, _, res in _solved_from_random_starts(robot, targets, solver, seed):
             solved += 1
-            branches = [a[0] for a in at_value(robot, target, req, float(res.q[held]))]
+            branches = [a[0] for a in at_value(robot, targets[k], req, float(res.q[held]))]
             on_branch += any(distance(robot, b, res.q) <= SAME for b in branches)
         rows.append(Check(robot.name, f"{solver}: every answer is a closed-form branch at its own joint {held + 1}",
-                          on_branch / max(solved, 1), 0.95, "%", f"{solved} of {count} solved from random starts",
-                          at_least=True))
+                          on_branch / max(solved, 1), 0.95, "%", f"{solved} of {len(targets)} solved from random "
+                          "starts", at_least=True))
     return rows
+
+
+def _closed_form_targets(robot: Robot, n: int, seed: int) -> list[Any]:
+    """max(10, n / 4) seeded targets, the FK of random configurations (oMtool)."""
+    rng = np.random.default_rng(seed + 5)
+    return [robot.fk(robot.random_q(rng)) for _ in range(max(10, n // 4))]
+
+
+def _worst(robot: Robot, targets: list[Any], answers: list[list[Any]]) -> float:
+    """The largest position or rotation error [m or rad] (Pinocchio) of any answer against its target."""
+    return max(max(robot.tool_error(a.q, t)) for t, found in zip(targets, answers, strict=True) for a in found)
+
+
+def _solved_from_random_starts(robot: Robot, targets: list[Any], solver: str,
+                               seed: int) -> list[tuple[int, np.ndarray, Any]]:
+    """(target index, start, answer) of each target that ``solver`` solves from its seeded random start."""
+    from kinelab.ik import solve
+
+    out = []
+    for k, target in enumerate(targets):
+        start = robot.random_q(np.random.default_rng(seed + 1000 + k))
+        res = solve(robot, target, solver=solver, q0=start, seed=k, time_budget=0.2)
+        if res.success:
+            out.append((k, start, res))
+    return out
 
 
 def collision_checks(robot: Robot, n: int, seed: int) -> list[Check]:
