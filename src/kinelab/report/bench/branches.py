@@ -93,18 +93,14 @@ def analytic_arm(robot: Robot, n: int, seed: int, repeats: int) -> dict[str, Any
     peer = _eaik(robot)
     if peer is not None:
         calls["EAIK (unchecked)"] = peer
-    for name in calls:  # warm-up: compilation
-        calls[name](poses[0], 0)
-    medians = rounds(poses, calls, repeats)
+    timed = _timed(poses, calls, repeats)
     closed = [solve_all(robot, t) for t in poses]
     searched = [solve_all(robot, t, solver="frdm", seed=seed + k) for k, t in enumerate(poses)]
     complete = sum(_complete(robot, s, c, SAME) for s, c in zip(searched, closed, strict=True))
     extra = sum(_complete(robot, c, s, SAME) is False for s, c in zip(searched, closed, strict=True))
     batch = _throughput(robot, rng)
     return {"robot": robot.name, "class": classify(robot).arm.name, "poses": n,  # type: ignore[union-attr]
-            "branches_mean": float(np.mean([len(c) for c in closed])),
-            "us": {k: 1e6 * float(np.median(v)) for k, v in medians.items()},
-            "spread_us": {k: (1e6 * min(v), 1e6 * max(v)) for k, v in medians.items()},
+            "branches_mean": float(np.mean([len(c) for c in closed])), **timed,
             "multistart_complete": complete / n, "multistart_beyond_closed_form": extra, **batch}
 
 
@@ -136,16 +132,12 @@ def numeric_arm(robot: Robot, n: int, seed: int, repeats: int) -> dict[str, Any]
     """An arm without a closed form: the multistart's time and its completeness against a dense search."""
     rng = np.random.default_rng(seed)
     poses = [robot.fk(robot.random_q(rng)) for _ in range(n)]
-    calls: dict[str, Call] = {"multistart": lambda t, s: solve_all(robot, t, seed=s)}
-    calls["multistart"](poses[0], 0)
-    medians = rounds(poses, calls, repeats)
+    timed = _timed(poses, {"multistart": lambda t, s: solve_all(robot, t, seed=s)}, repeats)
     complete = 0
     for k, target in enumerate(poses):
         dense = solve_all(robot, target, seed=10_000 + k, time_budget=0.5, stop_below=None)
         complete += _complete(robot, solve_all(robot, target, seed=seed + k), dense, SAME)
-    return {"robot": robot.name, "class": "none: " + classify(robot).reason, "poses": n,
-            "us": {k: 1e6 * float(np.median(v)) for k, v in medians.items()},
-            "spread_us": {k: (1e6 * min(v), 1e6 * max(v)) for k, v in medians.items()},
+    return {"robot": robot.name, "class": "none: " + classify(robot).reason, "poses": n, **timed,
             "multistart_complete": complete / n}
 
 
@@ -155,13 +147,27 @@ def redundant_arm(robot: Robot, n: int, seed: int, repeats: int) -> dict[str, An
     poses = [robot.fk(robot.random_q(rng)) for _ in range(n)]
     calls: dict[str, Call] = {"closed form": lambda t, s: solve_all(robot, t, redundancy=K),
                               "multistart": lambda t, s: solve_all(robot, t, solver="frdm", seed=s)}
-    for name in calls:
-        calls[name](poses[0], 0)
-    medians = rounds(poses, calls, repeats)
+    timed = _timed(poses, calls, repeats)
     found = [solve_all(robot, t, redundancy=K) for t in poses]
     return {"robot": robot.name, "class": f"{found[0][0].mode if found[0] else 'swept'}", "poses": n,
-            "branches_mean": float(np.mean([len(f) for f in found])), "samples": K,
-            "us": {k: 1e6 * float(np.median(v)) for k, v in medians.items()},
+            "branches_mean": float(np.mean([len(f) for f in found])), "samples": K, **timed}
+
+
+def _timed(poses: list[pin.SE3], calls: dict[str, Call], repeats: int) -> dict[str, Any]:
+    """:func:`figures` of :func:`warmed_rounds`."""
+    return figures(warmed_rounds(poses, calls, repeats))
+
+
+def warmed_rounds(poses: list[pin.SE3], calls: dict[str, Call], repeats: int) -> dict[str, list[float]]:
+    """Each call once on the first pose (compilation, not timed), then :func:`rounds`."""
+    for call in calls.values():
+        call(poses[0], 0)
+    return rounds(poses, calls, repeats)
+
+
+def figures(medians: dict[str, list[float]]) -> dict[str, Any]:
+    """{"us": the median over rounds [µs], "spread_us": (lowest, highest round) [µs]} per call."""
+    return {"us": {k: 1e6 * float(np.median(v)) for k, v in medians.items()},
             "spread_us": {k: (1e6 * min(v), 1e6 * max(v)) for k, v in medians.items()}}
 
 

@@ -19,7 +19,7 @@ from tqdm import tqdm
 
 from kinelab.collision import Collisions, Environment, Obstacle, collision_model
 from kinelab.ik.api import solve
-from kinelab.report.bench.branches import rounds
+from kinelab.report.bench.branches import figures, warmed_rounds
 from kinelab.robot import Robot, load
 
 ROBOTS = ("panda", "ur5", "kinova")
@@ -36,18 +36,14 @@ def arm(robot: Robot, n: int, seed: int, repeats: int) -> dict[str, Any]:
     targets = [robot.fk(q) for q in clear[:n]]
     calls = {"plain": lambda t, s: solve(robot, t, seed=s, time_budget=0.5),
              "collisions": lambda t, s: solve(robot, t, seed=s, time_budget=0.5, collisions=FLOOR_AND_TABLE)}
-    for call in calls.values():
-        call(targets[0], 0)
-    medians = rounds(targets, calls, repeats)
+    medians = warmed_rounds(targets, calls, repeats)
     plain = [solve(robot, t, seed=seed + k, time_budget=0.5) for k, t in enumerate(targets)]
     aware = [solve(robot, t, seed=seed + k, time_budget=0.5, collisions=FLOOR_AND_TABLE)
              for k, t in enumerate(targets)]
     ratio = [c / p for c, p in zip(medians["collisions"], medians["plain"], strict=True)]
     return {"robot": robot.name, "targets": len(targets), "pairs": len(model.pairs),
             "random_colliding": 1 - len(clear) / len(configurations),
-            "us": {k: 1e6 * float(np.median(v)) for k, v in medians.items()},
-            "spread_us": {k: (1e6 * min(v), 1e6 * max(v)) for k, v in medians.items()},
-            "ratio": float(np.median(ratio)), "ratio_spread": (min(ratio), max(ratio)),
+            **figures(medians), "ratio": float(np.median(ratio)), "ratio_spread": (min(ratio), max(ratio)),
             "plain_colliding": sum(r.success and model.colliding_pair(r.q) is not None for r in plain),
             "clear_success": sum(r.success for r in aware) / len(targets),
             "check_us": _check_cost(model, configurations[:1000]), "check_clear_us": _check_cost(model, clear[:1000])}
