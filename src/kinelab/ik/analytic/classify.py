@@ -112,13 +112,7 @@ def _parallel(h: np.ndarray, o: np.ndarray) -> np.ndarray | str:
 def _spherical(h: np.ndarray, o: np.ndarray) -> np.ndarray | str:
     """The points the class h₂ ∥ h₃, axes 4, 5, 6 meeting solves with (o[3..5] the wrist point), or the tests
     failed."""
-    misses = []
-    angle = _angle(h[1], h[2])
-    if angle > AXIS_TOL:
-        misses.append(f"axes 2 and 3 are {angle:.2g} rad from parallel (tolerance {AXIS_TOL:g})")
-    if _angle(h[0], h[1]) <= AXIS_TOL:
-        misses.append("axes 1 and 2 are parallel (joint 1 would not fix the plane of the elbow)")
-    return _with_wrist(h, o, misses)
+    return _with_wrist(h, o, _unparallel(h, ((1, 2),)) + _shoulder_parallel(h))
 
 
 def _meeting(h: np.ndarray, o: np.ndarray) -> np.ndarray | str:
@@ -137,11 +131,7 @@ def _meeting(h: np.ndarray, o: np.ndarray) -> np.ndarray | str:
 
 def _two_three(h: np.ndarray, o: np.ndarray) -> np.ndarray | str:
     """The points the class h₁ ∥ h₂, h₃ ∥ h₄ ∥ h₅ solves with (as given), or the tests failed."""
-    misses = []
-    for i, j in ((0, 1), (2, 3), (2, 4)):
-        angle = _angle(h[i], h[j])
-        if angle > AXIS_TOL:
-            misses.append(f"axes {i + 1} and {j + 1} are {angle:.2g} rad from parallel (tolerance {AXIS_TOL:g})")
+    misses = _unparallel(h, ((0, 1), (2, 3), (2, 4)))
     if _angle(h[0], h[2]) <= AXIS_TOL or _angle(h[2], h[5]) <= AXIS_TOL:
         misses.append("axis 3 is parallel to axis 1 or 6")
     if not misses and line_distance(o[0], h[0], o[1], h[1]) <= POINT_TOL:
@@ -174,13 +164,7 @@ CLASSES = {6: ((PARALLEL_6R, "6R, axes 2, 3, 4 parallel, axes 5 and 6 meeting", 
 
 def _misses(h: np.ndarray, o: np.ndarray) -> list[str]:
     """The class tests these axes fail, in words (empty: in the class)."""
-    misses = []
-    for i, j in ((1, 2), (1, 3)):
-        angle = _angle(h[i], h[j])
-        if angle > AXIS_TOL:
-            misses.append(f"axes {i + 1} and {j + 1} are {angle:.2g} rad from parallel (tolerance {AXIS_TOL:g})")
-    if _angle(h[0], h[1]) <= AXIS_TOL:
-        misses.append("axes 1 and 2 are parallel (joint 1 would not fix the plane of the elbow)")
+    misses = _unparallel(h, ((1, 2), (1, 3))) + _shoulder_parallel(h)
     if h.shape[0] == 6:
         gap = line_distance(o[4], h[4], o[5], h[5])
         if gap > POINT_TOL:
@@ -190,6 +174,19 @@ def _misses(h: np.ndarray, o: np.ndarray) -> list[str]:
     elif _angle(h[4], h[1]) <= AXIS_TOL:
         misses.append("axis 5 is parallel to axis 2 (the wrist could not turn the tool out of the arm's plane)")
     return misses
+
+
+def _unparallel(h: np.ndarray, pairs: tuple[tuple[int, int], ...]) -> list[str]:
+    """The pairs of axes (0-based indices) that are not parallel within AXIS_TOL, in words."""
+    return [f"axes {i + 1} and {j + 1} are {angle:.2g} rad from parallel (tolerance {AXIS_TOL:g})"
+            for i, j in pairs if (angle := _angle(h[i], h[j])) > AXIS_TOL]
+
+
+def _shoulder_parallel(h: np.ndarray) -> list[str]:
+    """The failed test, in words, when axes 1 and 2 are parallel (joint 1 would then not fix the elbow's plane)."""
+    if _angle(h[0], h[1]) <= AXIS_TOL:
+        return ["axes 1 and 2 are parallel (joint 1 would not fix the plane of the elbow)"]
+    return []
 
 
 def _angle(a: np.ndarray, b: np.ndarray) -> float:
