@@ -59,6 +59,15 @@ def mat9(M):
     return (M[0, 0], M[0, 1], M[0, 2], M[1, 0], M[1, 1], M[1, 2], M[2, 0], M[2, 1], M[2, 2])
 
 
+@njit(cache=True, inline="always")
+def _one_if_double(n, a, b):
+    """Subproblem 4's (count, θ₁, θ₂) with two roots closer than 2·SINGULAR_WRIST made one (their midpoint): the
+    double root of a singular wrist, whose two answers are one continuum."""
+    if n == 2 and abs(wrap(a - b)) < 2.0 * SINGULAR_WRIST:
+        return 1, a - 0.5 * wrap(a - b), b
+    return n, a, b
+
+
 @njit(cache=True)
 def _elbow(h, o, q1, R1, R06, v, R_rest, wrist, spin, out, free, row, flag):
     """Rows for one (q1, wrist) pair: θ₂₃₄ from R₁ᵀ·R·R_restᵀ, then θ₃ (two roots) and θ₂; returns the next row.
@@ -163,8 +172,7 @@ def parallel_6r(h, o, R0, N0, Rt, pt, out, free):
         R1 = rotation(row3(h, 0), q1)
         R1h2 = mv(R1, h2)
         n5, a5, b5 = sp4(h2, h5, h6, dot3(R1h2, mv(R06, h6)))
-        if n5 == 2 and abs(wrap(a5 - b5)) < 2.0 * SINGULAR_WRIST:  # a double root: h₆ ∥ h₂, q6 joins θ₂₃₄
-            n5, a5 = 1, a5 - 0.5 * wrap(a5 - b5)
+        n5, a5, b5 = _one_if_double(n5, a5, b5)  # a double root: h₆ ∥ h₂, q6 joins θ₂₃₄
         for i5 in range(max(n5, 0) if n5 != DEGENERATE else 1):
             q5 = (a5 if i5 == 0 else b5) if n5 != DEGENERATE else 0.0
             R5 = rotation(h5, q5)
@@ -260,8 +268,7 @@ def two_three_6r(h, o, R0, N0, Rt, pt, out, free):
     p12, p56 = sub3(row3(o, 1), row3(o, 0)), sub3(row3(o, 5), row3(o, 4))
     rest = sub3(sub3(pt, row3(o, 0)), mv(R06, sub3(N0, row3(o, 5))))
     n3, a3, b3 = sp4(h1, h3, h6, dot3(h1, mv(R06, h6)))
-    if n3 == 2 and abs(wrap(a3 - b3)) < 2.0 * SINGULAR_WRIST:
-        n3, a3 = 1, a3 - 0.5 * wrap(a3 - b3)
+    n3, a3, b3 = _one_if_double(n3, a3, b3)
     row = 0
     for i3 in range(max(n3, 0)):
         t3 = a3 if i3 == 0 else b3
@@ -304,8 +311,7 @@ def _spherical_wrist(h, Rw, q1, q2, q3, out, free, row, flag):
     wrist singular (h₆ turned onto h₄: q5's double root) q4 + q6 is a continuum: q4 = 0 and the row is flagged."""
     h4, h5, h6 = row3(h, 3), row3(h, 4), row3(h, 5)
     n5, a5, b5 = sp4(h4, h5, h6, dot3(h4, mv(Rw, h6)))
-    if n5 == 2 and abs(wrap(a5 - b5)) < 2.0 * SINGULAR_WRIST:
-        n5, a5 = 1, a5 - 0.5 * wrap(a5 - b5)
+    n5, a5, b5 = _one_if_double(n5, a5, b5)
     for i5 in range(max(n5, 0)):
         q5 = a5 if i5 == 0 else b5
         R5 = rotation(h5, q5)

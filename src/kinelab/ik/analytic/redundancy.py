@@ -136,9 +136,9 @@ def at_value(robot: Robot, target: pin.SE3, req: Request, theta: float,
     ref = None if q_ref is None else q_ref[keep]
     q6, found, free = arm_roots(sw.arm, sw.sub_target(target.homogeneous, theta), robot.lower[keep],
                                 robot.upper[keep], ref, limit_slack(req.tol_rot))
-    answers = []
+    held, answers = {robot.joints[sw.joint].name: theta}, []
     for r in range(q6.shape[0]):
-        verdict = judged(robot, np.insert(q6[r], sw.joint, theta), target, req, {robot.joints[sw.joint].name: theta})
+        verdict = judged(robot, np.insert(q6[r], sw.joint, theta), target, req, held)
         if verdict is not None:
             answers.append((*verdict, int(found[r]), bool(free[r])))
     return answers
