@@ -1,5 +1,7 @@
 """Shared test helpers: the robots the cross-checks use, and small URDFs written by the tests."""
 
+import contextlib
+import signal
 from pathlib import Path
 
 BUNDLED = ("stanford", "era", "youbot")
@@ -65,3 +67,20 @@ def ros_package(root: Path) -> Path:
         '<joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><origin xyz="0 0 0.3"/>'
         '<axis xyz="0 0 1"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint></robot>')
     return urdf
+
+
+@contextlib.contextmanager
+def no_hang(seconds: int = 30):
+    """Fail the test, instead of blocking the run, when the block takes longer than ``seconds`` (a hang, not a
+    speed: the bound is many times what the block needs on a loaded machine)."""
+
+    def hang(_signum, _frame):
+        raise AssertionError(f"still running after {seconds} s: a hang")
+
+    previous = signal.signal(signal.SIGALRM, hang)
+    signal.alarm(seconds)
+    try:
+        yield
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)

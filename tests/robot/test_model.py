@@ -3,7 +3,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 import pytest
-from helpers import revolute, write_urdf
+from helpers import no_hang, revolute, write_urdf
 
 import kinelab
 from kinelab.analysis.oracles import pose_error
@@ -256,6 +256,25 @@ def test_a_robot_from_an_in_memory_model_is_the_robot_of_its_file():
     target = loaded.fk(loaded.random_q(rng))
     res = kinelab.solve(robot, target, seed=0)
     assert res.success and np.allclose(loaded.fk(res.q).homogeneous, target.homogeneous, atol=1e-6)
+
+
+@pytest.mark.parametrize("locked", [("panda_finger_joint1", "panda_finger_joint2"),
+                                    ("panda_joint7", "panda_finger_joint1", "panda_finger_joint2"), ("panda_joint4",)])
+def test_a_reduced_model_is_taken_and_its_locked_joints_stay_locked(locked):
+    """#31.2: pin.buildReducedModel gives a locked joint's frame itself as its parent; the walk up the frame
+    tree looped forever. The robot's FK is the reduced model's own, at random configurations."""
+    whole = pin.buildModelFromUrdf(str(kinelab.load("panda").urdf_path))
+    reduced = pin.buildReducedModel(whole, [whole.getJointId(j) for j in locked], pin.neutral(whole))
+    assert any(f.parentFrame == i for i, f in enumerate(reduced.frames) if i > 0)  # the model that looped
+    with no_hang(10):
+        robot = kinelab.Robot.from_model(reduced, tool="panda_hand")
+        again = kinelab.Robot.from_model(robot.model, tool=robot.tool)  # kinelab's own reduced model
+    assert robot.joint_names == [j for j in (f"panda_joint{k}" for k in range(1, 8)) if j not in locked]
+    data, hand = reduced.createData(), reduced.getFrameId("panda_hand")
+    for q in robot.random_qs(20, np.random.default_rng(7)):
+        pin.framesForwardKinematics(reduced, data, np.concatenate([q, np.zeros(reduced.nq - robot.n)]))
+        assert np.allclose(robot.fk(q).homogeneous, data.oMf[hand].homogeneous, atol=1e-12)
+        assert np.allclose(again.fk(q).homogeneous, robot.fk(q).homogeneous, atol=1e-12)
 
 
 def test_from_model_re_roots_at_a_base_and_refuses_what_it_cannot_use():

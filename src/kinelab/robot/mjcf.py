@@ -122,12 +122,13 @@ def body_tree(model: pin.Model) -> UrdfTree:
     """The bodies of a Pinocchio model as a tree: each BODY frame's parent body and the joint (or fixed
     joint frame) that carries it; the root is the single top body, or "universe" when there are several."""
     bodies = [i for i, f in enumerate(model.frames) if f.type == pin.FrameType.BODY]
+    parents = _parent_frames(model)
     parent_of, joint_of = {}, {}
     for i in bodies:
-        up = model.frames[i].parentFrame
+        up = parents[i]
         carrier = model.frames[up].name if model.frames[up].type != pin.FrameType.BODY and up != 0 else None
         while up != 0 and model.frames[up].type != pin.FrameType.BODY:
-            up = model.frames[up].parentFrame
+            up = parents[up]
         name = model.frames[i].name
         parent_of[name] = model.frames[up].name
         joint_of[name] = carrier or f"{name}_fixed"
@@ -138,3 +139,35 @@ def body_tree(model: pin.Model) -> UrdfTree:
     links = [model.frames[i].name for i in bodies] + (["universe"] if root == "universe" else [])
     leaves = [b for b in links if b not in parent_of.values() and b != root]
     return UrdfTree(root, parent_of, joint_of, {}, links, leaves)
+
+
+def _parent_frames(model: pin.Model) -> list[int]:
+    """Each frame's parent frame, with the frame tree mended where it does not reach the root.
+
+    ``pin.buildReducedModel`` gives the frame of a locked joint itself as its parent. Such a frame hangs
+    from the nearest BODY frame before it on the same parent joint whose own chain reaches the root (the
+    body the joint was attached to, in the tree order Pinocchio's parsers add frames in), else from the
+    universe. Every chain is then a path to frame 0: no walk up the tree can loop.
+    """
+    parents = [int(f.parentFrame) for f in model.frames]
+    reaches = [False] * len(parents)
+    reaches[0] = True
+    for i in range(1, len(parents)):
+        if not _reaches_root(parents, i, reaches):
+            parents[i] = next((j for j in range(i - 1, 0, -1) if reaches[j]
+                               and model.frames[j].type == pin.FrameType.BODY
+                               and model.frames[j].parentJoint == model.frames[i].parentJoint), 0)
+        reaches[i] = True
+    return parents
+
+
+def _reaches_root(parents: list[int], i: int, reaches: list[bool]) -> bool:
+    """True when following ``parents`` up from frame ``i`` meets a frame known to reach frame 0."""
+    seen = {i}
+    up = parents[i]
+    while not reaches[up]:
+        if up in seen:
+            return False
+        seen.add(up)
+        up = parents[up]
+    return True
