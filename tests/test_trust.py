@@ -145,3 +145,41 @@ def test_each_round_of_solve_all_and_the_prefer_fallback_get_only_what_is_left(m
                         or real_one(robot, t, q0, req))
     res = kinelab.solve(ur5, target, prefer=np.zeros(6), time_budget=0.05, tol_pos=1e-300, tol_rot=1e-300, seed=0)
     assert not res.success and len(fallback) == 1 and fallback[0] is not None and fallback[0] < 0.05
+
+
+# --- #31: the fault and fuzz run of the core-issue round -------------------------------------------------------
+
+
+def _honest(robot, q, status, oMtarget, tol=1e-6):
+    """A row's status is what Pinocchio says of its q: converged means met within the limits, outside_limits met
+    beyond one; no row of a started solve holds NaN."""
+    assert np.isfinite(q).all(), q
+    dp, dr = robot.tool_error(q, oMtarget)
+    if status == "converged":
+        assert dp <= tol and dr <= tol and robot.within_limits(q)
+    elif status == "outside_limits":
+        assert dp <= tol and dr <= tol and not robot.within_limits(q)
+
+
+@pytest.mark.parametrize("name", ["ur5", "youbot"])
+def test_use_limits_false_works_on_every_path(name):
+    """#31.3: the compiled batch drew its starts between ±inf limits (NaN) and failed on every robot naming a Q
+    the caller never passed; IK(use_limits=False).solve_batch spent its budget and returned nothing."""
+    import pinocchio as pin
+
+    robot = kinelab.load(name)
+    targets = robot.fk_batch(robot.random_qs(12, 5))
+    for batch in (kinelab.solve_batch(robot, targets, use_limits=False, seed=0),
+                  kinelab.IK(robot, use_limits=False).solve_batch(targets, seed=0)):
+        assert np.isin(batch.status, ["converged", "outside_limits"]).mean() >= 0.5, batch.status
+        for b in range(len(targets)):
+            _honest(robot, batch.q[b], str(batch.status[b]), pin.SE3(targets[b]))
+    one = pin.SE3(targets[0])
+    for res in [*kinelab.solve_all(robot, one, solver="frdm", use_limits=False, seed=0),
+                *kinelab.solve_all(robot, one, use_limits=False, seed=0),  # "auto" with an FRDM option: FRDM
+                kinelab.IK(robot, use_limits=False).solve(one, seed=1)]:
+        _honest(robot, res.q, res.status.value, one)
+    path = kinelab.track(robot, targets[:1], use_limits=False)
+    _honest(robot, path.q[0], path.status[0], one)
+    with pytest.raises(kinelab.OptionError, match="use_limits"):  # the closed form has no such setting: named
+        kinelab.solve_all(robot, one, solver="analytic", use_limits=False)

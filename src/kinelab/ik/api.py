@@ -264,7 +264,7 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
     if method != "multistart" and (options is not None or solver_options):
         if method == "analytic":  # refusing says so rather than ignoring them
             refuse_options(options or solver_options)
-        method = "multistart"  # options name a multistart solver's settings: "auto" runs FRDM with them
+        method, solver = "multistart", "frdm"  # options name a multistart solver's settings: "auto" runs FRDM
     req = make_request("frdm" if method != "multistart" else solver, seed, tol_pos, tol_rot, time_budget, 0,
                        "refuse", options, task, axis, solver_options)
     check = _collision_model(robot, collisions)

@@ -166,16 +166,19 @@ def _judged(robot: Robot, rows: Rows, points: np.ndarray, rotations: np.ndarray,
     """Pinocchio's verdict on every solved row; statuses as :func:`kinelab.solve` gives them."""
     count, task = points.shape[0], req.task
     dp, dr, success = np.full(count, np.nan), np.full(count, np.nan), np.zeros(count, dtype=bool)
+    met = np.zeros(count, dtype=bool)
     solved = np.flatnonzero(rows.status != Status.TIME_BUDGET.value)
     if solved.size:
         H_target = stack_homogeneous(points[solved], rotations[solved])
         with np.errstate(over="ignore"):  # a target 1e200 m away is far, not an error
             dp[solved], dr[solved] = task.errors_batch(H_target, robot.fk_batch(rows.Q[solved]))
         within = robot.within_limits_batch(rows.Q[solved])
-        success[solved] = task.met_batch(dp[solved], dr[solved], req.tol_pos, req.tol_rot) & within
+        met[solved] = task.met_batch(dp[solved], dr[solved], req.tol_pos, req.tol_rot)
+        success[solved] = met[solved] & within
     status = rows.status
     status[success] = Status.CONVERGED.value
-    failed = ~success & (status != Status.TIME_BUDGET.value)
+    status[met & ~success] = Status.OUTSIDE_LIMITS.value  # use_limits=False: met beyond a limit, as solve says
+    failed = ~met & (status != Status.TIME_BUDGET.value)
     status[failed & (_beyond(robot, points, req) > 0)] = Status.UNREACHABLE.value
     status[failed & (status == Status.CONVERGED.value)] = Status.STALLED.value  # the solver's test passed only
     return BatchIKResult(rows.Q, success, rows.status, dp, dr, rows.iterations, rows.restarts, seed,

@@ -299,9 +299,12 @@ def wrap_into_limits(q, kind, lower, upper):
 
 @njit(cache=True)
 def random_configuration(q, kind, lower, upper, rng_state):
-    """q ← a seeded uniform configuration within the limits (continuous joints on [−π, π))."""
+    """q ← a seeded uniform configuration within the limits. A joint without a finite window (continuous, or
+    any joint of a solve with ``use_limits=False``) draws on [−π, π) when it turns and keeps its value when it
+    slides: there is no range to draw a length from, and a draw between infinite limits is NaN."""
     for i in range(q.shape[0]):
-        if kind[i] == CONTINUOUS:
-            q[i] = -np.pi + TWO_PI * xorshift_uniform(rng_state)
-        else:
-            q[i] = lower[i] + (upper[i] - lower[i]) * xorshift_uniform(rng_state)
+        u = xorshift_uniform(rng_state)
+        if np.isfinite(lower[i]) and np.isfinite(upper[i]) and kind[i] != CONTINUOUS:
+            q[i] = lower[i] + (upper[i] - lower[i]) * u
+        elif kind[i] != PRISMATIC:
+            q[i] = -np.pi + TWO_PI * u

@@ -31,7 +31,7 @@ from kinelab.ik.frdm.kernel import (
     Objective,
 )
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
-from kinelab.ik.multistart import clock_chunk
+from kinelab.ik.multistart import clock_chunk, first_start
 from kinelab.ik.result import Status
 from kinelab.robot import Robot
 
@@ -93,6 +93,10 @@ def run(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts: np.ndar
     count = points.shape[0]
     rows = Rows.unsolved(count, cm.n)
     Q = np.zeros((count, cm.n)) if starts is None else np.array(starts, dtype=float)
+    if starts is None and not opts.use_limits:  # drawn within the file's limits, as the single solve draws them
+        for b in range(count):
+            Q[b] = first_start(None, cm.kind, cm.lower, cm.upper, rng_states[b])
+        starts = Q
     codes, stats = np.zeros(count, dtype=np.int64), np.zeros((count, STATS_SIZE))
     lower, upper = (cm.lower, cm.upper) if opts.use_limits else (np.full(cm.n, -np.inf), np.full(cm.n, np.inf))
     stop = np.zeros(1, dtype=np.int64)  # set by a timer thread at the deadline; every row looks between chunks
