@@ -153,3 +153,61 @@ def test_a_mimic_off_the_chain_whose_leader_is_missing_is_locked_with_one_warnin
     with pytest.warns(UserWarning, match="'jf' mimics 'nosuch'.*off the chain and locked") as said:
         robot = kinelab.load(path, tool="c")
     assert len(said) == 1 and robot.joint_names == ["j1", "j2"] and "jf" in robot.locked
+
+
+# --- #31.4: files Pinocchio reads load, with the chain Pinocchio builds --------------------------------------
+
+
+def _same_fk_as_pinocchio(robot, path, tool="c"):
+    import pinocchio as pin
+
+    model = pin.buildModelFromUrdf(str(path))
+    data, fid = model.createData(), model.getFrameId(tool)
+    for q in robot.random_qs(10, np.random.default_rng(3)):
+        full = np.concatenate([[np.cos(v), np.sin(v)] if k == "continuous" else [v]
+                               for v, k in zip(q, robot.joint_kinds, strict=True)])
+        pin.framesForwardKinematics(model, data, full)
+        assert np.allclose(robot.fk(q).homogeneous, data.oMf[fid].homogeneous, atol=1e-12)
+
+
+def test_a_continuous_joint_on_a_tilted_axis_loads_and_solves(tmp_path):
+    """A raw KeyError: 'd' in the model builder (an unbounded revolute joint off the x, y, z axes has no `axis` in
+    Pinocchio's Python API)."""
+    j1 = revolute("j1", "a", "b", axis="0 0.6 0.8").replace('type="revolute"', 'type="continuous"')
+    path = write_urdf(tmp_path, _chain(j1, revolute("j2", "b", "c", axis="0.48 0.6 0.64")))
+    robot = kinelab.load(path)
+    assert robot.joint_kinds == ["continuous", "revolute"]
+    _same_fk_as_pinocchio(robot, path)
+    target = robot.fk(np.array([2.5, 0.4]))
+    res = kinelab.solve(robot, target, task="position", seed=0)
+    assert res.success and np.linalg.norm(robot.fk(res.q).translation - target.translation) <= 1e-6
+
+
+def test_a_comment_left_open_past_the_root_loads_as_pinocchio_reads_it(tmp_path):
+    """The CoIKS benchmark's Franka, UR5 and UR10 files end so, and were refused with a message about the text
+    encoding; Pinocchio reads the first <robot> and stops."""
+    path = tmp_path / "r.urdf"
+    tail = "</robot>\n  <!-- <transmission name='t'>\n  <!-- a note -->\n  <link name='x'/>\n  </joint>\n</robot> -->\n"
+    path.write_text('<robot name="t">' + _chain(revolute("j1", "a", "b")) + tail)
+    robot = kinelab.load(path)
+    assert robot.joint_names == ["j1", "j2"]
+    _same_fk_as_pinocchio(robot, path)
+    path.write_text('<robot name="t">' + _chain(revolute("j1", "a", "b")) + "</robot>\n<!-- never closed\n")
+    with pytest.raises(kinelab.URDFError, match="Pinocchio cannot read .*XML_ERROR_PARSING_COMMENT"):
+        kinelab.load(path)  # Pinocchio's own parser refuses this one: its reason is the one given
+
+
+def test_a_comment_nested_inside_a_comment_loads_as_pinocchio_reads_it(tmp_path):
+    """A comment holding a comment: the first --> ends it, the rest is read (the CoIKS Franka file)."""
+    path = tmp_path / "r.urdf"
+    body = _chain(revolute("j1", "a", "b"))
+    path.write_text(f'<robot name="t">{body}<!-- <link name="x"> <!-- inner --> </robot>')
+    assert kinelab.load(path).n == 2
+
+
+def test_a_file_broken_inside_its_root_is_refused_with_the_parser_s_reason(tmp_path):
+    path = tmp_path / "r.urdf"
+    path.write_text('<robot name="t">' + LINKS + '<joint name="j1" type="revolute"></robot>')
+    with pytest.raises(kinelab.URDFError, match=r"malformed URDF .*r.urdf: mismatched tag: line 1") as err:
+        kinelab.load(path)
+    assert "encoding" not in str(err.value)

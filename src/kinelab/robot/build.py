@@ -422,9 +422,6 @@ def _one_to_pin(kind: str, value: float) -> list[float]:
 
 
 
-_AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
-
-
 def _local_axes(model: pin.Model) -> list[np.ndarray]:
     """Unit axis of every 1-DoF joint in its own frame, from the joint models themselves (no Data: a
     Pinocchio Data holds nv³-sized tensors, so building one per joint made a load cubic in size)."""
@@ -434,10 +431,18 @@ def _local_axes(model: pin.Model) -> list[np.ndarray]:
         if joint.nq == 0:  # a mimic joint has no axis of its own in kinelab's q
             axes.append(np.zeros(3))
             continue
-        axis = getattr(joint.extract(), "axis", None)
-        if axis is None:  # an aligned joint: JointModelRX, PY, RUBZ, ...
-            axis = _AXES[joint.shortname()[-1]]
-        axes.append(np.asarray(axis, dtype=float))
+        axes.append(_motion_axis(joint))
     return axes
+
+
+def _motion_axis(joint: pin.JointModel) -> np.ndarray:
+    """A 1-DoF joint's unit axis in its own frame, read off its motion subspace S = [linear; angular] (every
+    joint kind has one; Pinocchio's Python API gives ``axis`` only to some, and none to an unbounded
+    revolute joint on a tilted axis)."""
+    data = joint.createData()
+    joint.calc(data, np.array([1.0, 0.0]) if joint.nq == 2 else np.zeros(joint.nq))
+    S = np.asarray(data.S, dtype=float).ravel()
+    axis = S[3:] if np.linalg.norm(S[3:]) > 0.5 else S[:3]  # a revolute joint turns, a prismatic one slides
+    return np.array(axis / np.linalg.norm(axis))
 
 

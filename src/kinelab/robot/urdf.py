@@ -13,6 +13,7 @@ a file) are tolerated; a mimic joint whose leader the file lacks is kept as a pl
 
 from __future__ import annotations
 
+import contextlib
 import math
 import re
 import warnings
@@ -143,9 +144,29 @@ def _parse_leniently(path: Path, first: ET.ParseError) -> ET.Element:
     declared = set(re.findall(r"xmlns:([\w.-]+)\s*=", text))
     extra = "".join(f' xmlns:{p}="urn:kinelab:undeclared:{p}"' for p in sorted(prefixes - declared))
     try:
-        return ET.fromstring(_ROOT_TAG.sub("<robot" + extra, text, count=1))
+        return _first_root(_ROOT_TAG.sub("<robot" + extra, text, count=1))
     except ET.ParseError:
-        raise URDFError(f"malformed URDF {path}: {first} (the text must be UTF-8 or declare its encoding)") from None
+        raise URDFError(f"malformed URDF {path}: {first}") from None
+
+
+def _first_root(text: str) -> ET.Element:
+    """The document's first top-level element, whatever follows its end tag (Pinocchio's parser takes the first
+    ``<robot>`` and reads no further: files in the wild leave a comment open past ``</robot>``).
+
+    Raises:
+        ET.ParseError: the text is not well-formed before that end tag.
+    """
+    parser = ET.XMLPullParser(events=("start", "end"))
+    with contextlib.suppress(ET.ParseError):  # an error past the root's end is not read; one before it is raised
+        parser.feed(text)
+    depth, root = 0, None
+    for event, element in parser.read_events():
+        root = element if root is None else root
+        depth += 1 if event == "start" else -1
+        if depth == 0:
+            return root
+    parser.close()  # raises the error that ended the text before the root's end tag
+    raise ET.ParseError("no element")
 
 
 def _declared_encoding(path: Path) -> str:
