@@ -1,4 +1,4 @@
-"""xacro sources, expanded by xacrodoc: arguments, macros, and the errors a bad file gets."""
+"""xacro sources, expanded by xacro as data: arguments, macros, and the errors a bad file gets."""
 
 import numpy as np
 import pytest
@@ -7,7 +7,7 @@ import kinelab
 import kinelab.cli
 from kinelab import URDFError, load
 
-pytest.importorskip("xacrodoc")
+pytest.importorskip("xacro")
 
 XACRO = """<?xml version="1.0"?>
 <robot name="two_links" xmlns:xacro="http://www.ros.org/wiki/xacro">
@@ -45,25 +45,30 @@ def test_a_bad_xacro_is_named_with_xacros_reason(tmp_path):
     bad.write_text('<robot name="b" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="${nowhere}"/></robot>')
     with pytest.raises(URDFError, match=r"xacro cannot expand .*bad.xacro: name 'nowhere' is not defined"):
         load(bad)
-    with pytest.raises(URDFError, match="no such xacro file"):
+    with pytest.raises(URDFError, match="xacro file not found"):
         load(tmp_path / "missing.urdf.xacro")
 
 
-HOSTILE = {  # construct refused → xacro text that uses it and expands to nothing when trusted
-    "$(eval ...)": """<xacro:property name="p" value="exec('open(&quot;{marker}&quot;, &quot;w&quot;)', {{}}) is None"/>
-  <xacro:if value="$(eval ${{p}})"></xacro:if>""",
-    "$(env ...)": """<xacro:if value="${{len('$(env HOME)') >= 0}}"></xacro:if>""",
-    "$(optenv ...)": """<xacro:if value="$(optenv KINELAB_NO_SUCH_VARIABLE 1)"></xacro:if>""",
-    "load_yaml": """<xacro:if value="${{len(xacro.load_yaml('/etc/hostname')) >= 0}}"></xacro:if>""",
-    "a '__' name": """<xacro:if value="${{len('x.__class__') > 0}}"></xacro:if>""",
+# construct named in the refusal → xacro text that uses it (harmless and empty when trusted), a key on its line
+OPEN = "open(&quot;{marker}&quot;, &quot;w&quot;)"
+HOSTILE = {
+    "$(eval ...)": ("""<xacro:property name="p" value="exec('""" + OPEN + """', {{}}) is None"/>
+  <xacro:if value="$(eval ${{p}})"></xacro:if>""", "$(eval"),
+    "$(env ...)": ("""<xacro:if value="${{len('$(env HOME)') >= 0}}"></xacro:if>""", "$(env"),
+    "$(optenv ...)": ("""<xacro:if value="$(optenv KINELAB_NO_SUCH_VARIABLE 1)"></xacro:if>""", "$(optenv"),
+    "$(cwd)": ("""<xacro:if value="${{len('$(cwd)') >= 0}}"></xacro:if>""", "$(cwd)"),
+    "xacro.load_yaml": ("""<xacro:if value="${{len(xacro.load_yaml('/etc/hostname')) >= 0}}"></xacro:if>""",
+                        "load_yaml"),
+    "attribute access ('.upper')": ("""<xacro:if value="${{len('a'.upper()) > 0}}"></xacro:if>""", "'a'.upper"),
+    "a call of 'python.type'": ("""<xacro:if value="${{len(str(python.type(1))) > 0}}"></xacro:if>""",
+                                "python.type"),
+    "a comprehension": ("""<xacro:if value="${{len([c for c in 'ab']) > 0}}"></xacro:if>""", "for c in"),
 }
-KEYS = {"$(eval ...)": "$(eval", "$(env ...)": "$(env", "$(optenv ...)": "$(optenv", "load_yaml": "load_yaml",
-        "a '__' name": "__class__"}
 
 
 def _hostile(tmp_path, construct):
     marker = tmp_path / "ran"
-    body = HOSTILE[construct].format(marker=marker)
+    body = HOSTILE[construct][0].format(marker=marker)
     path = tmp_path / "bad.urdf.xacro"
     path.write_text(XACRO.replace('<link name="base"/>', f'<link name="base"/>\n  {body}'))
     return path, marker
@@ -72,7 +77,7 @@ def _hostile(tmp_path, construct):
 @pytest.mark.parametrize("construct", list(HOSTILE))
 def test_a_xacro_that_would_run_code_or_read_the_machine_is_refused_with_its_line(tmp_path, construct):
     path, marker = _hostile(tmp_path, construct)
-    line = next(k for k, text in enumerate(path.read_text().splitlines(), 1) if KEYS[construct] in text)
+    line = next(k for k, text in enumerate(path.read_text().splitlines(), 1) if HOSTILE[construct][1] in text)
     with pytest.raises(URDFError, match=rf"at line {line} would run code or read the machine.*trust_xacro") as err:
         load(path)
     assert construct in str(err.value) and not marker.exists()

@@ -128,7 +128,9 @@ class _Builder:
                   xacro_args: dict[str, str] | None, trust_xacro: bool) -> _Builder:
         if xacro_args and not xacro.is_xacro(source):  # an argument that nothing reads is a mistake, said
             raise OptionError("xacro_args", xacro_args, f"arguments of a .xacro source; {source.name} is not one")
-        urdf_path = xacro.expand(source, xacro_args, trusted=trust_xacro) if xacro.is_xacro(source) else source
+        urdf_path = source
+        if xacro.is_xacro(source):
+            urdf_path = xacro.expand(source, xacro_args, trusted=trust_xacro, package_dirs=package_dirs)
         if is_mjcf(urdf_path):
             full, tree = read_mjcf(urdf_path)
         else:

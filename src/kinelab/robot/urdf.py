@@ -21,6 +21,7 @@ import xml.etree.ElementTree as ET
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any, cast
 
 from kinelab.errors import ChainError, URDFError
 
@@ -156,11 +157,12 @@ def _first_root(text: str) -> ET.Element:
     Raises:
         ET.ParseError: the text is not well-formed before that end tag.
     """
-    parser = ET.XMLPullParser(events=("start", "end"))
+    parser: ET.XMLPullParser[tuple[str, Any]] = ET.XMLPullParser(events=("start", "end"))
     with contextlib.suppress(ET.ParseError):  # an error past the root's end is not read; one before it is raised
         parser.feed(text)
     depth, root = 0, None
-    for event, element in parser.read_events():
+    for item in parser.read_events():
+        event, element = cast(tuple[str, ET.Element], item)
         root = element if root is None else root
         depth += 1 if event == "start" else -1
         if depth == 0:

@@ -1,14 +1,23 @@
-"""xacro files, expanded to URDF by xacrodoc (the optional extra ``kinelab[xacro]``), as data.
+"""xacro files, expanded to URDF by xacro (the optional extra ``kinelab[xacro]``), as data.
 
-A xacro file can hold programs: ``$(eval ...)`` is Python's ``eval`` with its builtins, ``$(env ...)`` and
-``$(optenv ...)`` read the environment, ``xacro.load_yaml`` reads any file, and a ``${...}`` expression can
-reach objects through ``__`` names or ``str.format``. kinelab refuses all of these unless the user trusts the
-file by name (``load(..., trust_xacro=True)``, ``--trust-xacro`` on the command line), naming the construct
-and its line; properties, arithmetic, macros, conditionals, ``$(arg ...)``, ``$(find ...)`` and includes
-expand as usual. Map workers load a xacro robot with the trust its user gave, never more.
+A xacro file is a program in xacro's own design: ``${...}`` is Python's ``eval`` with objects in reach,
+``$(eval ...)`` is Python's ``eval`` too, ``$(env ...)``, ``$(optenv ...)`` and ``$(cwd)`` read the machine,
+``load_yaml`` reads any file, and an include reads any path. Unless the user trusts the file by name
+(``load(..., trust_xacro=True)``, ``--trust-xacro``), kinelab expands it as data:
 
-kinelab reads the expanded URDF like any other; ``package://`` URIs are kept for the mesh search of
-:mod:`kinelab.robot.meshes`. The expansion is written to a temporary folder, never next to the user's file.
+- every ``${...}`` goes through :mod:`kinelab.robot.xacro_eval` (no attribute access, no calls but a fixed list of
+  math functions, bounded powers and repetitions);
+- ``$(eval)``, ``$(env)``, ``$(optenv)``, ``$(cwd)`` are refused, naming the construct, its file and line;
+- an include resolves against the including file's folder and must lie in the file's own folder, its ROS
+  package (the nearest folder above it with a ``package.xml``) or a package directory the user gave
+  (``package_dirs``, ``ROS_PACKAGE_PATH``); ``$(find PKG)`` looks only there;
+- the whole expansion has a time and an element limit (:data:`SECONDS`, :data:`ELEMENTS`), every file read a
+  size limit, and xacro's module state is reset before and restored after each expansion (a failed load leaves
+  nothing behind for the next one).
+
+Properties, math (``pi``, ``radians``, ``sqrt``...), conditionals, macros with parameters and blocks,
+``$(arg)``, ``$(find)``, ``$(dirname)``, namespaced includes expand as usual. The include and size limits hold
+for a trusted file too. The expansion is written to a private temporary folder, never beside the user's file.
 """
 
 from __future__ import annotations
@@ -21,25 +30,15 @@ from pathlib import Path
 from typing import Any
 
 from kinelab.errors import OptionError, URDFError
+from kinelab.files import checked_file, read_text
+from kinelab.robot import xacro_eval
 from kinelab.scratch import scratch_dir
 
-INSTALL_HINT = "pip install 'kinelab[xacro]' (xacrodoc)"
-# what an untrusted file may not use, and how to find it in the text to name its line
-UNSAFE = {
-    "$(eval ...)": re.compile(r"\$\(\s*eval\b"),
-    "$(env ...)": re.compile(r"\$\(\s*env\b"),
-    "$(optenv ...)": re.compile(r"\$\(\s*optenv\b"),
-    "load_yaml": re.compile(r"load_yaml"),
-    "a '__' name": re.compile(r"\.\s*__\w|__\w+__"),
-    "str.format": re.compile(r"\.\s*format\b|format_map"),
-}
-_LOCK = threading.Lock()  # the guard patches xacro's module state for the length of one expansion
-
-
-class _RefusedError(Exception):
-    def __init__(self, construct: str):
-        super().__init__(construct)
-        self.construct = construct
+INSTALL_HINT = "pip install 'kinelab[xacro]' (xacro)"
+SECONDS = 20.0  # [s] the longest expansion (a real robot's takes well under a second)
+ELEMENTS = 50_000  # elements an expansion may process (a humanoid's description: a few thousand)
+UNTRUSTED = {"$(eval ...)": "_eval", "$(env ...)": "_env", "$(optenv ...)": "_optenv"}  # xacro's handlers
+_LOCK = threading.Lock()  # xacro keeps its state in its module: one expansion at a time
 
 
 def is_xacro(path: Path) -> bool:
@@ -47,127 +46,249 @@ def is_xacro(path: Path) -> bool:
     return path.suffix == ".xacro"
 
 
-def expand(path: Path, args: dict[str, str] | None = None, trusted: bool = False) -> Path:
+def expand(path: Path, args: dict[str, str] | None = None, trusted: bool = False,
+           package_dirs: list[str] | None = None) -> Path:
     """The URDF that the xacro file at ``path`` expands to with ``args`` (xacro arguments, name → value).
 
     Args:
         path: the xacro file.
         args: xacro arguments (name → value).
-        trusted: let the file run what xacro runs (``$(eval)``, ``$(env)``, ``load_yaml``); False: refuse them.
+        trusted: let the file run what xacro runs (Python expressions, ``$(eval)``, ``$(env)``, ``load_yaml``).
+        package_dirs: folders that hold the ROS packages its includes and ``$(find)`` may read.
+
+    Returns:
+        The expanded URDF's path, in a private temporary folder.
 
     Raises:
-        URDFError: xacrodoc missing (with the install hint), a missing file, a construct refused without trust
-            (named, with its file and line), or a file xacro cannot expand (xacro's reason: a missing argument,
-            an undefined property or macro).
+        URDFError: xacro missing (with the install hint), a missing or oversized file, a construct refused without
+            trust (named, with its file and line), an include outside the folders it may read, an expansion past
+            its limits, or a file xacro cannot expand (xacro's reason).
     """
-    _check_declared(path, args or {})
+    checked_file(path, "xacro file", URDFError)
+    roots = _roots(path, package_dirs or [])
+    _check_declared(path, args or {}, roots)
     try:
-        from xacrodoc import XacroDoc  # optional extra: imported only for a xacro file
+        import xacro  # optional extra: imported only for a xacro file
     except ImportError:
-        raise URDFError(f"{path.name} is a xacro file; reading it needs xacrodoc: {INSTALL_HINT}") from None
-    if not path.is_file():
-        raise URDFError(f"no such xacro file: {path}")
+        raise URDFError(f"{path.name} is a xacro file; reading it needs xacro: {INSTALL_HINT}") from None
     try:
-        with _LOCK, (contextlib.nullcontext() if trusted else _guarded()):
-            doc = XacroDoc.from_file(str(path), walk_up=False, subargs={k: str(v) for k, v in (args or {}).items()})
-            text = doc.to_urdf_string()
+        with _LOCK, _session(xacro, path, roots, trusted):
+            doc = xacro.parse(None, str(path))
+            xacro.process_doc(doc, mappings={k: str(v) for k, v in (args or {}).items()})
+            text = doc.toxml()
+    except _RefusalError as refusal:
+        raise URDFError(str(refusal)) from None
     except Exception as exc:  # noqa: BLE001 - xacro raises its own and plain exceptions for a bad file
-        refused = _refusal(exc)
-        if refused is not None:
-            raise URDFError(f"{path}: {refused} {_where(path, refused)} would run code or read the machine; a "
-                            "robot file is data: load it with trust_xacro=True (--trust-xacro) only if you trust "
-                            "it") from None
-        reason = " ".join(str(exc).split())  # one line: xacro's messages span several
-        raise URDFError(f"xacro cannot expand {path}: {reason}") from None
+        raise URDFError(_failure(path, exc)) from None
     out = scratch_dir("kinelab-xacro-") / (path.name.removesuffix(".xacro") or "robot.urdf")
     out.write_text(text)
     return out
 
 
-def _refusal(exc: BaseException) -> str | None:
-    """The refused construct behind a xacro exception (xacro wraps what it catches), or None."""
+class _RefusalError(Exception):
+    """A construct refused, an include outside the roots, or a limit passed: the message is the user's."""
+
+
+def _failure(path: Path, exc: BaseException) -> str:
+    """The message for an expansion that failed: a refusal or limit found in xacro's chain of exceptions (xacro
+    wraps what it catches), else xacro's own reason on one line."""
     seen: BaseException | None = exc
     while seen is not None:
-        if isinstance(seen, _RefusedError):
-            return seen.construct
+        if isinstance(seen, _RefusalError):
+            return str(seen)
+        if isinstance(seen, xacro_eval.LimitError):
+            return f"{path}: {seen}; kinelab expands files within {SECONDS:g} s and {ELEMENTS} elements"
+        if isinstance(seen, RecursionError):
+            return f"xacro cannot expand {path}: its macros or includes nest without end"
         seen = getattr(seen, "exc", None) or seen.__cause__ or seen.__context__
+    return f"xacro cannot expand {path}: {' '.join(str(exc).split())}"
+
+
+def _roots(path: Path, package_dirs: list[str]) -> list[Path]:
+    """The folders an expansion may read: the file's own, its package's, and the package directories given."""
+    from kinelab.robot.meshes import mesh_package_dirs
+
+    folder = path.resolve().parent
+    package = next((p for p in (folder, *folder.parents) if (p / "package.xml").is_file()), None)
+    return [folder, *([package] if package else []), *(Path(d).resolve() for d in mesh_package_dirs(package_dirs))]
+
+
+def _inside(path: Path, roots: list[Path]) -> bool:
+    resolved = path.resolve()
+    return any(resolved.is_relative_to(root) for root in roots)
+
+
+def _find_package(name: str, roots: list[Path]) -> Path | None:
+    """``$(find name)`` within the roots: a root that is the package (by folder name or its package.xml), or a
+    folder of that name one or two levels below a root (a workspace's ``src``)."""
+    for root in roots:
+        xml = root / "package.xml"
+        if root.name == name or (xml.is_file() and f"<name>{name}</name>" in read_text(xml, "package.xml", URDFError)):
+            return root
+        for candidate in (root / name, *sorted(root.glob(f"*/{name}"))[:1]):
+            if candidate.is_dir() and _inside(candidate, roots):
+                return candidate
     return None
 
 
-def _where(path: Path, construct: str) -> str:
-    """"at line N" of the first use in the file itself, or "in a file it includes"."""
-    for number, line in enumerate(path.read_text(errors="replace").splitlines(), start=1):
-        if UNSAFE[construct].search(line):
-            return f"at line {number}"
-    return "in a file it includes"
-
-
-def _refuse(construct: str) -> Callable[..., Any]:
-    def refused(*_args: Any, **_kwargs: Any) -> Any:
-        raise _RefusedError(construct)
-    return refused
-
-
 @contextlib.contextmanager
-def _guarded() -> Iterator[None]:
-    """xacro with its code-running and machine-reading entry points replaced by refusals for the block."""
-    import xacro
+def _session(xacro: Any, path: Path, roots: list[Path], trusted: bool) -> Iterator[None]:
+    """xacro set up for one expansion of ``path``: fresh module state, the confined reader and finder, the budget,
+    and (untrusted) the safe evaluator and the refusals; everything restored afterwards."""
     from xacro import substitution_args as sa
 
-    plain_eval = xacro.safe_eval
-
-    def checked_eval(expr: str, globals: Any, locals: Any = None) -> Any:  # noqa: A002 - xacro's own names
-        for construct in ("a '__' name", "str.format", "load_yaml"):
-            if UNSAFE[construct].search(expr):
-                raise _RefusedError(construct)
-        return plain_eval(expr, globals, locals)
-
+    budget = xacro_eval.Budget(SECONDS, ELEMENTS)
     saved: list[tuple[Any, str, Any]] = []
 
     def swap(owner: Any, name: str, value: Any) -> None:
         saved.append((owner, name, getattr(owner, name)))
         setattr(owner, name, value)
 
-    swap(sa, "_eval", _refuse("$(eval ...)"))
-    swap(sa, "_env", _refuse("$(env ...)"))
-    swap(sa, "_optenv", _refuse("$(optenv ...)"))
-    swap(xacro, "safe_eval", checked_eval)
-    swap(xacro, "load_yaml", _refuse("load_yaml"))
-    symbols = xacro._global_symbols
-    plain_symbols = {k: symbols.get(k) for k in ("load_yaml",)}
-    namespace = symbols.get("xacro")
-    plain_ns = None if namespace is None else namespace.get("load_yaml")
+    context = dict(xacro.substitution_args_context)
+    for name in ("filestack", "macrostack", "all_includes", "verbosity"):
+        swap(xacro, name, getattr(xacro, name))
+    xacro.init_stacks(str(path))
+    xacro.all_includes, xacro.verbosity = [], 0
+    xacro.substitution_args_context.clear()
+    swap(xacro, "parse", _confined_parse(xacro, xacro.parse, roots))
+    swap(xacro, "eval_all", _counted(xacro.eval_all, budget))
+    swap(xacro, "eval_extension", _extensions(xacro, xacro.eval_extension, trusted))
+    swap(sa, "_eval_find", lambda name: _found(name, roots))
+    if not trusted:
+        swap(xacro, "safe_eval", _safe_eval(xacro, budget))
+        for construct, handler in UNTRUSTED.items():
+            swap(sa, handler, _refuser(xacro, construct))
     try:
-        symbols["load_yaml"] = _refuse("load_yaml")
-        if namespace is not None:
-            namespace["load_yaml"] = _refuse("load_yaml")
         yield
     finally:
         for owner, name, value in reversed(saved):
             setattr(owner, name, value)
-        symbols.update(plain_symbols)
-        if namespace is not None:
-            namespace["load_yaml"] = plain_ns
+        xacro.substitution_args_context.clear()
+        xacro.substitution_args_context.update(context)
+
+
+def _found(name: str, roots: list[Path]) -> str:
+    found = _find_package(name, roots)
+    if found is None:
+        raise _RefusalError(f"$(find {name}): no package {name!r} in the folders the file may read "
+                       f"({', '.join(map(str, roots))}); pass the folder that holds it in package_dirs "
+                       "(--package-dir)")
+    return str(found)
+
+
+def _confined_parse(xacro: Any, parse: Callable[..., Any], roots: list[Path]) -> Callable[..., Any]:
+    """xacro's ``parse`` for a file name: the file must lie inside the roots and within the size limit."""
+
+    def confined(inp: Any, filename: str | None = None) -> Any:
+        if inp is not None or filename is None:
+            return parse(inp, filename)
+        file = Path(filename)
+        if not _inside(file, roots):
+            raise _RefusalError(f"{_current(xacro)} includes {file}, outside the folders a robot file may read "
+                           f"({', '.join(map(str, roots))}); pass the folder that holds it in package_dirs "
+                           "(--package-dir)")
+        if not file.exists():
+            xacro.filestack.pop()  # as xacro's own parse does for a missing file
+            raise xacro.XacroException(f"No such file or directory: {file}", exc=FileNotFoundError(str(file)))
+        return parse(read_text(file, "xacro file", URDFError))
+
+    return confined
+
+
+def _counted(eval_all: Callable[..., Any], budget: xacro_eval.Budget) -> Callable[..., Any]:
+    def counted(node: Any, macros: Any, symbols: Any) -> Any:
+        budget.tick()
+        return eval_all(node, macros, symbols)
+
+    return counted
+
+
+def _extensions(xacro: Any, eval_extension: Callable[[str], Any], trusted: bool) -> Callable[[str], Any]:
+    """``$(...)`` with ``$(dirname)`` naming the folder of the file being read, and ``$(cwd)`` refused."""
+
+    def extension(s: str) -> Any:
+        if s.strip() == "$(cwd)" and not trusted:
+            _refuse(xacro, "$(cwd)", "$(cwd)")
+        xacro.substitution_args_context["filename"] = xacro.filestack[-1] if xacro.filestack else None
+        return eval_extension(s)
+
+    return extension
+
+
+def _safe_eval(xacro: Any, budget: xacro_eval.Budget) -> Callable[..., Any]:
+    """xacro's ``safe_eval`` replaced by the data-only evaluator, reading the file's own symbols only."""
+
+    def lookup_in(table: Any) -> Callable[[str], Any]:
+        def lookup(name: str) -> Any:
+            current = table
+            while isinstance(current, xacro.Table):  # the file's tables, never xacro's global symbols
+                if dict.__contains__(current, name):
+                    value = current[name]
+                    return xacro_eval.Namespace(lookup_in(value)) if isinstance(value, xacro.NameSpace) else value
+                current = current.parent
+            raise KeyError(name)
+
+        return lookup
+
+    def safe_eval(expr: str, symbols: Any, _locals: Any = None) -> Any:
+        budget.tick()
+        try:
+            return xacro_eval.evaluate(expr, lookup_in(symbols))
+        except xacro_eval.RefusedError as refused:
+            _refuse(xacro, refused.construct, expr)
+
+    return safe_eval
+
+
+def _refuser(xacro: Any, construct: str) -> Callable[..., Any]:
+    key = construct.split(" ")[0]
+
+    def refused(*_args: Any, **_kwargs: Any) -> Any:
+        _refuse(xacro, construct, key)
+
+    return refused
+
+
+def _refuse(xacro: Any, construct: str, text: str) -> None:
+    """Raise the refusal of ``construct``, found by ``text`` in the file being read."""
+    raise _RefusalError(f"{_current(xacro)}: {construct} {_where(_current(xacro), text)} would run code or read the "
+                   "machine; a robot file is data: load it with trust_xacro=True (--trust-xacro) only if you trust "
+                   "it")
+
+
+def _current(xacro: Any) -> Path:
+    return Path(xacro.filestack[-1]) if xacro.filestack and xacro.filestack[-1] else Path("<xacro>")
+
+
+def _where(file: Path, text: str) -> str:
+    """"at line N" of the first line of ``file`` holding ``text`` (or its first line), else ""."""
+    needle = text.strip().splitlines()[0] if text.strip() else text
+    with contextlib.suppress(OSError, URDFError):
+        for number, line in enumerate(read_text(file, "xacro file", URDFError).splitlines(), start=1):
+            if needle and needle in line:
+                return f"at line {number}"
+    return "in an expression"
 
 
 _ARG = re.compile(r"<xacro:arg\s[^>]*name\s*=\s*[\"']([^\"']+)[\"']")
 _INCLUDE = re.compile(r"<xacro:include\s[^>]*filename\s*=\s*[\"']([^\"']+)[\"']")
 
 
-def _check_declared(path: Path, args: dict[str, str]) -> None:
+def _check_declared(path: Path, args: dict[str, str], roots: list[Path]) -> None:
     """Refuse an argument that the file does not declare (``<xacro:arg name=...>``): xacro would ignore it
-    silently. Includes given as plain relative paths are read too; when the file includes one kinelab cannot
-    read without expanding it (``$(find pkg)/...``), an argument may be declared there and none is refused."""
-    if not args or not path.is_file():
+    silently. Includes given as plain relative paths inside the roots are read too; when the file includes one
+    kinelab cannot read without expanding it (``$(find pkg)/...``), an argument may be declared there and none
+    is refused."""
+    if not args:
         return
     declared: set[str] = set()
     todo, seen = [path], set()
     while todo:
         current = todo.pop()
-        if current in seen:
+        if current in seen or not _inside(current, roots) or not current.is_file():
             continue
         seen.add(current)
-        text = current.read_text(errors="replace")
+        text = read_text(current, "xacro file", URDFError)
         declared.update(_ARG.findall(text))
         for name in _INCLUDE.findall(text):
             if "$" in name:
@@ -175,7 +296,8 @@ def _check_declared(path: Path, args: dict[str, str]) -> None:
             todo.append((current.parent / name).resolve())
     unknown = sorted(set(args) - declared)
     if unknown:
-        raise OptionError("xacro_args", {k: args[k] for k in unknown},
-                          f"arguments {path.name} declares: {', '.join(sorted(declared)) or 'none'}",
+        listed = ", ".join(sorted(declared)) or "none"
+        raise OptionError("xacro_args", {k: args[k] for k in unknown}, f"arguments {path.name} declares: {listed}",
                           f"{path.name} declares no xacro argument {unknown[0]!r} (xacro would ignore it); it "
-                          f"declares: {', '.join(sorted(declared)) or 'none'}")
+                          f"declares: {listed}")
+
