@@ -52,9 +52,30 @@ def test_a_report_of_the_same_kind_is_replaced_whole_and_one_of_another_kind_is_
 def test_an_unmarked_folder_with_only_the_report_s_files_is_taken_as_an_earlier_report(tmp_path):
     out = tmp_path / "old"
     out.mkdir()
-    for name in ("report.json", "report.md", "report.html", "fig.png"):
+    for name in ("report.json", "report.md", "report.html", "era_elbow.png"):
         (out / name).write_text("")
     assert check_output_folder(out, "validate") == out
     (out / "mine.csv").write_text("")
     with pytest.raises(KinelabError, match="mine.csv"):
         check_output_folder(out, "validate")
+
+
+def test_a_folder_of_the_user_s_figures_is_never_taken_for_a_report(tmp_path):
+    """#31.5: validate --out DIR deleted a folder that held only the user's .png files."""
+    out = tmp_path / "photos"
+    out.mkdir()
+    for name in ("holiday.png", "era_elbow.png"):
+        (out / name).write_bytes(b"\x89PNG mine")
+    with pytest.raises(KinelabError, match="holiday.png"):
+        check_output_folder(out, "validate")
+    (out / "holiday.png").unlink()  # a figure named as validate names one, and no report beside it: still the user's
+    with pytest.raises(KinelabError, match="era_elbow.png"):
+        check_output_folder(out, "validate")
+    assert sorted(p.name for p in out.iterdir()) == ["era_elbow.png"]
+
+
+def test_the_figures_an_old_report_may_hold_are_the_ones_validate_captions():
+    from kinelab.report.outfolder import FIGURES
+    from kinelab.report.page import CAPTIONS
+
+    assert set(FIGURES) == set(CAPTIONS)

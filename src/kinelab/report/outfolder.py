@@ -18,6 +18,7 @@ from pathlib import Path
 from kinelab.errors import KinelabError
 
 MARKER = ".kinelab-report"
+FIGURES = ("era_elbow.png", "era_wrist.png", "era_shoulder.png", "seed001_convergence.png")  # validate's figures
 KINDS = {"validate": ("report.json", "report.md", "report.html"), "bench": ("bench.json", "bench.md", "bench.png")}
 
 
@@ -50,15 +51,19 @@ def check_output_folder(out: str | Path, kind: str) -> Path:
 
 
 def _replaceable(folder: Path, kind: str) -> bool:
-    """Empty, marked as a report of this kind, or holding only the files (and figures) this kind writes."""
+    """Empty, marked as a report of this kind, or an unmarked earlier report: the kind's main file (its JSON)
+    beside nothing but the files and figures this kind writes, by name (a folder of the user's figures is not
+    one)."""
     marker = folder / MARKER
     if marker.is_file():
         with contextlib.suppress(OSError, UnicodeDecodeError):
-            return marker.read_text().strip() == kind
+            return marker.read_text(errors="strict")[:100].strip() == kind
         return False
-    ours = set(KINDS[kind])
-    return all(p.is_file() and (p.name in ours or (kind == "validate" and p.suffix == ".png"))
-               for p in folder.iterdir())
+    names = {p.name: p.is_file() for p in folder.iterdir()}
+    if not names:
+        return True
+    ours = set(KINDS[kind]) | (set(FIGURES) if kind == "validate" else set())
+    return KINDS[kind][0] in names and all(is_file and name in ours for name, is_file in names.items())
 
 
 @contextlib.contextmanager
