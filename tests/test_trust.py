@@ -183,3 +183,74 @@ def test_use_limits_false_works_on_every_path(name):
     _honest(robot, path.q[0], path.status[0], one)
     with pytest.raises(kinelab.OptionError, match="use_limits"):  # the closed form has no such setting: named
         kinelab.solve_all(robot, one, solver="analytic", use_limits=False)
+
+
+def test_an_obstacle_file_is_bounded_in_size_depth_and_count(tmp_path):
+    """#31.5: Environment.from_file("/dev/zero") read until memory ran out; a deeply nested JSON gave a
+    RecursionError; 20,000 obstacles took > 150 s (Pinocchio's geometry model keeps an n × n pair table)."""
+    import json
+
+    from helpers import no_hang
+
+    from kinelab.collision.obstacles import MAX_OBSTACLES, Environment, Obstacle, ObstacleError
+
+    with no_hang(20), pytest.raises(ObstacleError, match="not a regular file"):
+        Environment.from_file("/dev/zero")
+    deep = tmp_path / "deep.json"
+    for text in ("[" * 100_000 + "]" * 100_000, '{"obstacles": [' + "[" * 50 + "]" * 50 + "]}"):
+        deep.write_text(text)
+        with pytest.raises(ObstacleError, match="nested at most 4 deep"):
+            Environment.from_file(deep)
+    many = tmp_path / "many.json"
+    many.write_text(json.dumps({"obstacles": [{"shape": "sphere", "size": [0.05], "xyz": [2, 0, 0]}] * 20_000}))
+    with no_hang(20), pytest.raises(ObstacleError, match=f"lists 20000 obstacles; an environment holds at most "
+                                                         f"{MAX_OBSTACLES}"):
+        Environment.from_file(many)
+    with pytest.raises(ObstacleError, match="at most"):
+        Environment(tuple([Obstacle("sphere", (0.05,), (2.0, 0.0, 0.0))] * (MAX_OBSTACLES + 1)))
+    many.write_text(json.dumps({"obstacles": [{"shape": "sphere", "size": [0.05], "xyz": [2, 0, k * 0.2]}
+                                              for k in range(MAX_OBSTACLES)]}))
+    ur5 = kinelab.load("ur5")
+    with no_hang(120):  # the most an environment may hold is checked, not refused
+        res = kinelab.solve(ur5, ur5.fk(ur5.random_q(0)), collisions=Environment.from_file(many), seed=0)
+    assert res.status.value in ("converged", "collision")
+
+
+def test_map_workers_are_capped_by_the_cores(capsys):
+    """#31.5: map reach --workers 1000 started 1,000 processes and computed nothing."""
+    from kinelab.maps import cluster
+
+    assert cli.main(["map", "reach", "ur5", "--workers", "1000"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"--workers must be 1 to {cluster.cores()}" in err
+    with pytest.raises(KinelabError, match="workers must be 1 to"):
+        cluster.client_for(None, cluster.cores() + 1)
+
+
+def test_three_thousand_nested_srdf_groups_neither_recurse_nor_take_seconds(tmp_path):
+    """#31.5: 3,000 nested SRDF groups still recursed (and the joint check was quadratic)."""
+    from helpers import no_hang
+
+    from kinelab.robot.srdf import read_srdf
+
+    n = 3000
+    groups = "".join(f'<group name="g{i}"><group name="g{i + 1}"/></group>' for i in range(n))
+    path = tmp_path / "nested.srdf"
+    path.write_text(f'<robot name="r">{groups}<group name="g{n}"><joint name="j1"/></group></robot>')
+    with no_hang(20):
+        srdf = read_srdf(path)
+        assert srdf.group_joints("g0") == ["j1"]
+        srdf.check_joints(["j1"])
+        with pytest.raises(kinelab.SRDFError, match="names joint 'j1', which the robot does not have"):
+            srdf.check_joints(["j2"])
+    path.write_text(f'<robot name="r">{groups}<group name="g{n}"><group name="g0"/></group></robot>')
+    with no_hang(20), pytest.raises(kinelab.SRDFError, match=r"group 'g0' includes itself \(g0 -> g1 -> g2"):
+        read_srdf(path).check_joints(["j1"])
+
+
+@pytest.mark.parametrize("where", ["/dev/zero", "folder"])
+def test_a_robot_file_that_is_not_a_regular_file_is_refused_before_reading(tmp_path, where):
+    from helpers import no_hang
+
+    with no_hang(20), pytest.raises(kinelab.URDFError, match="not a regular file"):
+        kinelab.load(where if where != "folder" else tmp_path)

@@ -108,6 +108,40 @@ def test_a_damaged_store_is_refused_on_load_and_recomputed_on_resume(ur5, tmp_pa
     assert not np.isnan(maps.load(out).array("reachability")).any()
 
 
+def test_a_chunk_of_garbage_or_an_edited_shape_is_refused_on_open_and_garbage_recomputed_on_resume(ur5, tmp_path):
+    """#31.5: a chunk of garbage gave a raw blosc RuntimeError; an edited array shape crashed the resume and left a
+    store that loaded as a 5-voxel map."""
+    import json
+
+    pytest.importorskip("zarr")
+    spec = reach.MapSpec(voxel=0.25, orientations=4, chunk_voxels=50, restarts=5)
+    out = tmp_path / "m.zarr"
+    whole = maps.reachability(ur5, spec, out=str(out))
+    (out / "reachability" / "1").write_bytes(bytes(range(256)) * 4)  # not a blosc chunk
+    with pytest.raises(KinelabError, match=r"1 chunk\(s\) no longer match their checksums \(first: 1\)"):
+        maps.load(out)
+    with pytest.warns(UserWarning, match="computed again"):
+        again = maps.reachability(ur5, spec, out=str(out))
+    np.testing.assert_array_equal(again.array("reachability"), whole.array("reachability"))
+    (out / "done" / "0").write_bytes(b"garbage")
+    with pytest.raises(KinelabError, match="the done array cannot be read"):
+        maps.load(out)
+    maps.reachability(ur5, spec, out=str(tmp_path / "n.zarr"))
+    meta = json.loads((tmp_path / "n.zarr" / "reachability" / ".zarray").read_text())
+    meta["shape"] = [5]
+    (tmp_path / "n.zarr" / "reachability" / ".zarray").write_text(json.dumps(meta))
+    for attempt in (lambda: maps.load(tmp_path / "n.zarr"),
+                    lambda: maps.reachability(ur5, spec, out=str(tmp_path / "n.zarr"))):
+        with pytest.raises(KinelabError, match=r"array 'reachability' has shape \(5,\)"):
+            attempt()
+    zarr = pytest.importorskip("zarr")  # the centres moved: their checksum says so
+    maps.reachability(ur5, spec, out=str(tmp_path / "c.zarr"))
+    group = zarr.open_group(str(tmp_path / "c.zarr"), mode="r+")
+    group["centres"][0] = [9.0, 9.0, 9.0]
+    with pytest.raises(KinelabError, match="voxel centres no longer match"):
+        maps.load(tmp_path / "c.zarr")
+
+
 def test_bad_maps_are_refused_with_the_reason(ur5, tmp_path, monkeypatch):
     pytest.importorskip("zarr")
     with pytest.raises(KinelabError, match="voxel side must be a positive"):

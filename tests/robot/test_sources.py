@@ -65,7 +65,7 @@ def test_bad_srdf_uses_and_bad_bases_are_named(tmp_path):
     bad.write_text('<robot name="panda"><group name="arm"><joint name="elbow_of_nobody"/></group></robot>')
     with pytest.raises(SRDFError, match="bad.srdf: group 'arm' names joint 'elbow_of_nobody'"):
         load("panda", srdf=bad)
-    with pytest.raises(SRDFError, match="cannot read SRDF"):
+    with pytest.raises(SRDFError, match="SRDF not found"):
         load("panda", srdf=tmp_path / "missing.srdf")
     with pytest.raises(ChainError, match="not on the path from the root"):
         load("panda", base="panda_leftfinger", tool="panda_hand_tcp")

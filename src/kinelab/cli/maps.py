@@ -138,11 +138,12 @@ def run_reach(args: argparse.Namespace) -> int:
                         collisions=common.collisions_of(args))
     if args.scheduler and args.workers:
         raise KinelabError("give --scheduler ADDRESS or --workers N, not both")
-    if args.workers is not None and args.workers < 1:
-        raise KinelabError(f"--workers must be at least 1, got {args.workers}")
+    from kinelab.maps import cluster
+
+    if args.workers is not None and not 1 <= args.workers <= cluster.cores():
+        raise KinelabError(f"--workers must be 1 to {cluster.cores()} (the cores here), got {args.workers}")
     client = None
     if args.scheduler is not None or args.workers:
-        from kinelab.maps import cluster
 
         client = cluster.client_for(args.scheduler, args.workers)
     t0 = time.perf_counter()

@@ -27,7 +27,11 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.errors import KinelabError
+from kinelab.files import read_text
 
+MAX_OBSTACLES = 1000  # Pinocchio's geometry model keeps an n × n pair table, rebuilt per object: 1000 cost 0.1–0.8 s
+MAX_DEPTH = 4  # {"obstacles": [{"size": [...]}]}
+MAX_FILE_BYTES = 16 * 2**20  # [bytes] 1000 obstacles take about 150 kB
 SIZES = {"plane": 0, "box": 3, "sphere": 1, "cylinder": 2, "capsule": 2, "mesh": 1}
 
 
@@ -115,8 +119,11 @@ class Environment:
     obstacles: tuple[Obstacle, ...] = ()
 
     def __post_init__(self) -> None:
-        if not all(isinstance(o, Obstacle) for o in self.obstacles):
-            raise ObstacleError("an Environment holds Obstacle objects")
+        if not isinstance(self.obstacles, list | tuple) or not all(isinstance(o, Obstacle) for o in self.obstacles):
+            raise ObstacleError("an Environment holds a list or tuple of Obstacle objects")
+        if len(self.obstacles) > MAX_OBSTACLES:
+            raise ObstacleError(f"an environment holds at most {MAX_OBSTACLES} obstacles, got {len(self.obstacles)} "
+                                "(merge small ones into a box or a mesh obstacle)")
         object.__setattr__(self, "obstacles", tuple(self.obstacles))
 
     @classmethod
@@ -127,13 +134,20 @@ class Environment:
             ObstacleError: a missing or malformed file, or a bad obstacle (its index named).
         """
         path = Path(path)
+        text = read_text(path, "obstacle file", ObstacleError, MAX_FILE_BYTES)
         try:
-            data = json.loads(path.read_text())
-        except (OSError, ValueError) as exc:
+            data = json.loads(text)
+        except ValueError as exc:
             raise ObstacleError(f"cannot read the obstacle file {path}: {exc}") from None
+        except RecursionError:
+            data = None  # nested past Python's limit: refused below with the others nested too deep
         rows = data.get("obstacles") if isinstance(data, dict) else None
-        if not isinstance(rows, list):
-            raise ObstacleError(f"{path}: an obstacle file is a JSON object with a list 'obstacles'")
+        if not isinstance(rows, list) or _depth(data) > MAX_DEPTH:
+            raise ObstacleError(f"{path}: an obstacle file is a JSON object with a list 'obstacles' of objects "
+                                f"(nested at most {MAX_DEPTH} deep)")
+        if len(rows) > MAX_OBSTACLES:
+            raise ObstacleError(f"{path} lists {len(rows)} obstacles; an environment holds at most {MAX_OBSTACLES} "
+                                "(merge small ones into a box or a mesh obstacle)")
         out = []
         for k, row in enumerate(rows):
             if not isinstance(row, dict) or set(row) - {"shape", "size", "xyz", "rpy", "name", "mesh"}:
@@ -143,6 +157,18 @@ class Environment:
                 row = {**row, "mesh": _inside(path, row["mesh"], k)}
             out.append(Obstacle(**{"name": f"{row.get('shape', '?')} {k}", **row}))
         return cls(tuple(out))
+
+
+def _depth(value: Any) -> int:
+    """How deep lists and objects nest in a JSON value (a number or string: 0)."""
+    stack, deepest = [(value, 1)], 0
+    while stack:
+        item, level = stack.pop()
+        if isinstance(item, dict | list):
+            deepest = max(deepest, level)
+            if level <= MAX_DEPTH:
+                stack.extend((child, level + 1) for child in (item.values() if isinstance(item, dict) else item))
+    return deepest
 
 
 def _inside(path: Path, mesh: Any, k: int) -> str:

@@ -154,7 +154,18 @@ def _bounded(connect: Callable[[], Any], address: str) -> Any:
                        "nothing was written")
 
 
+def cores() -> int:
+    """The cores this process may run on (its CPU affinity where the system tells it)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # macOS, Windows
+        return os.cpu_count() or 1
+
+
 def _local_client(workers: int | None) -> Any:
+    if workers is not None and not 1 <= workers <= cores():
+        raise KinelabError(f"workers must be 1 to {cores()} (the cores here; a local cluster of more processes only "
+                           f"adds their start-up), got {workers}")
     import dask
     from dask.distributed import Client, LocalCluster
 

@@ -47,6 +47,41 @@ def metadata(robot: Robot, spec: Any, voxels: int) -> dict:
             "base": robot.base, "tool": robot.tool}
 
 
+def centres_sha256(centres: np.ndarray) -> str:
+    """SHA-256 of the voxel centres (little-endian float64, row by row): kept with the map, checked on open."""
+    return hashlib.sha256(np.ascontiguousarray(centres, dtype="<f8").tobytes()).hexdigest()
+
+
+def _read(array: Any, where: slice | int, what: str, path: Path | None) -> np.ndarray:
+    """``array[where]`` as numpy; a chunk file that does not decode is a KinelabError naming the array."""
+    try:
+        return np.asarray(array[where])
+    except Exception as exc:  # noqa: BLE001 - zarr and its codecs raise RuntimeError, ValueError, ... on garbage
+        raise KinelabError(f"{path}: the {what} array cannot be read ({type(exc).__name__}: {exc}); the map file "
+                           "is damaged: remove it and compute the map again") from None
+
+
+def _check_layout(meta: dict, arrays: dict[str, Any], path: Path) -> None:
+    """Refuse a map whose arrays do not have the shapes and types its metadata implies, or whose centres differ
+    from the ones it was written with (an edited or truncated store)."""
+    voxels, spec = meta.get("voxels"), meta.get("spec")
+    size = spec.get("chunk_voxels") if isinstance(spec, dict) else None
+    if not (isinstance(voxels, int) and voxels >= 0 and isinstance(size, int) and size > 0):
+        raise KinelabError(f"{path}: the map's metadata is damaged (voxels {voxels!r}, chunk size {size!r})")
+    chunks = -(-voxels // size)
+    expected = {"centres": ((voxels, 3), "f8"), "done": ((chunks,), "bool"), "checksums": ((chunks, 32), "u1"),
+                **{k: ((voxels,), "f8") for k in VALUES}}
+    for name, (shape, dtype) in expected.items():
+        found = arrays[name]
+        if tuple(found.shape) != shape or np.dtype(found.dtype) != np.dtype(dtype):
+            raise KinelabError(f"{path}: array {name!r} has shape {tuple(found.shape)} and type {found.dtype}; a map "
+                               f"of {voxels} voxels in chunks of {size} has {shape} {np.dtype(dtype)}: the file was "
+                               "altered, compute the map again")
+    if centres_sha256(_read(arrays["centres"], slice(None), "centres", path)) != meta.get("centres_sha256"):
+        raise KinelabError(f"{path}: the voxel centres no longer match the checksum written with them: the file was "
+                           "altered, compute the map again")
+
+
 class ReachabilityMap:
     """The map's arrays (numpy, or Zarr arrays on disk) and its metadata."""
 
@@ -75,7 +110,11 @@ class ReachabilityMap:
         size = self.meta["spec"]["chunk_voxels"]
         h = hashlib.sha256()
         for name in VALUES:
-            h.update(np.ascontiguousarray(self.values[name][index * size:(index + 1) * size], dtype="<f8").tobytes())
+            try:
+                values = np.asarray(self.values[name][index * size:(index + 1) * size])
+            except Exception:  # noqa: BLE001 - a chunk file that does not decode: damaged, like one altered
+                return np.zeros(32, dtype=np.uint8)  # no SHA-256 is all zeros
+            h.update(np.ascontiguousarray(values, dtype="<f8").tobytes())
         return np.frombuffer(h.digest(), dtype=np.uint8)
 
     def damaged(self) -> list[int]:
@@ -83,8 +122,8 @@ class ReachabilityMap:
         file deleted or altered); none for a map in memory."""
         if self.checksums is None:
             return []
-        done = np.flatnonzero(np.asarray(self.done[:]))
-        sums = np.asarray(self.checksums[:])
+        done = np.flatnonzero(_read(self.done, slice(None), "done", self.path))
+        sums = _read(self.checksums, slice(None), "checksums", self.path)
         return [int(c) for c in done if not np.array_equal(sums[c], self._digest(int(c)))]
 
     def array(self, name: str) -> np.ndarray:
@@ -117,7 +156,7 @@ def open_map(out: str | Path | None, robot: Robot, spec: Any, centres: np.ndarra
                           "they are computed again", stacklevel=3)
         return found
     group = zarr.open_group(str(path), mode="w")
-    group.attrs.update(meta)
+    group.attrs.update({**meta, "centres_sha256": centres_sha256(centres)})
     group.create_dataset("centres", data=centres, chunks=(spec.chunk_voxels, 3))
     for name in VALUES:
         group.create_dataset(name, shape=(len(centres),), chunks=(spec.chunk_voxels,), dtype="f8", fill_value=np.nan)
@@ -144,11 +183,12 @@ def load(path: str | Path, check: bool = True) -> ReachabilityMap:
         group = zarr.open_group(str(path), mode="r+")
         meta = dict(group.attrs)
         arrays = {k: group[k] for k in ("centres", "done", "checksums", *VALUES)}
-    except (KeyError, ValueError, FileNotFoundError, zarr.errors.GroupNotFoundError):
-        raise KinelabError(f"{path} is not a kinelab reachability map") from None
+    except (KeyError, ValueError, TypeError, OSError, zarr.errors.GroupNotFoundError):
+        raise KinelabError(f"{path} is not a kinelab reachability map (or its metadata is damaged)") from None
     if meta.get("kinelab") != __version__:
         raise KinelabError(f"{path} was written by kinelab {meta.get('kinelab')}, this is {__version__}: "
                            "compute the map again")
+    _check_layout(meta, arrays, path)
     found = ReachabilityMap(meta, arrays, path)
     damaged = found.damaged() if check else []
     if damaged:

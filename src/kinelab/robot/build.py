@@ -27,6 +27,7 @@ from kinelab.errors import (
     SRDFError,
     URDFError,
 )
+from kinelab.files import checked_file
 from kinelab.robot import xacro
 from kinelab.robot.joints import Joint, Mimic
 from kinelab.robot.meshes import c_stderr_captured, mesh_package_dirs
@@ -126,6 +127,7 @@ class _Builder:
     def from_file(cls, source: Path, tool: str | None, locked: dict[str, float] | None, name: str | None,
                   base: str | None, package_dirs: list[str] | None, srdf: str | Path | None, group: str | None,
                   xacro_args: dict[str, str] | None, trust_xacro: bool) -> _Builder:
+        checked_file(source, "robot file", URDFError)  # a device, a pipe or 10 GB: refused before any parser reads
         if xacro_args and not xacro.is_xacro(source):  # an argument that nothing reads is a mistake, said
             raise OptionError("xacro_args", xacro_args, f"arguments of a .xacro source; {source.name} is not one")
         urdf_path = source

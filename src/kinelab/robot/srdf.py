@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from kinelab.errors import SRDFError
+from kinelab.files import read_text
 
 
 @dataclass(frozen=True)
@@ -48,24 +49,67 @@ class Srdf:
                             f"{', '.join(self.states) or 'none'}")
         return self.states[name]
 
-    def group_joints(self, name: str, _seen: tuple[str, ...] = ()) -> list[str]:
-        """The joints a group lists, its subgroups' included (a chain group lists none: see ``chain``).
+    def group_joints(self, name: str) -> list[str]:
+        """The joints a group lists, its subgroups' included in order (a chain group lists none: see ``chain``).
 
         Raises:
             SRDFError: an unknown group, or groups that include each other (the cycle named).
         """
-        if name in _seen:
-            raise SRDFError(f"{self.path.name}: group {name!r} includes itself "
-                            f"({' -> '.join((*_seen, name))}); a group may include only other groups")
-        g = self.group(name)
-        out = list(g.joints)
-        for sub in g.subgroups:
-            out += [j for j in self.group_joints(sub, (*_seen, name)) if j not in out]
+        cycle = self._cycle(name)
+        if cycle:
+            raise SRDFError(f"{self.path.name}: group {cycle[-1]!r} includes itself ({' -> '.join(cycle)}); a group "
+                            "may include only other groups")
+        out: list[str] = []
+        known: set[str] = set()
+        todo, visited = [name], set()
+        while todo:  # depth first, each group once: a chain of thousands of groups needs no recursion
+            current = todo.pop()
+            if current in visited:
+                continue
+            visited.add(current)
+            g = self.group(current)
+            out += [j for j in g.joints if j not in known]
+            known.update(g.joints)
+            todo.extend(reversed(g.subgroups))
         return out
+
+    def _cycle(self, name: str, done: set[str] | None = None) -> list[str]:
+        """The groups of a cycle reached from ``name`` (first and last the same), or []; ``done`` holds groups
+        already known to reach none (shared between calls, it makes a check of every group one pass).
+
+        Raises:
+            SRDFError: a subgroup that is not a group of the file.
+        """
+        on_path: dict[str, int] = {}
+        path: list[str] = []
+        done = set() if done is None else done
+        todo: list[tuple[str, bool]] = [(name, False)]
+        while todo:
+            current, leaving = todo.pop()
+            if leaving:
+                path.pop()
+                del on_path[current]
+                done.add(current)
+                continue
+            if current in on_path:
+                return [*path[on_path[current]:], current]
+            if current in done:
+                continue
+            on_path[current] = len(path)
+            path.append(current)
+            todo.append((current, True))
+            todo.extend((sub, False) for sub in reversed(self.group(current).subgroups))
+        return []
 
     def check_joints(self, known: list[str]) -> None:
         """Refuse a group or configuration naming a joint the robot does not have (file and joint named)."""
-        for where, names in [*((f"group {g!r}", self.group_joints(g)) for g in self.groups),
+        done: set[str] = set()
+        for g in self.groups:  # every subgroup named exists and none includes itself; one pass over them all
+            cycle = self._cycle(g, done)
+            if cycle:
+                raise SRDFError(f"{self.path.name}: group {cycle[-1]!r} includes itself ({' -> '.join(cycle)}); a "
+                                "group may include only other groups")
+        for where, names in [*((f"group {g!r}", list(self.groups[g].joints)) for g in self.groups),
                              *((f"configuration {s!r}", list(v)) for s, v in self.states.items())]:
             unknown = [j for j in names if j not in known and j not in self.virtual_joints]
             if unknown:
@@ -102,8 +146,8 @@ def read_srdf(path: str | Path) -> Srdf:
     """
     path = Path(path)
     try:
-        root = ET.parse(path).getroot()
-    except (OSError, ET.ParseError) as exc:
+        root = ET.fromstring(read_text(path, "SRDF", SRDFError))
+    except ET.ParseError as exc:
         raise SRDFError(f"cannot read SRDF {path}: {exc}") from None
     out = Srdf(path)
     for g in root.findall("group"):  # top-level definitions (a nested <group name=.../> only refers to one)
