@@ -123,3 +123,27 @@ def test_a_huge_model_file_is_refused_before_pinocchio_parses_it(tmp_path):
     mjcf.write_text(f"<mujoco><worldbody>{nested}</worldbody></mujoco>")
     with pytest.raises(kinelab.URDFError, match=f"{MAX_LINKS + 1} bodies"):
         load(str(mjcf))
+
+
+@pytest.mark.parametrize("tag", ["frame", "replicate", "attach"])
+def test_an_element_whose_bodies_pinocchio_drops_is_refused_by_name(tmp_path, tag):
+    """#31.6: a <frame>'s bodies were dropped without a word (the model was a wrong, shorter arm)."""
+    path = write_mjcf(tmp_path)
+    text = path.read_text()
+    path.write_text(text.replace("<worldbody>", f'<worldbody><body name="extra"><{tag}>'
+                                 f'<body name="inside"/></{tag}></body>', 1))
+    with pytest.raises(kinelab.URDFError, match=f"<{tag}> is not read by Pinocchio's MJCF parser"):
+        load(path)
+
+
+def test_a_class_that_no_default_defines_is_refused_by_name(tmp_path):
+    """#31.6: a bad childclass gave a raw IndexError from the parser (or a model without the class's values)."""
+    path = write_mjcf(tmp_path)
+    text = path.read_text().replace('<mujoco model="arm3">',
+                                    '<mujoco model="arm3"><default><default class="arm"/></default>')
+    path.write_text(text.replace('<body name="base"', '<body name="base" childclass="nosuch"', 1))
+    with pytest.raises(kinelab.URDFError, match="childclass='nosuch', which no <default class=...> defines; "
+                                                "classes: arm, main"):
+        load(path)
+    path.write_text(text.replace('<body name="base"', '<body name="base" childclass="arm"', 1))
+    assert load(path).joint_names == ["j1", "j2", "j3"]

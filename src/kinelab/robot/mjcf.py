@@ -15,7 +15,11 @@ from pathlib import Path
 import pinocchio as pin
 
 from kinelab.errors import URDFError
+from kinelab.files import read_text
 from kinelab.robot.urdf import MAX_OFFSET, UrdfTree, check_size
+
+
+UNREAD = ("frame", "replicate", "attach")  # MuJoCo 3 elements Pinocchio's parser skips, with their bodies
 
 
 def is_mjcf(path: Path) -> bool:
@@ -37,9 +41,9 @@ def read_mjcf(path: Path) -> tuple[pin.Model, UrdfTree]:
     check_mjcf(path)
     try:
         model = pin.buildModelFromMJCF(str(path))
-    except (RuntimeError, ValueError) as exc:
-        raise URDFError(f"Pinocchio cannot read the MJCF {path}: {exc}") from None
-    _restore_slide_ranges(model, ET.parse(path).getroot())
+    except Exception as exc:  # noqa: BLE001 - the parser raises RuntimeError, ValueError, IndexError, ...
+        raise URDFError(f"Pinocchio cannot read the MJCF {path}: {type(exc).__name__}: {exc}") from None
+    _restore_slide_ranges(model, ET.fromstring(read_text(path, "MJCF file", URDFError)))
     return model, body_tree(model)
 
 
@@ -52,13 +56,18 @@ def check_mjcf(path: Path) -> None:
         URDFError: the file, the element and the rule named.
     """
     try:
-        root = ET.parse(path).getroot()
-    except (OSError, ET.ParseError) as exc:
+        root = ET.fromstring(read_text(path, "MJCF file", URDFError))
+    except ET.ParseError as exc:
         raise URDFError(f"malformed MJCF {path}: {exc}") from None
     bodies = list(root.iter("body"))
     check_size(path, len(bodies), "bodies")
     if root.find(".//include") is not None:
         raise URDFError(f"{path}: <include> is not read by kinelab; merge the included file into {path.name}")
+    for tag in UNREAD:
+        if root.find(f".//worldbody//{tag}") is not None:
+            raise URDFError(f"{path}: <{tag}> is not read by Pinocchio's MJCF parser (the bodies in it would be "
+                            f"dropped without a word); write its bodies out of it, its placement composed into theirs")
+    _check_classes(path, root)
     for kind, elements in (("body", bodies), ("joint", list(root.iter("joint")))):
         names = [e.get("name", "") for e in elements if e.get("name")]
         twice = sorted({n for n in names if names.count(n) > 1})
@@ -68,6 +77,18 @@ def check_mjcf(path: Path) -> None:
         _check_body(path, body)
     for joint in root.iter("joint"):
         _check_joint(path, joint)
+
+
+def _check_classes(path: Path, root: ET.Element) -> None:
+    """Every ``class`` and ``childclass`` names a ``<default class=...>`` of the file (MuJoCo refuses the file
+    otherwise; Pinocchio's parser fails on it with a raw error)."""
+    defined = {d.get("class") for d in root.iter("default")} | {"main"}
+    for element in root.iter():
+        for attribute in ("class", "childclass"):
+            name = element.get(attribute)
+            if name is not None and element.tag != "default" and name not in defined:
+                raise URDFError(f"{path}: {element.tag} {element.get('name', '?')!r} has {attribute}={name!r}, which "
+                                f"no <default class=...> defines; classes: {', '.join(sorted(defined - {None}))}")
 
 
 def _numbers(path: Path, element: ET.Element, attribute: str, count: int) -> list[float] | None:
