@@ -54,6 +54,8 @@ class Collisions:
     margin: float = 0.0
 
     def __post_init__(self) -> None:
+        if not isinstance(self.self_collisions, bool | np.bool_):
+            raise CollisionError(f"self_collisions is True or False, got {self.self_collisions!r}")
         if not (isinstance(self.margin, int | float) and not isinstance(self.margin, bool)
                 and np.isfinite(self.margin) and self.margin >= 0):
             raise CollisionError(f"the collision margin is a clearance ≥ 0 m, got {self.margin!r}")

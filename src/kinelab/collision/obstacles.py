@@ -59,6 +59,9 @@ class Obstacle:
     mesh: str = ""
 
     def __post_init__(self) -> None:
+        if not isinstance(self.shape, str) or not isinstance(self.name, str) or not isinstance(self.mesh, str):
+            raise ObstacleError(f"an obstacle's shape, name and mesh are strings, got shape={self.shape!r}, "
+                                f"name={self.name!r}, mesh={self.mesh!r}")
         label = self.name or self.shape
         if self.shape not in SIZES:
             raise ObstacleError(f"obstacle {label!r}: unknown shape {self.shape!r}; shapes are {', '.join(SIZES)}")
@@ -66,7 +69,8 @@ class Obstacle:
             raise ObstacleError(f"obstacle {label!r}: a mesh obstacle names its file (mesh=...), and only a mesh does")
         if self.shape == "mesh" and not Path(self.mesh).is_file():
             raise ObstacleError(f"obstacle {label!r}: mesh file {self.mesh} not found")
-        size, xyz, rpy = _numbers(label, "size", self.size or ((1.0,) if self.shape == "mesh" else ())), \
+        given = (1.0,) if self.shape == "mesh" and isinstance(self.size, tuple) and not self.size else self.size
+        size, xyz, rpy = _numbers(label, "size", given), \
             _numbers(label, "xyz", self.xyz), _numbers(label, "rpy", self.rpy)
         if len(size) != SIZES[self.shape]:
             raise ObstacleError(f"obstacle {label!r}: a {self.shape} takes {SIZES[self.shape]} size number(s) "
@@ -104,6 +108,8 @@ class Obstacle:
 
 def _numbers(label: str, what: str, values: Any) -> tuple[float, ...]:
     try:
+        if isinstance(values, str | bytes) or np.ndim(values) != 1 or np.iscomplexobj(values):
+            raise TypeError
         out = tuple(float(v) for v in values)
     except (TypeError, ValueError):
         raise ObstacleError(f"obstacle {label!r}: {what} must be numbers, got {values!r}") from None

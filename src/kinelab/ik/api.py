@@ -29,7 +29,7 @@ from kinelab.ik.clear import clear_batch, clear_track, mark_colliding, solve_cle
 from kinelab.ik.driver import solve_one
 from kinelab.ik.frdm.tracking import PathSettings, path_options, run_track
 from kinelab.ik.registry import solver_module
-from kinelab.ik.request import Request, make_request
+from kinelab.ik.request import Request, check_robot, make_request
 from kinelab.ik.result import IKResult, TrackResult
 from kinelab.ik.targets import as_target, as_target_arrays
 from kinelab.robot import Robot
@@ -102,6 +102,7 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
         TypeError: arguments after the target given positionally.
         SolverNotFoundError, OptionError, TargetError, ConfigurationError: bad input, named.
     """
+    check_robot(robot)
     if positional:
         refuse_positional("solve", positional)
     if solver == "analytic":
@@ -196,6 +197,7 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
         TargetError: a bad target (its index named); ConfigurationError: a bad q0 (its row named);
         OptionError, SolverNotFoundError: a bad option or argument.
     """
+    check_robot(robot)
     if positional:
         refuse_positional("solve_batch", positional)
     if solver == "analytic":
@@ -258,6 +260,7 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
         TypeError: arguments after the target given positionally.
         TargetError, ConfigurationError, OptionError: bad input, named.
     """
+    check_robot(robot)
     if positional:
         refuse_positional("solve_all", positional)
     method = solver if solver in ("auto", "analytic") else "multistart"
@@ -319,6 +322,7 @@ def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
         OptionError: a bad option, a solver other than "frdm", a restriction named without its table.
         ConfigurationError, JointLimitError, TargetError: a bad q0 or target, named.
     """
+    check_robot(robot)
     if positional:
         refuse_positional("track", positional)
     if solver_module(solver) is not solver_module("frdm"):

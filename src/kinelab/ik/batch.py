@@ -121,7 +121,7 @@ def _starts(robot: Robot, q0: Any, count: int) -> np.ndarray | None:
     """The (count, n) starts, checked (None: every row draws its own)."""
     if q0 is None:
         return None
-    arr = np.asarray(q0, dtype=float) if not isinstance(q0, np.ndarray) or q0.dtype.kind in "fiu" else q0
+    arr = np.asarray(q0)
     if arr.dtype.kind not in "fiu":
         raise ConfigurationError(f"q0 must be numbers, got dtype {arr.dtype}")
     if arr.shape == (robot.n,):

@@ -26,6 +26,8 @@ def resolve(cls: type[T], solver: str, options: T | None, kwargs: dict[str, Any]
         OptionError: both an options object and keyword options, an unknown option, or a bad value.
     """
     if options is not None:
+        if not isinstance(options, cls):
+            raise OptionError("options", options, f"a {cls.__name__}(...) for solver {solver!r}, or keyword options")
         if kwargs:
             name = next(iter(kwargs))
             raise OptionError(name, kwargs[name], f"give either options={cls.__name__}(...) or keyword options, "

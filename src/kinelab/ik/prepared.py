@@ -23,7 +23,7 @@ from kinelab.ik.branches import UNSEEN, find_all
 from kinelab.ik.clear import clear_batch, mark_colliding, solve_clear
 from kinelab.ik.driver import prepare_checks, solve_one
 from kinelab.ik.lean import LeanFRDM
-from kinelab.ik.request import Request, check_seed, make_request
+from kinelab.ik.request import Request, check_robot, check_seed, make_request
 from kinelab.ik.result import IKResult
 from kinelab.ik.targets import as_target, as_target_arrays
 from kinelab.robot import Robot
@@ -62,6 +62,7 @@ class IK:
         if positional:
             raise TypeError("IK() takes the robot positionally and every setting by keyword: pass "
                             f"solver={positional[0]!r}")
+        check_robot(robot)
         self.robot = robot
         self.analytic = solver == "analytic"
         if self.analytic:

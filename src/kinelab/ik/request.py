@@ -16,7 +16,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
-from kinelab.errors import OptionError
+from kinelab.errors import ChainError, OptionError
 from kinelab.ik.registry import solver_module
 from kinelab.ik.tasks import POSE, Task
 
@@ -71,6 +71,19 @@ class Request:
     def task_label(self) -> str:
         """The task as results name it: "pose", "position", "orientation" or "axis z" (with its axis)."""
         return self.task.name if self.task.axis < 0 else f"axis {'xyz'[self.task.axis]}"
+
+
+def check_robot(robot: object) -> None:
+    """Refuse anything but a :class:`kinelab.Robot` where an entry point takes the robot.
+
+    Raises:
+        ChainError: naming what was given.
+    """
+    from kinelab.robot import Robot
+
+    if not isinstance(robot, Robot):
+        raise ChainError(f"the robot must be a kinelab.Robot (kinelab.load(...) or Robot.from_model(...)), got "
+                         f"{type(robot).__name__}")
 
 
 def make_request(solver: str = "frdm", seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6,

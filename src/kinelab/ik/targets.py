@@ -90,7 +90,13 @@ def _is_point(target: Any) -> bool:
 
 
 def _finite(values: ArrayLike, size: int, what: str) -> np.ndarray:
-    arr = np.asarray(values, dtype=float)
+    try:
+        raw = np.asarray(values)
+        if raw.dtype.kind not in "fiu":
+            raise TypeError
+        arr = raw.astype(float)
+    except (TypeError, ValueError):
+        raise TargetError(f"{what} must be {size} real numbers, got {values!r}") from None
     if arr.shape != (size,):
         raise TargetError(f"{what} must have {size} numbers, got shape {arr.shape}")
     if not np.all(np.isfinite(arr)):

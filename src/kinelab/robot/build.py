@@ -359,6 +359,8 @@ def _build_full_model(path: Path, mimic: bool = False) -> pin.Model:
 
 def frame_id(model: pin.Model, name: str, robot: str) -> int:
     """Id of frame ``name``, preferring the link (BODY) frame where a joint shares the name."""
+    if not isinstance(name, str):
+        raise FrameNotFoundError(repr(name), [f.name for f in model.frames], robot)
     body = [i for i, f in enumerate(model.frames) if f.name == name and f.type == pin.FrameType.BODY]
     if body:
         return body[0]

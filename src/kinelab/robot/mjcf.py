@@ -18,7 +18,6 @@ from kinelab.errors import URDFError
 from kinelab.files import read_text
 from kinelab.robot.urdf import MAX_OFFSET, UrdfTree, check_size
 
-
 UNREAD = ("frame", "replicate", "attach")  # MuJoCo 3 elements Pinocchio's parser skips, with their bodies
 
 
@@ -82,13 +81,13 @@ def check_mjcf(path: Path) -> None:
 def _check_classes(path: Path, root: ET.Element) -> None:
     """Every ``class`` and ``childclass`` names a ``<default class=...>`` of the file (MuJoCo refuses the file
     otherwise; Pinocchio's parser fails on it with a raw error)."""
-    defined = {d.get("class") for d in root.iter("default")} | {"main"}
+    defined = {str(d.get("class")) for d in root.iter("default") if d.get("class") is not None} | {"main"}
     for element in root.iter():
         for attribute in ("class", "childclass"):
             name = element.get(attribute)
             if name is not None and element.tag != "default" and name not in defined:
                 raise URDFError(f"{path}: {element.tag} {element.get('name', '?')!r} has {attribute}={name!r}, which "
-                                f"no <default class=...> defines; classes: {', '.join(sorted(defined - {None}))}")
+                                f"no <default class=...> defines; classes: {', '.join(sorted(defined))}")
 
 
 def _numbers(path: Path, element: ET.Element, attribute: str, count: int) -> list[float] | None:

@@ -149,9 +149,22 @@ class Robot:
     # -- coordinates ---------------------------------------------------------------------------
     def joint_index(self, name: str) -> int:
         """Position of joint ``name`` in kinelab's q (raises JointNotFoundError with the valid names)."""
-        if name not in self.joint_names:
+        if not isinstance(name, str) or name not in self.joint_names:
             raise JointNotFoundError(name, self.joint_names)
         return self.joint_names.index(name)
+
+    def _values(self, q: ArrayLike, what: str) -> np.ndarray:
+        """``q`` as n floats (NaN and ±inf kept); ConfigurationError for another shape or a non-real type."""
+        try:
+            raw = np.asarray(q)
+            if raw.dtype.kind not in "fiu":
+                raise TypeError
+        except (TypeError, ValueError):
+            raise ConfigurationError(f"{what} must be {self.n} numbers (real), got {q!r}") from None
+        if raw.shape != (self.n,):
+            raise ConfigurationError(f"{what} must have {self.n} numbers ({', '.join(self.joint_names)}) for "
+                                     f"{self.name}, got shape {raw.shape}")
+        return raw.astype(float)
 
     def check_q(self, q: ArrayLike, *, limits: bool = False, what: str = "q") -> np.ndarray:
         """``q`` as a float array of length n, refusing wrong shapes, NaN/inf and (if asked) limits."""
@@ -182,12 +195,17 @@ class Robot:
         return arr
 
     def within_limits(self, q: ArrayLike, slack: float = LIMIT_SLACK) -> bool:
-        """True when every bounded joint lies within its limits (plus ``slack``); continuous joints have none."""
+        """True when every bounded joint lies within its limits (plus ``slack``); continuous joints have none; a
+        NaN is within none.
+
+        Raises:
+            ConfigurationError: q is not n real numbers.
+        """
+        fast = type(q) is np.ndarray and q.shape == (self.n,) and q.dtype == np.float64
+        arr = cast(np.ndarray, q) if fast else self._values(q, "q")
         if slack == LIMIT_SLACK:
-            values = (q if type(q) is np.ndarray else np.asarray(q, dtype=float)).tolist()
-            return len(values) == self.n and all(map(operator.le, self._lower_list, values)) and \
-                all(map(operator.le, values, self._upper_list))
-        arr = np.asarray(q, dtype=float)
+            values = arr.tolist()
+            return all(map(operator.le, self._lower_list, values)) and all(map(operator.le, values, self._upper_list))
         return bool((arr >= self._lower_check - slack).all() and (arr <= self._upper_check + slack).all())
 
     def outside_limits(self, q: ArrayLike) -> list[str]:
@@ -234,7 +252,7 @@ class Robot:
 
     def wrap_continuous(self, q: ArrayLike) -> np.ndarray:
         """q with continuous joints wrapped into (−π, π] (the same pose)."""
-        q = np.array(q, dtype=float)
+        q = np.array(self.check_q(q))
         if self._cont_pos.size:
             q[self._cont_pos] = wrap_to_pi(q[self._cont_pos])
         return q
@@ -256,13 +274,13 @@ class Robot:
         """A configuration drawn uniformly within the limits (continuous joints on [−π, π]; a revolute joint
         whose limits lie beyond ±SAMPLE_TURNS turns, such as a rotor declared with ±1e16 rad, on ±SAMPLE_TURNS
         turns: every pose it can take, at angles where rounding does not swamp a step)."""
-        rng = np.random.default_rng(rng)
-        return rng.uniform(*self._sample_bounds)
+        return _generator(rng).uniform(*self._sample_bounds)
 
     def random_qs(self, count: int, rng: np.random.Generator | int | None = None) -> np.ndarray:
         """``count`` configurations (rows) drawn as :meth:`random_q` draws one."""
-        rng = np.random.default_rng(rng)
-        return rng.uniform(*self._sample_bounds, size=(count, self.n))
+        if not isinstance(count, int | np.integer) or isinstance(count, bool) or count < 0:
+            raise OptionError("count", count, "a whole number ≥ 0 of configurations")
+        return _generator(rng).uniform(*self._sample_bounds, size=(int(count), self.n))
 
     @functools.cached_property
     def _sample_bounds(self) -> tuple[np.ndarray, np.ndarray]:
@@ -364,7 +382,7 @@ class Robot:
 
     def integrate(self, q: ArrayLike, dq: ArrayLike) -> np.ndarray:
         """q ⊕ dq through ``pin.integrate`` (dq: n velocities × 1 s), back in one-number-per-joint form."""
-        dq = np.asarray(dq, dtype=float)
+        dq = self.check_q(dq, what="dq")
         return self.from_pin_q(pin.integrate(self.model, self.to_pin_q(q), dq))
 
     def difference(self, q0: ArrayLike, q1: ArrayLike) -> np.ndarray:
@@ -379,6 +397,8 @@ class Robot:
         ``ROS_PACKAGE_PATH``'s, then example-robot-data's); elements whose mesh cannot be found are left out
         with a warning naming the directories searched.
         """
+        if not isinstance(kind, str) or kind not in ("visual", "collision"):
+            raise OptionError("kind", kind, '"visual" or "collision"')
         b = self._built
         if b.urdf_path is None or b.full is None:
             return pin.GeometryModel()  # an in-memory model brings no geometry: the viewer draws a stick figure
@@ -420,6 +440,19 @@ class Robot:
 
     def __repr__(self) -> str:
         return f"Robot({self.name!r}, n={self.n}, tool={self.tool!r}, urdf={str(self.urdf_path)!r})"
+
+
+def _generator(rng: object) -> np.random.Generator:
+    """A numpy Generator from what ``random_q`` accepts: None, a whole number ≥ 0, or a Generator.
+
+    Raises:
+        OptionError: anything else (named).
+    """
+    if isinstance(rng, np.random.Generator):
+        return rng
+    if rng is None or (isinstance(rng, int | np.integer) and not isinstance(rng, bool) and rng >= 0):
+        return np.random.default_rng(rng)
+    raise OptionError("rng", rng, "None, a whole number ≥ 0 (a seed) or a numpy Generator")
 
 
 def _read_only(arr: np.ndarray) -> np.ndarray:
