@@ -206,19 +206,68 @@ COMMANDS = ["fk", "ik", "singular", "info", "validate", "animate", "robots", "vi
             "map base", "bench"]
 
 
+NONSENSE_ARGV = [  # each a user error: one line and exit 2, never a run (#31.6: 25 such runs exited 0)
+    ["fk", "ur5", "0", "0", "0"], ["fk", "ur5", "0", "0", "0", "0", "0", "nan"], ["fk", "nosuch", "0"],
+    ["fk", "ur5", "0", "0", "0", "0", "0", "x"], ["fk", "ur5", "9", "9", "9", "9", "9", "9"],
+    ["ik", "ur5", "--target-xyz", "0.3", "0.2"], ["ik", "ur5", "--target-xyz", "nan", "0", "0"],
+    ["ik", "ur5", "--target-xyz", "0.3", "0.2", "0.4", "--tol-pos", "-1"],
+    ["ik", "ur5", "--target-xyz", "0.3", "0.2", "0.4", "--time-budget", "0"],
+    ["ik", "ur5", "--target-xyz", "0.3", "0.2", "0.4", "--seed", "-1"],
+    ["ik", "ur5", "--target-xyz", "0.3", "0.2", "0.4", "--solver", "nosuch"],
+    ["ik", "ur5", "--target-xyz", "0.3", "0.2", "0.4", "--target-rpy", "90", "0", "0"],
+    ["ik", "ur5", "--target-xyz", "0.3", "0.2", "0.4", "--tool", "nosuch"],
+    ["ik", "ur5", "--target-xyz", "0.3", "0.2", "0.4", "--kick", "joint4=abc"],
+    ["ik", "ur5", "--target-xyz", "0.3", "0.2", "0.4", "--q0", "0", "0"],
+    ["singular", "ur5", "--sweep", "0"], ["singular", "ur5", "--sweep", "-5"], ["singular", "ur5", "--seed", "x"],
+    ["info", "nosuch"], ["info", "ur5", "--tool", "nosuch"], ["info", "ur5", "--lock", "x=1"],
+    ["info", "ur5", "--xacro-arg", "a=1"], ["info", "/dev/zero"], ["info", "ur5", "--srdf", "/nonexistent.srdf"],
+    ["validate", "--robots", "nosuch"], ["validate", "--n", "0"], ["validate", "--n", "-3"],
+    ["validate", "--out", "."], ["validate", "--out", "/proc/x"],
+    ["bench", "--robots", "nosuch"], ["bench", "--n", "0"], ["view", "ur5", "--html", "/proc/y.html"],
+    ["view", "ur5", "--q", "0", "0"], ["animate", "ur5", "--dt", "0"],
+    ["map", "reach", "ur5", "--voxel", "0"], ["map", "reach", "ur5", "--voxel", "nan"],
+    ["map", "reach", "ur5", "--workers", "1000"], ["map", "reach", "ur5", "--workers", "0"],
+    ["map", "reach", "ur5", "--orientations", "0"], ["map", "singular", "ur5", "--samples", "0"],
+    ["map", "base", "youbot", "--grasp", "1", "1"], ["map", "base", "youbot", "--grasp", "1", "1", "0.3", "0", "0",
+                                                       "0", "--step", "0"],
+    ["robots", "extra"], ["nosuch"],
+]
+
+
+def _cli(argv: list[str]) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "kinelab.cli", *argv], capture_output=True, text=True,
+                          timeout=HANG * 5, env={**os.environ, "PYTHONWARNINGS": "ignore"})
+
+
+def _cli_outcome(argv: list[str]) -> str:
+    """A command line's outcome: "clean" (one line, exit 2), "accepted" (exit 0 or 1), or raises (a traceback,
+    another exit code, or a user error that is not one line)."""
+    proc = _cli(argv)
+    assert "Traceback" not in proc.stderr, (argv, proc.stderr[-600:])
+    assert proc.returncode in (0, 1, 2), (argv, proc.returncode)
+    if proc.returncode != 2:
+        return "accepted"
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and re.match(r"(kinelab: error:|usage:)", lines[0]), (argv, proc.stderr)
+    return "clean"
+
+
 def test_bad_command_lines_end_in_one_line_and_exit_2_or_run():
     rng = random.Random("cli")
-    cases = max(12, CASES // 10)
-    for _ in range(cases):
-        command = rng.choice(COMMANDS).split()
-        argv = [*command, *rng.sample(CLI_WORDS, rng.randint(1, 6))]
-        proc = subprocess.run([sys.executable, "-m", "kinelab.cli", *argv], capture_output=True, text=True,
-                              timeout=300, env={**os.environ, "PYTHONWARNINGS": "ignore"})
-        assert "Traceback" not in proc.stderr, (argv, proc.stderr)
-        assert proc.returncode in (0, 1, 2), (argv, proc.returncode)
-        if proc.returncode == 2:
-            lines = proc.stderr.strip().splitlines()
-            assert len(lines) == 1 and re.match(r"(kinelab: error:|usage:)", lines[0]), (argv, proc.stderr)
+    tally = Tally("cli")
+    for argv in NONSENSE_ARGV:
+        tally.run(lambda a=argv: _raise_clean(_cli_outcome(a)), nonsense=True)
+    for _ in range(max(12, CASES // 10)):
+        argv = [*rng.choice(COMMANDS).split(), *rng.sample(CLI_WORDS, rng.randint(1, 6))]
+        tally.run(lambda a=argv: _raise_clean(_cli_outcome(a)))
+    tally.run(lambda: _raise_clean(_cli_outcome(["fk", "ur5", "0", "0", "0", "0", "0", "0"])))
+    assert _faults(tally) == ""
+
+
+def _raise_clean(outcome: str) -> str:
+    if outcome == "clean":
+        raise kinelab.KinelabError("exit 2")
+    return outcome
 
 
 # -- every entry point: the same bad values, each outcome counted ---------------------------------------------
@@ -301,6 +350,7 @@ def test_load_variants_count_no_raw_error_hang_or_nonsense_accepted(tmp_path):
     for _ in range(max(10, CASES // 3)):
         kwargs = {name: rng.choice(LOAD_VALUES) for name in rng.sample(
             ["tool", "base", "locked", "package_dirs", "srdf", "group", "xacro_args"], rng.randint(1, 2))}
+        kwargs = kwargs if tally.counts["cases"] else {"tool": "tool0"}  # the first case valid: both sides reached
         nonsense = bool(kwargs.get("xacro_args"))  # a plain URDF reads no xacro argument: saying nothing would lie
         robot = tally.run(lambda kw=kwargs: kinelab.load("ur5", **kw), nonsense)
         if robot is not None:
@@ -360,15 +410,132 @@ def test_mutated_mjcf_and_srdf_files_count_no_raw_error_or_hang(tmp_path, kind):
         path = tmp_path / f"m{k}.{'xml' if kind == 'mjcf' else 'srdf'}"
         path.write_bytes(ET.tostring(root))
         if kind == "mjcf":
-            robot = tally.run(lambda p=path: kinelab.load(str(p)))
+            _mjcf_extra(root, rng)
+            path.write_bytes(ET.tostring(root))
+            robot = tally.run(lambda p=path: kinelab.load(str(p)), nonsense=_mjcf_nonsense(root))
             if robot is not None:
                 _check_robot(robot)
+                dropped = [b.get("name") for b in root.iter("body")
+                           if b.get("name") and not robot.model.existFrame(b.get("name"))]
+                tally.counts["nonsense_accepted"] += bool(dropped)  # a body the model lost: a wrong model
         else:
             robot = tally.run(lambda p=path: kinelab.load("ur5", srdf=str(p), group="arm"))
             if robot is not None:
                 with contextlib.suppress(kinelab.KinelabError):
                     assert np.all(np.isfinite(robot.named_q("home")))
     assert _faults(tally) == ""
+
+
+def _mjcf_extra(root: ET.Element, rng: random.Random) -> None:
+    """Now and then one of the MJCF constructs Pinocchio's parser misreads (#31.6): a <frame> around a body, a
+    class no default defines, or a defined one."""
+    bodies = list(root.iter("body"))
+    pick = rng.random()
+    if pick < 0.15 and bodies:
+        parent = next(p for p in root.iter() if any(c is bodies[-1] for c in p))
+        frame = ET.SubElement(parent, rng.choice(["frame", "replicate"]), {"pos": "0 0 0.1"})
+        parent.remove(bodies[-1])
+        frame.append(bodies[-1])
+    elif pick < 0.3 and bodies:
+        rng.choice(bodies).set(rng.choice(["childclass", "class"]), rng.choice(["nosuch", "main"]))
+
+
+def _mjcf_nonsense(root: ET.Element) -> bool:
+    """A file MuJoCo itself refuses or Pinocchio misreads: a frame or replicate element, an undefined class."""
+    defined = {d.get("class") for d in root.iter("default")} | {"main"}
+    return root.find(".//frame") is not None or root.find(".//replicate") is not None or any(
+        e.get(a) not in defined for e in root.iter() for a in ("class", "childclass") if e.get(a) is not None
+        and e.tag != "default")
+
+
+XACRO_ATOMS = ["1", "0.5", "-2", "pi", "L", "'a'", "[1, 2]", "radians(90)", "sqrt(2)", "math.pi", "9**9**9",
+               "'a'*10**9", "python.type", "xacro.load_yaml('/etc/hostname')", "''.__class__", "(lambda: 1)()",
+               "[c for c in 'ab']", "$(env HOME)", "$(cwd)", "$(eval 1)", "len('abc')", "int('7')", "L if True else 0",
+               "{'k': 1}['k']", "'%999999d' % 1", "abs(-L)", "max(1, L)", "str(L) + 'x'", "nosuch", "1/0", "[0]*3"]
+XACRO_DANGER = ("9**9**9", "*10**9", "python", "xacro.", "__", "lambda", "for c", "$(env", "$(cwd", "$(eval",
+                "%999999d")
+
+
+def test_xacro_expressions_count_no_raw_error_hang_or_nonsense_accepted(tmp_path):
+    """Random ${...} expressions from safe and hostile atoms: each expands or is refused cleanly; one with a
+    hostile atom is never accepted (nonsense), and no marker file is ever written."""
+    pytest.importorskip("xacro")
+    rng = random.Random("xacro")
+    tally = Tally("files.xacro")
+    for k in range(max(20, CASES // 2)):
+        expr = " + ".join(rng.choice(XACRO_ATOMS) for _ in range(rng.randint(1, 3)))
+        path = tmp_path / f"x{k}.urdf.xacro"
+        path.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="L" '
+                        'value="0.3"/><link name="base"/><link name="tip"><visual><geometry><sphere radius="0.1"/>'
+                        f'</geometry><material name="m${{{expr}}}"/></visual></link><joint name="j" type="revolute">'
+                        '<parent link="base"/><child link="tip"/><origin xyz="0 0 0.3"/><axis xyz="0 0 1"/><limit '
+                        'lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>')
+        tally.run(lambda p=path: kinelab.load(p), nonsense=any(d in expr for d in XACRO_DANGER))
+    assert _faults(tally) == ""
+
+
+def test_obstacle_files_count_no_raw_error_hang_or_nonsense_accepted(tmp_path):
+    from kinelab.collision.obstacles import Environment
+
+    rng = random.Random("obstacles")
+    tally = Tally("files.obstacles")
+    values = [0.1, -1, 0, "x", None, [], [1, 2], [0.1, 0.1, 0.1], float("nan"), 1e308, {"a": 1}, True, [[0.1]]]
+    for k in range(max(20, CASES // 2)):
+        row = {"shape": rng.choice(["box", "sphere", "plane", "capsule", "cone", 3, None]),
+               "size": rng.choice(values), "xyz": rng.choice([[0.5, 0, 0.2], [1, 2], "x", [float("inf"), 0, 0]])}
+        if rng.random() < 0.3:  # a valid obstacle, so that both outcomes are reached
+            row = rng.choice([{"shape": "box", "size": [0.1, 0.2, 0.3], "xyz": [0.5, 0, 0.2]},
+                              {"shape": "sphere", "size": [0.1], "xyz": [0.5, 0, 0.2], "name": "ball"}])
+        if rng.random() < 0.2:
+            row[rng.choice(["rpy", "name", "extra", "mesh"])] = rng.choice(values + ["../../etc/passwd"])
+        path = tmp_path / f"o{k}.json"
+        text = json.dumps({"obstacles": [row] * rng.choice([1, 2])}) if rng.random() < 0.9 else rng.choice(
+            ["", "{", "[]", '{"obstacles": 3}', "[" * 5000 + "]" * 5000])
+        path.write_text(text)
+        out = tally.run(lambda p=path: Environment.from_file(p))
+        if out is not None:
+            assert all(isinstance(o.name, str) and all(math.isfinite(v) for v in o.xyz) for o in out.obstacles)
+    assert _faults(tally) == ""
+
+
+def test_map_stores_count_no_raw_error_hang_or_nonsense_accepted(tmp_path):
+    """A small map written once, then copies of it damaged at random (garbage chunks, edited shapes, types and
+    metadata, deleted files): each loads unchanged or is refused cleanly; a damaged one never loads as another
+    map."""
+    import shutil
+
+    zarr = pytest.importorskip("zarr")
+    from kinelab import maps
+    from kinelab.maps import chunk as reach
+
+    ur5 = kinelab.load("ur5")
+    original = tmp_path / "m.zarr"
+    maps.reachability(ur5, reach.MapSpec(voxel=0.3, orientations=2, chunk_voxels=16, restarts=2), out=str(original))
+    reference = {k: maps.load(original).array(k) for k in ("centres", "reachability")}
+    files = sorted(p.relative_to(original) for p in original.rglob("*") if p.is_file())
+    rng = random.Random("stores")
+    tally = Tally("files.map_store")
+    for k in range(max(10, CASES // 4)):
+        copy = tmp_path / f"c{k}.zarr"
+        shutil.copytree(original, copy)
+        target = copy / rng.choice(files)
+        kind = rng.choice(["garbage", "truncate", "delete", "json"]) if k else "none"  # the first copy: intact
+        if kind == "garbage":
+            target.write_bytes(bytes(rng.randrange(256) for _ in range(rng.randint(1, 200))))
+        elif kind == "truncate":
+            target.write_bytes(target.read_bytes()[: rng.randint(0, 20)])
+        elif kind == "delete":
+            target.unlink()
+        elif kind == "json" and target.name.startswith("."):
+            meta = json.loads(target.read_text())
+            key = rng.choice(sorted(meta)) if meta else "x"
+            meta[key] = rng.choice([5, -1, "x", None, [5], {"a": 1}, 1e308])
+            target.write_text(json.dumps(meta))
+        loaded = tally.run(lambda c=copy: maps.load(c))
+        if loaded is not None:
+            same = all(np.array_equal(loaded.array(n), reference[n], equal_nan=True) for n in reference)
+            tally.counts["nonsense_accepted"] += not same
+    assert _faults(tally) == "" and zarr is not None
 
 
 def test_the_fuzz_run_prints_no_warning_it_did_not_ask_for():
@@ -378,3 +545,59 @@ def test_the_fuzz_run_prints_no_warning_it_did_not_ask_for():
                           env={**os.environ, "KINELAB_FUZZ_CASES": "30"})
     assert done.returncode == 0, done.stdout[-2000:]
     assert "warnings summary" not in done.stdout and " warning" not in done.stdout.splitlines()[-1]
+
+
+# -- the public API beyond the entry points: every call with values it cannot use (#31.6) ---------------------
+
+NOT_Q = [None, "x", 1.5, float("nan"), [1, 2], np.zeros(5), np.zeros((2, 6)), {"a": 1}, True, b"ab",
+         np.zeros(6, dtype=complex), np.array(["a"] * 6), object()]
+NOT_NAME = [None, 1, 1.5, [1, 2], np.zeros(6), {"a": 1}, True, b"ab", object()]
+NOT_POSE = NOT_Q + [np.eye(4) * np.nan, np.eye(3), np.eye(4) * 2, [0.3, 0.1, float("nan")]]
+NOT_SIZE = [None, "x", 1.5, [float("nan")], np.zeros(5), np.zeros((2, 2)), {"a": 1}, b"ab", object(), [-1.0]]
+
+
+def _public_calls(robot):
+    """name → (call taking one value, values it must refuse, a value it must accept)."""
+    q, T = robot.random_q(0), robot.fk(robot.random_q(0))
+    one = {"fk": (robot.fk, q), "within_limits": (robot.within_limits, q), "to_pin_q": (robot.to_pin_q, q),
+           "jacobian_local": (robot.jacobian_local, q), "wrap_continuous": (robot.wrap_continuous, q),
+           "integrate": (lambda v: robot.integrate(q, v), np.zeros(robot.n)),
+           "difference": (lambda v: robot.difference(q, v), q)}
+    calls = {name: (call, NOT_Q, good) for name, (call, good) in one.items()}
+    calls.update({
+        "random_q": (robot.random_q, ["x", 1.5, -1, {"a": 1}, b"ab", object(), float("nan")], 3),
+        "random_qs": (robot.random_qs, [None, "x", 1.5, -1, [1, 2], True, object()], 2),
+        "joint_index": (robot.joint_index, NOT_NAME + ["nosuch"], robot.joint_names[0]),
+        "frame_placement": (lambda v: robot.frame_placement(q, v), NOT_NAME + ["nosuch"], robot.tool),
+        "visual_model": (lambda v: robot.visual_model(kind=v), NOT_NAME + ["x"], "collision"),
+        "target_from_xyz_rpy": (kinelab.target_from_xyz_rpy, NOT_Q + [[0.1, 0.2, 0.3, 0.4]], [0.3, 0.1, 0.4]),
+        "target_from_xyz_quat": (lambda v: kinelab.target_from_xyz_quat_wxyz([0.3, 0.1, 0.4], v),
+                                 NOT_Q + [[2.0, 0, 0, 0]], [1.0, 0, 0, 0]),
+        "solve.target": (lambda v: kinelab.solve(robot, v, time_budget=0.05), NOT_POSE, T),
+        "solve.q0": (lambda v: kinelab.solve(robot, T, q0=v, time_budget=0.05), NOT_Q[1:], q),
+        "solve.options": (lambda v: kinelab.solve(robot, T, options=v, time_budget=0.05),
+                          ["x", 1, {"a": 1}, object(), kinelab.Collisions()], None),
+        "solve_batch.q0": (lambda v: kinelab.solve_batch(robot, [T, T], q0=v, time_budget=0.05),
+                           [v for v in NOT_Q[1:] if np.shape(v) != (2, 6)], q),
+        "IK.robot": (kinelab.IK, NOT_NAME + ["ur5"], robot),
+        "Obstacle.shape": (lambda v: kinelab.Obstacle(v, size=(0.1,), xyz=(1, 0, 0)), NOT_NAME + ["cone"], "sphere"),
+        "Obstacle.size": (lambda v: kinelab.Obstacle("box", size=v, xyz=(1, 0, 0)), NOT_SIZE, (0.1, 0.1, 0.1)),
+        "Obstacle.name": (lambda v: kinelab.Obstacle("sphere", size=(0.1,), xyz=(1, 0, 0), name=v), NOT_NAME[1:],
+                          "ball"),
+        "Collisions.self": (lambda v: kinelab.Collisions(self_collisions=v), [None, "x", 1.5, np.zeros(3), object()],
+                            True),
+        "Collisions.margin": (lambda v: kinelab.Collisions(margin=v), [None, "x", -1.0, float("nan"), np.zeros(3)],
+                              0.01),
+        "Environment": (kinelab.Environment, ["x", 1, [1, 2], [None], {"a": 1}], ()),
+    })
+    return calls
+
+
+def test_the_public_api_counts_no_raw_error_hang_or_nonsense_accepted():
+    robot = kinelab.load("ur5")
+    tally = Tally("api.public")
+    for name, (call, refused, good) in _public_calls(robot).items():
+        for value in refused:
+            tally.run(functools.partial(call, value), nonsense=True)
+        assert tally.run(functools.partial(call, good)) is not None or name in ("solve.options",), name
+    assert _faults(tally) == ""

@@ -45,7 +45,7 @@ def test_a_bad_xacro_is_named_with_xacros_reason(tmp_path):
     bad.write_text('<robot name="b" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="${nowhere}"/></robot>')
     with pytest.raises(URDFError, match=r"xacro cannot expand .*bad.xacro: name 'nowhere' is not defined"):
         load(bad)
-    with pytest.raises(URDFError, match="xacro file not found"):
+    with pytest.raises(URDFError, match="robot file not found"):
         load(tmp_path / "missing.urdf.xacro")
 
 

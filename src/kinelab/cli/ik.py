@@ -74,7 +74,8 @@ def run(args: argparse.Namespace) -> int:
     robot = load_robot(args)
     target, options = _target(robot, args)
     q0 = None if args.start_q is None else q_from_cli(robot, args.start_q, args.deg, "--start-q")
-    if args.solver == "frdm" and args.polish:
+    _refuse_other_solvers_flags(args)
+    if args.polish:
         options["polish"] = True
     options.update(_bypass_options(robot, args))
     if args.solver == "biquat":
@@ -120,6 +121,20 @@ def _bypass_value(robot: Robot, joint: str, text: str, deg: bool, flag: str) -> 
         raise KinelabError(f"{flag} {joint}: {text!r} is not a number") from None
     kind = robot.joint_kinds[robot.joint_index(joint)]
     return float(np.deg2rad(value)) if deg and kind != "prismatic" else value
+
+
+def _refuse_other_solvers_flags(args: argparse.Namespace) -> None:
+    """A flag of another solver's is a mistake, said (it used to be dropped without a word); --axis goes with
+    --task axis only."""
+    given = [flag for flag, value, solver in (("--polish", args.polish, "frdm"), ("--law", args.law, "biquat"),
+                                              ("--integrator", args.integrator, "biquat"),
+                                              ("--step", args.step, "biquat"), ("--gain", args.gain, "biquat"))
+             if value not in (None, False) and solver != args.solver]
+    if given:
+        owner = "frdm" if given[0] == "--polish" else "biquat"
+        raise KinelabError(f"{given[0]} is an option of --solver {owner}, not of --solver {args.solver}")
+    if args.axis != "z" and args.task != "axis":
+        raise KinelabError(f"--axis {args.axis} names the tool axis of --task axis; the task is {args.task}")
 
 
 def _bypass_options(robot: Robot, args: argparse.Namespace) -> dict[str, Any]:
