@@ -59,16 +59,7 @@ class Obstacle:
     mesh: str = ""
 
     def __post_init__(self) -> None:
-        if not isinstance(self.shape, str) or not isinstance(self.name, str) or not isinstance(self.mesh, str):
-            raise ObstacleError(f"an obstacle's shape, name and mesh are strings, got shape={self.shape!r}, "
-                                f"name={self.name!r}, mesh={self.mesh!r}")
-        label = self.name or self.shape
-        if self.shape not in SIZES:
-            raise ObstacleError(f"obstacle {label!r}: unknown shape {self.shape!r}; shapes are {', '.join(SIZES)}")
-        if (self.shape == "mesh") != bool(self.mesh):
-            raise ObstacleError(f"obstacle {label!r}: a mesh obstacle names its file (mesh=...), and only a mesh does")
-        if self.shape == "mesh" and not Path(self.mesh).is_file():
-            raise ObstacleError(f"obstacle {label!r}: mesh file {self.mesh} not found")
+        label = self._check_kind()
         given = (1.0,) if self.shape == "mesh" and isinstance(self.size, tuple) and not self.size else self.size
         size, xyz, rpy = _numbers(label, "size", given), \
             _numbers(label, "xyz", self.xyz), _numbers(label, "rpy", self.rpy)
@@ -82,6 +73,20 @@ class Obstacle:
         object.__setattr__(self, "size", size)
         object.__setattr__(self, "xyz", xyz)
         object.__setattr__(self, "rpy", rpy)
+
+    def _check_kind(self) -> str:
+        """The obstacle's label for messages, once its shape, name and mesh are checked."""
+        if not isinstance(self.shape, str) or not isinstance(self.name, str) or not isinstance(self.mesh, str):
+            raise ObstacleError(f"an obstacle's shape, name and mesh are strings, got shape={self.shape!r}, "
+                                f"name={self.name!r}, mesh={self.mesh!r}")
+        label = self.name or self.shape
+        if self.shape not in SIZES:
+            raise ObstacleError(f"obstacle {label!r}: unknown shape {self.shape!r}; shapes are {', '.join(SIZES)}")
+        if (self.shape == "mesh") != bool(self.mesh):
+            raise ObstacleError(f"obstacle {label!r}: a mesh obstacle names its file (mesh=...), and only a mesh does")
+        if self.shape == "mesh" and not Path(self.mesh).is_file():
+            raise ObstacleError(f"obstacle {label!r}: mesh file {self.mesh} not found")
+        return label
 
     @property
     def placement(self) -> pin.SE3:

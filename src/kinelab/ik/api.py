@@ -44,6 +44,17 @@ _OLD_ORDER = {
 }
 
 
+def check_entry(robot: Any, function: str, positional: tuple[Any, ...]) -> None:
+    """What every entry point checks first: a Robot, and nothing positional after the target.
+
+    Raises:
+        ChainError: not a Robot. TypeError: a setting given positionally.
+    """
+    check_robot(robot)
+    if positional:
+        refuse_positional(function, positional)
+
+
 def refuse_positional(function: str, extra: tuple[Any, ...]) -> None:
     """Raise the TypeError of a call that passed more than the robot and its target(s) positionally.
 
@@ -102,9 +113,7 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
         TypeError: arguments after the target given positionally.
         SolverNotFoundError, OptionError, TargetError, ConfigurationError: bad input, named.
     """
-    check_robot(robot)
-    if positional:
-        refuse_positional("solve", positional)
+    check_entry(robot, "solve", positional)
     if solver == "analytic":
         req = make_request("frdm", seed, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, None,
                            task, axis, None)
@@ -197,9 +206,7 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
         TargetError: a bad target (its index named); ConfigurationError: a bad q0 (its row named);
         OptionError, SolverNotFoundError: a bad option or argument.
     """
-    check_robot(robot)
-    if positional:
-        refuse_positional("solve_batch", positional)
+    check_entry(robot, "solve_batch", positional)
     if solver == "analytic":
         refuse_options(options or solver_options)
         return nearest_batch(robot, targets, q0, make_request("frdm", seed, tol_pos, tol_rot, time_budget,
@@ -260,9 +267,7 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
         TypeError: arguments after the target given positionally.
         TargetError, ConfigurationError, OptionError: bad input, named.
     """
-    check_robot(robot)
-    if positional:
-        refuse_positional("solve_all", positional)
+    check_entry(robot, "solve_all", positional)
     method = solver if solver in ("auto", "analytic") else "multistart"
     if method != "multistart" and (options is not None or solver_options):
         if method == "analytic":  # refusing says so rather than ignoring them
@@ -322,9 +327,7 @@ def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
         OptionError: a bad option, a solver other than "frdm", a restriction named without its table.
         ConfigurationError, JointLimitError, TargetError: a bad q0 or target, named.
     """
-    check_robot(robot)
-    if positional:
-        refuse_positional("track", positional)
+    check_entry(robot, "track", positional)
     if solver_module(solver) is not solver_module("frdm"):
         raise OptionError("solver", solver, "'frdm' (track follows a path with FRDM's warm-started sweeps)")
     settings = PathSettings(jump_limit, restrict, hold, rest_weight)

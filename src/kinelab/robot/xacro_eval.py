@@ -246,17 +246,35 @@ def _function_name(func: ast.expr) -> str | None:
 
 def _check_operands(op: ast.operator, left: Any, right: Any) -> None:
     """Refuse an operation whose result would outgrow the bounds before Python builds it."""
-    if isinstance(op, ast.Pow) and _is_int(left) and _is_int(right) and right > 0:
-        if max(left.bit_length(), 1) * right > MAX_INT_BITS and abs(left) > 1:
-            raise RefusedError(f"a power of more than {MAX_INT_BITS} bits")
-    elif isinstance(op, ast.Mult):
-        for seq, count in ((left, right), (right, left)):
-            if isinstance(seq, str | list | tuple) and _is_int(count) and size(seq) * max(count, 0) > MAX_ITEMS:
-                raise RefusedError(f"a repetition of more than {MAX_ITEMS} items")
-    elif isinstance(op, ast.Mod) and isinstance(left, str) and _WIDE_FORMAT.search(left):
+    check = _OPERAND_CHECKS.get(type(op))
+    if check is not None:
+        check(left, right)
+
+
+def _check_power(left: Any, right: Any) -> None:
+    if _is_int(left) and _is_int(right) and right > 0 and abs(left) > 1 and left.bit_length() * right > MAX_INT_BITS:
+        raise RefusedError(f"a power of more than {MAX_INT_BITS} bits")
+
+
+def _check_repetition(left: Any, right: Any) -> None:
+    for seq, count in ((left, right), (right, left)):
+        if isinstance(seq, str | list | tuple) and _is_int(count) and size(seq) * max(count, 0) > MAX_ITEMS:
+            raise RefusedError(f"a repetition of more than {MAX_ITEMS} items")
+
+
+def _check_format(left: Any, _right: Any) -> None:
+    if isinstance(left, str) and _WIDE_FORMAT.search(left):
         raise RefusedError("a '%' format wider than 999 characters")
-    elif isinstance(op, ast.Add) and isinstance(left, str | list | tuple) and size(left) + size(right) > MAX_ITEMS:
+
+
+def _check_concatenation(left: Any, right: Any) -> None:
+    if isinstance(left, str | list | tuple) and size(left) + size(right) > MAX_ITEMS:
         raise RefusedError(f"a string or list of more than {MAX_ITEMS} items")
+
+
+_OPERAND_CHECKS: dict[type[ast.operator], Callable[[Any, Any], None]] = {
+    ast.Pow: _check_power, ast.Mult: _check_repetition, ast.Mod: _check_format, ast.Add: _check_concatenation,
+}
 
 
 def _is_int(value: Any) -> bool:
