@@ -463,7 +463,7 @@ def test_xacro_expressions_count_no_raw_error_hang_or_nonsense_accepted(tmp_path
     rng = random.Random("xacro")
     tally = Tally("files.xacro")
     for k in range(max(20, CASES // 2)):
-        expr = " + ".join(rng.choice(XACRO_ATOMS) for _ in range(rng.randint(1, 3)))
+        expr = " + ".join(f"({rng.choice(XACRO_ATOMS)})" for _ in range(rng.randint(1, 3)))  # each one evaluated
         path = tmp_path / f"x{k}.urdf.xacro"
         path.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><xacro:property name="L" '
                         'value="0.3"/><link name="base"/><link name="tip"><visual><geometry><sphere radius="0.1"/>'

@@ -57,10 +57,10 @@ HOSTILE = {
     "$(env ...)": ("""<xacro:if value="${{len('$(env HOME)') >= 0}}"></xacro:if>""", "$(env"),
     "$(optenv ...)": ("""<xacro:if value="$(optenv KINELAB_NO_SUCH_VARIABLE 1)"></xacro:if>""", "$(optenv"),
     "$(cwd)": ("""<xacro:if value="${{len('$(cwd)') >= 0}}"></xacro:if>""", "$(cwd)"),
-    "xacro.load_yaml": ("""<xacro:if value="${{len(xacro.load_yaml('/etc/hostname')) >= 0}}"></xacro:if>""",
+    "the name 'xacro'": ("""<xacro:if value="${{len(xacro.load_yaml('/etc/hostname')) >= 0}}"></xacro:if>""",
                         "load_yaml"),
     "attribute access ('.upper')": ("""<xacro:if value="${{len('a'.upper()) > 0}}"></xacro:if>""", "'a'.upper"),
-    "a call of 'python.type'": ("""<xacro:if value="${{len(str(python.type(1))) > 0}}"></xacro:if>""",
+    "the name 'python'": ("""<xacro:if value="${{len(str(python.type(1))) > 0}}"></xacro:if>""",
                                 "python.type"),
     "a comprehension": ("""<xacro:if value="${{len([c for c in 'ab']) > 0}}"></xacro:if>""", "for c in"),
 }

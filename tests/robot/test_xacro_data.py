@@ -202,3 +202,13 @@ def test_the_bundled_styles_are_copied_nowhere(tmp_path):
     shutil.copytree(DATA / "ur_like_description", copy)
     load(copy / "urdf" / "ur_like.urdf.xacro")
     assert sorted(p.name for p in (copy / "urdf").iterdir()) == ["ur_like.urdf.xacro", "ur_like_macro.xacro"]
+
+
+def test_object_access_is_refused_even_in_a_branch_never_taken(tmp_path):
+    """The refusal does not depend on values: a skipped branch that reaches xacro's python namespace is refused
+    as one that runs."""
+    for expression in ("L if True else python.type", "0 and xacro.arg('x')", "L if True else ''.__class__"):
+        path = _write(tmp_path / "skip.urdf.xacro", f'<xacro:property name="L" value="0.3"/>'
+                      f'<xacro:if value="${{({expression}) is not None}}"></xacro:if>{ARM}')
+        with pytest.raises(URDFError, match="would run code or read the machine"):
+            load(path)

@@ -86,7 +86,14 @@ class MapSpec:
 
     def to_dict(self) -> dict:
         """The JSON form stored with the map (tuples as lists, as the store gives them back)."""
-        return dict(json.loads(json.dumps(asdict(self))))
+        return dict(json.loads(json.dumps(asdict(self), default=_plain)))
+
+
+def _plain(value: object) -> object:
+    """A numpy number as the Python number JSON takes (a seed given as np.int64, say)."""
+    if isinstance(value, np.integer | np.floating | np.bool_):
+        return value.item()
+    raise TypeError(f"{type(value).__name__} is not stored with a map")
 
 
 def targets_of(centres: np.ndarray, rotations: np.ndarray) -> np.ndarray:

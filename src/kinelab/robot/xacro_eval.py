@@ -97,7 +97,23 @@ def evaluate(expr: str, lookup: Callable[[str], Any]) -> Any:
         NameError: a name nothing defines. SyntaxError, ArithmeticError, ValueError, TypeError: as Python's.
     """
     tree = ast.parse(expr.strip(), mode="eval")
+    _check_statically(tree)
     return _Evaluator(lookup).value(tree.body)
+
+
+_STATIC_NAMES = ("python", "xacro", "__builtins__")  # xacro's namespaces of Python objects
+
+
+def _check_statically(tree: ast.Expression) -> None:
+    """Refuse object access anywhere in the expression, evaluated or not (a branch a condition skips included):
+    xacro's Python namespaces, underscore attributes, and nodes the evaluator has no rule for."""
+    for node in ast.walk(tree.body):
+        if isinstance(node, ast.Name) and (node.id in _STATIC_NAMES or node.id.startswith("__")):
+            raise RefusedError(f"the name {node.id!r}")
+        if isinstance(node, ast.Attribute) and node.attr.startswith("_"):
+            raise RefusedError(f"attribute access ('.{node.attr}')")
+        if not isinstance(node, _ALLOWED_NODES):
+            raise RefusedError(_described(node))
 
 
 def size(value: Any, limit: int = MAX_ITEMS) -> int:
@@ -232,6 +248,11 @@ class _Evaluator:
         if any(k is None for k in node.keys):
             raise RefusedError("'**' in a dict")
         return {self.value(k): self.value(v) for k, v in zip(node.keys, node.values, strict=True) if k is not None}
+
+
+_ALLOWED_NODES = (ast.Constant, ast.Name, ast.Attribute, ast.BinOp, ast.UnaryOp, ast.BoolOp, ast.Compare, ast.IfExp,
+                  ast.Call, ast.Subscript, ast.Slice, ast.List, ast.Tuple, ast.Dict, ast.Load, ast.operator,
+                  ast.unaryop, ast.boolop, ast.cmpop, ast.Starred, ast.keyword)  # the last two refused by _Call
 
 
 def _function_name(func: ast.expr) -> str | None:
