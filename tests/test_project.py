@@ -103,3 +103,23 @@ def test_no_module_imports_itself_back():
         if module not in state and module not in packages:
             visit(module, [])
     assert len(state) >= 40  # every module of the tree was walked
+
+
+@pytest.mark.parametrize("script", [
+    "import kinelab; kinelab.load('ur5').fk([0.1] * 6)",
+    "from kinelab.cli import main; main(['fk', 'ur5', '0', '0', '0', '0', '0', '0'])",
+    "from kinelab.cli import main; main(['robots'])",
+])
+def test_a_load_fk_robots_or_help_imports_no_solver_and_no_jit(script):
+    """Start-up (#32): what a load and an fk need, nothing more: no numba (no solver kernel), no collision model,
+    no closed form, no maps or reports."""
+    import subprocess
+    import sys
+
+    probe = (f"import sys, contextlib, io\nwith contextlib.redirect_stdout(io.StringIO()):\n    {script}\n"
+             "print(' '.join(sorted(m for m in sys.modules if m.split('.')[0] in ('numba', 'scipy', 'matplotlib') or "
+             "m.startswith(('kinelab.collision', 'kinelab.ik.analytic', 'kinelab.maps', 'kinelab.report.b', "
+             "'kinelab.report.v', 'kinelab.report.r')))))")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr[-1000:]
+    assert done.stdout.strip() == "", done.stdout

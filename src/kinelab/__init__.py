@@ -5,7 +5,6 @@ The public API: :func:`load` a robot, :func:`solve` IK for a target (built with
 errors every call raises on bad input (all :class:`KinelabError`).
 """
 
-from importlib.metadata import PackageNotFoundError, version
 from typing import TYPE_CHECKING
 
 from kinelab.errors import (
@@ -46,6 +45,7 @@ _LAZY = {
     "Collisions": ("kinelab.collision.model", "Collisions"),
     "Environment": ("kinelab.collision.obstacles", "Environment"),
     "Obstacle": ("kinelab.collision.obstacles", "Obstacle"),
+    "__version__": ("kinelab.lazy", "package_version"),  # importlib.metadata costs 60 ms: read when asked for
 }
 
 
@@ -62,10 +62,6 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
     from kinelab.ik.targets import from_xyz_quat_wxyz as target_from_xyz_quat_wxyz
     from kinelab.ik.targets import from_xyz_rpy as target_from_xyz_rpy
 
-try:
-    __version__ = version("kinelab")
-except PackageNotFoundError:  # a source tree that was never installed
-    __version__ = "0+unknown"
 
 __all__ = [
     "BatchIKResult",

@@ -29,3 +29,16 @@ def loader(package: str, namespace: dict[str, Any], table: dict[str, tuple[str, 
         return value
 
     return module_getattr
+
+
+def __getattr__(name: str) -> Any:
+    """``package_version``: kinelab's installed version, looked up on first use ("0+unknown" in a source tree
+    that was never installed)."""
+    if name != "package_version":
+        raise AttributeError(f"module 'kinelab.lazy' has no attribute {name!r}")
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("kinelab")
+    except PackageNotFoundError:
+        return "0+unknown"

@@ -13,8 +13,8 @@ import argparse
 import os
 import sys
 import warnings
+from typing import Any
 
-from kinelab import __version__ as kinelab_version
 from kinelab.cli import bench, fk, ik, maps, robots, singular, validate, view, warmup
 from kinelab.cli.common import Parser
 from kinelab.errors import KinelabError
@@ -22,10 +22,21 @@ from kinelab.errors import KinelabError
 COMMANDS = (robots, fk, ik, singular, view, bench, maps, validate, warmup)
 
 
+class _Version(argparse.Action):
+    """``--version``, the installed version looked up only when asked for (the lookup costs 60 ms a start)."""
+
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace, values: Any,
+                 option_string: str | None = None) -> None:
+        import kinelab
+
+        print(f"kinelab {kinelab.__version__}")  # on stdout, as argparse's own version action prints it
+        parser.exit()
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The ``kinelab`` command line: one subparser per command."""
     p = Parser(prog="kinelab", description="Kinematics of serial arms, checked against Pinocchio.")
-    p.add_argument("--version", action="version", version=f"kinelab {kinelab_version}")
+    p.add_argument("--version", action=_Version, nargs=0, help="show kinelab's version and exit")
     sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
     for command in COMMANDS:
         command.add(sub)

@@ -8,7 +8,6 @@ from typing import Any
 import numpy as np
 
 from kinelab.cli.common import json_flag, load_robot, print_json, robot_arguments
-from kinelab.ik.analytic.redundancy import closed_form_summary
 from kinelab.robot import Joint, catalog
 
 
@@ -49,6 +48,8 @@ def _joint_row(j: Joint) -> dict[str, Any]:
 
 def run_info(args: argparse.Namespace) -> int:
     """The robot's chain: base, tool, joints with their limits, the locked joints."""
+    from kinelab.ik.analytic.redundancy import closed_form_summary  # the solvers load for info only, not for --help
+
     robot = load_robot(args)
     info = {"robot": robot.name, "urdf": str(robot.urdf_path), "base": robot.base, "tool": robot.tool,
             "dof": robot.n, "nq": robot.nq, "nv": robot.nv, "joints": [_joint_row(j) for j in robot.joints],
