@@ -411,3 +411,19 @@ def test_lock_holds_a_joint_from_the_command_line(capsys):
     assert code == 2 and "--lock panda_joint7=x" in err
     code, _, err = run(capsys, "info", "panda", "--lock", "panda_joint77=0.1")
     assert code == 2 and "panda_joint77" in err
+
+
+@pytest.mark.parametrize("solver", ["analytic", "dls", "biquat"])
+def test_no_solver_prints_another_solver_s_diagnostics(capsys, solver):
+    """#34.4: analytic answers printed FRDM's "monitor did not fire"."""
+    code, out, _ = run(capsys, "ik", "ur5", "--target-xyz", "0.3", "0.2", "0.4", "--solver", solver)
+    assert code == 0 and "monitor" not in out and "bypass" not in out
+
+
+def test_the_closed_form_is_named_where_solvers_are_listed(capsys):
+    """#34.5: solver='auto' was refused with a list that omitted analytic, and --help did not name it."""
+    with pytest.raises(kinelab.SolverNotFoundError, match="solvers are: analytic, biquat, dls, frdm"):
+        kinelab.solve(kinelab.load("ur5"), kinelab.target_from_xyz_rpy([0.3, 0.1, 0.4]), solver="auto")
+    with pytest.raises(SystemExit):
+        cli.main(["ik", "--help"])
+    assert "analytic" in capsys.readouterr().out

@@ -32,7 +32,9 @@ def add(sub: Any) -> None:
     """The ``ik`` subcommand."""
     s = sub.add_parser("ik", help="inverse kinematics to a target pose or configuration")
     s.add_argument("robot", help="registered name or model file (URDF, xacro, MJCF)")
-    s.add_argument("--solver", default="frdm", help="frdm, biquat or dls (the Pinocchio reference); default frdm")
+    s.add_argument("--solver", default="frdm",
+                   help="frdm, biquat, dls (the Pinocchio reference) or analytic (the closed form, for the arms "
+                        "`kinelab info` names one for); default frdm")
     s.add_argument("--target-q", nargs="+", help="target as a configuration (its FK pose), or an SRDF name")
     s.add_argument("--target-xyz", nargs=3, type=float, help="target position [m] in the base frame")
     s.add_argument("--target-rpy", nargs=3, type=float,
@@ -188,7 +190,8 @@ def _print_ik(robot: Robot, args: argparse.Namespace, result: IKResult) -> None:
         m0 = result.diagnostics.M0
         print(f"  model time {result.diagnostics.model_time:.4g} s, final M0 = "
               + (f"{m0:+.6f}" if m0 is not None else "n/a (give --target-q for the sign of N)"))
-    _print_events(result)
+    if args.solver == "frdm":  # the singularity monitor and its bypasses are FRDM's: no other solver has them
+        _print_events(result)
     if result.success and result.diagnostics.clear_after is not None:
         print(f"  clear of collisions ({plural(result.diagnostics.clear_after, 'colliding answer')} found before)")
     if result.message:
