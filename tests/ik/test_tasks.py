@@ -119,7 +119,7 @@ def test_a_stalled_attempt_is_finished_by_gauss_newton_steps_on_the_task_compone
         if res.success:
             finished += 1
             assert res.diagnostics.polished == 1 and judged_here(robot, res.q, target, "axis")
-        full = kinelab.solve(robot, target, task="axis", seed=0, time_budget=0.05)
+        full = kinelab.solve(robot, target, task="axis", seed=0, time_budget=1.0)  # a budget a loaded machine meets
         assert full.success and judged_here(robot, full.q, target, "axis")
     assert stalled >= 5 and finished >= 3  # measured: 12 stalled, 4 finished from the first stall
 
