@@ -55,7 +55,7 @@ def run_info(args: argparse.Namespace) -> int:
             "dof": robot.n, "nq": robot.nq, "nv": robot.nv, "joints": [_joint_row(j) for j in robot.joints],
             "locked": robot.locked, "mimics": {name: m.leader for name, m in robot.mimics.items()},
             "format": robot.source_format, "collisions": _collision_summary(robot),
-            "closed_form": closed_form_summary(robot)}
+            "closed_form": closed_form_summary(robot), "judge": str(robot.fk_certificate)}
     if args.json:
         print_json(info)
         return 0
@@ -73,6 +73,7 @@ def run_info(args: argparse.Namespace) -> int:
     if robot.locked:
         print(f"locked: {', '.join(f'{k}={v:g}' for k, v in robot.locked.items())}")
     print(f"closed form: {info['closed_form']}")
+    print(f"answers judged by: {info['judge']}")
     print(f"collisions: {info['collisions']}")
     return 0
 

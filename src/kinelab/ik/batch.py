@@ -46,6 +46,7 @@ class BatchIKResult:
         iterations: (B,) sweeps (FRDM) or the solver's iterations; restarts: (B,).
         seed: the base seed (row b used seed + b); wall_time: [s] for the whole batch, checks included.
         solver, mode: the solver and how it ran ("frdm (compiled batch, T threads)" or "per target").
+        judge: whose FK judged the rows: "compiled FK (certified)" or "Pinocchio FK" (``robot.fk_certificate``).
     """
 
     q: np.ndarray
@@ -59,6 +60,7 @@ class BatchIKResult:
     wall_time: float
     solver: str
     mode: str
+    judge: str = "Pinocchio FK"
 
     def __len__(self) -> int:
         return int(self.success.shape[0])
@@ -182,4 +184,4 @@ def _judged(robot: Robot, rows: Rows, points: np.ndarray, rotations: np.ndarray,
     status[failed & (_beyond(robot, points, req) > 0)] = Status.UNREACHABLE.value
     status[failed & (status == Status.CONVERGED.value)] = Status.STALLED.value  # the solver's test passed only
     return BatchIKResult(rows.Q, success, rows.status, dp, dr, rows.iterations, rows.restarts, seed,
-                         time.perf_counter() - t0, req.solver, mode)
+                         time.perf_counter() - t0, req.solver, mode, robot.fk_certificate.judge)

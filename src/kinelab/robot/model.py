@@ -27,6 +27,7 @@ from kinelab.errors import ConfigurationError, JointLimitError, JointNotFoundErr
 from kinelab.geometry import pose_error, wrap_to_pi
 from kinelab.robot import catalog, descriptions, xacro
 from kinelab.robot.build import LIMIT_SLACK, Built, build_file, build_model, frame_id
+from kinelab.robot.certificate import ChainArrays, FKCertificate, certify, chain_arrays
 from kinelab.robot.joints import Joint, Mimic
 from kinelab.robot.meshes import build_visual_model
 from kinelab.robot.mjcf import is_mjcf
@@ -274,16 +275,17 @@ class Robot:
         """A configuration drawn uniformly within the limits (continuous joints on [−π, π]; a revolute joint
         whose limits lie beyond ±SAMPLE_TURNS turns, such as a rotor declared with ±1e16 rad, on ±SAMPLE_TURNS
         turns: every pose it can take, at angles where rounding does not swamp a step)."""
-        return _generator(rng).uniform(*self._sample_bounds)
+        return _generator(rng).uniform(*self.sample_bounds)
 
     def random_qs(self, count: int, rng: np.random.Generator | int | None = None) -> np.ndarray:
         """``count`` configurations (rows) drawn as :meth:`random_q` draws one."""
         if not isinstance(count, int | np.integer) or isinstance(count, bool) or count < 0:
             raise OptionError("count", count, "a whole number ≥ 0 of configurations")
-        return _generator(rng).uniform(*self._sample_bounds, size=(int(count), self.n))
+        return _generator(rng).uniform(*self.sample_bounds, size=(int(count), self.n))
 
     @functools.cached_property
-    def _sample_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+    def sample_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lower, upper) that random configurations are drawn between [rad or m] (see :meth:`random_q`)."""
         revolute = np.array([k != "prismatic" for k in self.joint_kinds])
         span = SAMPLE_TURNS * 2 * np.pi
         return (np.where(revolute, np.maximum(self.lower, -span), self.lower),
@@ -300,18 +302,33 @@ class Robot:
         return pin.SE3(self.data.oMf[self.tool_frame_id])
 
     def fk_batch(self, Q: np.ndarray) -> np.ndarray:
-        """oMtool for every row of Q (B × n, rad or m): a (B, 4, 4) stack of homogeneous matrices (Pinocchio FK).
+        """oMtool for every row of Q (B × n, rad or m): a (B, 4, 4) stack of homogeneous matrices, by the judge
+        :attr:`fk_certificate` names (the compiled FK where it is certified equal to Pinocchio's, else Pinocchio's).
 
         Raises:
             ConfigurationError: Q not (B, n) finite numbers (the first bad row named).
         """
         Q = self.check_qs(Q)
+        arrays = self._judge_arrays()
+        if arrays is not None:
+            return arrays.fk_batch(Q)
         out = np.empty((Q.shape[0], 4, 4))
         model, data, fid = self.model, self.data, self.tool_frame_id
         for b in range(Q.shape[0]):
             pin.forwardKinematics(model, data, self._pin_q(Q[b]))
             out[b] = pin.updateFramePlacement(model, data, fid).homogeneous
         return out
+
+    @property
+    def fk_certificate(self) -> FKCertificate:
+        """How this robot's answers are judged: the compiled chain FK, certified against Pinocchio's FK at seeded
+        configurations including every joint's limits (≤ 1e-12 m and rad), or Pinocchio's FK with the reason
+        (:mod:`kinelab.robot.certificate`). Computed on first use, kept with the robot."""
+        return self.derived("fk certificate", certify)
+
+    def _judge_arrays(self) -> ChainArrays | None:
+        """The chain's arrays when the compiled FK is this robot's judge, else None."""
+        return self.derived("judge arrays", _judge_arrays)
 
     def jacobian_batch(self, Q: np.ndarray, frame: str = "local") -> np.ndarray:
         """The 6 × n tool Jacobian for every row of Q: (B, 6, n), rows [v; ω].
@@ -440,6 +457,11 @@ class Robot:
 
     def __repr__(self) -> str:
         return f"Robot({self.name!r}, n={self.n}, tool={self.tool!r}, urdf={str(self.urdf_path)!r})"
+
+
+def _judge_arrays(robot: Robot) -> ChainArrays | None:
+    arrays = chain_arrays(robot) if robot.fk_certificate.certified else None
+    return arrays if isinstance(arrays, ChainArrays) else None
 
 
 def _generator(rng: object) -> np.random.Generator:

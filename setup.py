@@ -1,0 +1,34 @@
+"""Builds kinelab's compiled core (``src/kinelab/core/*.pyx``, Cython) when kinelab is installed.
+
+Everything else about the package is in ``pyproject.toml``. The build records the SHA-256 of the sources it
+compiled in ``src/kinelab/core/_built.py`` (generated, not tracked), which ``kinelab.core`` compares with the
+sources beside it at import: a stale build is refused, never run.
+"""
+
+import importlib.util
+from pathlib import Path
+
+from Cython.Build import cythonize
+from setuptools import Extension, find_packages, setup
+
+ROOT = Path(__file__).resolve().parent
+CORE = ROOT / "src" / "kinelab" / "core"
+
+
+def _digest() -> str:
+    spec = importlib.util.spec_from_file_location("kinelab_core_digest", CORE / "digest.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.source_sha256(CORE)
+
+
+(CORE / "_built.py").write_text(f'"""Written by setup.py: the sources the compiled core was built from."""\n\n'
+                                f'SOURCE_SHA256 = "{_digest()}"\n')
+extensions = [Extension(f"kinelab.core.{pyx.stem}", [str(pyx.relative_to(ROOT))], extra_compile_args=["-O3"])
+              for pyx in sorted(CORE.glob("*.pyx"))]
+setup(
+    ext_modules=cythonize(extensions, language_level=3),
+    package_dir={"": "src", "kinelab.urdf": "urdf"},
+    packages=[*find_packages("src"), "kinelab.urdf"],
+    package_data={"kinelab.urdf": ["*.urdf"], "kinelab.core": ["*.pyx", "*.pyi"]},
+)

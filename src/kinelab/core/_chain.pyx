@@ -1,0 +1,94 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""The serial chain's forward kinematics, compiled when kinelab is installed (Cython, no JIT).
+
+A chain is its joints in series: joint i sits at ``placement_R[i]``, ``placement_t[i]`` in joint i−1's frame
+(i = 0: the base frame) and turns about, or slides along, ``axis[i]`` (a unit vector in its own frame); the tool
+sits at ``tool_R``, ``tool_t`` in the last joint's frame. Units: m, rad. ``kind[i]`` is 1 for a prismatic joint,
+anything else for a revolute or continuous one (a continuous joint's q is its angle). The same composition as
+Pinocchio's ``forwardKinematics`` + ``updateFramePlacement`` on a serial model: kinelab certifies the two equal
+on each robot (:mod:`kinelab.robot.certificate`).
+"""
+
+from libc.math cimport cos, sin
+
+cdef int PRISMATIC = 1
+
+
+cdef inline void _compose(double[3][3] R, double[3] t, const double[:, ::1] dR, const double[::1] dt) noexcept nogil:
+    """(R, t) ← (R, t) · (dR, dt)."""
+    cdef double out[3][3]
+    cdef double v[3]
+    cdef int i, j
+    for i in range(3):
+        v[i] = t[i] + R[i][0] * dt[0] + R[i][1] * dt[1] + R[i][2] * dt[2]
+        for j in range(3):
+            out[i][j] = R[i][0] * dR[0, j] + R[i][1] * dR[1, j] + R[i][2] * dR[2, j]
+    for i in range(3):
+        t[i] = v[i]
+        for j in range(3):
+            R[i][j] = out[i][j]
+
+
+cdef inline void _turn(double[3][3] R, const double[::1] a, double angle) noexcept nogil:
+    """R ← R · Rot(a, angle) (Rodrigues)."""
+    cdef double c = cos(angle), s = sin(angle)
+    cdef double C = 1.0 - c
+    cdef double x = a[0], y = a[1], z = a[2]
+    cdef double M[3][3]
+    cdef double out[3][3]
+    cdef int i, j
+    M[0][0] = c + x * x * C
+    M[0][1] = x * y * C - z * s
+    M[0][2] = x * z * C + y * s
+    M[1][0] = y * x * C + z * s
+    M[1][1] = c + y * y * C
+    M[1][2] = y * z * C - x * s
+    M[2][0] = z * x * C - y * s
+    M[2][1] = z * y * C + x * s
+    M[2][2] = c + z * z * C
+    for i in range(3):
+        for j in range(3):
+            out[i][j] = R[i][0] * M[0][j] + R[i][1] * M[1][j] + R[i][2] * M[2][j]
+    for i in range(3):
+        for j in range(3):
+            R[i][j] = out[i][j]
+
+
+cdef void _fk_row(const double[:, :, ::1] placement_R, const double[:, ::1] placement_t,
+                  const double[:, ::1] axis, const long long[::1] kind, const double[:, ::1] tool_R,
+                  const double[::1] tool_t, const double[::1] q, double[:, ::1] out) noexcept nogil:
+    cdef double R[3][3]
+    cdef double t[3]
+    cdef int i, j, n = q.shape[0]
+    for i in range(3):
+        t[i] = 0.0
+        for j in range(3):
+            R[i][j] = 1.0 if i == j else 0.0
+    for i in range(n):
+        _compose(R, t, placement_R[i], placement_t[i])
+        if kind[i] == PRISMATIC:
+            for j in range(3):
+                t[j] += (R[j][0] * axis[i, 0] + R[j][1] * axis[i, 1] + R[j][2] * axis[i, 2]) * q[i]
+        else:
+            _turn(R, axis[i], q[i])
+    _compose(R, t, tool_R, tool_t)
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = R[i][j]
+        out[i, 3] = t[i]
+        out[3, i] = 0.0
+    out[3, 3] = 1.0
+
+
+def fk_batch(const double[:, :, ::1] placement_R, const double[:, ::1] placement_t, const double[:, ::1] axis,
+             const long long[::1] kind, const double[:, ::1] tool_R, const double[::1] tool_t,
+             const double[:, ::1] Q, double[:, :, ::1] out):
+    """oMtool of every row of Q into out: (B, n) joint values [rad or m] → (B, 4, 4) homogeneous matrices.
+
+    Shapes are the caller's to get right (:mod:`kinelab.core` checks them): placement_R (n, 3, 3),
+    placement_t (n, 3), axis (n, 3), kind (n,) int64, tool_R (3, 3), tool_t (3,), Q (B, n), out (B, 4, 4).
+    """
+    cdef Py_ssize_t b
+    with nogil:
+        for b in range(Q.shape[0]):
+            _fk_row(placement_R, placement_t, axis, kind, tool_R, tool_t, Q[b], out[b])
