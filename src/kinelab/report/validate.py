@@ -90,7 +90,11 @@ def model_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     """yourdfpy vs Pinocchio FK at n configurations; Pinocchio's Jacobians vs finite differences."""
     fk = checks.fk_vs_yourdfpy(robot, n, seed)
     jac = checks.jacobians_vs_fd(robot, max(10, n // 10), seed)
+    cert = robot.fk_certificate
     return [
+        Check(robot.name, "judge: compiled FK vs Pinocchio (certificate)",
+              max(cert.max_position_error, cert.max_rotation_error), 1e-12, "m or rad",
+              f"{cert.configurations} q incl. limits" if cert.certified else cert.reason),
         Check(robot.name, "FK position: yourdfpy vs Pinocchio", fk.max_position, 1e-9, "m", f"{n} random q"),
         Check(robot.name, "FK rotation: yourdfpy vs Pinocchio", fk.max_rotation, 1e-9, "rad", f"{n} random q"),
         Check(robot.name, "Jacobians (3 frames) vs central differences", jac.max_rotation, 1e-6, "",
