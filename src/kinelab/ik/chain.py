@@ -21,6 +21,7 @@ from numba import njit
 from kinelab.errors import ChainError
 from kinelab.geometry import TWO_PI
 from kinelab.robot import Robot
+from kinelab.robot.certificate import chain_arrays
 
 REVOLUTE, PRISMATIC, CONTINUOUS = 0, 1, 2
 KIND_CODES = {"revolute": REVOLUTE, "prismatic": PRISMATIC, "continuous": CONTINUOUS}
@@ -88,27 +89,17 @@ def build(robot: Robot) -> ChainModel:
         ChainError: a joint not in series with the previous one, a tool frame not on the last joint, or a
             mimic joint (these kernels step one coordinate at a time about its own axis).
     """
-    model = robot.model
     if robot.mimics:
         mimic = next(iter(robot.mimics.values()))
         raise ChainError(f"{robot.name}: joint {mimic.name!r} mimics {mimic.leader!r}; the FRDM and biquaternion "
                          "kernels turn one joint at a time and do not model coupled joints: use solver='dls' "
                          "(Pinocchio's model couples them)")
-    for jid in range(1, model.njoints):
-        if model.parents[jid] != jid - 1:
-            raise ChainError(f"joint {model.names[jid]!r} is not in series with the previous one")
-    tool = model.frames[robot.tool_frame_id]
-    if tool.parentJoint != model.njoints - 1:
-        raise ChainError(f"the tool frame {robot.tool!r} is not carried by the last chain joint")
+    arrays = chain_arrays(robot)  # the same packing as the certified judge's
+    if isinstance(arrays, str):
+        raise ChainError(f"{robot.name}: {arrays}")
     kind = np.array([KIND_CODES[k] for k in robot.joint_kinds], dtype=np.int64)
-    chain = Chain(
-        placement_R=np.array([model.jointPlacements[j].rotation for j in range(1, model.njoints)]),
-        placement_t=np.array([model.jointPlacements[j].translation for j in range(1, model.njoints)]),
-        axis_local=np.array([j.axis_local for j in robot.joints], dtype=float),
-        kind=kind,
-        tool_R=tool.placement.rotation.copy(),
-        tool_t=tool.placement.translation.copy(),
-    )
+    chain = Chain(placement_R=arrays.placement_R, placement_t=arrays.placement_t, axis_local=arrays.axis, kind=kind,
+                  tool_R=arrays.tool_R, tool_t=arrays.tool_t)
     lower = np.where(kind == CONTINUOUS, -np.inf, robot.lower).astype(float)
     upper = np.where(kind == CONTINUOUS, np.inf, robot.upper).astype(float)
     return ChainModel(tuple(robot.joint_names), chain, lower, upper, robot.characteristic_length())
