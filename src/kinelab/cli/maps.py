@@ -144,7 +144,6 @@ def run_reach(args: argparse.Namespace) -> int:
         raise KinelabError(f"--workers must be 1 to {cluster.cores()} (the cores here), got {args.workers}")
     client = None
     if args.scheduler is not None or args.workers:
-
         client = cluster.client_for(args.scheduler, args.workers)
     t0 = time.perf_counter()
     try:
