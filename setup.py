@@ -24,11 +24,14 @@ def _digest() -> str:
 
 (CORE / "_built.py").write_text(f'"""Written by setup.py: the sources the compiled core was built from."""\n\n'
                                 f'SOURCE_SHA256 = "{_digest()}"\n')
-extensions = [Extension(f"kinelab.core.{pyx.stem}", [str(pyx.relative_to(ROOT))], extra_compile_args=["-O3"])
+# OpenMP runs the batches' rows in parallel (prange); -O3 without -ffast-math keeps IEEE arithmetic, so the kernels
+# compute what their reference computes, bit for bit
+extensions = [Extension(f"kinelab.core.{pyx.stem}", [str(pyx.relative_to(ROOT))],
+                        extra_compile_args=["-O3", "-fopenmp"], extra_link_args=["-fopenmp"])
               for pyx in sorted(CORE.glob("*.pyx"))]
 setup(
-    ext_modules=cythonize(extensions, language_level=3),
+    ext_modules=cythonize(extensions, language_level=3, include_path=[str(ROOT / "src")]),
     package_dir={"": "src", "kinelab.urdf": "urdf"},
     packages=[*find_packages("src"), "kinelab.urdf"],
-    package_data={"kinelab.urdf": ["*.urdf"], "kinelab.core": ["*.pyx", "*.pyi"]},
+    package_data={"kinelab.urdf": ["*.urdf"], "kinelab.core": ["*.pyx", "*.pxd", "*.pyi"]},
 )

@@ -1,5 +1,5 @@
-"""Names a package serves on first use (PEP 562): numba and the solver kernels cost most of a second to
-import, which ``kinelab fk``, ``info`` and ``robots`` (and a user who only loads a robot) should not pay."""
+"""Names a package serves on first use (PEP 562): the solvers, SciPy and the collision model cost most of a
+second to import, which ``kinelab fk``, ``info`` and ``robots`` (and a user who only loads a robot) should not pay."""
 
 from __future__ import annotations
 

@@ -171,7 +171,7 @@ def test_a_unit_biquaternion_is_a_valid_target_and_a_non_unit_one_is_not():
 
 @pytest.mark.parametrize("name", ("stanford", "panda", "youbot"))
 def test_compiled_preset_takes_the_same_steps_as_the_python_integrator(name):
-    """Law (9), Euler h = 1/k, 0.5 rad cap: the numba kernel against the readable Python integrator."""
+    """Law (9), Euler h = 1/k, 0.5 rad cap: the compiled kernel against the readable Python integrator."""
     from kinelab.ik.biquat import kernel as biquat_kernel
     from kinelab.ik.chain import chain_model as vector_model
 

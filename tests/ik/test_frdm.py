@@ -11,8 +11,9 @@ from helpers import revolute, write_urdf
 
 import kinelab
 from kinelab.ik import solve
+from kinelab.ik.chain import PRISMATIC
 from kinelab.ik.chain import chain_model as vector_model
-from kinelab.ik.frdm import attempts, kernel, reference
+from kinelab.ik.frdm import kernel, reference
 from kinelab.ik.multistart import seed_state
 
 ROBOTS = ("stanford", "era", "youbot", "panda", "ur5", "kinova")
@@ -35,7 +36,7 @@ def test_compiled_vector_model_matches_pinocchio(robots, name):
         np.testing.assert_allclose(mine["e"], ref["e"], atol=1e-12)
         np.testing.assert_allclose(mine["N"], oMtool.translation, atol=1e-12)
         np.testing.assert_allclose(mine["R"], oMtool.rotation, atol=1e-12)
-        revolute_rows = vm.kind != kernel.PRISMATIC
+        revolute_rows = vm.kind != PRISMATIC
         # the two points lie on the same axis line: their difference is parallel to e
         diff = mine["o"] - ref["o"]
         np.testing.assert_allclose(np.cross(diff, mine["e"])[revolute_rows], 0, atol=1e-11)
@@ -358,7 +359,7 @@ def test_mixed_order_restarts_turn_the_sweep_direction(robots):
                                      target.rotation, 3.0 / vm.length**2, np.ones(3), 1e-6, 1e-6, True, True,
                                      np.zeros(vm.n), 0.0, -1)
             settings = kernel.Settings(1.0, 1e-10, 10, 0.1, 5, 0, 0.0, 8)  # no polish: both attempts run
-            code = attempts.multistart(q, vm.chain, problem, settings, ORDERS[name], 100, seed_state(7), 2, 1e9, best,
+            code = kernel.multistart(q, vm.chain, problem, settings, ORDERS[name], 100, seed_state(7), 2, 1e9, best,
                                      stats, kernel.new_memory(vm.n, 5))
             last[name] = (q, stats[0], code)
         if last["mixed"][1] == 2 and last["base2tip"][1] == 2 and last["tip2base"][1] == 2:
@@ -387,7 +388,7 @@ def test_the_answer_does_not_depend_on_where_the_clock_chunks_end(chunk):
             rng_state, left, code = seed_state(3), 20, -1
             while left > 0:
                 before = stats[kernel.T_ATTEMPTS]
-                code = attempts.multistart(q, vm.chain, problem, settings, kernel.MIXED, 100, rng_state, left,
+                code = kernel.multistart(q, vm.chain, problem, settings, kernel.MIXED, 100, rng_state, left,
                                            stats[kernel.T_SWEEPS] + size, best, stats, mem)
                 left -= int(stats[kernel.T_ATTEMPTS] - before)
                 if code == kernel.CONVERGED:
@@ -395,50 +396,6 @@ def test_the_answer_does_not_depend_on_where_the_clock_chunks_end(chunk):
             results.append((code, best.copy(), stats[kernel.T_SWEEPS], stats[kernel.T_ATTEMPTS]))
         assert results[0][0] == results[1][0] and results[0][2:] == results[1][2:]
         np.testing.assert_array_equal(results[0][1], results[1][1])
-
-
-def test_a_cold_first_solve_compiles_before_its_clock_starts(tmp_path):
-    """With an empty numba cache every kernel a solve uses is compiled by prepare(), outside the budget."""
-    import os
-    import subprocess
-    import sys
-
-    code = (
-        "import numpy as np, kinelab\n"
-        "from kinelab.ik import solve\n"
-        "r = kinelab.load('ur5'); T = r.fk(r.random_q(np.random.default_rng(0)))\n"
-        "res = solve(r, T, seed=0, time_budget=0.05)\n"
-        "print(res.success, res.wall_time)\n"
-    )
-    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path), "PYTHONWARNINGS": "ignore"}
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=600)
-    success, wall_time = out.stdout.split()
-    assert success == "True" and float(wall_time) < 0.05, out.stdout + out.stderr
-
-
-def test_the_typed_entry_point_gives_the_dispatchers_answer(robots):
-    """solve() calls the compiled multistart through TypedKernel; numba's own dispatch must agree bit for bit."""
-    from kinelab.ik.frdm import kernel
-    from kinelab.ik.frdm import solver as frdm_solver
-    from kinelab.ik.multistart import seed_state
-
-    robot = robots["panda"]
-    cm = vector_model(robot)
-    opts = kinelab.FRDMOptions()
-    rng = np.random.default_rng(21)
-    solve(robot, robot.fk(robot.random_q(rng)))  # the typed entry point exists from here on
-    for k in range(20):
-        target, q0 = robot.fk(robot.random_q(rng)), robot.random_q(rng)
-        problem = frdm_solver._compiled_problem(cm, target, opts, 1e-6, 1e-6)
-        out = []
-        for call in (frdm_solver._MULTISTART, attempts.multistart):
-            q, best, stats = q0.copy(), q0.copy(), np.zeros(kernel.STATS_SIZE)
-            code = call(q, cm.chain, problem, opts.settings(), 3, 100, seed_state(k), 5, 1e9, best, stats,
-                        kernel.new_memory(cm.n, opts.accel_m))
-            out.append((code, best, stats))
-        assert out[0][0] == out[1][0]
-        np.testing.assert_array_equal(out[0][1], out[1][1])
-        np.testing.assert_array_equal(out[0][2], out[1][2])
 
 
 def test_numpy_scalars_as_arguments_give_the_same_answer_as_python_ones(robots):

@@ -46,6 +46,17 @@ def test_the_follower_reports_an_unreachable_sample_and_carries_on():
     assert res.reached[40:].all()  # within ten samples it is back on the path
 
 
+def test_the_follower_keeps_its_time_budget_and_leaves_the_samples_after_it_unsolved():
+    """#32: the compiled follower looks at the clock before every sample. A budget that has passed before the first
+    sample leaves every sample unstarted (NaN, status time_budget); none is passed off as reached."""
+    robot = load("ur5")
+    Q, targets = smooth_path(robot, 4, samples=50)
+    res = kinelab.track(robot, targets, q0=Q[0], time_budget=1e-9)
+    assert np.isnan(res.q).all() and set(res.status) == {"time_budget"} and not res.reached.any()
+    full = kinelab.track(robot, targets, q0=Q[0], time_budget=None)
+    assert full.reached.all() and not np.isnan(full.q).any()
+
+
 def test_bad_targets_are_named_by_index():
     robot = load("ur5")
     Q, targets = smooth_path(robot, 3, samples=5)

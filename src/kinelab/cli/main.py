@@ -15,11 +15,11 @@ import sys
 import warnings
 from typing import Any
 
-from kinelab.cli import bench, fk, ik, maps, robots, singular, validate, view, warmup
+from kinelab.cli import bench, fk, ik, maps, robots, singular, validate, view
 from kinelab.cli.common import Parser
 from kinelab.errors import KinelabError
 
-COMMANDS = (robots, fk, ik, singular, view, bench, maps, validate, warmup)
+COMMANDS = (robots, fk, ik, singular, view, bench, maps, validate)
 
 
 class _Version(argparse.Action):
@@ -45,9 +45,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _one_line(message: Warning | str, category: type[Warning], filename: str, lineno: int,
               line: str | None = None) -> str:
-    """A warning as the CLI shows it: one line, no source path (a compile notice is news, not a warning)."""
-    kind = "" if category.__name__ == "CompileNotice" else "warning: "
-    return f"kinelab: {kind}{' '.join(str(message).split())}\n"
+    """A warning as the CLI shows it: one line, no source path."""
+    return f"kinelab: warning: {' '.join(str(message).split())}\n"
 
 
 def main(argv: list[str] | None = None) -> int:

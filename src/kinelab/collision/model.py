@@ -26,13 +26,10 @@ import pinocchio as pin
 from kinelab.collision.obstacles import Environment
 from kinelab.collision.spheres import PLANE, Frames
 from kinelab.collision.spheres import candidates as sphere_candidates
-from kinelab.dispatch import TypedKernel
 from kinelab.errors import KinelabError
 from kinelab.robot import Robot
 from kinelab.robot.meshes import mesh_package_dirs, missing_meshes
 from kinelab.robot.mjcf import is_mjcf
-
-_SPHERES = TypedKernel(sphere_candidates)
 
 
 class CollisionError(KinelabError):
@@ -186,8 +183,8 @@ class CollisionModel:
         f = self.frames
         if f is None:  # a mimic follower in the chain: no sphere test, the hulls take every pair
             return np.arange(len(self.pairs))
-        count = _SPHERES(q, f.parents, f.place_R, f.place_t, f.axis, f.kind, f.q_index, self.joints, self.centres,
-                         self.radii, self.normals, self.pairs, self.margin, self._found)
+        count = sphere_candidates(q, f.parents, f.place_R, f.place_t, f.axis, f.kind, f.q_index, self.joints,
+                                  self.centres, self.radii, self.normals, self.pairs, self.margin, self._found)
         return self._found[:count]
 
     def contact_of(self, k: int) -> Contact:

@@ -306,8 +306,9 @@ def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
         tol_rot: rotation tolerance per sample [rad].
         task: the components to meet per sample, as :func:`solve`.
         axis: the tool axis of task "axis".
-        time_budget: wall-clock budget [s] of the whole path (None, the default: none); the monitored loop
-            stops each attempt at it.
+        time_budget: wall-clock budget [s] of the whole path (None, the default: none); the compiled follower
+            starts no sample after it (those are NaN rows with status ``time_budget``), the monitored loop stops
+            each attempt at it.
         options: an ``FRDMOptions`` (taken as it is), or its fields as keywords (``kicks``, ``intervals``,
             ``freeze``, ``policy``, ``order``, ``w_p``, ...) over the path's defaults (max_sweeps 2000,
             stall_window 100, stall_rel 1e-6).

@@ -2,7 +2,7 @@
 
 Row b is the answer :func:`kinelab.solve` gives for ``targets[b]`` alone with ``seed = seed + b`` and
 start ``q0[b]`` (or none), when neither runs out of time. FRDM with compiled options runs the rows in
-parallel inside one kernel (every core, numba ``prange``; the answers do not depend on the thread
+parallel inside one kernel (every core, OpenMP threads; the answers do not depend on the thread
 count); the other solvers and FRDM's monitored options run ``solve`` row by row on one core.
 """
 
@@ -12,10 +12,10 @@ import time
 from dataclasses import dataclass, replace
 from typing import Any
 
-import numba
 import numpy as np
 import pinocchio as pin
 
+from kinelab.core import threads
 from kinelab.errors import ConfigurationError
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.driver import solve_one
@@ -108,7 +108,7 @@ def run_batch(robot: Robot, targets: Any, q0: Any, req: Request) -> BatchIKResul
         attempts = np.where(_beyond(robot, points, req) > 0, 1, req.max_restarts + 1)
         rows = frdm_batch.run(robot, points, rotations, starts, seed_states(seed, points.shape[0]), attempts,
                               req.tol_pos, req.tol_rot, deadline, req.options)
-        mode = f"{req.options.label} (compiled batch, {numba.get_num_threads()} threads)"
+        mode = f"{req.options.label} (compiled batch, {threads.count()} threads)"
     else:
         rows = _per_target(robot, points, rotations, starts, replace(req, seed=seed), deadline)
         mode = f"{req.solver} (per target)"

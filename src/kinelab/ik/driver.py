@@ -16,18 +16,14 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from kinelab.ik.compiling import announce
 from kinelab.ik.limits import wrap_q
-from kinelab.ik.multistart import TypedKernel
 from kinelab.ik.request import Request
 from kinelab.ik.result import Attempt, BypassRecord, IKResult, SingularEvent, Status
 from kinelab.ik.targets import as_target
 from kinelab.ik.tasks import COMPONENTS, POSE, Task
-from kinelab.ik.verdict import pose_defect, pose_verdict
+from kinelab.ik.verdict import pose_verdict
 from kinelab.ik.workspace import out_of_reach
 from kinelab.robot import Robot
-
-_VERDICT = TypedKernel(pose_verdict)  # its arguments are always Pinocchio's matrices and float arrays
 
 
 class _LazyRng:
@@ -91,29 +87,11 @@ def solve_one(robot: Robot, target: Any, q0: Any, req: Request) -> IKResult:
     return _loop(module, problem, _start(robot, q0, rng, req.start_outside_limits), max_restarts, opts, rng, beyond)
 
 
-_CHECKS_COMPILED: list[bool] = []
-
-
 def _prepare(module: Any, robot: Robot, options: Any) -> None:
-    """Compilation and model building, which are not a solve's time: the solver's, and the checks'."""
+    """Model building, which is not a solve's time."""
     prepare = getattr(module, "prepare", None)
     if prepare is not None:
         prepare(robot, options)
-    prepare_checks(robot)
-
-
-def prepare_checks(robot: Robot) -> None:
-    """Compile (or load) the target check and Pinocchio's verdict kernel, once per process."""
-    if not _CHECKS_COMPILED:
-        announce("the verdict", [pose_verdict, pose_defect])
-        _compile_checks(robot)
-
-
-def _compile_checks(robot: Robot) -> None:
-    """Compile (or load) the target check and the verdict once per process, outside any solve's clock."""
-    target = as_target(pin.SE3.Identity())
-    Call(robot, target, "", 1.0, 1.0, 0.0, 0.0, None).judge(robot.neutral())
-    _CHECKS_COMPILED.append(True)
 
 
 @dataclass(slots=True)
@@ -135,10 +113,10 @@ class Call:
     def judge(self, q: np.ndarray) -> tuple[bool, float, float]:
         """Pinocchio's verdict on q: (success, position error [m], rotation error [rad]) on the task's
         components (the rotation error of task "axis" is the angle between the tool axes)."""
-        if not (q.dtype == np.float64 and q.ndim == 1 and q.flags.c_contiguous):  # the kernel's one signature
+        if not (q.dtype == np.float64 and q.ndim == 1 and q.flags.c_contiguous):
             q = np.ascontiguousarray(q, dtype=float)
         lower, upper = self.robot.check_bounds
-        dp, dr, within = _VERDICT(self.target.homogeneous, self.robot.tool_pose_of_float_q(q).homogeneous, q,
+        dp, dr, within = pose_verdict(self.target.homogeneous, self.robot.tool_pose_of_float_q(q).homogeneous, q,
                                   lower, upper, self.task.axis)
         task = self.task
         ok = within and (not task.position or dp <= self.tol_pos) and (not task.rotation or dr <= self.tol_rot)

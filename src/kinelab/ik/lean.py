@@ -18,49 +18,18 @@ from typing import Any
 
 import numpy as np
 import pinocchio as pin
-from numba import njit
 
-from kinelab.ik.compiling import announce
-from kinelab.ik.driver import Call, compiled_result, prepare_checks
+from kinelab.ik.driver import Call, compiled_result
 from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm import solver as frdm
-from kinelab.ik.multistart import TypedKernel
 from kinelab.ik.request import Request
 from kinelab.ik.result import IKResult, Status
-from kinelab.ik.verdict import pose_defect, pose_verdict
+from kinelab.ik.verdict import pose_verdict, usual_inputs
 from kinelab.ik.workspace import reach_bound
 from kinelab.robot import Robot
 
 SEED_LIMIT = 1 << 64
-OK, NOT_USUAL = 0, 1
-
-
-@njit(cache=True)
-def usual_inputs(H: np.ndarray, q0: np.ndarray, n: int, lower: np.ndarray, upper: np.ndarray,
-                 anchor: np.ndarray, radius: float, pstar: np.ndarray, Rstar: np.ndarray) -> int:
-    """OK when H is a proper pose whose point lies within ``radius`` [m] of ``anchor`` and q0 is empty (no start)
-    or n finite values within [lower, upper]: then H's point and rotation are copied into pstar and Rstar (the
-    kernel's target). NOT_USUAL otherwise (the general path then names what is wrong)."""
-    if pose_defect(H) != 0:
-        return NOT_USUAL
-    d = np.sqrt((H[0, 3] - anchor[0]) ** 2 + (H[1, 3] - anchor[1]) ** 2 + (H[2, 3] - anchor[2]) ** 2)
-    if not d <= radius:
-        return NOT_USUAL
-    if q0.shape[0] != 0:
-        if q0.shape[0] != n:
-            return NOT_USUAL
-        for i in range(n):
-            if not lower[i] <= q0[i] <= upper[i]:  # also False for NaN; ±inf never lies within finite limits
-                return NOT_USUAL
-    for i in range(3):
-        pstar[i] = H[i, 3]
-        for j in range(3):
-            Rstar[i, j] = H[i, j]
-    return OK
-
-
-_USUAL = TypedKernel(usual_inputs)
-_VERDICT = TypedKernel(pose_verdict)
+OK = 0  # usual_inputs: the call is the usual one
 
 
 class LeanFRDM:
@@ -84,14 +53,6 @@ class LeanFRDM:
         self.axis, self.n = req.task.axis, robot.n
         self.check_pos, self.check_rot = req.task.position, req.task.rotation
         self.tol_pos, self.tol_rot, self.task_label = req.tol_pos, req.tol_rot, req.task_label
-        prepare_checks(robot)
-        self._compile()
-
-    def _compile(self) -> None:
-        """Load (or compile) the input check before any call's clock starts."""
-        announce("the prepared solver's input check", [usual_inputs])
-        H = pin.SE3.Identity().homogeneous
-        _USUAL(H, self.none, self.n, self.lower, self.upper, self.anchor, self.radius, np.zeros(3), np.zeros((3, 3)))
 
     def solve(self, target: Any, q0: Any, seed: Any) -> IKResult | None:
         """The result for the usual call, or None for the general driver (see the module's docstring)."""
@@ -110,13 +71,13 @@ class LeanFRDM:
             return None
         H = target.homogeneous
         ctx = self.ctx
-        if _USUAL(H, start, self.n, self.lower, self.upper, self.anchor, self.radius, ctx.pstar, ctx.Rstar) != OK:
+        if usual_inputs(H, start, self.n, self.lower, self.upper, self.anchor, self.radius, ctx.pstar, ctx.Rstar) != OK:
             return None
         deadline = t_start + self.budget
         code, q, stats = ctx.run_aimed(None if q0 is None else start, seed, self.attempts, deadline)
         if ctx.continuous:
             q = self.robot.wrap_continuous(q)
-        dp, dr, within = _VERDICT(H, self.robot.tool_pose_of_float_q(q).homogeneous, q, self.lower, self.upper,
+        dp, dr, within = pose_verdict(H, self.robot.tool_pose_of_float_q(q).homogeneous, q, self.lower, self.upper,
                                   self.axis)
         ok = within and (not self.check_pos or dp <= self.tol_pos) and (not self.check_rot or dr <= self.tol_rot)
         if ok and code == kernel.CONVERGED:  # the usual outcome, built without the general path's bookkeeping

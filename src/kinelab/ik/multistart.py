@@ -7,8 +7,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from kinelab.dispatch import TypedKernel as TypedKernel  # exported: the solvers' kernels are called through it
-from kinelab.ik.chain import PRISMATIC, ChainModel, random_configuration
+from kinelab.core._frdm import draw_configuration
+from kinelab.ik.chain import PRISMATIC, ChainModel
 
 
 def seed_state(seed: int | None) -> np.ndarray:
@@ -40,7 +40,7 @@ def first_start(q0: np.ndarray | None, kind: np.ndarray, lower: np.ndarray, uppe
     if q0 is not None:
         return np.array(q0, dtype=float)
     q = np.empty(kind.shape[0])
-    random_configuration(q, kind, lower, upper, rng_state)
+    draw_configuration(q, kind, lower, upper, rng_state)
     return q
 
 

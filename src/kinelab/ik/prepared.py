@@ -21,7 +21,7 @@ from kinelab.ik.analytic.branches import analytic_one, arm_of, nearest_batch, re
 from kinelab.ik.batch import BatchIKResult, run_batch
 from kinelab.ik.branches import UNSEEN, find_all
 from kinelab.ik.clear import clear_batch, mark_colliding, solve_clear
-from kinelab.ik.driver import prepare_checks, solve_one
+from kinelab.ik.driver import solve_one
 from kinelab.ik.lean import LeanFRDM
 from kinelab.ik.request import Request, check_robot, check_seed, make_request
 from kinelab.ik.result import IKResult
@@ -75,8 +75,7 @@ class IK:
         else:
             prepare = getattr(self.request.module, "prepare", None)
             if prepare is not None:
-                prepare(robot, self.request.options)  # compile (or load) the kernels now, not in the first call
-        prepare_checks(robot)
+                prepare(robot, self.request.options)  # the solver's model now, not in the first call
         req = self.request
         self._lean = LeanFRDM(robot, req) if not self.analytic and req.solver == "frdm" and req.options.compiled \
             else None

@@ -10,10 +10,7 @@ from numpy.typing import ArrayLike
 
 from kinelab.dq.algebra import DualQuat
 from kinelab.errors import TargetError
-from kinelab.ik.multistart import TypedKernel
 from kinelab.ik.verdict import NOT_A_ROTATION, NOT_FINITE, pose_defect
-
-_POSE_DEFECT = TypedKernel(pose_defect)
 
 
 def from_xyz_rpy(xyz: ArrayLike, rpy: ArrayLike = (0.0, 0.0, 0.0), *, degrees: bool = False) -> pin.SE3:
@@ -71,7 +68,7 @@ def as_target(target: Any, task: str = "pose") -> pin.SE3:
             f"got {type(target).__name__}; "
             "build one with kinelab.target_from_xyz_rpy or kinelab.target_from_xyz_quat_wxyz"
         )
-    defect = _POSE_DEFECT(target.homogeneous)
+    defect = pose_defect(target.homogeneous)
     if defect == NOT_FINITE:
         raise TargetError("target has NaN or infinite entries")
     if defect == NOT_A_ROTATION:

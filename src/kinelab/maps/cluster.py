@@ -61,12 +61,11 @@ def _worker_robot(how: dict) -> Robot:
 
 
 def chunk_task(how: dict, spec: Any, centres: np.ndarray, index: int) -> tuple[int, dict]:
-    """One chunk on a worker: (index, values). One numba thread per task: the cluster gives the parallelism."""
-    import numba
-
+    """One chunk on a worker: (index, values). One kernel thread per task: the cluster gives the parallelism."""
+    from kinelab.core import threads
     from kinelab.maps.chunk import compute_chunk
 
-    numba.set_num_threads(1)
+    threads.set_count(1)
     return index, compute_chunk(_worker_robot(how), spec, centres, index)
 
 

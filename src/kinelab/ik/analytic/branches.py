@@ -18,13 +18,11 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.collision.model import CollisionModel
-from kinelab.dispatch import TypedKernel
 from kinelab.errors import OptionError
 from kinelab.geometry import pose_errors, stack_homogeneous
 from kinelab.ik.analytic.classify import ArmClass, classify
 from kinelab.ik.analytic.kernel import MAX_ROWS, branches, branches_batch
 from kinelab.ik.batch import BatchIKResult
-from kinelab.ik.compiling import announce
 from kinelab.ik.driver import solve_one
 from kinelab.ik.limits import distance
 from kinelab.ik.request import Request, make_request
@@ -44,7 +42,6 @@ def limit_slack(tol_rot: float) -> float:
     finishes when it falls short."""
     return max(LIMIT_SLACK, tol_rot)
 CONTINUUM = "one of a continuum: a singular pose, another angle of the free joint serves too"
-_KERNEL = TypedKernel(branches)
 _NO_REF = {n: np.zeros(n) for n in (5, 6)}
 
 
@@ -143,11 +140,10 @@ def roots(robot: Robot, arm: ArmClass, H: np.ndarray, q_ref: np.ndarray | None,
 def arm_roots(arm: ArmClass, H: np.ndarray, lower: np.ndarray, upper: np.ndarray,
               q_ref: np.ndarray | None, slack: float = LIMIT_SLACK) -> tuple[np.ndarray, ...]:
     """:func:`roots` of the arm ``arm`` with joint limits ``lower``, ``upper`` (arm.n each, rad)."""
-    announce("the closed form", [branches])
     n = arm.n
     out, found, free = np.empty((MAX_ROWS, n)), np.zeros(MAX_ROWS, dtype=np.int64), np.zeros(MAX_ROWS, dtype=np.bool_)
     ref = _NO_REF[n] if q_ref is None else np.ascontiguousarray(q_ref, dtype=float)
-    m = _KERNEL(arm.kind, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, np.ascontiguousarray(H, dtype=float),
+    m = branches(arm.kind, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, np.ascontiguousarray(H, dtype=float),
                 np.ascontiguousarray(lower), np.ascontiguousarray(upper), ref, q_ref is not None, SAME,
                 slack, out, found, free)
     return out[:m], found[:m], free[:m]
@@ -210,7 +206,6 @@ def all_branches_batch(robot: Robot, targets: Any, tol_pos: float = 1e-6, tol_ro
     """
     arm = arm_of(robot, make_request("frdm", tol_pos=tol_pos, tol_rot=tol_rot))
     H = stack_homogeneous(*as_target_arrays(targets))
-    announce("the closed form's batch", [branches_batch])
     B, n = H.shape[0], arm.n
     out = np.full((B, MAX_ROWS, n), np.nan)
     found, free = np.zeros((B, MAX_ROWS), dtype=np.int64), np.zeros((B, MAX_ROWS), dtype=np.bool_)

@@ -21,11 +21,10 @@ from kinelab.errors import BiquaternionError, KinelabError
 from kinelab.ik import multistart as restarts
 from kinelab.ik.biquat import kernel, laws
 from kinelab.ik.biquat.integrators import Stop, System, Trajectory, adaptive, fixed
-from kinelab.ik.biquat.options import LAWS, BiquatOptions
+from kinelab.ik.biquat.options import BiquatOptions
 from kinelab.ik.chain import chain_model
-from kinelab.ik.compiling import announce
 from kinelab.ik.limits import wrap_q
-from kinelab.ik.multistart import TypedKernel, clock_chunk
+from kinelab.ik.multistart import clock_chunk
 from kinelab.ik.result import Attempt, Diagnostics, Status
 from kinelab.robot import Robot
 
@@ -34,7 +33,6 @@ Options = BiquatOptions
 # two looks (≈ 0.05 ms of work); a cut attempt is resumed, so the answer does not depend on these
 JOINT_STEPS_PER_LOOK = 192
 JOINT_STEPS_PER_LATER_LOOK = 48
-_MULTISTART = TypedKernel(kernel.multistart)
 
 
 def error_biquaternion(N: DualQuat, Lam: DualQuat) -> DualQuat:
@@ -154,7 +152,7 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: 
 
     def chunk(attempts_left: int) -> int:
         size = steps[0] if stats[kernel.T_STEPS] == 0 else steps[1]
-        return _MULTISTART(q, cm.chain, cm.lower, cm.upper, prob, rng_state, attempts_left,
+        return kernel.multistart(q, cm.chain, cm.lower, cm.upper, prob, rng_state, attempts_left,
                            float(stats[kernel.T_STEPS] + size), stats, restart_lower, restart_upper)
 
     code = restarts.run_in_chunks(chunk, max_restarts + 1, stats, deadline, kernel.CONVERGED)
@@ -172,17 +170,6 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: 
     return Attempt(q, status, int(stats[kernel.T_STEPS]), diagnostics=diag, mode=mode), restarts_run
 
 
-_COMPILED: list[bool] = []
-
-
 def prepare(robot: Robot, options: BiquatOptions | None = None) -> None:
-    """Compile (or load) the kernels before a solve's clock starts (once per process), announced when it
-    compiles; ``options`` (the solves' options) make no difference: every path is loaded."""
+    """Build the chain model before a solve's clock starts (the kernels are compiled at install)."""
     chain_model(robot)
-    if not _COMPILED:
-        announce("the biquaternion solver", [kernel.multistart, kernel.integrate, laws.simple_law])
-        target = pin.SE3.Identity()
-        multistart(robot, target, robot.neutral(), 1e-6, 1e-6, np.inf, 0, 0)
-        for law in LAWS:  # the laws the Python integrators call are compiled too, outside any budget
-            attempt(robot, target, robot.neutral(), 1e-6, 1e-6, np.inf, law=law, step=0.01, max_steps=1)
-        _COMPILED.append(True)

@@ -7,10 +7,10 @@ from typing import Any
 
 import numpy as np
 
+from kinelab.core import _follow
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.chain import chain_model
-from kinelab.ik.compiling import announce
-from kinelab.ik.frdm import kernel, path_kernel
+from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.multistart import seed_state
 from kinelab.ik.result import SingularEvent, Status, TrackResult
@@ -18,16 +18,19 @@ from kinelab.ik.targets import as_target_arrays
 from kinelab.ik.tasks import POSE, Task
 from kinelab.robot import Robot
 
+NOT_STARTED = -2  # the follower's code for a sample the time budget left unstarted
 REST_WEIGHT = 0.01  # objective units (the weighted pose error is ~1 at a chain length's distance)
 REST_SWEEPS = 10  # sweeps of the first phase of a sample
 LM_ITERATIONS = 20  # Levenberg–Marquardt steps of the polish (mode "frdm+lm")
 CENTRE_PULL = 0.01  # share of the way from the previous answer to mid-range taken as the rest configuration
 # any other code (a kernel's converged that Pinocchio does not confirm, the polish's −1): max_iterations
-_STATUS = {kernel.STALL_STEP: Status.STALLED, kernel.STALL_WINDOW: Status.STALLED, kernel.BUDGET: Status.MAX_ITERATIONS}
+_STATUS = {kernel.STALL_STEP: Status.STALLED, kernel.STALL_WINDOW: Status.STALLED, kernel.BUDGET: Status.MAX_ITERATIONS,
+           NOT_STARTED: Status.TIME_BUDGET}
 
 
 def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: float, max_sweeps: int,
-           rest_weight: float | None, opts: FRDMOptions, task: Task = POSE, seed: int | None = None) -> TrackResult:
+           rest_weight: float | None, opts: FRDMOptions, task: Task = POSE, seed: int | None = None,
+           time_budget: float | None = None) -> TrackResult:
     """Solve every sample of a path in the compiled follower; each answer judged by Pinocchio.
 
     Args:
@@ -41,6 +44,8 @@ def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: 
         opts: FRDM options (order, weights, stall window).
         task: the components judged (FRDM's mode in ``opts`` is the same task).
         seed: seed of the recovery's restarts (None: fresh entropy).
+        time_budget: wall-clock budget [s] of the whole path (None: none); the samples not started when it runs
+            out are left unsolved (NaN, status ``time_budget``).
 
     Returns:
         A :class:`~kinelab.ik.frdm.tracking.TrackResult` with mode "frdm (compiled follower)". Continuous
@@ -56,15 +61,23 @@ def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: 
     bounded = np.isfinite(cm.lower) & np.isfinite(cm.upper)
     centre = np.where(bounded, (np.where(bounded, cm.lower, 0.0) + np.where(bounded, cm.upper, 0.0)) / 2, q0)
     lower, upper = (cm.lower, cm.upper) if opts.use_limits else (np.full(cm.n, -np.inf), np.full(cm.n, np.inf))
-    announce("the path follower", [path_kernel.follow])
     t0 = time.perf_counter()
-    path_kernel.follow(Q, np.array(q0, dtype=float), cm.chain, lower, upper, np.ones(cm.n, dtype=np.bool_), points,
-                       rotations, opts.position_weight(cm.length), opts.axis_weights(), float(tol_pos),
-                       float(tol_rot), opts.mode != "orientation", opts.mode != "position", opts.settings(), order,
-                       int(max_sweeps), float(rest_weight), REST_SWEEPS, centre, CENTRE_PULL,
-                       LM_ITERATIONS if opts.polish else 0, seed_state(seed), codes, sweeps)
-    dp, dr = task.errors_batch(stack_homogeneous(points, rotations), robot.fk_batch(Q))
-    ok = task.met_batch(dp, dr, tol_pos, tol_rot) & robot.within_limits_batch(Q) & np.isfinite(Q).all(axis=1)
+    deadline = np.inf if time_budget is None else t0 + float(time_budget)
+    shared = kernel.Objective(lower, upper, np.ones(cm.n, dtype=np.bool_), np.zeros(3), np.eye(3),
+                              opts.position_weight(cm.length), opts.axis_weights(), float(tol_pos), float(tol_rot),
+                              opts.mode != "orientation", opts.mode != "position", kernel.no_rest(cm.n), 0.0, -1)
+    _follow.follow(Q, np.array(q0, dtype=float), cm.chain, shared, np.ascontiguousarray(points, dtype=float),
+                   np.ascontiguousarray(rotations, dtype=float), opts.settings(), order, int(max_sweeps),
+                   float(rest_weight), REST_SWEEPS, centre, CENTRE_PULL, LM_ITERATIONS if opts.polish else 0,
+                   seed_state(seed), deadline, codes, sweeps)
+    started = np.isfinite(Q).all(axis=1)  # a sample the budget left unstarted is NaN: no error to judge
+    dp, dr = np.full(count, np.nan), np.full(count, np.nan)
+    ok = started.copy()
+    if started.any():
+        dp[started], dr[started] = task.errors_batch(stack_homogeneous(points[started], rotations[started]),
+                                                     robot.fk_batch(Q[started]))
+        ok[started] = task.met_batch(dp[started], dr[started], tol_pos, tol_rot) & \
+            robot.within_limits_batch(Q[started])
     status = [Status.CONVERGED.value if ok[k] else _STATUS.get(int(codes[k]), Status.MAX_ITERATIONS).value
               for k in range(count)]
     per_sample = (time.perf_counter() - t0) / count  # the kernel and Pinocchio's check of every answer

@@ -25,18 +25,17 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from kinelab.core import _frdm
 from kinelab.errors import KinelabError
 from kinelab.ik.chain import PRISMATIC, ChainModel
 from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm.kernel import no_rest
 from kinelab.ik.frdm.options import BYPASSES, ORDERS, FRDMOptions
-from kinelab.ik.multistart import TypedKernel
 from kinelab.ik.result import BypassRecord, SingularEvent, Status
 from kinelab.robot import Robot
 
 SINGULAR_SIGMA = 1e-4  # σ_min of the scaled Jacobian below this: a kinematic singularity
 CHUNK = 64  # sweeps between two looks at the clock
-_RUN = TypedKernel(kernel.run)
 
 
 @dataclass
@@ -151,7 +150,7 @@ class Runner:
     def kernel_run(self, q: np.ndarray, budget: int) -> tuple[int, int]:
         """Up to ``budget`` sweeps of the compiled kernel from q (in place)."""
         self.state[kernel.S_HELD] = 0.0  # the monitor may have moved q since: the kernel recomputes the FK
-        return _RUN(q, self.vm.chain, self.prob.tuple(), self.settings, self.order, int(budget), self.mem)
+        return _frdm.run_kernel(q, self.vm.chain, self.prob.tuple(), self.settings, self.order, int(budget), self.mem)
 
     def solve(self, q: np.ndarray, deadline: float, bypass: Bypass, max_events: int) -> Status:
         """Run until converged, out of sweeps or time, or the policy has no answer to a monitor event."""

@@ -16,21 +16,19 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from kinelab.core import _frdm
 from kinelab.ik import dls
 from kinelab.ik import multistart as restarts
 from kinelab.ik.chain import CONTINUOUS, ChainModel, chain_model
-from kinelab.ik.compiling import announce
 from kinelab.ik.frdm import kernel
-from kinelab.ik.frdm.attempts import multistart as compiled_multistart
 from kinelab.ik.frdm.kernel import no_rest
 from kinelab.ik.frdm.monitor import Bypass, Goal, Runner
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
-from kinelab.ik.multistart import TypedKernel, clock_chunk
+from kinelab.ik.multistart import clock_chunk
 from kinelab.ik.result import Attempt, Diagnostics, SingularEvent, Status
 from kinelab.robot import Robot
 
 Options = FRDMOptions
-_MULTISTART = TypedKernel(compiled_multistart)
 # joint steps before the first look at the clock (most solves end within them: one kernel call), and then
 # between two looks (≈ 0.03 ms of work: a budget is overrun by about that much whatever the chain's length)
 JOINT_SWEEPS_PER_LOOK = 256
@@ -38,27 +36,13 @@ JOINT_SWEEPS_PER_LATER_LOOK = 64
 
 
 def prepare(robot: Robot, options: FRDMOptions | None = None) -> None:
-    """Build the chain model and compile (or load) the kernels ``options`` run (None: both the compiled
-    multistart and the monitored loop): done before a solve's clock starts, announced when it compiles.
+    """Build the chain model before a solve's clock starts (the kernels are compiled at install).
 
     Args:
         robot: the robot.
-        options: the options of the solves to come.
+        options: the options of the solves to come (unused: every option runs compiled code built ahead).
     """
     chain_model(robot)
-    target = pin.SE3.Identity()
-    compiled = options is None or options.compiled
-    if compiled and "multistart" not in _COMPILED:
-        announce("FRDM", [compiled_multistart])
-        multistart(robot, target, robot.neutral(), 1e-6, 1e-6, np.inf, 0, 0)
-        _COMPILED.add("multistart")
-    if (options is None or not compiled) and "monitored" not in _COMPILED:
-        announce("the monitored FRDM loop", [kernel.run])
-        attempt(robot, target, robot.neutral(), 1e-6, 1e-6, np.inf, max_sweeps=2, policy=())
-        _COMPILED.add("monitored")
-
-
-_COMPILED: set[str] = set()  # the paths compiled (or loaded) in this process, whatever the robot
 
 
 def attempt(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol_rot: float, deadline: float,
@@ -135,6 +119,7 @@ class _Context:
         self.later_chunk = float(clock_chunk(JOINT_SWEEPS_PER_LATER_LOOK, cm.n))
         self.mode = opts.label
         self.memory = kernel.new_memory(cm.n, opts.accel_m)  # reused: every attempt resets what it reads
+        self.packed = _frdm.Packed(cm.chain, self.problem, self.settings, self.memory)
         self.seed: int | None = None
         self.seed_value = np.zeros(1, dtype=np.uint64)  # the generator state of ``self.seed``
 
@@ -157,16 +142,8 @@ class _Context:
         q = restarts.first_start(q0, cm.kind, cm.lower, cm.upper, rng_state)
         best_q = q.copy()
         stats = np.zeros(kernel.STATS_SIZE)
-        code = _MULTISTART(q, cm.chain, self.problem, self.settings, self.order, self.cap, rng_state, attempts,
-                           self.chunk, best_q, stats, self.memory)
-        attempts -= int(stats[kernel.T_ATTEMPTS])
-        if code != kernel.CONVERGED and attempts > 0 and time.perf_counter() <= deadline:
-            def chunk(attempts_left: int) -> int:
-                return _MULTISTART(q, cm.chain, self.problem, self.settings, self.order, self.cap, rng_state,
-                                   attempts_left, float(stats[kernel.T_SWEEPS] + self.later_chunk), best_q, stats,
-                                   self.memory)
-
-            code = restarts.run_in_chunks(chunk, attempts, stats, deadline, kernel.CONVERGED)
+        code = self.packed.solve(q, self.order, self.cap, rng_state, attempts, self.chunk, self.later_chunk, deadline,
+                                 best_q, stats)
         return code, best_q, stats
 
     def attempt(self, code: int, q: np.ndarray, stats: np.ndarray, deadline: float) -> Attempt:

@@ -1,7 +1,7 @@
 """Tracking: follow a Cartesian path in small steps, each FRDM solve warm-started from the last answer.
 
 This is FRDM's direct-control use (Danilov 2019): no restarts, so every jump or stall is visible. With
-no bypass named, the whole path runs in the compiled follower (:mod:`kinelab.ik.frdm.path_kernel`),
+no bypass named, the whole path runs in the compiled follower (:mod:`kinelab.core._follow`),
 which on an arm with more joints than the task constrains prefers, among the answers, the one nearest
 the previous sample (a rest term, then plain FRDM to the tolerance). With a bypass, a policy or a
 restriction named, the monitored loop below runs instead. Two monitors watch each of its samples:
@@ -92,7 +92,7 @@ def run_track(robot: Robot, targets: Any, q0: np.ndarray, req: Request, settings
     _check_restrict(settings.restrict, opts.intervals, opts.freeze)
     if _followable(opts) and not settings.restrict:
         return follow(robot, targets, q0, req.tol_pos, req.tol_rot, opts.sweep_cap, settings.rest_weight, opts,
-                      req.task, req.seed)
+                      req.task, req.seed, req.time_budget)
     policy = opts.policy or ()
     attempt_opts = replace(opts, policy=tuple(s for s in policy if s not in RESTRICTIONS))
     path = _Path(robot, req, attempt_opts, settings, [s for s in policy if s in RESTRICTIONS])

@@ -1,0 +1,93 @@
+# The FRDM kernel's C interface, shared by the compiled modules that run it (the batch, the path follower).
+
+cdef enum:
+    PRISMATIC = 1
+    CONTINUOUS = 2
+    TIP_TO_BASE = 0
+    BASE_TO_TIP = 1
+    ALTERNATE = 2
+    MIXED = 3
+    CONVERGED = 0
+    STALL_STEP = 1
+    STALL_WINDOW = 2
+    BUDGET = 3
+    NOT_STARTED = -2
+    STOPPED = -3
+
+cdef struct Chain:
+    int n
+    const double* PR       # (n, 3, 3) joint frames in their parents' at q = 0
+    const double* Pt       # (n, 3) [m]
+    const double* axis     # (n, 3) unit axes in the joint frames
+    const long long* kind  # (n,) REVOLUTE 0, PRISMATIC, CONTINUOUS
+    const double* TR       # (3, 3) tool frame in the last joint's
+    const double* Tt       # (3,) [m]
+
+cdef struct Objective:
+    const double* lower    # (n,) windows [rad or m]
+    const double* upper
+    const unsigned char* free  # (n,) 0: the joint is frozen
+    const double* pstar    # (3,) target point [m]
+    const double* Rstar    # (3, 3) target rotation
+    double w_p
+    const double* w_ax     # (3,)
+    double tol_pos
+    double tol_rot
+    int check_pos
+    int check_rot
+    const double* q_rest   # (n,)
+    double w_rest
+    int rot_axis
+
+cdef struct Settings:
+    double relax
+    double eps_q
+    int window
+    double window_rel
+    int accel_m
+    int polish
+    double finish_below
+    int finish_steps
+
+cdef struct Memory:
+    double* X              # (accel_m + 1, n)
+    double* G              # (accel_m + 1, n)
+    double* state          # (STATE_SIZE,)
+    double* trace          # (trace_len,)
+    int trace_len
+    double* held           # (2n + 4, 3)
+
+cdef void chain_fk(const Chain* ch, const double* q, double* e, double* o, double* p, double* R) noexcept nogil
+cdef double rotation_angle(const double* R, const double* Rstar) noexcept nogil
+cdef int within(const double* p, const double* R, const Objective* pb) noexcept nogil
+cdef double total_objective(const double* q, const Chain* ch, const double* p, const double* R,
+                            const Objective* pb) noexcept nogil
+cdef int run(double* q, const Chain* ch, const Objective* pb, const Settings* st, int order, int max_sweeps,
+             Memory* mem, int* sweeps) noexcept nogil
+cdef int lm_polish(double* q, const Chain* ch, const Objective* pb, int iterations, double max_step,
+                   int* spent) noexcept nogil
+cdef int multistart(double* q, const Chain* ch, const Objective* pb, const Settings* st, int order, int max_sweeps,
+                    unsigned long long* rng_state, int max_attempts, double sweep_budget, double* best_q,
+                    double* stats, Memory* mem) noexcept nogil
+cdef void random_configuration(double* q, const long long* kind, const double* lower, const double* upper, int n,
+                               unsigned long long* rng_state) noexcept nogil
+cdef double now() noexcept nogil
+cdef void rotm(double x, double y, double z, double angle, double* m) noexcept nogil
+cdef double uniform(unsigned long long* state) noexcept nogil
+cdef void world_error(const double* p, const double* R, const Objective* pb, double* err) noexcept nogil
+cdef void world_jacobian(const double* e, const double* o, const double* p, const double* R, const Chain* ch,
+                         const Objective* pb, double* J) noexcept nogil
+
+
+cdef class Packed:
+    cdef Chain ch
+    cdef Objective pb
+    cdef Settings st
+    cdef Memory mem
+    cdef list keep
+    cdef readonly int n
+    cdef void _objective(self, pb) except *
+    cdef void _settings(self, st) except *
+    cdef void _memory(self, mem) except *
+    cdef object _written(self, object array, Py_ssize_t size, str name)
+    cdef void _check(self, double[::1] q, str name) except *

@@ -1,0 +1,110 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""The checks a solve makes on its target and on its answer, compiled: arithmetic on Pinocchio's numbers.
+
+Pinocchio computes the tool pose; these functions only compare matrices (a solve in a loop would spend more on a
+dozen Python float operations than on the FK itself). Matrices are 4 × 4 homogeneous ones, in any memory order.
+"""
+
+from libc.math cimport atan2, fabs, isfinite, sqrt
+
+from kinelab.core._frdm cimport rotation_angle
+
+cdef enum:
+    C_NOT_FINITE = 1
+    C_NOT_A_ROTATION = 2
+    C_OK = 0
+    C_NOT_USUAL = 1
+
+NOT_FINITE, NOT_A_ROTATION = C_NOT_FINITE, C_NOT_A_ROTATION
+OK, NOT_USUAL = C_OK, C_NOT_USUAL
+
+
+cdef int _defect(const double[:, :] H) noexcept nogil:
+    cdef double total = 0.0, gram = 0.0, d, det
+    cdef int i, j, a, b
+    for i in range(3):
+        for j in range(4):
+            total += H[i, j]
+    if not isfinite(total):  # NaN and ±inf poison the sum; so does an overflow of huge finite entries
+        for i in range(3):
+            for j in range(4):
+                if not isfinite(H[i, j]):
+                    return C_NOT_FINITE
+    for a in range(3):
+        for b in range(a, 3):
+            d = H[0, a] * H[0, b] + H[1, a] * H[1, b] + H[2, a] * H[2, b] - (1.0 if a == b else 0.0)
+            gram = gram if gram >= fabs(d) else fabs(d)
+    det = (H[0, 0] * (H[1, 1] * H[2, 2] - H[1, 2] * H[2, 1]) - H[0, 1] * (H[1, 0] * H[2, 2] - H[1, 2] * H[2, 0])
+           + H[0, 2] * (H[1, 0] * H[2, 1] - H[1, 1] * H[2, 0]))
+    return C_NOT_A_ROTATION if gram > 1e-6 or det < 0.0 else 0
+
+
+def pose_defect(const double[:, :] H) -> int:
+    """0 when the 4 × 4 homogeneous matrix H has finite entries and a rotation block (RᵀR = I to 1e-6, det R > 0);
+    else NOT_FINITE or NOT_A_ROTATION."""
+    if H.shape[0] != 4 or H.shape[1] != 4:
+        raise ValueError("pose_defect: a 4 × 4 matrix expected")
+    return _defect(H)
+
+
+cdef inline void _rotation(const double[:, :] H, double* R) noexcept nogil:
+    cdef int i, j
+    for i in range(3):
+        for j in range(3):
+            R[3 * i + j] = H[i, j]
+
+
+def pose_verdict(const double[:, :] H_target, const double[:, :] H_tool, const double[::1] q,
+                 const double[::1] lower, const double[::1] upper, int axis) -> tuple:
+    """(position error [m], rotation error [rad], q within [lower, upper]) for the homogeneous matrices of the
+    target and of the tool (from Pinocchio's FK). The rotation error is the angle of R*ᵀR, or with ``axis`` = 0, 1,
+    2 the angle between the tool's and the target's x, y or z axes (task "axis"; −1 for the whole rotation)."""
+    if H_target.shape[0] != 4 or H_target.shape[1] != 4 or H_tool.shape[0] != 4 or H_tool.shape[1] != 4 \
+            or lower.shape[0] < q.shape[0] or upper.shape[0] < q.shape[0] or axis > 2:
+        raise ValueError("pose_verdict: two 4 × 4 matrices, limits for every joint and an axis −1 … 2 expected")
+    cdef double d0 = H_target[0, 3] - H_tool[0, 3], d1 = H_target[1, 3] - H_tool[1, 3]
+    cdef double d2 = H_target[2, 3] - H_tool[2, 3], angle, u0, u1, u2, v0, v1, v2, c0, c1, c2
+    cdef double R[9]
+    cdef double S[9]
+    cdef int i
+    cdef bint inside = True
+    if axis < 0:
+        _rotation(H_tool, R)
+        _rotation(H_target, S)
+        angle = rotation_angle(R, S)
+    else:
+        u0, u1, u2 = H_tool[0, axis], H_tool[1, axis], H_tool[2, axis]
+        v0, v1, v2 = H_target[0, axis], H_target[1, axis], H_target[2, axis]
+        c0, c1, c2 = u1 * v2 - u2 * v1, u2 * v0 - u0 * v2, u0 * v1 - u1 * v0
+        angle = atan2(sqrt(c0 * c0 + c1 * c1 + c2 * c2), u0 * v0 + u1 * v1 + u2 * v2)
+    for i in range(q.shape[0]):
+        inside = inside and lower[i] <= q[i] <= upper[i]
+    return sqrt(d0 * d0 + d1 * d1 + d2 * d2), angle, inside
+
+
+def usual_inputs(const double[:, :] H, const double[::1] q0, int n, const double[::1] lower,
+                 const double[::1] upper, const double[::1] anchor, double radius, double[::1] pstar,
+                 double[:, ::1] Rstar) -> int:
+    """OK when H is a proper pose whose point lies within ``radius`` [m] of ``anchor`` and q0 is empty (no start)
+    or n finite values within [lower, upper]: then H's point and rotation are copied into pstar and Rstar (the
+    kernel's target). NOT_USUAL otherwise (the general path then names what is wrong)."""
+    if H.shape[0] != 4 or H.shape[1] != 4 or anchor.shape[0] != 3 or pstar.shape[0] != 3 or Rstar.shape[0] != 3 \
+            or Rstar.shape[1] != 3 or lower.shape[0] != n or upper.shape[0] != n:
+        raise ValueError("usual_inputs: inconsistent shapes")
+    cdef int i, j
+    if _defect(H) != 0:
+        return NOT_USUAL
+    cdef double a0 = H[0, 3] - anchor[0], a1 = H[1, 3] - anchor[1], a2 = H[2, 3] - anchor[2]
+    if not sqrt(a0 * a0 + a1 * a1 + a2 * a2) <= radius:
+        return NOT_USUAL
+    if q0.shape[0] != 0:
+        if q0.shape[0] != n:
+            return NOT_USUAL
+        for i in range(n):
+            if not lower[i] <= q0[i] <= upper[i]:  # also False for NaN; ±inf never lies within finite limits
+                return NOT_USUAL
+    for i in range(3):
+        pstar[i] = H[i, 3]
+        for j in range(3):
+            Rstar[i, j] = H[i, j]
+    return OK

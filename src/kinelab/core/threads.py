@@ -1,0 +1,43 @@
+"""How many threads kinelab's compiled batches use: every core this process may run on, unless the environment
+variable ``KINELAB_THREADS`` or :func:`set_count` says fewer (a cluster's worker runs one, its cluster giving the
+parallelism). Answers never depend on it: each row of a batch is solved alone."""
+
+from __future__ import annotations
+
+import os
+
+from kinelab.errors import OptionError
+
+_COUNT: list[int] = []
+
+
+def available() -> int:
+    """The cores this process may run on (its CPU affinity where the system tells it)."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def count() -> int:
+    """The threads a compiled batch runs on now (≥ 1)."""
+    if _COUNT:
+        return _COUNT[-1]
+    told = os.environ.get("KINELAB_THREADS", "").strip()
+    if told.isdigit() and int(told) >= 1:
+        return min(int(told), available())
+    return available()
+
+
+def set_count(threads: int | None) -> None:
+    """Run compiled batches on ``threads`` threads from now on in this process (None: back to the default).
+
+    Raises:
+        OptionError: ``threads`` is not a positive integer.
+    """
+    if threads is None:
+        _COUNT.clear()
+        return
+    if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
+        raise OptionError("threads", threads, f"a positive integer (this machine has {available()} cores)")
+    _COUNT[:] = [threads]
