@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 import pytest
-from kinelab.core._follow import pose_between_of as pose_between
 
 import kinelab
+from kinelab.core._follow import pose_between_of as pose_between
 from kinelab.ik.workspace import out_of_reach
 from kinelab.report.bench.protocol import path_set
 from kinelab.studies import paper000_era as ep

@@ -16,7 +16,9 @@ import numpy as np
 import pinocchio as pin
 from tqdm import tqdm
 
+from kinelab.collision.model import CollisionError, Collisions, collision_model
 from kinelab.ik.api import solve, solve_all, solve_batch, track
+from kinelab.ik.prepared import IK
 from kinelab.ik.request import unmeetable_tolerances
 from kinelab.report.bench import peers
 from kinelab.report.bench.protocol import DEFAULT_ROBOTS, TOL_POS, TOL_ROT, cases, path_set
@@ -138,7 +140,8 @@ def budgets(robot: Robot, budget: float = 0.005, n: int = 200, seed: int = 0,
             solvers: tuple[str, ...] = ("frdm", "biquat", "dls")) -> list[dict[str, Any]]:
     """How well every path keeps ``time_budget`` [s]: n calls that cannot succeed (tolerances of 1e-300) from
     random starts, paths interleaved per problem; the wall time of each call, outside kinelab. The paths: each
-    solver's ``solve``, FRDM's ``solve_batch`` of 64 targets, ``solve_all`` and ``solve(prefer=)``."""
+    solver's ``solve``, the prepared ``IK.solve``, FRDM's ``solve_batch`` of 64 targets, ``solve_all``,
+    ``solve(prefer=)``, ``solve(collisions="self")`` (arms with collision geometry) and ``track`` of 50 samples."""
     problems = cases(robot, n, seed)
     paths = _budget_paths(robot, budget, solvers)
     times: dict[str, list[float]] = {name: [] for name in paths}
@@ -165,13 +168,36 @@ def _budget_paths(robot: Robot, budget: float, solvers: tuple[str, ...]) -> dict
                                              tol_pos=tol, tol_rot=tol, time_budget=budget)
 
     paths = {name: single(name) for name in solvers}
+    prepared: dict[float, IK] = {}
+
+    def ik_solve(case: Any, seed: int, tol: float) -> Any:
+        if tol not in prepared:  # built inside the call's tolerance context, once per tolerance
+            prepared[tol] = IK(robot, tol_pos=tol, tol_rot=tol, time_budget=budget)
+        return prepared[tol].solve(case.oMtarget, q0=case.q_start, seed=seed)
+
+    paths["frdm IK.solve"] = ik_solve
     paths["frdm batch of 64"] = lambda case, seed, tol: solve_batch(
         robot, [case.oMtarget] * 64, seed=seed, tol_pos=tol, tol_rot=tol, time_budget=budget)
     paths["frdm solve_all"] = lambda case, seed, tol: solve_all(robot, case.oMtarget, solver="frdm", seed=seed,
                                                                 tol_pos=tol, tol_rot=tol, time_budget=budget)
     paths["frdm prefer="] = lambda case, seed, tol: solve(robot, case.oMtarget, seed=seed, tol_pos=tol, tol_rot=tol,
                                                          time_budget=budget, prefer=case.q_start)
+    if _has_collision_geometry(robot):
+        paths["frdm collisions"] = lambda case, seed, tol: solve(
+            robot, case.oMtarget, q0=case.q_start, seed=seed, tol_pos=tol, tol_rot=tol, time_budget=budget,
+            collisions="self")
+    paths["frdm track of 50"] = lambda case, seed, tol: track(
+        robot, [case.oMtarget] * 50, q0=case.q_start, tol_pos=tol, tol_rot=tol, time_budget=budget)
     return paths
+
+
+def _has_collision_geometry(robot: Robot) -> bool:
+    """The robot's files give it collision geometry (the self-collision check can run)."""
+    try:
+        collision_model(robot, Collisions())
+    except CollisionError:
+        return False
+    return True
 
 
 def run(robots: list[str] | None, seed: int = 0, repeats: int = 3, n: int = 2000,
