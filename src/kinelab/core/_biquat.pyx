@@ -11,9 +11,8 @@ end. The linear algebra is BLAS and LAPACK's, called as NumPy calls them.
 
 from libc.math cimport ceil, cos, exp, fabs, isfinite, log, sin, sqrt, atan2, NAN, M_PI
 from libc.stdlib cimport free, malloc
-from scipy.linalg.cython_blas cimport ddot, dgemm, dgemv
-from scipy.linalg.cython_lapack cimport dgesdd, dgesv, dgetrf
 
+from kinelab.core._blas cimport ddot, dgemm, dgemv, dgesdd, dgesv, dgetrf, ready
 from kinelab.core._frdm cimport CONTINUOUS, PRISMATIC, Chain, Packed, chain_fk, random_configuration
 
 cdef enum:
@@ -376,6 +375,7 @@ def error_biquaternion_of(const double[::1] p, const double[:, :] R, const doubl
                           const double[:, :] Rstar):
     """M* = N̄∘Λ as an (8,) array: the tool's pose (p [m], R) in the target frame (p*, R*)."""
     import numpy as np
+    ready()
     cdef double Rc[9]
     cdef double Sc[9]
     cdef int i, j
@@ -408,6 +408,7 @@ def converged_of(const double[::1] M, double eps_rot, double eps_dual) -> bool:
 def joint_rates_of(const double[:, :] J, const double[::1] twist, double damping):
     """q̇ = A(q)⁻¹U from the local tool Jacobian J (6 × n) and the twist [v; ω] (see ``joint_rates``)."""
     import numpy as np
+    ready()
     cdef int n = J.shape[1], i, j
     if J.shape[0] != 6 or n < 1 or twist.shape[0] != 6:
         raise ValueError("joint_rates: J (6, n) and twist (6,) expected")

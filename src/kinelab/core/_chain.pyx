@@ -9,7 +9,9 @@ Pinocchio's ``forwardKinematics`` + ``updateFramePlacement`` on a serial model: 
 on each robot (:mod:`kinelab.robot.certificate`).
 """
 
-from libc.math cimport cos, sin
+from libc.math cimport atan2, cos, sin, sqrt
+
+from kinelab.core._frdm cimport rotation_angle
 
 cdef int PRISMATIC = 1
 
@@ -56,7 +58,8 @@ cdef inline void _turn(double[3][3] R, const double[::1] a, double angle) noexce
 
 cdef void _fk_row(const double[:, :, ::1] placement_R, const double[:, ::1] placement_t,
                   const double[:, ::1] axis, const long long[::1] kind, const double[:, ::1] tool_R,
-                  const double[::1] tool_t, const double[::1] q, double[:, ::1] out) noexcept nogil:
+                  const double[::1] tool_t, const double[::1] q, double* out) noexcept nogil:
+    """oMtool at q into out (4 × 4, row-major)."""
     cdef double R[3][3]
     cdef double t[3]
     cdef int i, j, n = q.shape[0]
@@ -74,10 +77,10 @@ cdef void _fk_row(const double[:, :, ::1] placement_R, const double[:, ::1] plac
     _compose(R, t, tool_R, tool_t)
     for i in range(3):
         for j in range(3):
-            out[i, j] = R[i][j]
-        out[i, 3] = t[i]
-        out[3, i] = 0.0
-    out[3, 3] = 1.0
+            out[4 * i + j] = R[i][j]
+        out[4 * i + 3] = t[i]
+        out[12 + i] = 0.0
+    out[15] = 1.0
 
 
 def fk_batch(const double[:, :, ::1] placement_R, const double[:, ::1] placement_t, const double[:, ::1] axis,
@@ -91,4 +94,62 @@ def fk_batch(const double[:, :, ::1] placement_R, const double[:, ::1] placement
     cdef Py_ssize_t b
     with nogil:
         for b in range(Q.shape[0]):
-            _fk_row(placement_R, placement_t, axis, kind, tool_R, tool_t, Q[b], out[b])
+            _fk_row(placement_R, placement_t, axis, kind, tool_R, tool_t, Q[b], &out[b, 0, 0])
+
+
+cdef class Judge:
+    """The verdict on one answer by the compiled chain FK (the judge a robot's certificate names): the arrays as
+    :func:`fk_batch` takes them, held once.
+
+    Args:
+        placement_R, placement_t, axis, kind, tool_R, tool_t: the chain (see :func:`fk_batch`).
+    """
+
+    cdef const double[:, :, ::1] placement_R
+    cdef const double[:, ::1] placement_t
+    cdef const double[:, ::1] axis
+    cdef const long long[::1] kind
+    cdef const double[:, ::1] tool_R
+    cdef const double[::1] tool_t
+
+    def __init__(self, const double[:, :, ::1] placement_R, const double[:, ::1] placement_t,
+                 const double[:, ::1] axis, const long long[::1] kind, const double[:, ::1] tool_R,
+                 const double[::1] tool_t):
+        cdef Py_ssize_t n = kind.shape[0]
+        if placement_R.shape[0] != n or placement_t.shape[0] != n or axis.shape[0] != n or tool_R.shape[0] != 3 \
+                or tool_R.shape[1] != 3 or tool_t.shape[0] != 3:
+            raise ValueError("Judge: a chain of n joints (placements, axes, kinds) and a tool placement")
+        self.placement_R, self.placement_t, self.axis, self.kind = placement_R, placement_t, axis, kind
+        self.tool_R, self.tool_t = tool_R, tool_t
+
+    def verdict(self, const double[:, :] H_target, const double[::1] q, const double[::1] lower,
+                const double[::1] upper, int rot_axis) -> tuple:
+        """(position error [m], rotation error [rad], q within [lower, upper]) of the answer q against the target
+        (4 × 4, base frame): the angle of R*ᵀR, or with ``rot_axis`` = 0, 1, 2 the angle between that tool axis
+        and the target's (task "axis"; −1 for the whole rotation)."""
+        cdef Py_ssize_t n = self.kind.shape[0], i
+        if q.shape[0] != n or lower.shape[0] != n or upper.shape[0] != n or H_target.shape[0] != 4 \
+                or H_target.shape[1] != 4 or rot_axis > 2:
+            raise ValueError("verdict: a 4 × 4 target, q and limits of one value per joint, an axis −1 … 2")
+        cdef double T[16]
+        cdef double R[9]
+        cdef double S[9]
+        cdef double d0, d1, d2, angle, c0, c1, c2
+        cdef int a, b, k = rot_axis
+        cdef bint inside = True
+        _fk_row(self.placement_R, self.placement_t, self.axis, self.kind, self.tool_R, self.tool_t, q, T)
+        d0, d1, d2 = H_target[0, 3] - T[3], H_target[1, 3] - T[7], H_target[2, 3] - T[11]
+        if k < 0:
+            for a in range(3):
+                for b in range(3):
+                    R[3 * a + b], S[3 * a + b] = T[4 * a + b], H_target[a, b]
+            angle = rotation_angle(R, S)
+        else:
+            c0 = T[4 + k] * H_target[2, k] - T[8 + k] * H_target[1, k]
+            c1 = T[8 + k] * H_target[0, k] - T[k] * H_target[2, k]
+            c2 = T[k] * H_target[1, k] - T[4 + k] * H_target[0, k]
+            angle = atan2(sqrt(c0 * c0 + c1 * c1 + c2 * c2),
+                          T[k] * H_target[0, k] + T[4 + k] * H_target[1, k] + T[8 + k] * H_target[2, k])
+        for i in range(n):
+            inside = inside and lower[i] <= q[i] <= upper[i]
+        return sqrt(d0 * d0 + d1 * d1 + d2 * d2), angle, inside

@@ -18,9 +18,8 @@ plain one: no recovery. The linear algebra is BLAS and LAPACK's, called as NumPy
 
 from libc.math cimport fabs, sqrt, INFINITY, NAN
 from libc.stdlib cimport calloc, free, malloc
-from scipy.linalg.cython_blas cimport ddot, dgemm, dgemv
-from scipy.linalg.cython_lapack cimport dgesv
 
+from kinelab.core._blas cimport ddot, dgemm, dgemv, dgesv, ready
 from kinelab.core._frdm cimport (
     CONVERGED, NOT_STARTED, Chain, Memory, Objective, Packed, Settings, chain_fk, lm_polish, now, rotation_angle,
     rotm, run, uniform, within, world_error, world_jacobian,
@@ -31,6 +30,8 @@ from kinelab.core._frdm cimport (
 cdef double TRUST_FLOOR = 0.02
 cdef double TRUST_FACTOR = 2.0
 cdef int STATE_SIZE = 11
+cdef int SWEEPS_PER_LOOK = 32  # a phase's sweeps between two looks at the clock
+cdef int BUDGET = 3  # run()'s code for a phase its sweep cap (or the clock) ended
 
 
 cdef struct Follow:
@@ -43,6 +44,7 @@ cdef struct Follow:
     const double* centre
     double pull
     int lm_iterations
+    double deadline  # [s] on time.perf_counter()'s clock (inf: none)
 
 
 cdef struct Scratch:
@@ -187,6 +189,29 @@ cdef void pose_between(const double* p0, const double* R0, const double* p1, con
             R_out[3 * r + c] = R0[3 * r] * m[c] + R0[3 * r + 1] * m[3 + c] + R0[3 * r + 2] * m[6 + c]
 
 
+cdef inline bint _late(const Follow* fw) noexcept nogil:
+    return fw.deadline < INFINITY and now() > fw.deadline
+
+
+cdef int _phase(double* q, const Chain* ch, const Objective* pb, const Follow* fw, int max_sweeps, Memory* mem,
+                int* spent) noexcept nogil:
+    """One FRDM phase of up to ``max_sweeps`` sweeps from q, the clock looked at every SWEEPS_PER_LOOK sweeps
+    (a cut run resumes where it stopped, so the answer is the one long run's unless the deadline ends it)."""
+    cdef int code = BUDGET, more = 0, left = max_sweeps, chunk
+    cdef int i
+    for i in range(STATE_SIZE):
+        mem.state[i] = 0.0
+    spent[0] = 0
+    while left > 0:
+        chunk = left if fw.deadline == INFINITY or left < SWEEPS_PER_LOOK else SWEEPS_PER_LOOK
+        code = run(q, ch, pb, fw.st, fw.order, chunk, mem, &more)
+        spent[0] += more
+        left -= more
+        if code != BUDGET or _late(fw):
+            break
+    return code
+
+
 cdef int _sample(double* q, const Chain* ch, const Objective* pb, const Follow* fw, double trust,
                  const double* pstar, const double* Rstar, double* rest, double* q_prev, Memory* mem,
                  int* spent) noexcept nogil:
@@ -202,20 +227,16 @@ cdef int _sample(double* q, const Chain* ch, const Objective* pb, const Follow* 
         if code == CONVERGED:
             return code
         _copy(q, q_prev, n)
-    if fw.w_rest > 0.0:
+    if fw.w_rest > 0.0 and not _late(fw):
         for i in range(n):
             rest[i] = q_prev[i] + _limit_pull(q_prev[i], pb.lower[i], pb.upper[i], fw.pull) * (fw.centre[i] - q_prev[i])
         rested = _aimed(pb, pstar, Rstar, rest, fw.w_rest)
-        for i in range(STATE_SIZE):
-            mem.state[i] = 0.0
-        code = run(q, ch, &rested, fw.st, fw.order, fw.rest_sweeps, mem, &more)
+        code = _phase(q, ch, &rested, fw, fw.rest_sweeps, mem, &more)
         spent[0] += more
-    if code != CONVERGED:
-        for i in range(STATE_SIZE):
-            mem.state[i] = 0.0
-        code = run(q, ch, &plain, fw.st, fw.order, fw.max_sweeps, mem, &more)
+    if code != CONVERGED and not _late(fw):
+        code = _phase(q, ch, &plain, fw, fw.max_sweeps, mem, &more)
         spent[0] += more
-    if code != CONVERGED and fw.lm_iterations > 0:
+    if code != CONVERGED and fw.lm_iterations > 0 and not _late(fw):
         code = lm_polish(q, ch, &plain, fw.lm_iterations, INFINITY, &more)
         spent[0] += more
     return code
@@ -254,6 +275,8 @@ cdef int _recover(double* q, const double* q_good, const double* p_good, const d
         _copy(q, q_good, n)
         code = CONVERGED
         for j in range(1, cuts + 1):
+            if _late(fw):
+                return code if code != CONVERGED else -1
             pose_between(p_good, R_good, pstar, Rstar, <double> j / <double> cuts, p_mid, R_mid)
             code = _sample(q, ch, pb, fw, trust, p_mid, R_mid, rest, q_prev, mem, &more)
             spent[0] += more
@@ -265,6 +288,8 @@ cdef int _recover(double* q, const double* q_good, const double* p_good, const d
     for r in range(3):
         radius = radii[r]
         for k in range(4):
+            if _late(fw):
+                return code
             for i in range(n):
                 lo, hi = _max(pb.lower[i], q_good[i] - radius), _min(pb.upper[i], q_good[i] + radius)
                 q[i] = lo + (hi - lo) * uniform(rng_state)
@@ -289,7 +314,7 @@ cdef int _tracked(double* q, const double* q_good, const double* p_good, const d
     _copy(q, q_good, n)
     code = _sample(q, ch, pb, fw, trust, pstar, Rstar, rest, q_prev, mem, &more)
     spent[0] += more
-    if code == CONVERGED:
+    if code == CONVERGED or _late(fw):
         return code
     _copy(first, q, n)
     code = _recover(q, q_good, p_good, R_good, ch, pb, fw, trust, pstar, Rstar, rest, q_prev, mem, rng_state, &more)
@@ -300,10 +325,11 @@ cdef int _tracked(double* q, const double* q_good, const double* p_good, const d
 
 
 cdef void _follow(double* Q, int count, const double* q0, const Chain* ch, const Objective* pb, const Follow* fw,
-                  const double* pstars, const double* Rstars, unsigned long long* rng_state, double deadline,
-                  long long* codes, long long* sweeps, double* work) noexcept nogil:
+                  const double* pstars, const double* Rstars, unsigned long long* rng_state, long long* codes,
+                  long long* sweeps, double* work) noexcept nogil:
     """Every sample k from the last reached configuration (q0 before the first), the clock looked at before each:
-    once it has passed ``deadline`` the samples left are not started (NaN rows, code NOT_STARTED). ``work``: 12n +
+    once it has passed ``fw.deadline`` the samples left are not started (NaN rows, code NOT_STARTED), and the sample
+    under way stops at its next look (between phases, every SWEEPS_PER_LOOK sweeps, between recovery steps). ``work``: 12n +
     12 + 2(accel_m + 1)n + STATE_SIZE + 3(2n + 4) values."""
     cdef int n = ch.n, k, i, code, spent = 0, rows = fw.st.accel_m + 1
     cdef int recover = fw.st.finish_below > 0.0
@@ -331,7 +357,7 @@ cdef void _follow(double* Q, int count, const double* q0, const Chain* ch, const
     for i in range(n):
         velocity[i] = 0.0
     for k in range(count):
-        if now() > deadline:
+        if _late(fw):
             for i in range(n):
                 Q[n * k + i] = NAN
             codes[k], sweeps[k] = NOT_STARTED, 0
@@ -388,13 +414,13 @@ def follow(double[:, ::1] Q, const double[::1] q0, chain, objective, const doubl
     if count == 0 or n == 0:
         return
     fw.st, fw.order, fw.max_sweeps, fw.w_rest, fw.rest_sweeps = &packed.st, order, max_sweeps, w_rest, rest_sweeps
-    fw.centre, fw.pull, fw.lm_iterations = &centre[0], pull, lm_iterations
+    fw.centre, fw.pull, fw.lm_iterations, fw.deadline = &centre[0], pull, lm_iterations, deadline
     cdef double* work = <double*> calloc(12 * n + 12 + 2 * rows * n + STATE_SIZE + 3 * (2 * n + 4), sizeof(double))
     if work == NULL:
         raise MemoryError("the path follower's work arrays")
     with nogil:
         _follow(&Q[0, 0], count, &q0[0], &packed.ch, &packed.pb, &fw, &pstars[0, 0], &Rstars[0, 0, 0],
-                &rng_state[0], deadline, &codes[0], &sweeps[0], work)
+                &rng_state[0], &codes[0], &sweeps[0], work)
     free(work)
 
 
@@ -405,6 +431,7 @@ def pose_between_of(const double[::1] p0, const double[:, :] R0, const double[::
     cdef double A[9]
     cdef double B[9]
     cdef int i, j
+    ready()
     if p0.shape[0] != 3 or p1.shape[0] != 3 or p_out.shape[0] != 3 or R0.shape[0] != 3 or R0.shape[1] != 3 \
             or R1.shape[0] != 3 or R1.shape[1] != 3 or R_out.shape[0] != 3 or R_out.shape[1] != 3:
         raise ValueError("pose_between: 3-vectors and 3 × 3 rotations expected")

@@ -68,7 +68,7 @@ cdef int lm_polish(double* q, const Chain* ch, const Objective* pb, int iteratio
                    int* spent) noexcept nogil
 cdef int multistart(double* q, const Chain* ch, const Objective* pb, const Settings* st, int order, int max_sweeps,
                     unsigned long long* rng_state, int max_attempts, double sweep_budget, double* best_q,
-                    double* stats, Memory* mem) noexcept nogil
+                    double* stats, Memory* mem, double deadline) noexcept nogil
 cdef void random_configuration(double* q, const long long* kind, const double* lower, const double* upper, int n,
                                unsigned long long* rng_state) noexcept nogil
 cdef double now() noexcept nogil

@@ -18,8 +18,8 @@ from libc.math cimport acos, atan2, cos, fabs, isfinite, sin, sqrt, INFINITY, M_
 from libc.stdlib cimport free, malloc
 from posix.time cimport clock_gettime, timespec, CLOCK_MONOTONIC
 from cython.parallel cimport prange
-from scipy.linalg.cython_blas cimport ddot, dgemm, dgemv
-from scipy.linalg.cython_lapack cimport dgesv
+
+from kinelab.core._blas cimport ddot, dgemm, dgemv, dgesv, ready
 
 import numpy as np
 
@@ -827,9 +827,10 @@ cdef int _polished(double* q, const Chain* ch, const Objective* pb, int iteratio
 
 cdef int multistart(double* q, const Chain* ch, const Objective* pb, const Settings* st, int order, int max_sweeps,
                     unsigned long long* rng_state, int max_attempts, double sweep_budget, double* best_q,
-                    double* stats, Memory* mem) noexcept nogil:
-    """Attempts from q, then from seeded uniform starts, until one converges, ``max_attempts`` have run or
-    ``sweep_budget`` sweeps (a total) are spent; a stall ends an attempt (a restart, not a bypass).
+                    double* stats, Memory* mem, double deadline) noexcept nogil:
+    """Attempts from q, then from seeded uniform starts, until one converges, ``max_attempts`` have run,
+    ``sweep_budget`` sweeps (a total) are spent or, after an attempt, the clock has passed ``deadline`` [s] (inf:
+    never looked at); a stall ends an attempt (a restart, not a bypass).
 
     Called in chunks: an attempt the sweep budget cuts is resumed by the next call where it stopped (stats[T_CUT]
     = 1 meanwhile), so the answer does not depend on where the chunks end. On return q holds the converged
@@ -875,7 +876,7 @@ cdef int multistart(double* q, const Chain* ch, const Objective* pb, const Setti
             if st.polish > 0 and _polished(q, ch, pb, st.polish, stats, mem):
                 _copy(best_q, q, n)
                 return CONVERGED
-        if stats[T_SWEEPS] >= sweep_budget:
+        if stats[T_SWEEPS] >= sweep_budget or (deadline < INFINITY and now() > deadline):
             stats[T_BEST_E] = best
             return BUDGET
     stats[T_BEST_E] = best
@@ -910,6 +911,7 @@ cdef class Packed:
     target written into the problem's ``pstar`` and ``Rstar`` in place is the next call's target."""
 
     def __init__(self, chain, objective, settings, memory=None):
+        ready()  # the kernels' BLAS and LAPACK, loaded by the first solve of the process
         cdef int n = len(chain.kind)
         cdef list keep = []
         self.keep, self.n = keep, n
@@ -996,7 +998,7 @@ cdef class Packed:
         cdef int code
         with nogil:
             code = multistart(&q[0], &self.ch, &self.pb, &self.st, order, max_sweeps, &rng_state[0], max_attempts,
-                              sweep_budget, &best_q[0], &stats[0], &self.mem)
+                              sweep_budget, &best_q[0], &stats[0], &self.mem, INFINITY)
         return code
 
     def solve(self, double[::1] q, int order, int max_sweeps, unsigned long long[::1] rng_state, int attempts,
@@ -1039,7 +1041,7 @@ cdef int _timed(double* q, const Chain* ch, const Objective* pb, const Settings*
             return code
         before = stats[T_ATTEMPTS]
         code = multistart(q, ch, pb, st, order, max_sweeps, rng_state, attempts, stats[T_SWEEPS] + chunk, best_q,
-                          stats, mem)
+                          stats, mem, deadline)
         chunk = later_chunk
         attempts -= <int> (stats[T_ATTEMPTS] - before)
         if code == CONVERGED or code < 0:

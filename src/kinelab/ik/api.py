@@ -328,6 +328,7 @@ def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
         OptionError: a bad option, a solver other than "frdm", a restriction named without its table.
         ConfigurationError, JointLimitError, TargetError: a bad q0 or target, named.
     """
+    t_start = time.perf_counter()  # the budget counts from the call, checks included
     check_entry(robot, "track", positional)
     if solver_module(solver) is not solver_module("frdm"):
         raise OptionError("solver", solver, "'frdm' (track follows a path with FRDM's warm-started sweeps)")
@@ -339,7 +340,7 @@ def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
     if q0 is None:
         q0 = _first_answer(robot, pin.SE3(rotations[0], points[0]), req, check)
     path = run_track(robot, stack_homogeneous(points, rotations), robot.check_q(q0, limits=True, what="q0"), req,
-                     settings)
+                     settings, t_start)
     return path if check is None else clear_track(path, check)
 
 

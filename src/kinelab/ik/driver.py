@@ -21,7 +21,6 @@ from kinelab.ik.request import Request
 from kinelab.ik.result import Attempt, BypassRecord, IKResult, SingularEvent, Status
 from kinelab.ik.targets import as_target
 from kinelab.ik.tasks import COMPONENTS, POSE, Task
-from kinelab.ik.verdict import pose_verdict
 from kinelab.ik.workspace import out_of_reach
 from kinelab.robot import Robot
 
@@ -111,13 +110,12 @@ class Call:
     finals: list[tuple[Status, float]] = field(default_factory=list)
 
     def judge(self, q: np.ndarray) -> tuple[bool, float, float]:
-        """Pinocchio's verdict on q: (success, position error [m], rotation error [rad]) on the task's
+        """The judge's verdict on q (Pinocchio's FK, or the compiled FK certified equal to it on this robot):
+        (success, position error [m], rotation error [rad]) on the task's
         components (the rotation error of task "axis" is the angle between the tool axes)."""
         if not (q.dtype == np.float64 and q.ndim == 1 and q.flags.c_contiguous):
             q = np.ascontiguousarray(q, dtype=float)
-        lower, upper = self.robot.check_bounds
-        dp, dr, within = pose_verdict(self.target.homogeneous, self.robot.tool_pose_of_float_q(q).homogeneous, q,
-                                  lower, upper, self.task.axis)
+        dp, dr, within = self.robot.verdict(self.target.homogeneous, q, self.task.axis)
         task = self.task
         ok = within and (not task.position or dp <= self.tol_pos) and (not task.rotation or dr <= self.tol_rot)
         return ok, dp, dr
@@ -159,6 +157,7 @@ def _loop(module: Any, pb: Call, start: np.ndarray, max_restarts: int, opts: Any
         iterations=iterations, restarts=restarts, wall_time=time.perf_counter() - pb.t_start, solver=pb.solver,
         mode=att.mode or pb.solver, singular_events=events, bypasses=bypasses,
         message=_explained(pb, status, message), diagnostics=diag, task=pb.task_label,
+        judge=pb.robot.fk_certificate.judge,
     )
 
 
@@ -170,7 +169,7 @@ def _fast(module: Any, pb: Call, start: np.ndarray | None, max_restarts: int, op
 
 
 def compiled_result(pb: Call, att: Attempt, restarts: int, success: bool, dp: float, dr: float) -> IKResult:
-    """The result of a compiled multistart's attempt, given Pinocchio's verdict on it (success, errors)."""
+    """The result of a compiled multistart's attempt, given the judge's verdict on it (success, errors)."""
     status, message = att.status, ""
     if success:
         status = Status.CONVERGED
@@ -186,7 +185,7 @@ def compiled_result(pb: Call, att: Attempt, restarts: int, success: bool, dp: fl
         q=att.q, success=success, status=status, position_error=dp, rotation_error=dr, iterations=att.iterations,
         restarts=restarts, wall_time=time.perf_counter() - pb.t_start, solver=pb.solver, mode=att.mode,
         singular_events=att.events, message=_explained(pb, status, message), diagnostics=att.diagnostics,
-        task=pb.task_label,
+        task=pb.task_label, judge=pb.robot.fk_certificate.judge,
     )
 
 

@@ -3,11 +3,11 @@
 :class:`kinelab.IK` checks its settings once; per call only the target and the start change. For the usual
 call — a ``pin.SE3`` target, a float64 start of the right length (or none), an integer seed or none — one
 compiled function checks both (finite, a proper rotation, the start within the limits, the target within
-the reach bound), the compiled multistart solves, Pinocchio's FK of the answer is judged by the compiled
-verdict, and the result is built directly. Anything else (a point target, a list start, a start outside the
-limits, a target beyond reach) returns None and the caller takes the general driver, which names the
-problem, warns or answers UNREACHABLE exactly as :func:`kinelab.solve` does: the lean call changes the cost,
-never the answer.
+the reach bound), the compiled multistart solves, the robot's judge (its certified compiled FK, or Pinocchio's)
+gives its verdict on the answer, and the result is built directly. Anything else (a point target, a list
+start, a start outside the limits, a target beyond reach) returns None and the caller takes the general driver,
+which names the problem, warns or answers UNREACHABLE exactly as :func:`kinelab.solve` does: the lean call
+changes the cost, never the answer.
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm import solver as frdm
 from kinelab.ik.request import Request
 from kinelab.ik.result import IKResult, Status
-from kinelab.ik.verdict import pose_verdict, usual_inputs
+from kinelab.ik.verdict import usual_inputs
 from kinelab.ik.workspace import reach_bound
 from kinelab.robot import Robot
 
@@ -53,6 +53,7 @@ class LeanFRDM:
         self.axis, self.n = req.task.axis, robot.n
         self.check_pos, self.check_rot = req.task.position, req.task.rotation
         self.tol_pos, self.tol_rot, self.task_label = req.tol_pos, req.tol_rot, req.task_label
+        self.judge = robot.fk_certificate.judge  # certified here, before any call's clock starts
 
     def solve(self, target: Any, q0: Any, seed: Any) -> IKResult | None:
         """The result for the usual call, or None for the general driver (see the module's docstring)."""
@@ -77,8 +78,7 @@ class LeanFRDM:
         code, q, stats = ctx.run_aimed(None if q0 is None else start, seed, self.attempts, deadline)
         if ctx.continuous:
             q = self.robot.wrap_continuous(q)
-        dp, dr, within = pose_verdict(H, self.robot.tool_pose_of_float_q(q).homogeneous, q, self.lower, self.upper,
-                                  self.axis)
+        dp, dr, within = self.robot.verdict(H, q, self.axis)
         ok = within and (not self.check_pos or dp <= self.tol_pos) and (not self.check_rot or dr <= self.tol_rot)
         if ok and code == kernel.CONVERGED:  # the usual outcome, built without the general path's bookkeeping
             return self._converged(q, stats, dp, dr, t_start)
@@ -89,7 +89,7 @@ class LeanFRDM:
         return compiled_result(call, att, max(0, int(stats[kernel.T_ATTEMPTS]) - 1), ok, dp, dr)
 
     def _converged(self, q: np.ndarray, stats: np.ndarray, dp: float, dr: float, t_start: float) -> IKResult:
-        """The result of a converged solve that Pinocchio confirmed (what the context's ``attempt`` and the
+        """The result of a converged solve that the judge confirmed (what the context's ``attempt`` and the
         driver would build, fewer steps)."""
         st = stats.tolist()
         sweeps, stalls = int(st[kernel.T_SWEEPS]), int(st[kernel.T_STALLS])
@@ -98,4 +98,4 @@ class LeanFRDM:
         return IKResult(q=q, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr,
                         iterations=sweeps, restarts=max(0, int(st[kernel.T_ATTEMPTS]) - 1),
                         wall_time=time.perf_counter() - t_start, solver="frdm", mode=self.ctx.mode,
-                        singular_events=events, diagnostics=diag, task=self.task_label)
+                        singular_events=events, diagnostics=diag, task=self.task_label, judge=self.judge)

@@ -205,9 +205,10 @@ NO_DIAGNOSTICS = Diagnostics()
 class IKResult:
     """The outcome of :func:`kinelab.solve`.
 
-    ``position_error`` [m] and ``rotation_error`` [rad] are measured by Pinocchio's FK of the returned
-    ``q`` against the target. ``success`` is true only when both are within tolerance and ``q`` is
-    within the joint limits. ``q`` is one number per joint (rad, m) in the robot's joint order.
+    ``position_error`` [m] and ``rotation_error`` [rad] are measured by the FK of the returned ``q`` that
+    ``judge`` names — Pinocchio's, or kinelab's compiled chain FK where the robot's certificate found it equal to
+    Pinocchio's (``robot.fk_certificate``) — against the target. ``success`` is true only when both are within
+    tolerance and ``q`` is within the joint limits. ``q`` is one number per joint (rad, m) in the robot's joint order.
     """
 
     q: np.ndarray
@@ -225,11 +226,13 @@ class IKResult:
     message: str = ""
     diagnostics: Diagnostics = NO_DIAGNOSTICS
     task: str = "pose"  # the components judged: pose, position, axis (with its axis) or orientation
+    judge: str = "Pinocchio FK"  # whose FK measured the errors: "Pinocchio FK" or "compiled FK (certified)"
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON form (the CLI's ``ik --json``; fields are only ever added)."""
         return {
             "task": self.task,
+            "judge": self.judge,
             "q": np.asarray(self.q).tolist(),
             "success": self.success,
             "status": self.status.value,

@@ -7,7 +7,7 @@ but no Python loader, so the ``robots/`` directory is found from the installed p
 from __future__ import annotations
 
 import functools
-import importlib.metadata
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -101,6 +101,12 @@ def bundled_urdf_dir() -> Path:
 @functools.cache
 def erd_share_dir() -> Path | None:
     """``.../share`` that holds ``example-robot-data/robots``, or None if the package is absent."""
+    for entry in sys.path:  # where its wheel puts it (cmeel's prefix): a few stat calls, not its file list
+        share = Path(entry or ".") / "cmeel.prefix" / "share"
+        if (share / "example-robot-data" / "robots").is_dir():
+            return share
+    import importlib.metadata  # elsewhere (another installer's layout): its file list says
+
     try:
         files = importlib.metadata.files("example-robot-data") or []
     except importlib.metadata.PackageNotFoundError:

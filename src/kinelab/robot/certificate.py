@@ -43,6 +43,12 @@ class ChainArrays:
                  np.ascontiguousarray(Q, dtype=float), out)
         return out
 
+    def judge(self) -> Any:
+        """The compiled verdict on one answer over these arrays (:class:`kinelab.core._chain.Judge`)."""
+        from kinelab.core._chain import Judge
+
+        return Judge(self.placement_R, self.placement_t, self.axis, self.kind, self.tool_R, self.tool_t)
+
 
 @dataclass(frozen=True)
 class FKCertificate:

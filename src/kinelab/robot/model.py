@@ -326,6 +326,20 @@ class Robot:
         (:mod:`kinelab.robot.certificate`). Computed on first use, kept with the robot."""
         return self.derived("fk certificate", certify)
 
+    def verdict(self, H_target: np.ndarray, q: np.ndarray, axis: int = -1) -> tuple[float, float, bool]:
+        """The judge's word on an answer: (position error [m], rotation error [rad], q within the limits) of q (n
+        finite floats, C-contiguous) against the target (4 × 4 homogeneous, base frame), by the FK
+        :attr:`fk_certificate` names. The rotation error is the angle of R*ᵀR, or with ``axis`` = 0, 1, 2 the angle
+        between that tool axis and the target's (task "axis")."""
+        judge = self.derived("compiled judge", _compiled_judge)
+        lower, upper = self.check_bounds
+        if judge is not None:
+            found: tuple[float, float, bool] = judge.verdict(H_target, q, lower, upper, axis)
+            return found
+        from kinelab.core._verdict import pose_verdict
+
+        return pose_verdict(H_target, self.tool_pose_of_float_q(q).homogeneous, q, lower, upper, axis)
+
     def _judge_arrays(self) -> ChainArrays | None:
         """The chain's arrays when the compiled FK is this robot's judge, else None."""
         return self.derived("judge arrays", _judge_arrays)
@@ -462,6 +476,11 @@ class Robot:
 def _judge_arrays(robot: Robot) -> ChainArrays | None:
     arrays = chain_arrays(robot) if robot.fk_certificate.certified else None
     return arrays if isinstance(arrays, ChainArrays) else None
+
+
+def _compiled_judge(robot: Robot) -> Any:
+    arrays = robot._judge_arrays()
+    return None if arrays is None else arrays.judge()
 
 
 def _generator(rng: object) -> np.random.Generator:

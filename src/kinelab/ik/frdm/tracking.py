@@ -72,7 +72,8 @@ def path_options(options: Any, solver_options: dict[str, Any]) -> dict[str, Any]
     return solver_options if options is not None else {**PATH_DEFAULTS, **solver_options}
 
 
-def run_track(robot: Robot, targets: Any, q0: np.ndarray, req: Request, settings: PathSettings) -> TrackResult:
+def run_track(robot: Robot, targets: Any, q0: np.ndarray, req: Request, settings: PathSettings,
+              t_start: float | None = None) -> TrackResult:
     """Solve each target in turn, warm-started from the previous answer, each sample judged by Pinocchio.
 
     Args:
@@ -81,6 +82,7 @@ def run_track(robot: Robot, targets: Any, q0: np.ndarray, req: Request, settings
         q0: the checked configuration at the start of the path [rad or m].
         req: the validated request (solver "frdm"; its options hold the bypass tables and the policy).
         settings: the path's own settings.
+        t_start: the ``time.perf_counter()`` value ``req.time_budget`` counts from (None: now).
 
     Returns:
         One row of q per sample, Pinocchio's errors on the task's components, statuses, the monitor log.
@@ -92,7 +94,7 @@ def run_track(robot: Robot, targets: Any, q0: np.ndarray, req: Request, settings
     _check_restrict(settings.restrict, opts.intervals, opts.freeze)
     if _followable(opts) and not settings.restrict:
         return follow(robot, targets, q0, req.tol_pos, req.tol_rot, opts.sweep_cap, settings.rest_weight, opts,
-                      req.task, req.seed, req.time_budget)
+                      req.task, req.seed, req.time_budget, t_start)
     policy = opts.policy or ()
     attempt_opts = replace(opts, policy=tuple(s for s in policy if s not in RESTRICTIONS))
     path = _Path(robot, req, attempt_opts, settings, [s for s in policy if s in RESTRICTIONS])
