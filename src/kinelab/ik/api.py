@@ -28,6 +28,7 @@ from kinelab.ik.branches import UNSEEN, find_all
 from kinelab.ik.clear import clear_batch, clear_track, mark_colliding, solve_clear
 from kinelab.ik.driver import solve_one
 from kinelab.ik.frdm.tracking import PathSettings, path_options, run_track
+from kinelab.ik.prepared import prepared
 from kinelab.ik.registry import solver_module
 from kinelab.ik.request import Request, check_robot, make_request
 from kinelab.ik.result import IKResult, TrackResult
@@ -114,6 +115,11 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
         SolverNotFoundError, OptionError, TargetError, ConfigurationError: bad input, named.
     """
     check_entry(robot, "solve", positional)
+    if prefer is None:  # the prepared solver's own route: solve is IK(robot, **settings).solve(target)
+        settings = dict(solver=solver, tol_pos=tol_pos, tol_rot=tol_rot, time_budget=time_budget,
+                        max_restarts=max_restarts, start_outside_limits=start_outside_limits, options=options,
+                        task=task, axis=axis, collisions=collisions, **solver_options)
+        return prepared(robot, settings).solve(target, q0=q0, seed=seed)
     if solver == "analytic":
         req = make_request("frdm", seed, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, None,
                            task, axis, None)
@@ -121,8 +127,6 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
     req = make_request(solver, seed, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options,
                        task, axis, solver_options)
     check = _collision_model(robot, collisions)
-    if prefer is None:
-        return _one_answer(robot, target, q0, req, check)
     if q0 is not None:
         raise OptionError("q0", "given", "None with prefer= (the branch search draws its own starts)")
     closed = solver == "frdm" and options is None and not solver_options

@@ -157,3 +157,33 @@ class IK:
                          max_solutions=max_solutions, stop_below=stop_below,
                          method="analytic" if self.analytic else "multistart")
         return found if self.collisions is None else mark_colliding(found, self.collisions, drop=False)
+
+
+PREPARED_PER_ROBOT = 16  # a caller sweeping settings: the prepared solvers kept stay bounded
+
+
+def prepared(robot: Robot, settings: dict[str, Any]) -> IK:
+    """The robot's prepared solver for these settings (``IK``'s keywords), built once and kept on the robot while
+    the same settings come back (a loop of :func:`kinelab.solve` calls); settings that cannot be a key (a dict of
+    kicks, say) get a new one each call. Either way the call takes the prepared solver's route.
+
+    Raises:
+        TypeError, SolverNotFoundError, OptionError: as ``IK``.
+    """
+    check_robot(robot)
+    try:
+        key = tuple(sorted(settings.items()))
+        hash(key)
+    except TypeError:
+        return IK(robot, **settings)
+    kept: dict[tuple[Any, ...], IK] = robot.derived("prepared solvers", _new_table)
+    ik = kept.get(key)
+    if ik is None:
+        if len(kept) >= PREPARED_PER_ROBOT:
+            kept.clear()
+        ik = kept[key] = IK(robot, **settings)
+    return ik
+
+
+def _new_table(_: Robot) -> dict[tuple[Any, ...], IK]:
+    return {}

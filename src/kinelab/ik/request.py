@@ -169,7 +169,7 @@ def check_seed(seed: Any, name: str = "seed") -> None:
         OptionError: naming the value and what is valid.
     """
     if not count_ok(seed):
-        raise OptionError(name, seed, "an integer ≥ 0")
+        raise OptionError(name, seed, "an integer ≥ 0" + (", or None for fresh entropy" if name == "seed" else ""))
 
 
 def count_ok(value: Any) -> bool:
