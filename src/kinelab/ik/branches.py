@@ -76,14 +76,8 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
     Raises:
         TargetError, ConfigurationError, OptionError: bad input, named.
     """
-    if method not in METHODS:
-        raise OptionError("method", method, " or ".join(map(repr, METHODS)))
+    _check_search(method, max_solutions, stop_below)
     target = as_target(target, req.task.name)
-    if max_solutions is not None and (not count_ok(max_solutions) or max_solutions < 1):
-        raise OptionError("max_solutions", max_solutions, "an integer ≥ 1, or None")
-    if stop_below is not None and not (isinstance(stop_below, float | int) and not isinstance(stop_below, bool)
-                                       and 0.0 < stop_below < 1.0):
-        raise OptionError("stop_below", stop_below, "a chance in (0, 1), or None to spend the whole budget")
     ref = None if q_ref is None else robot.check_q(q_ref, what="q_ref")
     if redundancy is not None:
         if method == "multistart":
@@ -92,6 +86,23 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
         return redundant_all(robot, target, req, check_redundancy(redundancy), ref, max_solutions)
     if method == "analytic" or (method == "auto" and has_closed_form(robot, req)):
         return analytic_all(robot, target, req, q_ref=ref, max_solutions=max_solutions)
+    return _multistart_all(robot, target, req, ref, max_solutions, stop_below)
+
+
+def _check_search(method: str, max_solutions: int | None, stop_below: float | None) -> None:
+    """Refuse a bad method, solution count or stopping chance, naming what is valid."""
+    if method not in METHODS:
+        raise OptionError("method", method, " or ".join(map(repr, METHODS)))
+    if max_solutions is not None and (not count_ok(max_solutions) or max_solutions < 1):
+        raise OptionError("max_solutions", max_solutions, "an integer ≥ 1, or None")
+    if stop_below is not None and not (isinstance(stop_below, float | int) and not isinstance(stop_below, bool)
+                                       and 0.0 < stop_below < 1.0):
+        raise OptionError("stop_below", stop_below, "a chance in (0, 1), or None to spend the whole budget")
+
+
+def _multistart_all(robot: Robot, target: Any, req: Request, ref: np.ndarray | None, max_solutions: int | None,
+                    stop_below: float | None) -> list[IKResult]:
+    """Every solution rounds of seeded starts find (see :func:`find_all`), nearest ``ref`` first when given."""
     t0 = time.perf_counter()
     found, rounds = _search(robot, target, req, max_solutions, stop_below, t0)
     elapsed = time.perf_counter() - t0

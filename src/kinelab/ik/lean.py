@@ -58,17 +58,8 @@ class LeanFRDM:
     def solve(self, target: Any, q0: Any, seed: Any) -> IKResult | None:
         """The result for the usual call, or None for the general driver (see the module's docstring)."""
         t_start = time.perf_counter()
-        if type(target) is not pin.SE3:
-            return None
-        if q0 is None:
-            start = self.none
-        elif type(q0) is np.ndarray and q0.dtype == np.float64 and q0.ndim == 1 and q0.flags.c_contiguous:
-            start = q0
-        else:
-            return None
-        if seed is None:
-            seed = int.from_bytes(os.urandom(8), "little")  # fresh entropy, as the general path draws
-        elif type(seed) is not int or not 0 <= seed < SEED_LIMIT:
+        start, seed = self._usual(target, q0, seed)
+        if start is None:
             return None
         H = target.homogeneous
         ctx = self.ctx
@@ -78,15 +69,36 @@ class LeanFRDM:
         code, q, stats = ctx.run_aimed(None if q0 is None else start, seed, self.attempts, deadline)
         if ctx.continuous:
             q = self.robot.wrap_continuous(q)
-        dp, dr, within = self.robot.verdict(H, q, self.axis)
-        ok = within and (not self.check_pos or dp <= self.tol_pos) and (not self.check_rot or dr <= self.tol_rot)
+        dp, dr, ok = self._judged(H, q)
         if ok and code == kernel.CONVERGED:  # the usual outcome, built without the general path's bookkeeping
             return self._converged(q, stats, dp, dr, t_start)
-        att = ctx.attempt(code, q, stats, deadline)
-        req = self.req
-        call = Call(self.robot, target, req.solver, req.tol_pos, req.tol_rot, t_start, deadline, seed, req.task,
-                    req.task_label)
-        return compiled_result(call, att, max(0, int(stats[kernel.T_ATTEMPTS]) - 1), ok, dp, dr)
+        call = Call(self.robot, target, self.req.solver, self.tol_pos, self.tol_rot, t_start, deadline, seed,
+                    self.req.task, self.task_label)
+        return compiled_result(call, ctx.attempt(code, q, stats, deadline), max(0, int(stats[kernel.T_ATTEMPTS]) - 1),
+                               ok, dp, dr)
+
+    def _judged(self, H: np.ndarray, q: np.ndarray) -> tuple[float, float, bool]:
+        """(position error [m], rotation error [rad], the task's components met within the limits)."""
+        dp, dr, within = self.robot.verdict(H, q, self.axis)
+        return dp, dr, within and (not self.check_pos or dp <= self.tol_pos) and \
+            (not self.check_rot or dr <= self.tol_rot)
+
+    def _usual(self, target: Any, q0: Any, seed: Any) -> tuple[np.ndarray | None, int]:
+        """(the kernel's start array, the seed) of a usual call — a ``pin.SE3`` target, a C-contiguous float64
+        start or none, an integer seed or none (fresh entropy, as the general path draws) — else (None, 0)."""
+        if type(target) is not pin.SE3:
+            return None, 0
+        if q0 is None:
+            start = self.none
+        elif type(q0) is np.ndarray and q0.dtype == np.float64 and q0.ndim == 1 and q0.flags.c_contiguous:
+            start = q0
+        else:
+            return None, 0
+        if seed is None:
+            return start, int.from_bytes(os.urandom(8), "little")
+        if type(seed) is not int or not 0 <= seed < SEED_LIMIT:
+            return None, 0
+        return start, seed
 
     def _converged(self, q: np.ndarray, stats: np.ndarray, dp: float, dr: float, t_start: float) -> IKResult:
         """The result of a converged solve that the judge confirmed (what the context's ``attempt`` and the

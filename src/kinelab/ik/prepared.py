@@ -70,17 +70,21 @@ class IK:
         self.request: Request = make_request("frdm" if self.analytic else solver, None, tol_pos, tol_rot,
                                              time_budget, max_restarts, start_outside_limits, options, task, axis,
                                              solver_options)
-        if self.analytic:
-            arm_of(robot, self.request)  # a chain without a closed form is refused here, by name
-        else:
-            prepare = getattr(self.request.module, "prepare", None)
-            if prepare is not None:
-                prepare(robot, self.request.options)  # the solver's model now, not in the first call
-        req = self.request
-        self._lean = LeanFRDM(robot, req) if not self.analytic and req.solver == "frdm" and req.options.compiled \
-            else None
+        self._lean = self._prepare()
         spec = as_collisions(collisions)
         self.collisions = None if spec is None else collision_model(robot, spec)
+
+    def _prepare(self) -> LeanFRDM | None:
+        """Everything a call would otherwise build first: the closed form's class (a chain without one refused
+        here, by name), or the solver's model and, for compiled FRDM, the lean call."""
+        robot, req = self.robot, self.request
+        if self.analytic:
+            arm_of(robot, req)
+            return None
+        prepare = getattr(req.module, "prepare", None)
+        if prepare is not None:
+            prepare(robot, req.options)
+        return LeanFRDM(robot, req) if req.solver == "frdm" and req.options.compiled else None
 
     def _request(self, seed: int | None) -> Request:
         if seed is None:
