@@ -15,6 +15,8 @@ from libc.stdlib cimport free, malloc
 from kinelab.core._blas cimport ddot, dgemm, dgemv, dgesdd, dgesv, dgetrf, ready
 from kinelab.core._frdm cimport CONTINUOUS, PRISMATIC, Chain, Packed, chain_fk, random_configuration
 
+from kinelab.core._frdm import pack_chain
+
 cdef enum:
     CONVERGED = 0
     SINGULAR = 1
@@ -337,7 +339,7 @@ def run_multistart(double[::1] q, chain, const double[::1] lower, const double[:
                    const double[::1] restart_lower, const double[::1] restart_upper) -> int:
     """One chunk of the preset's multistart (see ``multistart`` in the C part; ``control`` a
     :class:`kinelab.ik.biquat.kernel.Control`). Returns its code."""
-    cdef Packed packed = Packed(chain, _ChainOnly(len(chain.kind)), _SETTINGS)
+    cdef Packed packed = pack_chain(chain)
     cdef int n = packed.n
     if q.shape[0] != n or lower.shape[0] != n or upper.shape[0] != n or restart_lower.shape[0] != n \
             or restart_upper.shape[0] != n or stats.shape[0] < 8 or rng_state.shape[0] < 1:
@@ -349,26 +351,6 @@ def run_multistart(double[::1] q, chain, const double[::1] lower, const double[:
         code = multistart(&q[0], &packed.ch, &lower[0], &upper[0], &c, &rng_state[0], max_attempts, step_budget,
                           &stats[0], &restart_lower[0], &restart_upper[0])
     return code
-
-
-class _ChainOnly:
-    """A problem with nothing in it, for packing a chain alone."""
-
-    def __init__(self, n):
-        import numpy as np
-        self.lower = self.upper = self.q_rest = np.zeros(n)
-        self.free = np.ones(n, dtype=np.bool_)
-        self.pstar, self.Rstar, self.w_ax = np.zeros(3), np.eye(3), np.zeros(3)
-        self.w_p = self.tol_pos = self.tol_rot = self.w_rest = 0.0
-        self.check_pos = self.check_rot = False
-        self.rot_axis = -1
-
-
-class _NoSettings:
-    relax, eps_q, window, window_rel, accel_m, polish, finish_below, finish_steps = 1.0, 0.0, 1, 0.0, 0, 0, 0.0, 1
-
-
-_SETTINGS = _NoSettings()
 
 
 def error_biquaternion_of(const double[::1] p, const double[:, :] R, const double[::1] pstar,
@@ -427,7 +409,7 @@ def joint_rates_of(const double[:, :] J, const double[::1] twist, double damping
 def jacobian_local_of(chain, const double[::1] q):
     """6 × n tool Jacobian in the tool frame (rows v, ω) at q."""
     import numpy as np
-    cdef Packed packed = Packed(chain, _ChainOnly(len(chain.kind)), _SETTINGS)
+    cdef Packed packed = pack_chain(chain)
     cdef int n = packed.n
     if q.shape[0] != n:
         raise ValueError(f"jacobian_local: {n} joint values expected")
@@ -443,7 +425,7 @@ def jacobian_local_of(chain, const double[::1] q):
 
 def run_integrate(double[::1] q, chain, control, int max_steps):
     """Euler steps of the preset from q (in place): (code, steps, model time [s])."""
-    cdef Packed packed = Packed(chain, _ChainOnly(len(chain.kind)), _SETTINGS)
+    cdef Packed packed = pack_chain(chain)
     if q.shape[0] != packed.n or packed.n == 0:
         raise ValueError(f"run_integrate: {packed.n} joint values expected")
     cdef list keep = []

@@ -8,6 +8,8 @@ from libc.stdlib cimport free, malloc
 
 from kinelab.core._frdm cimport CONTINUOUS, PRISMATIC, Chain, Packed, chain_fk
 
+from kinelab.core._frdm import pack_chain
+
 cdef double PROGRESS = 1e-3  # a stall: PATIENCE iterations without gaining this share of the best error
 cdef int PATIENCE = 10
 cdef double SAME_POINT = 1e-9  # [m] a key point nearer a joint's axis than this does not move when the joint turns
@@ -148,7 +150,7 @@ cdef int _attempt(const Chain* ch, const double* lower, const double* upper, con
 def attempt(chain, const double[::1] lower, const double[::1] upper, const double[::1] target, double[::1] q,
             double tol, int max_iterations):
     """FABRIK from q (changed in place) towards the tool point ``target`` [m]; returns (iterations, error [m])."""
-    cdef Packed packed = Packed(chain, _Nothing(len(chain.kind)), _Nothing(0))
+    cdef Packed packed = pack_chain(chain)
     cdef int n = packed.n, iterations
     cdef double error = 0.0
     if q.shape[0] != n or lower.shape[0] != n or upper.shape[0] != n or target.shape[0] != 3 or n == 0:
@@ -160,18 +162,3 @@ def attempt(chain, const double[::1] lower, const double[::1] upper, const doubl
         iterations = _attempt(&packed.ch, &lower[0], &upper[0], &target[0], &q[0], tol, max_iterations, work, &error)
     free(work)
     return iterations, error
-
-
-class _Nothing:
-    """A problem and settings with nothing in them, for packing a chain alone."""
-
-    def __init__(self, n):
-        import numpy as np
-        self.lower = self.upper = self.q_rest = np.zeros(n)
-        self.free = np.ones(n, dtype=np.bool_)
-        self.pstar, self.Rstar, self.w_ax = np.zeros(3), np.eye(3), np.zeros(3)
-        self.w_p = self.tol_pos = self.tol_rot = self.w_rest = 0.0
-        self.check_pos = self.check_rot = False
-        self.rot_axis = -1
-        self.relax, self.eps_q, self.window, self.window_rel = 1.0, 0.0, 1, 0.0
-        self.accel_m, self.polish, self.finish_below, self.finish_steps = 0, 0, 0.0, 1

@@ -91,3 +91,5 @@ cdef class Packed:
     cdef void _memory(self, mem) except *
     cdef object _written(self, object array, Py_ssize_t size, str name)
     cdef void _check(self, double[::1] q, str name) except *
+    cdef void _check_multistart(self, double[::1] q, double[::1] best_q, double[::1] stats,
+                                unsigned long long[::1] rng_state) except *

@@ -980,6 +980,13 @@ cdef class Packed:
         if self.mem.state == NULL:
             raise ValueError("no memory given: this kernel only reads")
 
+    cdef void _check_multistart(self, double[::1] q, double[::1] best_q, double[::1] stats,
+                                unsigned long long[::1] rng_state) except *:
+        self._check(q, "q")
+        self._check(best_q, "best_q")
+        if stats.shape[0] < STATS_SIZE or rng_state.shape[0] < 1:
+            raise ValueError("stats and rng_state are too short")
+
     def run(self, double[::1] q, int order, int max_sweeps):
         """Sweep until converged, stalled or ``max_sweeps`` sweeps (q updated in place): (code, sweeps)."""
         self._check(q, "q")
@@ -991,10 +998,7 @@ cdef class Packed:
     def multistart(self, double[::1] q, int order, int max_sweeps, unsigned long long[::1] rng_state,
                    int max_attempts, double sweep_budget, double[::1] best_q, double[::1] stats):
         """One chunk of the multistart (see ``multistart`` in the C part): returns a run() code."""
-        self._check(q, "q")
-        self._check(best_q, "best_q")
-        if stats.shape[0] < STATS_SIZE or rng_state.shape[0] < 1:
-            raise ValueError("stats and rng_state are too short")
+        self._check_multistart(q, best_q, stats, rng_state)
         cdef int code
         with nogil:
             code = multistart(&q[0], &self.ch, &self.pb, &self.st, order, max_sweeps, &rng_state[0], max_attempts,
@@ -1006,10 +1010,7 @@ cdef class Packed:
         """The timed multistart: a first chunk of ``first_chunk`` sweeps, then chunks of ``later_chunk`` until an
         attempt converges, ``attempts`` have run or the clock (``time.perf_counter()``'s) passes ``deadline``
         [s], looked at between chunks. Returns the last run() code."""
-        self._check(q, "q")
-        self._check(best_q, "best_q")
-        if stats.shape[0] < STATS_SIZE or rng_state.shape[0] < 1:
-            raise ValueError("stats and rng_state are too short")
+        self._check_multistart(q, best_q, stats, rng_state)
         cdef int code
         with nogil:
             code = _timed(&q[0], &self.ch, &self.pb, &self.st, order, max_sweeps, &rng_state[0], attempts,
@@ -1056,14 +1057,26 @@ def run_kernel(q, chain, objective, settings, int order, int max_sweeps, memory)
 
 def polish(q, chain, objective, int iterations, double max_step=INFINITY):
     """Levenberg–Marquardt from q (in place) on the problem ``objective``: (CONVERGED or −1, iterations spent)."""
-    return Packed(chain, objective, _NO_SETTINGS).lm_polish(q, iterations, max_step)
+    return Packed(chain, objective, _Nothing(0)).lm_polish(q, iterations, max_step)
 
 
-class _NoSettings:
-    relax, eps_q, window, window_rel, accel_m, polish, finish_below, finish_steps = 1.0, 0.0, 1, 0.0, 0, 0, 0.0, 1
+def pack_chain(chain) -> Packed:
+    """The chain packed alone (an empty problem and settings): for kernels that read only the chain."""
+    return Packed(chain, _Nothing(len(chain.kind)), _Nothing(0))
 
 
-_NO_SETTINGS = _NoSettings()
+class _Nothing:
+    """A problem and settings with nothing in them (no target, no weights, one plain sweep setting)."""
+
+    def __init__(self, n):
+        self.lower = self.upper = self.q_rest = np.zeros(n)
+        self.free = np.ones(n, dtype=np.bool_)
+        self.pstar, self.Rstar, self.w_ax = np.zeros(3), np.eye(3), np.zeros(3)
+        self.w_p = self.tol_pos = self.tol_rot = self.w_rest = 0.0
+        self.check_pos = self.check_rot = False
+        self.rot_axis = -1
+        self.relax, self.eps_q, self.window, self.window_rel = 1.0, 0.0, 1, 0.0
+        self.accel_m, self.polish, self.finish_below, self.finish_steps = 0, 0, 0.0, 1
 
 
 def fk(chain, double[::1] q, double[:, ::1] e, double[:, ::1] o, double[::1] p, double[:, ::1] R):
