@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import kinelab
+from kinelab.ik.request import verdict_reserve
 
 
 @pytest.fixture(scope="module")
@@ -60,8 +61,9 @@ def test_an_unattainable_tolerance_ends_at_the_budget(solver, links, no_toleranc
     res = kinelab.solve(robot, target, solver=solver, q0=robot.random_q(3), seed=0, tol_pos=1e-300,
                         tol_rot=1e-300, time_budget=budget, max_restarts=10**9)  # the budget must bind
     assert not res.success and res.status.value == "time_budget"
-    # behaviour, not speed: it ran until the budget and then stopped (the bench measures the overrun's p99)
-    assert budget <= res.wall_time < budget + 10.0  # ten seconds: a hang, not a slow machine
+    # behaviour, not speed: it ran until the budget, less what it keeps back for the verdict, and then stopped (the
+    # bench measures the overrun's p99)
+    assert budget - verdict_reserve(budget) <= res.wall_time < budget + 10.0  # ten seconds: a hang, not a slow machine
 
 
 def test_the_same_seed_gives_the_same_answer_in_another_process():

@@ -17,7 +17,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.ik.limits import wrap_q
-from kinelab.ik.request import Request
+from kinelab.ik.request import Request, verdict_reserve
 from kinelab.ik.result import Attempt, BypassRecord, IKResult, SingularEvent, Status
 from kinelab.ik.targets import as_target
 from kinelab.ik.tasks import COMPONENTS, POSE, Task
@@ -72,7 +72,7 @@ def solve_one(robot: Robot, target: Any, q0: Any, req: Request) -> IKResult:
     t_start = time.perf_counter()
     target = as_target(target, req.task.name)
     rng = _LazyRng(req.seed)
-    budget = 1e9 if req.time_budget is None else req.time_budget
+    budget = 1e9 if req.time_budget is None else req.time_budget - verdict_reserve(req.time_budget)
     problem = Call(robot, target, req.solver, req.tol_pos, req.tol_rot, t_start, t_start + budget, req.seed,
                        req.task, req.task_label)
     max_restarts = req.max_restarts

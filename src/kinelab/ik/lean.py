@@ -22,7 +22,7 @@ import pinocchio as pin
 from kinelab.ik.driver import Call, compiled_result
 from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm import solver as frdm
-from kinelab.ik.request import Request
+from kinelab.ik.request import Request, verdict_reserve
 from kinelab.ik.result import IKResult, Status
 from kinelab.ik.verdict import usual_inputs
 from kinelab.ik.workspace import reach_bound
@@ -48,7 +48,8 @@ class LeanFRDM:
         self.anchor = np.array(anchor, dtype=float)
         self.radius = float(radius) if req.task.position else np.inf  # an ignored point is never out of reach
         self.none = np.empty(0)
-        self.budget = np.inf if req.time_budget is None else float(req.time_budget)
+        self.budget = np.inf if req.time_budget is None else \
+            float(req.time_budget) - verdict_reserve(float(req.time_budget))
         self.attempts = req.max_restarts + 1
         self.axis, self.n = req.task.axis, robot.n
         self.check_pos, self.check_rot = req.task.position, req.task.rotation

@@ -13,6 +13,7 @@ from kinelab.ik.chain import chain_model
 from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.multistart import seed_state
+from kinelab.ik.request import verdict_reserve
 from kinelab.ik.result import SingularEvent, Status, TrackResult
 from kinelab.ik.targets import as_target_arrays
 from kinelab.ik.tasks import POSE, Task
@@ -63,10 +64,9 @@ def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: 
     centre = np.where(bounded, (np.where(bounded, cm.lower, 0.0) + np.where(bounded, cm.upper, 0.0)) / 2, q0)
     lower, upper = (cm.lower, cm.upper) if opts.use_limits else (np.full(cm.n, -np.inf), np.full(cm.n, np.inf))
     t0 = time.perf_counter()
-    # the kernel stops early enough to leave time for the verdict on every sample (≈ 2 µs each, 50 µs more)
-    verdict_reserve = 5e-5 + 2e-6 * count
+    # the kernel stops early enough to leave time for the verdict on every sample (≈ 2 µs each, cold)
     deadline = np.inf if time_budget is None else (t0 if t_start is None else t_start) + float(time_budget) - \
-        verdict_reserve
+        verdict_reserve(float(time_budget)) - 2e-6 * count
     shared = kernel.Objective(lower, upper, np.ones(cm.n, dtype=np.bool_), np.zeros(3), np.eye(3),
                               opts.position_weight(cm.length), opts.axis_weights(), float(tol_pos), float(tol_rot),
                               opts.mode != "orientation", opts.mode != "position", kernel.no_rest(cm.n), 0.0, -1)
