@@ -107,8 +107,9 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
         solver_options: the solver's option fields as keyword arguments (instead of ``options``).
 
     Returns:
-        The result, checked by Pinocchio on the components the task constrains (``result.task``); with
-        ``prefer``, ``diagnostics.branches`` is the number of distinct solutions found.
+        The result, judged on the components the task constrains (``result.task``) by the FK ``result.judge``
+        names (Pinocchio's, or the compiled FK certified equal to it on this robot); with ``prefer``,
+        ``diagnostics.branches`` is the number of distinct solutions found.
 
     Raises:
         TypeError: arguments after the target given positionally.
@@ -203,7 +204,7 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
             is left of ``time_budget``, and fails with status ``collision`` when every answer collides.
 
     Returns:
-        The :class:`~kinelab.ik.batch.BatchIKResult`, every row judged by Pinocchio's FK.
+        The :class:`~kinelab.ik.batch.BatchIKResult`, every row judged by the FK its ``judge`` names.
 
     Raises:
         TypeError: arguments after the targets given positionally.

@@ -101,7 +101,7 @@ class IK:
             seed: seed of the random starts (None: fresh entropy).
 
         Returns:
-            The result, judged by Pinocchio on the task's components within the limits.
+            The result, judged on the task's components within the limits (by the FK ``result.judge`` names).
 
         Raises:
             TargetError, ConfigurationError, JointLimitError, OptionError: a bad target, start or seed.
@@ -126,7 +126,7 @@ class IK:
             seed: the base seed (None: one is drawn and reported).
 
         Returns:
-            The batch result, every row judged by Pinocchio.
+            The batch result, every row judged (by the FK its ``judge`` names).
 
         Raises:
             TargetError, ConfigurationError, OptionError: named.
