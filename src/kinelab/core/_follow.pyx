@@ -21,17 +21,15 @@ from libc.stdlib cimport calloc, free, malloc
 
 from kinelab.core._blas cimport ddot, dgemm, dgemv, dgesv, ready
 from kinelab.core._frdm cimport (
-    CONVERGED, NOT_STARTED, Chain, Memory, Objective, Packed, Settings, chain_fk, lm_polish, now, rotation_angle,
-    rotm, run, uniform, within, world_error, world_jacobian,
+    BUDGET, CONVERGED, NOT_STARTED, STATE_SIZE, Chain, Memory, Objective, Packed, Settings, chain_fk, lm_polish, now,
+    rotation_angle, rotm, run, uniform, within, world_error, world_jacobian,
 )
 
 # the Gauss–Newton steps of a sample move no joint by more than TRUST_FLOOR + TRUST_FACTOR × the last sample's
 # largest joint step [rad or m]: a smooth path's answer lies about that far from the last one
 cdef double TRUST_FLOOR = 0.02
 cdef double TRUST_FACTOR = 2.0
-cdef int STATE_SIZE = 11
 cdef int SWEEPS_PER_LOOK = 32  # a phase's sweeps between two looks at the clock
-cdef int BUDGET = 3  # run()'s code for a phase its sweep cap (or the clock) ended
 
 
 cdef struct Follow:
@@ -45,18 +43,6 @@ cdef struct Follow:
     double pull
     int lm_iterations
     double deadline  # [s] on time.perf_counter()'s clock (inf: none)
-
-
-cdef struct Scratch:
-    # the follower's work arrays, one allocation
-    double* q_prev
-    double* rest
-    double* first
-    double* sol
-    double* Jz
-    double* A
-    double* F
-    int* pivots
 
 
 cdef inline double _max(double a, double b) noexcept nogil:

@@ -14,6 +14,30 @@ cdef enum:
     NOT_STARTED = -2
     STOPPED = -3
 
+# state slots of an attempt, and statistics slots of a multistart (the Python side names them too)
+cdef enum:
+    S_HISTORY = 0
+    S_SWEEPS = 1
+    S_E_WINDOW = 2
+    S_WINDOW_START = 3
+    S_ACCEPTED = 4
+    S_E = 5
+    S_KICKED = 6
+    S_HELD = 7
+    S_SINCE_FK = 8
+    S_FINISH = 9
+    S_NEWTON = 10
+    STATE_SIZE = 11
+    T_ATTEMPTS = 0
+    T_SWEEPS = 1
+    T_STALLS = 2
+    T_ACCEPTED = 3
+    T_BEST_E = 4
+    T_CUT = 5
+    T_POLISHED = 6
+    T_NEWTON = 7
+    STATS_SIZE = 8
+
 cdef struct Chain:
     int n
     const double* PR       # (n, 3, 3) joint frames in their parents' at q = 0

@@ -26,31 +26,6 @@ import numpy as np
 cdef double TWO_PI = 2.0 * M_PI
 cdef int REFRESH_SWEEPS = 8  # sweeps carried incrementally before the chain FK is recomputed
 
-# state slots of an attempt, and statistics slots of a multistart (the Python side names them too)
-cdef enum:
-    S_HISTORY = 0
-    S_SWEEPS = 1
-    S_E_WINDOW = 2
-    S_WINDOW_START = 3
-    S_ACCEPTED = 4
-    S_E = 5
-    S_KICKED = 6
-    S_HELD = 7
-    S_SINCE_FK = 8
-    S_FINISH = 9
-    S_NEWTON = 10
-    STATE_SIZE = 11
-    T_ATTEMPTS = 0
-    T_SWEEPS = 1
-    T_STALLS = 2
-    T_ACCEPTED = 3
-    T_BEST_E = 4
-    T_CUT = 5
-    T_POLISHED = 6
-    T_NEWTON = 7
-    STATS_SIZE = 8
-
-
 cdef double now() noexcept nogil:
     """The monotonic clock [s]: the one ``time.perf_counter()`` reads on Linux."""
     cdef timespec ts
@@ -1017,15 +992,6 @@ cdef class Packed:
                           first_chunk, later_chunk, deadline, 0, &best_q[0], &stats[0], &self.mem)
         return code
 
-    def lm_polish(self, double[::1] q, int iterations, double max_step=INFINITY):
-        """Levenberg–Marquardt steps from q (in place): (CONVERGED or −1, iterations spent)."""
-        if q.shape[0] != self.n:
-            raise ValueError(f"q: {self.n} values expected, got {q.shape[0]}")
-        cdef int code, spent = 0
-        with nogil:
-            code = lm_polish(&q[0], &self.ch, &self.pb, iterations, max_step, &spent)
-        return code, spent
-
 
 cdef int _timed(double* q, const Chain* ch, const Objective* pb, const Settings* st, int order, int max_sweeps,
                 unsigned long long* rng_state, int attempts, double first_chunk, double later_chunk, double deadline,
@@ -1053,11 +1019,6 @@ cdef int _timed(double* q, const Chain* ch, const Objective* pb, const Settings*
 def run_kernel(q, chain, objective, settings, int order, int max_sweeps, memory):
     """kinelab 0.2's ``run(q, ch, pb, st, order, max_sweeps, mem)``: (code, sweeps of this call)."""
     return Packed(chain, objective, settings, memory).run(q, order, max_sweeps)
-
-
-def polish(q, chain, objective, int iterations, double max_step=INFINITY):
-    """Levenberg–Marquardt from q (in place) on the problem ``objective``: (CONVERGED or −1, iterations spent)."""
-    return Packed(chain, objective, _Nothing(0)).lm_polish(q, iterations, max_step)
 
 
 def pack_chain(chain) -> Packed:
