@@ -9,9 +9,9 @@ Pinocchio's ``forwardKinematics`` + ``updateFramePlacement`` on a serial model: 
 on each robot (:mod:`kinelab.robot.certificate`).
 """
 
-from libc.math cimport atan2, cos, sin, sqrt
+from libc.math cimport cos, sin
 
-from kinelab.core._frdm cimport rotation_angle
+from kinelab.core._verdict cimport verdict_of
 
 cdef int PRISMATIC = 1
 
@@ -127,29 +127,10 @@ cdef class Judge:
         """(position error [m], rotation error [rad], q within [lower, upper]) of the answer q against the target
         (4 × 4, base frame): the angle of R*ᵀR, or with ``rot_axis`` = 0, 1, 2 the angle between that tool axis
         and the target's (task "axis"; −1 for the whole rotation)."""
-        cdef Py_ssize_t n = self.kind.shape[0], i
+        cdef Py_ssize_t n = self.kind.shape[0]
         if q.shape[0] != n or lower.shape[0] != n or upper.shape[0] != n or H_target.shape[0] != 4 \
                 or H_target.shape[1] != 4 or rot_axis > 2:
             raise ValueError("verdict: a 4 × 4 target, q and limits of one value per joint, an axis −1 … 2")
         cdef double T[16]
-        cdef double R[9]
-        cdef double S[9]
-        cdef double d0, d1, d2, angle, c0, c1, c2
-        cdef int a, b, k = rot_axis
-        cdef bint inside = True
         _fk_row(self.placement_R, self.placement_t, self.axis, self.kind, self.tool_R, self.tool_t, q, T)
-        d0, d1, d2 = H_target[0, 3] - T[3], H_target[1, 3] - T[7], H_target[2, 3] - T[11]
-        if k < 0:
-            for a in range(3):
-                for b in range(3):
-                    R[3 * a + b], S[3 * a + b] = T[4 * a + b], H_target[a, b]
-            angle = rotation_angle(R, S)
-        else:
-            c0 = T[4 + k] * H_target[2, k] - T[8 + k] * H_target[1, k]
-            c1 = T[8 + k] * H_target[0, k] - T[k] * H_target[2, k]
-            c2 = T[k] * H_target[1, k] - T[4 + k] * H_target[0, k]
-            angle = atan2(sqrt(c0 * c0 + c1 * c1 + c2 * c2),
-                          T[k] * H_target[0, k] + T[4 + k] * H_target[1, k] + T[8 + k] * H_target[2, k])
-        for i in range(n):
-            inside = inside and lower[i] <= q[i] <= upper[i]
-        return sqrt(d0 * d0 + d1 * d1 + d2 * d2), angle, inside
+        return verdict_of(T, H_target, q, lower, upper, rot_axis)

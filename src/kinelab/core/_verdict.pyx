@@ -47,39 +47,45 @@ def pose_defect(const double[:, :] H) -> int:
     return _defect(H)
 
 
-cdef inline void _rotation(const double[:, :] H, double* R) noexcept nogil:
-    cdef int i, j
-    for i in range(3):
-        for j in range(3):
-            R[3 * i + j] = H[i, j]
-
-
-def pose_verdict(const double[:, :] H_target, const double[:, :] H_tool, const double[::1] q,
-                 const double[::1] lower, const double[::1] upper, int axis) -> tuple:
-    """(position error [m], rotation error [rad], q within [lower, upper]) for the homogeneous matrices of the
-    target and of the tool (from Pinocchio's FK). The rotation error is the angle of R*ᵀR, or with ``axis`` = 0, 1,
-    2 the angle between the tool's and the target's x, y or z axes (task "axis"; −1 for the whole rotation)."""
-    if H_target.shape[0] != 4 or H_target.shape[1] != 4 or H_tool.shape[0] != 4 or H_tool.shape[1] != 4 \
-            or lower.shape[0] < q.shape[0] or upper.shape[0] < q.shape[0] or axis > 2:
-        raise ValueError("pose_verdict: two 4 × 4 matrices, limits for every joint and an axis −1 … 2 expected")
-    cdef double d0 = H_target[0, 3] - H_tool[0, 3], d1 = H_target[1, 3] - H_tool[1, 3]
-    cdef double d2 = H_target[2, 3] - H_tool[2, 3], angle, u0, u1, u2, v0, v1, v2, c0, c1, c2
+cdef tuple verdict_of(const double* T, const double[:, :] H_target, const double[::1] q, const double[::1] lower,
+                      const double[::1] upper, int axis):
+    """(position error [m], rotation error [rad], q within [lower, upper]) of the tool pose T (4 × 4, row-major)
+    against the target H_target (4 × 4, shapes checked by the caller): the angle of R*ᵀR, or with ``axis`` = 0, 1, 2
+    the angle between the tool's and the target's x, y or z axes (task "axis"; −1 for the whole rotation)."""
+    cdef double d0 = H_target[0, 3] - T[3], d1 = H_target[1, 3] - T[7], d2 = H_target[2, 3] - T[11]
+    cdef double angle, u0, u1, u2, v0, v1, v2, c0, c1, c2
     cdef double R[9]
     cdef double S[9]
-    cdef int i
+    cdef int i, j
     cdef bint inside = True
     if axis < 0:
-        _rotation(H_tool, R)
-        _rotation(H_target, S)
+        for i in range(3):
+            for j in range(3):
+                R[3 * i + j], S[3 * i + j] = T[4 * i + j], H_target[i, j]
         angle = rotation_angle(R, S)
     else:
-        u0, u1, u2 = H_tool[0, axis], H_tool[1, axis], H_tool[2, axis]
+        u0, u1, u2 = T[axis], T[4 + axis], T[8 + axis]
         v0, v1, v2 = H_target[0, axis], H_target[1, axis], H_target[2, axis]
         c0, c1, c2 = u1 * v2 - u2 * v1, u2 * v0 - u0 * v2, u0 * v1 - u1 * v0
         angle = atan2(sqrt(c0 * c0 + c1 * c1 + c2 * c2), u0 * v0 + u1 * v1 + u2 * v2)
     for i in range(q.shape[0]):
         inside = inside and lower[i] <= q[i] <= upper[i]
     return sqrt(d0 * d0 + d1 * d1 + d2 * d2), angle, inside
+
+
+def pose_verdict(const double[:, :] H_target, const double[:, :] H_tool, const double[::1] q,
+                 const double[::1] lower, const double[::1] upper, int axis) -> tuple:
+    """(position error [m], rotation error [rad], q within [lower, upper]) for the homogeneous matrices of the
+    target and of the tool (from Pinocchio's FK); see :func:`verdict_of`."""
+    if H_target.shape[0] != 4 or H_target.shape[1] != 4 or H_tool.shape[0] != 4 or H_tool.shape[1] != 4 \
+            or lower.shape[0] < q.shape[0] or upper.shape[0] < q.shape[0] or axis > 2:
+        raise ValueError("pose_verdict: two 4 × 4 matrices, limits for every joint and an axis −1 … 2 expected")
+    cdef double T[16]
+    cdef int i, j
+    for i in range(4):
+        for j in range(4):
+            T[4 * i + j] = H_tool[i, j]
+    return verdict_of(T, H_target, q, lower, upper, axis)
 
 
 def usual_inputs(const double[:, :] H, const double[::1] q0, int n, const double[::1] lower,

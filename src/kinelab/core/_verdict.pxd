@@ -1,0 +1,4 @@
+# The verdict on one answer, shared by Pinocchio's judge (_verdict.pose_verdict) and the compiled one (_chain.Judge).
+
+cdef tuple verdict_of(const double* T, const double[:, :] H_target, const double[::1] q, const double[::1] lower,
+                      const double[::1] upper, int axis)
