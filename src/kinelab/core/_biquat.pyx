@@ -406,20 +406,23 @@ def joint_rates_of(const double[:, :] J, const double[::1] twist, double damping
     return out
 
 
-def jacobian_local_of(chain, const double[::1] q):
-    """6 × n tool Jacobian in the tool frame (rows v, ω) at q."""
+def jacobian_local_of(const double[:, ::1] e, const double[:, ::1] o, const long long[::1] kind,
+                      const double[::1] p, const double[:, :] R):
+    """6 × n tool Jacobian in the tool frame (rows v, ω) from the chain's axes e and points o (n × 3, base frame)
+    and the tool pose (p [m], R): the one the compiled preset integrates with."""
     import numpy as np
-    cdef Packed packed = pack_chain(chain)
-    cdef int n = packed.n
-    if q.shape[0] != n:
-        raise ValueError(f"jacobian_local: {n} joint values expected")
-    e, o, J = np.empty((max(n, 1), 3)), np.empty((max(n, 1), 3)), np.empty((6, n))
-    cdef double[:, ::1] ev = e, ov = o, Jv = J
-    cdef double p[3]
-    cdef double R[9]
-    if n:
-        chain_fk(&packed.ch, &q[0], &ev[0, 0], &ov[0, 0], p, R)
-        jacobian_local(&ev[0, 0], &ov[0, 0], packed.ch.kind, n, p, R, &Jv[0, 0])
+    ready()
+    cdef int n = e.shape[0], i, j
+    if o.shape[0] != n or kind.shape[0] != n or e.shape[1] != 3 or o.shape[1] != 3 or p.shape[0] != 3 \
+            or R.shape[0] != 3 or R.shape[1] != 3 or n == 0:
+        raise ValueError("jacobian_local: e and o (n, 3), kind (n,), p (3,) and R (3, 3) expected")
+    cdef double Rc[9]
+    for i in range(3):
+        for j in range(3):
+            Rc[3 * i + j] = R[i, j]
+    J = np.empty((6, n))
+    cdef double[:, ::1] Jv = J
+    jacobian_local(&e[0, 0], &o[0, 0], &kind[0], n, &p[0], Rc, &Jv[0, 0])
     return J
 
 

@@ -18,6 +18,7 @@ from typing import NamedTuple
 import numpy as np
 
 from kinelab.core import _frdm
+from kinelab.core._biquat import jacobian_local_of
 from kinelab.errors import ChainError
 from kinelab.robot import Robot
 from kinelab.robot.certificate import chain_arrays
@@ -118,8 +119,5 @@ def chain_fk(ch: Chain, q: np.ndarray, e_out: np.ndarray, o_out: np.ndarray, p_o
 
 def jacobian_local(e: np.ndarray, o: np.ndarray, kind: np.ndarray, p: np.ndarray, R: np.ndarray) -> np.ndarray:
     """6 × n tool Jacobian in the tool frame (rows v, ω), from the chain's axes e and points o (n × 3, base frame)
-    and the tool pose (p [m], R)."""
-    slides = (kind == PRISMATIC)[:, None]
-    v = np.where(slides, e, np.cross(e, p - o))
-    w = np.where(slides, 0.0, e)
-    return np.vstack([R.T @ v.T, R.T @ w.T])
+    and the tool pose (p [m], R): the compiled preset's own (:mod:`kinelab.core._biquat`)."""
+    return jacobian_local_of(e, o, kind, p, R)
