@@ -116,21 +116,31 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
         SolverNotFoundError, OptionError, TargetError, ConfigurationError: bad input, named.
     """
     check_entry(robot, "solve", positional)
+    settings = dict(solver=solver, tol_pos=tol_pos, tol_rot=tol_rot, time_budget=time_budget,
+                    max_restarts=max_restarts, start_outside_limits=start_outside_limits, options=options, task=task,
+                    axis=axis, collisions=collisions, **solver_options)
     if prefer is None:  # the prepared solver's own route: solve is IK(robot, **settings).solve(target)
-        settings = dict(solver=solver, tol_pos=tol_pos, tol_rot=tol_rot, time_budget=time_budget,
-                        max_restarts=max_restarts, start_outside_limits=start_outside_limits, options=options,
-                        task=task, axis=axis, collisions=collisions, **solver_options)
         return prepared(robot, settings).solve(target, q0=q0, seed=seed)
+    return _solve_preferring(robot, target, q0, seed, prefer, settings)
+
+
+def _solve_preferring(robot: Robot, target: Any, q0: Any, seed: int | None, prefer: Any,
+                      settings: dict[str, Any]) -> IKResult:
+    """``solve(prefer=...)`` with the rest of ``solve``'s settings (``settings``: its keywords but q0, seed and
+    prefer): the nearest branch in closed form for solver "analytic", else among those :func:`find_all` finds."""
+    rest = dict(settings)
+    solver, options, collisions = rest.pop("solver"), rest.pop("options"), rest.pop("collisions")
+    task, axis = rest.pop("task"), rest.pop("axis")
+    tol_pos, tol_rot, budget, restarts, outside = (
+        rest.pop(k) for k in ("tol_pos", "tol_rot", "time_budget", "max_restarts", "start_outside_limits"))
     if solver == "analytic":
-        req = make_request("frdm", seed, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, None,
-                           task, axis, None)
-        return _closed_form_one(robot, target, q0, prefer, collisions, options or solver_options, req)
-    req = make_request(solver, seed, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options,
-                       task, axis, solver_options)
+        req = make_request("frdm", seed, tol_pos, tol_rot, budget, restarts, outside, None, task, axis, None)
+        return _closed_form_one(robot, target, q0, prefer, collisions, options or rest, req)
+    req = make_request(solver, seed, tol_pos, tol_rot, budget, restarts, outside, options, task, axis, rest)
     check = _collision_model(robot, collisions)
     if q0 is not None:
         raise OptionError("q0", "given", "None with prefer= (the branch search draws its own starts)")
-    closed = solver == "frdm" and options is None and not solver_options
+    closed = solver == "frdm" and options is None and not rest
     return _preferred(robot, target, req, prefer, check, "auto" if closed else "multistart")
 
 
@@ -295,8 +305,7 @@ def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
 
     With no bypass, policy or restriction named, the whole path runs in the compiled follower; otherwise
     the monitored loop runs, switching the restrictions a policy names on when a monitor fires
-    (:mod:`kinelab.ik.frdm.tracking`). Every sample is judged by Pinocchio on the task's components within
-    the joint limits.
+    (:mod:`kinelab.ik.frdm.tracking`). Every sample is judged on the task's components within the joint limits.
 
     Args:
         robot: the robot.
@@ -341,7 +350,13 @@ def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
     req = make_request(solver, seed, tol_pos, tol_rot, time_budget, 0, "refuse", options, task, axis,
                        path_options(options, solver_options))
     points, rotations = as_target_arrays(targets)
-    check = _collision_model(robot, collisions)
+    return _follow_path(robot, points, rotations, q0, req, settings, _collision_model(robot, collisions), t_start)
+
+
+def _follow_path(robot: Robot, points: np.ndarray, rotations: np.ndarray, q0: Any, req: Request,
+                 settings: PathSettings, check: CollisionModel | None, t_start: float) -> TrackResult:
+    """:func:`track` once its settings and targets (points [m], rotations) are checked: the start (the first
+    target's answer when q0 is None), the path, and the collision check of every answer when ``check`` is given."""
     if q0 is None:
         q0 = _first_answer(robot, pin.SE3(rotations[0], points[0]), req, check)
     path = run_track(robot, stack_homogeneous(points, rotations), robot.check_q(q0, limits=True, what="q0"), req,
