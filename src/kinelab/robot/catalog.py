@@ -49,6 +49,10 @@ BUNDLED = (
     Entry("youbot", "kinelab", "youbot.urdf", "tool",
           "KUKA youBot arm on its planar base, Q = (X_C, Y_C, theta, theta1..theta5) (seed 003)",
           display=(0.0, 0.0, 0.0, 0.3, 0.5, 0.9, 0.7, 0.0)),
+    Entry("xarm6", "kinelab", "xarm6.urdf", "link_eef",
+          "UFACTORY xArm6, 6R without three axes meeting, from the maker's DH table"),
+    Entry("crx10ia", "kinelab", "crx10ia.urdf", "flange",
+          "FANUC CRX-10iA, 6R cuspidal cobot (up to 16 branches), from its published dimensions"),
 )
 
 ERD_ARMS = (
