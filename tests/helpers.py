@@ -4,6 +4,9 @@ import contextlib
 import signal
 from pathlib import Path
 
+import numpy as np
+import pinocchio as pin
+
 BUNDLED = ("stanford", "era", "youbot")
 ERD_ARMS = ("panda", "ur5", "kinova", "xarm7")
 
@@ -84,3 +87,25 @@ def no_hang(seconds: int = 30):
     finally:
         signal.alarm(0)
         signal.signal(signal.SIGALRM, previous)
+
+
+def chain_urdf(h, o, M, lower, upper, mount=None):
+    """A URDF of revolute joints with axes h_i through points o_i (base frame, q = 0) and the tool at M; links
+    are frames without rotation. ``mount``: (xyz, rpy) of the base under a "world" link."""
+    rows = ['<link name="base"/>']
+    if mount is not None:
+        rows += ['<link name="world"/>', f'<joint name="mount" type="fixed"><parent link="world"/><child link="base"/>'
+                 f'<origin xyz="{" ".join(map(repr, mount[0]))}" rpy="{" ".join(map(repr, mount[1]))}"/></joint>']
+    parent, at = "base", np.zeros(3)
+    for i in range(len(h)):
+        rows += [f'<link name="l{i + 1}"/>',
+                 f'<joint name="j{i + 1}" type="revolute"><parent link="{parent}"/><child link="l{i + 1}"/>'
+                 f'<origin xyz="{" ".join(map(repr, (o[i] - at).tolist()))}"/>'
+                 f'<axis xyz="{" ".join(map(repr, h[i].tolist()))}"/>'
+                 f'<limit lower="{float(lower[i])!r}" upper="{float(upper[i])!r}" effort="1" velocity="1"/></joint>']
+        parent, at = f"l{i + 1}", o[i]
+    rpy = pin.rpy.matrixToRpy(M.rotation)
+    rows += ['<link name="tool"/>', f'<joint name="tool_joint" type="fixed"><parent link="{parent}"/>'
+             f'<child link="tool"/><origin xyz="{" ".join(map(repr, (M.translation - at).tolist()))}" '
+             f'rpy="{" ".join(map(repr, rpy.tolist()))}"/></joint>']
+    return "\n".join(rows)

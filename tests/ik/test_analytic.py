@@ -11,11 +11,13 @@ import pinocchio as pin
 import pytest
 from closed_forms import BASE, UR_DH, ur_inverse
 from eaik.IK_HP import HPRobot
-from helpers import write_urdf
+from helpers import chain_urdf, write_urdf
 
 import kinelab
 from kinelab import OptionError, load
-from kinelab.ik.analytic.classify import classify
+from kinelab.ik.analytic.classify import CLASSES, classify
+from kinelab.ik.analytic.kernel import SEARCH_6R
+from kinelab.ik.chain import chain_model
 
 SAME = 1e-4  # [rad] two answers this close joint by joint (modulo 2π) are one branch (double roots split by rounding)
 POSES = 1000
@@ -195,15 +197,19 @@ def test_arms_are_classified_by_their_axes_and_others_are_refused_by_name(tmp_pa
                                                            "stanford")} == \
         {"ur3": True, "ur5": True, "ur10": True, "z1": True, "so101": True, "kinova": True, "panda": False,
          "stanford": False}
-    # a 6R in no class: the kinova with its wrist point moved 3 cm off axis 6
+    # the kinova with its wrist point moved 3 cm off axis 6 leaves the closed forms for the 1-D search (axes 4 and
+    # 5 still meet); moved 2 cm off axis 4 as well, it is in no class
     kinova = load("kinova")
     h, o, M = pinocchio_axes(kinova)
     o = o.copy()
     o[5] += 0.03 * np.cross(h[5], h[4])
-    off = load(write_urdf(tmp_path, chain_urdf(h, o, M, kinova.lower, kinova.upper)), tool="tool")
+    searched = load(write_urdf(tmp_path, chain_urdf(h, o, M, kinova.lower, kinova.upper)), tool="tool")
+    assert classify(searched).arm.searched and "1-D search over joint 6" in classify(searched).arm.mode
+    o[3] += 0.02 * np.cross(h[3], h[4])
+    off = load(write_urdf(tmp_path, chain_urdf(h, o, M, kinova.lower, kinova.upper), "off.urdf"), tool="tool")
     target = off.fk(off.random_q(0))
     with pytest.raises(OptionError, match="is not: .*axes 5 and 6 are 0.03 m apart .*axes 4, 5 and 6 miss a "
-                                          "common point by 0.03 m"):
+                                          "common point by 0.04 m.* nor a 1-D search class"):
         kinelab.solve_all(off, target, solver="analytic")
     auto = kinelab.solve_all(off, target, seed=0)  # the numeric search instead, saying so
     assert auto and all(s.solver == "frdm" and "multistart" in s.mode for s in auto)
@@ -212,28 +218,6 @@ def test_arms_are_classified_by_their_axes_and_others_are_refused_by_name(tmp_pa
         kinelab.solve_all(ur5, ur5.fk(ur5.random_q(0)), solver="analytic", task="position")
     with pytest.raises(OptionError, match="options"):
         kinelab.solve_all(ur5, ur5.fk(ur5.random_q(0)), solver="analytic", relax=1.2)
-
-
-def chain_urdf(h, o, M, lower, upper, mount=None):
-    """A URDF of revolute joints with axes h_i through points o_i (base frame, q = 0) and the tool at M; links
-    are frames without rotation. ``mount``: (xyz, rpy) of the base under a "world" link."""
-    rows = ['<link name="base"/>']
-    if mount is not None:
-        rows += ['<link name="world"/>', f'<joint name="mount" type="fixed"><parent link="world"/><child link="base"/>'
-                 f'<origin xyz="{" ".join(map(repr, mount[0]))}" rpy="{" ".join(map(repr, mount[1]))}"/></joint>']
-    parent, at = "base", np.zeros(3)
-    for i in range(len(h)):
-        rows += [f'<link name="l{i + 1}"/>',
-                 f'<joint name="j{i + 1}" type="revolute"><parent link="{parent}"/><child link="l{i + 1}"/>'
-                 f'<origin xyz="{" ".join(map(repr, (o[i] - at).tolist()))}"/>'
-                 f'<axis xyz="{" ".join(map(repr, h[i].tolist()))}"/>'
-                 f'<limit lower="{float(lower[i])!r}" upper="{float(upper[i])!r}" effort="1" velocity="1"/></joint>']
-        parent, at = f"l{i + 1}", o[i]
-    rpy = pin.rpy.matrixToRpy(M.rotation)
-    rows += ['<link name="tool"/>', f'<joint name="tool_joint" type="fixed"><parent link="{parent}"/>'
-             f'<child link="tool"/><origin xyz="{" ".join(map(repr, (M.translation - at).tolist()))}" '
-             f'rpy="{" ".join(map(repr, rpy.tolist()))}"/></joint>']
-    return "\n".join(rows)
 
 
 def test_a_mirrored_ur5_read_from_its_tool_classifies_and_solves_the_inverse_pose(tmp_path):
@@ -337,15 +321,24 @@ def tilted(h, angle):
     return out
 
 
+def _closed_form_misses(robot):
+    """The closed-form tests the robot's chain fails, in words (the search classes left out)."""
+    v = chain_model(robot).vectors(np.zeros(6))
+    return " / ".join(test(v["e"], v["o"]) for kind, _, test in CLASSES[6] if kind < SEARCH_6R)
+
+
 def test_near_parallel_axes_are_classified_by_the_stated_tolerance_and_never_answered_wrongly(tmp_path):
     ur5 = load("ur5")
     h, o, M = pinocchio_axes(ur5)
     off = load(write_urdf(tmp_path, chain_urdf(tilted(h, 1e-3), o, M, ur5.lower, ur5.upper), "off.urdf"), tool="tool")
-    assert classify(off).arm is None
-    target = off.fk(off.random_q(0))
-    with pytest.raises(OptionError, match=r"axes 2 and 3 are 0.001 rad from parallel \(tolerance 1e-05\)"):
-        kinelab.solve_all(off, target, solver="analytic")
-    assert all(s.solver == "frdm" for s in kinelab.solve_all(off, target, seed=0))
+    # 1e-3 rad out of parallel is out of the closed form, named; axes 1, 2 and 4, 5 still meet: the 1-D search
+    assert r"axes 2 and 3 are 0.001 rad from parallel (tolerance 1e-05)" in _closed_form_misses(off)
+    assert classify(off).arm.searched
+    q = off.random_q(0)
+    target = off.fk(q)
+    found = kinelab.solve_all(off, target)
+    assert all(s.solver == "analytic" and max(off.tool_error(s.q, target)) <= 1e-6 for s in found)
+    assert any(np.max(np.abs(wrapped(s.q - q))) <= 1e-9 for s in found)
     near = load(write_urdf(tmp_path, chain_urdf(tilted(h, 9e-6), o, M, ur5.lower, ur5.upper), "near.urdf"),
                 tool="tool")
     assert classify(near).arm is not None  # within the tolerance: the closed form, its answers finished

@@ -120,9 +120,9 @@ def test_holding_the_last_joint_solves_the_same_poses(era):
 
 
 def test_arms_that_cannot_be_swept_are_refused_by_name(era):
-    baxter, ur5 = kinelab.load("baxter_left"), kinelab.load("ur5")
-    with pytest.raises(kinelab.OptionError, match=r"baxter_left's is not: joint 1 held .*joint 7 held"):
-        kinelab.solve_all(baxter, baxter.fk(baxter.random_q(1)), redundancy=8)
+    tiago_pro, ur5 = kinelab.load("tiago_pro"), kinelab.load("ur5")
+    with pytest.raises(kinelab.OptionError, match=r"tiago_pro's is not: joint 1 held .*joint 7 held"):
+        kinelab.solve_all(tiago_pro, tiago_pro.fk(tiago_pro.random_q(1)), redundancy=8)
     with pytest.raises(kinelab.OptionError, match="6 joints"):
         kinelab.solve_all(ur5, ur5.fk(ur5.random_q(1)), redundancy=8)
     target = era.fk(era.random_q(1))

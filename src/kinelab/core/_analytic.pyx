@@ -30,7 +30,7 @@ and its angle was set to 0 (a continuum of answers: a wrist or shoulder singular
 numbers and rotations of 9 (row by row): they live in registers.
 """
 
-from libc.math cimport acos, atan2, cos, fabs, hypot, rint, sin, M_PI
+from libc.math cimport acos, atan2, cos, fabs, hypot, rint, sin, M_PI, NAN
 from cython.parallel cimport prange
 
 ctypedef (double, double, double) V3
@@ -40,7 +40,8 @@ ctypedef (int, double) Angle  # (status, θ)
 
 cdef enum:
     DEGENERATE = -1  # every angle serves (the caller picks one and marks the answer a continuum)
-    MAX_ROWS = 8
+    MAX_ROWS = 16  # distinct branches of a pose (a cuspidal 6R has up to 16)
+    RAW_ROWS = 32  # rows before coincident roots are merged
     PARALLEL_5R = 0
     PARALLEL_6R = 1
     SPHERICAL_6R = 2
@@ -176,7 +177,7 @@ cdef struct Rows:
 cdef inline int _write(Rows* rows, int row, double q1, double q2, double q3, double q4, double q5, double q6,
                        bint flag) noexcept nogil:
     """Row ``row`` ← the angles wrapped into (−π, π] (q6 ignored on a 5-joint arm); returns the next row."""
-    if row >= MAX_ROWS:
+    if row >= RAW_ROWS:
         return row
     cdef double* r = rows.out + rows.n * row
     r[0], r[1], r[2], r[3], r[4] = wrap(q1), wrap(q2), wrap(q3), wrap(q4), wrap(q5)
@@ -429,6 +430,9 @@ cdef int two_three_6r(const double* h, const double* o, M9 R0, V3 N0, M9 Rt, V3 
     return row
 
 
+include "_search.pxi"
+
+
 cdef bint _placed(const double* row, int n, const double* lower, const double* upper, const double* ref,
                   bint use_ref, double slack, double* out) noexcept nogil:
     """Each angle's copy θ + 2πk within [lower, upper] (slack allowed, then clipped), nearest ``ref`` (else nearest
@@ -476,8 +480,8 @@ cdef int _branches(const Arm* arm, M9 Rt, V3 pt, const double* ref, bint use_ref
                    unsigned char* free) noexcept nogil:
     """Every distinct branch of the pose (Rt, pt) within the limits, in the robot's joint order (see
     :func:`branches`); returns the number of rows written."""
-    cdef double raw[MAX_ROWS * 6]
-    cdef unsigned char loose[MAX_ROWS]
+    cdef double raw[RAW_ROWS * 6]
+    cdef unsigned char loose[RAW_ROWS]
     cdef double row[6]
     cdef Rows rows
     cdef int n = arm.n, count, m = 0, r, j, k
@@ -494,6 +498,8 @@ cdef int _branches(const Arm* arm, M9 Rt, V3 pt, const double* ref, bint use_ref
         count = meeting_6r(arm.h, arm.o, arm.R0, arm.N0, Rt, pt, &rows)
     elif arm.kind == TWO_THREE_6R:
         count = two_three_6r(arm.h, arm.o, arm.R0, arm.N0, Rt, pt, &rows)
+    elif arm.kind >= SEARCH_PAR23_45:
+        count = search_6r(arm.h, arm.o, arm.kind, arm.R0, arm.N0, Rt, pt, &rows)
     else:
         count = parallel_5r(arm.h, arm.o, arm.R0, arm.N0, Rt, pt, &rows)
     for r in range(count):
@@ -506,7 +512,7 @@ cdef int _branches(const Arm* arm, M9 Rt, V3 pt, const double* ref, bint use_ref
                 free[k] = free[k] or loose[r]
                 merged = True
                 break
-        if not merged and _placed(row, n, arm.lower, arm.upper, ref, use_ref, arm.slack, out + m * n):
+        if not merged and m < MAX_ROWS and _placed(row, n, arm.lower, arm.upper, ref, use_ref, arm.slack, out + m * n):
             found[m], free[m] = 1, loose[r]
             m += 1
     return m
@@ -522,7 +528,7 @@ cdef Arm _arm(int kind, bint mirrored, const double[:, ::1] h, const double[:, :
     cdef int n = h.shape[0]
     if n not in (5, 6) or h.shape[1] != 3 or o.shape[0] != n or o.shape[1] != 3 or R0.shape[0] != 3 \
             or R0.shape[1] != 3 or N0.shape[0] != 3 or lower.shape[0] != n or upper.shape[0] != n \
-            or not 0 <= kind <= TWO_THREE_6R or (n == 5) != (kind == PARALLEL_5R):
+            or not 0 <= kind <= SEARCH_MEET23_56 or (n == 5) != (kind == PARALLEL_5R):
         raise ValueError("an analytic arm: 5 or 6 axes and points (n, 3), R0 (3, 3), N0 (3,), limits (n,), "
                          "and a class code that fits n")
     cdef Arm arm
@@ -545,7 +551,8 @@ def branches(int kind, bint mirrored, const double[:, ::1] h, const double[:, ::
     back (q = −q' reversed).
 
     Args:
-        kind: the class's code (PARALLEL_5R 0, PARALLEL_6R 1, SPHERICAL_6R 2, MEETING_6R 3, TWO_THREE_6R 4).
+        kind: the class's code (PARALLEL_5R 0, PARALLEL_6R 1, SPHERICAL_6R 2, MEETING_6R 3, TWO_THREE_6R 4; the
+            search classes of _search.pxi 5 to 10).
         mirrored: the class is solved read from the tool back.
         h, o: (n, 3) unit axes at q = 0 and points on them [m], in the solved orientation.
         R0, N0: the tool's rotation and point [m] at q = 0.
@@ -583,3 +590,23 @@ def branches_batch(int kind, bint mirrored, const double[:, ::1] h, const double
         for b in prange(B, num_threads=max(1, threads), schedule="static"):
             count[b] = _branches(&arm, _rotation_of(H[b]), (H[b, 0, 3], H[b, 1, 3], H[b, 2, 3]), zero, False,
                                  &out[b, 0, 0], &found[b, 0], &free[b, 0])
+
+
+def search_errors(int kind, const double[:, ::1] h, const double[:, ::1] o, const double[:, :] R0, const double[:] N0,
+                  const double[:, :] H, const double[::1] t, double[:, ::1] e, double[:, ::1] margin):
+    """The 1-D search's error and margin of each of its WAYS ways at the values t [rad] of its search joint, for the
+    pose H (the class solved unmirrored): e and margin (len(t), 4), e NaN where a way has no roots, which is where
+    its margin is below 0 (docs/analytic.md)."""
+    cdef Search S
+    cdef Py_ssize_t k
+    if kind < SEARCH_PAR23_45 or kind > SEARCH_MEET23_56 or h.shape[0] != 6 or o.shape[0] != 6 \
+            or e.shape[0] != t.shape[0] or e.shape[1] != WAYS or margin.shape[0] != t.shape[0] \
+            or margin.shape[1] != WAYS:
+        raise ValueError("search_errors: a search class code, h and o (6, 3), e and margin (len(t), 4)")
+    S.h, S.o = &h[0, 0], &o[0, 0]
+    S.shoulder = (kind - SEARCH_PAR23_45) % 3
+    S.last_pair = kind >= SEARCH_PAR23_56
+    S.R06 = mm(_rotation_of(H), transpose(_rotation_of(R0)))
+    S.shift = sub3((H[0, 3], H[1, 3], H[2, 3]), mv(S.R06, (N0[0], N0[1], N0[2])))
+    for k in range(t.shape[0]):
+        _sample(&S, t[k], &e[k, 0], NULL, NULL, &margin[k, 0], -1)

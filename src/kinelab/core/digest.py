@@ -11,8 +11,8 @@ from pathlib import Path
 
 
 def source_sha256(folder: Path) -> str:
-    """SHA-256 over the folder's Cython sources (``.pyx``, ``.pxd``), in name order, each with its name."""
+    """SHA-256 over the folder's Cython sources (``.pyx``, ``.pxd``, ``.pxi``), in name order, each with its name."""
     h = hashlib.sha256()
-    for path in sorted([*folder.glob("*.pyx"), *folder.glob("*.pxd")]):
+    for path in sorted([*folder.glob("*.pyx"), *folder.glob("*.pxd"), *folder.glob("*.pxi")]):
         h.update(path.name.encode() + b"\0" + path.read_bytes())
     return h.hexdigest()

@@ -105,7 +105,8 @@ def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | No
             answers.append((*verdict, int(found[k]), bool(free[k])))
     if q_ref is not None:
         answers.sort(key=lambda a: distance(robot, a[0], q_ref))
-    return branch_results(answers, req, f"analytic ({arm.name})", time.perf_counter() - t0, max_solutions, 0.0)
+    return branch_results(answers, req, arm.mode, time.perf_counter() - t0, max_solutions,
+                          None if arm.searched else 0.0)
 
 
 def branch_results(answers: list[tuple[Any, ...]], req: Request, mode: str, elapsed: float,
@@ -247,7 +248,7 @@ def analytic_one(robot: Robot, target: Any, req: Request, q0: np.ndarray | None,
     t0 = time.perf_counter()
     arm = arm_of(robot, req)
     q, found, free, order = nearest_roots(robot, arm, target, req, q0)
-    mode, collided = f"analytic ({arm.name})", None
+    mode, collided = arm.mode, None
     for k in order:
         verdict = judged(robot, q[k], target, req)
         if verdict is None:

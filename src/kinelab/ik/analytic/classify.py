@@ -11,6 +11,10 @@ from the tool back to the base, which solves the inverse pose):
   up to 8;
 - **5R, h₂ ∥ h₃ ∥ h₄** (the SO-101): up to 4 candidates, of which a pose keeps those that meet it.
 
+Outside them, a **6R arm with two consecutive wrist axes meeting** (4 and 5, or 5 and 6) and a shoulder that
+places a point in closed form (h₂ ∥ h₃, axes 1 and 2 meeting, or axes 2 and 3 meeting) gets every branch by a
+1-D search over the wrist joint not in the pair (the xArm6, the FANUC CRX, Baxter's first six joints): up to 16.
+
 Axes count as parallel when their angle is below AXIS_TOL and as meeting when their distance is below
 POINT_TOL; a chain that misses a test by more gets the numeric path, with the tests it failed named.
 """
@@ -18,11 +22,12 @@ POINT_TOL; a chain that misses a test by more gets the numeric path, with the te
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from kinelab.errors import ChainError
-from kinelab.ik.analytic.kernel import MEETING_6R, PARALLEL_5R, PARALLEL_6R, SPHERICAL_6R, TWO_THREE_6R
+from kinelab.ik.analytic.kernel import MEETING_6R, PARALLEL_5R, PARALLEL_6R, SEARCH_6R, SPHERICAL_6R, TWO_THREE_6R
 from kinelab.ik.chain import PRISMATIC, chain_model
 from kinelab.robot import Robot
 
@@ -54,6 +59,27 @@ class ArmClass:
         """Number of joints."""
         return int(self.h.shape[0])
 
+    @property
+    def searched(self) -> bool:
+        """True when the branches come from the 1-D search (a root finder), not a closed form."""
+        return self.kind >= SEARCH_6R
+
+    @property
+    def method(self) -> str:
+        """How the branches are found, in words (``kinelab info``)."""
+        if not self.searched:
+            return "every branch in closed form"
+        joint = 4 if (self.kind - SEARCH_6R) // 3 else 6
+        if self.mirrored:
+            joint = 7 - joint
+        return f"every branch by a 1-D search over joint {joint}"
+
+    @property
+    def mode(self) -> str:
+        """The answers' ``mode``: the class, and the search joint when searched."""
+        return f"analytic ({self.name}; {self.method.removeprefix('every branch by a ')})" if self.searched \
+            else f"analytic ({self.name})"
+
 
 @dataclass(frozen=True, eq=False)
 class Classification:
@@ -83,18 +109,26 @@ def _classify(robot: Robot) -> Classification:
 
 def classify_vectors(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray) -> Classification:
     """The analytic class of a revolute chain given by its (n, 3) unit axes h and points o at q = 0 and its
-    tool's rotation R0 and point N0 there (base frame, metres), n = 5 or 6."""
+    tool's rotation R0 and point N0 there (base frame, metres), n = 5 or 6: a closed form in either orientation
+    before a search class in either."""
     failed = []
-    for mirrored in (False, True):
-        hh, oo, RR, NN = reverse(h, o, R0, N0) if mirrored else (h, o, R0, N0)
-        misses = []
-        for kind, name, test in CLASSES[h.shape[0]]:
-            missed = test(hh, oo)
-            if isinstance(missed, np.ndarray):  # in the class: the points it solves with
-                name += " (mirrored: read from the tool)" if mirrored else ""
-                return Classification(ArmClass(name, kind, mirrored, hh, missed, RR, NN), "")
-            misses.append(missed)
-        failed.append(("read from the tool: " if mirrored else "") + " / ".join(misses))
+    for searched in (False, True):
+        for mirrored in (False, True):
+            hh, oo, RR, NN = reverse(h, o, R0, N0) if mirrored else (h, o, R0, N0)
+            misses = []
+            for kind, name, test in CLASSES[h.shape[0]]:
+                if (kind >= SEARCH_6R) != searched:
+                    continue
+                missed = test(hh, oo)
+                if isinstance(missed, np.ndarray):  # in the class: the points it solves with
+                    name += " (mirrored: read from the tool)" if mirrored else ""
+                    return Classification(ArmClass(name, kind, mirrored, hh, missed, RR, NN), "")
+                misses.append(missed)
+            if not searched:
+                failed.append(("read from the tool: " if mirrored else "") + " / ".join(misses))
+    if h.shape[0] == 6:
+        failed.append("nor a 1-D search class (two consecutive wrist axes meeting, with axes 2, 3 parallel or axes "
+                      "1, 2 or 2, 3 meeting, read either way)")
     return Classification(None, " | ".join(failed))
 
 
@@ -155,10 +189,53 @@ def _with_wrist(h: np.ndarray, o: np.ndarray, misses: list[str]) -> np.ndarray |
     return oo
 
 
+_SHOULDERS = ("axes 2, 3 parallel", "axes 1, 2 meeting", "axes 2, 3 meeting")
+_PAIRS = ((3, "axes 4, 5 meeting"), (4, "axes 5, 6 meeting"))
+
+
+def _searched(pair: int, shoulder: int) -> tuple[int, str, Any]:
+    """The search class (kernel code, name, test) of a wrist pair (0: axes 4, 5; 1: axes 5, 6) and a shoulder
+    (0: h₂ ∥ h₃; 1: axes 1, 2 meeting; 2: axes 2, 3 meeting)."""
+    a, pair_name = _PAIRS[pair]
+
+    def test(h: np.ndarray, o: np.ndarray) -> np.ndarray | str:
+        misses = _shoulder_places(h, o, shoulder)
+        if _angle(h[a], h[a + 1]) <= AXIS_TOL:
+            misses.append(f"axes {a + 1} and {a + 2} are parallel")
+        elif (gap := line_distance(o[a], h[a], o[a + 1], h[a + 1])) > POINT_TOL:
+            misses.append(f"axes {a + 1} and {a + 2} are {gap:.2g} m apart")
+        if misses:
+            return "; ".join(misses)
+        oo: np.ndarray = o.copy()
+        oo[a] = oo[a + 1] = meeting_point(o[a], h[a], o[a + 1], h[a + 1])
+        if shoulder:
+            i = shoulder - 1
+            oo[i] = oo[i + 1] = meeting_point(o[i], h[i], o[i + 1], h[i + 1])
+        return oo
+
+    name = f"6R, {_SHOULDERS[shoulder]}, {pair_name}"
+    return SEARCH_6R + 3 * pair + shoulder, name, test
+
+
+def _shoulder_places(h: np.ndarray, o: np.ndarray, shoulder: int) -> list[str]:
+    """The tests, in words, that keep joints 1–3 from placing a point in closed form the way ``shoulder`` does."""
+    if shoulder == 0:
+        return _unparallel(h, ((1, 2),)) + _shoulder_parallel(h)
+    i = shoulder - 1
+    if _angle(h[i], h[i + 1]) <= AXIS_TOL:
+        return [f"axes {i + 1} and {i + 2} are parallel"]
+    if (gap := line_distance(o[i], h[i], o[i + 1], h[i + 1])) > POINT_TOL:
+        return [f"axes {i + 1} and {i + 2} are {gap:.2g} m apart"]
+    if shoulder == 2 and line_distance(o[0], h[0], meeting_point(o[1], h[1], o[2], h[2]), h[0]) <= POINT_TOL:
+        return ["axes 1, 2 and 3 meet (joint 1 would not move the point's distance from them)"]
+    return []
+
+
 CLASSES = {6: ((PARALLEL_6R, "6R, axes 2, 3, 4 parallel, axes 5 and 6 meeting", _parallel),
                (SPHERICAL_6R, "6R, axes 2, 3 parallel, axes 4, 5, 6 meeting (spherical wrist)", _spherical),
                (MEETING_6R, "6R, axes 1, 2 meeting, axes 4, 5, 6 meeting (spherical wrist)", _meeting),
-               (TWO_THREE_6R, "6R, axes 1, 2 parallel, axes 3, 4, 5 parallel", _two_three)),
+               (TWO_THREE_6R, "6R, axes 1, 2 parallel, axes 3, 4, 5 parallel", _two_three),
+               *(_searched(pair, shoulder) for pair in (0, 1) for shoulder in (0, 1, 2))),
            5: ((PARALLEL_5R, "5R, axes 2, 3, 4 parallel", _parallel),)}
 
 

@@ -82,12 +82,15 @@ def _swept(robot: Robot) -> SweptArm | str:
     if cm.n != 7 or (cm.kind == PRISMATIC).any():
         return f"{cm.n} joints{', one prismatic' if (cm.kind == PRISMATIC).any() else ''} (a 7R chain is swept)"
     v = cm.vectors(np.zeros(7))
-    reasons = []
+    reasons, held = [], []
     for joint in (0, 6):
         found = holding(v["e"], v["o"], v["R"], v["N"], joint)
         if isinstance(found, SweptArm):
-            return found
-        reasons.append(f"joint {joint + 1} held (the other six's axes numbered 1 to 6): {found}")
+            held.append(found)
+        else:
+            reasons.append(f"joint {joint + 1} held (the other six's axes numbered 1 to 6): {found}")
+    if held:  # a closed form at either end before a search
+        return min(held, key=lambda sw: sw.arm.searched)
     return "; ".join(reasons)
 
 
@@ -173,7 +176,8 @@ def redundant_all(robot: Robot, target: pin.SE3, req: Request, k: int, q_ref: np
         answers += at_value(robot, target, req, float(theta), q_ref)
     if q_ref is not None:
         answers.sort(key=lambda a: distance(robot, a[0], q_ref))
-    mode = f"analytic ({sw.arm.name}; joint {j + 1} swept over {k} samples)"
+    search = f"; {sw.arm.method.removeprefix('every branch by a ')} of the other six" if sw.arm.searched else ""
+    mode = f"analytic ({sw.arm.name}{search}; joint {j + 1} swept over {k} samples)"
     return branch_results(answers, req, mode, time.perf_counter() - t0, max_solutions, None)
 
 
@@ -181,10 +185,10 @@ def closed_form_summary(robot: Robot) -> str:
     """One line on the robot's closed form (``kinelab info``): its class, the joint a 7R arm holds, or none."""
     arm = classify(robot).arm
     if arm is not None:
-        return f"{arm.name}: every branch in closed form"
+        return f"{arm.name}: {arm.method}"
     if has_swept_form(robot):
         sw = swept_arm(robot)
-        return (f"with joint {sw.joint + 1} ({robot.joints[sw.joint].name}) held: {sw.arm.name} "
-                "(solve_all(..., redundancy=K))")
+        return (f"with joint {sw.joint + 1} ({robot.joints[sw.joint].name}) held: {sw.arm.name}, {sw.arm.method} of "
+                "the other six (solve_all(..., redundancy=K))")
     return "none (the numeric multistart; solver='analytic' names the failed tests)"
 

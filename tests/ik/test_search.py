@@ -1,0 +1,153 @@
+"""Every branch by the 1-D search (docs/analytic.md): arms with two consecutive wrist axes meeting and a shoulder
+that places a point in closed form.
+
+The oracle is the configuration each pose is made from (it must be among the branches) and Pinocchio's FK, which
+judges every answer; the branch sets are compared with ssik's, a peer solving the same URDF its own way.
+"""
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from helpers import chain_urdf, write_urdf
+
+import kinelab
+from kinelab.ik.analytic.classify import classify
+from kinelab.ik.analytic.kernel import SEARCH_6R
+from kinelab.ik.analytic.redundancy import at_value, swept_arm
+from kinelab.ik.request import make_request
+
+TOL = 1e-6  # [m, rad] every answer meets the pose to this (Pinocchio's FK)
+FOUND = 1e-9  # [rad] the pose's own configuration is a branch to this, joint by joint, modulo 2π
+
+
+def wrapped(d):
+    return np.arctan2(np.sin(d), np.cos(d))
+
+
+def unit(rng):
+    v = rng.normal(size=3)
+    return v / np.linalg.norm(v)
+
+
+def random_arm(rng, pair, shoulder):
+    """Axes h, points o (base frame, q = 0) and a tool pose of a random 6R arm of the search class (pair 0: axes
+    4, 5 meeting; 1: axes 5, 6; shoulder 0: h₂ ∥ h₃; 1: axes 1, 2 meeting; 2: axes 2, 3 meeting), every other
+    axis at a random angle and every other point at random within 0.4 m."""
+    h = np.array([unit(rng) for _ in range(6)])
+    o = rng.uniform(-0.4, 0.4, (6, 3))
+    if shoulder == 0:
+        h[2] = h[1] * (1 if rng.random() < 0.5 else -1)
+    else:
+        i = shoulder - 1
+        o[i + 1] = o[i] + rng.uniform(-0.2, 0.2) * h[i] + rng.uniform(-0.2, 0.2) * h[i + 1]
+    a = 3 + pair
+    o[a + 1] = o[a] + rng.uniform(-0.2, 0.2) * h[a] + rng.uniform(-0.2, 0.2) * h[a + 1]
+    tool = pin.SE3(pin.exp3(rng.normal(size=3)), rng.uniform(-0.4, 0.4, 3))
+    return h, o, tool
+
+
+def contains(found, q):
+    return any(np.max(np.abs(wrapped(s.q - q))) <= FOUND for s in found)
+
+
+@pytest.mark.parametrize("pair", [0, 1])
+@pytest.mark.parametrize("shoulder", [0, 1, 2])
+def test_random_arms_of_each_search_class_give_the_pose_s_own_configuration_among_judged_branches(tmp_path, pair,
+                                                                                                   shoulder):
+    rng = np.random.default_rng(100 + 10 * pair + shoulder)
+    limits = np.full(6, -np.pi), np.full(6, np.pi)
+    for arm_index in range(3):
+        h, o, tool = random_arm(rng, pair, shoulder)
+        robot = kinelab.load(write_urdf(tmp_path, chain_urdf(h, o, tool, *limits), f"a{arm_index}.urdf"), tool="tool")
+        arm = classify(robot).arm
+        assert arm is not None and arm.kind == SEARCH_6R + 3 * pair + shoulder and not arm.mirrored
+        for _ in range(40):
+            q = robot.random_q(rng)
+            target = robot.fk(q)
+            found = kinelab.solve_all(robot, target, solver="analytic")
+            assert contains(found, q)
+            assert all(max(robot.tool_error(s.q, target)) <= TOL and robot.within_limits(s.q) for s in found)
+            assert len(found) <= 16
+
+
+def test_an_arm_of_a_search_class_written_tool_first_is_solved_mirrored(tmp_path):
+    rng = np.random.default_rng(7)
+    h, o, tool = random_arm(rng, 0, 0)
+    R0, N0 = tool.rotation, tool.translation
+    limits = np.full(6, -np.pi), np.full(6, np.pi)
+    robot = kinelab.load(write_urdf(tmp_path, chain_urdf(h[::-1] @ R0, (o[::-1] - N0) @ R0, tool.inverse(), *limits)),
+                         tool="tool")
+    arm = classify(robot).arm
+    assert arm.mirrored and arm.searched and "1-D search over joint 1" in arm.mode
+    for _ in range(60):
+        q = robot.random_q(rng)
+        target = robot.fk(q)
+        found = kinelab.solve_all(robot, target)
+        assert contains(found, q) and all(max(robot.tool_error(s.q, target)) <= TOL for s in found)
+
+
+@pytest.mark.parametrize("name", ["xarm6", "crx10ia"])
+def test_the_registered_non_pieper_arms_give_every_pose_s_own_configuration(name):
+    robot = kinelab.load(name)
+    assert classify(robot).arm.searched
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        q = robot.random_q(rng)
+        target = robot.fk(q)
+        found = kinelab.solve_all(robot, target)
+        assert found and all(s.solver == "analytic" and s.diagnostics.unseen is None for s in found)
+        assert contains(found, q)
+        assert all(max(robot.tool_error(s.q, target)) <= TOL and robot.within_limits(s.q) for s in found)
+
+
+# a CRX-10iA pose with 16 real branches, all within the file's limits (found by sampling random configurations)
+CRX_SIXTEEN = (-2.57382778, 1.29186362, -0.93753732, -2.98766846, -2.72802256, -1.92793594)
+
+
+def test_a_crx_pose_has_sixteen_branches_each_a_distinct_configuration_that_pinocchio_confirms():
+    crx = kinelab.load("crx10ia")
+    target = crx.fk(np.array(CRX_SIXTEEN))
+    found = kinelab.solve_all(crx, target)
+    assert len(found) == 16 and found[0].diagnostics.branches == 16
+    for s in found:
+        assert max(crx.tool_error(s.q, target)) <= 1e-10  # the search refines each root to rounding
+    gaps = [np.max(np.abs(wrapped(a.q - b.q))) for i, a in enumerate(found) for b in found[i + 1:]]
+    assert min(gaps) > 1e-3  # sixteen different configurations
+    assert contains(found, np.array(CRX_SIXTEEN))
+
+
+@pytest.mark.parametrize("name", ["xarm6", "crx10ia"])
+def test_branch_sets_equal_ssik_s_for_the_same_urdf(name):
+    ssik = pytest.importorskip("ssik")
+    robot = kinelab.load(name)
+    peer = ssik.Manipulator.from_urdf(robot.urdf_path, base="base_link", ee=robot.tool)
+    rng = np.random.default_rng(11)
+    for _ in range(12):
+        q = rng.uniform(-np.pi, np.pi, 6)
+        H = robot.fk(q).homogeneous
+        np.testing.assert_allclose(peer.fk(q), H, atol=1e-12)  # the same arm
+        ours = kinelab.solve_all(robot, pin.SE3(H), solver="analytic")
+        theirs = [np.asarray(s.q) for s in peer.solve(H, respect_limits=True, enumerate_windings=False)]
+        theirs = [t for t in theirs if max(robot.tool_error(t, pin.SE3(H))) <= TOL]  # judged as ours are
+        distinct = []
+        for t in theirs:
+            if not any(np.max(np.abs(wrapped(t - d))) <= 1e-6 for d in distinct):
+                distinct.append(t)
+        assert len(ours) == len(distinct)
+        assert all(any(np.max(np.abs(wrapped(s.q - t))) <= 1e-6 for s in ours) for t in distinct)
+
+
+def test_baxter_held_at_its_first_joint_is_searched_and_gives_each_pose_s_own_configuration():
+    baxter = kinelab.load("baxter_left")
+    sw = swept_arm(baxter)
+    assert sw.joint == 0 and sw.arm.searched
+    req = make_request("frdm")
+    rng = np.random.default_rng(8)
+    for _ in range(100):
+        q = baxter.random_q(rng)
+        target = baxter.fk(q)
+        answers = at_value(baxter, target, req, float(q[0]))
+        assert any(np.max(np.abs(wrapped(a[0] - q))) <= FOUND for a in answers)
+        assert all(max(baxter.tool_error(a[0], target)) <= TOL and baxter.within_limits(a[0]) for a in answers)
+    found = kinelab.solve_all(baxter, baxter.fk(baxter.random_q(rng)), redundancy=8)
+    assert found and "1-D search over joint 4" in found[0].mode and "joint 1 swept over 8 samples" in found[0].mode
