@@ -1,0 +1,34 @@
+"""The URDFs kinelab writes from published Denavit–Hartenberg tables (urdf/xarm6.urdf, urdf/crx10ia.urdf) are
+those tables: Pinocchio's FK of each file equals the standard DH product at seeded random configurations."""
+
+import numpy as np
+import pytest
+
+import kinelab
+
+PI = np.pi
+# (θ offset [rad], d [m], α [rad], a [m]) per joint, copied from each file's header (the published numbers)
+TABLES = {
+    "xarm6": [(0, 0.267, -PI / 2, 0), (-1.3849179, 0, 0, 0.28948866), (1.3849179, 0, -PI / 2, 0.0775),
+              (0, 0.3425, PI / 2, 0), (0, 0, -PI / 2, 0.076), (0, 0.097, 0, 0)],
+    "crx10ia": [(0, 0, PI / 2, 0), (PI / 2, 0, 0, 0.54), (0, 0, PI / 2, 0), (0, 0.54, -PI / 2, 0),
+                (0, 0.15, PI / 2, 0), (0, 0.16, 0, 0)],
+}
+
+
+def dh(theta, d, alpha, a):
+    """Rz(θ)·Tz(d)·Tx(a)·Rx(α), the standard DH link transform."""
+    ct, st, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
+    return np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, d], [0, 0, 0, 1]])
+
+
+@pytest.mark.parametrize("name", sorted(TABLES))
+def test_the_file_is_its_dh_table(name):
+    robot = kinelab.load(name)
+    rng = np.random.default_rng(4)
+    for _ in range(50):
+        q = robot.random_q(rng)
+        M = np.eye(4)
+        for (offset, d, alpha, a), qi in zip(TABLES[name], q, strict=True):
+            M = M @ dh(qi + offset, d, alpha, a)
+        np.testing.assert_allclose(robot.fk(q).homogeneous, M, atol=1e-12)
