@@ -14,7 +14,9 @@ import kinelab
 from kinelab.ik.analytic.classify import classify
 from kinelab.ik.analytic.kernel import SEARCH_6R
 from kinelab.ik.analytic.redundancy import at_value, swept_arm
+from kinelab.ik.limits import distance
 from kinelab.ik.request import make_request
+from kinelab.report.bench.completeness import random_search_arm
 
 TOL = 1e-6  # [m, rad] every answer meets the pose to this (Pinocchio's FK)
 FOUND = 1e-9  # [rad] the pose's own configuration is a branch to this, joint by joint, modulo 2π
@@ -22,28 +24,6 @@ FOUND = 1e-9  # [rad] the pose's own configuration is a branch to this, joint by
 
 def wrapped(d):
     return np.arctan2(np.sin(d), np.cos(d))
-
-
-def unit(rng):
-    v = rng.normal(size=3)
-    return v / np.linalg.norm(v)
-
-
-def random_arm(rng, pair, shoulder):
-    """Axes h, points o (base frame, q = 0) and a tool pose of a random 6R arm of the search class (pair 0: axes
-    4, 5 meeting; 1: axes 5, 6; shoulder 0: h₂ ∥ h₃; 1: axes 1, 2 meeting; 2: axes 2, 3 meeting), every other
-    axis at a random angle and every other point at random within 0.4 m."""
-    h = np.array([unit(rng) for _ in range(6)])
-    o = rng.uniform(-0.4, 0.4, (6, 3))
-    if shoulder == 0:
-        h[2] = h[1] * (1 if rng.random() < 0.5 else -1)
-    else:
-        i = shoulder - 1
-        o[i + 1] = o[i] + rng.uniform(-0.2, 0.2) * h[i] + rng.uniform(-0.2, 0.2) * h[i + 1]
-    a = 3 + pair
-    o[a + 1] = o[a] + rng.uniform(-0.2, 0.2) * h[a] + rng.uniform(-0.2, 0.2) * h[a + 1]
-    tool = pin.SE3(pin.exp3(rng.normal(size=3)), rng.uniform(-0.4, 0.4, 3))
-    return h, o, tool
 
 
 def contains(found, q):
@@ -57,7 +37,7 @@ def test_random_arms_of_each_search_class_give_the_pose_s_own_configuration_amon
     rng = np.random.default_rng(100 + 10 * pair + shoulder)
     limits = np.full(6, -np.pi), np.full(6, np.pi)
     for arm_index in range(3):
-        h, o, tool = random_arm(rng, pair, shoulder)
+        h, o, tool = random_search_arm(rng, pair, shoulder)
         robot = kinelab.load(write_urdf(tmp_path, chain_urdf(h, o, tool, *limits), f"a{arm_index}.urdf"), tool="tool")
         arm = classify(robot).arm
         assert arm is not None and arm.kind == SEARCH_6R + 3 * pair + shoulder and not arm.mirrored
@@ -72,7 +52,7 @@ def test_random_arms_of_each_search_class_give_the_pose_s_own_configuration_amon
 
 def test_an_arm_of_a_search_class_written_tool_first_is_solved_mirrored(tmp_path):
     rng = np.random.default_rng(7)
-    h, o, tool = random_arm(rng, 0, 0)
+    h, o, tool = random_search_arm(rng, 0, 0)
     R0, N0 = tool.rotation, tool.translation
     limits = np.full(6, -np.pi), np.full(6, np.pi)
     robot = kinelab.load(write_urdf(tmp_path, chain_urdf(h[::-1] @ R0, (o[::-1] - N0) @ R0, tool.inverse(), *limits)),
@@ -151,3 +131,37 @@ def test_baxter_held_at_its_first_joint_is_searched_and_gives_each_pose_s_own_co
         assert all(max(baxter.tool_error(a[0], target)) <= TOL and baxter.within_limits(a[0]) for a in answers)
     found = kinelab.solve_all(baxter, baxter.fk(baxter.random_q(rng)), redundancy=8)
     assert found and "1-D search over joint 4" in found[0].mode and "joint 1 swept over 8 samples" in found[0].mode
+
+
+def test_a_searched_arm_s_map_counts_its_branches_and_reaches_all_the_numeric_map_reaches():
+    from kinelab.maps import chunk as reach
+    from kinelab.maps import grid
+
+    xarm6 = kinelab.load("xarm6")
+    rng = np.random.default_rng(2)
+    centres = np.array([xarm6.fk(xarm6.random_q(rng)).translation for _ in range(12)])
+    spec = reach.MapSpec(orientations=8)
+    assert spec.closed_form(xarm6)
+    searched = reach.compute_chunk(xarm6, spec, centres, 0)
+    numeric = reach.compute_chunk(xarm6, reach.MapSpec(orientations=8, restarts=20, method="numeric"), centres, 0)
+    assert (searched["reachability"] >= numeric["reachability"]).all() and searched["reachability"].mean() > 0.3
+    H = reach.targets_of(centres[:4], grid.rotations(8))
+    counts = [len(kinelab.solve_all(xarm6, pin.SE3(T))) for T in H]
+    assert np.allclose(searched["branches"][:4], np.reshape(counts, (4, 8)).mean(axis=1))
+
+
+def test_solve_from_a_start_returns_the_searched_branch_nearest_it():
+    crx = kinelab.load("crx10ia")
+    rng = np.random.default_rng(12)
+    for _ in range(20):
+        q = crx.random_q(rng)
+        target = crx.fk(q)
+        start = np.clip(q + rng.normal(0.0, 0.05, 6), crx.lower, crx.upper)
+        res = kinelab.solve(crx, target, solver="analytic", q0=start)
+        assert res.success and max(crx.tool_error(res.q, target)) <= TOL
+        branches = kinelab.solve_all(crx, target)
+        nearest = min(branches, key=lambda s: np.max(np.abs(wrapped(s.q - start))))
+        assert np.max(np.abs(wrapped(res.q - nearest.q))) <= 1e-9
+        preferred = kinelab.solve(crx, target, prefer=start)  # the nearest branch by solve_all's distance
+        by_distance = min(branches, key=lambda s: distance(crx, s.q, start))
+        assert np.max(np.abs(wrapped(preferred.q - by_distance.q))) <= 1e-9

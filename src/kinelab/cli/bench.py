@@ -41,6 +41,10 @@ def add(sub: Any) -> None:
                    help="also every branch of a pose: the closed form against the multistart and EAIK, the batch's "
                         "poses per second (the arms with a closed form, the Stanford arm's multistart, the ERA and "
                         "the Panda swept)")
+    s.add_argument("--completeness", action="store_true",
+                   help="also every-branch completeness: each arm with a class on 10,000 seeded poses (its own "
+                        "configuration among the branches), against ssik's branch sets on 1,000 (pip install ssik), "
+                        "and random arms of each 1-D search class")
     s.add_argument("--collisions", action="store_true",
                    help="also solve with and without collisions= around a floor and a table (panda, ur5, kinova): "
                         "time ratio with its spread, clear success, the check's own cost")
@@ -83,6 +87,10 @@ def run(args: argparse.Namespace) -> int:
         from kinelab.report.bench import branches
 
         result["branches"] = branches.run(None, seed=args.seed, repeats=max(args.repeats, 2), progress=not args.json)
+    if args.completeness:
+        from kinelab.report.bench import completeness
+
+        result["completeness"] = completeness.run(seed=args.seed, progress=not args.json)
     if args.collisions:
         from kinelab.report.bench import collisions
 
@@ -127,3 +135,7 @@ def _print_tables(result: dict[str, Any]) -> None:
         from kinelab.report.bench import collisions
 
         print(collisions.markdown(result["collisions"]))
+    if "completeness" in result:
+        from kinelab.report.bench import completeness
+
+        print(completeness.markdown(result["completeness"]))
