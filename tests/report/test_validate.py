@@ -1,5 +1,6 @@
 import json
 
+import numpy as np
 import pytest
 
 from kinelab import cli
@@ -126,12 +127,35 @@ def test_the_closed_form_checks_hold_on_ur5_and_fail_when_a_branch_is_missing(mo
     rows = validate.analytic_checks(ur5, 40, 0)
     assert [r.name for r in rows] == ["closed form: every branch met (Pinocchio-checked)",
                                       *(f"{s}: every answer is one of the closed form's branches"
-                                        for s in ("frdm", "biquat", "dls"))]
+                                        for s in ("frdm", "biquat", "dls")),
+                                      "completeness: the pose's own configuration among the branches, to 1e-06 rad"]
     assert all(r.passed for r in rows) and "on the branch nearest its start" in rows[1].detail
-    assert validate.analytic_checks(kinelab.load("baxter_left"), 40, 0) == []  # no closed form, not even swept
+    assert "2000 poses, 0 missed" in rows[-1].detail
+    assert validate.analytic_checks(kinelab.load("tiago_pro"), 40, 0) == []  # no class, not even swept
     real = ik.solve_all
     monkeypatch.setattr(ik, "solve_all", lambda *a, **kw: real(*a, **kw)[1:])
     assert not all(r.passed for r in validate.analytic_checks(ur5, 40, 0)[1:])
+
+
+def test_the_completeness_check_fails_when_the_batch_loses_a_branch(monkeypatch):
+    import dataclasses
+
+    import kinelab
+    from kinelab.report.bench import completeness
+
+    xarm6 = kinelab.load("xarm6")
+    assert validate.completeness_checks(xarm6, 0)[0].passed
+    real = completeness.all_branches_batch
+
+    def first_lost(robot, targets):
+        batch = real(robot, targets)
+        q = batch.q.copy()
+        q[:, 0] = np.nan  # every pose's first branch gone
+        return dataclasses.replace(batch, q=q)
+
+    monkeypatch.setattr(completeness, "all_branches_batch", first_lost)
+    row = validate.completeness_checks(xarm6, 0)[0]
+    assert not row.passed and row.value < 0.9
 
 
 def test_the_collision_checks_hold_on_panda_and_fail_when_the_check_sees_nothing(monkeypatch):
@@ -156,9 +180,9 @@ def test_the_swept_closed_form_checks_hold_on_the_era_and_fail_when_its_branches
 
     era = kinelab.load("era")
     rows = validate.analytic_checks(era, 40, 0)
-    assert [r.name.split(":")[0] for r in rows] == ["closed form, joint 1 swept", "frdm", "dls"]
+    assert [r.name.split(":")[0] for r in rows] == ["closed form, joint 1 swept", "frdm", "dls", "completeness"]
     assert all(r.passed for r in rows)
     real = redundancy.at_value
     monkeypatch.setattr(redundancy, "at_value", lambda *a, **k: [(q + 0.01, *rest) for q, *rest in real(*a, **k)])
     rows = validate.analytic_checks(era, 40, 0)
-    assert not any(r.passed for r in rows)  # the moved branches miss the pose, and every answer misses them
+    assert not any(r.passed for r in rows[:3])  # the moved branches miss the pose, and every answer misses them

@@ -39,7 +39,8 @@ def add(sub: Any) -> None:
                         "and random starts, interleaved and blocked rounds, ratios with their spread")
     s.add_argument("--branches", action="store_true",
                    help="also every branch of a pose: the closed form against the multistart and EAIK, the batch's "
-                        "poses per second (the arms with a closed form, the Stanford arm's multistart, the ERA and "
+                        "poses per second (the arms with a closed form or a 1-D search, the Stanford arm's "
+                        "multistart, the ERA, Baxter and "
                         "the Panda swept)")
     s.add_argument("--completeness", action="store_true",
                    help="also every-branch completeness: each arm with a class on 10,000 seeded poses (its own "

@@ -30,6 +30,7 @@ SECTIONS = (
     ("seed 000", "Seed paper 000 — FRDM on the European Robotic Arm (Danilov)", "era_"),
     ("seed 001", "Seed paper 001 — biquaternion control of the Stanford arm (Lomovtseva & Chelnokov)", "seed001"),
     ("seed 003", "Seed paper 003 — singular configurations of the KUKA youBot (Kapustina)", "seed003"),
+    ("completeness", "Completeness — every branch: each pose's own configuration among its branches", "-"),
 )
 STYLE = """
 body{font:15px/1.5 system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#1d1d1f}

@@ -92,6 +92,11 @@ def _write_validate_files(report: Report, folder: Path) -> None:
           "| robot | check | measured | limit | result |", "|---|---|---|---|---|"]
     md += [f"| {c.robot} | {c.name} | {c.measured} {c.unit if c.unit not in ('yes/no', '%') else ''} | {c.limit} | "
            f"{'PASS' if c.passed else 'FAIL'} |" for c in report.checks]
+    complete = [c for c in report.checks if c.name.startswith("completeness")]
+    if complete:
+        md += ["", "## Completeness", "", "| robot | own configuration found | poses, misses, branches |",
+               "|---|---|---|"]
+        md += [f"| {c.robot} | {c.measured} | {c.detail} |" for c in complete]
     md += [""] + [f"![{CAPTIONS.get(name, name)}]({name})" for name in figures]
     (folder / "report.md").write_text("\n".join(md) + "\n")
     (folder / "report.html").write_text(validate_html(report, {n: (folder / n).read_bytes() for n in figures}))

@@ -161,10 +161,11 @@ def analytic_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     from kinelab.ik.limits import distance
 
     if classify(robot).arm is None:
-        return _swept_checks(robot, n, seed)
+        return _swept_checks(robot, n, seed) + completeness_checks(robot, seed)
+    form = "1-D search" if classify(robot).arm.searched else "closed form"  # type: ignore[union-attr]
     targets = _closed_form_targets(robot, n, seed)
     branches = [solve_all(robot, t, solver="analytic") for t in targets]
-    rows = [Check(robot.name, "closed form: every branch met (Pinocchio-checked)", _worst(robot, targets, branches),
+    rows = [Check(robot.name, f"{form}: every branch met (Pinocchio-checked)", _worst(robot, targets, branches),
                   1e-6, "m or rad", f"{len(targets)} targets, {np.mean([len(b) for b in branches]):.2f} branches "
                   "each within the limits")]
     for solver in ("frdm", "biquat", "dls"):
@@ -177,9 +178,29 @@ def analytic_checks(robot: Robot, n: int, seed: int) -> list[Check]:
         detail = f"{solved} of {len(targets)} solved from random starts"
         if solver == "frdm" and solved:
             detail += f"; on the branch nearest its start in {100 * nearest / solved:.0f} %"
-        rows.append(Check(robot.name, f"{solver}: every answer is one of the closed form's branches",
+        rows.append(Check(robot.name, f"{solver}: every answer is one of the {form}'s branches",
                           on_branch / max(solved, 1), 1.0, "%", detail, at_least=True))
-    return rows
+    return rows + completeness_checks(robot, seed)
+
+
+COMPLETENESS_POSES = 2000
+
+
+def completeness_checks(robot: Robot, seed: int) -> list[Check]:
+    """Where the arm has every branch (a closed form or a 1-D search, at a held joint for a 7R arm): the share of
+    COMPLETENESS_POSES seeded poses whose own configuration is among the branches Pinocchio confirms, 99.9 % at
+    least (a double root is met to the square root of rounding only: its misses are counted apart)."""
+    from kinelab.ik.analytic.classify import classify
+    from kinelab.ik.analytic.redundancy import has_swept_form
+    from kinelab.report.bench.completeness import FOUND, own_configuration
+
+    if classify(robot).arm is None and not has_swept_form(robot):
+        return []
+    r = own_configuration(robot, COMPLETENESS_POSES, seed)
+    return [Check(robot.name, f"completeness: the pose's own configuration among the branches, to {FOUND:g} rad",
+                  r["found"], 0.999, "%", f"{r['method']}; {r['poses']} poses, {r['misses']} missed "
+                  f"({r['near_misses']} at a double root), {r['branches_mean']:.2f} branches each within the limits "
+                  f"(at most {r['branches_max']})", at_least=True)]
 
 
 def _swept_checks(robot: Robot, n: int, seed: int) -> list[Check]:

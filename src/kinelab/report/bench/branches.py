@@ -1,6 +1,6 @@
 """``kinelab bench --branches``: every branch of a pose — the closed form against the multistart and EAIK.
 
-Per arm with a closed form (:mod:`kinelab.ik.analytic`), the same n seeded poses (the FK of random
+Per arm with a closed form or a 1-D search (:mod:`kinelab.ik.analytic`), the same n seeded poses (the FK of random
 configurations) go to ``solve_all`` (the closed form, every answer judged by Pinocchio), ``solve_all(...,
 solver="frdm")`` (the multistart with its stopping rule) and, when installed, EAIK's ``IK`` (the peer's own
 closed form, unchecked). Rounds alternate interleaved (each solver on each pose in turn, the order rotating)
@@ -33,9 +33,9 @@ from kinelab.ik.limits import distance
 from kinelab.report.bench.protocol import round_plan
 from kinelab.robot import Robot, load
 
-ANALYTIC_ROBOTS = ("ur3", "ur5", "ur10", "z1", "kinova", "so101")
+ANALYTIC_ROBOTS = ("ur3", "ur5", "ur10", "z1", "kinova", "so101", "xarm6", "crx10ia")
 NUMERIC_ROBOTS = ("stanford",)
-REDUNDANT_ROBOTS = ("era", "panda")
+REDUNDANT_ROBOTS = ("era", "panda", "baxter_left")
 K = 16  # samples of a 7R arm's swept joint
 Call = Callable[[pin.SE3, int], Any]
 
@@ -47,7 +47,7 @@ def _eaik(robot: Robot) -> Call | None:
     except ImportError:
         return None
     arm = classify(robot).arm
-    if arm is None or arm.mirrored:
+    if arm is None or arm.mirrored or arm.searched:  # EAIK solves the closed-form classes alone
         return None
     from kinelab.ik.chain import chain_model
 
@@ -173,8 +173,8 @@ def figures(medians: dict[str, list[float]]) -> dict[str, Any]:
 
 def run(robots: list[str] | None = None, n: int = 100, seed: int = 0, repeats: int = 4,
         progress: bool = False) -> list[dict[str, Any]]:
-    """Every arm asked for (default: the arms with a closed form, the Stanford arm, the ERA and the Panda), a row
-    each."""
+    """Every arm asked for (default: the arms with a closed form or a 1-D search, the Stanford arm, the ERA, the
+    Panda and Baxter), a row each."""
     names = list(robots or (*ANALYTIC_ROBOTS, *NUMERIC_ROBOTS, *REDUNDANT_ROBOTS))
     rows = []
     for name in tqdm(names, desc="bench --branches", disable=not progress, unit="arm"):
