@@ -47,16 +47,20 @@ def test_info_json_is_stable(capsys):
     assert json.loads(out)["collisions"].startswith("17 collision object(s) of panda, 0 obstacle(s); 75 pairs")
 
 
-def test_info_names_the_closed_form_or_the_joint_a_7r_arm_holds(capsys):
+def test_info_names_the_closed_form_the_search_or_the_joint_a_7r_arm_holds(capsys):
     lines = {}
-    for name in ("ur5", "kinova", "panda", "youbot"):
+    for name in ("ur5", "kinova", "panda", "youbot", "xarm6", "baxter_left"):
         code, out, _ = run(capsys, "info", name)
         assert code == 0
-        lines[name] = next(line for line in out.splitlines() if line.startswith("closed form: "))
-    assert lines["ur5"] == "closed form: 6R, axes 2, 3, 4 parallel, axes 5 and 6 meeting: every branch in closed form"
+        lines[name] = next(line for line in out.splitlines() if line.startswith("branches: "))
+    assert lines["ur5"] == "branches: 6R, axes 2, 3, 4 parallel, axes 5 and 6 meeting: every branch in closed form"
     assert "spherical wrist" in lines["kinova"] and lines["kinova"].endswith("every branch in closed form")
-    assert lines["panda"].startswith("closed form: with joint 7 (panda_joint7) held: ")
-    assert "redundancy=K" in lines["panda"] and lines["youbot"].startswith("closed form: none")
+    assert lines["panda"].startswith("branches: with joint 7 (panda_joint7) held: ")
+    assert "redundancy=K" in lines["panda"] and lines["youbot"].startswith("branches: none")
+    assert lines["xarm6"] == ("branches: 6R, axes 2, 3 parallel, axes 4, 5 meeting: every branch by a 1-D search "
+                              "over joint 6")
+    assert lines["baxter_left"].startswith("branches: with joint 1 (left_s0) held: ") and "1-D search" in \
+        lines["baxter_left"]
 
 
 def test_fk_stanford_matches_the_papers_rotation(capsys):

@@ -166,7 +166,7 @@ def run_reach(args: argparse.Namespace) -> int:
         print(f"{robot.name}: {plural(summary['voxels'], 'voxel')} of {args.voxel:g} m × {spec.orientations} "
               f"orientations; {summary['reached_voxels']} voxels reached, mean reachability "
               f"{summary['mean_reachability']:.3f}"
-              + (f"; every branch in closed form: {summary['mean_branches']:.2f} per pose within the limits in the "
+              + (f"; every branch (docs/analytic.md): {summary['mean_branches']:.2f} per pose within the limits in the "
                  "reached voxels"
                  if summary["mean_branches"] is not None else "")
               + f"; {summary['seconds']:.1f} s"

@@ -72,7 +72,7 @@ def run_info(args: argparse.Namespace) -> int:
         print(f"mimic: {name} follows {m.leader}")
     if robot.locked:
         print(f"locked: {', '.join(f'{k}={v:g}' for k, v in robot.locked.items())}")
-    print(f"closed form: {info['closed_form']}")
+    print(f"branches: {info['closed_form']}")
     print(f"answers judged by: {info['judge']}")
     print(f"collisions: {info['collisions']}")
     return 0
