@@ -165,3 +165,19 @@ def test_solve_from_a_start_returns_the_searched_branch_nearest_it():
         preferred = kinelab.solve(crx, target, prefer=start)  # the nearest branch by solve_all's distance
         by_distance = min(branches, key=lambda s: distance(crx, s.q, start))
         assert np.max(np.abs(wrapped(preferred.q - by_distance.q))) <= 1e-9
+
+
+def test_a_held_value_given_by_name_returns_every_branch_there_and_bad_values_are_refused_by_name():
+    baxter = kinelab.load("baxter_left")
+    rng = np.random.default_rng(21)
+    for _ in range(20):
+        q = baxter.random_q(rng)
+        target = baxter.fk(q)
+        found = kinelab.solve_all(baxter, target, redundancy={"left_s0": float(q[0])})
+        assert contains(found, q) and all(abs(s.q[0] - q[0]) <= 1e-12 for s in found)
+        assert f"joint 1 held at {q[0]:.6g} rad" in found[0].mode
+    target = baxter.fk(baxter.random_q(rng))
+    for bad in ({"left_s1": 0.1}, {"left_s0": float("nan")}, {"left_s0": 9.0}, {"left_s0": "0.1"},
+                {"left_s0": 0.1, "left_s1": 0.2}):
+        with pytest.raises(kinelab.OptionError, match=r"\{'left_s0': a value in \[-1.70168, 1.70168\] rad\}"):
+            kinelab.solve_all(baxter, target, redundancy=bad)

@@ -241,7 +241,7 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
               tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float = 0.05, options: Any = None,
               task: str = "pose", axis: str = "z", q_ref: Any = None, max_solutions: int | None = None,
               stop_below: float | None = UNSEEN, collisions: Any = None, drop_colliding: bool = False,
-              redundancy: int | None = None, **solver_options: Any) -> list[IKResult]:
+              redundancy: int | dict[str, float] | None = None, **solver_options: Any) -> list[IKResult]:
     """The distinct solutions (branches) of ``target``: every one in closed form where the chain's geometry
     allows it (docs/analytic.md), else those that seeded starts find, in rounds of 64, until the estimated
     chance that one more start finds a new branch falls below ``stop_below`` or ``time_budget`` is spent.
@@ -272,7 +272,8 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
             ``collision``, ``diagnostics.contact`` naming the pair), or left out with ``drop_colliding``.
         drop_colliding: leave colliding branches out instead of marking them.
         redundancy: K, for a 7R arm that is analytic with its first or last joint held (the ERA): every
-            branch at K values of that joint, evenly spread over its range (docs/analytic.md); solver "auto" or
+            branch at K values of that joint, evenly spread over its range (docs/analytic.md); or
+            ``{joint name: value}`` [rad]: every branch with that joint at that value; solver "auto" or
             "analytic". None: a 7R arm gets the multistart.
 
     Returns:

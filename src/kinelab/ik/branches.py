@@ -17,7 +17,7 @@ import numpy as np
 
 from kinelab.errors import OptionError
 from kinelab.ik.analytic.branches import analytic_all, has_closed_form
-from kinelab.ik.analytic.redundancy import check_redundancy, redundant_all
+from kinelab.ik.analytic.redundancy import redundant_all
 from kinelab.ik.batch import fresh_seed, run_batch
 from kinelab.ik.limits import distance as distance  # exported: the branch distance users sort by
 from kinelab.ik.request import Request, count_ok
@@ -45,7 +45,7 @@ def unseen(counts: list[int]) -> float:
 
 def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_solutions: int | None = None,
              stop_below: float | None = UNSEEN, method: str = "multistart",
-             redundancy: int | None = None) -> list[IKResult]:
+             redundancy: int | dict[str, float] | None = None) -> list[IKResult]:
     """The distinct solutions of ``target``, each checked by Pinocchio: every branch in closed form where the
     chain's class allows it (:mod:`kinelab.ik.analytic`), else those seeded starts find within the request's
     time budget.
@@ -63,8 +63,9 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
             below this, after MIN_ROUNDS rounds (None: spend the whole budget).
         method: "multistart"; "analytic" (the closed form, refused by name where the chain or the task has
             none); "auto" (the closed form where there is one and the task is "pose", else the multistart).
-        redundancy: K samples of a 7R arm's swept end joint (:mod:`kinelab.ik.analytic.redundancy`), with
-            method "analytic" or "auto"; None: no sweep.
+        redundancy: K samples of a 7R arm's swept end joint (:mod:`kinelab.ik.analytic.redundancy`), or
+            ``{joint name: value}`` [rad] for that joint held at one value, with method "analytic" or "auto";
+            None: no sweep.
 
     Returns:
         One :class:`IKResult` per distinct solution. Multistart: ``diagnostics.found``, how many starts reached
@@ -83,7 +84,7 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
         if method == "multistart":
             raise OptionError("redundancy", redundancy, f"None with solver={req.solver!r} and options (redundancy= "
                               "sweeps a joint of the closed form: solver 'auto' or 'analytic', no options)")
-        return redundant_all(robot, target, req, check_redundancy(redundancy), ref, max_solutions)
+        return redundant_all(robot, target, req, redundancy, ref, max_solutions)
     if method == "analytic" or (method == "auto" and has_closed_form(robot, req)):
         return analytic_all(robot, target, req, q_ref=ref, max_solutions=max_solutions)
     return _multistart_all(robot, target, req, ref, max_solutions, stop_below)

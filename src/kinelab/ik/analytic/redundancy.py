@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -55,7 +56,7 @@ class SweptArm:
         return back @ H if self.joint == 0 else H @ back
 
 
-def swept_arm(robot: Robot, k: int | None = None) -> SweptArm:
+def swept_arm(robot: Robot, k: object = None) -> SweptArm:
     """The robot's swept form, built once per Robot.
 
     Raises:
@@ -122,8 +123,30 @@ def check_redundancy(k: object) -> int:
         OptionError: K is not an integer in [1, 4096].
     """
     if isinstance(k, bool) or not isinstance(k, int | np.integer) or not 1 <= k <= 4096:
-        raise OptionError("redundancy", k, "an integer in [1, 4096]: the samples of the swept joint, or None")
+        raise OptionError("redundancy", k, "an integer in [1, 4096]: the samples of the swept joint, or "
+                          "{joint name: value}, or None")
     return int(k)
+
+
+def held_values(robot: Robot, redundancy: object) -> tuple[np.ndarray, str]:
+    """The values [rad] of the swept joint that ``redundancy`` asks for, and how they read in ``mode``: K samples
+    (:func:`samples`), or the one value of ``{joint name: value}``.
+
+    Raises:
+        OptionError: K out of range, or a mapping that does not name the swept joint once with a finite value
+            within its limits (the joint and its limits named), or a chain that cannot be swept.
+    """
+    sw = swept_arm(robot, redundancy)
+    joint = robot.joints[sw.joint]
+    if not isinstance(redundancy, Mapping):
+        k = check_redundancy(redundancy)
+        return samples(float(robot.lower[sw.joint]), float(robot.upper[sw.joint]), k), f"swept over {k} samples"
+    value = redundancy.get(joint.name) if len(redundancy) == 1 else None
+    lo, hi = float(robot.lower[sw.joint]), float(robot.upper[sw.joint])
+    if isinstance(value, bool) or not isinstance(value, int | float | np.number) or not lo <= float(value) <= hi:
+        raise OptionError("redundancy", dict(redundancy), f"{{{joint.name!r}: a value in [{lo:.6g}, {hi:.6g}] rad}}, "
+                          "the joint the closed form holds, or an integer K")
+    return np.array([float(value)]), f"held at {float(value):.6g} rad"
 
 
 def at_value(robot: Robot, target: pin.SE3, req: Request, theta: float,
@@ -147,16 +170,16 @@ def at_value(robot: Robot, target: pin.SE3, req: Request, theta: float,
     return answers
 
 
-def redundant_all(robot: Robot, target: pin.SE3, req: Request, k: int, q_ref: np.ndarray | None = None,
-                  max_solutions: int | None = None) -> list[IKResult]:
-    """Every branch of ``target`` (oMtarget, base frame) at K values of the swept joint, each judged by
-    Pinocchio within the limits.
+def redundant_all(robot: Robot, target: pin.SE3, req: Request, redundancy: object,
+                  q_ref: np.ndarray | None = None, max_solutions: int | None = None) -> list[IKResult]:
+    """Every branch of ``target`` (oMtarget, base frame) at the values of the swept joint ``redundancy`` asks for
+    (:func:`held_values`), each judged by Pinocchio within the limits.
 
     Args:
         robot: a 7R robot that :func:`swept_arm` accepts.
         target: the pose.
         req: the validated request (task "pose").
-        k: samples of the swept joint (:func:`samples`).
+        redundancy: K samples of the swept joint (:func:`samples`), or ``{joint name: value}`` for one value.
         q_ref: sort the answers by distance to this configuration; each angle's copy is picked nearest it.
         max_solutions: at most this many answers (the nearest ``q_ref`` first when given).
 
@@ -164,20 +187,20 @@ def redundant_all(robot: Robot, target: pin.SE3, req: Request, k: int, q_ref: np
         One :class:`IKResult` per answer; ``diagnostics.branches`` counts them all.
 
     Raises:
-        OptionError: the chain cannot be swept, or the task is not "pose".
+        OptionError: the chain cannot be swept, ``redundancy`` is not valid, or the task is not "pose".
     """
     t0 = time.perf_counter()
     if req.task.name != "pose":
         raise OptionError("task", req.task_label, "'pose' with redundancy= (other tasks: solver='frdm')")
-    sw = swept_arm(robot, k)
-    j = sw.joint
+    values, how = held_values(robot, redundancy)
+    sw = swept_arm(robot)
     answers = []
-    for theta in samples(float(robot.lower[j]), float(robot.upper[j]), k):
+    for theta in values:
         answers += at_value(robot, target, req, float(theta), q_ref)
     if q_ref is not None:
         answers.sort(key=lambda a: distance(robot, a[0], q_ref))
     search = f"; {sw.arm.method.removeprefix('every branch by a ')} of the other six" if sw.arm.searched else ""
-    mode = f"analytic ({sw.arm.name}{search}; joint {j + 1} swept over {k} samples)"
+    mode = f"analytic ({sw.arm.name}{search}; joint {sw.joint + 1} {how})"
     return branch_results(answers, req, mode, time.perf_counter() - t0, max_solutions, None)
 
 
