@@ -282,8 +282,8 @@ def _no_branch(robot: Robot, target: Any, req: Request, q0: np.ndarray | None, c
     dp, dr = robot.tool_error(np.clip(q, robot.lower, robot.upper), target)
     return IKResult(q=q, success=False, status=Status.UNREACHABLE, position_error=dp, rotation_error=dr,
                     iterations=0, restarts=0, wall_time=time.perf_counter() - t0, solver="analytic", mode=mode,
-                    message="no branch of the closed form meets the pose within the joint limits: the pose is beyond "
-                            "the arm's reach, or only reached with a joint outside its limits",
+                    message="no branch (closed form or 1-D search) meets the pose within the joint limits: the pose is "
+                            "beyond the arm's reach, or only reached with a joint outside its limits",
                     task=req.task_label, diagnostics=Diagnostics(path="compiled", branches=0))
 
 
