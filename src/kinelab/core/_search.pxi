@@ -28,6 +28,7 @@ cdef enum:
 
 cdef double REFINE_TOL = 1e-15  # [rad] a root's bracket is narrowed to this
 cdef double TURN = 0.03  # [rad] a span whose shoulder joints turn more than this between samples is halved
+cdef double END_ROOT = 1e-8  # an error this small where a way ends is a root there (the pose met to about as much)
 cdef double DOUBLE_ROOT = 1e-10  # a dip of |e| to this is a double root (its pose is met to about as much)
 cdef int MAX_DEPTH = 8  # halvings at most (a span of 2π/SAMPLES/256)
 
@@ -237,7 +238,7 @@ cdef int _edge(const Search* S, int w, double last, double e_last, double outsid
             outside = mid
     if end == last:
         return row
-    if e_end == 0.0:
+    if fabs(e_end) <= END_ROOT:  # a root at the end itself: the fold is a double root of a subproblem
         row = _root(S, end, w, rows, row)
     row = _stretch(S, w, last, e_last, end, e_end, rows, row)
     if e_inner == e_inner and not _opposite(e_inner, e_last) and e_last != 0.0 and fabs(e_last) < fabs(e_inner):
@@ -247,30 +248,32 @@ cdef int _edge(const Search* S, int w, double last, double e_last, double outsid
 
 cdef int _stretch(const Search* S, int w, double a, double ea, double b, double eb, Rows* rows,
                   int row) noexcept nogil:
-    """The roots of way w from a to b (errors ea, eb), searched over PIECES equal pieces: each sign change refined,
-    each dip of |e| between pieces searched; returns the next row."""
+    """The roots of way w from a sample a to the way's end b (errors ea, eb), searched over PIECES pieces that
+    shrink towards the end as the square of their distance (there e turns like the square root of it): each sign
+    change refined, each dip of |e| between pieces searched; returns the next row."""
     cdef double f[PIECES + 1]
-    cdef double step = (b - a) / PIECES, sign
+    cdef double t[PIECES + 1]
+    cdef double sign
     cdef int i
-    f[0], f[PIECES] = ea, eb
+    for i in range(PIECES + 1):
+        t[i] = b + (a - b) * ((PIECES - i) / <double> PIECES) ** 2
+    f[0], f[PIECES], t[0], t[PIECES] = ea, eb, a, b
     for i in range(1, PIECES):
-        f[i] = _way(S, a + i * step, w)
+        f[i] = _way(S, t[i], w)
     for i in range(PIECES):
         if f[i] != f[i] or f[i + 1] != f[i + 1]:
             continue
         if f[i] == 0.0 and i > 0:
-            row = _root(S, a + i * step, w, rows, row)
+            row = _root(S, t[i], w, rows, row)
         elif _opposite(f[i], f[i + 1]):
-            row = _root(S, _refine(S, w, a + i * step, f[i], a + (i + 1) * step, f[i + 1]), w, rows, row)
+            row = _root(S, _refine(S, w, t[i], f[i], t[i + 1], f[i + 1]), w, rows, row)
         elif f[i] != 0.0 and f[i + 1] != 0.0:  # a dip: |e| least at a piece's end, or falling to either end
             sign = 1.0 if f[i] > 0 else -1.0
             if i > 0 and f[i - 1] == f[i - 1] and not _opposite(f[i - 1], f[i]) and fabs(f[i]) < fabs(f[i - 1]) \
                     and fabs(f[i]) <= fabs(f[i + 1]):
-                row = _dip(S, w, _min(a + (i - 1) * step, a + (i + 1) * step),
-                           _max(a + (i - 1) * step, a + (i + 1) * step), sign, rows, row)
+                row = _dip(S, w, _min(t[i - 1], t[i + 1]), _max(t[i - 1], t[i + 1]), sign, rows, row)
             elif (i == 0 and fabs(f[0]) < fabs(f[1])) or (i == PIECES - 1 and fabs(f[PIECES]) < fabs(f[i])):
-                row = _dip(S, w, _min(a + i * step, a + (i + 1) * step), _max(a + i * step, a + (i + 1) * step),
-                           sign, rows, row)
+                row = _dip(S, w, _min(t[i], t[i + 1]), _max(t[i], t[i + 1]), sign, rows, row)
     return row
 
 
