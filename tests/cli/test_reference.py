@@ -27,7 +27,7 @@ def test_every_option_named_in_the_readme_exists():
             if hasattr(action, "choices") and isinstance(action.choices, dict):
                 stack += list(action.choices.values())
     readme = (ROOT / "README.md").read_text()
-    commands = re.findall(r"kinelab (?:robots|info|fk|ik|singular|view|animate|bench|map|validate)\b[^`\n]*",
+    commands = re.findall(r"kinelab (?:robots|info|fk|ik|branches|singular|view|animate|bench|map|validate)\b[^`\n]*",
                           readme)
     named = {option for line in commands for option in re.findall(r"(?<![\w-])(--[a-z][a-z-]+)", line)}
     assert len(commands) > 10 and named <= options, sorted(named - options)

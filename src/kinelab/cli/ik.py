@@ -93,6 +93,11 @@ def run(args: argparse.Namespace) -> int:
     return 0 if result.success else 1
 
 
+def target_of(robot: Robot, args: argparse.Namespace) -> Any:
+    """The target pose of ``--target-q`` or ``--target-xyz``/``--target-rpy`` (shared with ``kinelab branches``)."""
+    return _target(robot, args)[0]
+
+
 def _target(robot: Robot, args: argparse.Namespace) -> tuple[Any, dict[str, Any]]:
     """The target pose, and the biquaternion solver's signed target when it is given as a configuration."""
     from kinelab.ik import target_from_xyz_rpy

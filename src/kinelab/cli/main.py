@@ -1,10 +1,10 @@
 """The ``kinelab`` command: the parser of every subcommand, and how a run ends.
 
 Each command lives in a module of its own with its parser beside its handler (:mod:`~kinelab.cli.robots`,
-:mod:`~kinelab.cli.fk`, :mod:`~kinelab.cli.ik`, :mod:`~kinelab.cli.singular`, :mod:`~kinelab.cli.view`,
-:mod:`~kinelab.cli.bench`, :mod:`~kinelab.cli.maps`, :mod:`~kinelab.cli.validate`); what they share is in
-:mod:`~kinelab.cli.common`. User errors print one line and exit with code 2; Ctrl-C exits with 130. Every
-command that prints results takes ``--json`` for a stable machine-readable form (see README).
+:mod:`~kinelab.cli.fk`, :mod:`~kinelab.cli.ik`, :mod:`~kinelab.cli.branches`, :mod:`~kinelab.cli.singular`,
+:mod:`~kinelab.cli.view`, :mod:`~kinelab.cli.bench`, :mod:`~kinelab.cli.maps`, :mod:`~kinelab.cli.validate`);
+what they share is in :mod:`~kinelab.cli.common`. User errors print one line and exit with code 2; Ctrl-C exits
+with 130. Every command that prints results takes ``--json`` for a stable machine-readable form (see README).
 """
 
 from __future__ import annotations
@@ -15,11 +15,11 @@ import sys
 import warnings
 from typing import Any
 
-from kinelab.cli import bench, fk, ik, maps, robots, singular, validate, view
+from kinelab.cli import bench, branches, fk, ik, maps, robots, singular, validate, view
 from kinelab.cli.common import Parser
 from kinelab.errors import KinelabError
 
-COMMANDS = (robots, fk, ik, singular, view, bench, maps, validate)
+COMMANDS = (robots, fk, ik, branches, singular, view, bench, maps, validate)
 
 
 class _Version(argparse.Action):

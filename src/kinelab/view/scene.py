@@ -261,7 +261,8 @@ class Scene:
 
 
 
-def side_by_side(robot: Robot, qs: list, spacing: float | None = None, viewer: Any = None) -> Scene:
+def side_by_side(robot: Robot, qs: list, spacing: float | None = None, viewer: Any = None,
+                 labels: list[str] | None = None, highlight: int | None = None) -> Scene:
     """One scene with the robot drawn once per configuration as a stick figure (joints as spheres, the
     segments between joint origins and the tool point as cylinders), side by side on a grid (columns
     along the base y axis, rows along x): the branches of one IK target, say, each with its tool frame.
@@ -273,16 +274,21 @@ def side_by_side(robot: Robot, qs: list, spacing: float | None = None, viewer: A
         qs: the configurations (one number per joint each, rad or m), at least one.
         spacing: distance between neighbouring copies [m]; default 0.9 × the arm's reach.
         viewer: a meshcat viewer to draw in (default: a new one on 127.0.0.1).
+        labels: one label per configuration, named with its place in the grid in the caption (default "copy k").
+        highlight: the index of a copy drawn with orange joints (the nearest branch, say), named in the caption.
 
     Returns:
         A :class:`Scene` whose viewer holds the row (``save_html`` writes it; ``close`` stops its server).
 
     Raises:
         ConfigurationError: a q of the wrong length, non-finite, or no q at all.
+        ValueError: labels of another length than qs.
     """
     checked = [robot.check_q(q) for q in qs]
     if not checked:
         raise ConfigurationError("side_by_side needs at least one configuration; got none")
+    if labels is not None and len(labels) != len(checked):
+        raise ValueError(f"side_by_side: {len(labels)} labels for {len(checked)} configurations")
     scene = Scene(robot, viewer=viewer)
     scene.viewer[scene.root].delete()
     scene.viewer["frames"].delete()
@@ -292,13 +298,23 @@ def side_by_side(robot: Robot, qs: list, spacing: float | None = None, viewer: A
     for k, q in enumerate(checked):
         offset = pin.SE3(np.eye(3), np.array([(k // columns) * spacing, (k % columns) * spacing, 0.0]))
         points = chain_points(robot, q)
-        _stick_figure(scene.viewer["branches"][str(k)], [offset.act(p) for p in points], scene.frame_length)
+        _stick_figure(scene.viewer["branches"][str(k)], [offset.act(p) for p in points], scene.frame_length,
+                      HIGHLIGHT if k == highlight else JOINTS)
         scene.frame(f"tool_{k}", offset * robot.fk(q))
         occupied += [offset.act(p) for p in points] + [offset.translation]
     scene.title = f"{robot.name}: {len(checked)} configurations side by side"
     scene.legend = {"figures": "joints: blue spheres; links: grey cylinders; copies in rows along the base x axis",
-                    "tool": "tool frames: x red, y green, z blue"}
+                    "tool": "tool frames: x red, y green, z blue",
+                    "copies": _grid_labels(labels or [f"copy {k + 1}" for k in range(len(checked))], columns)}
+    if highlight is not None:
+        scene.legend["highlight"] = f"orange joints: {(labels or [])[highlight] if labels else f'copy {highlight + 1}'}"
     return scene._aim(np.array(occupied), fill=SPREAD_FILL if len(checked) > 1 else FILL)
+
+
+def _grid_labels(labels: list[str], columns: int) -> str:
+    """Where each copy stands, in words: "row 1 (nearest the base), column 1 (at the base's y = 0): label; ..."."""
+    return "; ".join(f"row {k // columns + 1}, column {k % columns + 1}: {label}" for k, label in enumerate(labels)) \
+        + " (rows counted along the base x axis from the first copy, columns along y)"
 
 
 def chain_points(robot: Robot, q: Any) -> list[np.ndarray]:
@@ -306,13 +322,17 @@ def chain_points(robot: Robot, q: Any) -> list[np.ndarray]:
     return [m.translation for m in robot.joint_placements(q).values()] + [robot.fk(q).translation]
 
 
-def _stick_figure(node, points: list[np.ndarray], size: float) -> None:
-    """Spheres at the points and cylinders between consecutive distinct ones, under the meshcat ``node``."""
+JOINTS, HIGHLIGHT = 0x4363D8, 0xF58231  # blue, orange
+
+
+def _stick_figure(node, points: list[np.ndarray], size: float, colour: int = JOINTS) -> None:
+    """Spheres (``colour``) at the points and cylinders between consecutive distinct ones, under the meshcat
+    ``node``."""
     import meshcat.geometry as g
 
     radius = 0.16 * size  # links as thick as an arm's: readable when a page holds a grid of copies
     for k, p in enumerate(points):
-        node[f"joint{k}"].set_object(g.Sphere(1.6 * radius), g.MeshLambertMaterial(color=0x4363D8))
+        node[f"joint{k}"].set_object(g.Sphere(1.6 * radius), g.MeshLambertMaterial(color=colour))
         node[f"joint{k}"].set_transform(pin.SE3(np.eye(3), p).homogeneous)
     for k, (a, b) in enumerate(zip(points, points[1:], strict=False)):
         length = float(np.linalg.norm(b - a))

@@ -1,0 +1,116 @@
+"""``kinelab branches``: every inverse-kinematics branch of one pose, as a table and, with ``--html``, side by side."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+import numpy as np
+
+from kinelab.cli.common import (
+    json_flag,
+    load_robot,
+    pose_dict,
+    print_json,
+    q_from_cli,
+    seed_argument,
+    source_arguments,
+)
+from kinelab.errors import KinelabError
+from kinelab.ik.result import IKResult
+from kinelab.robot import Robot
+
+
+def add(sub: Any) -> None:
+    """The ``branches`` subcommand."""
+    s = sub.add_parser("branches", help="every inverse-kinematics branch of a pose: a table, or a page with --html")
+    s.add_argument("robot", help="registered name or model file (URDF, xacro, MJCF)")
+    s.add_argument("--target-q", nargs="+", help="target as a configuration (its FK pose), or an SRDF name")
+    s.add_argument("--target-xyz", nargs=3, type=float, help="target position [m] in the base frame")
+    s.add_argument("--target-rpy", nargs=3, type=float,
+                   help="target roll, pitch, yaw (rad; deg with --deg); without it the target rotation is the identity")
+    s.add_argument("--ref-q", nargs="+", help="sort the branches nearest this configuration first (or an SRDF name)")
+    s.add_argument("--deg", action="store_true", help="angles in degrees (revolute/continuous joints, rpy)")
+    s.add_argument("--solver", default="auto", choices=("auto", "analytic", "frdm", "dls"),
+                   help="auto (default: the closed form or 1-D search where the arm has one, else the multistart), "
+                        "analytic (refused, with the reason, where there is none), frdm or dls (the multistart)")
+    s.add_argument("--redundancy", type=int, metavar="K",
+                   help="a 7R arm with a joint held (docs/analytic.md): every branch at K values of that joint")
+    seed_argument(s)
+    s.add_argument("--time-budget", type=float, default=0.05,
+                   help="the multistart's wall-clock budget [s] (default 0.05); the closed form needs none")
+    s.add_argument("--html", help="also write the branches side by side, labelled, as a self-contained page")
+    source_arguments(s)
+    json_flag(s, "the branches")
+    s.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Find, print (or print as JSON), and with --html draw, every branch; exit 0 when there is one, 1 when none."""
+    from kinelab.cli.ik import target_of
+    from kinelab.ik import solve_all
+
+    robot = load_robot(args)
+    target = target_of(robot, args)
+    ref = None if args.ref_q is None else q_from_cli(robot, args.ref_q, args.deg, "--ref-q")
+    found = solve_all(robot, target, solver=args.solver, seed=args.seed, time_budget=args.time_budget, q_ref=ref,
+                      redundancy=args.redundancy)
+    if args.json:
+        print_json({"robot": robot.name, "target": pose_dict(target), "method": _method(found),
+                    "completeness": _completeness(found), "branches": [r.to_dict() for r in found]})
+    else:
+        _print_branches(robot, args, found, ref)
+    if args.html:
+        _write_page(robot, found, args.html, ref is not None)
+    return 0 if found else 1
+
+
+def _method(found: list[IKResult]) -> str:
+    return found[0].mode if found else "none found"
+
+
+def _completeness(found: list[IKResult]) -> str:
+    """How sure the list is to hold every branch, in words."""
+    if not found:
+        return "no branch found: the pose is out of reach or every branch is outside the joint limits"
+    first = found[0]
+    if first.solver == "analytic" and first.diagnostics.unseen == 0.0:
+        return "every branch: closed form"
+    if first.solver == "analytic":
+        return ("every branch the search finds, each root refined to rounding (measured: docs/analytic.md, "
+                "Completeness)")
+    return f"multistart: chance that one more start finds a new branch estimated at {first.diagnostics.unseen:.2g}"
+
+
+def _print_branches(robot: Robot, args: argparse.Namespace, found: list[IKResult], ref: Any) -> None:
+    """One line per branch: its configuration and Pinocchio's errors (nearest ``ref`` first when given)."""
+    unit = " [deg, m]" if args.deg else " [rad, m]"
+    print(f"{robot.name}: {len(found)} branch{'es' if len(found) != 1 else ''}, {_method(found)}")
+    print(f"  {_completeness(found)}")
+    if ref is not None:
+        print("  nearest --ref-q first (revolute joints compared modulo 2π)")
+    for k, r in enumerate(found):
+        q = np.where([j != "prismatic" for j in robot.joint_kinds], np.rad2deg(r.q), r.q) if args.deg else r.q
+        print(f"  {k + 1:>2}  q{unit} {' '.join(f'{v:9.4f}' for v in q)}   errors {r.position_error:.1e} m, "
+              f"{r.rotation_error:.1e} rad"
+              + (f"  ({r.message})" if r.message else ""))
+    if found:
+        print(f"  {found[0].wall_time * 1e3:.2f} ms for all of them (solve_all; the first call in a process also "
+              "loads the solver)")
+
+
+def _write_page(robot: Robot, found: list[IKResult], path: str, nearest_first: bool) -> None:
+    """The branches side by side, each copy labelled in the caption by its number (nearest first when sorted)."""
+    from kinelab.view.scene import side_by_side
+
+    if not found:
+        raise KinelabError("no branch to draw: the pose has none within the joint limits")
+    labels = [f"branch {k + 1}" + (" (nearest --ref-q)" if nearest_first and k == 0 else "")
+              for k in range(len(found))]
+    scene = side_by_side(robot, [r.q for r in found], labels=labels, highlight=0 if nearest_first else None)
+    scene.title = f"{robot.name}: {len(found)} branch{'es' if len(found) != 1 else ''} of one pose, {_method(found)}"
+    try:
+        scene.save_html(path)
+    finally:
+        scene.close()
+    print(f"wrote {path}")

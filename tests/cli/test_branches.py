@@ -1,0 +1,88 @@
+"""``kinelab branches``: every branch of a pose on the command line, checked against Pinocchio's FK."""
+
+import json
+import os
+
+import numpy as np
+import pytest
+from browser import find_chromium, scene_paths, screenshot
+
+import kinelab
+from kinelab import cli
+
+UR5_Q = ["0.3", "-1.2", "1.0", "-0.5", "0.8", "0.2"]
+CRX_SIXTEEN = ["-2.57382778", "1.29186362", "-0.93753732", "-2.98766846", "-2.72802256", "-1.92793594"]
+
+
+def run(capsys, *argv):
+    code = cli.main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_every_branch_of_a_ur5_pose_is_printed_nearest_first_and_each_meets_the_pose(capsys):
+    ur5 = kinelab.load("ur5")
+    target = ur5.fk(np.array(UR5_Q, dtype=float))
+    code, out, _ = run(capsys, "branches", "ur5", "--target-q", *UR5_Q, "--ref-q", *UR5_Q, "--json")
+    found = json.loads(out)
+    assert code == 0 and len(found["branches"]) == 8 and found["completeness"] == "every branch: closed form"
+    qs = np.array([b["q"] for b in found["branches"]])
+    assert np.abs(qs[0] - np.array(UR5_Q, dtype=float)).max() <= 1e-9  # the reference itself is a branch: first
+    for q in qs:
+        assert max(ur5.tool_error(q, target)) <= 1e-9
+    assert len({tuple(np.round(q, 6)) for q in qs}) == 8
+    code, out, _ = run(capsys, "branches", "ur5", "--target-q", *UR5_Q, "--ref-q", *UR5_Q)
+    lines = out.splitlines()
+    assert code == 0 and lines[0].startswith("ur5: 8 branches, analytic") and "nearest --ref-q first" in out
+    rows = [line.split() for line in lines if line.strip()[:2].strip().isdigit()]
+    assert [int(r[0]) for r in rows] == list(range(1, 9))
+    np.testing.assert_allclose([float(v) for v in rows[0][4:10]], np.array(UR5_Q, dtype=float), atol=1e-4)
+
+
+def test_a_crx_pose_prints_its_sixteen_searched_branches(capsys):
+    code, out, _ = run(capsys, "branches", "crx10ia", "--target-q", *CRX_SIXTEEN, "--json")
+    found = json.loads(out)
+    assert code == 0 and len(found["branches"]) == 16 and "1-D search over joint 6" in found["method"]
+    assert "search" in found["completeness"]
+    crx = kinelab.load("crx10ia")
+    target = crx.fk(np.array(CRX_SIXTEEN, dtype=float))
+    assert all(max(crx.tool_error(np.array(b["q"]), target)) <= 1e-9 for b in found["branches"])
+
+
+def test_an_unreachable_pose_exits_1_and_bad_input_exits_2_with_one_line(capsys):
+    code, out, _ = run(capsys, "branches", "ur5", "--target-xyz", "5", "0", "0")
+    assert code == 1 and out.startswith("ur5: 0 branches") and "out of reach" in out
+    for argv in (("branches", "ur5"), ("branches", "ur5", "--target-q", "1", "2"),
+                 ("branches", "ur5", "--target-q", *UR5_Q, "--redundancy", "8"),
+                 ("branches", "stanford", "--target-q", "0", "0", "0.3", "0", "0", "0", "--solver", "analytic")):
+        code, out, err = run(capsys, *argv)
+        assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, argv
+
+
+def test_the_page_draws_every_branch_and_names_the_nearest(capsys, tmp_path):
+    page = tmp_path / "b.html"
+    code, out, _ = run(capsys, "branches", "ur5", "--target-q", *UR5_Q, "--ref-q", *UR5_Q, "--html", str(page))
+    assert code == 0 and f"wrote {page}" in out
+    html = page.read_text()
+    assert "orange joints: branch 1 (nearest --ref-q)" in html and "row 3, column 2: branch 8" in html
+    assert {f"/meshcat/branches/{k}/joint0" for k in range(8)} <= scene_paths(html)
+
+
+@pytest.mark.browser
+@pytest.mark.skipif(find_chromium() is None and not os.environ.get("CI"),
+                    reason="no chromium on PATH (Debian: apt-get install chromium)")
+def test_the_nearest_branch_is_orange_in_the_browser(capsys, tmp_path):
+    """The highlighted copy is drawn in orange: the page with --ref-q has orange pixels, the page without none."""
+    with_ref, without = tmp_path / "ref.html", tmp_path / "plain.html"
+    run(capsys, "branches", "ur5", "--target-q", *UR5_Q, "--ref-q", *UR5_Q, "--html", str(with_ref))
+    run(capsys, "branches", "ur5", "--target-q", *UR5_Q, "--html", str(without))
+    from PIL import Image
+
+    a = screenshot(with_ref, tmp_path / "ref.png", size=(1200, 900))
+    b = screenshot(without, tmp_path / "plain.png", size=(1200, 900))
+
+    def orange(png):
+        rgb = np.asarray(Image.open(png).convert("RGB"), dtype=int)
+        return int(((rgb[..., 0] > 180) & (rgb[..., 1] > 80) & (rgb[..., 1] < 170) & (rgb[..., 2] < 90)).sum())
+
+    assert orange(a) > 200 and orange(b) == 0
