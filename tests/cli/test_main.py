@@ -101,6 +101,14 @@ def test_ik_reaches_the_papers_stanford_target_and_reports_pinocchios_errors(cap
     assert res["position_error_m"] <= 1e-6 and res["rotation_error_rad"] <= 1e-6
 
 
+def test_ik_says_what_its_time_measured_and_prints_frdm_s_monitor_for_frdm_alone(capsys):
+    q = ["0.3", "-1.2", "1.0", "-0.5", "0.8", "0.2"]
+    code, out, _ = run(capsys, "ik", "ur5", "--target-q", *q, "--solver", "analytic")
+    assert code == 0 and "ms (one call, first-call costs included" in out and "monitor" not in out
+    code, out, _ = run(capsys, "ik", "ur5", "--target-q", *q, "--seed", "0")
+    assert code == 0 and "ms (one call, first-call costs included" in out and "monitor did not fire" in out
+
+
 def test_ik_beyond_reach_is_unreachable_with_exit_1(capsys):
     code, out, _ = run(capsys, "ik", "ur5", "--target-xyz", "3", "0", "0", "--json")
     res = json.loads(out)

@@ -190,7 +190,8 @@ def _print_ik(robot: Robot, args: argparse.Namespace, result: IKResult) -> None:
           f"{'axis' if args.task == 'axis' else 'rotation'} error {result.rotation_error:.3e} rad"
           f"{' (free)' if free[1] else ''} (Pinocchio FK)")
     print(f"  {plural(result.iterations, 'iteration')}, {plural(result.restarts, 'restart')}, "
-          f"{result.wall_time * 1e3:.2f} ms, mode {result.mode}")
+          f"{result.wall_time * 1e3:.2f} ms (one call, first-call costs included; `kinelab bench` times repeated "
+          f"calls), mode {result.mode}")
     if result.diagnostics.model_time:
         m0 = result.diagnostics.M0
         print(f"  model time {result.diagnostics.model_time:.4g} s, final M0 = "
