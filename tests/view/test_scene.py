@@ -192,3 +192,51 @@ def test_a_branch_grid_is_readable_at_1280_by_900(tmp_path):
     share = browser.changed_share(browser.screenshot(page, tmp_path / "b.png", size=size),
                                   browser.screenshot(tmp_path / "empty.html", tmp_path / "e.png", size=size))
     assert len(branches) >= 4 and share > 0.012, f"the branches cover only {share:.2%} of the picture"
+
+
+MISSING_MESHES = """<link name="base"><visual><geometry><mesh filename="package://missing_pkg/meshes/base.stl"/></geometry>
+</visual></link>
+<link name="l1"><visual><geometry><mesh filename="meshes/l1.stl"/></geometry></visual></link>
+<link name="tool"/>
+<joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><origin xyz="0 0 0.3"/><axis xyz="0 1 0"/>
+<limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+<joint name="t" type="fixed"><parent link="l1"/><child link="tool"/><origin xyz="0.4 0 0"/></joint>"""
+
+
+def test_a_robot_without_drawable_visuals_is_a_stick_figure_and_the_caption_says_why(tmp_path):
+    from helpers import write_urdf
+
+    lost = kinelab.load(write_urdf(tmp_path, MISSING_MESHES), tool="tool")
+    with pytest.warns(UserWarning, match="2 visual mesh"):
+        s = viz.Scene(lost).show([0.4])
+    html = s.static_html()
+    s.close()
+    paths = browser.scene_paths(html)
+    assert {"/meshcat/stick/joint0", "/meshcat/stick/joint1", "/meshcat/stick/link0"} <= paths  # joint 1, tool
+    assert "2 visual mesh(es) of the file not found (first: package://missing_pkg/meshes/base.stl" in html
+    assert "drawn as a stick figure" in html
+    s = viz.Scene(kinelab.load("xarm6")).show(np.zeros(6))
+    html = s.static_html()
+    s.animate(np.linspace(np.zeros(6), np.full(6, 0.5), 5))  # the stick figure moves with the frames
+    s.close()
+    assert "the file has no visual geometry: drawn as a stick figure" in html
+    assert len({p for p in browser.scene_paths(html) if p.startswith("/meshcat/stick/joint")}) == 7  # 6 origins, tool
+    s = viz.Scene(kinelab.load("ur5"))
+    html = s.static_html()
+    s.close()
+    assert not any(p.startswith("/meshcat/stick") for p in browser.scene_paths(html)) and "stick figure" not in html
+
+
+@pytest.mark.browser
+@needs_browser
+def test_a_meshless_robot_is_drawn_in_the_browser(tmp_path):
+    if CHROMIUM is None:
+        pytest.fail("CI must have chromium: .ci/run installs Debian's chromium")
+    s = viz.Scene(kinelab.load("crx10ia")).show([0.3, 0.5, 0.2, 0.4, 0.6, 0.1])
+    page = s.save_html(tmp_path / "crx.html")
+    s.viewer["stick"].delete()
+    (tmp_path / "empty.html").write_text(s.static_html())
+    s.close()
+    share = browser.changed_share(browser.screenshot(page, tmp_path / "crx.png"),
+                                  browser.screenshot(tmp_path / "empty.html", tmp_path / "empty.png"))
+    assert share > 0.005, f"the stick figure covers only {share:.2%} of the picture"

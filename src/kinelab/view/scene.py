@@ -45,7 +45,9 @@ class Scene:
             viewer_url = self.server.zmq_url
         with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL; we expose it as .url
             self.viewer = viewer if viewer is not None else meshcat.Visualizer(zmq_url=viewer_url)
-        self.geom = robot.visual_model()
+        self.geom, missing = _visuals(robot)
+        self.stick = self.geom.ngeoms == 0  # nothing to draw from the file: the chain as a stick figure
+        self._lengths: list[float] = []
         self.pinviz = MeshcatVisualizer(robot.model, pin.GeometryModel(), self.geom)
         self.pinviz.initViewer(viewer=self.viewer)
         self.root = name or robot.name
@@ -54,6 +56,8 @@ class Scene:
         self._reach = self._arm_reach()
         self.title = robot.name
         self.legend: dict[str, str] = {}  # what each mark means, by mark (the caption's lines)
+        if missing or self.stick:
+            self.legend["figure"] = _figure_note(robot, missing, self.stick)
         self.viewer["/Axes"].set_property("visible", False)  # an unlabelled world triad; the tool frame is drawn
         self.show(robot.display_q())
         if open:
@@ -118,6 +122,8 @@ class Scene:
         """Draw the robot at q (one number per joint) with its tool frame."""
         q = self.robot.check_q(q)
         self.pinviz.display(self.robot.to_pin_q(q))
+        if self.stick:
+            self._lengths = _stick_figure(self.viewer["stick"], chain_points(self.robot, q), self.frame_length)
         self.frame("tool", self.robot.fk(q))
         self.title = f"{self.robot.name} at q = [{', '.join(f'{v:.4g}' for v in q)}] (rad, m)"
         self.legend["tool"] = f"tool frame {self.robot.tool!r}: x red, y green, z blue"
@@ -167,6 +173,8 @@ class Scene:
                     T = gdata.oMg[self.geom.getGeometryId(obj.name)].homogeneous.copy()
                     T[:3, :3] = T[:3, :3] * np.asarray(obj.meshScale)
                     frame[path].set_transform(T)
+                if self.stick:
+                    _move_stick(frame["stick"], chain_points(self.robot, q), self._lengths)
                 oMtool = self.robot.fk(q)
                 frame["frames"]["tool"].set_transform(oMtool.homogeneous)
             tool_points.append(oMtool.translation)
@@ -325,20 +333,64 @@ def chain_points(robot: Robot, q: Any) -> list[np.ndarray]:
 JOINTS, HIGHLIGHT = 0x4363D8, 0xF58231  # blue, orange
 
 
-def _stick_figure(node, points: list[np.ndarray], size: float, colour: int = JOINTS) -> None:
-    """Spheres (``colour``) at the points and cylinders between consecutive distinct ones, under the meshcat
-    ``node``."""
+def _stick_figure(node, points: list[np.ndarray], size: float, colour: int = JOINTS) -> list[float]:
+    """Spheres (``colour``) at the points and cylinders between consecutive ones, under the meshcat ``node``;
+    returns each segment's length [m] as drawn (0: two points at one place, no cylinder)."""
     import meshcat.geometry as g
 
     radius = 0.16 * size  # links as thick as an arm's: readable when a page holds a grid of copies
-    for k, p in enumerate(points):
+    lengths = []
+    for k in range(len(points)):
         node[f"joint{k}"].set_object(g.Sphere(1.6 * radius), g.MeshLambertMaterial(color=colour))
+    for k, (a, b) in enumerate(zip(points, points[1:], strict=False)):
+        length = float(np.linalg.norm(b - a))
+        lengths.append(length if length >= 1e-9 else 0.0)
+        if length >= 1e-9:
+            node[f"link{k}"].set_object(g.Cylinder(length, radius), g.MeshLambertMaterial(color=0xA9A9A9))
+    _move_stick(node, points, lengths)
+    return lengths
+
+
+def _move_stick(node, points: list[np.ndarray], lengths: list[float]) -> None:
+    """Place a stick figure drawn by :func:`_stick_figure` (segment lengths ``lengths``) at new points: a prismatic
+    joint's segment is stretched to its new length."""
+    for k, p in enumerate(points):
         node[f"joint{k}"].set_transform(pin.SE3(np.eye(3), p).homogeneous)
     for k, (a, b) in enumerate(zip(points, points[1:], strict=False)):
         length = float(np.linalg.norm(b - a))
-        if length < 1e-9:
+        if lengths[k] == 0.0 or length < 1e-12:
             continue
         # meshcat's cylinder stands along its local y axis: turn y onto the segment
-        along = pin.Quaternion.FromTwoVectors(np.array([0.0, 1.0, 0.0]), (b - a) / length).matrix()
-        node[f"link{k}"].set_object(g.Cylinder(length, radius), g.MeshLambertMaterial(color=0xA9A9A9))
-        node[f"link{k}"].set_transform(pin.SE3(along, (a + b) / 2).homogeneous)
+        T = pin.SE3(pin.Quaternion.FromTwoVectors(np.array([0.0, 1.0, 0.0]), (b - a) / length).matrix(),
+                    (a + b) / 2).homogeneous
+        T[:3, 1] *= length / lengths[k]
+        node[f"link{k}"].set_transform(T)
+
+
+def _visuals(robot: Robot) -> tuple[pin.GeometryModel, list[str]]:
+    """The robot's visual geometry, and the meshes its file names that were not found (their warning still
+    raised)."""
+    import warnings
+
+    from kinelab.robot.meshes import mesh_package_dirs, missing_meshes
+    from kinelab.robot.mjcf import is_mjcf
+
+    geom = robot.visual_model()
+    path = robot.urdf_path
+    if path is None or is_mjcf(path):
+        return geom, []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        given = robot.package_dirs  # as visual_model looks them up
+        return geom, missing_meshes(path, mesh_package_dirs() if given is None else list(given))
+
+
+def _figure_note(robot: Robot, missing: list[str], stick: bool) -> str:
+    """The caption line that says what the file could not give the view, and how the robot is drawn instead."""
+    lost = (f"{len(missing)} visual mesh(es) of the file not found (first: {missing[0]}; --package-dir or "
+            "package_dirs= finds them)") if missing else ""
+    if not stick:
+        return lost + ": those parts are not drawn"
+    why = lost or ("a model built in memory has no visual geometry" if robot.urdf_path is None
+                   else "the file has no visual geometry")
+    return why + ": drawn as a stick figure (joints blue spheres, links grey cylinders)"
