@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import shlex
 import time
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -54,6 +55,11 @@ def _add_reach(kinds: Any) -> None:
 
 
 def _add_base(kinds: Any) -> None:
+    v = kinds.add_parser("view", help="a stored reachability map as a page: its voxels in 3-D and three slices")
+    v.add_argument("store", help="the map's folder (written by `kinelab map reach --out`)")
+    v.add_argument("--html", required=True, help="the page to write")
+    v.add_argument("--robot", help="the robot, by name or file, when the map's own name does not load it")
+    v.set_defaults(func=run_view)
     b = kinds.add_parser("base", help="platform positions (and headings) from which a mobile manipulator reaches "
                                       "a grasp")
     b.add_argument("robot", help="a mobile manipulator with joints platform_x, platform_y, platform_yaw (youbot)")
@@ -171,4 +177,27 @@ def run_reach(args: argparse.Namespace) -> int:
                  if summary["mean_branches"] is not None else "")
               + f"; {summary['seconds']:.1f} s"
               + (f"; written to {args.out}" if args.out else ""))
+    return 0
+
+
+def run_view(args: argparse.Namespace) -> int:
+    """Write the page of a stored map (its robot loaded by the name the map records, or --robot)."""
+    from kinelab import maps
+    from kinelab.maps.store import model_sha256
+    from kinelab.robot import load
+    from kinelab.view.maps import map_page
+
+    rmap = maps.load(args.store)
+    meta = rmap.meta
+    robot = load(args.robot or meta["robot"], base=meta.get("base"), tool=meta.get("tool"))
+    if model_sha256(robot) != meta["source_sha256"]:
+        raise KinelabError(f"{robot.name}'s model file is not the one the map at {args.store} was computed for: "
+                           "give that robot with --robot")
+    page = map_page(robot, rmap)
+    try:
+        Path(args.html).write_text(page)
+    except OSError as err:
+        raise KinelabError(f"cannot write the page {args.html}: {err.strerror or err}") from None
+    print(f"wrote {args.html}: {robot.name}, {int((rmap.array('reachability') > 0).sum())} reached voxels of "
+          f"{meta['voxels']}, {meta['spec']['voxel']:g} m")
     return 0

@@ -64,3 +64,40 @@ def reachability_slice(rmap: Any, axis: int = 2, value: float | None = None, ax:
     ax.set_title(f"reachability index at {'xyz'[axis]} = {level:.3g} m")
     ax.figure.colorbar(art, ax=ax, label="share of orientations reached")
     return ax
+
+
+SLICES_STYLE = ("position:fixed;right:10px;top:40px;width:300px;padding:6px;border-radius:6px;"
+                "background:rgba(255,255,255,0.92);box-shadow:0 1px 4px rgba(0,0,0,0.3);z-index:10")
+
+
+def map_page(robot: Robot, rmap: Any) -> str:
+    """A reachability map as one self-contained page: the reached voxels in 3-D over the robot's stick figure
+    (the caption says what the colours mean) and the three slices through the map's centre (x, y and z layers)
+    as images in a box on the right."""
+    import base64
+    import io
+
+    from matplotlib.figure import Figure
+
+    scene = reachability_cloud(robot, rmap, meshes=False)
+    spec = rmap.meta["spec"]
+    scene.title = (f"{robot.name}: reachability map, {rmap.meta['voxels']} voxels of {spec['voxel']:g} m, "
+                   f"{spec['orientations']} orientations each ({rmap.meta['solver']})")
+    scene.legend["slices"] = ("right: the reachability index on the voxel layers through the map's centre, across z, "
+                              "y and x (dark red: no orientation reached)")
+    try:
+        page = scene.static_html()
+    finally:
+        scene.close()
+    images = []
+    for axis in (2, 1, 0):
+        fig = Figure(figsize=(4.2, 3.6))
+        reachability_slice(rmap, axis=axis, ax=fig.subplots())
+        fig.tight_layout()
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=80)
+        images.append(f'<img alt="reachability slice across {"xyz"[axis]}" style="width:100%" '
+                      f'src="data:image/png;base64,{base64.b64encode(buf.getvalue()).decode()}">')
+    box = f'<div id="kinelab-slices" style="{SLICES_STYLE}">{"".join(images)}</div>'
+    at = page.rfind("</body>")
+    return page[:at] + box + page[at:] if at >= 0 else page + box
