@@ -240,3 +240,30 @@ def test_a_meshless_robot_is_drawn_in_the_browser(tmp_path):
     share = browser.changed_share(browser.screenshot(page, tmp_path / "crx.png"),
                                   browser.screenshot(tmp_path / "empty.html", tmp_path / "empty.png"))
     assert share > 0.005, f"the stick figure covers only {share:.2%} of the picture"
+
+
+def test_obstacles_are_drawn_each_in_its_own_colour_and_named_with_it_in_the_caption():
+    import base64
+    import re
+
+    import umsgpack
+
+    from kinelab.collision import Environment, Obstacle
+    from kinelab.view.collisions import draw_obstacles
+
+    ur5 = kinelab.load("ur5")
+    s = viz.Scene(ur5)
+    env = Environment((Obstacle("plane", name="floor"), Obstacle("box", size=(0.4, 0.4, 0.3), xyz=(0.5, 0, 0.15),
+                                                                 name="table"), Obstacle("sphere", size=(0.1,))))
+    draw_obstacles(s, env)
+    html = s.static_html()
+    s.close()
+    assert s.legend["obstacles"] == ("3 obstacle(s), translucent: teal: floor (plane); brown: table (box); "
+                                     "olive: obstacle 3 (sphere)")
+    colours = {}
+    for blob in re.findall(r"data:application/octet-binary;base64,([A-Za-z0-9+/=]+)", html):
+        cmd = umsgpack.unpackb(base64.b64decode(blob))
+        if isinstance(cmd, dict) and cmd.get("type") == "set_object" and cmd["path"].startswith("/meshcat/obstacles/"):
+            colours[cmd["path"]] = cmd["object"]["materials"][0]["color"]
+    assert len(colours) == 3 and len(set(colours.values())) == 3
+    assert 0xE6194B not in colours.values()  # red stays the contacts' colour

@@ -10,7 +10,8 @@ import pinocchio as pin
 from kinelab.collision.model import CollisionModel, Contact
 from kinelab.collision.obstacles import Environment, Obstacle
 
-OBSTACLE_COLOR = 0x9A9A9A
+OBSTACLE_COLOURS = ((0x469990, "teal"), (0x9A6324, "brown"), (0x808000, "olive"), (0x911EB4, "purple"),
+                    (0xBFEF45, "lime"), (0xFABED4, "pink"))  # none red (contacts), blue (joints) or orange
 CONTACT_COLOR = 0xE6194B
 PLANE_SIDE = 4.0  # [m] the square drawn for an (unbounded) plane
 
@@ -29,19 +30,21 @@ def draw_collisions(scene: Any, model: CollisionModel, q: Any) -> list[Contact]:
 
 
 def draw_obstacles(scene: Any, environment: Environment) -> Any:
-    """Draw the obstacles (grey, translucent; a plane as a 4 m square) in ``scene``; returns the scene."""
+    """Draw the obstacles (translucent, each its own colour, named with it in the caption; a plane as a 4 m
+    square) in ``scene``; returns the scene."""
     import meshcat.geometry as g
 
     obstacles = environment.obstacles
+    named = []
     for k, obstacle in enumerate(obstacles):
+        colour, word = OBSTACLE_COLOURS[k % len(OBSTACLE_COLOURS)]
         node = scene.viewer["obstacles"][f"{k}"]
         opacity = 0.25 if obstacle.shape == "plane" else 0.6
-        material = g.MeshLambertMaterial(color=OBSTACLE_COLOR, opacity=opacity, transparent=True)
-        node.set_object(_shape(obstacle), material)
+        node.set_object(_shape(obstacle), g.MeshLambertMaterial(color=colour, opacity=opacity, transparent=True))
         node.set_transform(_placement(obstacle).homogeneous)
+        named.append(f"{word}: {obstacle.name or 'obstacle ' + str(k + 1)} ({obstacle.shape})")
     if obstacles:
-        named = ", ".join(o.name or o.shape for o in obstacles)
-        scene.legend["obstacles"] = f"grey: {len(obstacles)} obstacle(s) ({named})"
+        scene.legend["obstacles"] = f"{len(obstacles)} obstacle(s), translucent: " + "; ".join(named)
     return scene
 
 
