@@ -277,7 +277,8 @@ def test_a_scene_draws_the_obstacles_and_the_links_in_contact():
         paths = scene_paths(s.static_html())
         red = {p for p in paths if p.startswith("/meshcat/contacts/")}
         assert len(red) == len(names - {"floor", "table"}) and {"/meshcat/obstacles/0", "/meshcat/obstacles/1"} <= paths
-        assert "red links: in contact" in s.legend["collisions"] and "teal: floor (plane); brown: table (box)" in s.legend["obstacles"]
+        assert "red links: in contact" in s.legend["collisions"]
+        assert "teal: floor (plane); brown: table (box)" in s.legend["obstacles"]
         clear = draw_collisions(s, model, np.array([0.0, -1.57, 0.0, -1.57, 0.0, 0.0]))
         assert clear == [] and "no contact" in s.legend["collisions"]
         assert not {p for p in scene_paths(s.static_html()) if p.startswith("/meshcat/contacts/")}
