@@ -15,6 +15,7 @@ from kinelab.cli.common import (
     q_from_cli,
     seed_argument,
     source_arguments,
+    target_arguments,
 )
 from kinelab.errors import KinelabError
 from kinelab.ik.result import IKResult
@@ -25,10 +26,7 @@ def add(sub: Any) -> None:
     """The ``branches`` subcommand."""
     s = sub.add_parser("branches", help="every inverse-kinematics branch of a pose: a table, or a page with --html")
     s.add_argument("robot", help="registered name or model file (URDF, xacro, MJCF)")
-    s.add_argument("--target-q", nargs="+", help="target as a configuration (its FK pose), or an SRDF name")
-    s.add_argument("--target-xyz", nargs=3, type=float, help="target position [m] in the base frame")
-    s.add_argument("--target-rpy", nargs=3, type=float,
-                   help="target roll, pitch, yaw (rad; deg with --deg); without it the target rotation is the identity")
+    target_arguments(s)
     s.add_argument("--ref-q", nargs="+", help="sort the branches nearest this configuration first (or an SRDF name)")
     s.add_argument("--deg", action="store_true", help="angles in degrees (revolute/continuous joints, rpy)")
     s.add_argument("--solver", default="auto", choices=("auto", "analytic", "frdm", "dls"),

@@ -117,6 +117,14 @@ def source_arguments(s: argparse.ArgumentParser) -> None:
                    help="let a .xacro robot run what xacro runs ($(eval), $(env), load_yaml); refused without it")
 
 
+def target_arguments(s: argparse.ArgumentParser) -> None:
+    """``--target-q`` or ``--target-xyz`` with ``--target-rpy``: an IK target (``kinelab ik``, ``branches``)."""
+    s.add_argument("--target-q", nargs="+", help="target as a configuration (its FK pose), or an SRDF name")
+    s.add_argument("--target-xyz", nargs=3, type=float, help="target position [m] in the base frame")
+    s.add_argument("--target-rpy", nargs=3, type=float,
+                   help="target roll, pitch, yaw (rad; deg with --deg); without it the target rotation is the identity")
+
+
 def collision_arguments(s: argparse.ArgumentParser) -> None:
     """--collisions, --obstacles FILE and --margin: what answers must not collide with."""
     s.add_argument("--collisions", action="store_true", help="the robot must not collide with itself")

@@ -20,6 +20,7 @@ from kinelab.cli.common import (
     seed_argument,
     shown,
     source_arguments,
+    target_arguments,
 )
 from kinelab.errors import KinelabError
 from kinelab.ik.frdm.policy import SWITCHABLE, bypass_plan
@@ -33,12 +34,9 @@ def add(sub: Any) -> None:
     s = sub.add_parser("ik", help="inverse kinematics to a target pose or configuration")
     s.add_argument("robot", help="registered name or model file (URDF, xacro, MJCF)")
     s.add_argument("--solver", default="frdm",
-                   help="frdm, biquat, dls (the Pinocchio reference) or analytic (the closed form, for the arms "
-                        "`kinelab info` names one for); default frdm")
-    s.add_argument("--target-q", nargs="+", help="target as a configuration (its FK pose), or an SRDF name")
-    s.add_argument("--target-xyz", nargs=3, type=float, help="target position [m] in the base frame")
-    s.add_argument("--target-rpy", nargs=3, type=float,
-                   help="target roll, pitch, yaw (rad; deg with --deg); without it the target rotation is the identity")
+                   help="frdm, biquat, dls (the Pinocchio reference) or analytic (the closed form or 1-D search, "
+                        "for the arms `kinelab info` names one for: the branch nearest --start-q); default frdm")
+    target_arguments(s)
     s.add_argument("--task", choices=TASKS, default="pose",
                    help="the components to meet: pose (all, the default), position, axis (point and one tool axis, "
                         "roll free), orientation")
