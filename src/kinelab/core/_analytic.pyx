@@ -603,10 +603,7 @@ def search_errors(int kind, const double[:, ::1] h, const double[:, ::1] o, cons
             or e.shape[0] != t.shape[0] or e.shape[1] != WAYS or margin.shape[0] != t.shape[0] \
             or margin.shape[1] != WAYS:
         raise ValueError("search_errors: a search class code, h and o (6, 3), e and margin (len(t), 4)")
-    S.h, S.o = &h[0, 0], &o[0, 0]
-    S.shoulder = (kind - SEARCH_PAR23_45) % 3
-    S.last_pair = kind >= SEARCH_PAR23_56
-    S.R06 = mm(_rotation_of(H), transpose(_rotation_of(R0)))
-    S.shift = sub3((H[0, 3], H[1, 3], H[2, 3]), mv(S.R06, (N0[0], N0[1], N0[2])))
+    _prepare(&S, &h[0, 0], &o[0, 0], kind, _rotation_of(R0), (N0[0], N0[1], N0[2]), _rotation_of(H),
+             (H[0, 3], H[1, 3], H[2, 3]))
     for k in range(t.shape[0]):
         _sample(&S, t[k], &e[k, 0], NULL, NULL, &margin[k, 0], -1)

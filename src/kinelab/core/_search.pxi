@@ -42,6 +42,16 @@ cdef struct Search:
     V3 shift  # p_target − R06·N0: the point E(x) = R06·x + shift is where x (at q = 0) goes
 
 
+cdef void _prepare(Search* S, const double* h, const double* o, int kind, M9 R0, V3 N0, M9 Rt,
+                   V3 pt) noexcept nogil:
+    """S for the arm (axes h, points o, class ``kind``, tool R0, N0 at q = 0) and the pose (Rt, pt)."""
+    S.h, S.o = h, o
+    S.shoulder = (kind - SEARCH_PAR23_45) % 3
+    S.last_pair = kind >= SEARCH_PAR23_56
+    S.R06 = mm(Rt, transpose(R0))
+    S.shift = sub3(pt, mv(S.R06, N0))
+
+
 cdef inline V3 _moved(const Search* S, V3 x) noexcept nogil:
     return add3(mv(S.R06, x), S.shift)
 
@@ -379,11 +389,7 @@ cdef int search_6r(const double* h, const double* o, int kind, M9 R0, V3 N0, M9 
     cdef double q[(SAMPLES + 2) * WAYS * 3]
     cdef double step = TWO_PI / SAMPLES, t0 = -M_PI
     cdef int k, w, j, row = 0
-    S.h, S.o = h, o
-    S.shoulder = (kind - SEARCH_PAR23_45) % 3
-    S.last_pair = kind >= SEARCH_PAR23_56
-    S.R06 = mm(Rt, transpose(R0))
-    S.shift = sub3(pt, mv(S.R06, N0))
+    _prepare(&S, h, o, kind, R0, N0, Rt, pt)
     for k in range(SAMPLES):
         _sample(&S, t0 + k * step, e + k * WAYS, NULL, q + k * WAYS * 3, m + k * WAYS, -1)
     for j in range(2 * WAYS):  # the turn closes: samples SAMPLES and SAMPLES + 1 are samples 0 and 1

@@ -36,6 +36,12 @@ def mesh_package_dirs(user: list[str] | None = None) -> list[str]:
     return dirs + ros + catalog.package_dirs()
 
 
+def search_dirs(package_dirs: list[str] | None) -> list[str]:
+    """The directories a robot's meshes are looked up in: ``package_dirs`` as given, or (None) the defaults of
+    :func:`mesh_package_dirs`."""
+    return mesh_package_dirs() if package_dirs is None else list(package_dirs)
+
+
 MESH_SUFFIXES = {".stl", ".dae", ".obj", ".ply", ".glb", ".gltf", ".off", ".3ds", ".fbx", ".mesh"}
 
 
@@ -127,7 +133,7 @@ def build_visual_model(
     model of the URDF), its meshes found as :func:`resolve_uri` finds them; an element whose mesh cannot be
     found is left out with a warning naming the directories searched."""
     urdf_path = Path(urdf_path)
-    dirs = mesh_package_dirs() if package_dirs is None else list(package_dirs)
+    dirs = search_dirs(package_dirs)
     missing = missing_meshes(urdf_path, dirs, kind)
     if missing:
         warnings.warn(f"{len(missing)} {kind} mesh(es) of {urdf_path} not found (first: {missing[0]}; searched "

@@ -448,6 +448,16 @@ class Robot:
                     geom.geometryObjects[gid] = obj
         return geom
 
+    def missing_meshes(self, package_dirs: list[str] | None = None, kind: str = "visual") -> list[str]:
+        """The mesh URIs of the file's ``<visual>`` (or ``<collision>``) elements that :meth:`visual_model`, looking
+        where it looks, cannot find (none for an in-memory model or an MJCF file)."""
+        from kinelab.robot.meshes import missing_meshes, search_dirs
+
+        path = self._built.urdf_path
+        if path is None or is_mjcf(path):
+            return []
+        return missing_meshes(path, search_dirs(package_dirs or self.package_dirs), kind)
+
     @property
     def frame_names(self) -> list[str]:
         """Every frame of the reduced model, by name."""

@@ -21,6 +21,10 @@ def caption_html(title: str, lines: list[str]) -> str:
 
 def with_caption(page: str, title: str, lines: list[str]) -> str:
     """The page with the caption box placed just before ``</body>`` (or at its end)."""
-    box = caption_html(title, lines)
+    return before_body(page, caption_html(title, lines))
+
+
+def before_body(page: str, box: str) -> str:
+    """The page with the HTML ``box`` placed just before ``</body>`` (or at its end)."""
     at = page.rfind("</body>")
     return page[:at] + box + page[at:] if at >= 0 else page + box

@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 
 from kinelab.robot import Robot
+from kinelab.view.caption import before_body
 from kinelab.view.scene import Scene, _stick_figure, chain_points
 
 
@@ -98,6 +99,4 @@ def map_page(robot: Robot, rmap: Any) -> str:
         fig.savefig(buf, format="png", dpi=80)
         images.append(f'<img alt="reachability slice across {"xyz"[axis]}" style="width:100%" '
                       f'src="data:image/png;base64,{base64.b64encode(buf.getvalue()).decode()}">')
-    box = f'<div id="kinelab-slices" style="{SLICES_STYLE}">{"".join(images)}</div>'
-    at = page.rfind("</body>")
-    return page[:at] + box + page[at:] if at >= 0 else page + box
+    return before_body(page, f'<div id="kinelab-slices" style="{SLICES_STYLE}">{"".join(images)}</div>')

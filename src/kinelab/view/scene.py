@@ -45,7 +45,7 @@ class Scene:
             viewer_url = self.server.zmq_url
         with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL; we expose it as .url
             self.viewer = viewer if viewer is not None else meshcat.Visualizer(zmq_url=viewer_url)
-        self.geom, missing = _visuals(robot)
+        self.geom, missing = robot.visual_model(), robot.missing_meshes()  # missing: named in the caption
         self.stick = self.geom.ngeoms == 0  # nothing to draw from the file: the chain as a stick figure
         self._lengths: list[float] = []
         self.pinviz = MeshcatVisualizer(robot.model, pin.GeometryModel(), self.geom)
@@ -365,24 +365,6 @@ def _move_stick(node, points: list[np.ndarray], lengths: list[float]) -> None:
                     (a + b) / 2).homogeneous
         T[:3, 1] *= length / lengths[k]
         node[f"link{k}"].set_transform(T)
-
-
-def _visuals(robot: Robot) -> tuple[pin.GeometryModel, list[str]]:
-    """The robot's visual geometry, and the meshes its file names that were not found (their warning still
-    raised)."""
-    import warnings
-
-    from kinelab.robot.meshes import mesh_package_dirs, missing_meshes
-    from kinelab.robot.mjcf import is_mjcf
-
-    geom = robot.visual_model()
-    path = robot.urdf_path
-    if path is None or is_mjcf(path):
-        return geom, []
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        given = robot.package_dirs  # as visual_model looks them up
-        return geom, missing_meshes(path, mesh_package_dirs() if given is None else list(given))
 
 
 def _figure_note(robot: Robot, missing: list[str], stick: bool) -> str:

@@ -24,6 +24,7 @@ import numpy as np
 import pinocchio as pin
 from tqdm import tqdm
 
+from kinelab.geometry import wrap_to_pi
 from kinelab.ik.analytic.branches import all_branches_batch, arm_roots
 from kinelab.ik.analytic.classify import classify, classify_vectors
 from kinelab.ik.analytic.redundancy import at_value, has_swept_form, swept_arm
@@ -36,10 +37,6 @@ SAME_SET = 1e-6  # [rad] two answers this close are one
 ROBOTS = ("ur5", "ur10", "kinova", "z1", "xarm6", "crx10ia", "panda", "baxter_left")
 
 
-def _wrapped(d: np.ndarray) -> np.ndarray:
-    return np.asarray(np.arctan2(np.sin(d), np.cos(d)))
-
-
 def own_configuration(robot: Robot, n: int, seed: int) -> dict[str, Any]:
     """The share of n seeded poses whose own configuration is among the branches (6R arms: the batch; 7R arms:
     the branches at the held joint's own value), and the misses' nearest distances."""
@@ -47,13 +44,13 @@ def own_configuration(robot: Robot, n: int, seed: int) -> dict[str, Any]:
     t0 = time.perf_counter()
     if classify(robot).arm is not None:
         batch = all_branches_batch(robot, robot.fk_batch(Q))
-        gaps = np.nanmin(np.abs(_wrapped(batch.q - Q[:, None, :])).max(axis=2), axis=1, initial=np.inf,
+        gaps = np.nanmin(np.abs(wrap_to_pi(batch.q - Q[:, None, :])).max(axis=2), axis=1, initial=np.inf,
                          where=~np.isnan(batch.q[:, :, 0]))
         counts = batch.count
     else:
         sw, req = swept_arm(robot), make_request("frdm")
         found = [at_value(robot, robot.fk(q), req, float(q[sw.joint])) for q in Q]
-        gaps = np.array([min((float(np.abs(_wrapped(a[0] - q)).max()) for a in f), default=np.inf)
+        gaps = np.array([min((float(np.abs(wrap_to_pi(a[0] - q)).max()) for a in f), default=np.inf)
                          for f, q in zip(found, Q, strict=True)])
         counts = np.array([len(f) for f in found])
     elapsed = time.perf_counter() - t0
@@ -102,13 +99,13 @@ def against_ssik(robot: Robot, n: int, seed: int) -> dict[str, Any] | None:
 def _distinct(qs: list[np.ndarray]) -> list[np.ndarray]:
     kept: list[np.ndarray] = []
     for q in qs:
-        if not any(np.abs(_wrapped(q - k)).max() <= SAME_SET for k in kept):
+        if not any(np.abs(wrap_to_pi(q - k)).max() <= SAME_SET for k in kept):
             kept.append(q)
     return kept
 
 
 def _same_set(a: list[np.ndarray], b: list[np.ndarray]) -> bool:
-    return len(a) == len(b) and all(any(np.abs(_wrapped(x - y)).max() <= SAME_SET for y in b) for x in a)
+    return len(a) == len(b) and all(any(np.abs(wrap_to_pi(x - y)).max() <= SAME_SET for y in b) for x in a)
 
 
 def random_arms(arms: int, poses: int, seed: int) -> list[dict[str, Any]]:
@@ -127,7 +124,7 @@ def random_arms(arms: int, poses: int, seed: int) -> list[dict[str, Any]]:
                 for _ in range(poses):
                     q = rng.uniform(-np.pi, np.pi, 6)
                     Q, _, _ = arm_roots(arm, poe(h, o, tool, q), np.full(6, -10.0), np.full(6, 10.0), None)
-                    gaps.append(float(np.abs(_wrapped(Q - q)).max(axis=1).min()) if len(Q) else np.inf)
+                    gaps.append(float(np.abs(wrap_to_pi(Q - q)).max(axis=1).min()) if len(Q) else np.inf)
             g = np.array(gaps)
             rows.append({"class": name, "poses": g.size, "found": float((g <= FOUND).mean()),
                          "misses": int((g > FOUND).sum()), "near_misses": int(((g > FOUND) & (g <= NEAR)).sum())})
