@@ -2,6 +2,7 @@
 
 import contextlib
 import signal
+import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -87,6 +88,17 @@ def no_hang(seconds: int = 30):
     finally:
         signal.alarm(0)
         signal.signal(signal.SIGALRM, previous)
+
+
+def _default_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+def interruptible(argv, **kwargs) -> subprocess.Popen:
+    """A child process that Ctrl-C (SIGINT) reaches whatever its parent does with the signal: a test suite started
+    from a background job or under nohup inherits SIGINT ignored, and a child would inherit that too (it would
+    then rightly not stop, and a test of kinelab's Ctrl-C would test its caller)."""
+    return subprocess.Popen(argv, preexec_fn=_default_sigint, **kwargs)
 
 
 def chain_urdf(h, o, M, lower, upper, mount=None):

@@ -1,11 +1,13 @@
 import json
 import os
+import signal
 import subprocess
 import sys
 import time
 
 import numpy as np
 import pytest
+from helpers import interruptible
 
 import kinelab
 from kinelab import cli
@@ -219,12 +221,16 @@ def test_bad_values_end_in_one_line_and_exit_2_before_any_work(argv, needle):
     assert proc.stdout == ""
 
 
-def test_ctrl_c_stops_a_long_command_with_one_line_and_130():
-    import signal
-
-    proc = subprocess.Popen([sys.executable, "-m", "kinelab.cli", "singular", "ur5", "--sweep", "1000000", "--json"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            env={**os.environ, "PYTHONWARNINGS": "ignore"})
+@pytest.mark.parametrize("caller", [signal.SIG_DFL, signal.SIG_IGN], ids=["foreground", "background-job"])
+def test_ctrl_c_stops_a_long_command_with_one_line_and_130(caller):
+    """Whatever the suite's own SIGINT disposition (a background job or nohup ignores it), kinelab stops."""
+    previous = signal.signal(signal.SIGINT, caller)
+    try:
+        proc = interruptible([sys.executable, "-m", "kinelab.cli", "singular", "ur5", "--sweep", "1000000", "--json"],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                             env={**os.environ, "PYTHONWARNINGS": "ignore"})
+    finally:
+        signal.signal(signal.SIGINT, previous)
     time.sleep(4.0)  # well inside the sweep's Jacobians
     proc.send_signal(signal.SIGINT)
     out, err = proc.communicate(timeout=30)

@@ -14,17 +14,43 @@ import kinelab
 DATA = Path(__file__).with_name("data")
 
 
-def test_the_pure_option_reproduces_the_answers_pinned_before_the_finish_bit_for_bit():
+def _pinned_module():
     sys.path.insert(0, str(DATA))
     try:
         import make_frdm_pure
     finally:
         sys.path.remove(str(DATA))
+    return make_frdm_pure
+
+
+def test_the_pure_option_reproduces_the_answers_pinned_before_the_finish_on_any_processor():
+    """What holds on every machine: each pinned answer reproduced to 1e-9 rad (BLAS kernels round differently
+    from one processor to another: 3.1e-10 rad was seen on an AVX-512 server), the same counts, and both the
+    pinned and the new answer meeting its pose within the joint limits (the pinned runs all converged)."""
+    make = _pinned_module()
     pinned = np.load(DATA / "frdm_pure.npz")
-    now = make_frdm_pure.answers({"finish": "none"})
+    now = make.answers({"finish": "none"})
     assert sorted(now) == sorted(pinned.files)
-    for key in pinned.files:
-        assert np.array_equal(now[key], pinned[key]), key
+    for name in make.ROBOTS:
+        robot = kinelab.load(name)
+        targets, starts = make.cases(robot)
+        for path in ("warm", "random", "monitored", "batch", "track"):
+            key = f"{name}/{path}"
+            assert now[key].shape == pinned[key].shape, key
+            np.testing.assert_allclose(now[key], pinned[key], rtol=0, atol=1e-9, err_msg=key)
+            poses = make.path_targets(robot, starts) if path == "track" else targets
+            for q_pinned, q_now, pose in zip(pinned[key], now[key], poses, strict=True):
+                for q in (q_pinned, q_now):
+                    dp, dr = robot.tool_error(q, pose)
+                    assert dp <= 1e-6 and dr <= 1e-6 and robot.within_limits(q), (key, dp, dr)
+
+
+def test_the_pure_option_gives_the_same_bits_twice_on_one_machine():
+    """Bit-for-bit identity is a property of one machine: two runs of every path agree to the last bit."""
+    make = _pinned_module()
+    first, second = make.answers({"finish": "none"}), make.answers({"finish": "none"})
+    for key in first:
+        assert first[key].tobytes() == second[key].tobytes(), key
 
 
 @pytest.mark.parametrize("name", ["ur5", "panda", "era"])

@@ -3,6 +3,7 @@ interruption, and clear errors for bad input."""
 
 import numpy as np
 import pytest
+from helpers import interruptible
 
 import kinelab
 from kinelab import KinelabError, maps
@@ -212,7 +213,7 @@ def test_an_interrupted_cli_run_resumes_to_the_identical_map(ur5, tmp_path):
     argv = [sys.executable, "-m", "kinelab.cli", "map", "reach", "ur5", "--voxel", "0.15", "--orientations", "4",
             "--restarts", "3", "--chunk", "16", "--out", str(out), "--json"]
     env = {**os.environ, "PYTHONWARNINGS": "ignore"}
-    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    proc = interruptible(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     deadline = time.time() + 600  # a wait for three chunks, generous for a loaded machine: not a speed
     done = 0
     while time.time() < deadline and proc.poll() is None:

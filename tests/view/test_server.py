@@ -10,6 +10,7 @@ import urllib.request
 from pathlib import Path
 
 import pytest
+from helpers import interruptible
 
 from kinelab.view.server import Server
 
@@ -66,8 +67,8 @@ def _children(pid: int) -> list[int]:
 
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT, signal.SIGKILL])
 def test_kinelab_view_takes_its_server_with_it(sig):
-    proc = subprocess.Popen([sys.executable, "-m", "kinelab.cli", "view", "ur5"], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, env={**os.environ, "PYTHONWARNINGS": "ignore"})
+    proc = interruptible([sys.executable, "-m", "kinelab.cli", "view", "ur5"], stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True, env={**os.environ, "PYTHONWARNINGS": "ignore"})
     try:
         line = proc.stdout.readline()
         assert "127.0.0.1" in line, line  # (reading stderr here would wait for a server that never ends)

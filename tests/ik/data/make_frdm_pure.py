@@ -23,6 +23,11 @@ def cases(robot: kinelab.Robot) -> tuple[list, np.ndarray]:
     return [robot.fk(q) for q in qs], starts
 
 
+def path_targets(robot: kinelab.Robot, starts: np.ndarray) -> list:
+    """The tracked path's 40 targets: FK along the straight joint-space segment between the first two starts."""
+    return [robot.fk(starts[0] + s * (starts[1] - starts[0])) for s in np.linspace(0, 1, 40)]
+
+
 def answers(finish: dict) -> dict[str, np.ndarray]:
     """Each path's answers: compiled single solves (warm and random starts), the monitored loop, a batch,
     a tracked path."""
@@ -37,7 +42,7 @@ def answers(finish: dict) -> dict[str, np.ndarray]:
         out[f"{name}/monitored"] = np.array([kinelab.solve(robot, t, q0=q, seed=3, policy=("auto_kick",), **opts).q
                                              for t, q in zip(targets, starts, strict=True)])
         out[f"{name}/batch"] = kinelab.solve_batch(robot, targets, q0=starts, seed=5, **opts).q
-        path = [robot.fk(starts[0] + s * (starts[1] - starts[0])) for s in np.linspace(0, 1, 40)]
+        path = path_targets(robot, starts)
         out[f"{name}/track"] = kinelab.track(robot, path, q0=starts[0], **finish).q
     return out
 
