@@ -34,6 +34,7 @@ _LAZY = {
     "solve_batch": ("kinelab.ik.api", "solve_batch"),
     "track": ("kinelab.ik.api", "track"),
     "BatchIKResult": ("kinelab.ik.batch", "BatchIKResult"),
+    "Branches": ("kinelab.ik.result", "Branches"),
     "FRDMOptions": ("kinelab.ik.frdm.options", "FRDMOptions"),
     "IK": ("kinelab.ik.prepared", "IK"),
     "Diagnostics": ("kinelab.ik.result", "Diagnostics"),
@@ -58,7 +59,7 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
     from kinelab.ik.batch import BatchIKResult
     from kinelab.ik.frdm.options import FRDMOptions
     from kinelab.ik.prepared import IK
-    from kinelab.ik.result import Diagnostics, IKResult, Status, TrackResult
+    from kinelab.ik.result import Branches, Diagnostics, IKResult, Status, TrackResult
     from kinelab.ik.targets import from_xyz_quat_wxyz as target_from_xyz_quat_wxyz
     from kinelab.ik.targets import from_xyz_rpy as target_from_xyz_rpy
 
@@ -66,6 +67,7 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
 __all__ = [
     "BatchIKResult",
     "BiquaternionError",
+    "Branches",
     "ChainError",
     "Collisions",
     "ConfigurationError",

@@ -51,7 +51,8 @@ def test_a_crx_pose_prints_its_sixteen_searched_branches(capsys):
 
 def test_an_unreachable_pose_exits_1_and_bad_input_exits_2_with_one_line(capsys):
     code, out, _ = run(capsys, "branches", "ur5", "--target-xyz", "5", "0", "0")
-    assert code == 1 and out.startswith("ur5: 0 branches") and "out of reach" in out
+    assert code == 1 and out.startswith("ur5: 0 branches") and "no branch (unreachable)" in out \
+        and "beyond the robot's reach" in out
     for argv in (("branches", "ur5"), ("branches", "ur5", "--target-q", "1", "2"),
                  ("branches", "ur5", "--target-q", *UR5_Q, "--redundancy", "8"),
                  ("branches", "stanford", "--target-q", "0", "0", "0.3", "0", "0", "0", "--solver", "analytic")):
@@ -86,3 +87,18 @@ def test_the_nearest_branch_is_orange_in_the_browser(capsys, tmp_path):
         return int(((rgb[..., 0] > 180) & (rgb[..., 1] > 80) & (rgb[..., 1] < 170) & (rgb[..., 2] < 90)).sum())
 
     assert orange(a) > 200 and orange(b) == 0
+
+
+@pytest.mark.parametrize("name", ["baxter_left", "tiago_pro"])
+def test_the_wording_of_no_branch_follows_the_status(capsys, name):
+    """#39 item 6b: "out of reach" only where something proved it. A reachable pose of a multistart arm gets
+    branches; starved of time it says the budget ran out, not that the pose is unreachable."""
+    robot = kinelab.load(name)
+    q = [f"{v:.9f}" for v in robot.random_q(np.random.default_rng(12))]
+    code, out, _ = run(capsys, "branches", name, "--target-q", *q, "--seed", "0", "--json")
+    found = json.loads(out)
+    assert code == 0 and found["branches"]
+    for b in found["branches"]:
+        assert max(robot.tool_error(np.array(b["q"]), robot.fk(np.array(q, dtype=float)))) <= 1e-6
+    code, out, _ = run(capsys, "branches", name, "--target-q", *q, "--seed", "0", "--time-budget", "0.0001")
+    assert code == 1 and "no branch (time_budget)" in out and "unreachable" not in out

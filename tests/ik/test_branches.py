@@ -133,3 +133,41 @@ def test_the_search_stops_by_its_rule_with_every_closed_form_branch():
     assert stopped == 20 and complete >= 19
     with pytest.raises(OptionError, match="stop_below"):
         kinelab.solve_all(ur5, target, stop_below=1.5)
+
+
+def test_no_budget_pays_for_the_first_calls_preparation(monkeypatch):
+    """#39 item 5: the first solve_all of a robot once spent its 50 ms certifying the judge and returned [] — read as
+    "unreachable". Here the certificate is made to take 0.3 s: the search must still get its whole budget."""
+    import time
+
+    from kinelab.robot import model
+
+    real = model.certify
+
+    def slow_certify(robot):
+        time.sleep(0.3)
+        return real(robot)
+
+    monkeypatch.setattr(model, "certify", slow_certify)
+    robot = load("tiago_pro")  # a fresh Robot: nothing prepared yet; the multistart serves it
+    target = robot.fk(robot.random_q(np.random.default_rng(7)))
+    found = kinelab.solve_all(robot, target, seed=0, time_budget=0.05)
+    assert found and found.status == kinelab.Status.CONVERGED and found.message == ""
+    assert all(r.success and robot.tool_error(r.q, target)[0] <= 1e-6 for r in found)
+
+
+def test_an_empty_set_of_branches_says_why():
+    """#39 item 5: an empty answer carries its status; "unreachable" only where something proved it."""
+    ur5, tiago = load("ur5"), load("tiago_pro")
+    far = kinelab.target_from_xyz_rpy([3.0, 0.0, 0.5], [0.0, 0.0, 0.0])
+    by_search = kinelab.solve_all(ur5, far, solver="frdm", seed=0)  # proved by the reach bound
+    assert by_search == [] and by_search.status == kinelab.Status.UNREACHABLE and "beyond" in by_search.message
+    closed = kinelab.solve_all(ur5, far, seed=0)  # the closed form computes every branch: none is a proof
+    assert closed == [] and closed.status == kinelab.Status.UNREACHABLE and "beyond" in closed.message
+    limited = kinelab.solve_all(ur5, ur5.fk(np.array([0.3, -1.2, 1.0, -0.5, 0.8, 0.2])), seed=0, tol_pos=1e-12)
+    assert len(limited) == 8 and limited.status == kinelab.Status.CONVERGED
+    reachable = tiago.fk(tiago.random_q(np.random.default_rng(3)))
+    starved = kinelab.solve_all(tiago, reachable, seed=0, time_budget=1e-4)  # no round fits: nothing was proved
+    assert starved == [] and starved.status == kinelab.Status.TIME_BUDGET and "nothing proves" in starved.message
+    found = kinelab.solve_all(tiago, reachable, seed=0)
+    assert found and found.status == kinelab.Status.CONVERGED

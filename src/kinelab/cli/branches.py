@@ -18,7 +18,7 @@ from kinelab.cli.common import (
     target_arguments,
 )
 from kinelab.errors import KinelabError
-from kinelab.ik.result import IKResult
+from kinelab.ik.result import Branches, IKResult
 from kinelab.robot import Robot
 
 
@@ -67,10 +67,10 @@ def _method(found: list[IKResult]) -> str:
     return found[0].mode if found else "none found"
 
 
-def _completeness(found: list[IKResult]) -> str:
-    """How sure the list is to hold every branch, in words."""
+def _completeness(found: Branches) -> str:
+    """How sure the list is to hold every branch, in words (none: why, as the result's status says it)."""
     if not found:
-        return "no branch found: the pose is out of reach or every branch is outside the joint limits"
+        return f"no branch ({found.status.value}): {found.message}"
     first = found[0]
     if first.solver == "analytic" and first.diagnostics.unseen == 0.0:
         return "every branch: closed form"
@@ -80,7 +80,7 @@ def _completeness(found: list[IKResult]) -> str:
     return f"multistart: chance that one more start finds a new branch estimated at {first.diagnostics.unseen:.2g}"
 
 
-def _print_branches(robot: Robot, args: argparse.Namespace, found: list[IKResult], ref: Any) -> None:
+def _print_branches(robot: Robot, args: argparse.Namespace, found: Branches, ref: Any) -> None:
     """One line per branch: its configuration and Pinocchio's errors (nearest ``ref`` first when given)."""
     unit = " [deg, m]" if args.deg else " [rad, m]"
     print(f"{robot.name}: {len(found)} branch{'es' if len(found) != 1 else ''}, {_method(found)}")

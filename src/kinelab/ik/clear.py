@@ -24,7 +24,7 @@ from kinelab.ik.analytic.branches import arm_of, has_closed_form, nearest_roots
 from kinelab.ik.batch import BatchIKResult, fresh_seed
 from kinelab.ik.driver import solve_one
 from kinelab.ik.request import Request
-from kinelab.ik.result import Diagnostics, IKResult, Status, TrackResult
+from kinelab.ik.result import Branches, Diagnostics, IKResult, Status, TrackResult
 from kinelab.robot import Robot
 
 ROW_RUNS = 20  # runs a colliding batch row gets (each a full solve): a row with no clear answer must not take the
@@ -102,10 +102,10 @@ def _collided(res: IKResult, t0: float, runs: int, model: CollisionModel) -> IKR
                    message=f"the pose is met, but every answer of {runs} run(s) collides; the last: {contact}")
 
 
-def mark_colliding(found: list[IKResult], model: CollisionModel, drop: bool) -> list[IKResult]:
+def mark_colliding(found: Branches, model: CollisionModel, drop: bool) -> Branches:
     """``solve_all``'s branches with those that collide marked (success False, status ``collision``,
-    ``diagnostics.contact`` set), or left out with ``drop``."""
-    out = []
+    ``diagnostics.contact`` set), or left out with ``drop`` (every one left out: status ``collision``)."""
+    out = Branches([], found.status, found.message)
     for res in found:
         contact = model.contact(res.q)
         if contact is None:
@@ -113,6 +113,8 @@ def mark_colliding(found: list[IKResult], model: CollisionModel, drop: bool) -> 
         elif not drop:
             out.append(replace(res, success=False, status=Status.COLLISION, message=f"collides: {contact}",
                                diagnostics=replace(res.diagnostics, contact=contact)))
+    if found and not any(res.success for res in out):
+        out.status, out.message = Status.COLLISION, f"every one of the {len(found)} branches found collides"
     return out
 
 

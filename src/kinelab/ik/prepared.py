@@ -24,7 +24,7 @@ from kinelab.ik.clear import clear_batch, mark_colliding, solve_clear
 from kinelab.ik.driver import solve_one
 from kinelab.ik.lean import LeanFRDM
 from kinelab.ik.request import Request, check_robot, check_seed, make_request
-from kinelab.ik.result import IKResult
+from kinelab.ik.result import Branches, IKResult
 from kinelab.ik.targets import as_target, as_target_arrays
 from kinelab.robot import Robot
 
@@ -141,7 +141,7 @@ class IK:
         return clear_batch(self.robot, stack_homogeneous(*as_target_arrays(targets)), res, req, self.collisions, t0)
 
     def solve_all(self, target: Any, *, seed: int | None = None, q_ref: Any = None,
-                  max_solutions: int | None = None, stop_below: float | None = UNSEEN) -> list[IKResult]:
+                  max_solutions: int | None = None, stop_below: float | None = UNSEEN) -> Branches:
         """The distinct branches of ``target`` found within the time budget, as :func:`kinelab.solve_all`.
 
         Args:

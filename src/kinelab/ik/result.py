@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field, fields, replace
 from enum import Enum
 from typing import Any
@@ -248,6 +249,28 @@ class IKResult:
             "message": self.message,
             "info": self.diagnostics.to_dict(),
         }
+
+
+class Branches(list[IKResult]):
+    """The distinct solutions of one target, as :func:`kinelab.solve_all` returns them: a list of
+    :class:`IKResult` (nearest ``q_ref`` first when asked) that says why it is empty.
+
+    Attributes:
+        status: ``converged`` when it holds a branch that met the target; else why there is none:
+            ``unreachable`` (proved: the target point lies beyond the reach bound, or the closed form or the search,
+            which return every branch, have none within the joint limits), ``time_budget`` (the multistart's budget
+            ran out before any start met the target: nothing was proved) or ``collision`` (every branch found
+            collides).
+        message: the reason in words ("" for a list of branches).
+    """
+
+    status: Status
+    message: str
+
+    def __init__(self, found: Iterable[IKResult] = (), status: Status | None = None, message: str = ""):
+        super().__init__(found)
+        self.status = status if status is not None else Status.CONVERGED if self else Status.TIME_BUDGET
+        self.message = message
 
 
 @dataclass

@@ -31,3 +31,10 @@ def out_of_reach(robot: Robot, position: np.ndarray) -> float:
     """How far [m] a position lies beyond the reach bound (≤ 0 when it may be reachable)."""
     anchor, radius = robot.derived("reach_bound", _reach)
     return math.dist(np.asarray(position, dtype=float).tolist(), anchor) - radius
+
+
+def beyond_reach(robot: Robot, position: np.ndarray) -> str:
+    """Why no configuration can reach ``position`` [m] (base frame) when it lies beyond the reach bound, in words;
+    "" when it may be reachable."""
+    beyond = out_of_reach(robot, position)
+    return f"the target point is at least {beyond:.4g} m beyond the robot's reach" if beyond > 0 else ""

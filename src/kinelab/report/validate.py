@@ -6,7 +6,7 @@ is a list of :class:`Check` rows, printed as a table, written as Markdown/HTML/J
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -241,7 +241,7 @@ def _closed_form_targets(robot: Robot, n: int, seed: int) -> list[Any]:
     return [robot.fk(robot.random_q(rng)) for _ in range(max(10, n // 4))]
 
 
-def _worst(robot: Robot, targets: list[Any], answers: list[list[Any]]) -> float:
+def _worst(robot: Robot, targets: list[Any], answers: Sequence[Sequence[Any]]) -> float:
     """The largest position or rotation error [m or rad] (Pinocchio) of any answer against its target."""
     return max(max(robot.tool_error(a.q, t)) for t, found in zip(targets, answers, strict=True) for a in found)
 

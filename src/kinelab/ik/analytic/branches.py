@@ -26,8 +26,9 @@ from kinelab.ik.batch import BatchIKResult
 from kinelab.ik.driver import solve_one
 from kinelab.ik.limits import distance
 from kinelab.ik.request import Request, make_request
-from kinelab.ik.result import Diagnostics, IKResult, Status
+from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target_arrays
+from kinelab.ik.workspace import beyond_reach
 from kinelab.robot import Robot
 
 SAME = 1e-5  # [rad] roots closer than this joint by joint are one branch (a double root split by rounding:
@@ -76,7 +77,7 @@ def has_closed_form(robot: Robot, req: Request) -> bool:
 
 
 def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | None = None,
-                 max_solutions: int | None = None) -> list[IKResult]:
+                 max_solutions: int | None = None) -> Branches:
     """Every branch of the pose ``target`` (oMtarget, base frame) that Pinocchio confirms within the limits.
 
     Args:
@@ -106,19 +107,25 @@ def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | No
     if q_ref is not None:
         answers.sort(key=lambda a: distance(robot, a[0], q_ref))
     return branch_results(answers, req, arm.mode, time.perf_counter() - t0, max_solutions,
-                          None if arm.searched else 0.0)
+                          None if arm.searched else 0.0,
+                          beyond_reach(robot, target.translation)
+                          or f"no branch within the joint limits ({arm.method})")
 
 
 def branch_results(answers: list[tuple[Any, ...]], req: Request, mode: str, elapsed: float,
-                   max_solutions: int | None, unseen: float | None) -> list[IKResult]:
+                   max_solutions: int | None, unseen: float | None, empty: str) -> Branches:
     """The closed form's answers — (q, position error, rotation error, finished, roots merged, one of a
-    continuum) each — as IKResults, the first ``max_solutions``; ``diagnostics.branches`` counts them all."""
-    return [IKResult(q=q, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr, iterations=0,
-                     restarts=0, wall_time=elapsed, solver="analytic", mode=mode, message=CONTINUUM if loose else "",
-                     diagnostics=Diagnostics(path="compiled", branches=len(answers), found=count, unseen=unseen,
-                                             polished=1 if finished else None),
-                     task=req.task_label)
-            for q, dp, dr, finished, count, loose in answers[:max_solutions]]
+    continuum) each — as IKResults, the first ``max_solutions``; ``diagnostics.branches`` counts them all. No
+    answer is status ``unreachable`` with the reason ``empty``: the closed form and the search compute every
+    branch, so none is a proof."""
+    return Branches([IKResult(q=q, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr,
+                              iterations=0, restarts=0, wall_time=elapsed, solver="analytic", mode=mode,
+                              message=CONTINUUM if loose else "",
+                              diagnostics=Diagnostics(path="compiled", branches=len(answers), found=count,
+                                                      unseen=unseen, polished=1 if finished else None),
+                              task=req.task_label)
+                     for q, dp, dr, finished, count, loose in answers[:max_solutions]],
+                    None if answers else Status.UNREACHABLE, "" if answers else empty)
 
 
 def nearest_roots(robot: Robot, arm: ArmClass, target: Any, req: Request,

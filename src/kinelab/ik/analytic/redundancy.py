@@ -27,7 +27,8 @@ from kinelab.ik.analytic.classify import ArmClass, classify, classify_vectors
 from kinelab.ik.chain import PRISMATIC, chain_model
 from kinelab.ik.limits import distance
 from kinelab.ik.request import Request
-from kinelab.ik.result import IKResult
+from kinelab.ik.result import Branches
+from kinelab.ik.workspace import beyond_reach
 from kinelab.robot import Robot
 
 
@@ -171,7 +172,7 @@ def at_value(robot: Robot, target: pin.SE3, req: Request, theta: float,
 
 
 def redundant_all(robot: Robot, target: pin.SE3, req: Request, redundancy: object,
-                  q_ref: np.ndarray | None = None, max_solutions: int | None = None) -> list[IKResult]:
+                  q_ref: np.ndarray | None = None, max_solutions: int | None = None) -> Branches:
     """Every branch of ``target`` (oMtarget, base frame) at the values of the swept joint ``redundancy`` asks for
     (:func:`held_values`), each judged by Pinocchio within the limits.
 
@@ -201,7 +202,9 @@ def redundant_all(robot: Robot, target: pin.SE3, req: Request, redundancy: objec
         answers.sort(key=lambda a: distance(robot, a[0], q_ref))
     search = f"; {sw.arm.method.removeprefix('every branch by a ')} of the other six" if sw.arm.searched else ""
     mode = f"analytic ({sw.arm.name}{search}; joint {sw.joint + 1} {how})"
-    return branch_results(answers, req, mode, time.perf_counter() - t0, max_solutions, None)
+    return branch_results(answers, req, mode, time.perf_counter() - t0, max_solutions, None,
+                          beyond_reach(robot, target.translation)
+                          or f"no branch within the joint limits with joint {sw.joint + 1} {how}")
 
 
 def closed_form_summary(robot: Robot) -> str:
