@@ -181,3 +181,22 @@ def test_a_held_value_given_by_name_returns_every_branch_there_and_bad_values_ar
                 {"left_s0": 0.1, "left_s1": 0.2}):
         with pytest.raises(kinelab.OptionError, match=r"\{'left_s0': a value in \[-1.70168, 1.70168\] rad\}"):
             kinelab.solve_all(baxter, target, redundancy=bad)
+
+
+def test_a_root_detected_many_times_never_crowds_out_another():
+    """#39 item 6a: on this CRX pose the search detects six roots about five times each along a nearly tangent
+    stretch; 32 raw rows filled up and the four clean roots (the pose's own configuration among them) were dropped.
+    Now a root found again counts towards its row, and a pose with more distinct roots than the room gets more."""
+    from kinelab.ik.analytic.branches import arm_roots
+
+    crx = kinelab.load("crx10ia")
+    q = np.array([0.73601738445, -2.37884221366, 4.19420429382, -1.86016907455, 2.39362086083, -0.41011882427])
+    target = crx.fk(q)
+    found = kinelab.solve_all(crx, target)
+    assert len(found) == 4 and min(distance(crx, r.q, q) for r in found) <= 1e-9
+    for r in found:
+        assert max(crx.tool_error(r.q, target)) <= 1e-9 and crx.within_limits(r.q)
+    Q, hits, _ = arm_roots(classify(crx).arm, target.homogeneous, np.full(6, -np.pi), np.full(6, np.pi), None)
+    assert Q.shape[0] == 12 and hits.sum() > 32  # every root within ±π, each detection counted
+    for row in Q:
+        assert max(crx.tool_error(row, target)) <= 1e-9

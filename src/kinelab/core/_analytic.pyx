@@ -31,6 +31,7 @@ numbers and rotations of 9 (row by row): they live in registers.
 """
 
 from libc.math cimport acos, atan2, cos, fabs, hypot, rint, sin, M_PI, NAN
+from libc.stdlib cimport free as release, malloc
 from cython.parallel cimport prange
 
 ctypedef (double, double, double) V3
@@ -41,7 +42,8 @@ ctypedef (int, double) Angle  # (status, θ)
 cdef enum:
     DEGENERATE = -1  # every angle serves (the caller picks one and marks the answer a continuum)
     MAX_ROWS = 16  # distinct branches of a pose (a cuspidal 6R has up to 16)
-    RAW_ROWS = 32  # rows before coincident roots are merged
+    RAW_ROWS = 32  # distinct roots a class writes before the caller places them (coincident ones merge as written)
+    GROWN_ROWS = 512  # the room a pose gets when RAW_ROWS was not enough (a continuum sampled at many points)
     PARALLEL_5R = 0
     PARALLEL_6R = 1
     SPHERICAL_6R = 2
@@ -168,22 +170,35 @@ cdef inline Roots _one_if_double(Roots r) noexcept nogil:
 
 
 cdef struct Rows:
-    # where a class writes its rows: (MAX_ROWS, n) angles and their flags
+    # where a class writes its rows: (cap, n) angles, their flags and how many roots each row stands for
     double* out
     unsigned char* free
+    long long* hits
     int n
+    int cap
+    double same  # [rad] a root this close to a written row, joint by joint modulo 2π, is that row
+    int dropped  # distinct roots that found no room (the caller then grows the room and solves again)
 
 
 cdef inline int _write(Rows* rows, int row, double q1, double q2, double q3, double q4, double q5, double q6,
                        bint flag) noexcept nogil:
-    """Row ``row`` ← the angles wrapped into (−π, π] (q6 ignored on a 5-joint arm); returns the next row."""
-    if row >= RAW_ROWS:
+    """The angles wrapped into (−π, π] (q6 ignored on a 5-joint arm) as row ``row``, or counted towards the row they
+    equal (a root the search detects several times is one row); returns the next row. A distinct root with no room
+    left is counted in ``rows.dropped``, never lost silently."""
+    cdef double r[6]
+    cdef int k, j
+    r[0], r[1], r[2], r[3], r[4], r[5] = wrap(q1), wrap(q2), wrap(q3), wrap(q4), wrap(q5), wrap(q6)
+    for k in range(row):
+        if _close(r, rows.out + rows.n * k, rows.n, rows.same):
+            rows.hits[k] += 1
+            rows.free[k] = rows.free[k] or flag
+            return row
+    if row >= rows.cap:
+        rows.dropped += 1
         return row
-    cdef double* r = rows.out + rows.n * row
-    r[0], r[1], r[2], r[3], r[4] = wrap(q1), wrap(q2), wrap(q3), wrap(q4), wrap(q5)
-    if rows.n > 5:
-        r[5] = wrap(q6)
-    rows.free[row] = flag
+    for j in range(rows.n):
+        rows.out[rows.n * row + j] = r[j]
+    rows.free[row], rows.hits[row] = flag, 1
     return row + 1
 
 
@@ -482,38 +497,61 @@ cdef int _branches(const Arm* arm, M9 Rt, V3 pt, const double* ref, bint use_ref
     :func:`branches`); returns the number of rows written."""
     cdef double raw[RAW_ROWS * 6]
     cdef unsigned char loose[RAW_ROWS]
-    cdef double row[6]
+    cdef long long hits[RAW_ROWS]
     cdef Rows rows
-    cdef int n = arm.n, count, m = 0, r, j, k
-    cdef bint merged
-    rows.out, rows.free, rows.n = raw, loose, n
+    cdef int m
+    rows.out, rows.free, rows.hits, rows.n, rows.cap, rows.same = raw, loose, hits, arm.n, RAW_ROWS, arm.same
     if arm.mirrored:
         pt = scale3(mtv(Rt, pt), -1.0)
         Rt = transpose(Rt)
+    m = _placed_rows(arm, Rt, pt, ref, use_ref, out, found, free, &rows)
+    if rows.dropped == 0:
+        return m
+    # more distinct roots than RAW_ROWS (seen: a search along a nearly tangent stretch): solve again with room
+    rows.out = <double*> malloc(sizeof(double) * GROWN_ROWS * 6)
+    rows.free = <unsigned char*> malloc(GROWN_ROWS)
+    rows.hits = <long long*> malloc(sizeof(long long) * GROWN_ROWS)
+    if rows.out != NULL and rows.free != NULL and rows.hits != NULL:
+        rows.cap = GROWN_ROWS
+        m = _placed_rows(arm, Rt, pt, ref, use_ref, out, found, free, &rows)
+    release(rows.out)
+    release(rows.free)
+    release(rows.hits)
+    return m
+
+
+cdef int _placed_rows(const Arm* arm, M9 Rt, V3 pt, const double* ref, bint use_ref, double* out, long long* found,
+                      unsigned char* free, Rows* rows) noexcept nogil:
+    """The class's roots of (Rt, pt) (already in the solved orientation) written into ``rows``, then merged, turned
+    back to the robot's joint order and placed within the limits into ``out``; returns the branches written."""
+    cdef double row[6]
+    cdef int n = arm.n, count, m = 0, r, j, k
+    cdef bint merged
+    rows.dropped = 0
     if arm.kind == PARALLEL_6R:
-        count = parallel_6r(arm.h, arm.o, arm.R0, arm.N0, Rt, pt, &rows)
+        count = parallel_6r(arm.h, arm.o, arm.R0, arm.N0, Rt, pt, rows)
     elif arm.kind == SPHERICAL_6R:
-        count = spherical_6r(arm.h, arm.o, arm.R0, arm.N0, Rt, pt, &rows)
+        count = spherical_6r(arm.h, arm.o, arm.R0, arm.N0, Rt, pt, rows)
     elif arm.kind == MEETING_6R:
-        count = meeting_6r(arm.h, arm.o, arm.R0, arm.N0, Rt, pt, &rows)
+        count = meeting_6r(arm.h, arm.o, arm.R0, arm.N0, Rt, pt, rows)
     elif arm.kind == TWO_THREE_6R:
-        count = two_three_6r(arm.h, arm.o, arm.R0, arm.N0, Rt, pt, &rows)
+        count = two_three_6r(arm.h, arm.o, arm.R0, arm.N0, Rt, pt, rows)
     elif arm.kind >= SEARCH_PAR23_45:
-        count = search_6r(arm.h, arm.o, arm.kind, arm.R0, arm.N0, Rt, pt, &rows)
+        count = search_6r(arm.h, arm.o, arm.kind, arm.R0, arm.N0, Rt, pt, rows)
     else:
-        count = parallel_5r(arm.h, arm.o, arm.R0, arm.N0, Rt, pt, &rows)
+        count = parallel_5r(arm.h, arm.o, arm.R0, arm.N0, Rt, pt, rows)
     for r in range(count):
         for j in range(n):
-            row[j] = -raw[r * n + n - 1 - j] if arm.mirrored else raw[r * n + j]
+            row[j] = -rows.out[r * n + n - 1 - j] if arm.mirrored else rows.out[r * n + j]
         merged = False
         for k in range(m):
             if _close(row, out + k * n, n, arm.same):
-                found[k] += 1
-                free[k] = free[k] or loose[r]
+                found[k] += rows.hits[r]
+                free[k] = free[k] or rows.free[r]
                 merged = True
                 break
         if not merged and m < MAX_ROWS and _placed(row, n, arm.lower, arm.upper, ref, use_ref, arm.slack, out + m * n):
-            found[m], free[m] = 1, loose[r]
+            found[m], free[m] = rows.hits[r], rows.free[r]
             m += 1
     return m
 
