@@ -101,6 +101,18 @@ def interruptible(argv, **kwargs) -> subprocess.Popen:
     return subprocess.Popen(argv, preexec_fn=_default_sigint, **kwargs)
 
 
+def pinocchio_axes(robot):
+    """Unit axes, points on them and the tool pose at q = 0, read from Pinocchio's model and Jacobians."""
+    model, data = robot.model, robot.model.createData()
+    q0 = pin.neutral(model)
+    pin.computeJointJacobians(model, data, q0)
+    pin.framesForwardKinematics(model, data, q0)
+    h = np.array([pin.getJointJacobian(model, data, j, pin.WORLD)[3:, model.joints[j].idx_v]
+                  for j in range(1, model.njoints)])
+    o = np.array([data.oMi[j].translation for j in range(1, model.njoints)])
+    return h, o, data.oMf[robot.tool_frame_id]
+
+
 def chain_urdf(h, o, M, lower, upper, mount=None):
     """A URDF of revolute joints with axes h_i through points o_i (base frame, q = 0) and the tool at M; links
     are frames without rotation. ``mount``: (xyz, rpy) of the base under a "world" link."""

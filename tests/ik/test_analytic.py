@@ -11,7 +11,7 @@ import pinocchio as pin
 import pytest
 from closed_forms import BASE, UR_DH, ur_inverse
 from eaik.IK_HP import HPRobot
-from helpers import chain_urdf, write_urdf
+from helpers import chain_urdf, pinocchio_axes, write_urdf
 
 import kinelab
 from kinelab import OptionError, load
@@ -55,18 +55,6 @@ def confirmed(robot, target, qs, tol=1e-9):
 def same_set(a, b, tol=SAME):
     return all(any(np.max(np.abs(wrapped(x - y))) <= tol for y in b) for x in a) and \
         all(any(np.max(np.abs(wrapped(x - y))) <= tol for x in a) for y in b)
-
-
-def pinocchio_axes(robot):
-    """Unit axes, points on them and the tool pose at q = 0, read from Pinocchio's model and Jacobians."""
-    model, data = robot.model, robot.model.createData()
-    q0 = pin.neutral(model)
-    pin.computeJointJacobians(model, data, q0)
-    pin.framesForwardKinematics(model, data, q0)
-    h = np.array([pin.getJointJacobian(model, data, j, pin.WORLD)[3:, model.joints[j].idx_v]
-                  for j in range(1, model.njoints)])
-    o = np.array([data.oMi[j].translation for j in range(1, model.njoints)])
-    return h, o, data.oMf[robot.tool_frame_id]
 
 
 class Eaik:

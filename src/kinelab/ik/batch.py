@@ -21,6 +21,7 @@ from kinelab.geometry import stack_homogeneous
 from kinelab.ik.driver import solve_one
 from kinelab.ik.frdm import batch as frdm_batch
 from kinelab.ik.frdm.batch import Rows
+from kinelab.ik.limits import wrap_q
 from kinelab.ik.multistart import seed_states
 from kinelab.ik.request import Request
 from kinelab.ik.result import Status
@@ -190,6 +191,7 @@ def _judged(robot: Robot, rows: Rows, points: np.ndarray, rotations: np.ndarray,
     met = np.zeros(count, dtype=bool)
     solved = np.flatnonzero(rows.status != Status.TIME_BUDGET.value)
     if solved.size:
+        rows.Q[solved] = wrap_q(robot, rows.Q[solved])  # a whole turn into the limits: the same pose
         H_target = stack_homogeneous(points[solved], rotations[solved])
         with np.errstate(over="ignore"):  # a target 1e200 m away is far, not an error
             dp[solved], dr[solved] = task.errors_batch(H_target, robot.fk_batch(rows.Q[solved]))

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from kinelab.ik.limits import wrap_q
+from kinelab.ik.limits import turned_verdict, wrap_q
 from kinelab.ik.request import Request, verdict_reserve
 from kinelab.ik.result import Attempt, BypassRecord, IKResult, SingularEvent, Status
 from kinelab.ik.targets import as_target
@@ -109,16 +109,17 @@ class Call:
     task_label: str = "pose"
     finals: list[tuple[Status, float]] = field(default_factory=list)
 
-    def judge(self, q: np.ndarray) -> tuple[bool, float, float]:
-        """The judge's verdict on q (Pinocchio's FK, or the compiled FK certified equal to it on this robot):
-        (success, position error [m], rotation error [rad]) on the task's
-        components (the rotation error of task "axis" is the angle between the tool axes)."""
+    def judge(self, q: np.ndarray) -> tuple[np.ndarray, bool, float, float]:
+        """The answer and the judge's verdict on it (Pinocchio's FK, or the compiled FK certified equal to it on
+        this robot): (q, success, position error [m], rotation error [rad]) on the task's components (the rotation
+        error of task "axis" is the angle between the tool axes). A revolute joint outside its limits with a whole
+        turn of it inside is turned there first: the answer returned and judged is that one (the same pose)."""
         if not (q.dtype == np.float64 and q.ndim == 1 and q.flags.c_contiguous):
             q = np.ascontiguousarray(q, dtype=float)
-        dp, dr, within = self.robot.verdict(self.target.homogeneous, q, self.task.axis)
+        q, dp, dr, within = turned_verdict(self.robot, self.target.homogeneous, q, self.task.axis)
         task = self.task
         ok = within and (not task.position or dp <= self.tol_pos) and (not task.rotation or dr <= self.tol_rot)
-        return ok, dp, dr
+        return q, ok, dp, dr
 
 
 def _loop(module: Any, pb: Call, start: np.ndarray, max_restarts: int, opts: Any, rng: _LazyRng,
@@ -136,7 +137,7 @@ def _loop(module: Any, pb: Call, start: np.ndarray, max_restarts: int, opts: Any
         iterations += att.iterations
         events += att.events
         bypasses += att.bypasses
-        ok, dp, dr = pb.judge(att.q)
+        att.q, ok, dp, dr = pb.judge(att.q)
         score = dp / scale + dr
         if best is None or ok or score < best[0]:
             best, best_ok = (score, att, dp, dr), ok
@@ -165,7 +166,8 @@ def _fast(module: Any, pb: Call, start: np.ndarray | None, max_restarts: int, op
     """Restarts inside the solver's compiled kernel; the answer is then checked by Pinocchio."""
     att, restarts = module.multistart(pb.robot, pb.target, start, pb.tol_pos, pb.tol_rot, pb.deadline, pb.seed,
                                       max_restarts, opts)
-    return compiled_result(pb, att, restarts, *pb.judge(att.q))
+    att.q, ok, dp, dr = pb.judge(att.q)
+    return compiled_result(pb, att, restarts, ok, dp, dr)
 
 
 def compiled_result(pb: Call, att: Attempt, restarts: int, success: bool, dp: float, dr: float) -> IKResult:

@@ -22,6 +22,7 @@ import pinocchio as pin
 from kinelab.ik.driver import Call, compiled_result
 from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm import solver as frdm
+from kinelab.ik.limits import turned_verdict
 from kinelab.ik.request import Request, verdict_reserve
 from kinelab.ik.result import IKResult, Status
 from kinelab.ik.verdict import usual_inputs
@@ -70,7 +71,7 @@ class LeanFRDM:
         code, q, stats = ctx.run_aimed(None if q0 is None else start, seed, self.attempts, deadline)
         if ctx.continuous:
             q = self.robot.wrap_continuous(q)
-        dp, dr, ok = self._judged(H, q)
+        q, dp, dr, ok = self._judged(H, q)
         if ok and code == kernel.CONVERGED:  # the usual outcome, built without the general path's bookkeeping
             return self._converged(q, stats, dp, dr, t_start)
         call = Call(self.robot, target, self.req.solver, self.tol_pos, self.tol_rot, t_start, deadline, seed,
@@ -78,10 +79,11 @@ class LeanFRDM:
         return compiled_result(call, ctx.attempt(code, q, stats, deadline), max(0, int(stats[kernel.T_ATTEMPTS]) - 1),
                                ok, dp, dr)
 
-    def _judged(self, H: np.ndarray, q: np.ndarray) -> tuple[float, float, bool]:
-        """(position error [m], rotation error [rad], the task's components met within the limits)."""
-        dp, dr, within = self.robot.verdict(H, q, self.axis)
-        return dp, dr, within and (not self.check_pos or dp <= self.tol_pos) and \
+    def _judged(self, H: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, float, float, bool]:
+        """(the answer, turned into the limits where a whole turn does it; position error [m], rotation error
+        [rad], the task's components met within the limits)."""
+        q, dp, dr, within = turned_verdict(self.robot, H, q, self.axis)
+        return q, dp, dr, within and (not self.check_pos or dp <= self.tol_pos) and \
             (not self.check_rot or dr <= self.tol_rot)
 
     def _usual(self, target: Any, q0: Any, seed: Any) -> tuple[np.ndarray | None, int]:

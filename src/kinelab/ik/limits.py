@@ -40,6 +40,22 @@ def wrap_q(robot: Robot, q: np.ndarray) -> np.ndarray:
     return np.where(outside & (lowest <= robot.upper), lowest, q)
 
 
+def turned_verdict(robot: Robot, H_target: np.ndarray, q: np.ndarray,
+                   axis: int = -1) -> tuple[np.ndarray, float, float, bool]:
+    """The judge's word on an answer q (n floats, C-contiguous) against H_target (4 × 4, base frame), on the answer
+    turned into the limits: (q or :func:`wrap_q`'s turn of it, position error [m], rotation error [rad], within the
+    limits). Only an answer outside its limits is turned (and judged again): the usual call pays nothing."""
+    dp, dr, within = robot.verdict(H_target, q, axis)
+    if within:
+        return q, dp, dr, within
+    turned = wrap_q(robot, q)
+    if np.array_equal(turned, q):
+        return q, dp, dr, within
+    turned = np.ascontiguousarray(turned)
+    dp, dr, within = robot.verdict(H_target, turned, axis)
+    return turned, dp, dr, within
+
+
 def distance(robot: Robot, q: np.ndarray, ref: np.ndarray) -> float:
     """max |q_i − ref_i| over the joints [rad or m], revolute and continuous joints modulo 2π."""
     d = np.asarray(q, dtype=float) - np.asarray(ref, dtype=float)

@@ -12,6 +12,7 @@ from kinelab.geometry import stack_homogeneous
 from kinelab.ik.chain import chain_model
 from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
+from kinelab.ik.limits import wrap_q
 from kinelab.ik.multistart import seed_state
 from kinelab.ik.request import verdict_reserve
 from kinelab.ik.result import SingularEvent, Status, TrackResult
@@ -78,6 +79,7 @@ def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: 
     dp, dr = np.full(count, np.nan), np.full(count, np.nan)
     ok = started.copy()
     if started.any():
+        Q[started] = wrap_q(robot, Q[started])  # a joint past a limit by whole turns (use_limits=False) turned back
         dp[started], dr[started] = task.errors_batch(stack_homogeneous(points[started], rotations[started]),
                                                      robot.fk_batch(Q[started]))
         ok[started] = task.met_batch(dp[started], dr[started], tol_pos, tol_rot) & \

@@ -28,6 +28,7 @@ from kinelab.ik import options as opt
 from kinelab.ik.frdm import solver
 from kinelab.ik.frdm.follower import follow
 from kinelab.ik.frdm.options import FRDMOptions
+from kinelab.ik.limits import wrap_q
 from kinelab.ik.request import Request
 from kinelab.ik.result import Attempt, BypassRecord, SingularEvent, Status, TrackResult
 from kinelab.ik.targets import as_target_arrays
@@ -168,7 +169,8 @@ class _Path:
         """Pinocchio's verdict on the sample: the task's components within tolerance and q within the limits
         (the solver's own status is kept only to say why a sample failed)."""
         robot, req = self.robot, self.req
-        dp, dr = req.task.errors(target, robot.tool_pose_of_float_q(np.ascontiguousarray(att.q, dtype=float)))
+        att.q = np.ascontiguousarray(wrap_q(robot, att.q), dtype=float)  # whole turns into the limits: the same pose
+        dp, dr = req.task.errors(target, robot.tool_pose_of_float_q(att.q))
         met = req.task.met(dp, dr, req.tol_pos, req.tol_rot)
         within = bool(np.all(np.isfinite(att.q))) and robot.within_limits(att.q)
         if met and within:
