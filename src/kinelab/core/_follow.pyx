@@ -30,6 +30,12 @@ from kinelab.core._frdm cimport (
 cdef double TRUST_FLOOR = 0.02
 cdef double TRUST_FACTOR = 2.0
 cdef int SWEEPS_PER_LOOK = 32  # a phase's sweeps between two looks at the clock
+# a redundant arm's pull towards mid-range moves no joint by more than PULL_FLOOR + PULL_SHARE × the largest joint
+# step the task itself asks of the sample [rad or m]: the self-motion it steers stays as smooth as the path (uncapped,
+# a path starting at rest moved joints 18 times faster than the path itself did; capped by the last sample's whole
+# step, the pull fed on itself)
+cdef double PULL_FLOOR = 1e-5
+cdef double PULL_SHARE = 0.5
 
 
 cdef struct Follow:
@@ -76,6 +82,20 @@ cdef double _limit_pull(double x, double lo, double hi, double pull) noexcept no
     return _min(0.5, pull * (dl + du) * (dl + du) / (4.0 * dl * du))
 
 
+cdef void _pull_towards_centre(const double* q, int n, const Objective* pb, const double* centre, double pull,
+                               double cap, double* z) noexcept nogil:
+    """z ← the pull of a redundant arm's n joints from q towards mid-range (``pull`` times each joint's Chan–Dubey
+    measure, :func:`_limit_pull`; frozen joints 0), scaled down so that no joint moves by more than ``cap``."""
+    cdef int i
+    cdef double largest = 0.0
+    for i in range(n):
+        z[i] = _limit_pull(q[i], pb.lower[i], pb.upper[i], pull) * (centre[i] - q[i]) if pb.free[i] else 0.0
+        largest = _max(largest, fabs(z[i]))
+    if largest > cap:
+        for i in range(n):
+            z[i] *= cap / largest
+
+
 cdef void _solve6(const double* A, const double* b, double* x, double* F, int* pivots) noexcept nogil:
     """x = A⁻¹ b for the 6 × 6 row-major A, by LAPACK as NumPy's solve calls it (A copied to Fortran order)."""
     cdef int six = 6, one = 1, info = 0, i, j
@@ -93,7 +113,7 @@ cdef int redundant_newton(double* q, const Chain* ch, const Objective* pb, int i
     limits instead of drifting into one. Steps capped at ``max_step`` [rad or m]. Returns CONVERGED or −1, the
     steps in ``spent``; q is updated in place."""
     cdef int n = ch.n, it, i, six = 6, one_i = 1
-    cdef double one = 1.0, zero = 0.0, damping, largest
+    cdef double one = 1.0, zero = 0.0, damping, largest, task, pulled, scale
     cdef char t = b't', nt = b'n'
     cdef double p[3]
     cdef double R[9]
@@ -129,17 +149,24 @@ cdef int redundant_newton(double* q, const Chain* ch, const Objective* pb, int i
         damping = 1e-9 + 1e-3 * ddot(&six, err, &one_i, err, &one_i)
         for i in range(6):
             A[7 * i] += damping
-        for i in range(n):  # the pull acts on the first step only: the later ones converge as Gauss–Newton does
-            z[i] = _limit_pull(q[i], pb.lower[i], pb.upper[i], pull) * (centre[i] - q[i]) \
-                if it == 0 and pb.free[i] else 0.0
+        if it == 0:  # the pull acts on the first step only: the later ones converge as Gauss–Newton does
+            _pull_towards_centre(q, n, pb, centre, pull, INFINITY, z)
+        else:
+            for i in range(n):
+                z[i] = 0.0
         _solve6(A, err, s1, F, pivots)
         dgemv(&nt, &n, &six, &one, J, &n, s1, &one_i, &zero, a, &one_i)
         dgemv(&t, &n, &six, &one, J, &n, z, &one_i, &zero, Jz, &one_i)
         _solve6(A, Jz, s2, F, pivots)
         dgemv(&nt, &n, &six, &one, J, &n, s2, &one_i, &zero, b, &one_i)
+        task = pulled = 0.0
+        for i in range(n):
+            b[i] = z[i] - b[i]  # the pull's share in the task's null space
+            task, pulled = _max(task, fabs(a[i])), _max(pulled, fabs(b[i]))
+        scale = 1.0 if pulled <= PULL_FLOOR + PULL_SHARE * task else (PULL_FLOOR + PULL_SHARE * task) / pulled
         largest = 0.0
         for i in range(n):
-            a[i] = a[i] + z[i] - b[i]
+            a[i] += scale * b[i]
             largest = _max(largest, fabs(a[i]))
         if largest > max_step:
             for i in range(n):
@@ -173,6 +200,12 @@ cdef void pose_between(const double* p0, const double* R0, const double* p1, con
     for r in range(3):
         for c in range(3):
             R_out[3 * r + c] = R0[3 * r] * m[c] + R0[3 * r + 1] * m[3 + c] + R0[3 * r + 2] * m[6 + c]
+
+
+cdef inline double _pull_cap(double trust) noexcept nogil:
+    """The largest pull towards mid-range in one sample [rad or m], from the trust radius (which holds the last
+    sample's largest step)."""
+    return PULL_FLOOR + PULL_SHARE * (trust - TRUST_FLOOR) / TRUST_FACTOR
 
 
 cdef inline bint _late(const Follow* fw) noexcept nogil:
@@ -214,8 +247,9 @@ cdef int _sample(double* q, const Chain* ch, const Objective* pb, const Follow* 
             return code
         _copy(q, q_prev, n)
     if fw.w_rest > 0.0 and not _late(fw):
+        _pull_towards_centre(q_prev, n, pb, fw.centre, fw.pull, _pull_cap(trust), rest)
         for i in range(n):
-            rest[i] = q_prev[i] + _limit_pull(q_prev[i], pb.lower[i], pb.upper[i], fw.pull) * (fw.centre[i] - q_prev[i])
+            rest[i] += q_prev[i]
         rested = _aimed(pb, pstar, Rstar, rest, fw.w_rest)
         code = _phase(q, ch, &rested, fw, fw.rest_sweeps, mem, &more)
         spent[0] += more
