@@ -108,3 +108,36 @@ def test_a_tolerance_finer_than_double_precision_can_check_is_refused(name):
     res = kinelab.solve(robot, target, seed=0, **{name: 1e-12})
     dp, dr = robot.tool_error(res.q, target)
     assert res.success and (dp if name == "tol_pos" else dr) <= 1e-12
+
+
+def test_counts_past_the_kernels_integers_and_empty_starts_are_refused_by_name():
+    """#39 item 9: max_restarts of 2³¹ − 1 or 10³⁰ once overflowed a C int in the kernel (an OverflowError), an empty
+    q0 a ValueError from the kernel, threads.set_count(1000) ended the process."""
+    from kinelab.core import threads
+
+    ur5 = kinelab.load("ur5")
+    target = ur5.fk(ur5.random_q(0))
+    for restarts in (2**31 - 1, 10**30):
+        for call in (kinelab.solve, kinelab.solve_batch):
+            with pytest.raises(kinelab.OptionError, match="max_restarts.*an integer from 0 to 1,000,000,000"):
+                call(ur5, [target] if call is kinelab.solve_batch else target, max_restarts=restarts)
+        with pytest.raises(kinelab.OptionError, match="max_restarts"):
+            kinelab.IK(ur5, max_restarts=restarts)
+    for q0 in (np.zeros(0), np.zeros(7), np.zeros((2, 6))):
+        with pytest.raises(kinelab.ConfigurationError, match="6"):
+            kinelab.solve(ur5, target, q0=q0)
+    with pytest.raises(kinelab.OptionError, match="threads=1000 is not valid: an integer from 1 to"):
+        threads.set_count(1000)
+    assert kinelab.solve(ur5, target, max_restarts=10**9, seed=0).success  # the largest count is a count
+
+
+def test_an_anderson_memory_past_its_use_and_starts_that_do_not_match_the_targets_are_refused():
+    """#39 item 9: accel_memory=10**6 was accepted and every solve then ended max_iterations; an analytic batch with 3
+    starts for 2 targets ended in numpy's broadcast error."""
+    ur5 = kinelab.load("ur5")
+    target = ur5.fk(ur5.random_q(0))
+    with pytest.raises(kinelab.OptionError, match="accel_memory.*from 1 to 50"):
+        kinelab.solve(ur5, target, accel_memory=10**6)
+    assert kinelab.solve(ur5, target, accel_memory=50, seed=0).success
+    with pytest.raises(kinelab.ConfigurationError, match=r"\(2, 6\) for 2 targets"):
+        kinelab.solve_batch(ur5, [target, target], solver="analytic", q0=np.zeros((3, 6)))

@@ -29,6 +29,9 @@ def count() -> int:
     return available()
 
 
+MAX_THREADS = 64  # threads a batch may be given beyond the cores (OpenMP ends the process when it cannot start one)
+
+
 def set_count(threads: int | None) -> None:
     """Run compiled batches on ``threads`` threads from now on in this process (None: back to the default).
 
@@ -38,6 +41,7 @@ def set_count(threads: int | None) -> None:
     if threads is None:
         _COUNT.clear()
         return
-    if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
-        raise OptionError("threads", threads, f"a positive integer (this machine has {available()} cores)")
+    most = max(MAX_THREADS, available())
+    if isinstance(threads, bool) or not isinstance(threads, int) or not 1 <= threads <= most:
+        raise OptionError("threads", threads, f"an integer from 1 to {most} (this machine has {available()} cores)")
     _COUNT[:] = [threads]

@@ -93,7 +93,7 @@ class LeanFRDM:
             return None, 0
         if q0 is None:
             start = self.none
-        elif type(q0) is np.ndarray and q0.dtype == np.float64 and q0.ndim == 1 and q0.flags.c_contiguous:
+        elif type(q0) is np.ndarray and q0.dtype == np.float64 and q0.shape == (self.n,) and q0.flags.c_contiguous:
             start = q0
         else:
             return None, 0

@@ -135,8 +135,9 @@ def check_arguments(tol_pos: Any, tol_rot: Any, time_budget: Any, max_restarts: 
     _check_positive("tol_rot", tol_rot, TOL_FLOOR)
     if time_budget is not None:
         _check_positive("time_budget", time_budget, 0.0)
-    if not count_ok(max_restarts):
-        raise OptionError("max_restarts", max_restarts, "an integer ≥ 0")
+    if not count_ok(max_restarts) or max_restarts > MAX_RESTARTS:
+        raise OptionError("max_restarts", max_restarts, f"an integer from 0 to {MAX_RESTARTS:,} (the kernels count "
+                          "attempts in 32-bit integers; a time_budget bounds a long search)")
     if seed is not None and not count_ok(seed):
         raise OptionError("seed", seed, "an integer ≥ 0, or None for fresh entropy")
     if not isinstance(start_outside_limits, str) or start_outside_limits not in START_POLICIES:
@@ -159,7 +160,8 @@ def _plain_positive(a: Any, b: Any, c: Any) -> bool:
 
 
 def _plain_counts(max_restarts: Any, seed: Any) -> bool:
-    return type(max_restarts) is int and max_restarts >= 0 and (seed is None or (type(seed) is int and seed >= 0))
+    return type(max_restarts) is int and 0 <= max_restarts <= MAX_RESTARTS and \
+        (seed is None or (type(seed) is int and seed >= 0))
 
 
 def check_seed(seed: Any, name: str = "seed") -> None:
@@ -170,6 +172,9 @@ def check_seed(seed: Any, name: str = "seed") -> None:
     """
     if not count_ok(seed):
         raise OptionError(name, seed, "an integer ≥ 0" + (", or None for fresh entropy" if name == "seed" else ""))
+
+
+MAX_RESTARTS = 10**9  # restarts a solve may ask for: more than any budget runs, and within the kernels' C ints
 
 
 def count_ok(value: Any) -> bool:

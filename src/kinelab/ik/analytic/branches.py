@@ -18,7 +18,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.collision.model import CollisionModel
-from kinelab.errors import OptionError
+from kinelab.errors import ConfigurationError, OptionError
 from kinelab.geometry import pose_errors, stack_homogeneous
 from kinelab.ik.analytic.classify import ArmClass, classify
 from kinelab.ik.analytic.kernel import MAX_ROWS, branches, branches_batch
@@ -303,7 +303,11 @@ def nearest_batch(robot: Robot, targets: Any, q0: Any, req: Request, model: Coll
     """
     t0 = time.perf_counter()
     H = stack_homogeneous(*as_target_arrays(targets))
-    starts = None if q0 is None else np.broadcast_to(robot.check_qs(np.atleast_2d(q0), what="q0"), (len(H), robot.n))
+    starts = None if q0 is None else robot.check_qs(np.atleast_2d(q0), what="q0")
+    if starts is not None and starts.shape[0] not in (1, len(H)):
+        raise ConfigurationError(f"q0 must be None, {robot.n} numbers or ({len(H)}, {robot.n}) for {len(H)} targets of "
+                                 f"{robot.name}, got shape {np.shape(q0)}")
+    starts = None if starts is None else np.broadcast_to(starts, (len(H), robot.n))
     rows = [analytic_one(robot, pin.SE3(H[b, :3, :3], H[b, :3, 3]), req, None if starts is None else starts[b], model)
             for b in range(len(H))]
     return BatchIKResult(q=np.array([r.q for r in rows]), success=np.array([r.success for r in rows]),

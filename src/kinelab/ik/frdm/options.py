@@ -26,6 +26,7 @@ BYPASSES = ("kicks", "intervals", "freeze", "auto_kick")
 W_P_FACTOR = 3.0
 STALL_WINDOW = 10
 PLAIN_STALL_WINDOW = 50
+MAX_ACCEL_MEMORY = 50  # sweeps Anderson acceleration may remember (each costs a column in its least squares)
 
 
 @dataclass(frozen=True)
@@ -119,6 +120,9 @@ class FRDMOptions:
         opt.positive("w_p_factor", self.w_p_factor)
         opt.positive("eps_q", self.eps_q)
         opt.positive("accel_memory", self.accel_memory, integer=True)
+        if self.accel_memory > MAX_ACCEL_MEMORY:  # a longer memory only costs: every solve then ran out of sweeps
+            raise OptionError("accel_memory", self.accel_memory, f"an integer from 1 to {MAX_ACCEL_MEMORY} (sweeps "
+                              "Anderson acceleration remembers; 5 is the default)")
         opt.positive("max_sweeps", self.max_sweeps, allow_none=True, integer=True)
         opt.positive("stall_window", self.stall_window, allow_none=True, integer=True)
         opt.positive("stall_rel", self.stall_rel, allow_none=True)
