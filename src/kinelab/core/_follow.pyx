@@ -202,12 +202,6 @@ cdef void pose_between(const double* p0, const double* R0, const double* p1, con
             R_out[3 * r + c] = R0[3 * r] * m[c] + R0[3 * r + 1] * m[3 + c] + R0[3 * r + 2] * m[6 + c]
 
 
-cdef inline double _pull_cap(double trust) noexcept nogil:
-    """The largest pull towards mid-range in one sample [rad or m], from the trust radius (which holds the last
-    sample's largest step)."""
-    return PULL_FLOOR + PULL_SHARE * (trust - TRUST_FLOOR) / TRUST_FACTOR
-
-
 cdef inline bint _late(const Follow* fw) noexcept nogil:
     return fw.deadline < INFINITY and now() > fw.deadline
 
@@ -247,7 +241,7 @@ cdef int _sample(double* q, const Chain* ch, const Objective* pb, const Follow* 
             return code
         _copy(q, q_prev, n)
     if fw.w_rest > 0.0 and not _late(fw):
-        _pull_towards_centre(q_prev, n, pb, fw.centre, fw.pull, _pull_cap(trust), rest)
+        _pull_towards_centre(q_prev, n, pb, fw.centre, fw.pull, INFINITY, rest)  # uncapped: the paper's FRDM path
         for i in range(n):
             rest[i] += q_prev[i]
         rested = _aimed(pb, pstar, Rstar, rest, fw.w_rest)
