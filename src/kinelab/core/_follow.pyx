@@ -83,17 +83,12 @@ cdef double _limit_pull(double x, double lo, double hi, double pull) noexcept no
 
 
 cdef void _pull_towards_centre(const double* q, int n, const Objective* pb, const double* centre, double pull,
-                               double cap, double* z) noexcept nogil:
-    """z ← the pull of a redundant arm's n joints from q towards mid-range (``pull`` times each joint's Chan–Dubey
-    measure, :func:`_limit_pull`; frozen joints 0), scaled down so that no joint moves by more than ``cap``."""
+                               double* z) noexcept nogil:
+    """z ← the pull of a redundant arm's n joints from q towards mid-range: ``pull`` times each joint's Chan–Dubey
+    measure (:func:`_limit_pull`) of the way there; frozen joints 0."""
     cdef int i
-    cdef double largest = 0.0
     for i in range(n):
         z[i] = _limit_pull(q[i], pb.lower[i], pb.upper[i], pull) * (centre[i] - q[i]) if pb.free[i] else 0.0
-        largest = _max(largest, fabs(z[i]))
-    if largest > cap:
-        for i in range(n):
-            z[i] *= cap / largest
 
 
 cdef void _solve6(const double* A, const double* b, double* x, double* F, int* pivots) noexcept nogil:
@@ -150,7 +145,7 @@ cdef int redundant_newton(double* q, const Chain* ch, const Objective* pb, int i
         for i in range(6):
             A[7 * i] += damping
         if it == 0:  # the pull acts on the first step only: the later ones converge as Gauss–Newton does
-            _pull_towards_centre(q, n, pb, centre, pull, INFINITY, z)
+            _pull_towards_centre(q, n, pb, centre, pull, z)
         else:
             for i in range(n):
                 z[i] = 0.0
@@ -241,7 +236,7 @@ cdef int _sample(double* q, const Chain* ch, const Objective* pb, const Follow* 
             return code
         _copy(q, q_prev, n)
     if fw.w_rest > 0.0 and not _late(fw):
-        _pull_towards_centre(q_prev, n, pb, fw.centre, fw.pull, INFINITY, rest)  # uncapped: the paper's FRDM path
+        _pull_towards_centre(q_prev, n, pb, fw.centre, fw.pull, rest)
         for i in range(n):
             rest[i] += q_prev[i]
         rested = _aimed(pb, pstar, Rstar, rest, fw.w_rest)

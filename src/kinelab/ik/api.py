@@ -23,7 +23,7 @@ from kinelab.collision.model import CollisionModel, as_collisions, collision_mod
 from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.analytic.branches import analytic_one, nearest_batch, refuse_options
-from kinelab.ik.batch import BatchIKResult, prepare, run_batch
+from kinelab.ik.batch import BatchIKResult, prepare, prepare_robot, run_batch
 from kinelab.ik.branches import UNSEEN, find_all
 from kinelab.ik.chain import chain_model
 from kinelab.ik.clear import clear_batch, clear_track, mark_colliding, solve_clear
@@ -349,7 +349,7 @@ def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
     """
     check_entry(robot, "track", positional)
     chain_model(robot)  # the follower's chain and the judge are built once per robot, on no budget's clock
-    robot.fk_certificate  # noqa: B018
+    prepare_robot(robot)
     t_start = time.perf_counter()  # the budget counts from here, the checks of the call included
     if solver_module(solver) is not solver_module("frdm"):
         raise OptionError("solver", solver, "'frdm' (track follows a path with FRDM's warm-started sweeps)")

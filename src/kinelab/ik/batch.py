@@ -18,7 +18,7 @@ import pinocchio as pin
 from kinelab.core import _blas, threads
 from kinelab.errors import ConfigurationError
 from kinelab.geometry import stack_homogeneous
-from kinelab.ik.driver import solve_one
+from kinelab.ik.driver import prepare_solver, solve_one
 from kinelab.ik.frdm import batch as frdm_batch
 from kinelab.ik.frdm.batch import Rows
 from kinelab.ik.limits import wrap_q
@@ -114,24 +114,26 @@ def run_batch(robot: Robot, targets: Any, q0: Any, req: Request) -> BatchIKResul
 
 
 def prepare(robot: Robot, req: Request) -> bool:
-    """Build what a batch of this request needs once per robot, before any clock starts: the solver's chain model,
-    the certified judge, the reach bound and the BLAS routines (the kernels are compiled at install). No budget
-    pays for this: a first call with a 50 ms budget once spent it all on the certificate and returned nothing.
+    """Build what a batch of this request needs once per robot, before any clock starts: the solver's model and
+    what :func:`prepare_robot` builds. No budget pays for this: a first call with a 50 ms budget once spent it all
+    on the certificate and returned nothing.
 
     Returns:
         True when the rows run in FRDM's compiled batch (else one by one through the driver).
     """
     compiled = bool(req.solver == "frdm" and req.options.compiled)
-    if compiled:
-        frdm_batch.prepare(robot)
-        _blas.ready()
-    else:
-        prepare_solver = getattr(req.module, "prepare", None)
-        if prepare_solver is not None:
-            prepare_solver(robot, req.options)
+    prepare_solver(req.module, robot, req.options)  # FRDM's: the chain model its batch runs on
+    prepare_robot(robot)
+    return compiled
+
+
+def prepare_robot(robot: Robot) -> None:
+    """What the compiled kernels and the judge need once per robot, before any clock starts: the certified judge, the
+    reach bound and the BLAS routines (the kernels themselves are compiled at install; a solver's own model is its
+    ``prepare``'s)."""
+    _blas.ready()
     robot.fk_certificate  # noqa: B018 - certified once per robot
     reach_bound(robot)
-    return compiled
 
 
 def fresh_seed() -> int:

@@ -120,8 +120,9 @@ def _multistart_all(robot: Robot, target: Any, req: Request, ref: np.ndarray | N
                       "of reach (a larger time_budget may find one)")
     return Branches([IKResult(q=q, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr,
                               iterations=0, restarts=rounds * ROUND - 1, wall_time=elapsed, solver=req.solver,
-                     mode=f"{req.solver} (all branches, multistart)",
-                     diagnostics=Diagnostics(found=count, starts=rounds * ROUND, unseen=missing), task=req.task_label)
+                              mode=f"{req.solver} (all branches, multistart)",
+                              diagnostics=Diagnostics(found=count, starts=rounds * ROUND, unseen=missing),
+                              task=req.task_label)
                      for q, dp, dr, count in found[:max_solutions]], status, why)
 
 

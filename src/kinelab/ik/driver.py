@@ -68,7 +68,7 @@ def solve_one(robot: Robot, target: Any, q0: Any, req: Request) -> IKResult:
         TargetError, ConfigurationError, JointLimitError: bad target or start, named.
     """
     module, opts = req.module, req.options
-    _prepare(module, robot, opts)
+    prepare_solver(module, robot, opts)
     t_start = time.perf_counter()
     target = as_target(target, req.task.name)
     rng = _LazyRng(req.seed)
@@ -86,8 +86,8 @@ def solve_one(robot: Robot, target: Any, q0: Any, req: Request) -> IKResult:
     return _loop(module, problem, _start(robot, q0, rng, req.start_outside_limits), max_restarts, opts, rng, beyond)
 
 
-def _prepare(module: Any, robot: Robot, options: Any) -> None:
-    """Model building, which is not a solve's time."""
+def prepare_solver(module: Any, robot: Robot, options: Any) -> None:
+    """The solver module's model building for this robot (its ``prepare``, where it has one): not a solve's time."""
     prepare = getattr(module, "prepare", None)
     if prepare is not None:
         prepare(robot, options)

@@ -21,7 +21,7 @@ from kinelab.ik.analytic.branches import analytic_one, arm_of, nearest_batch, re
 from kinelab.ik.batch import BatchIKResult, run_batch
 from kinelab.ik.branches import UNSEEN, find_all
 from kinelab.ik.clear import clear_batch, mark_colliding, solve_clear
-from kinelab.ik.driver import solve_one
+from kinelab.ik.driver import prepare_solver, solve_one
 from kinelab.ik.lean import LeanFRDM
 from kinelab.ik.request import Request, check_robot, check_seed, make_request
 from kinelab.ik.result import Branches, IKResult
@@ -81,9 +81,7 @@ class IK:
         if self.analytic:
             arm_of(robot, req)
             return None
-        prepare = getattr(req.module, "prepare", None)
-        if prepare is not None:
-            prepare(robot, req.options)
+        prepare_solver(req.module, robot, req.options)
         return LeanFRDM(robot, req) if req.solver == "frdm" and req.options.compiled else None
 
     def _request(self, seed: int | None) -> Request:

@@ -115,9 +115,9 @@ def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | No
 def branch_results(answers: list[tuple[Any, ...]], req: Request, mode: str, elapsed: float,
                    max_solutions: int | None, unseen: float | None, empty: str) -> Branches:
     """The closed form's answers — (q, position error, rotation error, finished, roots merged, one of a
-    continuum) each — as IKResults, the first ``max_solutions``; ``diagnostics.branches`` counts them all. No
-    answer is status ``unreachable`` with the reason ``empty``: the closed form and the search compute every
-    branch, so none is a proof."""
+    continuum) each — as IKResults, the first ``max_solutions``; ``diagnostics.branches`` counts them all. With no
+    answer the set's status is ``unreachable`` for the reason ``empty``: the closed form and the search compute
+    every branch, so finding none proves it."""
     return Branches([IKResult(q=q, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr,
                               iterations=0, restarts=0, wall_time=elapsed, solver="analytic", mode=mode,
                               message=CONTINUUM if loose else "",

@@ -41,11 +41,6 @@ class Rows:
                    np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64))
 
 
-def prepare(robot: Robot) -> None:
-    """Build the chain model before the batch's clock starts (the kernel is compiled at install)."""
-    chain_model(robot)
-
-
 def run(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts: np.ndarray | None, rng_states: np.ndarray,
         attempts: np.ndarray, tol_pos: float, tol_rot: float, deadline: float, opts: FRDMOptions) -> Rows:
     """Solve every row in one parallel compiled call; each row looks at the clock between its chunks of sweeps (the

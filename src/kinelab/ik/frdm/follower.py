@@ -75,15 +75,7 @@ def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: 
                    np.ascontiguousarray(rotations, dtype=float), opts.settings(), order, int(max_sweeps),
                    float(rest_weight), REST_SWEEPS, centre, CENTRE_PULL, LM_ITERATIONS if opts.polish else 0,
                    seed_state(seed), deadline, codes, sweeps)
-    started = np.isfinite(Q).all(axis=1)  # a sample the budget left unstarted is NaN: no error to judge
-    dp, dr = np.full(count, np.nan), np.full(count, np.nan)
-    ok = started.copy()
-    if started.any():
-        Q[started] = wrap_q(robot, Q[started])  # a joint past a limit by whole turns (use_limits=False) turned back
-        dp[started], dr[started] = task.errors_batch(stack_homogeneous(points[started], rotations[started]),
-                                                     robot.fk_batch(Q[started]))
-        ok[started] = task.met_batch(dp[started], dr[started], tol_pos, tol_rot) & \
-            robot.within_limits_batch(Q[started])
+    dp, dr, ok = _judged(robot, Q, points, rotations, task, tol_pos, tol_rot)
     status = [Status.CONVERGED.value if ok[k] else _STATUS.get(int(codes[k]), Status.MAX_ITERATIONS).value
               for k in range(count)]
     per_sample = (time.perf_counter() - t0) / count  # the kernel and Pinocchio's check of every answer
@@ -91,5 +83,23 @@ def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: 
               for k in range(count) if codes[k] in (kernel.STALL_STEP, kernel.STALL_WINDOW)]
     return TrackResult(Q, dp, dr, status, sweeps, np.full(count, per_sample), events, [],
                        mode=opts.label + ("+lm" if opts.polish else "") + " (compiled follower)")
+
+
+def _judged(robot: Robot, Q: np.ndarray, points: np.ndarray, rotations: np.ndarray, task: Task, tol_pos: float,
+            tol_rot: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The judge's word on every sample the follower started (the others are NaN rows): position errors [m],
+    rotation errors [rad], and whether the task's components are met within the limits. A joint past a limit by
+    whole turns (``use_limits=False``) is turned back into Q first, in place: the same pose."""
+    count = Q.shape[0]
+    started = np.isfinite(Q).all(axis=1)
+    dp, dr = np.full(count, np.nan), np.full(count, np.nan)
+    ok = started.copy()
+    if started.any():
+        Q[started] = wrap_q(robot, Q[started])
+        dp[started], dr[started] = task.errors_batch(stack_homogeneous(points[started], rotations[started]),
+                                                     robot.fk_batch(Q[started]))
+        ok[started] = task.met_batch(dp[started], dr[started], tol_pos, tol_rot) & \
+            robot.within_limits_batch(Q[started])
+    return dp, dr, ok
 
 
