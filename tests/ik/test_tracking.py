@@ -133,3 +133,18 @@ def test_every_reached_sample_is_met_whatever_the_options(seed):
             dr = np.linalg.norm(pin.log3(target.rotation.T @ robot.fk(q).rotation))
         met = dp <= tol and (task == "position" or dr <= tol) and robot.within_limits(q)
         assert res.reached[k] == met, (k, task, options, dp, dr)
+
+
+def test_the_compiled_follower_reports_a_jump_as_the_monitored_loop_does():
+    """#39 item 4: a step above jump_limit is an event in the result on the compiled path too (it had none)."""
+    ur5 = kinelab.load("ur5")
+    a, b = ur5.random_q(1), ur5.random_q(2)
+    path = [ur5.fk(a), ur5.fk(a), ur5.fk(b)]  # two samples apart by whole radians: a jump the path asks for
+    for policy in (None, ("auto_kick",)):
+        res = kinelab.track(ur5, path, q0=a, policy=policy)
+        assert res.mode.endswith("(compiled follower)") == (policy is None)
+        jumps = [e for e in res.events if e.trigger == "jump"]
+        step = np.abs(res.q[2] - res.q[1]).max()
+        assert step > 0.2 and [e.sample for e in jumps] == [2] and jumps[0].max_joint_step == pytest.approx(step)
+    quiet = kinelab.track(ur5, path, q0=a, jump_limit=None)
+    assert not [e for e in quiet.events if e.trigger == "jump"]

@@ -94,8 +94,10 @@ def run_track(robot: Robot, targets: Any, q0: np.ndarray, req: Request, settings
     opts: FRDMOptions = req.options
     _check_restrict(settings.restrict, opts.intervals, opts.freeze)
     if _followable(opts) and not settings.restrict:
-        return follow(robot, targets, q0, req.tol_pos, req.tol_rot, opts.sweep_cap, settings.rest_weight, opts,
+        path = follow(robot, targets, q0, req.tol_pos, req.tol_rot, opts.sweep_cap, settings.rest_weight, opts,
                       req.task, req.seed, req.time_budget, t_start)
+        path.events += jump_events(path.q, q0, settings.jump_limit)
+        return path
     policy = opts.policy or ()
     attempt_opts = replace(opts, policy=tuple(s for s in policy if s not in RESTRICTIONS))
     path = _Path(robot, req, attempt_opts, settings, [s for s in policy if s in RESTRICTIONS])
@@ -104,6 +106,16 @@ def run_track(robot: Robot, targets: Any, q0: np.ndarray, req: Request, settings
     for k in range(points.shape[0]):
         q_prev = path.sample(k, pin.SE3(rotations[k], points[k]), q_prev)
     return path.result()
+
+
+def jump_events(Q: np.ndarray, q0: np.ndarray, jump_limit: float | None) -> list[SingularEvent]:
+    """A "jump" event for every sample whose largest joint step from the sample before (q0 before the first) exceeds
+    ``jump_limit`` [rad or m] (None: none); samples left unsolved (NaN) are skipped."""
+    if jump_limit is None or Q.shape[0] == 0:
+        return []
+    steps = np.abs(np.diff(np.vstack([q0, Q]), axis=0)).max(axis=1)
+    return [SingularEvent("jump", sample=int(k), max_joint_step=float(steps[k]))
+            for k in np.flatnonzero(np.nan_to_num(steps, nan=0.0) > jump_limit)]
 
 
 def _followable(opts: FRDMOptions) -> bool:
