@@ -11,7 +11,7 @@ finished by a warm-started solve from it; one that still misses is dropped.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -25,7 +25,7 @@ from kinelab.ik.analytic.kernel import MAX_ROWS, branches, branches_batch
 from kinelab.ik.batch import BatchIKResult
 from kinelab.ik.driver import solve_one
 from kinelab.ik.limits import distance
-from kinelab.ik.request import Request, make_request
+from kinelab.ik.request import Request, make_request, verdict_reserve
 from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target_arrays
 from kinelab.ik.workspace import beyond_reach
@@ -308,12 +308,27 @@ def nearest_batch(robot: Robot, targets: Any, q0: Any, req: Request, model: Coll
         raise ConfigurationError(f"q0 must be None, {robot.n} numbers or ({len(H)}, {robot.n}) for {len(H)} targets of "
                                  f"{robot.name}, got shape {np.shape(q0)}")
     starts = None if starts is None else np.broadcast_to(starts, (len(H), robot.n))
-    rows = [analytic_one(robot, pin.SE3(H[b, :3, :3], H[b, :3, 3]), req, None if starts is None else starts[b], model)
-            for b in range(len(H))]
-    return BatchIKResult(q=np.array([r.q for r in rows]), success=np.array([r.success for r in rows]),
-                         status=np.array([r.status.value for r in rows]),
-                         position_error=np.array([r.position_error for r in rows]),
-                         rotation_error=np.array([r.rotation_error for r in rows]),
-                         iterations=np.zeros(len(rows), dtype=int), restarts=np.zeros(len(rows), dtype=int),
-                         seed=0, wall_time=time.perf_counter() - t0, solver="analytic",
-                         mode=rows[0].mode if rows else "analytic")
+    return _nearest_rows(robot, H, starts, req, model, t0)
+
+
+def _nearest_rows(robot: Robot, H: np.ndarray, starts: np.ndarray | None, req: Request, model: CollisionModel | None,
+                  t0: float) -> BatchIKResult:
+    """:func:`analytic_one` row by row within what is left of the request's budget (counted from t0): each row gets
+    the rest of it, and the rows not started when it has run out are NaN with status ``time_budget``."""
+    arm = arm_of(robot, req)
+    deadline = np.inf if req.time_budget is None else t0 + req.time_budget - verdict_reserve(req.time_budget)
+    B = len(H)
+    q, dp, dr = np.full((B, robot.n), np.nan), np.full(B, np.nan), np.full(B, np.nan)
+    success, status = np.zeros(B, dtype=bool), np.full(B, Status.TIME_BUDGET.value, dtype="<U14")
+    for b in range(B):
+        left = deadline - time.perf_counter()
+        if left <= 0:
+            break
+        row = analytic_one(robot, pin.SE3(H[b, :3, :3], H[b, :3, 3]),
+                           req if req.time_budget is None else replace(req, time_budget=left),
+                           None if starts is None else starts[b], model)
+        q[b], success[b], status[b] = row.q, row.success, row.status.value
+        dp[b], dr[b] = row.position_error, row.rotation_error
+    return BatchIKResult(q=q, success=success, status=status, position_error=dp, rotation_error=dr,
+                         iterations=np.zeros(B, dtype=int), restarts=np.zeros(B, dtype=int), seed=0,
+                         wall_time=time.perf_counter() - t0, solver="analytic", mode=arm.mode)

@@ -94,10 +94,10 @@ def run_track(robot: Robot, targets: Any, q0: np.ndarray, req: Request, settings
     opts: FRDMOptions = req.options
     _check_restrict(settings.restrict, opts.intervals, opts.freeze)
     if _followable(opts) and not settings.restrict:
-        path = follow(robot, targets, q0, req.tol_pos, req.tol_rot, opts.sweep_cap, settings.rest_weight, opts,
-                      req.task, req.seed, req.time_budget, t_start)
-        path.events += jump_events(path.q, q0, settings.jump_limit)
-        return path
+        followed = follow(robot, targets, q0, req.tol_pos, req.tol_rot, opts.sweep_cap, settings.rest_weight, opts,
+                          req.task, req.seed, req.time_budget, t_start)
+        followed.events += jump_events(followed.q, q0, settings.jump_limit)
+        return followed
     policy = opts.policy or ()
     attempt_opts = replace(opts, policy=tuple(s for s in policy if s not in RESTRICTIONS))
     path = _Path(robot, req, attempt_opts, settings, [s for s in policy if s in RESTRICTIONS])
