@@ -212,6 +212,14 @@ def test_singular_on_an_arm_with_fewer_than_six_joints(capsys):
     (["ik", "ur5", "--target-xyz", "0.3", "0.2", "0.4", "--seed", "-1"], "seed"),
     (["bench", "--out", "/proc/kinelab-bench", "--n", "1"], "not a writable folder"),
     (["fk", "rd:finger_edu_descripton", "0", "0", "0"], "close names: rd:finger_edu_description"),
+    # #39 item 10: an empty value read as "not given" (exit 0 with the default; view --html '' served for ever)
+    (["fk", "ur5", "0", "0", "0", "0", "0", "0", "--tool", ""], "argument --tool: an empty value"),
+    (["fk", "ur5", "0", "0", "0", "0", "0", "0", "--base", " "], "argument --base: an empty value"),
+    (["fk", "ur5", "0", "0", "0", "0", "0", "0", "--package-dir", ""], "argument --package-dir: an empty value"),
+    (["validate", "--out", ""], "argument --out: an empty value"),
+    (["view", "ur5", "--html", ""], "argument --html: an empty value"),
+    (["fk", "", "0"], "argument robot: an empty value"),
+    (["map", "base", "youbot", "--grasp", "0.5", "0", "0.2", "0", "0", "0", "--top", "-1"], "count=-1 is not valid"),
 ])
 def test_bad_values_end_in_one_line_and_exit_2_before_any_work(argv, needle):
     proc = subprocess.run([sys.executable, "-m", "kinelab.cli", *argv], capture_output=True, text=True,

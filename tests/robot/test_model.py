@@ -287,3 +287,11 @@ def test_from_model_re_roots_at_a_base_and_refuses_what_it_cannot_use():
         kinelab.Robot.from_model(whole, tool="nosuch")
     with pytest.raises(kinelab.ChainError, match="pinocchio.Model"):
         kinelab.Robot.from_model("panda.urdf", tool="x")
+
+
+@pytest.mark.parametrize("keyword", ["tool", "base", "group", "srdf", "package_dirs"])
+def test_an_empty_name_is_refused_not_read_as_none(keyword):
+    """#39 item 10: tool='' read as "the default tool", package_dirs=[''] as the working folder."""
+    value = [""] if keyword == "package_dirs" else ""
+    with pytest.raises(kinelab.KinelabError, match=f"{keyword}="):
+        kinelab.load("ur5", **{keyword: value})

@@ -26,6 +26,21 @@ class Parser(argparse.ArgumentParser):
         command = " ".join(self.prog.split()[1:])  # "" for the top parser, "ik" for a subcommand
         self.exit(2, f"kinelab: error: {message} (see 'kinelab {command + ' ' if command else ''}--help')\n")
 
+    def parse_known_args(self, args: Any = None, namespace: Any = None) -> Any:
+        """argparse's parse, then a refusal of any empty value: ``--tool ''`` or ``--out ''`` would otherwise read as
+        "not given" and the command would run with the default (a page served for ever, a report written where the
+        user did not ask)."""
+        found, extra = super().parse_known_args(args, namespace)
+        for action in self._actions:
+            value = getattr(found, action.dest, None)
+            values = value if isinstance(value, list) else [value]
+            flat = [v for item in values for v in (item if isinstance(item, list) else [item])]
+            if any(isinstance(v, str) and not v.strip() for v in flat):
+                name = action.option_strings[-1] if action.option_strings else action.dest
+                leave = " or leave the option out" if action.option_strings else ""
+                self.error(f"argument {name}: an empty value; give {action.metavar or action.dest.upper()}{leave}")
+        return found, extra
+
 
 def q_from_cli(robot: Robot, values: list[str], deg: bool, what: str = "q") -> np.ndarray:
     """One number per joint (rad or m; degrees with --deg), or the name of an SRDF configuration.

@@ -77,7 +77,9 @@ def run_base(args: argparse.Namespace) -> int:
     """The platform positions that reach the grasp, best manipulability first."""
     from kinelab import maps
     from kinelab.ik import target_from_xyz_rpy
+    from kinelab.maps.base import check_count
 
+    check_count(args.top)  # before the map's work
     robot = load_robot(args)
     grasp = target_from_xyz_rpy(args.grasp[:3], args.grasp[3:])
     result = maps.base_map(robot, grasp, step=args.step, seed=args.seed)

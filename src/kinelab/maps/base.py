@@ -14,12 +14,13 @@ one answer per position.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
 from kinelab.analysis.singular import conditioning_batch
-from kinelab.errors import KinelabError
+from kinelab.errors import KinelabError, OptionError
 from kinelab.ik.analytic.branches import all_branches_batch
 from kinelab.ik.analytic.classify import classify
 from kinelab.ik.api import solve_batch
@@ -51,9 +52,24 @@ class BaseMap:
     q: np.ndarray
 
     def ranked(self, count: int = 10) -> np.ndarray:
-        """Indices of the best ``count`` reachable poses, highest manipulability first."""
+        """Indices of the best ``count`` reachable poses, highest manipulability first.
+
+        Raises:
+            OptionError: ``count`` is not an integer ≥ 0 (a negative count once listed the unreachable poses).
+        """
+        check_count(count)
         order = np.argsort(-np.where(self.reachable, self.manipulability, -1.0))
         return order[: min(count, int(self.reachable.sum()))]
+
+
+def check_count(count: Any) -> None:
+    """Refuse a count of best poses that is not an integer ≥ 0 (a negative one once listed the unreachable poses).
+
+    Raises:
+        OptionError: naming the value and what is valid.
+    """
+    if isinstance(count, bool) or not isinstance(count, int | np.integer) or count < 0:
+        raise OptionError("count", count, "an integer ≥ 0: how many of the best poses (kinelab map base --top)")
 
 
 def base_map(robot: Robot, grasp: pin.SE3, step: float = 0.05, restarts: int = 10, seed: int = 0) -> BaseMap:

@@ -584,9 +584,9 @@ def _check_load_arguments(source: Any, tool: Any, locked: Any, base: Any, packag
     """Refuse an argument of the wrong type, naming it and what it takes (before any file is read)."""
     checks = (
         ("name_or_path", source, _is_path(source), "a registered name, a file path or 'rd:NAME'"),
-        ("tool", tool, tool is None or isinstance(tool, str), "a frame name, or None"),
-        ("base", base, base is None or isinstance(base, str), "a frame name, or None"),
-        ("group", group, group is None or isinstance(group, str), "an SRDF group name, or None"),
+        ("tool", tool, tool is None or _is_name(tool), "a frame name, or None"),
+        ("base", base, base is None or _is_name(base), "a frame name, or None"),
+        ("group", group, group is None or _is_name(group), "an SRDF group name, or None"),
         ("srdf", srdf, srdf is None or _is_path(srdf), "a path to an SRDF file, or None"),
         ("package_dirs", package_dirs, package_dirs is None or (isinstance(package_dirs, list | tuple)
                                                                 and all(map(_is_path, package_dirs))),
@@ -602,7 +602,12 @@ def _check_load_arguments(source: Any, tool: Any, locked: Any, base: Any, packag
 
 
 def _is_path(value: Any) -> bool:
-    return not isinstance(value, bool) and isinstance(value, str | Path)
+    """A Path, or a string that names one (an empty string names nothing, though Path("") is the current folder)."""
+    return isinstance(value, Path) or _is_name(value)
+
+
+def _is_name(value: Any) -> bool:
+    return isinstance(value, str) and value.strip() != ""
 
 
 def _is_named_table(value: Any) -> bool:
