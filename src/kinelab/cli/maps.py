@@ -187,10 +187,17 @@ def run_view(args: argparse.Namespace) -> int:
     from kinelab import maps
     from kinelab.maps.store import model_sha256
     from kinelab.robot import load
+    from kinelab.robot.catalog import names
     from kinelab.view.maps import map_page
 
     rmap = maps.load(args.store)
+    if Path(args.store).resolve() in (html := Path(args.html).resolve(), *html.parents):
+        raise KinelabError(f"--html {args.html} lies inside the map {args.store}: the page would overwrite it; give a "
+                           "file outside the store")
     meta = rmap.meta
+    if args.robot is None and meta["robot"] not in names():  # a store is data: it names no file to be read
+        raise KinelabError(f"the map at {args.store} names its robot {meta['robot']!r}, which is not a registered "
+                           "robot (kinelab robots): give its model file with --robot")
     robot = load(args.robot or meta["robot"], base=meta.get("base"), tool=meta.get("tool"))
     if model_sha256(robot) != meta["source_sha256"]:
         raise KinelabError(f"{robot.name}'s model file is not the one the map at {args.store} was computed for: "

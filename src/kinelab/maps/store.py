@@ -61,13 +61,45 @@ def _read(array: Any, where: slice | int, what: str, path: Path | None) -> np.nd
                            "is damaged: remove it and compute the map again") from None
 
 
+def _text(value: Any) -> bool:
+    return isinstance(value, str) and value != ""
+
+
+def _count(value: Any, least: int = 0) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool) and value >= least
+
+
+def _positive(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool) and 0.0 < value < float("inf")
+
+
+# what a map's metadata holds and how each item must look (a store is data: an edited one is refused by name)
+_META = {
+    "robot": _text, "source_sha256": _text, "kinelab": _text, "solver": _text, "centres_sha256": _text,
+    "voxels": _count, "base": lambda v: v is None or _text(v), "tool": lambda v: v is None or _text(v),
+}
+_SPEC = {"voxel": _positive, "orientations": lambda v: _count(v, 1), "chunk_voxels": lambda v: _count(v, 1)}
+
+
+def _check_meta(meta: dict, path: Path) -> None:
+    """Refuse metadata with an item missing or of the wrong kind, naming it."""
+    spec = meta.get("spec")
+    if not isinstance(spec, dict):
+        raise KinelabError(f"{path}: the map's metadata is damaged: 'spec' is {spec!r}, not a table; compute the map "
+                           "again")
+    for table, rules, where in ((meta, _META, ""), (spec, _SPEC, "spec.")):
+        for key, ok in rules.items():
+            if not ok(table.get(key)):
+                raise KinelabError(f"{path}: the map's metadata is damaged: {where}{key} is {table.get(key)!r}; "
+                                   "compute the map again")
+
+
 def _check_layout(meta: dict, arrays: dict[str, Any], path: Path) -> None:
-    """Refuse a map whose arrays do not have the shapes and types its metadata implies, or whose centres differ
-    from the ones it was written with (an edited or truncated store)."""
-    voxels, spec = meta.get("voxels"), meta.get("spec")
-    size = spec.get("chunk_voxels") if isinstance(spec, dict) else None
-    if not (isinstance(voxels, int) and voxels >= 0 and isinstance(size, int) and size > 0):
-        raise KinelabError(f"{path}: the map's metadata is damaged (voxels {voxels!r}, chunk size {size!r})")
+    """Refuse a map whose metadata is damaged, whose arrays do not have the shapes and types its metadata implies,
+    whose centres were not all written (a store declaring more voxels than it holds) or differ from the ones it was
+    written with (an edited or truncated store)."""
+    _check_meta(meta, path)
+    voxels, size = meta["voxels"], meta["spec"]["chunk_voxels"]
     chunks = -(-voxels // size)
     expected = {"centres": ((voxels, 3), "f8"), "done": ((chunks,), "bool"), "checksums": ((chunks, 32), "u1"),
                 **{k: ((voxels,), "f8") for k in VALUES}}
@@ -77,7 +109,11 @@ def _check_layout(meta: dict, arrays: dict[str, Any], path: Path) -> None:
             raise KinelabError(f"{path}: array {name!r} has shape {tuple(found.shape)} and type {found.dtype}; a map "
                                f"of {voxels} voxels in chunks of {size} has {shape} {np.dtype(dtype)}: the file was "
                                "altered, compute the map again")
-    if centres_sha256(_read(arrays["centres"], slice(None), "centres", path)) != meta.get("centres_sha256"):
+    centres = arrays["centres"]
+    if centres.nchunks_initialized != centres.nchunks:  # a map writes its centres whole, before any value
+        raise KinelabError(f"{path}: the voxel centres were not all written ({centres.nchunks_initialized} of "
+                           f"{centres.nchunks} chunks): the file was altered, compute the map again")
+    if centres_sha256(_read(centres, slice(None), "centres", path)) != meta.get("centres_sha256"):
         raise KinelabError(f"{path}: the voxel centres no longer match the checksum written with them: the file was "
                            "altered, compute the map again")
 
@@ -155,7 +191,11 @@ def open_map(out: str | Path | None, robot: Robot, spec: Any, centres: np.ndarra
             warnings.warn(f"{path}: {len(damaged)} chunk(s) no longer match their checksums (first: {damaged[0]}); "
                           "they are computed again", stacklevel=3)
         return found
-    group = zarr.open_group(str(path), mode="w")
+    try:
+        group = zarr.open_group(str(path), mode="w")
+    except (KeyError, OSError) as err:  # zarr's directory store says KeyError for a file it cannot create
+        why = getattr(err, "strerror", None) or "not a writable folder"
+        raise KinelabError(f"cannot write the map to {path}: {why}; give --out a folder you can write") from None
     group.attrs.update({**meta, "centres_sha256": centres_sha256(centres)})
     group.create_dataset("centres", data=centres, chunks=(spec.chunk_voxels, 3))
     for name in VALUES:
