@@ -146,3 +146,57 @@ def test_an_argument_the_file_does_not_declare_is_refused_by_name(tmp_path, caps
     code = kinelab.cli.main(["info", str(path), "--xacro-arg", "nosuch=1"])
     err = capsys.readouterr().err
     assert code == 2 and "declares no xacro argument 'nosuch'" in err and len(err.strip().splitlines()) == 1
+
+
+HEAD = '<?xml version="1.0"?><robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="base"/>'
+ARM = ('<joint name="j" type="revolute"><parent link="base"/><child link="l"/><axis xyz="0 0 1"/>'
+       '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint><link name="l"/></robot>')
+
+
+def _abusive(tmp_path, body):
+    path = tmp_path / "hostile.urdf.xacro"
+    path.write_text(HEAD + body + ARM)
+    return path
+
+
+def test_an_expansion_is_bounded_in_time_as_a_whole(tmp_path, monkeypatch):
+    """#39 item 7: one expression's own evaluation (a rounding to -10⁹ digits, a quadratic sum of a million lists)
+    ran > 60 s, inside every per-expression limit. The whole expansion is a child process with a deadline (20 s;
+    3 s here so the test is short)."""
+    from helpers import no_hang
+
+    from kinelab.robot import xacro_bounded
+
+    monkeypatch.setattr(xacro_bounded, "SECONDS", 3.0)
+    for body in ('<xacro:property name="x" value="${round(1, -10**9)}"/><link name="u${x}"/>',
+                 '<xacro:property name="x" value="${sum([[0]]*1000000, [])}"/><link name="u${len(x)}"/>'):
+        with no_hang(60), pytest.raises(URDFError, match="the expansion took more than 3 s"):
+            load(_abusive(tmp_path, body), tool="l")
+
+
+def test_an_expansion_is_bounded_in_memory_and_output(tmp_path):
+    """#39 item 7: a 6 kB file repeating a 1 MB value a thousand times took 2.9 GB and wrote 953 MB to the temp
+    folder; seventy repeats make a URDF past the 64 MB output limit."""
+    big = '<xacro:property name="big" value="${\'a\' * 1000000}"/>'
+    links = ''.join(f'<link name="x{i}"><visual><geometry><mesh filename="${{big}}"/></geometry></visual></link>'
+                    for i in range(1000))
+    with pytest.raises(URDFError, match="needs more than 1024 MB"):
+        load(_abusive(tmp_path, big + links), tool="l")
+    links = ''.join(f'<link name="x{i}"><visual><geometry><mesh filename="${{big}}"/></geometry></visual></link>'
+                    for i in range(70))
+    with pytest.raises(URDFError, match="larger than 64 MB"):
+        load(_abusive(tmp_path, big + links), tool="l")
+
+
+def test_a_wildcard_include_outside_the_allowed_folders_reveals_nothing(tmp_path):
+    """#39 item 7: an include of /etc/* named the files it matched, one refusal at a time; a pattern inside the
+    file's folder still includes what it matches."""
+    with pytest.raises(URDFError, match=r"includes the pattern /etc/\*, outside") as refused:
+        load(_abusive(tmp_path, '<xacro:include filename="/etc/*"/>'), tool="l")
+    assert "passwd" not in str(refused.value) and "hosts" not in str(refused.value)
+    (tmp_path / "part_a.xacro").write_text('<robot xmlns:xacro="http://www.ros.org/wiki/xacro">'
+                                           '<xacro:property name="reach" value="0.4"/></robot>')
+    path = tmp_path / "globbed.urdf.xacro"
+    path.write_text(HEAD + '<xacro:include filename="part_*.xacro"/>' + ARM.replace(
+        '<axis xyz="0 0 1"/>', '<origin xyz="0 0 ${reach}"/><axis xyz="0 0 1"/>'))
+    np.testing.assert_allclose(load(path, tool="l").fk(np.zeros(1)).translation, [0, 0, 0.4], atol=1e-12)

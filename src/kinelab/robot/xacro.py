@@ -11,9 +11,11 @@ A xacro file is a program in xacro's own design: ``${...}`` is Python's ``eval``
 - an include resolves against the including file's folder and must lie in the file's own folder, its ROS
   package (the nearest folder above it with a ``package.xml``) or a package directory the user gave
   (``package_dirs``, ``ROS_PACKAGE_PATH``); ``$(find PKG)`` looks only there;
-- the whole expansion has a time and an element limit (:data:`SECONDS`, :data:`ELEMENTS`), every file read a
-  size limit, and xacro's module state is reset before and restored after each expansion (a failed load leaves
-  nothing behind for the next one).
+- the whole expansion runs in a child process bounded in time, memory and output (:mod:`kinelab.robot.xacro_bounded`),
+  has an element limit (:data:`ELEMENTS`), every file read a size limit, and xacro's module state is reset before
+  and restored after each expansion;
+- an include pattern with wildcards is listed only when the folder above its first wildcard lies inside those
+  folders (a pattern outside them is refused without revealing what it would match).
 
 Properties, math (``pi``, ``radians``, ``sqrt``...), conditionals, macros with parameters and blocks,
 ``$(arg)``, ``$(find)``, ``$(dirname)``, namespaced includes expand as usual. The include and size limits hold
@@ -23,6 +25,7 @@ for a trusted file too. The expansion is written to a private temporary folder, 
 from __future__ import annotations
 
 import contextlib
+import importlib.util
 import re
 import threading
 from collections.abc import Callable, Iterator
@@ -31,11 +34,12 @@ from typing import Any
 
 from kinelab.errors import OptionError, URDFError
 from kinelab.files import checked_file, read_text
+from kinelab.robot import xacro_bounded as bounded
 from kinelab.robot import xacro_eval
 from kinelab.scratch import scratch_dir
 
 INSTALL_HINT = "pip install 'kinelab[xacro]' (xacro)"
-SECONDS = 20.0  # [s] the longest expansion (a real robot's takes well under a second)
+SECONDS = bounded.SECONDS  # [s] the longest expansion (a real robot's takes well under a second)
 ELEMENTS = 50_000  # elements an expansion may process (a humanoid's description: a few thousand)
 UNTRUSTED = {"$(eval ...)": "_eval", "$(env ...)": "_env", "$(optenv ...)": "_optenv"}  # xacro's handlers
 _LOCK = threading.Lock()  # xacro keeps its state in its module: one expansion at a time
@@ -67,22 +71,33 @@ def expand(path: Path, args: dict[str, str] | None = None, trusted: bool = False
     checked_file(path, "xacro file", URDFError)
     roots = _roots(path, package_dirs or [])
     _check_declared(path, args or {}, roots)
-    try:
-        import xacro  # optional extra: imported only for a xacro file
-    except ImportError:
-        raise URDFError(f"{path.name} is a xacro file; reading it needs xacro: {INSTALL_HINT}") from None
+    if importlib.util.find_spec("xacro") is None:  # optional extra: imported only by the expansion
+        raise URDFError(f"{path.name} is a xacro file; reading it needs xacro: {INSTALL_HINT}")
+    out = scratch_dir("kinelab-xacro-") / (path.name.removesuffix(".xacro") or "robot.urdf")
+    bounded.run(path, {"path": str(path), "args": {k: str(v) for k, v in (args or {}).items()}, "trusted": trusted,
+                       "roots": [str(r) for r in roots], "out": str(out)})
+    return out
+
+
+def expand_here(path: Path, args: dict[str, str], trusted: bool, roots: list[Path]) -> str:
+    """The URDF text the xacro file at ``path`` expands to, in this process (:mod:`kinelab.robot.xacro_bounded`
+    calls it in a child bounded in time, memory and output).
+
+    Raises:
+        URDFError: a construct refused, an include outside the roots, a limit passed, or xacro's own reason.
+    """
+    import xacro
+
     try:
         with _LOCK, _session(xacro, path, roots, trusted):
             doc = xacro.parse(None, str(path))
-            xacro.process_doc(doc, mappings={k: str(v) for k, v in (args or {}).items()})
-            text = doc.toxml()
+            xacro.process_doc(doc, mappings=args)
+            text: str = doc.toxml()
+            return text
     except _RefusalError as refusal:
         raise URDFError(str(refusal)) from None
     except Exception as exc:  # noqa: BLE001 - xacro raises its own and plain exceptions for a bad file
         raise URDFError(_failure(path, exc)) from None
-    out = scratch_dir("kinelab-xacro-") / (path.name.removesuffix(".xacro") or "robot.urdf")
-    out.write_text(text)
-    return out
 
 
 class _RefusalError(Exception):
@@ -151,6 +166,7 @@ def _session(xacro: Any, path: Path, roots: list[Path], trusted: bool) -> Iterat
     xacro.all_includes, xacro.verbosity = [], 0
     xacro.substitution_args_context.clear()
     swap(xacro, "parse", _confined_parse(xacro, xacro.parse, roots))
+    swap(xacro, "get_include_files", _confined_patterns(xacro, xacro.get_include_files, roots))
     swap(xacro, "eval_all", _counted(xacro.eval_all, budget))
     swap(xacro, "eval_extension", _extensions(xacro, xacro.eval_extension, trusted))
     swap(sa, "_eval_find", lambda name: _found(name, roots))
@@ -191,6 +207,20 @@ def _confined_parse(xacro: Any, parse: Callable[..., Any], roots: list[Path]) ->
             xacro.filestack.pop()  # as xacro's own parse does for a missing file
             raise xacro.XacroException(f"No such file or directory: {file}", exc=FileNotFoundError(str(file)))
         return parse(read_text(file, "xacro file", URDFError))
+
+    return confined
+
+
+def _confined_patterns(xacro: Any, get_include_files: Callable[..., Any], roots: list[Path]) -> Callable[..., Any]:
+    """xacro's include resolver, a wildcard pattern refused before it is listed unless the folder above its first
+    wildcard lies inside the roots: ``/etc/*`` once named files outside them, one refusal at a time."""
+
+    def confined(filename_spec: str, symbols: Any) -> Iterator[str]:
+        spec = xacro.abs_filename_spec(xacro.eval_text(filename_spec, symbols))
+        if _WILDCARD.search(spec) and not _inside(Path(_WILDCARD.split(spec, maxsplit=1)[0] + "x").parent, roots):
+            raise _RefusalError(f"{_current(xacro)} includes the pattern {spec}, outside the folders a robot file may "
+                                f"read ({', '.join(map(str, roots))}); it is not listed")
+        yield from get_include_files(filename_spec, symbols)
 
     return confined
 
@@ -270,6 +300,7 @@ def _where(file: Path, text: str) -> str:
     return "in an expression"
 
 
+_WILDCARD = re.compile(r"[*?\[]")
 _ARG = re.compile(r"<xacro:arg\s[^>]*name\s*=\s*[\"']([^\"']+)[\"']")
 _INCLUDE = re.compile(r"<xacro:include\s[^>]*filename\s*=\s*[\"']([^\"']+)[\"']")
 
