@@ -10,6 +10,17 @@ from kinelab.errors import KinelabError
 MAX_BYTES = 64 * 2**20  # [bytes] the largest robot, SRDF, obstacle or metadata file read (URDFs are kilobytes)
 
 
+def as_path(value: object, what: str, error: type[KinelabError]) -> Path:
+    """``value`` as a Path when it is one or a non-empty string.
+
+    Raises:
+        error: anything else (None, a number, ""), naming what was given and what is valid.
+    """
+    if isinstance(value, Path) or (isinstance(value, str) and value.strip()):
+        return Path(value)
+    raise error(f"{what} must be a path (a str or pathlib.Path), got {value!r}")
+
+
 def checked_file(path: str | Path, what: str, error: type[KinelabError], limit: int = MAX_BYTES) -> Path:
     """``path`` when it names a regular file of at most ``limit`` bytes.
 
@@ -20,9 +31,10 @@ def checked_file(path: str | Path, what: str, error: type[KinelabError], limit: 
         limit: the largest size accepted [bytes].
 
     Raises:
-        error: the file is missing, not a regular file (a folder, a device, a fifo), or larger than ``limit``.
+        error: not a path, the file is missing, not a regular file (a folder, a device, a fifo), or larger than
+            ``limit``.
     """
-    path = Path(path)
+    path = as_path(path, what, error)
     try:
         info = path.stat()
     except OSError:

@@ -27,7 +27,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.errors import KinelabError
-from kinelab.files import read_text
+from kinelab.files import as_path, read_text
 
 MAX_OBSTACLES = 1000  # Pinocchio's geometry model keeps an n × n pair table, rebuilt per object: 1000 cost 0.1–0.8 s
 MAX_DEPTH = 4  # {"obstacles": [{"size": [...]}]}
@@ -144,7 +144,7 @@ class Environment:
         Raises:
             ObstacleError: a missing or malformed file, or a bad obstacle (its index named).
         """
-        path = Path(path)
+        path = as_path(path, "obstacle file", ObstacleError)
         text = read_text(path, "obstacle file", ObstacleError, MAX_FILE_BYTES)
         try:
             data = json.loads(text)

@@ -770,11 +770,13 @@ cdef void random_configuration(double* q, const long long* kind, const double* l
     """q ← a seeded uniform configuration within the limits; a joint without a finite window draws on [−π, π)
     when it turns and keeps its value when it slides."""
     cdef int i
-    cdef double u
+    cdef double u, span
     for i in range(n):
         u = uniform(rng_state)
         if isfinite(lower[i]) and isfinite(upper[i]) and kind[i] != CONTINUOUS:
-            q[i] = lower[i] + (upper[i] - lower[i]) * u
+            span = upper[i] - lower[i]
+            # a window of ±1e308 overflows its width: then the same draw as a blend of the two ends
+            q[i] = lower[i] + span * u if isfinite(span) else lower[i] * (1.0 - u) + upper[i] * u
         elif kind[i] != PRISMATIC:
             q[i] = -M_PI + TWO_PI * u
 

@@ -113,7 +113,9 @@ def attempt(
     for it in range(opts.max_iterations):
         pin.computeJointJacobians(model, data, q)  # FK and every joint Jacobian in one pass
         oMtool = pin.updateFramePlacement(model, data, fid)
-        err, J = _rows(task, oMtool, oMtarget, pin.getFrameJacobian(model, data, fid, pin.LOCAL))
+        # (6, nv) even for one joint: Pinocchio returns a 6 × 1 Jacobian as a flat (6,) array
+        J_local = pin.getFrameJacobian(model, data, fid, pin.LOCAL).reshape(6, model.nv)
+        err, J = _rows(task, oMtool, oMtarget, J_local)
         dp, dr = task.errors(oMtarget, oMtool)
         if task.met(dp, dr, tol_pos, tol_rot):
             return Attempt(robot.from_pin_q(q), Status.CONVERGED, it)

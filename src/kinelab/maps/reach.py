@@ -5,9 +5,10 @@ The chunks and the spec are :mod:`kinelab.maps.chunk`'s; the storage :mod:`kinel
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
-from kinelab.errors import KinelabError
+from kinelab.errors import KinelabError, OptionError
 from kinelab.maps import cluster, grid, store
 from kinelab.maps.chunk import MAX_TARGETS, MapSpec, compute_chunk
 from kinelab.progress import bar
@@ -40,6 +41,10 @@ def reachability(robot: Robot, spec: MapSpec | None = None, out: str | None = No
     """
     spec = spec or MapSpec(**fields)
     spec.check()
+    if out is not None and not (isinstance(out, Path) or (isinstance(out, str) and out.strip())):
+        raise OptionError("out", out, "a folder path (a str or pathlib.Path), or None (in memory)")
+    if client is not None and not (callable(getattr(client, "submit", None)) and hasattr(client, "scatter")):
+        raise OptionError("client", client, "a dask.distributed.Client, or None (this process)")
     estimate = grid.estimated_voxels(robot, spec.voxel) * spec.orientations
     if estimate > 1.2 * MAX_TARGETS and not force:  # refused before the grid is built (a 1e-9 m voxel, say)
         raise KinelabError(f"this map asks for about {estimate:.3g} targets (counted before any grid is built); the "

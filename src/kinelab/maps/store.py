@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from kinelab.errors import KinelabError
+from kinelab.files import as_path
 from kinelab.robot import Robot
 
 INSTALL_HINT = "pip install 'kinelab[maps]' (zarr)"
@@ -180,7 +181,7 @@ def open_map(out: str | Path | None, robot: Robot, spec: Any, centres: np.ndarra
         arrays = {"centres": centres, "done": np.zeros(chunks, dtype=bool),
                   **{k: np.full(len(centres), np.nan) for k in VALUES}}
         return ReachabilityMap(meta, arrays)
-    zarr, path = _zarr(), Path(out)
+    zarr, path = _zarr(), as_path(out, "the map's out", KinelabError)
     if path.exists():
         found = load(path, check=False)
         _same(found.meta, meta, path)
@@ -218,7 +219,7 @@ def load(path: str | Path, check: bool = True) -> ReachabilityMap:
     """
     from kinelab import __version__
 
-    zarr, path = _zarr(), Path(path)
+    zarr, path = _zarr(), as_path(path, "a reachability map", KinelabError)
     try:
         group = zarr.open_group(str(path), mode="r+")
         meta = dict(group.attrs)

@@ -138,6 +138,7 @@ class _Builder:
         else:
             tree = read_tree(urdf_path)
             full = _build_full_model(urdf_path)
+        _check_names(full, urdf_path)
         b = cls(name or full.name or urdf_path.stem, source, urdf_path, full, tree, mesh_package_dirs(package_dirs),
                 dict(xacro_args or {}), bool(trust_xacro))
         b.srdf = b._read_srdf(srdf, tree)
@@ -342,6 +343,20 @@ def _narrowed(leader: str, lo: float, hi: float, mimics: Iterable[Mimic]) -> tup
                 raise ChainError(f"joint {m.name!r} mimics {leader!r}: no value of {leader!r} keeps both "
                                  "within their limits")
     return lo, hi
+
+
+def _check_names(model: pin.Model, path: Path) -> None:
+    """Refuse a model whose names are not UTF-8: Pinocchio keeps a name's bytes as the file has them (a latin-1
+    file naming its robot "é"), and Python cannot read them back.
+
+    Raises:
+        URDFError: naming the file and what to do.
+    """
+    try:
+        [model.name, *model.names, *(f.name for f in model.frames)]
+    except UnicodeDecodeError:
+        raise URDFError(f"robot file {path}: a robot, joint or link name is not UTF-8 text (the file declares "
+                        "another encoding); kinelab reads names as UTF-8: save the file as UTF-8") from None
 
 
 def _build_full_model(path: Path, mimic: bool = False) -> pin.Model:

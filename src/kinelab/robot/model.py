@@ -275,13 +275,13 @@ class Robot:
         """A configuration drawn uniformly within the limits (continuous joints on [−π, π]; a revolute joint
         whose limits lie beyond ±SAMPLE_TURNS turns, such as a rotor declared with ±1e16 rad, on ±SAMPLE_TURNS
         turns: every pose it can take, at angles where rounding does not swamp a step)."""
-        return _generator(rng).uniform(*self.sample_bounds)
+        return _uniform(_generator(rng), *self.sample_bounds, None)
 
     def random_qs(self, count: int, rng: np.random.Generator | int | None = None) -> np.ndarray:
         """``count`` configurations (rows) drawn as :meth:`random_q` draws one."""
         if not isinstance(count, int | np.integer) or isinstance(count, bool) or count < 0:
             raise OptionError("count", count, "a whole number ≥ 0 of configurations")
-        return _generator(rng).uniform(*self.sample_bounds, size=(int(count), self.n))
+        return _uniform(_generator(rng), *self.sample_bounds, (int(count), self.n))
 
     @functools.cached_property
     def sample_bounds(self) -> tuple[np.ndarray, np.ndarray]:
@@ -599,6 +599,16 @@ def _check_load_arguments(source: Any, tool: Any, locked: Any, base: Any, packag
     for name, value, ok, valid in checks:
         if not ok:
             raise OptionError(name, value, valid)
+
+
+def _uniform(rng: np.random.Generator, lower: np.ndarray, upper: np.ndarray, size: Any) -> np.ndarray:
+    """Uniform draws between lower and upper, also where upper − lower overflows (a prismatic joint declared with
+    ±1e308 m: numpy's uniform refuses that range)."""
+    if (upper / 2 - lower / 2 < 0.5 * np.finfo(float).max).all():  # the width fits a float
+        drawn: np.ndarray = rng.uniform(lower, upper, size)
+        return drawn
+    u = rng.random(size if size is not None else lower.shape)
+    return np.asarray(lower * (1.0 - u) + upper * u)
 
 
 def _is_path(value: Any) -> bool:
