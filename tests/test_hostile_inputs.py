@@ -54,3 +54,76 @@ def test_arguments_of_the_wrong_kind_are_named(call, needle):
     pytest.importorskip("zarr")
     with pytest.raises(kinelab.KinelabError, match=needle):
         call()
+
+
+TWO = ('<link name="base"/><link name="l1"/><link name="l2"/><joint name="j1" type="revolute"><parent link="base"/>'
+       '<child link="l1"/><axis xyz="0 0 1"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint>'
+       '<joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0 0 0.3"/>'
+       '<axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="1" velocity="1"/></joint>')
+GROUP = '<group name="arm"><chain base_link="base" tip_link="l2"/></group>'
+
+
+@pytest.mark.parametrize("body, error, needle", [
+    (GROUP + '<group_state name="s" group="arm"><joint name="j1" value="1e308"/><joint name="j2" value="0"/>'
+     '</group_state>', kinelab.JointLimitError, "outside its limits"),
+    (GROUP + '<group_state name="s" group="arm"><joint name="j1" value="100"/><joint name="j2" value="0"/>'
+     '</group_state>', kinelab.JointLimitError, "outside its limits"),
+    (GROUP + GROUP, kinelab.SRDFError, "two group elements are named 'arm'"),
+    (GROUP + '<end_effector name="e" parent_link="nolink" group="arm"/>', kinelab.SRDFError, "link 'nolink'"),
+])
+def test_srdf_nonsense_is_refused(tmp_path, body, error, needle):
+    """Named states of 1e308 or 100 rad, a duplicate group and an unknown end-effector link were accepted."""
+    srdf = tmp_path / "r.srdf"
+    srdf.write_text(f'<?xml version="1.0"?><robot name="t">{body}</robot>')
+    with pytest.raises(error, match=needle):
+        kinelab.load(write_urdf(tmp_path, TWO), srdf=srdf, tool="l2").named_q("s")
+
+
+MJCF = ('<mujoco><worldbody><body name="b1" pos="0 0 0.1"><joint name="a" type="hinge" axis="{axis}" ref="{ref}" '
+        'range="-1 1" limited="true"/><geom size="0.1"/><body name="b2" pos="0 0 0.3" xyaxes="{xyaxes}">'
+        '<joint name="c" type="hinge" axis="0 1 0" range="-1 1" limited="true"/><geom size="0.1"/></body></body>'
+        '</worldbody></mujoco>')
+
+
+@pytest.mark.parametrize("change, needle", [
+    ({"xyaxes": "0 0 0 0 0 0"}, "not two independent directions"),
+    ({"xyaxes": "1 0 0 2 0 0"}, "not two independent directions"),
+    ({"xyaxes": "nan 0 0 0 1 0"}, "6 finite numbers"),
+    ({"axis": "1e308 1e308 0"}, "axis is zero or has a component beyond"),
+    ({"ref": "1e308"}, r"ref 1e\+308 lies beyond"),
+])
+def test_mjcf_nonsense_is_refused(tmp_path, change, needle):
+    """Zero or NaN xyaxes loaded as a zero or garbage rotation, an axis of 1e308 as a zero axis."""
+    fields = {"axis": "0 0 1", "ref": "0", "xyaxes": "1 0 0 0 1 0", **change}
+    path = tmp_path / "m.xml"
+    path.write_text(MJCF.format(**fields))
+    with pytest.raises(kinelab.URDFError, match=needle):
+        kinelab.load(path, tool="b2")
+    path.write_text(MJCF.format(axis="0 0 1", ref="0", xyaxes="1 0 0 0 1 0"))
+    assert kinelab.load(path, tool="b2").n == 2  # the same file, sound, loads
+
+
+def _stl(path, triangles):
+    import struct
+
+    with open(path, "wb") as f:
+        f.write(b"\0" * 80 + struct.pack("<I", len(triangles)))
+        for triangle in triangles:
+            f.write(struct.pack("<3f", 0, 0, 1) + b"".join(struct.pack("<3f", *v) for v in triangle) + b"\0\0")
+
+
+@pytest.mark.parametrize("mesh", ["garbage", "nan"])
+def test_a_bad_mesh_is_named_for_collisions_and_the_view(tmp_path, mesh):
+    """A mesh coal cannot read was its raw ValueError; a NaN vertex was accepted as collision geometry."""
+    if mesh == "garbage":
+        (tmp_path / "m.stl").write_text("this is not an STL file")
+    else:
+        _stl(tmp_path / "m.stl", [[(0, 0, 0), (1, 0, 0), (float("nan"), 1, 0)]])
+    body = TWO.replace('<link name="l1"/>', '<link name="l1"><collision><geometry><mesh filename="m.stl"/></geometry>'
+                       '</collision><visual><geometry><mesh filename="m.stl"/></geometry></visual></link>')
+    robot = kinelab.load(write_urdf(tmp_path, body), tool="l2")
+    needle = "cannot be read" if mesh == "garbage" else "not a finite number"
+    with pytest.raises(kinelab.URDFError, match=needle):
+        kinelab.solve(robot, robot.fk(np.array([0.3, 0.4])), task="position", collisions="self", seed=0)
+    with pytest.raises(kinelab.URDFError, match=needle):
+        robot.visual_model()

@@ -262,6 +262,7 @@ class _Builder:
             return None
         found = read_srdf(srdf)
         found.check_joints(list(tree.joint_of.values()))
+        found.check_links(tree.links)
         return found
 
     def _group_frames(self, group: str, tree: UrdfTree, tool: str | None, base: str | None) -> tuple[str, str | None]:

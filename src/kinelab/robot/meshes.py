@@ -15,6 +15,7 @@ import xml.etree.ElementTree as ET
 from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
 import pinocchio as pin
 
 from kinelab.errors import URDFError
@@ -144,11 +145,32 @@ def build_visual_model(
     with tempfile.TemporaryDirectory(prefix="kinelab-") as folder:  # Pinocchio reads it once, here
         resolved = _with_resolved_meshes(urdf_path, dirs, Path(folder), kind)
         with c_stderr_captured(said):  # urdfdom prints its complaints on the process's stderr
-            geom = pin.buildGeomFromUrdf(model, str(resolved), geometry_type, package_dirs=dirs)
+            try:
+                geom = pin.buildGeomFromUrdf(model, str(resolved), geometry_type, package_dirs=dirs)
+            except ValueError as err:  # coal's mesh loader: a file it cannot read
+                said_ = [line.removeprefix("message:").strip() for line in str(err).splitlines()
+                         if line.startswith("message:")] or ["no reason given"]
+                raise URDFError(f"a {kind} mesh of {urdf_path} cannot be read ({' '.join(said_[0].split())}); fix or "
+                                "remove the mesh file") from None
+    _check_vertices(geom, urdf_path, kind)
     if said:
         warnings.warn(f"Pinocchio's URDF parser on {urdf_path.name} ({kind} geometry): {' '.join(said)}",
                       stacklevel=2)
     return geom
+
+
+def _check_vertices(geom: pin.GeometryModel, urdf_path: Path, kind: str) -> None:
+    """Refuse a mesh with a vertex that is not a finite number (a NaN in an STL): its collision tests and its
+    drawing would be nonsense.
+
+    Raises:
+        URDFError: the geometry and its mesh file named.
+    """
+    for obj in geom.geometryObjects:
+        vertices = getattr(obj.geometry, "vertices", None)
+        if callable(vertices) and not np.isfinite(np.asarray(vertices())).all():
+            raise URDFError(f"{kind} mesh {obj.meshPath or obj.name} of {urdf_path.name} has a vertex that is not a "
+                            "finite number; fix the mesh file")
 
 
 @contextlib.contextmanager

@@ -18,6 +18,8 @@ from kinelab.errors import URDFError
 from kinelab.files import read_text
 from kinelab.robot.urdf import MAX_OFFSET, UrdfTree, check_size
 
+MAX_COMPONENT = 1e6  # the largest component of a direction (an axis, xyaxes, zaxis): its length must fit a float
+
 UNREAD = ("frame", "replicate", "attach")  # MuJoCo 3 elements Pinocchio's parser skips, with their bodies
 
 
@@ -114,13 +116,36 @@ def _check_body(path: Path, body: ET.Element) -> None:
         if values is not None and math.hypot(*values[part]) < 1e-12:
             raise URDFError(f"{path}: body {name!r} {attribute} is zero; give a non-zero {attribute}")
     _numbers(path, body, "euler", 3)
+    xyaxes, zaxis = _numbers(path, body, "xyaxes", 6), _numbers(path, body, "zaxis", 3)
+    if xyaxes is not None and not _frame_axes(xyaxes[:3], xyaxes[3:]):
+        raise URDFError(f"{path}: body {name!r} xyaxes {xyaxes} are not two independent directions (x zero, y zero "
+                        "or y along x); give an x and a y axis")
+    if zaxis is not None and not _direction(zaxis):
+        raise URDFError(f"{path}: body {name!r} zaxis is zero or beyond ±{MAX_COMPONENT:g}; give a direction")
+
+
+def _direction(v: list[float]) -> bool:
+    """A non-zero direction whose length a float holds (1e308 components overflow it to a zero axis)."""
+    return max(abs(x) for x in v) <= MAX_COMPONENT and math.hypot(*v) >= 1e-12
+
+
+def _frame_axes(x: list[float], y: list[float]) -> bool:
+    """Two directions that span a plane (MJCF's xyaxes: y is made orthogonal to x)."""
+    if not (_direction(x) and _direction(y)):
+        return False
+    cross = (x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0])
+    return math.hypot(*cross) >= 1e-9 * math.hypot(*x) * math.hypot(*y)
 
 
 def _check_joint(path: Path, joint: ET.Element) -> None:
     name = joint.get("name", "?")
     axis = _numbers(path, joint, "axis", 3)
-    if axis is not None and math.hypot(*axis) < 1e-12:
-        raise URDFError(f"{path}: joint {name!r} axis is zero; an axis must be a non-zero direction")
+    if axis is not None and not _direction(axis):
+        raise URDFError(f"{path}: joint {name!r} axis is zero or has a component beyond ±{MAX_COMPONENT:g}; an axis "
+                        "must be a non-zero direction")
+    ref = _numbers(path, joint, "ref", 1)
+    if ref is not None and abs(ref[0]) > MAX_OFFSET:
+        raise URDFError(f"{path}: joint {name!r} ref {ref[0]:g} lies beyond ±{MAX_OFFSET:g} (rad, degrees or m)")
     span = _numbers(path, joint, "range", 2)
     if span is not None and span[0] > span[1]:
         raise URDFError(f"{path}: joint {name!r} range lower {span[0]:g} > upper {span[1]:g}")

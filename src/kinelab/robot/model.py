@@ -136,6 +136,7 @@ class Robot:
 
         Raises:
             SRDFError: no SRDF, an unknown name (the names listed), or a chain joint the configuration omits.
+            JointLimitError: a value outside its joint's limits (the joint named).
         """
         if self.srdf is None:
             raise SRDFError(f"{self.name} was loaded without an SRDF: load(..., srdf=PATH) to use named "
@@ -145,7 +146,8 @@ class Robot:
         if missing:
             raise SRDFError(f"{self.srdf.path.name}: configuration {name!r} gives no value for chain joint "
                             f"{missing[0]!r}")
-        return np.array([values[j] for j in self.joint_names])
+        return self.check_q([values[j] for j in self.joint_names], limits=True,
+                            what=f"{self.srdf.path.name}'s configuration {name!r}")
 
     # -- coordinates ---------------------------------------------------------------------------
     def joint_index(self, name: str) -> int:

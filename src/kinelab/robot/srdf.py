@@ -115,6 +115,14 @@ class Srdf:
             if unknown:
                 raise SRDFError(f"{self.path.name}: {where} names joint {unknown[0]!r}, which the robot does not have")
 
+    def check_links(self, known: list[str]) -> None:
+        """Refuse an end effector or a chain naming a link the robot does not have (file and link named)."""
+        for where, link in [*((f"end effector of group {g!r}", link) for g, link in self.end_effectors.items()),
+                            *((f"group {g!r}'s chain", link) for g, grp in self.groups.items() if grp.chain
+                              for link in grp.chain)]:
+            if link not in known:
+                raise SRDFError(f"{self.path.name}: the {where} names link {link!r}, which the robot does not have")
+
     def tool_and_base(self, group: str, child_link: dict[str, str]) -> tuple[str, str | None]:
         """(tool link, base link or None for the root) of a group: its chain's tip and base, else its end
         effector's parent link, else the child link of its last joint (``child_link``: joint → link)."""
@@ -150,6 +158,11 @@ def read_srdf(path: str | Path) -> Srdf:
     except ET.ParseError as exc:
         raise SRDFError(f"cannot read SRDF {path}: {exc}") from None
     out = Srdf(path)
+    for tag, elements in (("group", root.findall("group")), ("group_state", list(root.iter("group_state")))):
+        names = [e.get("name", "") for e in elements]
+        twice = sorted({n for n in names if names.count(n) > 1})
+        if twice:  # the second would be dropped (a group) or win (a configuration) without a word
+            raise SRDFError(f"{path.name}: two {tag} elements are named {twice[0]!r}; names must be unique")
     for g in root.findall("group"):  # top-level definitions (a nested <group name=.../> only refers to one)
         chain = g.find("chain")
         out.groups.setdefault(g.get("name", ""), Group(
