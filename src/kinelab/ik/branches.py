@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from kinelab.errors import OptionError
-from kinelab.ik.analytic.branches import analytic_all, has_closed_form
+from kinelab.ik.analytic.branches import analytic_all, arm_of, has_closed_form
 from kinelab.ik.analytic.redundancy import redundant_all
 from kinelab.ik.batch import fresh_seed, prepare, run_batch
 from kinelab.ik.limits import distance as distance  # exported: the branch distance users sort by
@@ -87,7 +87,11 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
                               "sweeps a joint of the closed form: solver 'auto' or 'analytic', no options)")
         return redundant_all(robot, target, req, redundancy, ref, max_solutions)
     if method == "analytic" or (method == "auto" and has_closed_form(robot, req)):
-        return analytic_all(robot, target, req, q_ref=ref, max_solutions=max_solutions)
+        found = analytic_all(robot, target, req, q_ref=ref, max_solutions=max_solutions)
+        # the 1-D search is measured complete, not proved so: a pose within reach it finds nothing for is searched
+        # again by the multistart rather than called unreachable
+        if found or not arm_of(robot, req).searched or beyond_reach(robot, target.translation):
+            return found
     return _multistart_all(robot, target, req, ref, max_solutions, stop_below)
 
 

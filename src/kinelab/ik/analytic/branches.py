@@ -271,7 +271,20 @@ def analytic_one(robot: Robot, target: Any, req: Request, q0: np.ndarray | None,
                                                 polished=1 if finished else None,
                                                 clear_after=None if model is None else 0))
     contact = None if collided is None or model is None else model.contact(collided[0])
+    if collided is None and arm.searched and not beyond_reach(robot, target.translation):
+        return _numeric_check(robot, target, req, q0, t0)
     return _no_branch(robot, target, req, q0, q.shape[0], (collided, contact), mode, t0)
+
+
+def _numeric_check(robot: Robot, target: Any, req: Request, q0: np.ndarray | None, t0: float) -> IKResult:
+    """When the 1-D search finds no branch of a pose within reach: FRDM from q0 (or seeded starts) within what is
+    left of the budget. The search is measured complete (99.99 %), not proved so, and a reachable pose must never be
+    answered "unreachable" by it alone (2 of 6,120 poses of random arms whose axes nearly meet were)."""
+    left = None if req.time_budget is None else max(req.time_budget - (time.perf_counter() - t0), 1e-4)
+    res = solve_one(robot, target, q0, replace(req, time_budget=left))
+    note = "the 1-D search found no branch; FRDM's answer"
+    return replace(res, mode=f"{res.mode} ({note})", message=f"{res.message}; {note}" if res.message else note,
+                   wall_time=time.perf_counter() - t0)
 
 
 def _no_branch(robot: Robot, target: Any, req: Request, q0: np.ndarray | None, count: int, collided: Any, mode: str,
