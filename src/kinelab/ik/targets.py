@@ -10,7 +10,7 @@ from numpy.typing import ArrayLike
 
 from kinelab.dq.algebra import DualQuat
 from kinelab.errors import TargetError
-from kinelab.ik.verdict import NOT_A_ROTATION, NOT_FINITE, pose_defect
+from kinelab.ik.verdict import NOT_A_ROTATION, NOT_FINITE, NOT_HOMOGENEOUS, first_defect, pose_defect
 
 
 def from_xyz_rpy(xyz: ArrayLike, rpy: ArrayLike = (0.0, 0.0, 0.0), *, degrees: bool = False) -> pin.SE3:
@@ -112,19 +112,12 @@ def as_target_arrays(targets: Any) -> tuple[np.ndarray, np.ndarray]:
         TargetError: an empty sequence, a wrong shape or a bad target (its index named).
     """
     H = _stack(targets)
-    finite = np.isfinite(H).all(axis=(1, 2))
-    R = H[:, :3, :3]
-    with np.errstate(invalid="ignore"):
-        gram = np.abs(np.einsum("bki,bkj->bij", R, R) - np.eye(3)).max(axis=(1, 2))
-        det = np.linalg.det(np.where(finite[:, None, None], R, 0.0))
-    bad = ~finite | ~(gram <= 1e-6) | (det < 0) | (np.abs(H[:, 3] - (0.0, 0.0, 0.0, 1.0)).max(axis=1) > 0)
-    if bad.any():
-        k = int(np.flatnonzero(bad)[0])
-        why = ("has NaN or infinite entries" if not finite[k] else
-               "its last row is not (0, 0, 0, 1)" if gram[k] <= 1e-6 and det[k] >= 0 else
-               "its rotation is not a rotation matrix (RᵀR ≠ I or det R < 0)")
+    k, defect = first_defect(H)
+    if k >= 0:
+        why = {NOT_FINITE: "has NaN or infinite entries", NOT_HOMOGENEOUS: "its last row is not (0, 0, 0, 1)",
+               NOT_A_ROTATION: "its rotation is not a rotation matrix (RᵀR ≠ I or det R < 0)"}[defect]
         raise TargetError(f"targets[{k}] {why}")
-    return np.ascontiguousarray(H[:, :3, 3]), np.ascontiguousarray(R)
+    return np.ascontiguousarray(H[:, :3, 3]), np.ascontiguousarray(H[:, :3, :3])
 
 
 def _stack(targets: Any) -> np.ndarray:
@@ -140,6 +133,8 @@ def _stack(targets: Any) -> np.ndarray:
     if not items:
         raise TargetError("targets is empty: give at least one pin.SE3")
     for k, target in enumerate(items):
+        if type(target) is pin.SE3:  # the usual case, first: this loop is most of a large batch's reading
+            continue
         if isinstance(target, DualQuat):
             try:
                 items[k] = as_target(target)

@@ -5,6 +5,15 @@ Pinocchio computes the tool pose; these functions only compare matrices.
 
 from __future__ import annotations
 
-from kinelab.core._verdict import NOT_A_ROTATION, NOT_FINITE, pose_defect, pose_verdict, usual_inputs
+from kinelab.core._verdict import (
+    NOT_A_ROTATION,
+    NOT_FINITE,
+    NOT_HOMOGENEOUS,
+    first_defect,
+    pose_defect,
+    pose_verdict,
+    usual_inputs,
+)
 
-__all__ = ["NOT_A_ROTATION", "NOT_FINITE", "pose_defect", "pose_verdict", "usual_inputs"]
+__all__ = ["NOT_A_ROTATION", "NOT_FINITE", "NOT_HOMOGENEOUS", "first_defect", "pose_defect", "pose_verdict",
+           "usual_inputs"]

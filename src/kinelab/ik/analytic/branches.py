@@ -327,15 +327,18 @@ def nearest_batch(robot: Robot, targets: Any, q0: Any, req: Request, model: Coll
 def _nearest_rows(robot: Robot, H: np.ndarray, starts: np.ndarray | None, req: Request, model: CollisionModel | None,
                   t0: float) -> BatchIKResult:
     """:func:`analytic_one` row by row within what is left of the request's budget (counted from t0): each row gets
-    the rest of it, and the rows not started when it has run out are NaN with status ``time_budget``."""
+    the rest of it, a row starts only while the rows so far say it fits (a search cannot stop inside a pose), and
+    the rows not started are NaN with status ``time_budget``."""
     arm = arm_of(robot, req)
     deadline = np.inf if req.time_budget is None else t0 + req.time_budget - verdict_reserve(req.time_budget)
     B = len(H)
     q, dp, dr = np.full((B, robot.n), np.nan), np.full(B, np.nan), np.full(B, np.nan)
     success, status = np.zeros(B, dtype=bool), np.full(B, Status.TIME_BUDGET.value, dtype="<U14")
+    t_rows = time.perf_counter()
     for b in range(B):
-        left = deadline - time.perf_counter()
-        if left <= 0:
+        now = time.perf_counter()
+        left = deadline - now
+        if left <= 0 or (b and left < (now - t_rows) / b):
             break
         row = analytic_one(robot, pin.SE3(H[b, :3, :3], H[b, :3, 3]),
                            req if req.time_budget is None else replace(req, time_budget=left),
