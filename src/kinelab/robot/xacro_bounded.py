@@ -1,18 +1,17 @@
 """A xacro expansion bounded as a whole: run in a child process with a wall-clock limit, a memory limit and an
 output limit, so that no file — however it nests, repeats or formats — takes more than :data:`SECONDS`,
-:data:`MEMORY` bytes beyond the child's own start, or writes more than :data:`OUTPUT` bytes.
+:data:`MEMORY` bytes beyond the child's own start, or writes more than :data:`OUTPUT` bytes. The child's side is
+:mod:`kinelab.robot.xacro_child`.
 
 Limits per expression (:mod:`kinelab.robot.xacro_eval`) catch most abuse with a clear message; these catch the
 rest: an expression whose own evaluation is slow (``round(1, -10**9)``), a quadratic one (``sum`` of a million
-lists), a value repeated a thousand times, a URDF of a gigabyte. The child runs
-:func:`kinelab.robot.xacro.expand_here` and writes the URDF itself, so writing is bounded too.
+lists), a value repeated a thousand times, a URDF of a gigabyte. The child writes the URDF itself, so writing is
+bounded too.
 """
 
 from __future__ import annotations
 
 import json
-import resource
-import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -36,7 +35,7 @@ def run(path: Path, job: dict[str, Any]) -> None:
         URDFError: the expansion's own refusal or failure, or a limit passed (named, with its value).
     """
     try:
-        done = subprocess.run([sys.executable, "-m", "kinelab.robot.xacro_bounded"], input=json.dumps(job),
+        done = subprocess.run([sys.executable, "-m", "kinelab.robot.xacro_child"], input=json.dumps(job),
                               capture_output=True, text=True, timeout=SECONDS)
     except subprocess.TimeoutExpired:
         raise URDFError(f"{path}: the expansion took more than {SECONDS:g} s (kinelab's limit for a whole xacro "
@@ -52,50 +51,3 @@ def run(path: Path, job: dict[str, Any]) -> None:
         raise URDFError(said["error"])
     last = (done.stderr.strip().splitlines() or [f"exit code {done.returncode}"])[-1]
     raise URDFError(f"{path}: the expansion ended abnormally ({last})")
-
-
-def _child() -> int:
-    """The child's side: read the job on stdin, expand within the memory and output limits, say how it ended on
-    the last line of stdout (JSON)."""
-    from kinelab.robot.xacro import expand_here
-
-    job = json.loads(sys.stdin.read())
-    path = Path(job["path"])
-    _limit(resource.RLIMIT_AS, _address_space() + MEMORY)
-    try:
-        text = expand_here(path, job["args"], bool(job["trusted"]), [Path(r) for r in job["roots"]])
-        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # past the limit a write fails (EFBIG) instead of killing
-        _limit(resource.RLIMIT_FSIZE, OUTPUT)
-        Path(job["out"]).write_text(text)
-    except URDFError as err:
-        return _say({"error": str(err)})
-    except MemoryError:
-        return _say({"error": f"{path}: the expansion needs more than {MEMORY >> 20} MB (kinelab's limit for a "
-                              "whole xacro expansion)"})
-    except OSError as err:
-        return _say({"error": f"{path}: the expanded URDF is larger than {OUTPUT >> 20} MB (kinelab's limit) or "
-                              f"cannot be written ({err.strerror or err})"})
-    return _say({"ok": True})
-
-
-def _limit(kind: int, value: int) -> None:
-    soft, hard = resource.getrlimit(kind)
-    value = value if hard == resource.RLIM_INFINITY else min(value, hard)
-    resource.setrlimit(kind, (value, hard))
-
-
-def _address_space() -> int:
-    """The child's address space now [bytes] (Python, pinocchio and xacro loaded)."""
-    for line in Path("/proc/self/status").read_text().splitlines():
-        if line.startswith("VmSize:"):
-            return int(line.split()[1]) * 1024
-    return 0
-
-
-def _say(message: dict[str, Any]) -> int:
-    print(json.dumps(message), flush=True)
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(_child())
