@@ -125,7 +125,8 @@ def test_fk_and_jacobian_batches_equal_the_single_calls():
     (lambda H: H.__setitem__((3, 0), np.nan), "has NaN or infinite entries"),
     (lambda H: H.__setitem__((3, 3, 0), 0.5), "its last row is not (0, 0, 0, 1)"),
     (lambda H: H.__setitem__((3, slice(0, 3), 0), -H[3, :3, 0]), "its rotation is not a rotation matrix"),
-    (lambda H: H.__setitem__((3, slice(0, 3), slice(0, 3)), 1.001 * H[3, :3, :3]), "its rotation is not a rotation matrix"),
+    (lambda H: H.__setitem__((3, slice(0, 3), slice(0, 3)), 1.001 * H[3, :3, :3]),
+     "its rotation is not a rotation matrix"),
 ])
 def test_the_compiled_target_check_names_the_first_bad_target(defect, needle):
     """The batch's targets are checked in one compiled pass (numpy's stacked checks cost 2 ms for 2,000): each
