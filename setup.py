@@ -8,6 +8,7 @@ sources beside it at import: a stale build is refused, never run.
 import importlib.util
 from pathlib import Path
 
+import numpy
 from Cython.Build import cythonize
 from setuptools import Extension, find_packages, setup
 
@@ -26,7 +27,9 @@ def _digest() -> str:
                                 f'SOURCE_SHA256 = "{_digest()}"\n')
 # OpenMP runs the batches' rows in parallel (prange); -O3 without -ffast-math keeps IEEE arithmetic, so the kernels
 # compute what their reference computes, bit for bit
-extensions = [Extension(f"kinelab.core.{pyx.stem}", [str(pyx.relative_to(ROOT))],
+# NumPy's C API (headers from the numpy that builds) lets an engine make its result arrays without a Python call
+extensions = [Extension(f"kinelab.core.{pyx.stem}", [str(pyx.relative_to(ROOT))], include_dirs=[numpy.get_include()],
+                        define_macros=[("NPY_NO_DEPRECATED_API", "NPY_1_7_API_VERSION")],
                         extra_compile_args=["-O3", "-fopenmp"], extra_link_args=["-fopenmp"])
               for pyx in sorted(CORE.glob("*.pyx"))]
 setup(

@@ -18,6 +18,7 @@ import subprocess
 import sys
 import warnings
 import xml.etree.ElementTree as ET
+from collections.abc import Sequence
 
 import numpy as np
 import pytest
@@ -329,7 +330,7 @@ def _check_successes(robot, out, target, kwargs) -> None:
     """Whatever came back: every success is Pinocchio's verdict at the tolerances asked for, on a finite q."""
     if out is None:
         return
-    rows = out if isinstance(out, list) else [out]
+    rows = out if isinstance(out, Sequence) else [out]  # solve_all's Branches is a sequence of results
     for res in rows:
         q = np.atleast_2d(res.q)
         ok = np.atleast_1d(res.reached if hasattr(res, "reached") else res.success)

@@ -31,6 +31,8 @@ from kinelab.robot.catalog import names as robots
 _LAZY = {
     "solve": ("kinelab.ik.api", "solve"),
     "solve_all": ("kinelab.ik.api", "solve_all"),
+    "solve_all_batch": ("kinelab.ik.api", "solve_all_batch"),
+    "BranchBatch": ("kinelab.ik.analytic.branches", "BranchBatch"),
     "solve_batch": ("kinelab.ik.api", "solve_batch"),
     "track": ("kinelab.ik.api", "track"),
     "BatchIKResult": ("kinelab.ik.batch", "BatchIKResult"),
@@ -55,7 +57,8 @@ __getattr__ = loader(__name__, globals(), _LAZY)
 if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and editors
     from kinelab.collision.model import Collisions
     from kinelab.collision.obstacles import Environment, Obstacle
-    from kinelab.ik.api import solve, solve_all, solve_batch, track
+    from kinelab.ik.analytic.branches import BranchBatch
+    from kinelab.ik.api import solve, solve_all, solve_all_batch, solve_batch, track
     from kinelab.ik.batch import BatchIKResult
     from kinelab.ik.frdm.options import FRDMOptions
     from kinelab.ik.prepared import IK
@@ -67,6 +70,7 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
 __all__ = [
     "BatchIKResult",
     "BiquaternionError",
+    "BranchBatch",
     "Branches",
     "ChainError",
     "Collisions",
@@ -97,6 +101,7 @@ __all__ = [
     "robots",
     "solve",
     "solve_all",
+    "solve_all_batch",
     "solve_batch",
     "target_from_xyz_quat_wxyz",
     "target_from_xyz_rpy",

@@ -455,3 +455,75 @@ def test_random_arms_of_each_class_find_the_configuration_each_pose_came_from(tm
             assert hit or continuum(answers) or (n == 5 and answers), (k, q)
             found_all += hit
     assert found_all >= 0.99 * 300
+
+
+@pytest.mark.parametrize("name", ["ur5", "kinova", "so101", "crx10ia"])
+def test_the_compiled_closed_form_gives_the_root_by_root_answers(name):
+    """Every branch judged in one compiled pass equals the route that judges root by root with Pinocchio's FK: the
+    same rows in the same order, the errors Pinocchio's to 1e-12, on seeded poses (crx10ia: the 1-D search)."""
+    from kinelab.ik.analytic.branches import Rows, arm_of, judged_roots, limit_slack, roots
+    from kinelab.ik.request import make_request
+
+    robot = load(name)
+    req = make_request("frdm")
+    arm = arm_of(robot, req)
+    rng = np.random.default_rng(23)
+    for _ in range(30):
+        target = robot.fk(robot.random_q(rng))
+        found = kinelab.solve_all(robot, target)
+        q, merged, free = roots(robot, arm, target.homogeneous, None, limit_slack(req.tol_rot))
+        general = Rows.of(judged_roots(robot, q, merged, free, target, req), robot.n)
+        np.testing.assert_array_equal(found.q, general.q)
+        assert found.method == ("search" if arm.searched else "closed form") and found.status.value == "converged"
+        for k, res in enumerate(found):
+            dp, dr = robot.tool_error(res.q, target)  # Pinocchio's FK
+            assert abs(res.position_error - dp) <= 1e-12 and abs(res.rotation_error - dr) <= 1e-12
+            assert found.position_error[k] == res.position_error and res.diagnostics.found == general.merged[k]
+            assert res.judge == "compiled FK (certified)" and res.diagnostics.branches == len(found)
+
+
+def test_a_set_of_branches_is_arrays_and_builds_its_results_only_when_read(monkeypatch):
+    import pickle
+
+    from kinelab.ik.result import IKResult
+
+    robot = load("ur5")
+    target = robot.fk(robot.random_q(5))
+    built = []
+    real_init = IKResult.__init__
+    monkeypatch.setattr(IKResult, "__init__", lambda self, *a, **k: built.append(1) or real_init(self, *a, **k))
+    found = kinelab.solve_all(robot, target)
+    assert built == [] and found.q.shape == (len(found), 6) and len(found) >= 2
+    assert found.rotation_error.shape == (len(found),) and np.all(found.position_error <= 1e-6)
+    np.testing.assert_array_equal(found[1].q, found.q[1])
+    assert len(built) == len(found)  # every result made at the first read, then kept
+    assert [r.q.tolist() for r in found] == found.q.tolist() and len(built) == len(found)
+    again = pickle.loads(pickle.dumps(kinelab.solve_all(robot, target)))
+    np.testing.assert_array_equal(again.q, found.q)
+    assert again[0].diagnostics == found[0].diagnostics
+    far = kinelab.solve_all(robot, pin.SE3(np.eye(3), np.array([9.0, 0.0, 0.0])))
+    assert far == [] and not far and far.status.value == "unreachable" and far.q.shape[0] == 0
+
+
+@pytest.mark.parametrize("name", ["ur10", "kinova", "crx10ia"])
+def test_the_every_branch_batch_gives_each_target_what_solve_all_gives(name):
+    """kinelab.solve_all_batch: row b is solve_all(targets[b]) (rows, order, errors), on all cores; a target beyond
+    reach has count 0; a chain without a closed form is refused by name."""
+    robot = load(name)
+    rng = np.random.default_rng(31)
+    targets = [robot.fk(robot.random_q(rng)) for _ in range(60)]
+    targets.append(pin.SE3(np.eye(3), np.array([9.0, 0.0, 0.0])))
+    batch = kinelab.solve_all_batch(robot, targets)
+    assert batch.q.shape == (61, 16, robot.n) and batch.count[-1] == 0 and (batch.count[:-1] >= 1).all()
+    for b, target in enumerate(targets):
+        one, k = kinelab.solve_all(robot, target), int(batch.count[b])
+        assert k == len(one)
+        np.testing.assert_array_equal(batch.q[b, :k], one.q)
+        np.testing.assert_array_equal(batch.position_error[b, :k], one.position_error)
+        assert np.isnan(batch.q[b, k:]).all() and np.isnan(batch.rotation_error[b, k:]).all()
+        for row in batch.q[b, :k]:
+            dp, dr = robot.tool_error(row, target)  # Pinocchio's FK
+            assert dp <= 1e-6 and dr <= 1e-6 and robot.within_limits(row)
+    assert batch.method == ("search" if name == "crx10ia" else "closed form")
+    with pytest.raises(kinelab.OptionError, match="analytic class"):
+        kinelab.solve_all_batch(load("panda"), targets[:2])

@@ -56,3 +56,56 @@ def test_the_biquaternion_solver_takes_one_route_too():
         assert plain.status == prepared.status and plain.iterations == prepared.iterations
         assert plain.diagnostics.steps == prepared.diagnostics.steps
         assert plain.diagnostics.attempts == prepared.diagnostics.attempts
+
+
+def _general_route(robot, target, q0, seed):
+    """The driver's route (checks, the compiled multistart, Pinocchio-side verdict in Python): what every solve
+    took before the one compiled call."""
+    from dataclasses import replace
+
+    from kinelab.ik.driver import solve_one
+    from kinelab.ik.request import make_request
+
+    req = make_request("frdm", None, 1e-6, 1e-6, None, 1000, "project", None, "pose", "z", {})
+    return solve_one(robot, target, q0, replace(req, seed=seed))
+
+
+@pytest.mark.parametrize("name", ["ur5", "panda", "kinova", "stanford", "youbot"])
+def test_the_one_compiled_call_gives_the_driver_s_answers(name):
+    """Same q, status, counters, errors and diagnostics as the general route, on seeded targets from random,
+    warm and no starts (kinova has continuous joints: the wrap happens inside the compiled call too)."""
+    robot = kinelab.load(name)
+    ik = kinelab.IK(robot, time_budget=None)
+    assert ik.engine is not None, "the robot's compiled FK is certified: the one-call engine serves it"
+    rng = np.random.default_rng(40)
+    for k in range(24):
+        q = robot.random_q(rng)
+        target = robot.fk(q)
+        q0 = [None, robot.random_q(rng), np.clip(q + rng.normal(0, 0.2, q.size), robot.lower, robot.upper)][k % 3]
+        one, general = ik.solve(target, q0=q0, seed=k), _general_route(robot, target, q0, k)
+        np.testing.assert_array_equal(one.q, general.q)
+        assert (one.status, one.success, one.iterations, one.restarts, one.message) == \
+            (general.status, general.success, general.iterations, general.restarts, general.message)
+        assert (one.position_error, one.rotation_error, one.mode, one.judge) == \
+            (general.position_error, general.rotation_error, general.mode, general.judge)
+        assert one.diagnostics.to_dict() == general.diagnostics.to_dict()
+        assert one.singular_events == general.singular_events
+
+
+def test_a_result_s_diagnostics_are_built_only_when_read(monkeypatch):
+    import copy
+    import pickle
+
+    robot = kinelab.load("panda")
+    ik = kinelab.IK(robot, time_budget=None)
+    ctx, built = ik._lean.ctx, []
+    made_by = ctx.diagnostics
+    monkeypatch.setattr(ctx, "diagnostics", lambda st: built.append(1) or made_by(st))
+    q = robot.random_q(3)
+    res = ik.solve(robot.fk(q), q0=q, seed=0)
+    assert res.success and built == []
+    assert res.diagnostics.path == "compiled" and res.diagnostics.attempts == 1
+    assert res.diagnostics is res.diagnostics and built == [1]  # made once, then kept
+    later = ik.solve(robot.fk(q), q0=q, seed=0)
+    assert pickle.loads(pickle.dumps(later)).diagnostics == res.diagnostics and built == [1, 1]
+    assert copy.deepcopy(ik.solve(robot.fk(q), q0=q, seed=0)).diagnostics == res.diagnostics and len(built) == 3

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -63,7 +64,7 @@ def run(args: argparse.Namespace) -> int:
     return 0 if found else 1
 
 
-def _method(found: list[IKResult]) -> str:
+def _method(found: Sequence[IKResult]) -> str:
     return found[0].mode if found else "none found"
 
 
@@ -97,7 +98,7 @@ def _print_branches(robot: Robot, args: argparse.Namespace, found: Branches, ref
               "loads the solver)")
 
 
-def _write_page(robot: Robot, found: list[IKResult], path: str, nearest_first: bool) -> None:
+def _write_page(robot: Robot, found: Sequence[IKResult], path: str, nearest_first: bool) -> None:
     """The branches side by side, each copy labelled in the caption by its number (nearest first when sorted)."""
     from kinelab.view.scene import side_by_side
 

@@ -30,9 +30,14 @@ and its angle was set to 0 (a continuum of answers: a wrist or shoulder singular
 numbers and rotations of 9 (row by row): they live in registers.
 """
 
+import numpy as np
+
 from libc.math cimport acos, atan2, cos, fabs, hypot, rint, sin, M_PI, NAN
 from libc.stdlib cimport free as release, malloc
 from cython.parallel cimport prange
+
+from kinelab.core._chain cimport Judge
+from kinelab.core._verdict cimport pose_defect_of, pose_errors
 
 ctypedef (double, double, double) V3
 ctypedef (double, double, double, double, double, double, double, double, double) M9
@@ -114,8 +119,14 @@ cdef inline M9 rotation(V3 k, double theta) noexcept nogil:
 
 
 cdef inline double wrap(double theta) noexcept nogil:
-    """θ wrapped into (−π, π]."""
-    return atan2(sin(theta), cos(theta))
+    """θ wrapped into (−π, π] by whole turns: exact for an angle already inside, and no trigonometry (the rows'
+    wraps cost as much as solving them)."""
+    cdef double t = theta - TWO_PI * rint(theta / TWO_PI)
+    if t <= -M_PI:
+        return t + TWO_PI
+    if t > M_PI:
+        return t - TWO_PI
+    return t
 
 
 cdef inline double _max(double a, double b) noexcept nogil:
@@ -468,10 +479,13 @@ cdef bint _placed(const double* row, int n, const double* lower, const double* u
 
 
 cdef inline bint _close(const double* a, const double* b, int n, double same) noexcept nogil:
-    """a and b equal joint by joint to ``same``, angles modulo 2π."""
+    """a and b equal joint by joint to ``same``, angles modulo 2π (the difference reduced by whole turns: no
+    trigonometry, which made the merging of a pose's rows cost more than solving them)."""
     cdef int j
+    cdef double d
     for j in range(n):
-        if fabs(wrap(a[j] - b[j])) > same:
+        d = a[j] - b[j]
+        if fabs(d - TWO_PI * rint(d / TWO_PI)) > same:
             return False
     return True
 
@@ -645,3 +659,172 @@ def search_errors(int kind, const double[:, ::1] h, const double[:, ::1] o, cons
              (H[0, 3], H[1, 3], H[2, 3]))
     for k in range(t.shape[0]):
         _sample(&S, t[k], &e[k, 0], NULL, NULL, &margin[k, 0], -1)
+
+
+# ---- the prepared closed form: every branch of a pose, judged, in one compiled call ----
+
+cdef enum:
+    KEPT = 0  # the judge confirms the root
+    NEAR = 1  # short of the tolerances but near them: a warm-started solve may finish it (the caller's)
+    DROPPED = 2  # not this pose's root
+
+
+cdef class ClosedForm:
+    """One robot's closed form with one pair of tolerances, prepared: every branch of a pose, each judged by the
+    robot's certified compiled FK, in one compiled call (and a batch of poses on all cores).
+
+    Args:
+        judge: the robot's certified compiled FK.
+        spec: read once: ``kind``, ``mirrored``, ``h``, ``o``, ``R0``, ``N0`` the class (as :func:`branches`
+            takes them); ``lower``, ``upper`` the joint limits [rad] the roots are placed within, ``same`` [rad] and
+            ``slack`` [rad] as :func:`branches`; ``check_lower``, ``check_upper`` the limits an answer must lie within;
+            ``tol_pos`` [m], ``tol_rot`` [rad] the tolerances.
+    """
+
+    cdef Arm arm
+    cdef Judge judge
+    cdef list keep
+    cdef const double[::1] check_lower, check_upper
+    cdef double tol_pos, tol_rot
+    cdef readonly int n
+
+    def __init__(self, Judge judge, spec):
+        c = [np.ascontiguousarray(getattr(spec, name), dtype=np.float64)
+             for name in ("h", "o", "R0", "N0", "lower", "upper", "check_lower", "check_upper")]
+        self.keep = c
+        self.arm = _arm(spec.kind, spec.mirrored, c[0], c[1], c[2], c[3], c[4], c[5], spec.same, spec.slack)
+        self.n = self.arm.n
+        self.check_lower, self.check_upper = c[6], c[7]
+        if judge.kind.shape[0] != self.n or self.check_lower.shape[0] != self.n or self.check_upper.shape[0] != self.n:
+            raise ValueError("ClosedForm: a judge and check limits of the arm's joints")
+        self.judge, self.tol_pos, self.tol_rot = judge, spec.tol_pos, spec.tol_rot
+
+    def solve(self, const double[:, :] H, ref):
+        """Every branch of the pose H (4 × 4 homogeneous, base frame) within the limits that the judge confirms.
+
+        Args:
+            H: oMtarget.
+            ref: None, or n angles [rad]: each angle's copy nearest it (else nearest 0).
+
+        Returns:
+            (q (k, n) [rad], position errors (k,) [m], rotation errors (k,) [rad], roots merged (k,), one of a
+            continuum (k,) bool, roots placed within the limits) in the roots' order; None when a root falls
+            short of the tolerances but near them (a warm-started solve may finish it: the caller's general route),
+            or H is not a 4 × 4 pose.
+        """
+        cdef double out[MAX_ROWS * 6]
+        cdef double errors[MAX_ROWS * 2]
+        cdef long long found[MAX_ROWS]
+        cdef unsigned char loose[MAX_ROWS]
+        cdef double T[16]
+        cdef const double[::1] r
+        cdef const double* aim = out  # read only with a reference
+        cdef bint use_ref = ref is not None, near = False
+        cdef int n = self.n, m = 0, kept, i, j
+        if H.shape[0] != 4 or H.shape[1] != 4 or pose_defect_of(H) != 0:
+            return None
+        if use_ref:
+            r = ref
+            if r.shape[0] != n:
+                raise ValueError("ClosedForm.solve: ref needs one angle per joint")
+            aim = &r[0]
+        for i in range(4):
+            for j in range(4):
+                T[4 * i + j] = H[i, j]
+        with nogil:
+            kept = self._pose(T, aim, use_ref, out, errors, found, loose, &near, &m)
+        if near:
+            return None
+        q = np.empty((kept, n))
+        position_error, rotation_error = np.empty(kept), np.empty(kept)
+        merged, continuum = np.empty(kept, dtype=np.int64), np.empty(kept, dtype=np.bool_)
+        cdef double[:, ::1] qv = q
+        cdef double[::1] pv = position_error, rv = rotation_error
+        cdef long long[::1] fv = merged
+        cdef unsigned char[::1] cv = continuum.view(np.uint8)
+        for i in range(kept):
+            for j in range(n):
+                qv[i, j] = out[i * n + j]
+            pv[i], rv[i], fv[i], cv[i] = errors[2 * i], errors[2 * i + 1], found[i], loose[i]
+        return q, position_error, rotation_error, merged, continuum, m
+
+    def solve_batch(self, const double[:, :, ::1] H, double[:, :, ::1] q, double[:, :, ::1] errors,
+                    long long[:, ::1] merged, unsigned char[:, ::1] continuum, long long[::1] count,
+                    unsigned char[::1] near, int threads):
+        """:meth:`solve` for every pose of the (B, 4, 4) stack H (proper poses, checked by the caller; copies
+        nearest 0) on ``threads`` OpenMP threads: per pose b the branches the judge confirms in
+        q[b, :count[b]] [rad], errors[b, :count[b]] ([m, rad] each), merged and continuum (a bool array's
+        ``view(np.uint8)``); rows after count[b] are left as given. near[b] = 1 (and count[b] = 0) where a root
+        fell short of the tolerances but near them: the caller solves that pose by the general route."""
+        cdef Py_ssize_t B = H.shape[0], b
+        cdef int n = self.n, m
+        cdef double zero[6]
+        if H.shape[1] != 4 or H.shape[2] != 4 or q.shape[0] != B or q.shape[1] < MAX_ROWS or q.shape[2] != n \
+                or errors.shape[0] != B or errors.shape[1] < MAX_ROWS or errors.shape[2] != 2 \
+                or merged.shape[0] != B or merged.shape[1] < MAX_ROWS or continuum.shape[0] != B \
+                or continuum.shape[1] < MAX_ROWS or count.shape[0] != B or near.shape[0] != B:
+            raise ValueError("ClosedForm.solve_batch: H (B, 4, 4), q (B, MAX_ROWS, n), errors (B, MAX_ROWS, 2), "
+                             "merged and continuum (B, MAX_ROWS), count and near (B,)")
+        for m in range(6):
+            zero[m] = 0.0
+        if B == 0:
+            return
+        with nogil:
+            for b in prange(B, num_threads=max(1, threads), schedule="dynamic", chunksize=32):
+                count[b] = self._pose_row(&H[b, 0, 0], zero, &q[b, 0, 0], &errors[b, 0, 0], &merged[b, 0],
+                                          &continuum[b, 0], &near[b])
+
+    cdef int _pose_row(self, const double* T, const double* zero, double* q, double* errors, long long* merged,
+                       unsigned char* continuum, unsigned char* near) noexcept nogil:
+        """One pose of a batch (:meth:`solve_batch`)."""
+        cdef bint short = False
+        cdef int m = 0, kept
+        kept = self._pose(T, zero, False, q, errors, merged, continuum, &short, &m)
+        near[0] = short
+        return 0 if short else kept
+
+    cdef int _pose(self, const double* T, const double* aim, bint use_ref, double* q, double* errors,
+                   long long* merged, unsigned char* continuum, bint* near, int* placed) noexcept nogil:
+        """The branches of the pose T (4 × 4, row-major) the judge confirms, compacted into q (MAX_ROWS × n),
+        errors (MAX_ROWS × 2), merged and continuum; returns how many. ``near`` set (and the count meaningless)
+        when a root fell short of the tolerances but near them; ``placed``: the roots placed within the limits."""
+        cdef double out[MAX_ROWS * 6]
+        cdef long long found[MAX_ROWS]
+        cdef unsigned char loose[MAX_ROWS]
+        cdef int n = self.n, m, k, j, kept = 0
+        cdef unsigned char verdict
+        cdef M9 Rt = (T[0], T[1], T[2], T[4], T[5], T[6], T[8], T[9], T[10])
+        m = _branches(&self.arm, Rt, (T[3], T[7], T[11]), aim, use_ref, out, found, loose)
+        placed[0] = m
+        for k in range(m):
+            verdict = self._judged(T, out + k * n, errors + 2 * kept, errors + 2 * kept + 1)
+            if verdict == NEAR:
+                near[0] = True
+                return kept
+            if verdict == KEPT:
+                for j in range(n):
+                    q[kept * n + j] = out[k * n + j]
+                merged[kept], continuum[kept] = found[k], loose[k]
+                kept += 1
+        return kept
+
+    cdef unsigned char _judged(self, const double* H, const double* q, double* dp, double* dr) noexcept nogil:
+        """KEPT, NEAR or DROPPED for one root against the pose H (4 × 4, row-major); its errors written."""
+        cdef double T[16]
+        cdef double p[3]
+        cdef double S[9]
+        cdef int i, j
+        for i in range(3):
+            p[i] = H[4 * i + 3]
+            for j in range(3):
+                S[3 * i + j] = H[4 * i + j]
+        self.judge.pose(q, T)
+        pose_errors(T, p, S, -1, dp, dr)
+        for i in range(self.n):
+            if not self.check_lower[i] <= q[i] <= self.check_upper[i]:
+                return DROPPED
+        if dp[0] <= self.tol_pos and dr[0] <= self.tol_rot:
+            return KEPT
+        if dp[0] <= 1e3 * self.tol_pos + 1e-6 and dr[0] <= 1e3 * self.tol_rot + 1e-6:
+            return NEAR
+        return DROPPED

@@ -11,7 +11,7 @@ on each robot (:mod:`kinelab.robot.certificate`).
 
 from libc.math cimport cos, sin
 
-from kinelab.core._verdict cimport verdict_of
+from kinelab.core._verdict cimport pose_errors, verdict_of
 
 cdef int PRISMATIC = 1
 
@@ -56,13 +56,13 @@ cdef inline void _turn(double[3][3] R, const double[::1] a, double angle) noexce
             R[i][j] = out[i][j]
 
 
-cdef void _fk_row(const double[:, :, ::1] placement_R, const double[:, ::1] placement_t,
-                  const double[:, ::1] axis, const long long[::1] kind, const double[:, ::1] tool_R,
-                  const double[::1] tool_t, const double[::1] q, double* out) noexcept nogil:
-    """oMtool at q into out (4 × 4, row-major)."""
+cdef void fk_row(const double[:, :, ::1] placement_R, const double[:, ::1] placement_t,
+                 const double[:, ::1] axis, const long long[::1] kind, const double[:, ::1] tool_R,
+                 const double[::1] tool_t, const double* q, double* out) noexcept nogil:
+    """oMtool at q (one value per joint of ``kind``) into out (4 × 4, row-major)."""
     cdef double R[3][3]
     cdef double t[3]
-    cdef int i, j, n = q.shape[0]
+    cdef int i, j, n = kind.shape[0]
     for i in range(3):
         t[i] = 0.0
         for j in range(3):
@@ -94,7 +94,7 @@ def fk_batch(const double[:, :, ::1] placement_R, const double[:, ::1] placement
     cdef Py_ssize_t b
     with nogil:
         for b in range(Q.shape[0]):
-            _fk_row(placement_R, placement_t, axis, kind, tool_R, tool_t, Q[b], &out[b, 0, 0])
+            fk_row(placement_R, placement_t, axis, kind, tool_R, tool_t, &Q[b, 0], &out[b, 0, 0])
 
 
 cdef class Judge:
@@ -104,13 +104,6 @@ cdef class Judge:
     Args:
         placement_R, placement_t, axis, kind, tool_R, tool_t: the chain (see :func:`fk_batch`).
     """
-
-    cdef const double[:, :, ::1] placement_R
-    cdef const double[:, ::1] placement_t
-    cdef const double[:, ::1] axis
-    cdef const long long[::1] kind
-    cdef const double[:, ::1] tool_R
-    cdef const double[::1] tool_t
 
     def __init__(self, const double[:, :, ::1] placement_R, const double[:, ::1] placement_t,
                  const double[:, ::1] axis, const long long[::1] kind, const double[:, ::1] tool_R,
@@ -132,5 +125,36 @@ cdef class Judge:
                 or H_target.shape[1] != 4 or rot_axis > 2:
             raise ValueError("verdict: a 4 × 4 target, q and limits of one value per joint, an axis −1 … 2")
         cdef double T[16]
-        _fk_row(self.placement_R, self.placement_t, self.axis, self.kind, self.tool_R, self.tool_t, q, T)
+        self.pose(&q[0] if n else NULL, T)
         return verdict_of(T, H_target, q, lower, upper, rot_axis)
+
+    def verdicts(self, const double[:, :] H_target, const double[:, ::1] Q, const double[::1] lower,
+                 const double[::1] upper, double[::1] position_error, double[::1] rotation_error,
+                 unsigned char[::1] within):
+        """The verdict on every row of Q (m × n answers) against one target (4 × 4, base frame), in one pass:
+        position error [m], rotation error [rad] (the angle of R*ᵀR) and within [lower, upper] written per row."""
+        cdef Py_ssize_t n = self.kind.shape[0], m = Q.shape[0], k
+        if Q.shape[1] != n or lower.shape[0] != n or upper.shape[0] != n or H_target.shape[0] != 4 \
+                or H_target.shape[1] != 4 or position_error.shape[0] < m or rotation_error.shape[0] < m \
+                or within.shape[0] < m:
+            raise ValueError("verdicts: a 4 × 4 target, (m, n) answers, limits of one value per joint, m outputs")
+        cdef double T[16]
+        cdef double p[3]
+        cdef double S[9]
+        cdef int i, j
+        cdef bint inside
+        for i in range(3):
+            p[i] = H_target[i, 3]
+            for j in range(3):
+                S[3 * i + j] = H_target[i, j]
+        for k in range(m):
+            self.pose(&Q[k, 0], T)
+            pose_errors(T, p, S, -1, &position_error[k], &rotation_error[k])
+            inside = True
+            for i in range(n):
+                inside = inside and lower[i] <= Q[k, i] <= upper[i]
+            within[k] = inside
+
+    cdef void pose(self, const double* q, double* T) noexcept nogil:
+        """oMtool at q (n values) into T (4 × 4, row-major)."""
+        fk_row(self.placement_R, self.placement_t, self.axis, self.kind, self.tool_R, self.tool_t, q, T)

@@ -93,6 +93,9 @@ cdef int lm_polish(double* q, const Chain* ch, const Objective* pb, int iteratio
 cdef int multistart(double* q, const Chain* ch, const Objective* pb, const Settings* st, int order, int max_sweeps,
                     unsigned long long* rng_state, int max_attempts, double sweep_budget, double* best_q,
                     double* stats, Memory* mem, double deadline) noexcept nogil
+cdef int timed(double* q, const Chain* ch, const Objective* pb, const Settings* st, int order, int max_sweeps,
+               unsigned long long* rng_state, int attempts, double first_chunk, double later_chunk, double deadline,
+               int stop_before, double* best_q, double* stats, Memory* mem) noexcept nogil
 cdef void random_configuration(double* q, const long long* kind, const double* lower, const double* upper, int n,
                                unsigned long long* rng_state) noexcept nogil
 cdef double now() noexcept nogil

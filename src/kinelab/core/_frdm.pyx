@@ -990,14 +990,14 @@ cdef class Packed:
         self._check_multistart(q, best_q, stats, rng_state)
         cdef int code
         with nogil:
-            code = _timed(&q[0], &self.ch, &self.pb, &self.st, order, max_sweeps, &rng_state[0], attempts,
+            code = timed(&q[0], &self.ch, &self.pb, &self.st, order, max_sweeps, &rng_state[0], attempts,
                           first_chunk, later_chunk, deadline, 0, &best_q[0], &stats[0], &self.mem)
         return code
 
 
-cdef int _timed(double* q, const Chain* ch, const Objective* pb, const Settings* st, int order, int max_sweeps,
-                unsigned long long* rng_state, int attempts, double first_chunk, double later_chunk, double deadline,
-                int stop_before, double* best_q, double* stats, Memory* mem) noexcept nogil:
+cdef int timed(double* q, const Chain* ch, const Objective* pb, const Settings* st, int order, int max_sweeps,
+               unsigned long long* rng_state, int attempts, double first_chunk, double later_chunk, double deadline,
+               int stop_before, double* best_q, double* stats, Memory* mem) noexcept nogil:
     """The multistart in chunks of sweeps, the clock looked at between them. ``stop_before``: also before the
     first chunk (the batch's rows: NOT_STARTED when the deadline passed before the row began, STOPPED when it
     passed while it ran); else the first chunk always runs (the single solve's)."""
@@ -1139,7 +1139,7 @@ cdef int _row(const Chain* ch, const Objective* shared, const Settings* st, doub
     if draw_start:
         random_configuration(q, ch.kind, pb.lower, pb.upper, n, rng_state)
     _copy(best_q, q, n)
-    code = _timed(q, ch, &pb, st, order, max_sweeps, rng_state, attempts, first_chunk, later_chunk,
+    code = timed(q, ch, &pb, st, order, max_sweeps, rng_state, attempts, first_chunk, later_chunk,
                   deadline, 1, best_q, stats, &mem)
     _copy(q_out, best_q, n)
     free(block)

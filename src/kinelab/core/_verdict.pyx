@@ -20,7 +20,8 @@ NOT_FINITE, NOT_A_ROTATION, NOT_HOMOGENEOUS = C_NOT_FINITE, C_NOT_A_ROTATION, C_
 OK, NOT_USUAL = C_OK, C_NOT_USUAL
 
 
-cdef int _defect(const double[:, :] H) noexcept nogil:
+cdef int pose_defect_of(const double[:, :] H) noexcept nogil:
+    """0, NOT_FINITE or NOT_A_ROTATION (see :func:`pose_defect`)."""
     cdef double total = 0.0, gram = 0.0, d, det
     cdef int i, j, a, b
     for i in range(3):
@@ -45,7 +46,7 @@ def pose_defect(const double[:, :] H) -> int:
     else NOT_FINITE or NOT_A_ROTATION."""
     if H.shape[0] != 4 or H.shape[1] != 4:
         raise ValueError("pose_defect: a 4 × 4 matrix expected")
-    return _defect(H)
+    return pose_defect_of(H)
 
 
 def first_defect(const double[:, :, :] H) -> tuple:
@@ -57,7 +58,7 @@ def first_defect(const double[:, :, :] H) -> tuple:
     cdef Py_ssize_t b
     cdef int code, j
     for b in range(H.shape[0]):
-        code = _defect(H[b])
+        code = pose_defect_of(H[b])
         if code == 0:
             for j in range(4):
                 if not isfinite(H[b, 3, j]):
@@ -69,30 +70,45 @@ def first_defect(const double[:, :, :] H) -> tuple:
     return (-1, 0)
 
 
-cdef tuple verdict_of(const double* T, const double[:, :] H_target, const double[::1] q, const double[::1] lower,
-                      const double[::1] upper, int axis):
-    """(position error [m], rotation error [rad], q within [lower, upper]) of the tool pose T (4 × 4, row-major)
-    against the target H_target (4 × 4, shapes checked by the caller): the angle of R*ᵀR, or with ``axis`` = 0, 1, 2
-    the angle between the tool's and the target's x, y or z axes (task "axis"; −1 for the whole rotation)."""
-    cdef double d0 = H_target[0, 3] - T[3], d1 = H_target[1, 3] - T[7], d2 = H_target[2, 3] - T[11]
-    cdef double angle, u0, u1, u2, v0, v1, v2, c0, c1, c2
+cdef void pose_errors(const double* T, const double* pstar, const double* Rstar, int axis, double* dp,
+                      double* dr) noexcept nogil:
+    """dp ← position error [m], dr ← rotation error [rad] of the tool pose T (4 × 4, row-major) against the target
+    point pstar and rotation Rstar (3 × 3, row-major): the angle of R*ᵀR, or with ``axis`` = 0, 1, 2 the angle
+    between the tool's and the target's x, y or z axes (task "axis"; −1 for the whole rotation)."""
+    cdef double d0 = pstar[0] - T[3], d1 = pstar[1] - T[7], d2 = pstar[2] - T[11]
+    cdef double u0, u1, u2, v0, v1, v2, c0, c1, c2
     cdef double R[9]
-    cdef double S[9]
     cdef int i, j
-    cdef bint inside = True
     if axis < 0:
         for i in range(3):
             for j in range(3):
-                R[3 * i + j], S[3 * i + j] = T[4 * i + j], H_target[i, j]
-        angle = rotation_angle(R, S)
+                R[3 * i + j] = T[4 * i + j]
+        dr[0] = rotation_angle(R, Rstar)
     else:
         u0, u1, u2 = T[axis], T[4 + axis], T[8 + axis]
-        v0, v1, v2 = H_target[0, axis], H_target[1, axis], H_target[2, axis]
+        v0, v1, v2 = Rstar[axis], Rstar[3 + axis], Rstar[6 + axis]
         c0, c1, c2 = u1 * v2 - u2 * v1, u2 * v0 - u0 * v2, u0 * v1 - u1 * v0
-        angle = atan2(sqrt(c0 * c0 + c1 * c1 + c2 * c2), u0 * v0 + u1 * v1 + u2 * v2)
+        dr[0] = atan2(sqrt(c0 * c0 + c1 * c1 + c2 * c2), u0 * v0 + u1 * v1 + u2 * v2)
+    dp[0] = sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+
+
+cdef tuple verdict_of(const double* T, const double[:, :] H_target, const double[::1] q, const double[::1] lower,
+                      const double[::1] upper, int axis):
+    """(position error [m], rotation error [rad], q within [lower, upper]) of the tool pose T (4 × 4, row-major)
+    against the target H_target (4 × 4, shapes checked by the caller); see :func:`pose_errors`."""
+    cdef double p[3]
+    cdef double S[9]
+    cdef double dp, dr
+    cdef int i, j
+    cdef bint inside = True
+    for i in range(3):
+        p[i] = H_target[i, 3]
+        for j in range(3):
+            S[3 * i + j] = H_target[i, j]
+    pose_errors(T, p, S, axis, &dp, &dr)
     for i in range(q.shape[0]):
         inside = inside and lower[i] <= q[i] <= upper[i]
-    return sqrt(d0 * d0 + d1 * d1 + d2 * d2), angle, inside
+    return dp, dr, inside
 
 
 def pose_verdict(const double[:, :] H_target, const double[:, :] H_tool, const double[::1] q,
@@ -120,7 +136,7 @@ def usual_inputs(const double[:, :] H, const double[::1] q0, int n, const double
             or Rstar.shape[1] != 3 or lower.shape[0] != n or upper.shape[0] != n:
         raise ValueError("usual_inputs: inconsistent shapes")
     cdef int i, j
-    if _defect(H) != 0:
+    if pose_defect_of(H) != 0:
         return NOT_USUAL
     cdef double a0 = H[0, 3] - anchor[0], a1 = H[1, 3] - anchor[1], a2 = H[2, 3] - anchor[2]
     if not sqrt(a0 * a0 + a1 * a1 + a2 * a2) <= radius:

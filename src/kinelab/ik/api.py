@@ -22,14 +22,14 @@ import pinocchio as pin
 from kinelab.collision.model import CollisionModel, as_collisions, collision_model
 from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
-from kinelab.ik.analytic.branches import analytic_one, nearest_batch, refuse_options
+from kinelab.ik.analytic.branches import BranchBatch, all_branches_batch, analytic_one, nearest_batch, refuse_options
 from kinelab.ik.batch import BatchIKResult, prepare, prepare_robot, run_batch
-from kinelab.ik.branches import UNSEEN, find_all
+from kinelab.ik.branches import UNSEEN, find_all, usual_closed_form
 from kinelab.ik.chain import chain_model
 from kinelab.ik.clear import clear_batch, clear_track, mark_colliding, solve_clear
 from kinelab.ik.driver import solve_one
 from kinelab.ik.frdm.tracking import PathSettings, path_options, run_track
-from kinelab.ik.prepared import prepared
+from kinelab.ik.prepared import kept_solver, prepared
 from kinelab.ik.registry import solver_module
 from kinelab.ik.request import Request, check_robot, make_request
 from kinelab.ik.result import Branches, IKResult, TrackResult
@@ -117,11 +117,19 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
         SolverNotFoundError, OptionError, TargetError, ConfigurationError: bad input, named.
     """
     check_entry(robot, "solve", positional)
+    if prefer is None:  # the prepared solver's own route: solve is IK(robot, **settings).solve(target)
+        key = (solver, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options, task, axis,
+               collisions, *solver_options.items())
+        ik = kept_solver(robot, key)
+        if ik is not None:
+            engine = ik.engine
+            res = None if engine is None else engine.solve(target, q0, seed)  # the usual call: one compiled call
+            return ik.solve(target, q0=q0, seed=seed) if res is None else res
     settings = dict(solver=solver, tol_pos=tol_pos, tol_rot=tol_rot, time_budget=time_budget,
                     max_restarts=max_restarts, start_outside_limits=start_outside_limits, options=options, task=task,
                     axis=axis, collisions=collisions, **solver_options)
-    if prefer is None:  # the prepared solver's own route: solve is IK(robot, **settings).solve(target)
-        return prepared(robot, settings).solve(target, q0=q0, seed=seed)
+    if prefer is None:
+        return prepared(robot, settings, key).solve(target, q0=q0, seed=seed)
     return _solve_preferring(robot, target, q0, seed, prefer, settings)
 
 
@@ -239,6 +247,34 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
     return clear_batch(robot, stack_homogeneous(*as_target_arrays(targets)), res, req, check, t0)
 
 
+def solve_all_batch(robot: Robot, targets: Any, *positional: Any, tol_pos: float = 1e-6,
+                    tol_rot: float = 1e-6) -> BranchBatch:
+    """Every branch of each target, in closed form, on all cores: arrays in, arrays out.
+
+    Row b holds what ``solve_all(robot, targets[b])`` returns for a chain with a closed form (each angle's copy
+    within the limits nearest 0), every branch judged within the limits by the FK the result's ``judge`` names.
+
+    Args:
+        robot: a robot whose chain is in an analytic class (docs/analytic.md).
+        targets: a sequence of ``pin.SE3`` or a (B, 4, 4) array of oMtarget, base frame.
+        positional: nothing: the tolerances are keyword-only.
+        tol_pos: position tolerance [m].
+        tol_rot: rotation tolerance [rad].
+
+    Returns:
+        The :class:`~kinelab.ik.analytic.branches.BranchBatch`: ``q`` (B, 16, n) [rad] with the first ``count[b]``
+        rows of target b set (NaN after them), their errors, roots merged and continuum flags, and how complete each
+        set is (``method``: "closed form" or "search").
+
+    Raises:
+        TypeError: a tolerance given positionally.
+        ChainError, TargetError, OptionError: not a robot, a bad target (its index named), a bad tolerance, or a
+            chain without a closed form (named: its branches come from ``solve_all`` one target at a time).
+    """
+    check_entry(robot, "solve_all_batch", positional)
+    return all_branches_batch(robot, targets, tol_pos, tol_rot)
+
+
 def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto", seed: int | None = None,
               tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float = 0.05, options: Any = None,
               task: str = "pose", axis: str = "z", q_ref: Any = None, max_solutions: int | None = None,
@@ -288,6 +324,11 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
         TargetError, ConfigurationError, OptionError: bad input, named.
     """
     check_entry(robot, "solve_all", positional)
+    if solver == "auto" and options is None and not solver_options and q_ref is None and max_solutions is None \
+            and collisions is None and redundancy is None and task == "pose" and axis == "z":
+        found = usual_closed_form(robot, target, seed, (tol_pos, tol_rot, time_budget, stop_below))
+        if found is not None:
+            return found
     method = solver if solver in ("auto", "analytic") else "multistart"
     if method != "multistart" and (options is not None or solver_options):
         if method == "analytic":  # refusing says so rather than ignoring them

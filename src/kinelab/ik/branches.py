@@ -14,13 +14,14 @@ from dataclasses import replace
 from typing import Any
 
 import numpy as np
+import pinocchio as pin
 
 from kinelab.errors import OptionError
-from kinelab.ik.analytic.branches import analytic_all, arm_of, has_closed_form
+from kinelab.ik.analytic.branches import Rows, analytic_all, arm_of, branch_results, has_closed_form, prepared_form
 from kinelab.ik.analytic.redundancy import redundant_all
 from kinelab.ik.batch import fresh_seed, prepare, run_batch
 from kinelab.ik.limits import distance as distance  # exported: the branch distance users sort by
-from kinelab.ik.request import Request, count_ok
+from kinelab.ik.request import Request, check_seed, count_ok, make_request
 from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target
 from kinelab.ik.workspace import beyond_reach
@@ -95,6 +96,52 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
     return _multistart_all(robot, target, req, ref, max_solutions, stop_below)
 
 
+def usual_closed_form(robot: Robot, target: Any, seed: Any, settings: tuple[Any, ...]) -> Branches | None:
+    """Every branch of ``target`` in one compiled call for the usual call of :func:`kinelab.solve_all` — solver
+    "auto" on a chain with a closed form and a certified compiled FK, a ``pin.SE3`` target, no options, references,
+    collisions or sweeps — with ``settings`` = (tol_pos, tol_rot, time_budget, stop_below) checked once per robot;
+    None otherwise (the general route then answers, or names what is wrong)."""
+    kept: dict[tuple[Any, ...], Any] = robot.derived("usual closed forms", _new_kept)
+    try:
+        entry = kept.get(settings)
+    except TypeError:  # an unhashable setting: the general route names it
+        return None
+    if entry is None:
+        entry = kept[settings] = _usual_entry(robot, settings)
+    if entry is False or type(target) is not pin.SE3:
+        return None
+    if seed is not None:
+        check_seed(seed)
+    t0 = time.perf_counter()
+    req, form, arm = entry
+    found = form.solve(target.homogeneous, None)
+    if found is None or not len(found[0]):  # a root to finish, a bad pose or none: the general route says which
+        return None
+    q, dp, dr, merged, continuum, _ = found
+    rows = Rows(q, dp, dr, np.zeros(len(q), dtype=np.bool_), merged, continuum)
+    return branch_results(robot, rows, req, arm.mode, time.perf_counter() - t0, None,
+                          "search" if arm.searched else "closed form", "")
+
+
+def _usual_entry(robot: Robot, settings: tuple[Any, ...]) -> Any:
+    """(request, compiled closed form, class) for these settings, or False when the usual call does not apply.
+
+    Raises:
+        OptionError: a bad setting, named (as the general route would).
+    """
+    tol_pos, tol_rot, time_budget, stop_below = settings
+    req = make_request("frdm", None, tol_pos, tol_rot, time_budget, 0, "refuse", None, "pose", "z", {})
+    _check_search("auto", None, stop_below)
+    if not has_closed_form(robot, req):
+        return False
+    form = prepared_form(robot, req)
+    return False if form is None else (req, form, arm_of(robot, req))
+
+
+def _new_kept(_: Robot) -> dict[tuple[Any, ...], Any]:
+    return {}
+
+
 def _check_search(method: str, max_solutions: int | None, stop_below: float | None) -> None:
     """Refuse a bad method, solution count or stopping chance, naming what is valid."""
     if method not in METHODS:
@@ -127,7 +174,7 @@ def _multistart_all(robot: Robot, target: Any, req: Request, ref: np.ndarray | N
                               mode=f"{req.solver} (all branches, multistart)",
                               diagnostics=Diagnostics(found=count, starts=rounds * ROUND, unseen=missing),
                               task=req.task_label)
-                     for q, dp, dr, count in found[:max_solutions]], status, why)
+                     for q, dp, dr, count in found[:max_solutions]], status, why, "multistart", missing)
 
 
 def _search(robot: Robot, target: Any, req: Request, max_solutions: int | None, stop_below: float | None,

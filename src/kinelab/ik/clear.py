@@ -105,14 +105,15 @@ def _collided(res: IKResult, t0: float, runs: int, model: CollisionModel) -> IKR
 def mark_colliding(found: Branches, model: CollisionModel, drop: bool) -> Branches:
     """``solve_all``'s branches with those that collide marked (success False, status ``collision``,
     ``diagnostics.contact`` set), or left out with ``drop`` (every one left out: status ``collision``)."""
-    out = Branches([], found.status, found.message)
+    kept = []
     for res in found:
         contact = model.contact(res.q)
         if contact is None:
-            out.append(res)
+            kept.append(res)
         elif not drop:
-            out.append(replace(res, success=False, status=Status.COLLISION, message=f"collides: {contact}",
-                               diagnostics=replace(res.diagnostics, contact=contact)))
+            kept.append(replace(res, success=False, status=Status.COLLISION, message=f"collides: {contact}",
+                                diagnostics=replace(res.diagnostics, contact=contact)))
+    out = Branches(kept, found.status, found.message, found.method, found.unseen)
     if found and not any(res.success for res in out):
         out.status, out.message = Status.COLLISION, f"every one of the {len(found)} branches found collides"
     return out

@@ -1,12 +1,13 @@
 """The prepared solver's lean call: compiled FRDM for one target with nothing checked twice.
 
 :class:`kinelab.IK` checks its settings once; per call only the target and the start change. For the usual
-call — a ``pin.SE3`` target, a float64 start of the right length (or none), an integer seed or none — one
-compiled function checks both (finite, a proper rotation, the start within the limits, the target within
-the reach bound), the compiled multistart solves, the robot's judge (its certified compiled FK, or Pinocchio's)
-gives its verdict on the answer, and the result is built directly. Anything else (a point target, a list
-start, a start outside the limits, a target beyond reach) returns None and the caller takes the general driver,
-which names the problem, warns or answers UNREACHABLE exactly as :func:`kinelab.solve` does: the lean call
+call — a ``pin.SE3`` target, a float64 start of the right length (or none), an integer seed or none — on a robot
+whose compiled FK is certified, one compiled call (:class:`kinelab.core._engine.FRDMEngine`) checks both (finite, a
+proper rotation, the start within the limits, the target within the reach bound), runs the multistart and judges
+the answer; the result is built directly, its diagnostics only when read. On a robot judged by Pinocchio's FK the
+same steps run as three compiled calls with Pinocchio's verdict between them. Anything else (a point target, a
+list start, a start outside the limits, a target beyond reach) returns None and the caller takes the general
+driver, which names the problem, warns or answers UNREACHABLE exactly as :func:`kinelab.solve` does: the lean call
 changes the cost, never the answer.
 """
 
@@ -14,11 +15,13 @@ from __future__ import annotations
 
 import os
 import time
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
+from kinelab.core._engine import FRDMEngine
 from kinelab.ik.driver import Call, compiled_result
 from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm import solver as frdm
@@ -28,6 +31,7 @@ from kinelab.ik.result import IKResult, Status
 from kinelab.ik.verdict import usual_inputs
 from kinelab.ik.workspace import reach_bound
 from kinelab.robot import Robot
+from kinelab.robot.model import _compiled_judge
 
 SEED_LIMIT = 1 << 64
 OK = 0  # usual_inputs: the call is the usual one
@@ -56,9 +60,41 @@ class LeanFRDM:
         self.check_pos, self.check_rot = req.task.position, req.task.rotation
         self.tol_pos, self.tol_rot, self.task_label = req.tol_pos, req.tol_rot, req.task_label
         self.judge = robot.fk_certificate.judge  # certified here, before any call's clock starts
+        self.engine = self._engine()
+
+    def _engine(self) -> FRDMEngine | None:
+        """The one-call engine, where the robot's compiled FK is its judge (else None)."""
+        judge = self.robot.derived("compiled judge", _compiled_judge)
+        if judge is None:
+            return None
+        ctx, cm = self.ctx, self.ctx.cm
+        spec = SimpleNamespace(
+            kind=cm.kind, draw_lower=cm.lower, draw_upper=cm.upper, check_lower=self.lower, check_upper=self.upper,
+            turn_lower=np.asarray(self.robot.lower, dtype=float), turn_upper=np.asarray(self.robot.upper, dtype=float),
+            anchor=self.anchor, radius=self.radius, pstar=ctx.pstar, Rstar=ctx.Rstar, order=ctx.order, cap=ctx.cap,
+            attempts=self.attempts, first_chunk=ctx.chunk, later_chunk=ctx.later_chunk, budget=self.budget,
+            tol_pos=float(self.tol_pos), tol_rot=float(self.tol_rot), check_pos=bool(self.check_pos),
+            check_rot=bool(self.check_rot), axis=self.axis, se3=pin.SE3, result=IKResult, fields=dict(
+                success=True, status=Status.CONVERGED, solver="frdm", mode=ctx.mode, message="",
+                task=self.task_label, judge=self.judge),
+            diagnostics=self._diagnostics, stall_events=ctx.stall_events, unmet=self._unmet)
+        return FRDMEngine(ctx.packed, judge, spec)
+
+    def _diagnostics(self, stats: np.ndarray) -> Any:
+        return self.ctx.diagnostics(stats.tolist())
+
+    def _unmet(self, target: Any, code: int, q: np.ndarray, stats: np.ndarray, dp: float, dr: float, ok: bool,
+               t_start: float, deadline: float, seed: int) -> IKResult:
+        """The engine's result of any outcome but a confirmed convergence (the general path's bookkeeping)."""
+        call = Call(self.robot, target, self.req.solver, self.tol_pos, self.tol_rot, t_start, deadline, seed,
+                    self.req.task, self.task_label)
+        return compiled_result(call, self.ctx.attempt(code, q, stats, deadline),
+                               max(0, int(stats[kernel.T_ATTEMPTS]) - 1), ok, dp, dr)
 
     def solve(self, target: Any, q0: Any, seed: Any) -> IKResult | None:
         """The result for the usual call, or None for the general driver (see the module's docstring)."""
+        if self.engine is not None:
+            return self.engine.solve(target, q0, seed)
         t_start = time.perf_counter()
         start, seed = self._usual(target, q0, seed)
         if start is None:

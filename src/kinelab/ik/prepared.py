@@ -16,6 +16,7 @@ from dataclasses import replace
 from typing import Any
 
 from kinelab.collision.model import as_collisions, collision_model
+from kinelab.core._engine import FRDMEngine
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.analytic.branches import analytic_one, arm_of, nearest_batch, refuse_options
 from kinelab.ik.batch import BatchIKResult, run_batch
@@ -73,6 +74,10 @@ class IK:
         self._lean = self._prepare()
         spec = as_collisions(collisions)
         self.collisions = None if spec is None else collision_model(robot, spec)
+        # the usual call's one compiled call (kinelab.core._engine), where the solver has one
+        self.engine: FRDMEngine | None = None
+        if self._lean is not None and self.collisions is None:
+            self.engine = self._lean.engine
 
     def _prepare(self) -> LeanFRDM | None:
         """Everything a call would otherwise build first: the closed form's class (a chain without one refused
@@ -104,12 +109,16 @@ class IK:
         Raises:
             TargetError, ConfigurationError, JointLimitError, OptionError: a bad target, start or seed.
         """
+        if self.engine is not None:  # the usual call, in one compiled call (None: take the general route)
+            res = self.engine.solve(target, q0, seed)
+            if res is not None:
+                return res
         if self.analytic:
             return analytic_one(self.robot, as_target(target, self.request.task.name), self.request,
                                 None if q0 is None else self.robot.check_q(q0, what="q0"), self.collisions)
         if self.collisions is not None:
             return solve_clear(self.robot, target, q0, self._request(seed), self.collisions)
-        if self._lean is not None:
+        if self._lean is not None and self.engine is None:
             res = self._lean.solve(target, q0, seed)
             if res is not None:
                 return res
@@ -164,27 +173,38 @@ class IK:
 PREPARED_PER_ROBOT = 16  # a caller sweeping settings: the prepared solvers kept stay bounded
 
 
-def prepared(robot: Robot, settings: dict[str, Any]) -> IK:
-    """The robot's prepared solver for these settings (``IK``'s keywords), built once and kept on the robot while
-    the same settings come back (a loop of :func:`kinelab.solve` calls); settings that cannot be a key (a dict of
-    kicks, say) get a new one each call. Either way the call takes the prepared solver's route.
+def prepared(robot: Robot, settings: dict[str, Any], key: tuple[Any, ...] | None = None) -> IK:
+    """The robot's prepared solver for these settings (``IK``'s keywords), built once and kept on the robot under
+    ``key`` (default: the settings sorted) while the same settings come back (a loop of :func:`kinelab.solve`
+    calls); settings that cannot be a key (a dict of kicks, say) get a new one each call. Either way the call takes
+    the prepared solver's route.
 
     Raises:
         TypeError, SolverNotFoundError, OptionError: as ``IK``.
     """
     check_robot(robot)
+    key = tuple(sorted(settings.items())) if key is None else key
     try:
-        key = tuple(sorted(settings.items()))
         hash(key)
     except TypeError:
         return IK(robot, **settings)
     kept: dict[tuple[Any, ...], IK] = robot.derived("prepared solvers", _new_table)
     ik = kept.get(key)
     if ik is None:
+        ik = IK(robot, **settings)
         if len(kept) >= PREPARED_PER_ROBOT:
             kept.clear()
-        ik = kept[key] = IK(robot, **settings)
+        kept[key] = ik
     return ik
+
+
+def kept_solver(robot: Robot, key: tuple[Any, ...]) -> IK | None:
+    """The prepared solver :func:`prepared` keeps on the robot under ``key``, or None (none yet, or a key that
+    cannot be one)."""
+    try:
+        return robot.derived("prepared solvers", _new_table).get(key)
+    except TypeError:
+        return None
 
 
 def _new_table(_: Robot) -> dict[tuple[Any, ...], IK]:

@@ -19,6 +19,7 @@ from typing import Any
 from kinelab.errors import ChainError, OptionError
 from kinelab.ik.registry import solver_module
 from kinelab.ik.tasks import POSE, Task
+from kinelab.robot import Robot
 
 START_POLICIES = ("project", "refuse")
 TOL_FLOOR = 1e-12
@@ -79,8 +80,6 @@ def check_robot(robot: object) -> None:
     Raises:
         ChainError: naming what was given.
     """
-    from kinelab.robot import Robot
-
     if not isinstance(robot, Robot):
         raise ChainError(f"the robot must be a kinelab.Robot (kinelab.load(...) or Robot.from_model(...)), got "
                          f"{type(robot).__name__}")

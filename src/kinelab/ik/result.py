@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import asdict, dataclass, field, fields, replace
 from enum import Enum
-from typing import Any
+from typing import Any, overload
 
 import numpy as np
 
@@ -202,6 +202,21 @@ class Diagnostics:
 NO_DIAGNOSTICS = Diagnostics()
 
 
+class _Deferred:
+    """A result's ``diagnostics`` built only when read: a compiled solve (:mod:`kinelab.core._engine`) stores how to
+    make it (``_make_diagnostics`` in the instance's dict, a callable) instead of the record; the first read makes
+    it and keeps it. Results built the usual way store the record itself, which shadows this (a non-data
+    descriptor)."""
+
+    def __get__(self, obj: Any, owner: Any = None) -> Diagnostics:
+        if obj is None:
+            return NO_DIAGNOSTICS  # the field's default (the dataclass reads it here)
+        make = obj.__dict__.pop("_make_diagnostics", None)
+        made: Diagnostics = NO_DIAGNOSTICS if make is None else make()
+        obj.__dict__["diagnostics"] = made
+        return made
+
+
 @dataclass
 class IKResult:
     """The outcome of :func:`kinelab.solve`.
@@ -225,9 +240,14 @@ class IKResult:
     singular_events: list[SingularEvent] = field(default_factory=list)
     bypasses: list[BypassRecord] = field(default_factory=list)
     message: str = ""
-    diagnostics: Diagnostics = NO_DIAGNOSTICS
+    diagnostics: Diagnostics = _Deferred()  # type: ignore[assignment]
     task: str = "pose"  # the components judged: pose, position, axis (with its axis) or orientation
     judge: str = "Pinocchio FK"  # whose FK measured the errors: "Pinocchio FK" or "compiled FK (certified)"
+
+    def __getstate__(self) -> dict[str, Any]:
+        """The fields, diagnostics built (a pickle or a copy never carries the maker)."""
+        _ = self.diagnostics
+        return self.__dict__
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON form (the CLI's ``ik --json``; fields are only ever added)."""
@@ -251,26 +271,87 @@ class IKResult:
         }
 
 
-class Branches(list[IKResult]):
-    """The distinct solutions of one target, as :func:`kinelab.solve_all` returns them: a list of
-    :class:`IKResult` (nearest ``q_ref`` first when asked) that says why it is empty.
+class Branches(Sequence[IKResult]):
+    """The distinct solutions of one target, as :func:`kinelab.solve_all` returns them: every branch as arrays, and
+    a sequence of :class:`IKResult` (nearest ``q_ref`` first when asked) built only when indexed or iterated.
 
     Attributes:
+        q: (k, n) the branches [rad or m], one row per branch (k = 0: (0, n)).
+        position_error: (k,) [m] and rotation_error: (k,) [rad], by the FK each result's ``judge`` names.
         status: ``converged`` when it holds a branch that met the target; else why there is none:
             ``unreachable`` (proved: the target point lies beyond the reach bound, or the closed form or the search,
             which return every branch, have none within the joint limits), ``time_budget`` (the multistart's budget
             ran out before any start met the target: nothing was proved) or ``collision`` (every branch found
             collides).
-        message: the reason in words ("" for a list of branches).
+        message: the reason in words ("" for a set of branches).
+        method: how the set was found, and so how complete it is: "closed form" (every branch), "search" (the 1-D
+            search: every branch, measured complete), "multistart" (those seeded starts found: ``unseen`` says
+            how likely one more start would find another), "sweep" (a redundant arm's joint swept: every branch at
+            each sampled value) or "" (unknown).
+        unseen: the estimated chance that one more start would find a new branch (multistart), 0 for a closed form
+            or a search, None when not known.
     """
 
-    status: Status
-    message: str
+    def __init__(self, found: Iterable[IKResult] = (), status: Status | None = None, message: str = "",
+                 method: str = "", unseen: float | None = None):
+        results = list(found)
+        self._results: list[IKResult] | None = results
+        self._make: Callable[[int], IKResult] | None = None
+        self.q = np.array([r.q for r in results], dtype=float) if results else np.empty((0, 0))
+        self.position_error = np.array([r.position_error for r in results], dtype=float)
+        self.rotation_error = np.array([r.rotation_error for r in results], dtype=float)
+        self.status = status if status is not None else Status.CONVERGED if results else Status.TIME_BUDGET
+        self.message, self.method, self.unseen = message, method, unseen
 
-    def __init__(self, found: Iterable[IKResult] = (), status: Status | None = None, message: str = ""):
-        super().__init__(found)
-        self.status = status if status is not None else Status.CONVERGED if self else Status.TIME_BUDGET
-        self.message = message
+    @classmethod
+    def from_arrays(cls, q: np.ndarray, position_error: np.ndarray, rotation_error: np.ndarray,
+                    make: Callable[[int], IKResult], status: Status | None = None, message: str = "",
+                    method: str = "", unseen: float | None = None) -> Branches:
+        """The branches as arrays (q: (k, n), the errors: (k,)); ``make(i)`` builds the i-th result when the set is
+        first indexed or iterated."""
+        made = cls.__new__(cls)
+        made.q, made.position_error, made.rotation_error = q, position_error, rotation_error
+        made._results, made._make = None, make
+        made.status = status if status is not None else Status.CONVERGED if len(q) else Status.TIME_BUDGET
+        made.message, made.method, made.unseen = message, method, unseen
+        return made
+
+    def _built(self) -> list[IKResult]:
+        if self._results is None:
+            make = self._make
+            self._results = [make(i) for i in range(self.q.shape[0])]  # type: ignore[misc]
+        return self._results
+
+    def __len__(self) -> int:
+        return int(self.q.shape[0])
+
+    @overload
+    def __getitem__(self, index: int) -> IKResult: ...
+
+    @overload
+    def __getitem__(self, index: slice) -> list[IKResult]: ...
+
+    def __getitem__(self, index: int | slice) -> IKResult | list[IKResult]:
+        return self._built()[index]
+
+    def __iter__(self) -> Iterator[IKResult]:
+        return iter(self._built())
+
+    def __eq__(self, other: object) -> bool:
+        """Equal to a list or Branches of the same results (an empty set equals ``[]``)."""
+        if not isinstance(other, list | Branches):
+            return NotImplemented
+        return len(self) == len(other) and list(self) == list(other)
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        return f"Branches({len(self)} branches, status={self.status.value!r}, method={self.method!r})"
+
+    def __getstate__(self) -> dict[str, Any]:
+        """The arrays and the results, built (a pickle never carries the maker)."""
+        self._built()
+        return {**self.__dict__, "_make": None}
 
 
 @dataclass

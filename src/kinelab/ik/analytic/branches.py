@@ -12,12 +12,15 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, replace
-from typing import Any
+from types import SimpleNamespace
+from typing import Any, NamedTuple
 
 import numpy as np
 import pinocchio as pin
 
 from kinelab.collision.model import CollisionModel
+from kinelab.core import threads
+from kinelab.core._analytic import ClosedForm
 from kinelab.errors import ConfigurationError, OptionError
 from kinelab.geometry import pose_errors, stack_homogeneous
 from kinelab.ik.analytic.classify import ArmClass, classify
@@ -30,6 +33,7 @@ from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target_arrays
 from kinelab.ik.workspace import beyond_reach
 from kinelab.robot import Robot
+from kinelab.robot.model import _compiled_judge
 
 SAME = 1e-5  # [rad] roots closer than this joint by joint are one branch (a double root split by rounding:
 # the two roots of arccos(1 − ε) are √(2ε) apart, 1.4e-6 rad at ε = 1e-12)
@@ -98,34 +102,118 @@ def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | No
     """
     t0 = time.perf_counter()
     arm = arm_of(robot, req)
-    q, found, free = roots(robot, arm, target.homogeneous, q_ref, limit_slack(req.tol_rot))
-    answers = []
-    for k in range(q.shape[0]):
-        verdict = judged(robot, q[k], target, req)
-        if verdict is not None:
-            answers.append((*verdict, int(found[k]), bool(free[k])))
+    form = prepared_form(robot, req)
+    compiled = None if form is None else form.solve(target.homogeneous, q_ref)
+    if compiled is None:  # no certified compiled FK, or a root to finish: root by root
+        q, found, free = roots(robot, arm, target.homogeneous, q_ref, limit_slack(req.tol_rot))
+        rows = Rows.of(judged_roots(robot, q, found, free, target, req), robot.n)
+    else:
+        q, dp, dr, found, free, _ = compiled
+        rows = Rows(q, dp, dr, np.zeros(len(q), dtype=np.bool_), found, free)
     if q_ref is not None:
-        answers.sort(key=lambda a: distance(robot, a[0], q_ref))
-    return branch_results(answers, req, arm.mode, time.perf_counter() - t0, max_solutions,
-                          None if arm.searched else 0.0,
+        rows = rows.taken(sorted(range(len(rows.q)), key=lambda k: distance(robot, rows.q[k], q_ref)))
+    return branch_results(robot, rows, req, arm.mode, time.perf_counter() - t0, max_solutions,
+                          "search" if arm.searched else "closed form",
                           beyond_reach(robot, target.translation)
                           or f"no branch within the joint limits ({arm.method})")
 
 
-def branch_results(answers: list[tuple[Any, ...]], req: Request, mode: str, elapsed: float,
-                   max_solutions: int | None, unseen: float | None, empty: str) -> Branches:
-    """The closed form's answers — (q, position error, rotation error, finished, roots merged, one of a
-    continuum) each — as IKResults, the first ``max_solutions``; ``diagnostics.branches`` counts them all. With no
-    answer the set's status is ``unreachable`` for the reason ``empty``: the closed form and the search compute
-    every branch, so finding none proves it."""
-    return Branches([IKResult(q=q, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr,
-                              iterations=0, restarts=0, wall_time=elapsed, solver="analytic", mode=mode,
-                              message=CONTINUUM if loose else "",
-                              diagnostics=Diagnostics(path="compiled", branches=len(answers), found=count,
-                                                      unseen=unseen, polished=1 if finished else None),
-                              task=req.task_label)
-                     for q, dp, dr, finished, count, loose in answers[:max_solutions]],
-                    None if answers else Status.UNREACHABLE, "" if answers else empty)
+def prepared_form(robot: Robot, req: Request) -> ClosedForm | None:
+    """The robot's compiled closed form for the request's tolerances (kept on the robot), or None where its compiled
+    FK is not certified (Pinocchio then judges root by root)."""
+    forms: dict[tuple[float, float], ClosedForm | None] = robot.derived("closed forms", _new_forms)
+    key = (float(req.tol_pos), float(req.tol_rot))
+    if key not in forms:
+        judge, arm = robot.derived("compiled judge", _compiled_judge), arm_of(robot, req)
+        if len(forms) >= 16:  # a caller sweeping tolerances: keep the memory bounded
+            forms.clear()
+        lower, upper = robot.check_bounds
+        forms[key] = None if judge is None else ClosedForm(judge, SimpleNamespace(
+            kind=arm.kind, mirrored=arm.mirrored, h=arm.h, o=arm.o, R0=arm.R0, N0=arm.N0, lower=robot.lower,
+            upper=robot.upper, same=SAME, slack=limit_slack(req.tol_rot), check_lower=lower, check_upper=upper,
+            tol_pos=key[0], tol_rot=key[1]))
+    return forms[key]
+
+
+def _new_forms(_: Robot) -> dict[tuple[float, float], ClosedForm | None]:
+    return {}
+
+
+Answer = tuple[np.ndarray, float, float, bool, int, bool]  # q, errors [m, rad], finished, roots merged, continuum
+
+
+class Rows(NamedTuple):
+    """A pose's judged branches as arrays, one row each: q (k, n) [rad], position_error (k,) [m], rotation_error
+    (k,) [rad], finished (k,) (a warm-started solve finished the root), merged (k,) (roots merged into it),
+    continuum (k,) (one of a continuum)."""
+
+    q: np.ndarray
+    position_error: np.ndarray
+    rotation_error: np.ndarray
+    finished: np.ndarray
+    merged: np.ndarray
+    continuum: np.ndarray
+
+    @classmethod
+    def of(cls, answers: list[Answer], n: int) -> Rows:
+        """The rows of :data:`Answer` tuples."""
+        columns = list(zip(*answers, strict=True)) if answers else [()] * 6
+        return cls(np.array(columns[0], dtype=float).reshape(len(answers), n), np.array(columns[1], dtype=float),
+                   np.array(columns[2], dtype=float), np.array(columns[3], dtype=np.bool_),
+                   np.array(columns[4], dtype=np.int64), np.array(columns[5], dtype=np.bool_))
+
+    def taken(self, order: Any) -> Rows:
+        """These rows in ``order`` (indices; a slice keeps the first ones)."""
+        return Rows(*(column[order] for column in self))
+
+
+def judged_roots(robot: Robot, q: np.ndarray, found: np.ndarray, free: np.ndarray, target: Any,
+                 req: Request, held: dict[str, float] | None = None) -> list[Answer]:
+    """The roots q (m × n) the judge confirms, in their order: each as (q, position error [m], rotation error [rad],
+    finished, roots merged, one of a continuum). Where the robot's compiled FK is certified, every root is judged in
+    one compiled pass; a root short of the tolerances but near them is finished by :func:`judged` (FRDM, the
+    joints of ``held`` frozen)."""
+    judge = robot.derived("compiled judge", _compiled_judge)
+    m = q.shape[0]
+    if judge is None or m == 0:
+        return [(*v, int(found[k]), bool(free[k])) for k in range(m)
+                if (v := judged(robot, q[k], target, req, held)) is not None]
+    dp, dr, inside = np.empty(m), np.empty(m), np.empty(m, dtype=np.uint8)
+    lower, upper = robot.check_bounds
+    judge.verdicts(target.homogeneous, q, lower, upper, dp, dr, inside)
+    answers = []
+    for k, (p, r, within) in enumerate(zip(dp.tolist(), dr.tolist(), inside.tolist(), strict=True)):
+        if within and p <= req.tol_pos and r <= req.tol_rot:
+            answers.append((q[k], p, r, False, int(found[k]), bool(free[k])))
+        elif p <= 1e3 * req.tol_pos + 1e-6 and r <= 1e3 * req.tol_rot + 1e-6:
+            v = judged(robot, q[k], target, req, held)
+            if v is not None:
+                answers.append((*v, int(found[k]), bool(free[k])))
+    return answers
+
+
+def branch_results(robot: Robot, rows: Rows, req: Request, mode: str, elapsed: float, max_solutions: int | None,
+                   method: str, empty: str) -> Branches:
+    """The closed form's judged rows as :class:`Branches`, the first ``max_solutions``: arrays, and an IKResult per
+    row built when the set is first read; ``diagnostics.branches`` counts them all. With no row the set's status is
+    ``unreachable`` for the reason ``empty``: the closed form and the search compute every branch, so finding none
+    proves it. ``method``: "closed form", "search" or "sweep"."""
+    total = len(rows.q)
+    kept = rows if max_solutions is None or max_solutions >= total else rows.taken(slice(max_solutions))
+    unseen = 0.0 if method == "closed form" else None
+    judge = robot.fk_certificate.judge
+
+    def make(i: int) -> IKResult:
+        return IKResult(q=kept.q[i].copy(), success=True, status=Status.CONVERGED,
+                        position_error=float(kept.position_error[i]), rotation_error=float(kept.rotation_error[i]),
+                        iterations=0, restarts=0, wall_time=elapsed, solver="analytic", mode=mode,
+                        message=CONTINUUM if kept.continuum[i] else "",
+                        diagnostics=Diagnostics(path="compiled", branches=total, found=int(kept.merged[i]),
+                                                unseen=unseen, polished=1 if kept.finished[i] else None),
+                        task=req.task_label, judge=judge)
+
+    return Branches.from_arrays(kept.q, kept.position_error, kept.rotation_error, make,
+                                None if total else Status.UNREACHABLE, "" if total else empty, method, unseen)
 
 
 def nearest_roots(robot: Robot, arm: ArmClass, target: Any, req: Request,
@@ -176,28 +264,33 @@ def judged(robot: Robot, q: np.ndarray, target: Any, req: Request,
 
 @dataclass(frozen=True, eq=False)
 class BranchBatch:
-    """Every branch of each pose of a batch, each confirmed by Pinocchio within the limits.
+    """Every branch of each pose of a batch, each confirmed by the judge within the limits.
 
     Attributes:
         q: (B, MAX_ROWS, n) branches [rad], the first ``count[b]`` rows of pose b; NaN after them.
-        count: (B,) branches per pose.
+        count: (B,) branches per pose (0: none within the limits, which the closed form proves).
         found: (B, MAX_ROWS) roots merged into each branch (2 at a double root); 0 after ``count``.
         free: (B, MAX_ROWS) the branch is one of a continuum (a singular pose).
+        position_error: (B, MAX_ROWS) [m] and rotation_error: (B, MAX_ROWS) [rad] of each branch, by the FK
+            ``judge`` names; NaN after ``count``.
+        method: "closed form" (every branch) or "search" (the 1-D search: every branch, measured complete).
+        judge: whose FK judged the branches.
     """
 
     q: np.ndarray
     count: np.ndarray
     found: np.ndarray
     free: np.ndarray
+    position_error: np.ndarray
+    rotation_error: np.ndarray
+    method: str = "closed form"
+    judge: str = "Pinocchio FK"
 
 
 def all_branches_batch(robot: Robot, targets: Any, tol_pos: float = 1e-6, tol_rot: float = 1e-6) -> BranchBatch:
-    """Every branch of each pose in ``targets``, the closed form run in threads over the batch.
-
-    Each joint takes the copy of its angle within the limits nearest 0; every branch is then judged by
-    Pinocchio's FK (one call per branch) and kept only when it meets both tolerances. Unlike
-    :func:`analytic_all` an answer that falls short is dropped, not finished (the classes' geometry is exact to
-    rounding; a chain within the class tolerance but not exact should use :func:`analytic_all`).
+    """Every branch of each pose in ``targets`` (what :func:`analytic_all` gives each, copies nearest 0), on all
+    cores: where the robot's compiled FK is certified the closed form and the judge run in one compiled pass; a pose
+    with a root short of the tolerances but near them is solved by :func:`analytic_all` (which finishes it).
 
     Args:
         robot: a robot whose chain is in an analytic class.
@@ -210,26 +303,50 @@ def all_branches_batch(robot: Robot, targets: Any, tol_pos: float = 1e-6, tol_ro
 
     Raises:
         TargetError: a bad target, its index named.
-        OptionError: the chain is in no analytic class.
+        OptionError: the chain is in no analytic class, or a bad tolerance.
     """
-    arm = arm_of(robot, make_request("frdm", tol_pos=tol_pos, tol_rot=tol_rot))
-    H = stack_homogeneous(*as_target_arrays(targets))
+    req = make_request("frdm", tol_pos=tol_pos, tol_rot=tol_rot)
+    arm = arm_of(robot, req)
+    H = np.ascontiguousarray(stack_homogeneous(*as_target_arrays(targets)))
+    form = prepared_form(robot, req)
+    if form is None:
+        return _pinocchio_batch(robot, arm, H, req)
+    B, n = H.shape[0], arm.n
+    q, errors = np.full((B, MAX_ROWS, n), np.nan), np.full((B, MAX_ROWS, 2), np.nan)
+    found, free = np.zeros((B, MAX_ROWS), dtype=np.int64), np.zeros((B, MAX_ROWS), dtype=np.bool_)
+    count, near = np.zeros(B, dtype=np.int64), np.zeros(B, dtype=np.uint8)
+    form.solve_batch(H, q, errors, found, free.view(np.uint8), count, near, threads.count())
+    for b in np.flatnonzero(near):
+        one = analytic_all(robot, pin.SE3(H[b]), req)
+        k = count[b] = len(one)
+        q[b, :k], errors[b, :k, 0], errors[b, :k, 1] = one.q, one.position_error, one.rotation_error
+        found[b, :k] = [int(r.diagnostics.found or 0) for r in one]
+        free[b, :k] = [r.message == CONTINUUM for r in one]
+    return BranchBatch(q, count, found, free, errors[..., 0], errors[..., 1],
+                       "search" if arm.searched else "closed form", robot.fk_certificate.judge)
+
+
+def _pinocchio_batch(robot: Robot, arm: ArmClass, H: np.ndarray, req: Request) -> BranchBatch:
+    """:func:`all_branches_batch` where Pinocchio's FK judges: the closed form in threads, then every branch judged
+    in one FK batch; a root that falls short is dropped."""
     B, n = H.shape[0], arm.n
     out = np.full((B, MAX_ROWS, n), np.nan)
     found, free = np.zeros((B, MAX_ROWS), dtype=np.int64), np.zeros((B, MAX_ROWS), dtype=np.bool_)
     count = np.zeros(B, dtype=np.int64)
     branches_batch(arm.kind, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, H, robot.lower, robot.upper, SAME,
-                   limit_slack(tol_rot), out, found, free, count)
+                   limit_slack(req.tol_rot), out, found, free, count)
     pose, row = np.nonzero(np.arange(MAX_ROWS)[None, :] < count[:, None])
     dp, dr = pose_errors(H[pose], robot.fk_batch(out[pose, row]))
-    ok = (dp <= tol_pos) & (dr <= tol_rot)
+    ok = (dp <= req.tol_pos) & (dr <= req.tol_rot)
     kept = np.bincount(pose[ok], minlength=B)
     rank = np.arange(int(ok.sum())) - np.concatenate([[0], np.cumsum(kept)[:-1]])[pose[ok]]
-    q = np.full_like(out, np.nan)
+    q, errors = np.full_like(out, np.nan), np.full((B, MAX_ROWS, 2), np.nan)
     q[pose[ok], rank] = out[pose[ok], row[ok]]
+    errors[pose[ok], rank, 0], errors[pose[ok], rank, 1] = dp[ok], dr[ok]
     f, loose = np.zeros_like(found), np.zeros_like(free)
     f[pose[ok], rank], loose[pose[ok], rank] = found[pose[ok], row[ok]], free[pose[ok], row[ok]]
-    return BranchBatch(q, kept, f, loose)
+    return BranchBatch(q, kept, f, loose, errors[..., 0], errors[..., 1],
+                       "search" if arm.searched else "closed form", robot.fk_certificate.judge)
 
 
 def analytic_one(robot: Robot, target: Any, req: Request, q0: np.ndarray | None,

@@ -22,7 +22,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.errors import ChainError, OptionError
-from kinelab.ik.analytic.branches import arm_roots, branch_results, judged, limit_slack
+from kinelab.ik.analytic.branches import Answer, Rows, arm_roots, branch_results, judged_roots, limit_slack
 from kinelab.ik.analytic.classify import ArmClass, classify, classify_vectors
 from kinelab.ik.chain import PRISMATIC, chain_model
 from kinelab.ik.limits import distance
@@ -151,7 +151,7 @@ def held_values(robot: Robot, redundancy: object) -> tuple[np.ndarray, str]:
 
 
 def at_value(robot: Robot, target: pin.SE3, req: Request, theta: float,
-             q_ref: np.ndarray | None = None) -> list[tuple[np.ndarray, float, float, bool, int, bool]]:
+             q_ref: np.ndarray | None = None) -> list[Answer]:
     """Every branch of ``target`` with the swept joint at ``theta`` [rad] that Pinocchio confirms within the
     limits: (q, position error [m], rotation error [rad], finished by FRDM, roots merged, one of a continuum).
 
@@ -163,12 +163,8 @@ def at_value(robot: Robot, target: pin.SE3, req: Request, theta: float,
     ref = None if q_ref is None else q_ref[keep]
     q6, found, free = arm_roots(sw.arm, sw.sub_target(target.homogeneous, theta), robot.lower[keep],
                                 robot.upper[keep], ref, limit_slack(req.tol_rot))
-    held, answers = {robot.joints[sw.joint].name: theta}, []
-    for r in range(q6.shape[0]):
-        verdict = judged(robot, np.insert(q6[r], sw.joint, theta), target, req, held)
-        if verdict is not None:
-            answers.append((*verdict, int(found[r]), bool(free[r])))
-    return answers
+    q = np.ascontiguousarray(np.insert(q6, sw.joint, theta, axis=1))
+    return judged_roots(robot, q, found, free, target, req, {robot.joints[sw.joint].name: theta})
 
 
 def redundant_all(robot: Robot, target: pin.SE3, req: Request, redundancy: object,
@@ -202,7 +198,7 @@ def redundant_all(robot: Robot, target: pin.SE3, req: Request, redundancy: objec
         answers.sort(key=lambda a: distance(robot, a[0], q_ref))
     search = f"; {sw.arm.method.removeprefix('every branch by a ')} of the other six" if sw.arm.searched else ""
     mode = f"analytic ({sw.arm.name}{search}; joint {sw.joint + 1} {how})"
-    return branch_results(answers, req, mode, time.perf_counter() - t0, max_solutions, None,
+    return branch_results(robot, Rows.of(answers, robot.n), req, mode, time.perf_counter() - t0, max_solutions, "sweep",
                           beyond_reach(robot, target.translation)
                           or f"no branch within the joint limits with joint {sw.joint + 1} {how}")
 

@@ -16,7 +16,7 @@ completeness).
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -79,7 +79,7 @@ def rounds(poses: list[pin.SE3], calls: dict[str, Call], repeats: int) -> dict[s
     return medians
 
 
-def _complete(robot: Robot, found: list[Any], reference: list[Any], same: float) -> bool:
+def _complete(robot: Robot, found: Sequence[Any], reference: Sequence[Any], same: float) -> bool:
     """Every reference answer has a found answer within ``same`` (joint by joint, modulo 2π)."""
     return all(any(distance(robot, f.q, r.q) <= same for f in found) for r in reference)
 

@@ -1,0 +1,245 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""A prepared solver's usual call in one compiled call: check the target and the start, run the kernel, judge the
+answer with the certified compiled FK (turned into the limits by whole turns where that is needed).
+
+The prepared solver (:class:`kinelab.IK`) builds an engine once; per call only the target, the start, the seed
+and the clock change. An unusual call (a target that is not a ``pin.SE3``, a start that is not n float64 values
+within the limits, a target beyond the reach bound, a seed that is not a whole number in [0, 2⁶⁴)) gets None, and
+the caller takes the general route, which names what is wrong: the engine changes the cost, never the answer.
+"""
+
+import os
+from functools import partial
+
+import numpy as np
+
+cimport numpy as cnp
+from libc.math cimport M_PI, atan2, ceil, cos, sin, sqrt
+from libc.stdlib cimport free, malloc
+from libc.string cimport memcpy
+
+from kinelab.core._chain cimport Judge
+from kinelab.core._frdm cimport (CONTINUOUS, CONVERGED, STATS_SIZE, T_ATTEMPTS, T_STALLS, T_SWEEPS, Packed, now,
+                                 random_configuration, timed)
+from kinelab.core._verdict cimport pose_defect_of, pose_errors
+
+cnp.import_array()
+
+cdef double TWO_PI = 2.0 * M_PI
+cdef int REVOLUTE = 0
+SEED_LIMIT = 1 << 64
+
+
+cdef unsigned long long splitmix(unsigned long long x) noexcept nogil:
+    """A non-zero generator state from a seed (splitmix64; :func:`kinelab.ik.multistart.seed_state`'s)."""
+    x = x + 0x9E3779B97F4A7C15ULL
+    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL
+    x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL
+    return (x ^ (x >> 31)) | 1ULL
+
+
+cdef class FRDMEngine:
+    """Compiled FRDM's usual call for one prepared solver (see the module's docstring).
+
+    Args:
+        packed: the kernel's chain, problem (its ``pstar`` and ``Rstar`` are the arrays given here), settings and
+            memory.
+        judge: the robot's certified compiled FK.
+        spec: the call's constants, read once: ``kind`` (n,) joint codes; ``draw_lower``, ``draw_upper`` the
+            window random starts are drawn in; ``check_lower``, ``check_upper`` the limits a start and an answer
+            must lie within; ``turn_lower``, ``turn_upper`` the limits a whole turn brings a revolute answer into;
+            ``anchor`` (3,) and ``radius`` [m] the reach bound (inf: none); ``pstar`` (3,), ``Rstar`` (3, 3) the
+            problem's target arrays; ``order``, ``cap``, ``attempts``, ``first_chunk``, ``later_chunk`` as the
+            timed multistart takes them; ``budget`` [s] (inf: none); ``tol_pos`` [m], ``tol_rot`` [rad],
+            ``check_pos``, ``check_rot``, ``axis`` (−1, or 0, 1, 2 for task "axis") the verdict's; ``se3`` the
+            target type of a usual call; ``result`` the result type, ``fields`` the values every converged
+            result shares (a dict), ``diagnostics`` (stats → the diagnostics, called when a result's are first
+            read), ``stall_events`` (stalls → the events) and ``unmet`` (the general result of any other outcome:
+            ``unmet(target, code, q, stats, position error, rotation error, met, t_start, deadline, seed)``).
+    """
+
+    cdef Packed packed
+    cdef Judge judge
+    cdef const long long[::1] kind
+    cdef const double[::1] draw_lower, draw_upper, check_lower, check_upper, turn_lower, turn_upper, anchor
+    cdef double[::1] pstar
+    cdef double[:, ::1] Rstar
+    cdef double radius, first_chunk, later_chunk, budget, tol_pos, tol_rot
+    cdef int n, order, cap, attempts, check_pos, check_rot, axis, continuous
+    cdef double* q  # the kernel's working configuration
+    cdef object se3, result, fields, diagnostics, stall_events, unmet
+
+    def __init__(self, Packed packed, Judge judge, spec):
+        self.packed, self.judge = packed, judge
+        self.kind = spec.kind
+        self.n = packed.n
+        self.draw_lower, self.draw_upper = spec.draw_lower, spec.draw_upper
+        self.check_lower, self.check_upper = spec.check_lower, spec.check_upper
+        self.turn_lower, self.turn_upper = spec.turn_lower, spec.turn_upper
+        self.anchor, self.radius = spec.anchor, spec.radius
+        self.pstar, self.Rstar = spec.pstar, spec.Rstar
+        self.order, self.cap, self.attempts = spec.order, spec.cap, spec.attempts
+        self.first_chunk, self.later_chunk, self.budget = spec.first_chunk, spec.later_chunk, spec.budget
+        self.tol_pos, self.tol_rot, self.axis = spec.tol_pos, spec.tol_rot, spec.axis
+        self.check_pos, self.check_rot = spec.check_pos, spec.check_rot
+        self.se3, self.result, self.fields = spec.se3, spec.result, dict(spec.fields)
+        self.diagnostics, self.stall_events, self.unmet = spec.diagnostics, spec.stall_events, spec.unmet
+        for name in ("kind", "draw_lower", "draw_upper", "check_lower", "check_upper", "turn_lower", "turn_upper"):
+            if len(getattr(spec, name)) != self.n:
+                raise ValueError(f"FRDMEngine: {name} needs one value per joint ({self.n})")
+        if self.anchor.shape[0] != 3 or self.pstar.shape[0] != 3 or self.Rstar.shape[0] != 3 \
+                or self.Rstar.shape[1] != 3 or judge.kind.shape[0] != self.n or not -1 <= self.axis <= 2:
+            raise ValueError("FRDMEngine: a 3-vector anchor and target point, a 3 × 3 rotation, a judge of the chain")
+        self.continuous = any(k == CONTINUOUS for k in spec.kind)
+        self.q = <double*> malloc(sizeof(double) * max(1, self.n))
+        if self.q == NULL:
+            raise MemoryError("FRDMEngine: no memory for one configuration")
+
+    def solve(self, target, q0, seed):
+        """The usual call (see the module's docstring), or None for the general route.
+
+        Args:
+            target: oMtarget (base frame).
+            q0: the first start [rad or m] (None: drawn from the seed's generator).
+            seed: the restarts' seed (None: fresh entropy).
+
+        Returns:
+            The result: built here for a converged answer the judge confirms (the answer turned into the limits
+            where whole turns do it; its diagnostics made when first read), else by ``unmet``; None for an unusual
+            call.
+        """
+        cdef double t_start = now()
+        cdef const double* start = NULL
+        if type(target) is not self.se3 or self.n == 0:
+            return None
+        if q0 is not None:
+            start = self._start(q0)
+            if start == NULL:
+                return None
+        if seed is None:
+            seed = int.from_bytes(os.urandom(8), "little")
+        elif type(seed) is not int or not 0 <= seed < SEED_LIMIT:
+            return None
+        if not self._aim(target.homogeneous) or (start != NULL and not self._within(start)):
+            return None
+        cdef cnp.npy_intp n = self.n
+        cdef cnp.ndarray best = cnp.PyArray_EMPTY(1, &n, cnp.NPY_FLOAT64, 0)
+        cdef double* q = <double*> cnp.PyArray_DATA(best)
+        cdef double deadline = t_start + self.budget
+        cdef double stats[STATS_SIZE]
+        cdef int code = self._run(q, stats, start, <unsigned long long> seed, deadline)
+        cdef double dp, dr
+        cdef bint met = self._judged(q, &dp, &dr)
+        if not met or code != CONVERGED:
+            return self.unmet(target, code, best, _array(stats, STATS_SIZE), dp, dr, met, t_start, deadline, seed)
+        return self._converged(best, stats, dp, dr, t_start)
+
+    cdef const double* _start(self, object q0):
+        """The start's values when q0 is n float64 values in one C-contiguous run, else NULL."""
+        if type(q0) is not np.ndarray:
+            return NULL
+        cdef cnp.ndarray a = q0
+        if cnp.PyArray_TYPE(a) != cnp.NPY_FLOAT64 or cnp.PyArray_NDIM(a) != 1 or cnp.PyArray_DIM(a, 0) != self.n \
+                or not cnp.PyArray_IS_C_CONTIGUOUS(a):
+            return NULL
+        return <const double*> cnp.PyArray_DATA(a)
+
+    cdef bint _aim(self, object homogeneous):
+        """True when the target's matrix is a proper 4 × 4 pose within the reach bound: its point and rotation are
+        then the problem's target."""
+        if type(homogeneous) is not np.ndarray:
+            return False
+        cdef cnp.ndarray a = homogeneous
+        if cnp.PyArray_TYPE(a) != cnp.NPY_FLOAT64 or cnp.PyArray_NDIM(a) != 2 or cnp.PyArray_DIM(a, 0) != 4 \
+                or cnp.PyArray_DIM(a, 1) != 4:
+            return False
+        cdef const double[:, :] H = homogeneous
+        if pose_defect_of(H) != 0:
+            return False
+        cdef double a0 = H[0, 3] - self.anchor[0], a1 = H[1, 3] - self.anchor[1], a2 = H[2, 3] - self.anchor[2]
+        if not sqrt(a0 * a0 + a1 * a1 + a2 * a2) <= self.radius:
+            return False
+        cdef int i, j
+        for i in range(3):
+            self.pstar[i] = H[i, 3]
+            for j in range(3):
+                self.Rstar[i, j] = H[i, j]
+        return True
+
+    cdef bint _within(self, const double* q) noexcept:
+        cdef int i
+        for i in range(self.n):
+            if not self.check_lower[i] <= q[i] <= self.check_upper[i]:  # also False for NaN
+                return False
+        return True
+
+    cdef int _run(self, double* best, double* stats, const double* start, unsigned long long seed, double deadline):
+        """The timed multistart from ``start`` (NULL: a drawn one), the best answer in ``best``."""
+        cdef unsigned long long rng = splitmix(seed)
+        cdef int i, code, n = self.n
+        cdef Packed pk = self.packed
+        cdef double* q = self.q
+        if start == NULL:
+            random_configuration(q, &self.kind[0], &self.draw_lower[0], &self.draw_upper[0], n, &rng)
+        else:
+            for i in range(n):
+                q[i] = start[i]
+        for i in range(n):
+            best[i] = q[i]
+        for i in range(STATS_SIZE):
+            stats[i] = 0.0
+        with nogil:
+            code = timed(q, &pk.ch, &pk.pb, &pk.st, self.order, self.cap, &rng, self.attempts, self.first_chunk,
+                         self.later_chunk, deadline, 0, best, stats, &pk.mem)
+        return code
+
+    cdef bint _judged(self, double* q, double* dp, double* dr):
+        """The judge's word on q (continuous joints wrapped into (−π, π], then the whole turn into the limits
+        where one exists): True when the task's components are met and q is within the limits."""
+        cdef int i, n = self.n
+        cdef bint turned = False
+        cdef double lowest
+        if self.continuous:
+            for i in range(n):
+                if self.kind[i] == CONTINUOUS:
+                    q[i] = atan2(sin(q[i]), cos(q[i]))
+        cdef bint within = self._verdict(q, dp, dr)
+        if not within:
+            for i in range(n):
+                if self.kind[i] == REVOLUTE and (q[i] < self.turn_lower[i] or q[i] > self.turn_upper[i]):
+                    lowest = q[i] + TWO_PI * ceil((self.turn_lower[i] - q[i]) / TWO_PI)
+                    if lowest <= self.turn_upper[i]:
+                        q[i], turned = lowest, True
+            if turned:
+                within = self._verdict(q, dp, dr)
+        return within and (not self.check_pos or dp[0] <= self.tol_pos) and (not self.check_rot or dr[0] <= self.tol_rot)
+
+    cdef bint _verdict(self, const double* q, double* dp, double* dr):
+        cdef double T[16]
+        self.judge.pose(q, T)
+        pose_errors(T, &self.pstar[0], &self.Rstar[0, 0], self.axis, dp, dr)
+        return self._within(q)
+
+    cdef object _converged(self, object best, const double* stats, double dp, double dr, double t_start):
+        """The result of a converged answer the judge confirmed."""
+        cdef int stalls = <int> stats[T_STALLS]
+        made = self.result.__new__(self.result)
+        values = made.__dict__
+        values.update(self.fields)
+        values["q"], values["position_error"], values["rotation_error"] = best, dp, dr
+        values["iterations"], values["restarts"] = <int> stats[T_SWEEPS], max(0, <int> stats[T_ATTEMPTS] - 1)
+        values["singular_events"] = self.stall_events(stalls) if stalls else []
+        values["bypasses"] = []
+        values["_make_diagnostics"] = partial(self.diagnostics, _array(stats, STATS_SIZE))
+        values["wall_time"] = now() - t_start
+        return made
+
+    def __dealloc__(self):
+        free(self.q)
+
+
+cdef cnp.ndarray _array(const double* values, cnp.npy_intp size):
+    """A new float64 array of these values."""
+    cdef cnp.ndarray out = cnp.PyArray_EMPTY(1, &size, cnp.NPY_FLOAT64, 0)
+    memcpy(cnp.PyArray_DATA(out), values, sizeof(double) * size)
+    return out
