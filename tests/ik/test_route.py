@@ -109,3 +109,65 @@ def test_a_result_s_diagnostics_are_built_only_when_read(monkeypatch):
     later = ik.solve(robot.fk(q), q0=q, seed=0)
     assert pickle.loads(pickle.dumps(later)).diagnostics == res.diagnostics and built == [1, 1]
     assert copy.deepcopy(ik.solve(robot.fk(q), q0=q, seed=0)).diagnostics == res.diagnostics and len(built) == 3
+
+
+@pytest.mark.parametrize(("name", "solver"), [("ur5", "auto"), ("kinova", "analytic"), ("stanford", "frdm"),
+                                              ("ur5", "dls")])
+def test_every_branch_from_a_prepared_solver_is_kinelab_s(name, solver):
+    """#40.3: ``IK.solve_all`` never took the closed form that ``kinelab.solve_all`` takes; both now read the route
+    from the solver's capabilities. The multistart's rounds are seeded alike and stop by the same rule (the budget
+    is far from spent), so its sets are equal too."""
+    robot = kinelab.load(name)
+    ik = kinelab.IK(robot, solver=solver, time_budget=2.0)
+    rng = np.random.default_rng(5)
+    for k in range(2):
+        target = robot.fk(robot.random_q(rng))
+        mine = ik.solve_all(target, seed=k)
+        theirs = kinelab.solve_all(robot, target, solver=solver, seed=k, time_budget=2.0)
+        assert mine.method == theirs.method == ("multistart" if solver in ("frdm", "dls") else "closed form")
+        assert len(mine) == len(theirs) > 0
+        np.testing.assert_allclose(mine.q, theirs.q, rtol=0, atol=1e-12)
+        for res in mine:
+            dp, dr = robot.tool_error(res.q, target)
+            assert dp <= 1e-6 and dr <= 1e-6 and robot.within_limits(res.q)
+
+
+def test_a_registered_solver_gets_no_capability_it_did_not_declare(monkeypatch):
+    """The entry points read what a solver can do, not its name: a copy of FRDM registered under another name
+    answers ``solve`` (through the driver, not the one-call engine), but ``track`` (FRDM's path follower) refuses
+    it until it declares that it follows paths."""
+    from kinelab.ik import register, registry
+    from kinelab.ik.frdm import solver as frdm
+
+    monkeypatch.setattr(registry, "SOLVERS", dict(registry.SOLVERS))
+    monkeypatch.setattr(registry, "CAPABILITIES", dict(registry.CAPABILITIES))
+    robot = kinelab.load("ur5")
+    q = robot.random_q(3)
+    register("twin", frdm)
+    res = kinelab.solve(robot, robot.fk(q), solver="twin", seed=1, time_budget=None)
+    assert res.success and kinelab.IK(robot, solver="twin").engine is None  # no one-call engine undeclared
+    with pytest.raises(kinelab.OptionError, match="solver"):
+        kinelab.track(robot, [robot.fk(q)], q0=q, solver="twin")
+    register("twin", frdm, registry.Capabilities(follows_paths=True))
+    assert kinelab.track(robot, [robot.fk(q)], q0=q, solver="twin").reached.all()
+
+
+def test_no_entry_point_compares_a_solver_s_name():
+    """#40 goal 6: the solve route and the CLI ask the registry what a solver can do (comparisons of a solver's
+    name to a literal crept back in one by one before)."""
+    import ast
+    from pathlib import Path
+
+    import kinelab.cli
+    import kinelab.ik
+
+    names = {"frdm", "biquat", "dls", "analytic", "auto"}
+    found = []
+    for package in (kinelab.ik, kinelab.cli):
+        for path in Path(package.__file__).parent.glob("*.py"):
+            for node in ast.walk(ast.parse(path.read_text())):
+                if isinstance(node, ast.Compare):
+                    literals = [c.value for c in ast.walk(node) if isinstance(c, ast.Constant)]
+                    if names & {v for v in literals if isinstance(v, str)}:
+                        found.append(f"{path.name}:{node.lineno}")
+    assert found == []

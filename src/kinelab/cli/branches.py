@@ -68,17 +68,19 @@ def _method(found: Sequence[IKResult]) -> str:
     return found[0].mode if found else "none found"
 
 
+COMPLETENESS = {
+    "closed form": "every branch: closed form",
+    "sweep": "every branch at each value of the swept joint: closed form",
+    "search": "every branch the search finds, each root refined to rounding (measured: docs/analytic.md, Completeness)",
+}
+
+
 def _completeness(found: Branches) -> str:
     """How sure the list is to hold every branch, in words (none: why, as the result's status says it)."""
     if not found:
         return f"no branch ({found.status.value}): {found.message}"
-    first = found[0]
-    if first.solver == "analytic" and first.diagnostics.unseen == 0.0:
-        return "every branch: closed form"
-    if first.solver == "analytic":
-        return ("every branch the search finds, each root refined to rounding (measured: docs/analytic.md, "
-                "Completeness)")
-    return f"multistart: chance that one more start finds a new branch estimated at {first.diagnostics.unseen:.2g}"
+    return COMPLETENESS.get(found.method) or ("multistart: chance that one more start finds a new branch estimated "
+                                              f"at {found[0].diagnostics.unseen:.2g}")
 
 
 def _print_branches(robot: Robot, args: argparse.Namespace, found: Branches, ref: Any) -> None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import re
+from dataclasses import fields
 from typing import Any
 
 import numpy as np
@@ -24,9 +25,25 @@ from kinelab.cli.common import (
 )
 from kinelab.errors import KinelabError
 from kinelab.ik.frdm.policy import SWITCHABLE, bypass_plan
+from kinelab.ik.registry import capabilities, names, solver_module
 from kinelab.ik.result import IKResult, Status
 from kinelab.ik.tasks import AXES, TASKS
 from kinelab.robot import Robot
+
+SOLVER_FLAGS = (("--polish", "polish", "polish"), ("--law", "law", "law"), ("--integrator", "integrator", "integrator"),
+                ("--step", "step", "step"), ("--gain", "gain", "k"))  # (flag, its argparse name, the option field)
+
+
+def option_fields(solver: str) -> frozenset[str]:
+    """The option fields of the solver a ``--solver`` name runs (none for the closed form, which takes none).
+
+    Raises:
+        SolverNotFoundError: an unknown solver, the valid ones named.
+    """
+    kind = capabilities(solver)
+    if kind.closed_form:
+        return frozenset()
+    return frozenset(f.name for f in fields(solver_module(kind.request_solver(solver)).Options))
 
 
 def add(sub: Any) -> None:
@@ -59,7 +76,8 @@ def add(sub: Any) -> None:
                         "policy): kick, interval, freeze")
     s.add_argument("--law", choices=["simple", "regular"], help="biquat: control law (9)/(16) or (11)/(12)")
     s.add_argument("--integrator", choices=["euler", "rk4", "adaptive"], help="biquat: integrator")
-    s.add_argument("--step", type=float, help="biquat: fixed step h [s] (the paper: 0.01; default 1/k)")
+    s.add_argument("--step", type=float, help="biquat: fixed step h [s] (the paper: 0.01; default 1/k); dls: fraction "
+                   "of the Gauss–Newton step per iteration, in (0, 2)")
     s.add_argument("--gain", type=float, help="biquat: gain k [1/s] (default 1)")
     collision_arguments(s)
     source_arguments(s)
@@ -75,12 +93,9 @@ def run(args: argparse.Namespace) -> int:
     target, options = _target(robot, args)
     q0 = None if args.start_q is None else q_from_cli(robot, args.start_q, args.deg, "--start-q")
     _refuse_other_solvers_flags(args)
-    if args.polish:
-        options["polish"] = True
     options.update(_bypass_options(robot, args))
-    if args.solver == "biquat":
-        options.update({k: v for k, v in (("law", args.law), ("integrator", args.integrator), ("step", args.step),
-                                          ("k", args.gain)) if v is not None})
+    options.update({field: getattr(args, dest) for _, dest, field in SOLVER_FLAGS
+                    if getattr(args, dest) not in (None, False)})
     result = solve(robot, target, solver=args.solver, q0=q0, seed=args.seed, tol_pos=args.tol_pos,
                    tol_rot=args.tol_rot, time_budget=args.time_budget, task=args.task, axis=args.axis,
                    collisions=collisions_of(args), **options)
@@ -112,7 +127,7 @@ def _target(robot: Robot, args: argparse.Namespace) -> tuple[Any, dict[str, Any]
         return target_from_xyz_rpy(args.target_xyz, rpy, degrees=args.deg), options
     q_target = robot.check_q(q_from_cli(robot, args.target_q, args.deg, "--target-q"), limits=True,
                              what="--target-q")
-    if args.solver == "biquat":
+    if "target_biquaternion" in option_fields(args.solver):  # a solver that wants the signed target gets it
         from kinelab.dq import kinematics as biquat_kinematics
 
         options["target_biquaternion"] = biquat_kinematics.pose(robot, q_target)  # N with its sign
@@ -131,13 +146,13 @@ def _bypass_value(robot: Robot, joint: str, text: str, deg: bool, flag: str) -> 
 def _refuse_other_solvers_flags(args: argparse.Namespace) -> None:
     """A flag of another solver's is a mistake, said (it used to be dropped without a word); --axis goes with
     --task axis only."""
-    given = [flag for flag, value, solver in (("--polish", args.polish, "frdm"), ("--law", args.law, "biquat"),
-                                              ("--integrator", args.integrator, "biquat"),
-                                              ("--step", args.step, "biquat"), ("--gain", args.gain, "biquat"))
-             if value not in (None, False) and solver != args.solver]
+    mine = option_fields(args.solver)
+    given = [(flag, field) for flag, dest, field in SOLVER_FLAGS
+             if getattr(args, dest) not in (None, False) and field not in mine]
     if given:
-        owner = "frdm" if given[0] == "--polish" else "biquat"
-        raise KinelabError(f"{given[0]} is an option of --solver {owner}, not of --solver {args.solver}")
+        flag, field = given[0]
+        owners = [name for name in names() if field in option_fields(name)]
+        raise KinelabError(f"{flag} is an option of --solver {' or '.join(owners)}, not of --solver {args.solver}")
     if args.axis != "z" and args.task != "axis":
         raise KinelabError(f"--axis {args.axis} names the tool axis of --task axis; the task is {args.task}")
 
@@ -150,8 +165,10 @@ def _bypass_options(robot: Robot, args: argparse.Namespace) -> dict[str, Any]:
         if args.on_singular:
             raise KinelabError("--on-singular switches bypasses given by --kick, --interval or --freeze; none is")
         return {}
-    if args.solver != "frdm":
-        raise KinelabError("--kick, --interval and --freeze are FRDM's bypasses; use --solver frdm")
+    if "kicks" not in option_fields(args.solver):
+        owners = " or ".join(name for name in names() if "kicks" in option_fields(name))
+        raise KinelabError(f"--kick, --interval and --freeze are bypasses of --solver {owners}, not of "
+                           f"--solver {args.solver}")
     out: dict[str, Any] = {}
     for spec in specs["kicks"]:
         joint, value = _split_spec(spec, "--kick", "JOINT=DELTA")
@@ -194,7 +211,7 @@ def _print_ik(robot: Robot, args: argparse.Namespace, result: IKResult) -> None:
         m0 = result.diagnostics.M0
         print(f"  model time {result.diagnostics.model_time:.4g} s, final M0 = "
               + (f"{m0:+.6f}" if m0 is not None else "n/a (give --target-q for the sign of N)"))
-    if args.solver == "frdm":  # the singularity monitor and its bypasses are FRDM's: no other solver has them
+    if capabilities(args.solver).monitored:  # only a solver with the singularity monitor has events to tell
         _print_events(result)
     if result.success and result.diagnostics.clear_after is not None:
         print(f"  clear of collisions ({plural(result.diagnostics.clear_after, 'colliding answer')} found before)")

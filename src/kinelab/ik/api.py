@@ -24,13 +24,13 @@ from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.analytic.branches import BranchBatch, all_branches_batch, analytic_one, nearest_batch, refuse_options
 from kinelab.ik.batch import BatchIKResult, prepare, prepare_robot, run_batch
-from kinelab.ik.branches import UNSEEN, find_all, usual_closed_form
+from kinelab.ik.branches import UNSEEN, Route, find_all, route_of, usual_closed_form
 from kinelab.ik.chain import chain_model
 from kinelab.ik.clear import clear_batch, clear_track, mark_colliding, solve_clear
 from kinelab.ik.driver import solve_one
 from kinelab.ik.frdm.tracking import PathSettings, path_options, run_track
 from kinelab.ik.prepared import kept_solver, prepared
-from kinelab.ik.registry import solver_module
+from kinelab.ik.registry import capabilities, one_answer
 from kinelab.ik.request import Request, check_robot, make_request
 from kinelab.ik.result import Branches, IKResult, TrackResult
 from kinelab.ik.targets import as_target, as_target_arrays
@@ -125,6 +125,7 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
             engine = ik.engine
             res = None if engine is None else engine.solve(target, q0, seed)  # the usual call: one compiled call
             return ik.solve(target, q0=q0, seed=seed) if res is None else res
+    one_answer(solver)
     settings = dict(solver=solver, tol_pos=tol_pos, tol_rot=tol_rot, time_budget=time_budget,
                     max_restarts=max_restarts, start_outside_limits=start_outside_limits, options=options, task=task,
                     axis=axis, collisions=collisions, **solver_options)
@@ -142,15 +143,17 @@ def _solve_preferring(robot: Robot, target: Any, q0: Any, seed: int | None, pref
     task, axis = rest.pop("task"), rest.pop("axis")
     tol_pos, tol_rot, budget, restarts, outside = (
         rest.pop(k) for k in ("tol_pos", "tol_rot", "time_budget", "max_restarts", "start_outside_limits"))
-    if solver == "analytic":
-        req = make_request("frdm", seed, tol_pos, tol_rot, budget, restarts, outside, None, task, axis, None)
+    kind = one_answer(solver)
+    if kind.closed_form:
+        req = make_request(kind.request_solver(solver), seed, tol_pos, tol_rot, budget, restarts, outside, None, task,
+                           axis, None)
         return _closed_form_one(robot, target, q0, prefer, collisions, options or rest, req)
     req = make_request(solver, seed, tol_pos, tol_rot, budget, restarts, outside, options, task, axis, rest)
     check = _collision_model(robot, collisions)
     if q0 is not None:
         raise OptionError("q0", "given", "None with prefer= (the branch search draws its own starts)")
-    closed = solver == "frdm" and options is None and not rest
-    return _preferred(robot, target, req, prefer, check, "auto" if closed else "multistart")
+    closed = kind.stands_in and options is None and not rest
+    return _preferred(robot, target, req, prefer, check, Route.EITHER if closed else Route.MULTISTART)
 
 
 def _one_answer(robot: Robot, target: Any, q0: Any, req: Request, check: CollisionModel | None) -> IKResult:
@@ -159,7 +162,7 @@ def _one_answer(robot: Robot, target: Any, q0: Any, req: Request, check: Collisi
 
 
 def _preferred(robot: Robot, target: Any, req: Request, prefer: Any, check: CollisionModel | None,
-               method: str) -> IKResult:
+               method: Route) -> IKResult:
     """``solve(prefer=)``: the (clear) branch nearest ``prefer`` among every branch found."""
     prepare(robot, req)  # not the budget's time
     t0 = time.perf_counter()
@@ -232,11 +235,12 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
         OptionError, SolverNotFoundError: a bad option or argument.
     """
     check_entry(robot, "solve_batch", positional)
-    if solver == "analytic":
+    kind = one_answer(solver)
+    if kind.closed_form:
         refuse_options(options or solver_options)
-        return nearest_batch(robot, targets, q0, make_request("frdm", seed, tol_pos, tol_rot, time_budget,
-                                                              max_restarts, start_outside_limits, None, task, axis,
-                                                              None), _collision_model(robot, collisions))
+        return nearest_batch(robot, targets, q0, make_request(kind.request_solver(solver), seed, tol_pos, tol_rot,
+                                                              time_budget, max_restarts, start_outside_limits, None,
+                                                              task, axis, None), _collision_model(robot, collisions))
     req = make_request(solver, seed, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options,
                        task, axis, solver_options)
     check = _collision_model(robot, collisions)
@@ -324,21 +328,20 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
         TargetError, ConfigurationError, OptionError: bad input, named.
     """
     check_entry(robot, "solve_all", positional)
-    if solver == "auto" and options is None and not solver_options and q_ref is None and max_solutions is None \
-            and collisions is None and redundancy is None and task == "pose" and axis == "z":
+    kind = capabilities(solver)
+    given = options is not None or bool(solver_options)
+    if kind.picks and not given and q_ref is None and max_solutions is None and collisions is None \
+            and redundancy is None and task == "pose" and axis == "z":
         found = usual_closed_form(robot, target, seed, (tol_pos, tol_rot, time_budget, stop_below))
         if found is not None:
             return found
-    method = solver if solver in ("auto", "analytic") else "multistart"
-    if method != "multistart" and (options is not None or solver_options):
-        if method == "analytic":  # refusing says so rather than ignoring them
-            refuse_options(options or solver_options)
-        method, solver = "multistart", "frdm"  # options name a multistart solver's settings: "auto" runs FRDM
-    req = make_request("frdm" if method != "multistart" else solver, seed, tol_pos, tol_rot, time_budget, 0,
-                       "refuse", options, task, axis, solver_options)
+    if kind.closed_form and given:  # refusing says so rather than ignoring them
+        refuse_options(options or solver_options)
+    req = make_request(kind.request_solver(solver), seed, tol_pos, tol_rot, time_budget, 0, "refuse", options, task,
+                       axis, solver_options)
     check = _collision_model(robot, collisions)
     found = find_all(robot, target, req, q_ref=q_ref, max_solutions=max_solutions, stop_below=stop_below,
-                     method=method, redundancy=redundancy)
+                     method=route_of(kind, given), redundancy=redundancy)
     return found if check is None else mark_colliding(found, check, drop=bool(drop_colliding))
 
 
@@ -392,7 +395,7 @@ def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
     chain_model(robot)  # the follower's chain and the judge are built once per robot, on no budget's clock
     prepare_robot(robot)
     t_start = time.perf_counter()  # the budget counts from here, the checks of the call included
-    if solver_module(solver) is not solver_module("frdm"):
+    if not capabilities(solver).follows_paths:
         raise OptionError("solver", solver, "'frdm' (track follows a path with FRDM's warm-started sweeps)")
     settings = PathSettings(jump_limit, restrict, hold, rest_weight)
     req = make_request(solver, seed, tol_pos, tol_rot, time_budget, 0, "refuse", options, task, axis,

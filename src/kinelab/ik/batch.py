@@ -23,6 +23,7 @@ from kinelab.ik.frdm import batch as frdm_batch
 from kinelab.ik.frdm.batch import Rows
 from kinelab.ik.limits import wrap_q
 from kinelab.ik.multistart import seed_states
+from kinelab.ik.registry import capabilities
 from kinelab.ik.request import Request
 from kinelab.ik.result import Status
 from kinelab.ik.targets import as_target_arrays
@@ -121,7 +122,7 @@ def prepare(robot: Robot, req: Request) -> bool:
     Returns:
         True when the rows run in FRDM's compiled batch (else one by one through the driver).
     """
-    compiled = bool(req.solver == "frdm" and req.options.compiled)
+    compiled = bool(capabilities(req.solver).compiled and req.options.compiled)
     prepare_solver(req.module, robot, req.options)  # FRDM's: the chain model its batch runs on
     prepare_robot(robot)
     return compiled

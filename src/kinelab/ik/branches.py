@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import replace
+from enum import Enum
 from typing import Any
 
 import numpy as np
@@ -21,6 +22,7 @@ from kinelab.ik.analytic.branches import Rows, analytic_all, arm_of, branch_resu
 from kinelab.ik.analytic.redundancy import redundant_all
 from kinelab.ik.batch import fresh_seed, prepare, run_batch
 from kinelab.ik.limits import distance as distance  # exported: the branch distance users sort by
+from kinelab.ik.registry import Capabilities
 from kinelab.ik.request import Request, check_seed, count_ok, make_request
 from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target
@@ -32,7 +34,6 @@ SAME = 1e-3  # [rad or m] two answers closer than this, joint by joint, are one 
 ROUND = 64  # starts per round (one batch call)
 ROUND_SECONDS = 1e-3  # [s] a round's fixed cost (arrays, threads, the verdict of ROUND rows)
 UNSEEN = 0.01  # the search stops once a further start is estimated this unlikely to find a new branch
-METHODS = ("multistart", "analytic", "auto")
 MIN_ROUNDS = 2  # rounds before the rule may stop the search (a single round's counts are too few to judge)
 
 
@@ -45,8 +46,24 @@ def unseen(counts: list[int]) -> float:
     return 1.0 if n == 0 else min(1.0, (sum(1 for c in counts if c == 1) + 1) / n)
 
 
+class Route(Enum):
+    """How :func:`find_all` looks for the branches."""
+
+    MULTISTART = "multistart"  # seeded starts, in rounds, until the stopping rule or the budget
+    CLOSED_FORM = "closed form"  # the chain's closed form, refused by name where there is none
+    EITHER = "closed form where there is one"  # and the task is "pose"; else the multistart
+
+
+def route_of(kind: Capabilities, options_given: bool) -> Route:
+    """The route of every branch for a solver that can do ``kind``; options (a multistart solver's settings) given
+    to a picking solver send it to the multistart, which they configure."""
+    if kind.closed_form:
+        return Route.CLOSED_FORM
+    return Route.EITHER if kind.picks and not options_given else Route.MULTISTART
+
+
 def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_solutions: int | None = None,
-             stop_below: float | None = UNSEEN, method: str = "multistart",
+             stop_below: float | None = UNSEEN, method: Route = Route.MULTISTART,
              redundancy: int | dict[str, float] | None = None) -> Branches:
     """The distinct solutions of ``target``, each checked by Pinocchio: every branch in closed form where the
     chain's class allows it (:mod:`kinelab.ik.analytic`), else those seeded starts find within the request's
@@ -63,10 +80,9 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
         max_solutions: stop once this many distinct solutions are found (None: no such limit).
         stop_below: stop once the estimated chance that one more start finds a new branch (:func:`unseen`) is
             below this, after MIN_ROUNDS rounds (None: spend the whole budget).
-        method: "multistart"; "analytic" (the closed form, refused by name where the chain or the task has
-            none); "auto" (the closed form where there is one and the task is "pose", else the multistart).
+        method: the :class:`Route`.
         redundancy: K samples of a 7R arm's swept end joint (:mod:`kinelab.ik.analytic.redundancy`), or
-            ``{joint name: value}`` [rad] for that joint held at one value, with method "analytic" or "auto";
+            ``{joint name: value}`` [rad] for that joint held at one value, on a route with the closed form;
             None: no sweep.
 
     Returns:
@@ -83,11 +99,11 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
     target = as_target(target, req.task.name)
     ref = None if q_ref is None else robot.check_q(q_ref, what="q_ref")
     if redundancy is not None:
-        if method == "multistart":
+        if method is Route.MULTISTART:
             raise OptionError("redundancy", redundancy, f"None with solver={req.solver!r} and options (redundancy= "
                               "sweeps a joint of the closed form: solver 'auto' or 'analytic', no options)")
         return redundant_all(robot, target, req, redundancy, ref, max_solutions)
-    if method == "analytic" or (method == "auto" and has_closed_form(robot, req)):
+    if method is Route.CLOSED_FORM or (method is Route.EITHER and has_closed_form(robot, req)):
         found = analytic_all(robot, target, req, q_ref=ref, max_solutions=max_solutions)
         # the 1-D search is measured complete, not proved so: a pose within reach it finds nothing for is searched
         # again by the multistart rather than called unreachable
@@ -131,7 +147,7 @@ def _usual_entry(robot: Robot, settings: tuple[Any, ...]) -> Any:
     """
     tol_pos, tol_rot, time_budget, stop_below = settings
     req = make_request("frdm", None, tol_pos, tol_rot, time_budget, 0, "refuse", None, "pose", "z", {})
-    _check_search("auto", None, stop_below)
+    _check_search(Route.EITHER, None, stop_below)
     if not has_closed_form(robot, req):
         return False
     form = prepared_form(robot, req)
@@ -142,10 +158,10 @@ def _new_kept(_: Robot) -> dict[tuple[Any, ...], Any]:
     return {}
 
 
-def _check_search(method: str, max_solutions: int | None, stop_below: float | None) -> None:
+def _check_search(method: Route, max_solutions: int | None, stop_below: float | None) -> None:
     """Refuse a bad method, solution count or stopping chance, naming what is valid."""
-    if method not in METHODS:
-        raise OptionError("method", method, " or ".join(map(repr, METHODS)))
+    if not isinstance(method, Route):
+        raise OptionError("method", method, " or ".join(f"Route.{r.name}" for r in Route))
     if max_solutions is not None and (not count_ok(max_solutions) or max_solutions < 1):
         raise OptionError("max_solutions", max_solutions, "an integer ≥ 1, or None")
     if stop_below is not None and not (isinstance(stop_below, float | int) and not isinstance(stop_below, bool)

@@ -20,10 +20,11 @@ from kinelab.core._engine import FRDMEngine
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.analytic.branches import analytic_one, arm_of, nearest_batch, refuse_options
 from kinelab.ik.batch import BatchIKResult, run_batch
-from kinelab.ik.branches import UNSEEN, find_all
+from kinelab.ik.branches import UNSEEN, find_all, route_of
 from kinelab.ik.clear import clear_batch, mark_colliding, solve_clear
 from kinelab.ik.driver import prepare_solver, solve_one
 from kinelab.ik.lean import LeanFRDM
+from kinelab.ik.registry import capabilities
 from kinelab.ik.request import Request, check_robot, check_seed, make_request
 from kinelab.ik.result import Branches, IKResult
 from kinelab.ik.targets import as_target, as_target_arrays
@@ -36,8 +37,11 @@ class IK:
     Args:
         robot: the robot.
         positional: nothing: every setting is keyword-only.
-        solver: "frdm", "biquat" or "dls"; or "analytic" (the closed form, docs/analytic.md: ``solve`` returns the
-            branch nearest ``q0``, ``solve_all`` every branch; refused here, by name, for a chain without one).
+        solver: "frdm", "biquat" or "dls"; "analytic" (the closed form, docs/analytic.md: ``solve`` returns the
+            branch nearest ``q0``, ``solve_all`` every branch; refused here, by name, for a chain without one); or
+            "auto" (``solve_all`` as :func:`kinelab.solve_all`'s default: the closed form where the chain has one,
+            else FRDM's multistart; ``solve`` and ``solve_batch`` run FRDM). ``solve_all`` takes the route
+            :func:`kinelab.solve_all` takes for the same solver and options.
         tol_pos: position tolerance [m].
         tol_rot: rotation tolerance [rad].
         time_budget: wall-clock budget of each call [s] (None: none).
@@ -65,12 +69,13 @@ class IK:
                             f"solver={positional[0]!r}")
         check_robot(robot)
         self.robot = robot
-        self.analytic = solver == "analytic"
+        kind = capabilities(solver)
+        self.analytic = kind.closed_form
+        self.route = route_of(kind, options is not None or bool(solver_options))  # of solve_all, as kinelab's
         if self.analytic:
             refuse_options(options or solver_options)
-        self.request: Request = make_request("frdm" if self.analytic else solver, None, tol_pos, tol_rot,
-                                             time_budget, max_restarts, start_outside_limits, options, task, axis,
-                                             solver_options)
+        self.request: Request = make_request(kind.request_solver(solver), None, tol_pos, tol_rot, time_budget,
+                                             max_restarts, start_outside_limits, options, task, axis, solver_options)
         self._lean = self._prepare()
         spec = as_collisions(collisions)
         self.collisions = None if spec is None else collision_model(robot, spec)
@@ -87,7 +92,7 @@ class IK:
             arm_of(robot, req)
             return None
         prepare_solver(req.module, robot, req.options)
-        return LeanFRDM(robot, req) if req.solver == "frdm" and req.options.compiled else None
+        return LeanFRDM(robot, req) if capabilities(req.solver).compiled and req.options.compiled else None
 
     def _request(self, seed: int | None) -> Request:
         if seed is None:
@@ -166,7 +171,7 @@ class IK:
         """
         found = find_all(self.robot, target, replace(self._request(seed), max_restarts=0), q_ref=q_ref,
                          max_solutions=max_solutions, stop_below=stop_below,
-                         method="analytic" if self.analytic else "multistart")
+                         method=self.route)
         return found if self.collisions is None else mark_colliding(found, self.collisions, drop=False)
 
 

@@ -1,8 +1,10 @@
-"""The solvers by name: the built-in ones imported on first use, and those a user registers."""
+"""The solvers by name: the built-in ones imported on first use, and those a user registers; and what each can do
+(:class:`Capabilities`), which the entry points read instead of comparing names."""
 
 from __future__ import annotations
 
 import importlib
+from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
@@ -14,6 +16,47 @@ from kinelab.robot import Robot
 
 BUILTIN = {"frdm": "kinelab.ik.frdm.solver", "biquat": "kinelab.ik.biquat.solver", "dls": "kinelab.ik.dls"}
 SOLVERS: dict[str, Any] = {}
+
+
+@dataclass(frozen=True)
+class Capabilities:
+    """What a solver can do, as the entry points (``solve``, ``solve_batch``, ``solve_all``, ``track``, ``IK``, the
+    CLI) read it.
+
+    Attributes:
+        closed_form: its answers come from the chain's closed form (docs/analytic.md): every branch, no options and
+            no restarts; a chain without one is refused by name.
+        picks: the closed form where the chain has one and the task is "pose", else the multistart of ``runs``.
+        runs: the solver whose request (tolerances, task, options) a closed-form or picking solver's call is
+            built with; None: itself.
+        stands_in: with no options, ``solve(prefer=)`` may take every branch from the closed form for it.
+        compiled: options with ``compiled`` set run kinelab's compiled kernels: one compiled call per solve, the
+            threaded batch.
+        follows_paths: ``track`` follows a path with it (warm-started sweeps).
+        monitored: its results carry the singularity monitor's events and bypasses.
+    """
+
+    closed_form: bool = False
+    picks: bool = False
+    runs: str | None = None
+    stands_in: bool = False
+    compiled: bool = False
+    follows_paths: bool = False
+    monitored: bool = False
+
+    def request_solver(self, name: str) -> str:
+        """The solver whose request a call with solver ``name`` is built with."""
+        return self.runs or name
+
+
+BUILTIN_CAPABILITIES = {
+    "frdm": Capabilities(stands_in=True, compiled=True, follows_paths=True, monitored=True),
+    "biquat": Capabilities(),
+    "dls": Capabilities(),
+    "analytic": Capabilities(closed_form=True, runs="frdm"),
+    "auto": Capabilities(picks=True, runs="frdm"),
+}
+CAPABILITIES: dict[str, Capabilities] = {}
 
 
 class SolverModule(Protocol):
@@ -28,14 +71,43 @@ class SolverModule(Protocol):
         """One run from ``q0`` towards ``oMtarget``, before kinelab's Pinocchio check."""
 
 
-def register(name: str, module: Any) -> None:
+def register(name: str, module: Any, capabilities: Capabilities | None = None) -> None:
     """Make a solver module (see :class:`SolverModule`) available as ``solve(..., solver=name)``.
 
     Args:
         name: the solver's name.
         module: a module or object with ``Options`` and ``attempt``.
+        capabilities: what it can do beyond one answer at a time through kinelab's driver (default: nothing).
     """
     SOLVERS[name] = module
+    CAPABILITIES[name] = capabilities or Capabilities()
+
+
+def capabilities(name: str) -> Capabilities:
+    """What solver ``name`` can do.
+
+    Raises:
+        SolverNotFoundError: an unknown name (the valid ones listed).
+    """
+    found = CAPABILITIES.get(name) if isinstance(name, str) else None
+    if found is None:
+        found = BUILTIN_CAPABILITIES.get(name) if isinstance(name, str) else None
+    if found is None:
+        raise SolverNotFoundError(str(name), [*names(), "analytic"])
+    return found
+
+
+def one_answer(name: str) -> Capabilities:
+    """What solver ``name`` can do, for an entry point that answers one target at a time (``solve``,
+    ``solve_batch``): a picking solver ("auto") chooses among every branch, which is ``solve_all``'s.
+
+    Raises:
+        SolverNotFoundError: an unknown or picking name (the valid ones listed).
+    """
+    kind = capabilities(name)
+    if kind.picks:
+        raise SolverNotFoundError(str(name), [*names(), "analytic"])
+    return kind
 
 
 def names() -> list[str]:
