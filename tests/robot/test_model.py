@@ -295,3 +295,42 @@ def test_an_empty_name_is_refused_not_read_as_none(keyword):
     value = [""] if keyword == "package_dirs" else ""
     with pytest.raises(kinelab.KinelabError, match=f"{keyword}="):
         kinelab.load("ur5", **{keyword: value})
+
+
+@pytest.mark.parametrize("name", ["kinova", "ur5", "panda"])
+def test_fk_and_jacobians_are_pinocchio_s_on_any_array_and_owned_by_the_caller(name):
+    """#40 goal 5: fk, jacobian_local and jacobian_world check q and build Pinocchio's q in one compiled pass and
+    return what Pinocchio returns. Against Pinocchio at seeded configurations, given as contiguous arrays, strided
+    views, integer arrays and lists; and what a call returned is not changed by the next call."""
+    robot = kinelab.load(name)
+    model, data = robot.model, robot.model.createData()
+    rng = np.random.default_rng(11)
+    for _ in range(20):
+        q = robot.random_q(rng)
+        q_pin = pin.neutral(model)
+        for value, joint in zip(q, robot.joints, strict=True):
+            i = joint.idx_q
+            q_pin[i: i + 2 if joint.kind == "continuous" else i + 1] = \
+                [np.cos(value), np.sin(value)] if joint.kind == "continuous" else [value]
+        pin.framesForwardKinematics(model, data, q_pin)
+        oMtool = data.oMf[robot.tool_frame_id].copy()
+        J_local = pin.computeFrameJacobian(model, data, q_pin, robot.tool_frame_id, pin.LOCAL)
+        J_world = pin.computeFrameJacobian(model, data, q_pin, robot.tool_frame_id, pin.WORLD)
+        strided = np.empty(2 * robot.n)
+        strided[::2] = q
+        for given in (q, strided[::2], q.tolist()):
+            mine = robot.fk(given)
+            assert np.abs(mine.homogeneous - oMtool.homogeneous).max() <= 1e-14
+            assert np.abs(robot.jacobian_local(given) - J_local).max() <= 1e-12
+            assert np.abs(robot.jacobian_world(given) - J_world).max() <= 1e-12
+        before, J_before = mine.homogeneous.copy(), robot.jacobian_local(q)
+        robot.fk(robot.random_q(rng))
+        J_copy = J_before.copy()
+        robot.jacobian_local(robot.random_q(rng))
+        np.testing.assert_array_equal(mine.homogeneous, before)
+        np.testing.assert_array_equal(J_before, J_copy)
+    np.testing.assert_allclose(robot.fk(np.zeros(robot.n, dtype=int)).homogeneous, robot.fk(np.zeros(robot.n))
+                               .homogeneous, rtol=0, atol=0)
+    for bad in (np.full(robot.n, np.nan), np.array([0.0] * (robot.n - 1) + [np.inf]), np.zeros(robot.n + 1)):
+        with pytest.raises(kinelab.ConfigurationError):
+            robot.fk(bad)

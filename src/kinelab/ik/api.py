@@ -79,12 +79,10 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
 
     Args:
         robot: the robot (:func:`kinelab.load`).
-        target: oMtarget, the wanted tool pose in the base frame (a point, three numbers [m], for task
-            "position").
+        target: oMtarget, the wanted tool pose in the base frame (three numbers [m] for task "position").
         positional: nothing: every argument after the target is keyword-only.
-        solver: "frdm", "biquat" or "dls" (the Pinocchio reference); or "analytic": the branch nearest ``q0``
-            (without it the first) from the closed form, where the chain has one (docs/analytic.md), refused by
-            name elsewhere.
+        solver: "frdm", "biquat", "dls" (the Pinocchio reference) or "analytic": the closed form's branch nearest
+            ``q0`` (else the first), where the chain has one (docs/analytic.md), refused by name elsewhere.
         q0: first start (one number per joint, rad or m); default a seeded random configuration.
         seed: seed of the random starts, an int ≥ 0 (None: fresh entropy). A solve that does not run out of
             budget returns the same answer for the same seed in any process; one that does depends on speed.
@@ -292,12 +290,10 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
         robot: the robot.
         target: oMtarget (base frame).
         positional: nothing: every argument after the target is keyword-only.
-        solver: "auto" (the closed form when the chain is in an analytic class and the task is "pose", else
-            "frdm"), "analytic" (refused, with the reason, where there is no closed form), or a multistart
-            solver: "frdm" (one compiled batch per round of starts) or "dls". The results' ``solver`` and
-            ``mode`` say which ran.
-        seed: base seed of the starts (None: fresh entropy); the same seed finds the same branches when the
-            budget allows the same number of rounds.
+        solver: "auto" (the closed form for a chain in an analytic class and task "pose", else "frdm"),
+            "analytic" (refused, with the reason, where there is none), or a multistart solver: "frdm" (a compiled
+            batch per round of starts) or "dls". ``method`` of the result says how the set was found.
+        seed: base seed of the starts (None: fresh entropy): the same branches when as many rounds run.
         tol_pos: position tolerance [m].
         tol_rot: rotation tolerance [rad].
         options: the solver's options object.
@@ -310,13 +306,12 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
         max_solutions: stop once this many distinct solutions are found (None: no such limit).
         stop_below: the stopping rule (:func:`kinelab.ik.branches.unseen`, a Good–Turing estimate from how many
             starts reached each branch; checked after two rounds); None: spend the whole budget.
-        collisions: as :func:`solve`: a branch that collides is marked (``success`` False, status
-            ``collision``, ``diagnostics.contact`` naming the pair), or left out with ``drop_colliding``.
+        collisions: as :func:`solve`: a colliding branch is marked (``success`` False, status ``collision``,
+            ``diagnostics.contact`` naming the pair), or left out with ``drop_colliding``.
         drop_colliding: leave colliding branches out instead of marking them.
-        redundancy: K, for a 7R arm that is analytic with its first or last joint held (the ERA): every
-            branch at K values of that joint, evenly spread over its range (docs/analytic.md); or
-            ``{joint name: value}`` [rad]: every branch with that joint at that value; solver "auto" or
-            "analytic". None: a 7R arm gets the multistart.
+        redundancy: K, for a 7R arm analytic with its first or last joint held: every branch at K values of that
+            joint spread over its range (docs/analytic.md), or ``{joint name: value}`` [rad]: every branch with it
+            at that value; solver "auto" or "analytic". None: a 7R arm gets the multistart.
 
     Returns:
         The :class:`~kinelab.ik.result.Branches`: one :class:`IKResult` per distinct solution, nearest ``q_ref``
@@ -328,10 +323,9 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
         TargetError, ConfigurationError, OptionError: bad input, named.
     """
     check_entry(robot, "solve_all", positional)
-    kind = capabilities(solver)
-    given = options is not None or bool(solver_options)
-    if kind.picks and not given and q_ref is None and max_solutions is None and collisions is None \
-            and redundancy is None and task == "pose" and axis == "z":
+    kind, given = capabilities(solver), options is not None or bool(solver_options)
+    if kind.picks and not given and all(v is None for v in (q_ref, max_solutions, collisions, redundancy)) \
+            and (task, axis) == ("pose", "z"):  # the usual call: the closed form's one compiled call serves it
         found = usual_closed_form(robot, target, seed, (tol_pos, tol_rot, time_budget, stop_below))
         if found is not None:
             return found

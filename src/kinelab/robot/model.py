@@ -23,6 +23,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from kinelab.core._joints import PinForm, plain_q
 from kinelab.errors import ConfigurationError, JointLimitError, JointNotFoundError, OptionError, SRDFError
 from kinelab.geometry import pose_error, wrap_to_pi
 from kinelab.robot import catalog, descriptions, xacro
@@ -105,6 +106,9 @@ class Robot:
         self._cont_pos = np.flatnonzero(continuous)
         self._cont_idx = idx_q[continuous]
         self._identity_q = self.nq == self.n and bool(np.all(self._scalar_idx == np.arange(self.n)))
+        order = np.argsort(idx_q)  # Pinocchio's q in its own order: kinelab's position and kind per joint
+        self._pin_form = PinForm(np.ascontiguousarray(order, dtype=np.intp),
+                                 np.ascontiguousarray(continuous[order], dtype=np.uint8), self.nq)
         self._lower_check = np.where(continuous, -np.inf, self.lower)
         self._upper_check = np.where(continuous, np.inf, self.upper)
         # the same bounds with the default slack, as Python floats: a solve checks limits twice, and a
@@ -171,6 +175,8 @@ class Robot:
 
     def check_q(self, q: ArrayLike, *, limits: bool = False, what: str = "q") -> np.ndarray:
         """``q`` as a float array of length n, refusing wrong shapes, NaN/inf and (if asked) limits."""
+        if not limits and plain_q(q, self.n):  # the usual call, checked in one compiled pass
+            return cast(np.ndarray, q)
         try:
             raw = q if type(q) is np.ndarray else np.asarray(q)
             if raw.dtype.kind not in "fiu":  # complex, bool, text and objects are not joint values
@@ -178,8 +184,6 @@ class Robot:
             arr = raw if raw.dtype == np.float64 else raw.astype(float)
         except (TypeError, ValueError):
             raise ConfigurationError(f"{what} must be {self.n} numbers (real), got {q!r}") from None
-        if arr.shape == (self.n,) and not limits and np.isfinite(sum(arr.tolist())):  # NaN, ±inf poison it
-            return arr
         if arr.shape != (self.n,):
             raise ConfigurationError(
                 f"{what} must have {self.n} numbers ({', '.join(self.joint_names)}) for {self.name}, "
@@ -236,12 +240,7 @@ class Robot:
         arr = self.check_q(q)
         if self._identity_q:
             return arr
-        out = np.empty(self.nq)
-        out[self._scalar_idx] = arr[self._scalar_pos]
-        angles = arr[self._cont_pos]
-        out[self._cont_idx] = np.cos(angles)
-        out[self._cont_idx + 1] = np.sin(angles)
-        return out
+        return self._pin_form.of(arr)
 
     def from_pin_q(self, q_pin: ArrayLike) -> np.ndarray:
         """Pinocchio's q → one number per joint (continuous joints as atan2(sin, cos) in (−π, π])."""
@@ -299,9 +298,10 @@ class Robot:
         pin.updateFramePlacements(self.model, self.data)
 
     def fk(self, q: ArrayLike) -> pin.SE3:
-        """oMtool: pose of the tool frame in the base frame at ``q`` (m, rad)."""
-        self._forward(q)
-        return pin.SE3(self.data.oMf[self.tool_frame_id])
+        """oMtool: pose of the tool frame in the base frame at ``q`` (m, rad); a new SE3 (Pinocchio's
+        ``updateFramePlacement`` returns the tool frame's placement by value)."""
+        pin.forwardKinematics(self.model, self.data, self._pin_q(q))
+        return pin.updateFramePlacement(self.model, self.data, self.tool_frame_id)
 
     def fk_batch(self, Q: np.ndarray) -> np.ndarray:
         """oMtool for every row of Q (B × n, rad or m): a (B, 4, 4) stack of homogeneous matrices, by the judge
@@ -397,9 +397,8 @@ class Robot:
         return {j.name: pin.SE3(self.data.oMi[self.model.getJointId(j.name)]) for j in self.joints}
 
     def _jacobian(self, q: ArrayLike, frame: pin.ReferenceFrame) -> np.ndarray:
-        q_pin = self.to_pin_q(q)
-        J = pin.computeFrameJacobian(self.model, self.data, q_pin, self.tool_frame_id, frame)
-        return np.array(J).reshape(6, self.nv)  # a 1-DoF chain comes back as a flat 6-vector
+        J: np.ndarray = pin.computeFrameJacobian(self.model, self.data, self._pin_q(q), self.tool_frame_id, frame)
+        return J if J.ndim == 2 else J.reshape(6, self.nv)  # a 1-DoF chain comes back as a flat 6-vector
 
     def jacobian_local(self, q: ArrayLike) -> np.ndarray:
         """6 × n tool Jacobian in the tool frame (LOCAL): twist [v; ω] of the tool in its own axes."""

@@ -1,0 +1,54 @@
+# cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
+"""A joint vector's usual check and its Pinocchio form, compiled: ``robot.fk``, ``robot.jacobian_*`` and every check
+of a configuration pay these on each call, and from Python they cost more than Pinocchio's FK itself."""
+
+cimport numpy as cnp
+from libc.math cimport cos, isfinite, sin
+
+cnp.import_array()
+
+
+def plain_q(object q, Py_ssize_t n):
+    """True when ``q`` is an ndarray of n float64 numbers (any stride), every one finite: the usual configuration,
+    which needs neither conversion nor copy."""
+    if not cnp.PyArray_Check(q):
+        return False
+    cdef cnp.ndarray a = <cnp.ndarray> q
+    if cnp.PyArray_TYPE(a) != cnp.NPY_FLOAT64 or cnp.PyArray_NDIM(a) != 1 or cnp.PyArray_DIM(a, 0) != n:
+        return False
+    cdef char* data = <char*> cnp.PyArray_DATA(a)
+    cdef Py_ssize_t stride = cnp.PyArray_STRIDE(a, 0), i
+    cdef double total = 0.0
+    for i in range(n):
+        total += (<double*> (data + i * stride))[0]
+    return bool(isfinite(total))  # NaN and ±inf poison the sum (an overflow too: the caller's slow path decides)
+
+
+cdef class PinForm:
+    """Pinocchio's q of kinelab's for one robot: joint k of Pinocchio's order is q[position[k]], or its (cos, sin)
+    when ``continuous[k]`` (a continuous joint is two numbers in Pinocchio's q)."""
+
+    cdef cnp.intp_t[::1] position
+    cdef unsigned char[::1] continuous
+    cdef cnp.npy_intp nq
+
+    def __init__(self, cnp.intp_t[::1] position, unsigned char[::1] continuous, Py_ssize_t nq):
+        self.position, self.continuous, self.nq = position, continuous, nq
+
+    def of(self, cnp.ndarray q):
+        """Pinocchio's q (a new array of nq numbers) of ``q``: n float64 numbers, any stride."""
+        cdef char* data = <char*> cnp.PyArray_DATA(q)
+        cdef Py_ssize_t stride = cnp.PyArray_STRIDE(q, 0), k, j = 0
+        cdef cnp.ndarray out = cnp.PyArray_EMPTY(1, &self.nq, cnp.NPY_FLOAT64, 0)
+        cdef double* o = <double*> cnp.PyArray_DATA(out)
+        cdef double x
+        for k in range(self.position.shape[0]):
+            x = (<double*> (data + self.position[k] * stride))[0]
+            if self.continuous[k]:
+                o[j] = cos(x)
+                o[j + 1] = sin(x)
+                j += 2
+            else:
+                o[j] = x
+                j += 1
+        return out
