@@ -8,9 +8,7 @@ from libc.math cimport cos, isfinite, sin
 cnp.import_array()
 
 
-def plain_q(object q, Py_ssize_t n):
-    """True when ``q`` is an ndarray of n float64 numbers (any stride), every one finite: the usual configuration,
-    which needs neither conversion nor copy."""
+cdef bint is_plain(object q, Py_ssize_t n):
     if not cnp.PyArray_Check(q):
         return False
     cdef cnp.ndarray a = <cnp.ndarray> q
@@ -21,7 +19,13 @@ def plain_q(object q, Py_ssize_t n):
     cdef double total = 0.0
     for i in range(n):
         total += (<double*> (data + i * stride))[0]
-    return bool(isfinite(total))  # NaN and ±inf poison the sum (an overflow too: the caller's slow path decides)
+    return isfinite(total)  # NaN and ±inf poison the sum (an overflow too: the caller's slow path decides)
+
+
+def plain_q(object q, Py_ssize_t n):
+    """True when ``q`` is an ndarray of n float64 numbers (any stride), every one finite: the usual configuration,
+    which needs neither conversion nor copy."""
+    return bool(is_plain(q, n))
 
 
 cdef class PinForm:
@@ -31,9 +35,20 @@ cdef class PinForm:
     cdef cnp.intp_t[::1] position
     cdef unsigned char[::1] continuous
     cdef cnp.npy_intp nq
+    cdef bint identity
 
     def __init__(self, cnp.intp_t[::1] position, unsigned char[::1] continuous, Py_ssize_t nq):
         self.position, self.continuous, self.nq = position, continuous, nq
+        self.identity = nq == position.shape[0]
+        for k in range(position.shape[0]):
+            self.identity = self.identity and position[k] == k and not continuous[k]
+
+    def usual(self, object q):
+        """Pinocchio's q of a plain ``q`` (n finite float64 numbers, see :func:`plain_q`): q itself when the two
+        orders coincide, else a new array; None for anything else (the caller's check names what is wrong)."""
+        if not is_plain(q, self.position.shape[0]):
+            return None
+        return q if self.identity else self.of(q)
 
     def of(self, cnp.ndarray q):
         """Pinocchio's q (a new array of nq numbers) of ``q``: n float64 numbers, any stride."""

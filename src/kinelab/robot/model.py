@@ -237,6 +237,9 @@ class Robot:
 
     def _pin_q(self, q: ArrayLike) -> np.ndarray:
         """Pinocchio's q for reading only: q itself when the two orders coincide (no copy)."""
+        usual = self._pin_form.usual(q)  # a plain q, checked and converted in one compiled call
+        if usual is not None:
+            return usual
         arr = self.check_q(q)
         if self._identity_q:
             return arr
@@ -300,7 +303,8 @@ class Robot:
     def fk(self, q: ArrayLike) -> pin.SE3:
         """oMtool: pose of the tool frame in the base frame at ``q`` (m, rad); a new SE3 (Pinocchio's
         ``updateFramePlacement`` returns the tool frame's placement by value)."""
-        pin.forwardKinematics(self.model, self.data, self._pin_q(q))
+        q_pin = self._pin_form.usual(q)  # one compiled call for a plain q; else the checks that name what is wrong
+        pin.forwardKinematics(self.model, self.data, self._pin_q(q) if q_pin is None else q_pin)
         return pin.updateFramePlacement(self.model, self.data, self.tool_frame_id)
 
     def fk_batch(self, Q: np.ndarray) -> np.ndarray:
@@ -397,7 +401,9 @@ class Robot:
         return {j.name: pin.SE3(self.data.oMi[self.model.getJointId(j.name)]) for j in self.joints}
 
     def _jacobian(self, q: ArrayLike, frame: pin.ReferenceFrame) -> np.ndarray:
-        J: np.ndarray = pin.computeFrameJacobian(self.model, self.data, self._pin_q(q), self.tool_frame_id, frame)
+        q_pin = self._pin_form.usual(q)
+        J: np.ndarray = pin.computeFrameJacobian(self.model, self.data, self._pin_q(q) if q_pin is None else q_pin,
+                                                 self.tool_frame_id, frame)
         return J if J.ndim == 2 else J.reshape(6, self.nv)  # a 1-DoF chain comes back as a flat 6-vector
 
     def jacobian_local(self, q: ArrayLike) -> np.ndarray:
