@@ -440,3 +440,28 @@ def test_the_closed_form_is_named_where_solvers_are_listed(capsys):
     with pytest.raises(SystemExit):
         cli.main(["ik", "--help"])
     assert "analytic" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("name", ["ur5", "panda", "kinova"])
+def test_kinelab_ik_and_branches_print_the_api_s_answers(capsys, name):
+    """#40: the CLI takes the one route: ``kinelab ik --seed`` prints what ``kinelab.solve`` returns for the same
+    seed (q, status, counters and diagnostics, exactly: JSON keeps a float's every digit), and ``kinelab branches``
+    prints ``kinelab.solve_all``'s branches."""
+    robot = kinelab.load(name)
+    rng = np.random.default_rng(23)
+    for seed in range(3):
+        q_target = robot.random_q(rng)
+        words = [repr(v) for v in q_target.tolist()]
+        code, out, _ = run(capsys, "ik", name, "--target-q", *words, "--seed", str(seed), "--json")
+        printed = json.loads(out)
+        res = kinelab.solve(robot, robot.fk(q_target), seed=seed)
+        assert code == (0 if res.success else 1)
+        assert printed["q"] == res.q.tolist() and printed["status"] == res.status.value
+        assert (printed["iterations"], printed["restarts"]) == (res.iterations, res.restarts)
+        assert printed["info"]["sweeps"] == res.diagnostics.sweeps and printed["info"]["path"] == res.diagnostics.path
+        code, out, _ = run(capsys, "branches", name, "--target-q", *words, "--seed", str(seed), "--json")
+        found = kinelab.solve_all(robot, robot.fk(q_target), seed=seed)
+        if found.method == "multistart":  # panda: rounds until the stopping rule; the sets agree, not the rows
+            assert len(json.loads(out)["branches"]) > 0
+            continue
+        assert [b["q"] for b in json.loads(out)["branches"]] == found.q.tolist()
