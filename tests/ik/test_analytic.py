@@ -485,13 +485,15 @@ def test_the_compiled_closed_form_gives_the_root_by_root_answers(name):
 def test_a_set_of_branches_is_arrays_and_builds_its_results_only_when_read(monkeypatch):
     import pickle
 
+    from kinelab.ik.analytic import branches
     from kinelab.ik.result import IKResult
 
     robot = load("ur5")
     target = robot.fk(robot.random_q(5))
     built = []
-    real_init = IKResult.__init__
+    real_init, real_filled = IKResult.__init__, branches._filled  # the general route's results and the one call's
     monkeypatch.setattr(IKResult, "__init__", lambda self, *a, **k: built.append(1) or real_init(self, *a, **k))
+    monkeypatch.setattr(branches, "_filled", lambda *a, **k: built.append(1) or real_filled(*a, **k))
     found = kinelab.solve_all(robot, target)
     assert built == [] and found.q.shape == (len(found), 6) and len(found) >= 2
     assert found.rotation_error.shape == (len(found),) and np.all(found.position_error <= 1e-6)
@@ -527,3 +529,35 @@ def test_the_every_branch_batch_gives_each_target_what_solve_all_gives(name):
     assert batch.method == ("search" if name == "crx10ia" else "closed form")
     with pytest.raises(kinelab.OptionError, match="analytic class"):
         kinelab.solve_all_batch(load("panda"), targets[:2])
+
+
+@pytest.mark.parametrize("name", ["ur5", "kinova", "so101", "crx10ia"])
+def test_the_nearest_branch_in_one_compiled_call_is_the_general_route_s(name):
+    """``solve(solver="analytic")``'s usual call (NearestBranch: every branch found and judged in one compiled call,
+    the nearest kept) answers what the general route answers root by root with Pinocchio's FK: the same q, status and
+    roots merged, the errors Pinocchio's to 1e-12, with a start near the pose, a random start and none."""
+    from kinelab.ik.analytic.branches import analytic_one
+    from kinelab.ik.request import make_request
+
+    robot = load(name)
+    ik = kinelab.IK(robot, solver="analytic")
+    req = make_request("frdm")
+    rng = np.random.default_rng(31)
+    one_call = 0
+    for k in range(30):
+        q = robot.random_q(rng)
+        target = robot.fk(q)
+        q0 = [np.clip(q + rng.normal(0, 0.3, robot.n), robot.lower, robot.upper), robot.random_q(rng), None][k % 3]
+        fast = ik.solve(target, q0=q0)
+        general = analytic_one(robot, target, req, q0)
+        np.testing.assert_array_equal(fast.q, general.q)
+        assert fast.status == general.status and fast.success and fast.message == general.message
+        assert fast.diagnostics.found == general.diagnostics.found
+        dp, dr = robot.tool_error(fast.q, target)
+        assert abs(fast.position_error - dp) <= 1e-12 and abs(fast.rotation_error - dr) <= 1e-12
+        if fast.judge == "compiled FK (certified)":  # the one call (else a root to finish: the general route)
+            one_call += 1
+            # the pose's branches within the limits, as solve_all counts them (the root-by-root route also counts a
+            # 5R arm's candidates that are no root of the pose)
+            assert fast.diagnostics.branches == len(kinelab.solve_all(robot, target)) <= general.diagnostics.branches
+    assert one_call >= 25

@@ -222,6 +222,7 @@ def test_a_reachable_pose_the_search_misses_is_never_called_unreachable(monkeypa
     while FRDM converged. The search is measured complete, not proved so: where it finds nothing for a pose within
     reach, FRDM (one answer) or the multistart (every branch) searches again. Here the search is made to miss."""
     from kinelab.ik import branches as entry
+    from kinelab.ik import prepared
     from kinelab.ik.analytic import branches as analytic
 
     crx = kinelab.load("crx10ia")
@@ -234,7 +235,7 @@ def test_a_reachable_pose_the_search_misses_is_never_called_unreachable(monkeypa
         def solve(self, H, ref):
             return np.empty((0, 6)), np.empty(0), np.empty(0), *nothing[1:], 0
 
-    for module in (analytic, entry):
+    for module in (analytic, entry, prepared):
         monkeypatch.setattr(module, "prepared_form", lambda *a, **k: Missing())
     one = kinelab.solve(crx, target, solver="analytic", q0=q * 0.9)
     assert one.success and "1-D search found no branch" in one.mode and max(crx.tool_error(one.q, target)) <= 1e-6

@@ -3,7 +3,7 @@
 of a configuration pay these on each call, and from Python they cost more than Pinocchio's FK itself."""
 
 cimport numpy as cnp
-from libc.math cimport cos, isfinite, sin
+from libc.math cimport M_PI, cos, fabs, isfinite, remainder, sin
 
 cnp.import_array()
 
@@ -67,3 +67,23 @@ cdef class PinForm:
                 o[j] = x
                 j += 1
         return out
+
+
+def turn_distances(const double[:, :] q, const double[:] ref):
+    """How far each row of q (k × n angles [rad]) is from ``ref`` (n angles): the largest joint difference, each taken
+    modulo 2π into [−π, π]; a new array of k numbers [rad]."""
+    cdef cnp.npy_intp k = q.shape[0]
+    cdef cnp.ndarray out = cnp.PyArray_EMPTY(1, &k, cnp.NPY_FLOAT64, 0)
+    cdef double* o = <double*> cnp.PyArray_DATA(out)
+    cdef Py_ssize_t i, j
+    cdef double worst, d
+    if q.shape[1] != ref.shape[0]:
+        raise ValueError(f"turn_distances: rows of {q.shape[1]} angles against a reference of {ref.shape[0]}")
+    for i in range(k):
+        worst = 0.0
+        for j in range(q.shape[1]):
+            d = fabs(remainder(q[i, j] - ref[j], 2.0 * M_PI))
+            if d > worst:
+                worst = d
+        o[i] = worst
+    return out

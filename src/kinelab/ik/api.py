@@ -324,8 +324,7 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
     """
     check_entry(robot, "solve_all", positional)
     kind, given = capabilities(solver), options is not None or bool(solver_options)
-    if kind.picks and not given and all(v is None for v in (q_ref, max_solutions, collisions, redundancy)) \
-            and (task, axis) == ("pose", "z"):  # the usual call: the closed form's one compiled call serves it
+    if kind.picks and not given and _usual_all(q_ref, max_solutions, collisions, redundancy, task, axis):
         found = usual_closed_form(robot, target, seed, (tol_pos, tol_rot, time_budget, stop_below))
         if found is not None:
             return found
@@ -337,6 +336,12 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
     found = find_all(robot, target, req, q_ref=q_ref, max_solutions=max_solutions, stop_below=stop_below,
                      method=route_of(kind, given), redundancy=redundancy)
     return found if check is None else mark_colliding(found, check, drop=bool(drop_colliding))
+
+
+def _usual_all(q_ref: Any, max_solutions: Any, collisions: Any, redundancy: Any, task: Any, axis: Any) -> bool:
+    """:func:`solve_all`'s usual call, which the closed form's one compiled call serves: none of these given."""
+    return q_ref is None and max_solutions is None and collisions is None and redundancy is None \
+        and task == "pose" and axis == "z"
 
 
 def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any = None, solver: str = "frdm",

@@ -12,13 +12,12 @@ from __future__ import annotations
 import time
 from dataclasses import replace
 from enum import Enum
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
-import pinocchio as pin
 
 from kinelab.errors import OptionError
-from kinelab.ik.analytic.branches import Rows, analytic_all, arm_of, branch_results, has_closed_form, prepared_form
+from kinelab.ik.analytic.branches import EveryBranch, analytic_all, arm_of, has_closed_form, prepared_form
 from kinelab.ik.analytic.redundancy import redundant_all
 from kinelab.ik.batch import fresh_seed, prepare, run_batch
 from kinelab.ik.limits import distance as distance  # exported: the branch distance users sort by
@@ -117,30 +116,22 @@ def usual_closed_form(robot: Robot, target: Any, seed: Any, settings: tuple[Any,
     "auto" on a chain with a closed form and a certified compiled FK, a ``pin.SE3`` target, no options, references,
     collisions or sweeps — with ``settings`` = (tol_pos, tol_rot, time_budget, stop_below) checked once per robot;
     None otherwise (the general route then answers, or names what is wrong)."""
-    kept: dict[tuple[Any, ...], Any] = robot.derived("usual closed forms", _new_kept)
+    kept: dict[tuple[Any, ...], EveryBranch | Literal[False]] = robot.derived("usual closed forms", _new_kept)
     try:
         entry = kept.get(settings)
     except TypeError:  # an unhashable setting: the general route names it
         return None
     if entry is None:
         entry = kept[settings] = _usual_entry(robot, settings)
-    if entry is False or type(target) is not pin.SE3:
+    if entry is False:
         return None
     if seed is not None:
         check_seed(seed)
-    t0 = time.perf_counter()
-    req, form, arm = entry
-    found = form.solve(target.homogeneous, None)
-    if found is None or not len(found[0]):  # a root to finish, a bad pose or none: the general route says which
-        return None
-    q, dp, dr, merged, continuum, _ = found
-    rows = Rows(q, dp, dr, np.zeros(len(q), dtype=np.bool_), merged, continuum)
-    return branch_results(robot, rows, req, arm.mode, time.perf_counter() - t0, None,
-                          "search" if arm.searched else "closed form", "")
+    return entry.solve(target)  # None: a root to finish, a bad pose or none, which the general route says
 
 
-def _usual_entry(robot: Robot, settings: tuple[Any, ...]) -> Any:
-    """(request, compiled closed form, class) for these settings, or False when the usual call does not apply.
+def _usual_entry(robot: Robot, settings: tuple[Any, ...]) -> EveryBranch | Literal[False]:
+    """The one-call solver of every branch for these settings, or False when the usual call does not apply.
 
     Raises:
         OptionError: a bad setting, named (as the general route would).
@@ -151,7 +142,7 @@ def _usual_entry(robot: Robot, settings: tuple[Any, ...]) -> Any:
     if not has_closed_form(robot, req):
         return False
     form = prepared_form(robot, req)
-    return False if form is None else (req, form, arm_of(robot, req))
+    return False if form is None else EveryBranch(robot, req, form)
 
 
 def _new_kept(_: Robot) -> dict[tuple[Any, ...], Any]:

@@ -18,7 +18,14 @@ from typing import Any
 from kinelab.collision.model import as_collisions, collision_model
 from kinelab.core._engine import FRDMEngine
 from kinelab.geometry import stack_homogeneous
-from kinelab.ik.analytic.branches import analytic_one, arm_of, nearest_batch, refuse_options
+from kinelab.ik.analytic.branches import (
+    NearestBranch,
+    analytic_one,
+    arm_of,
+    nearest_batch,
+    prepared_form,
+    refuse_options,
+)
 from kinelab.ik.batch import BatchIKResult, run_batch
 from kinelab.ik.branches import UNSEEN, find_all, route_of
 from kinelab.ik.clear import clear_batch, mark_colliding, solve_clear
@@ -76,9 +83,10 @@ class IK:
             refuse_options(options or solver_options)
         self.request: Request = make_request(kind.request_solver(solver), None, tol_pos, tol_rot, time_budget,
                                              max_restarts, start_outside_limits, options, task, axis, solver_options)
-        self._lean = self._prepare()
         spec = as_collisions(collisions)
         self.collisions = None if spec is None else collision_model(robot, spec)
+        self._nearest: NearestBranch | None = None
+        self._lean = self._prepare()
         # the usual call's one compiled call (kinelab.core._engine), where the solver has one
         self.engine: FRDMEngine | None = None
         if self._lean is not None and self.collisions is None:
@@ -90,6 +98,9 @@ class IK:
         robot, req = self.robot, self.request
         if self.analytic:
             arm_of(robot, req)
+            if self.collisions is None:  # the usual call's one compiled call: branches found and judged together
+                form = prepared_form(robot, req)
+                self._nearest = None if form is None else NearestBranch(robot, req, form)
             return None
         prepare_solver(req.module, robot, req.options)
         return LeanFRDM(robot, req) if capabilities(req.solver).compiled and req.options.compiled else None
@@ -114,20 +125,22 @@ class IK:
         Raises:
             TargetError, ConfigurationError, JointLimitError, OptionError: a bad target, start or seed.
         """
-        if self.engine is not None:  # the usual call, in one compiled call (None: take the general route)
+        if self.engine is not None:  # the usual call, in one compiled call (None: the driver's general route)
             res = self.engine.solve(target, q0, seed)
-            if res is not None:
-                return res
+            return solve_one(self.robot, target, q0, self._request(seed)) if res is None else res
         if self.analytic:
-            return analytic_one(self.robot, as_target(target, self.request.task.name), self.request,
-                                None if q0 is None else self.robot.check_q(q0, what="q0"), self.collisions)
+            return self._nearest_branch(target, q0)
         if self.collisions is not None:
             return solve_clear(self.robot, target, q0, self._request(seed), self.collisions)
-        if self._lean is not None and self.engine is None:
-            res = self._lean.solve(target, q0, seed)
-            if res is not None:
-                return res
-        return solve_one(self.robot, target, q0, self._request(seed))
+        res = None if self._lean is None else self._lean.solve(target, q0, seed)
+        return solve_one(self.robot, target, q0, self._request(seed)) if res is None else res
+
+    def _nearest_branch(self, target: Any, q0: Any) -> IKResult:
+        """Solver "analytic": the branch nearest q0 in one compiled call where that serves, else root by root."""
+        ref = None if q0 is None else self.robot.check_q(q0, what="q0")
+        found = None if self._nearest is None else self._nearest.solve(target, ref)
+        return found or analytic_one(self.robot, as_target(target, self.request.task.name), self.request, ref,
+                                     self.collisions)
 
     def solve_batch(self, targets: Any, *, q0: Any = None, seed: int | None = None) -> BatchIKResult:
         """Every target of a batch, as :func:`kinelab.solve_batch` with these settings (row b: seed + b).

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, replace
+from functools import partial
 from types import SimpleNamespace
 from typing import Any, NamedTuple
 
@@ -21,6 +22,7 @@ import pinocchio as pin
 from kinelab.collision.model import CollisionModel
 from kinelab.core import threads
 from kinelab.core._analytic import ClosedForm
+from kinelab.core._joints import turn_distances
 from kinelab.errors import ConfigurationError, OptionError
 from kinelab.geometry import pose_errors, stack_homogeneous
 from kinelab.ik.analytic.classify import ArmClass, classify
@@ -221,7 +223,7 @@ def nearest_roots(robot: Robot, arm: ArmClass, target: Any, req: Request,
     """:func:`roots` of the pose ``target`` (copies nearest ``ref``, roots up to ``tol_rot`` past a limit tried at
     it) and the order to try them in: nearest ``ref`` first (joint by joint, modulo 2π), as found without it."""
     q, found, free = roots(robot, arm, target.homogeneous, ref, limit_slack(req.tol_rot))
-    order = range(q.shape[0]) if ref is None else np.argsort(np.abs(np.angle(np.exp(1j * (q - ref)))).max(axis=1))
+    order = range(q.shape[0]) if ref is None else np.argsort(turn_distances(q, ref), kind="stable")
     return q, found, free, order
 
 
@@ -347,6 +349,80 @@ def _pinocchio_batch(robot: Robot, arm: ArmClass, H: np.ndarray, req: Request) -
     f[pose[ok], rank], loose[pose[ok], rank] = found[pose[ok], row[ok]], free[pose[ok], row[ok]]
     return BranchBatch(q, kept, f, loose, errors[..., 0], errors[..., 1],
                        "search" if arm.searched else "closed form", robot.fk_certificate.judge)
+
+
+def _constant_fields(robot: Robot, req: Request) -> dict[str, Any]:
+    """The fields every closed-form answer of this robot and request shares."""
+    return {"success": True, "status": Status.CONVERGED, "iterations": 0, "restarts": 0, "solver": "analytic",
+            "mode": arm_of(robot, req).mode, "task": req.task_label, "judge": robot.fk_certificate.judge}
+
+
+def _filled(fields: dict[str, Any], found: tuple[Any, ...], k: int, wall_time: float,
+            unseen: float | None = None) -> IKResult:
+    """Row k of the compiled closed form's ``found`` (q, errors, roots merged, continuum flags) as an IKResult whose
+    diagnostics are built when first read."""
+    q, dp, dr, merged, continuum = found[:5]
+    made = IKResult.__new__(IKResult)
+    made.__dict__.update(fields, q=q[k].copy(), position_error=float(dp[k]), rotation_error=float(dr[k]),
+                         wall_time=wall_time, message=CONTINUUM if continuum[k] else "", singular_events=[],
+                         bypasses=[], _make_diagnostics=partial(Diagnostics, path="compiled", branches=q.shape[0],
+                                                                found=int(merged[k]), unseen=unseen))
+    return made
+
+
+class NearestBranch:
+    """:func:`analytic_one`'s usual call in one compiled call: a ``pin.SE3`` target whose branches the compiled
+    closed form finds and judges together, no collision model. The result's constant fields are made once, its
+    diagnostics when first read.
+
+    Args:
+        robot: a robot whose chain is in an analytic class and whose compiled FK is certified.
+        req: the validated request (task "pose").
+        form: the robot's compiled closed form for the request's tolerances (:func:`prepared_form`).
+    """
+
+    def __init__(self, robot: Robot, req: Request, form: ClosedForm):
+        self.form, self.fields = form, _constant_fields(robot, req)
+
+    def solve(self, target: Any, ref: np.ndarray | None) -> IKResult | None:
+        """The branch nearest ``ref`` (checked, [rad]; None: the first), or None where :func:`analytic_one` must
+        answer (a root to finish, no branch, a target that is not a ``pin.SE3`` or not a pose)."""
+        if type(target) is not pin.SE3:
+            return None
+        t0 = time.perf_counter()
+        found = self.form.solve(target.homogeneous, ref)
+        if found is None or not len(found[0]):
+            return None
+        k = 0 if ref is None else int(np.argmin(turn_distances(found[0], ref)))  # the first nearest, as nearest_roots
+        return _filled(self.fields, found, k, time.perf_counter() - t0)
+
+
+class EveryBranch:
+    """:func:`kinelab.solve_all`'s usual call in one compiled call: every branch of a ``pin.SE3`` target found and
+    judged together, as arrays; each IKResult built when the set is first read (as :func:`branch_results` builds it).
+
+    Args:
+        robot: a robot whose chain is in an analytic class and whose compiled FK is certified.
+        req: the validated request (task "pose").
+        form: the robot's compiled closed form for the request's tolerances (:func:`prepared_form`).
+    """
+
+    def __init__(self, robot: Robot, req: Request, form: ClosedForm):
+        self.form, self.fields = form, _constant_fields(robot, req)
+        self.method = "search" if arm_of(robot, req).searched else "closed form"
+        self.unseen = 0.0 if self.method == "closed form" else None
+
+    def solve(self, target: Any) -> Branches | None:
+        """Every branch of ``target``, or None where the general route must answer (a root to finish, no branch, a
+        target that is not a ``pin.SE3`` or not a pose)."""
+        if type(target) is not pin.SE3:
+            return None
+        t0 = time.perf_counter()
+        found = self.form.solve(target.homogeneous, None)
+        if found is None or not len(found[0]):
+            return None
+        make = partial(_filled, self.fields, found, wall_time=time.perf_counter() - t0, unseen=self.unseen)
+        return Branches.from_arrays(found[0], found[1], found[2], make, None, "", self.method, self.unseen)
 
 
 def analytic_one(robot: Robot, target: Any, req: Request, q0: np.ndarray | None,
