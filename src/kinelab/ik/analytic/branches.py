@@ -370,36 +370,10 @@ def _filled(fields: dict[str, Any], found: tuple[Any, ...], k: int, wall_time: f
     return made
 
 
-class NearestBranch:
-    """:func:`analytic_one`'s usual call in one compiled call: a ``pin.SE3`` target whose branches the compiled
-    closed form finds and judges together, no collision model. The result's constant fields are made once, its
-    diagnostics when first read.
-
-    Args:
-        robot: a robot whose chain is in an analytic class and whose compiled FK is certified.
-        req: the validated request (task "pose").
-        form: the robot's compiled closed form for the request's tolerances (:func:`prepared_form`).
-    """
-
-    def __init__(self, robot: Robot, req: Request, form: ClosedForm):
-        self.form, self.fields = form, _constant_fields(robot, req)
-
-    def solve(self, target: Any, ref: np.ndarray | None) -> IKResult | None:
-        """The branch nearest ``ref`` (checked, [rad]; None: the first), or None where :func:`analytic_one` must
-        answer (a root to finish, no branch, a target that is not a ``pin.SE3`` or not a pose)."""
-        if type(target) is not pin.SE3:
-            return None
-        t0 = time.perf_counter()
-        found = self.form.solve(target.homogeneous, ref)
-        if found is None or not len(found[0]):
-            return None
-        k = 0 if ref is None else int(np.argmin(turn_distances(found[0], ref)))  # the first nearest, as nearest_roots
-        return _filled(self.fields, found, k, time.perf_counter() - t0)
-
-
-class EveryBranch:
-    """:func:`kinelab.solve_all`'s usual call in one compiled call: every branch of a ``pin.SE3`` target found and
-    judged together, as arrays; each IKResult built when the set is first read (as :func:`branch_results` builds it).
+class OneCall:
+    """The closed form's usual call in one compiled call: the branches of a ``pin.SE3`` target found and judged
+    together by the compiled ``ClosedForm``, no collision model; the results' constant fields made once, their
+    diagnostics when first read. :class:`NearestBranch` keeps one branch, :class:`EveryBranch` all.
 
     Args:
         robot: a robot whose chain is in an analytic class and whose compiled FK is certified.
@@ -412,17 +386,42 @@ class EveryBranch:
         self.method = "search" if arm_of(robot, req).searched else "closed form"
         self.unseen = 0.0 if self.method == "closed form" else None
 
-    def solve(self, target: Any) -> Branches | None:
-        """Every branch of ``target``, or None where the general route must answer (a root to finish, no branch, a
-        target that is not a ``pin.SE3`` or not a pose)."""
+    def found(self, target: Any, ref: np.ndarray | None) -> tuple[Any, float] | None:
+        """(the compiled closed form's rows, the start of the clock [s]), or None where the general route must
+        answer (a root to finish, no branch, a target that is not a ``pin.SE3`` or not a pose)."""
         if type(target) is not pin.SE3:
             return None
         t0 = time.perf_counter()
-        found = self.form.solve(target.homogeneous, None)
-        if found is None or not len(found[0]):
+        rows = self.form.solve(target.homogeneous, ref)
+        return None if rows is None or not len(rows[0]) else (rows, t0)
+
+
+class NearestBranch(OneCall):
+    """:func:`analytic_one`'s usual call: the branch nearest the reference, in one compiled call."""
+
+    def solve(self, target: Any, ref: np.ndarray | None) -> IKResult | None:
+        """The branch nearest ``ref`` (checked, [rad]; None: the first), or None where :func:`analytic_one` must
+        answer."""
+        got = self.found(target, ref)
+        if got is None:
             return None
-        make = partial(_filled, self.fields, found, wall_time=time.perf_counter() - t0, unseen=self.unseen)
-        return Branches.from_arrays(found[0], found[1], found[2], make, None, "", self.method, self.unseen)
+        rows, t0 = got
+        k = 0 if ref is None else int(np.argmin(turn_distances(rows[0], ref)))  # the first nearest, as nearest_roots
+        return _filled(self.fields, rows, k, time.perf_counter() - t0)
+
+
+class EveryBranch(OneCall):
+    """:func:`kinelab.solve_all`'s usual call: every branch as arrays, each IKResult built when the set is first read
+    (as :func:`branch_results` builds it)."""
+
+    def solve(self, target: Any) -> Branches | None:
+        """Every branch of ``target``, or None where the general route must answer."""
+        got = self.found(target, None)
+        if got is None:
+            return None
+        rows, t0 = got
+        make = partial(_filled, self.fields, rows, wall_time=time.perf_counter() - t0, unseen=self.unseen)
+        return Branches.from_arrays(rows[0], rows[1], rows[2], make, None, "", self.method, self.unseen)
 
 
 def analytic_one(robot: Robot, target: Any, req: Request, q0: np.ndarray | None,
