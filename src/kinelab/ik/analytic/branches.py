@@ -187,7 +187,7 @@ def judged_roots(robot: Robot, q: np.ndarray, found: np.ndarray, free: np.ndarra
     for k, (p, r, within) in enumerate(zip(dp.tolist(), dr.tolist(), inside.tolist(), strict=True)):
         if within and p <= req.tol_pos and r <= req.tol_rot:
             answers.append((q[k], p, r, False, int(found[k]), bool(free[k])))
-        elif p <= 1e3 * req.tol_pos + 1e-6 and r <= 1e3 * req.tol_rot + 1e-6:
+        elif near_enough(p, r, req):
             v = judged(robot, q[k], target, req, held)
             if v is not None:
                 answers.append((*v, int(found[k]), bool(free[k])))
@@ -203,17 +203,7 @@ def branch_results(robot: Robot, rows: Rows, req: Request, mode: str, elapsed: f
     total = len(rows.q)
     kept = rows if max_solutions is None or max_solutions >= total else rows.taken(slice(max_solutions))
     unseen = 0.0 if method == "closed form" else None
-    judge = robot.fk_certificate.judge
-
-    def make(i: int) -> IKResult:
-        return IKResult(q=kept.q[i].copy(), success=True, status=Status.CONVERGED,
-                        position_error=float(kept.position_error[i]), rotation_error=float(kept.rotation_error[i]),
-                        iterations=0, restarts=0, wall_time=elapsed, solver="analytic", mode=mode,
-                        message=CONTINUUM if kept.continuum[i] else "",
-                        diagnostics=Diagnostics(path="compiled", branches=total, found=int(kept.merged[i]),
-                                                unseen=unseen, polished=1 if kept.finished[i] else None),
-                        task=req.task_label, judge=judge)
-
+    make = partial(_filled, _constant_fields(robot, req, mode), kept, wall_time=elapsed, branches=total, unseen=unseen)
     return Branches.from_arrays(kept.q, kept.position_error, kept.rotation_error, make,
                                 None if total else Status.UNREACHABLE, "" if total else empty, method, unseen)
 
@@ -247,6 +237,12 @@ def arm_roots(arm: ArmClass, H: np.ndarray, lower: np.ndarray, upper: np.ndarray
     return out[:m], found[:m], free[:m]
 
 
+def near_enough(dp: float, dr: float, req: Request) -> bool:
+    """A root short of the tolerances by errors dp [m], dr [rad] that a warm-started solve may finish (the compiled
+    ClosedForm draws the same line); farther off it is not this pose's root."""
+    return dp <= 1e3 * req.tol_pos + 1e-6 and dr <= 1e3 * req.tol_rot + 1e-6
+
+
 def judged(robot: Robot, q: np.ndarray, target: Any, req: Request,
            held: dict[str, float] | None = None) -> tuple[np.ndarray, float, float, bool] | None:
     """(q, position error, rotation error, finished) when Pinocchio's FK of q meets the tolerances, after a
@@ -255,7 +251,7 @@ def judged(robot: Robot, q: np.ndarray, target: Any, req: Request,
     dp, dr = robot.tool_error(q, target)
     if dp <= req.tol_pos and dr <= req.tol_rot:
         return q, dp, dr, False
-    if dp > 1e3 * req.tol_pos + 1e-6 or dr > 1e3 * req.tol_rot + 1e-6:
+    if not near_enough(dp, dr, req):
         return None  # not this pose's root (a 5R arm's candidate for the other shoulder side, say)
     frozen = {} if held is None else {"freeze": held, "active": ("freeze",)}
     finish = make_request("frdm", seed=0, tol_pos=req.tol_pos, tol_rot=req.tol_rot, max_restarts=0,
@@ -351,22 +347,23 @@ def _pinocchio_batch(robot: Robot, arm: ArmClass, H: np.ndarray, req: Request) -
                        "search" if arm.searched else "closed form", robot.fk_certificate.judge)
 
 
-def _constant_fields(robot: Robot, req: Request) -> dict[str, Any]:
-    """The fields every closed-form answer of this robot and request shares."""
+def _constant_fields(robot: Robot, req: Request, mode: str) -> dict[str, Any]:
+    """The fields every closed-form answer of this robot, request and mode shares."""
     return {"success": True, "status": Status.CONVERGED, "iterations": 0, "restarts": 0, "solver": "analytic",
-            "mode": arm_of(robot, req).mode, "task": req.task_label, "judge": robot.fk_certificate.judge}
+            "mode": mode, "task": req.task_label, "judge": robot.fk_certificate.judge}
 
 
-def _filled(fields: dict[str, Any], found: tuple[Any, ...], k: int, wall_time: float,
+def _filled(fields: dict[str, Any], rows: Rows, k: int, wall_time: float, branches: int,
             unseen: float | None = None) -> IKResult:
-    """Row k of the compiled closed form's ``found`` (q, errors, roots merged, continuum flags) as an IKResult whose
-    diagnostics are built when first read."""
-    q, dp, dr, merged, continuum = found[:5]
+    """Row k of ``rows`` as an IKResult (``branches``: how many the pose has), its diagnostics built when first
+    read."""
     made = IKResult.__new__(IKResult)
-    made.__dict__.update(fields, q=q[k].copy(), position_error=float(dp[k]), rotation_error=float(dr[k]),
-                         wall_time=wall_time, message=CONTINUUM if continuum[k] else "", singular_events=[],
-                         bypasses=[], _make_diagnostics=partial(Diagnostics, path="compiled", branches=q.shape[0],
-                                                                found=int(merged[k]), unseen=unseen))
+    made.__dict__.update(fields, q=rows.q[k].copy(), position_error=float(rows.position_error[k]),
+                         rotation_error=float(rows.rotation_error[k]), wall_time=wall_time,
+                         message=CONTINUUM if rows.continuum[k] else "", singular_events=[], bypasses=[],
+                         _make_diagnostics=partial(Diagnostics, path="compiled", branches=branches,
+                                                   found=int(rows.merged[k]), unseen=unseen,
+                                                   polished=1 if rows.finished[k] else None))
     return made
 
 
@@ -382,18 +379,23 @@ class OneCall:
     """
 
     def __init__(self, robot: Robot, req: Request, form: ClosedForm):
-        self.form, self.fields = form, _constant_fields(robot, req)
-        self.method = "search" if arm_of(robot, req).searched else "closed form"
+        arm = arm_of(robot, req)
+        self.form, self.fields = form, _constant_fields(robot, req, arm.mode)
+        self.method = "search" if arm.searched else "closed form"
         self.unseen = 0.0 if self.method == "closed form" else None
+        self.unfinished = np.zeros(MAX_ROWS, dtype=np.bool_)  # the compiled form finishes no root
 
-    def found(self, target: Any, ref: np.ndarray | None) -> tuple[Any, float] | None:
+    def found(self, target: Any, ref: np.ndarray | None) -> tuple[Rows, float] | None:
         """(the compiled closed form's rows, the start of the clock [s]), or None where the general route must
         answer (a root to finish, no branch, a target that is not a ``pin.SE3`` or not a pose)."""
         if type(target) is not pin.SE3:
             return None
         t0 = time.perf_counter()
-        rows = self.form.solve(target.homogeneous, ref)
-        return None if rows is None or not len(rows[0]) else (rows, t0)
+        got = self.form.solve(target.homogeneous, ref)
+        if got is None or not len(got[0]):
+            return None
+        q, dp, dr, merged, continuum, _ = got
+        return Rows(q, dp, dr, self.unfinished[:len(q)], merged, continuum), t0
 
 
 class NearestBranch(OneCall):
@@ -406,8 +408,8 @@ class NearestBranch(OneCall):
         if got is None:
             return None
         rows, t0 = got
-        k = 0 if ref is None else int(np.argmin(turn_distances(rows[0], ref)))  # the first nearest, as nearest_roots
-        return _filled(self.fields, rows, k, time.perf_counter() - t0)
+        k = 0 if ref is None else int(np.argmin(turn_distances(rows.q, ref)))  # the first nearest, as nearest_roots
+        return _filled(self.fields, rows, k, time.perf_counter() - t0, len(rows.q))
 
 
 class EveryBranch(OneCall):
@@ -420,8 +422,10 @@ class EveryBranch(OneCall):
         if got is None:
             return None
         rows, t0 = got
-        make = partial(_filled, self.fields, rows, wall_time=time.perf_counter() - t0, unseen=self.unseen)
-        return Branches.from_arrays(rows[0], rows[1], rows[2], make, None, "", self.method, self.unseen)
+        make = partial(_filled, self.fields, rows, wall_time=time.perf_counter() - t0, branches=len(rows.q),
+                       unseen=self.unseen)
+        return Branches.from_arrays(rows.q, rows.position_error, rows.rotation_error, make, None, "", self.method,
+                                    self.unseen)
 
 
 def analytic_one(robot: Robot, target: Any, req: Request, q0: np.ndarray | None,
