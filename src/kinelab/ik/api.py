@@ -30,7 +30,7 @@ from kinelab.ik.clear import clear_batch, clear_track, mark_colliding, solve_cle
 from kinelab.ik.driver import solve_one
 from kinelab.ik.frdm.tracking import PathSettings, path_options, run_track
 from kinelab.ik.prepared import kept_solver, prepared
-from kinelab.ik.registry import capabilities, one_answer
+from kinelab.ik.registry import Capabilities, capabilities, one_answer
 from kinelab.ik.request import Request, check_robot, make_request
 from kinelab.ik.result import Branches, IKResult, TrackResult
 from kinelab.ik.targets import as_target, as_target_arrays
@@ -123,25 +123,25 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
             engine = ik.engine
             res = None if engine is None else engine.solve(target, q0, seed)  # the usual call: one compiled call
             return ik.solve(target, q0=q0, seed=seed) if res is None else res
-    one_answer(solver)
+    kind = one_answer(solver)
     settings = dict(solver=solver, tol_pos=tol_pos, tol_rot=tol_rot, time_budget=time_budget,
                     max_restarts=max_restarts, start_outside_limits=start_outside_limits, options=options, task=task,
                     axis=axis, collisions=collisions, **solver_options)
     if prefer is None:
         return prepared(robot, settings, key).solve(target, q0=q0, seed=seed)
-    return _solve_preferring(robot, target, q0, seed, prefer, settings)
+    return _solve_preferring(robot, target, q0, seed, prefer, settings, kind)
 
 
 def _solve_preferring(robot: Robot, target: Any, q0: Any, seed: int | None, prefer: Any,
-                      settings: dict[str, Any]) -> IKResult:
+                      settings: dict[str, Any], kind: Capabilities) -> IKResult:
     """``solve(prefer=...)`` with the rest of ``solve``'s settings (``settings``: its keywords but q0, seed and
-    prefer): the nearest branch in closed form for solver "analytic", else among those :func:`find_all` finds."""
+    prefer; ``kind``: what the solver can do): the nearest branch in closed form for solver "analytic", else among
+    those :func:`find_all` finds."""
     rest = dict(settings)
     solver, options, collisions = rest.pop("solver"), rest.pop("options"), rest.pop("collisions")
     task, axis = rest.pop("task"), rest.pop("axis")
     tol_pos, tol_rot, budget, restarts, outside = (
         rest.pop(k) for k in ("tol_pos", "tol_rot", "time_budget", "max_restarts", "start_outside_limits"))
-    kind = one_answer(solver)
     if kind.closed_form:
         req = make_request(kind.request_solver(solver), seed, tol_pos, tol_rot, budget, restarts, outside, None, task,
                            axis, None)

@@ -92,9 +92,9 @@ class LeanFRDM:
                                max(0, int(stats[kernel.T_ATTEMPTS]) - 1), ok, dp, dr)
 
     def solve(self, target: Any, q0: Any, seed: Any) -> IKResult | None:
-        """The result for the usual call, or None for the general driver (see the module's docstring)."""
-        if self.engine is not None:
-            return self.engine.solve(target, q0, seed)
+        """The result for the usual call in three compiled calls with the robot's verdict between them, or None for
+        the general driver (see the module's docstring); where :attr:`engine` exists, the prepared solver calls it
+        instead."""
         t_start = time.perf_counter()
         start, seed = self._usual(target, q0, seed)
         if start is None:

@@ -238,8 +238,10 @@ class Robot:
     def _pin_q(self, q: ArrayLike) -> np.ndarray:
         """Pinocchio's q for reading only: q itself when the two orders coincide (no copy)."""
         usual = self._pin_form.usual(q)  # a plain q, checked and converted in one compiled call
-        if usual is not None:
-            return usual
+        return self._checked_pin_q(q) if usual is None else usual
+
+    def _checked_pin_q(self, q: ArrayLike) -> np.ndarray:
+        """:meth:`_pin_q` for any other q: the checks that name what is wrong, then the conversion."""
         arr = self.check_q(q)
         if self._identity_q:
             return arr
@@ -304,7 +306,7 @@ class Robot:
         """oMtool: pose of the tool frame in the base frame at ``q`` (m, rad); a new SE3 (Pinocchio's
         ``updateFramePlacement`` returns the tool frame's placement by value)."""
         q_pin = self._pin_form.usual(q)  # one compiled call for a plain q; else the checks that name what is wrong
-        pin.forwardKinematics(self.model, self.data, self._pin_q(q) if q_pin is None else q_pin)
+        pin.forwardKinematics(self.model, self.data, self._checked_pin_q(q) if q_pin is None else q_pin)
         return pin.updateFramePlacement(self.model, self.data, self.tool_frame_id)
 
     def fk_batch(self, Q: np.ndarray) -> np.ndarray:
@@ -402,8 +404,9 @@ class Robot:
 
     def _jacobian(self, q: ArrayLike, frame: pin.ReferenceFrame) -> np.ndarray:
         q_pin = self._pin_form.usual(q)
-        J: np.ndarray = pin.computeFrameJacobian(self.model, self.data, self._pin_q(q) if q_pin is None else q_pin,
-                                                 self.tool_frame_id, frame)
+        if q_pin is None:
+            q_pin = self._checked_pin_q(q)
+        J: np.ndarray = pin.computeFrameJacobian(self.model, self.data, q_pin, self.tool_frame_id, frame)
         return J if J.ndim == 2 else J.reshape(6, self.nv)  # a 1-DoF chain comes back as a flat 6-vector
 
     def jacobian_local(self, q: ArrayLike) -> np.ndarray:
