@@ -791,13 +791,19 @@ cdef class ClosedForm:
         cdef double out[MAX_ROWS * 6]
         cdef long long found[MAX_ROWS]
         cdef unsigned char loose[MAX_ROWS]
-        cdef int n = self.n, m, k, j, kept = 0
+        cdef double p[3]
+        cdef double S[9]
+        cdef int n = self.n, m, k, i, j, kept = 0
         cdef unsigned char verdict
         cdef M9 Rt = (T[0], T[1], T[2], T[4], T[5], T[6], T[8], T[9], T[10])
         m = _branches(&self.arm, Rt, (T[3], T[7], T[11]), aim, use_ref, out, found, loose)
         placed[0] = m
+        for i in range(3):  # the target's point and rotation, as the verdict reads them
+            p[i] = T[4 * i + 3]
+            for j in range(3):
+                S[3 * i + j] = T[4 * i + j]
         for k in range(m):
-            verdict = self._judged(T, out + k * n, errors + 2 * kept, errors + 2 * kept + 1)
+            verdict = self._judged(p, S, out + k * n, errors + 2 * kept, errors + 2 * kept + 1)
             if verdict == NEAR:
                 near[0] = True
                 return kept
@@ -808,16 +814,12 @@ cdef class ClosedForm:
                 kept += 1
         return kept
 
-    cdef unsigned char _judged(self, const double* H, const double* q, double* dp, double* dr) noexcept nogil:
-        """KEPT, NEAR or DROPPED for one root against the pose H (4 × 4, row-major); its errors written."""
+    cdef unsigned char _judged(self, const double* p, const double* S, const double* q, double* dp,
+                               double* dr) noexcept nogil:
+        """KEPT, NEAR or DROPPED for one root against the target point p and rotation S (3 × 3, row-major); its
+        errors written."""
         cdef double T[16]
-        cdef double p[3]
-        cdef double S[9]
-        cdef int i, j
-        for i in range(3):
-            p[i] = H[4 * i + 3]
-            for j in range(3):
-                S[3 * i + j] = H[4 * i + j]
+        cdef int i
         self.judge.pose(q, T)
         pose_errors(T, p, S, -1, dp, dr)
         for i in range(self.n):

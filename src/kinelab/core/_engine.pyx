@@ -14,14 +14,14 @@ from functools import partial
 import numpy as np
 
 cimport numpy as cnp
-from libc.math cimport M_PI, atan2, ceil, cos, sin, sqrt
+from libc.math cimport M_PI, atan2, ceil, cos, sin
 from libc.stdlib cimport free, malloc
 from libc.string cimport memcpy
 
 from kinelab.core._chain cimport Judge
 from kinelab.core._frdm cimport (CONTINUOUS, CONVERGED, STATS_SIZE, T_ATTEMPTS, T_STALLS, T_SWEEPS, Packed, now,
                                  random_configuration, timed)
-from kinelab.core._verdict cimport pose_defect_of, pose_errors
+from kinelab.core._verdict cimport pose_errors, take_target
 
 cnp.import_array()
 
@@ -153,18 +153,7 @@ cdef class FRDMEngine:
         if cnp.PyArray_TYPE(a) != cnp.NPY_FLOAT64 or cnp.PyArray_NDIM(a) != 2 or cnp.PyArray_DIM(a, 0) != 4 \
                 or cnp.PyArray_DIM(a, 1) != 4:
             return False
-        cdef const double[:, :] H = homogeneous
-        if pose_defect_of(H) != 0:
-            return False
-        cdef double a0 = H[0, 3] - self.anchor[0], a1 = H[1, 3] - self.anchor[1], a2 = H[2, 3] - self.anchor[2]
-        if not sqrt(a0 * a0 + a1 * a1 + a2 * a2) <= self.radius:
-            return False
-        cdef int i, j
-        for i in range(3):
-            self.pstar[i] = H[i, 3]
-            for j in range(3):
-                self.Rstar[i, j] = H[i, j]
-        return True
+        return take_target(homogeneous, self.anchor, self.radius, self.pstar, self.Rstar)
 
     cdef bint _within(self, const double* q) noexcept:
         cdef int i

@@ -5,3 +5,5 @@ cdef tuple verdict_of(const double* T, const double[:, :] H_target, const double
 cdef int pose_defect_of(const double[:, :] H) noexcept nogil
 cdef void pose_errors(const double* T, const double* pstar, const double* Rstar, int axis, double* dp,
                       double* dr) noexcept nogil
+cdef bint take_target(const double[:, :] H, const double[::1] anchor, double radius, double[::1] pstar,
+                      double[:, ::1] Rstar) noexcept

@@ -135,20 +135,28 @@ def usual_inputs(const double[:, :] H, const double[::1] q0, int n, const double
     if H.shape[0] != 4 or H.shape[1] != 4 or anchor.shape[0] != 3 or pstar.shape[0] != 3 or Rstar.shape[0] != 3 \
             or Rstar.shape[1] != 3 or lower.shape[0] != n or upper.shape[0] != n:
         raise ValueError("usual_inputs: inconsistent shapes")
-    cdef int i, j
-    if pose_defect_of(H) != 0:
-        return NOT_USUAL
-    cdef double a0 = H[0, 3] - anchor[0], a1 = H[1, 3] - anchor[1], a2 = H[2, 3] - anchor[2]
-    if not sqrt(a0 * a0 + a1 * a1 + a2 * a2) <= radius:
-        return NOT_USUAL
+    cdef int i
     if q0.shape[0] != 0:
         if q0.shape[0] != n:
             return NOT_USUAL
         for i in range(n):
             if not lower[i] <= q0[i] <= upper[i]:  # also False for NaN; ±inf never lies within finite limits
                 return NOT_USUAL
+    return OK if take_target(H, anchor, radius, pstar, Rstar) else NOT_USUAL
+
+
+cdef bint take_target(const double[:, :] H, const double[::1] anchor, double radius, double[::1] pstar,
+                      double[:, ::1] Rstar) noexcept:
+    """True when H (4 × 4) is a proper pose whose point lies within ``radius`` [m] of ``anchor``: its point and
+    rotation are then copied into pstar and Rstar (the kernel's target); False, and nothing written, otherwise."""
+    cdef int i, j
+    if pose_defect_of(H) != 0:
+        return False
+    cdef double a0 = H[0, 3] - anchor[0], a1 = H[1, 3] - anchor[1], a2 = H[2, 3] - anchor[2]
+    if not sqrt(a0 * a0 + a1 * a1 + a2 * a2) <= radius:
+        return False
     for i in range(3):
         pstar[i] = H[i, 3]
         for j in range(3):
             Rstar[i, j] = H[i, j]
-    return OK
+    return True
