@@ -147,8 +147,9 @@ def test_each_round_of_solve_all_and_the_prefer_fallback_get_only_what_is_left(m
     real_one = api.solve_one
     monkeypatch.setattr(api, "solve_one", lambda robot, t, q0, req: fallback.append(req.time_budget)
                         or real_one(robot, t, q0, req))
+    monkeypatch.setattr(api, "time", Clock())  # the branch search took one reading's 7.5 ms of the 50 ms
     res = kinelab.solve(ur5, target, prefer=np.zeros(6), time_budget=0.05, tol_pos=1e-300, tol_rot=1e-300, seed=0)
-    assert not res.success and len(fallback) == 1 and fallback[0] is not None and fallback[0] < 0.05
+    assert not res.success and fallback == [pytest.approx(0.05 - 0.0075, abs=1e-12)]
 
 
 # --- #31: the fault and fuzz run of the core-issue round -------------------------------------------------------

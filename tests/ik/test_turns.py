@@ -18,15 +18,18 @@ def _turnable(robot, q) -> bool:
     return not robot.within_limits(q) and robot.within_limits(wrap_q(robot, q))
 
 
-def _check(robot, q, target, status):
-    """Never outside a limit with a turn inside; where every joint's range spans a whole turn (ur5, the ±π file),
-    every answer converges within the limits; where one does not (the kinova's joint 2), an answer met beyond it is
-    honestly ``outside_limits``."""
-    assert not _turnable(robot, q), (q, status)
-    assert max(robot.tool_error(q, target)) <= 1e-6
+def _faults(robot, q, target, status) -> list[str]:
+    """What is wrong with an answer (empty: nothing). Never outside a limit with a turn inside; where every joint's
+    range spans a whole turn (ur5, the ±π file), every answer converges within the limits; where one does not (the
+    kinova's joint 2), an answer met beyond it is honestly ``outside_limits``."""
     whole_turns = bool(np.all(robot.upper - robot.lower >= 2 * np.pi - 1e-12))
-    assert status == "converged" if whole_turns else status in ("converged", "outside_limits"), (q, status)
-    assert (status == "converged") == robot.within_limits(q)
+    checks = {
+        "outside a limit with a whole turn inside": not _turnable(robot, q),
+        "pose not met to 1e-6": max(robot.tool_error(q, target)) <= 1e-6,
+        f"status {status}": status == "converged" if whole_turns else status in ("converged", "outside_limits"),
+        "status disagrees with the limits": (status == "converged") == robot.within_limits(q),
+    }
+    return [f"{what}: q = {q}" for what, ok in checks.items() if not ok]
 
 
 @pytest.fixture(scope="module", params=["ur5", "kinova", "pi_limits"])
@@ -49,7 +52,7 @@ def test_single_solves_come_back_inside_the_limits(arm):
     for k, target in enumerate(_targets(arm)):
         for res in (kinelab.solve(arm, target, use_limits=False, seed=k), ik.solve(target, seed=k),
                     kinelab.solve(arm, target, use_limits=False, seed=k, q0=arm.random_q(k), policy=("auto_kick",))):
-            _check(arm, res.q, target, res.status.value)
+            assert _faults(arm, res.q, target, res.status.value) == []
 
 
 @pytest.mark.parametrize("solver", ["biquat", "dls"])
@@ -64,11 +67,11 @@ def test_batch_rows_and_branches_come_back_inside_the_limits(arm):
     targets = _targets(arm)
     batch = kinelab.solve_batch(arm, targets, use_limits=False, seed=1)
     for q, target, status in zip(batch.q, targets, batch.status, strict=True):
-        _check(arm, q, target, status)
+        assert _faults(arm, q, target, status) == []
     found = kinelab.solve_all(arm, targets[0], solver="frdm", use_limits=False, seed=2, time_budget=0.2)
     assert found
     for res in found:
-        _check(arm, res.q, targets[0], res.status.value)
+        assert _faults(arm, res.q, targets[0], res.status.value) == []
 
 
 @pytest.mark.parametrize("policy", [None, ("auto_kick",)])
@@ -77,5 +80,6 @@ def test_a_tracked_path_comes_back_inside_the_limits(arm, policy):
     a, b = arm.random_q(rng), arm.random_q(rng)
     path = [arm.fk(a + s * (b - a)) for s in np.linspace(0.0, 1.0, 30)]
     tracked = kinelab.track(arm, path, q0=a, use_limits=False, policy=policy)
+    assert len(tracked.q) == len(path)
     for q, target, status in zip(tracked.q, path, tracked.status, strict=True):
-        _check(arm, q, target, status)
+        assert _faults(arm, q, target, status) == []
