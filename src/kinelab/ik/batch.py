@@ -25,7 +25,7 @@ from kinelab.ik.limits import wrap_q
 from kinelab.ik.multistart import seed_states
 from kinelab.ik.registry import capabilities
 from kinelab.ik.request import Request
-from kinelab.ik.result import Status
+from kinelab.ik.result import Status, status_counts
 from kinelab.ik.targets import as_target_arrays
 from kinelab.ik.workspace import reach_bound
 from kinelab.robot import Robot
@@ -43,7 +43,7 @@ class BatchIKResult:
     Attributes:
         q: (B, n) answers [rad or m] (NaN in rows the time budget left unsolved).
         success: (B,) Pinocchio confirms both tolerances within the joint limits.
-        status: (B,) :class:`~kinelab.ik.result.Status` values as strings.
+        status_code: (B,) int8 codes of :class:`~kinelab.ik.result.Status` (``status`` gives the members).
         position_error: (B,) [m]; rotation_error: (B,) [rad] (Pinocchio's FK against the target).
         iterations: (B,) sweeps (FRDM) or the solver's iterations; restarts: (B,).
         seed: the base seed (row b used seed + b); wall_time: [s] for the whole batch, checks included.
@@ -53,7 +53,7 @@ class BatchIKResult:
 
     q: np.ndarray
     success: np.ndarray
-    status: np.ndarray
+    status_code: np.ndarray
     position_error: np.ndarray
     rotation_error: np.ndarray
     iterations: np.ndarray
@@ -67,11 +67,15 @@ class BatchIKResult:
     def __len__(self) -> int:
         return int(self.success.shape[0])
 
+    @property
+    def status(self) -> np.ndarray:
+        """(B,) the rows' :class:`~kinelab.ik.result.Status` members (an object array; ``== "converged"`` works)."""
+        return Status.of_codes(self.status_code)
+
     def summary(self) -> dict[str, Any]:
         """Counts per status, the success rate and the throughput [solves/s]."""
-        values, counts = np.unique(self.status, return_counts=True)
         return {"targets": len(self), "solved": int(self.success.sum()), "success_rate": float(self.success.mean()),
-                "status": dict(zip(values.tolist(), counts.tolist(), strict=True)),
+                "status": status_counts(self.status_code),
                 "solves_per_second": len(self) / self.wall_time if self.wall_time > 0 else float("inf"),
                 "mode": self.mode}
 
@@ -182,7 +186,7 @@ def _per_target(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts:
         row = replace(req, seed=seed + b, time_budget=min(left, 1e9), start_outside_limits="refuse")
         res = solve_one(robot, pin.SE3(rotations[b], points[b]), None if starts is None else starts[b], row)
         rows.Q[b], rows.iterations[b], rows.restarts[b] = res.q, res.iterations, res.restarts
-        rows.status[b] = res.status.value
+        rows.code[b] = res.status.code
     return rows
 
 
@@ -192,7 +196,7 @@ def _judged(robot: Robot, rows: Rows, points: np.ndarray, rotations: np.ndarray,
     count, task = points.shape[0], req.task
     dp, dr, success = np.full(count, np.nan), np.full(count, np.nan), np.zeros(count, dtype=bool)
     met = np.zeros(count, dtype=bool)
-    solved = np.flatnonzero(rows.status != Status.TIME_BUDGET.value)
+    solved = np.flatnonzero(rows.code != Status.TIME_BUDGET.code)
     if solved.size:
         rows.Q[solved] = wrap_q(robot, rows.Q[solved])  # a whole turn into the limits: the same pose
         H_target = stack_homogeneous(points[solved], rotations[solved])
@@ -201,11 +205,11 @@ def _judged(robot: Robot, rows: Rows, points: np.ndarray, rotations: np.ndarray,
         within = robot.within_limits_batch(rows.Q[solved])
         met[solved] = task.met_batch(dp[solved], dr[solved], req.tol_pos, req.tol_rot)
         success[solved] = met[solved] & within
-    status = rows.status
-    status[success] = Status.CONVERGED.value
-    status[met & ~success] = Status.OUTSIDE_LIMITS.value  # use_limits=False: met beyond a limit, as solve says
-    failed = ~met & (status != Status.TIME_BUDGET.value)
-    status[failed & (_beyond(robot, points, req) > 0)] = Status.UNREACHABLE.value
-    status[failed & (status == Status.CONVERGED.value)] = Status.STALLED.value  # the solver's test passed only
-    return BatchIKResult(rows.Q, success, rows.status, dp, dr, rows.iterations, rows.restarts, seed,
+    code = rows.code
+    code[success] = Status.CONVERGED.code
+    code[met & ~success] = Status.OUTSIDE_LIMITS.code  # use_limits=False: met beyond a limit, as solve says
+    failed = ~met & (code != Status.TIME_BUDGET.code)
+    code[failed & (_beyond(robot, points, req) > 0)] = Status.UNREACHABLE.code
+    code[failed & (code == Status.CONVERGED.code)] = Status.STALLED.code  # the solver's test passed only
+    return BatchIKResult(rows.Q, success, code, dp, dr, rows.iterations, rows.restarts, seed,
                          time.perf_counter() - t0, req.solver, mode, robot.fk_certificate.judge)

@@ -123,7 +123,7 @@ def clear_batch(robot: Robot, H: np.ndarray, res: BatchIKResult, req: Request, m
                 t0: float) -> BatchIKResult:
     """The batch with every colliding row solved again by :func:`solve_clear` (fresh seeds, what is left of the
     budget); a row with no clear answer fails with status ``collision``."""
-    q, success, status = res.q.copy(), res.success.copy(), res.status.copy()
+    q, success, code = res.q.copy(), res.success.copy(), res.status_code.copy()
     dp, dr = res.position_error.copy(), res.rotation_error.copy()
     for b in np.flatnonzero(success):
         if model.colliding_pair(q[b]) is None:
@@ -132,20 +132,19 @@ def clear_batch(robot: Robot, H: np.ndarray, res: BatchIKResult, req: Request, m
         again = solve_clear(robot, pin.SE3(H[b, :3, :3], H[b, :3, 3]), None,
                             replace(req, seed=res.seed + b + STRIDE, time_budget=left,
                                     max_restarts=min(req.max_restarts, ROW_RUNS)), model)
-        q[b], success[b], status[b] = again.q, again.success, again.status.value
+        q[b], success[b], code[b] = again.q, again.success, again.status.code
         dp[b], dr[b] = again.position_error, again.rotation_error
-    return replace(res, q=q, success=success, status=status, position_error=dp, rotation_error=dr,
+    return replace(res, q=q, success=success, status_code=code, position_error=dp, rotation_error=dr,
                    wall_time=time.perf_counter() - t0)
 
 
 def clear_track(res: TrackResult, model: CollisionModel) -> TrackResult:
     """The path with every reached sample whose answer collides marked ``collision`` (not reached), the
     contacts listed by sample."""
-    status, contacts = list(res.status), []
-    for k, (q, s) in enumerate(zip(res.q, res.status, strict=True)):
-        if s == Status.CONVERGED.value:
-            contact = model.contact(q)
-            if contact is not None:
-                status[k] = Status.COLLISION.value
-                contacts.append((k, contact))
-    return replace(res, status=status, contacts=contacts)
+    code, contacts = res.status_code.copy(), []
+    for k in np.flatnonzero(code == Status.CONVERGED.code):
+        contact = model.contact(res.q[k])
+        if contact is not None:
+            code[k] = Status.COLLISION.code
+            contacts.append((int(k), contact))
+    return replace(res, status_code=code, contacts=contacts)

@@ -22,6 +22,35 @@ class Status(str, Enum):
     OUTSIDE_LIMITS = "outside_limits"  # the pose is met, but only with a joint outside its limits
     COLLISION = "collision"  # the pose is met, but every answer found collides (``collisions=``)
 
+    def __str__(self) -> str:
+        return str(self.value)
+
+    def __format__(self, spec: str) -> str:
+        return format(str(self.value), spec)
+
+    @property
+    def code(self) -> int:
+        """The status's integer code: its place in the class (how arrays of results store it)."""
+        return _CODES[self]
+
+    @staticmethod
+    def of_codes(codes: np.ndarray) -> np.ndarray:
+        """The statuses of an array of codes, as an object array of :class:`Status` members (same shape)."""
+        return _MEMBERS[np.asarray(codes, dtype=np.intp)]
+
+    @staticmethod
+    def codes(statuses: Iterable[Any]) -> np.ndarray:
+        """The int8 codes of statuses given as members or their string values.
+
+        Raises:
+            ValueError: a value that names no status.
+        """
+        return np.array([Status(s).code for s in statuses], dtype=np.int8)
+
+
+_MEMBERS = np.array(list(Status), dtype=object)
+_CODES = {s: k for k, s in enumerate(Status)}
+
 
 @dataclass(frozen=True)
 class SingularEvent:
@@ -372,13 +401,22 @@ class Attempt:
 
 @dataclass
 class TrackResult:
-    """One q per path sample (rows, rad/m) with its Pinocchio-measured errors and the monitor log."""
+    """One q per path sample (rows, rad/m) with its Pinocchio-measured errors and the monitor log.
+
+    Attributes:
+        q: (K, n) one configuration per sample [rad or m].
+        position_error: (K,) [m]; rotation_error: (K,) [rad] (the judge's FK against each sample's target).
+        status_code: (K,) int8 codes of :class:`Status` (``status`` gives the members).
+        iterations: (K,) the solver's iterations per sample (FRDM sweeps); wall_time: (K,) [s] per sample.
+        events, bypasses: the monitor's log; mode: how the path was followed; contacts: (sample, Contact) pairs
+            with ``collisions=``.
+    """
 
     q: np.ndarray
     position_error: np.ndarray  # [m]
     rotation_error: np.ndarray  # [rad]
-    status: list[str]
-    sweeps: np.ndarray
+    status_code: np.ndarray
+    iterations: np.ndarray
     wall_time: np.ndarray  # [s] per sample
     events: list[SingularEvent] = field(default_factory=list)
     bypasses: list[BypassRecord] = field(default_factory=list)
@@ -396,9 +434,19 @@ class TrackResult:
         return float(self.joint_steps.max())
 
     @property
+    def status(self) -> np.ndarray:
+        """(K,) each sample's :class:`Status` member (an object array; ``== "converged"`` works)."""
+        return Status.of_codes(self.status_code)
+
+    @property
+    def sweeps(self) -> np.ndarray:
+        """The same as :attr:`iterations` (this field's earlier name, kept for code that reads it)."""
+        return self.iterations
+
+    @property
     def reached(self) -> np.ndarray:
-        """Per sample: True when Pinocchio confirms the tolerances within the limits."""
-        return np.array([s == Status.CONVERGED.value for s in self.status])
+        """Per sample: True when the judge confirms the tolerances within the limits."""
+        return np.asarray(self.status_code == Status.CONVERGED.code)
 
     @property
     def success(self) -> np.ndarray:
@@ -408,7 +456,8 @@ class TrackResult:
     def summary(self) -> dict[str, Any]:
         """Samples, reached, the worst errors and step, monitor counts, the median time per sample."""
         return {
-            "samples": len(self.status),
+            "samples": len(self.status_code),
+            "status": status_counts(self.status_code),
             "reached": int(self.reached.sum()),
             "max_position_error_m": float(self.position_error.max()),
             "max_rotation_error_rad": float(self.rotation_error.max()),
@@ -418,3 +467,9 @@ class TrackResult:
             "median_time_per_sample_s": float(np.median(self.wall_time)),
             "mode": self.mode,
         }
+
+
+def status_counts(codes: np.ndarray) -> dict[str, int]:
+    """How many rows end in each status, by the status's name, in the order :class:`Status` lists them."""
+    counts = np.bincount(np.asarray(codes, dtype=np.intp), minlength=len(_MEMBERS))
+    return {str(s): int(c) for s, c in zip(_MEMBERS, counts, strict=True) if c}

@@ -223,9 +223,10 @@ def dls_tracking(passage: Passage, robot: Robot | None = None) -> TrackResult:
         rows.append(q)
         perr.append(res.position_error)
         rerr.append(res.rotation_error)
-        status.append(res.status.value)
+        status.append(res.status.code)
         iters.append(res.iterations)
-    return TrackResult(np.array(rows), np.array(perr), np.array(rerr), status, np.array(iters), np.array(times))
+    return TrackResult(np.array(rows), np.array(perr), np.array(rerr), np.array(status, dtype=np.int8),
+                       np.array(iters), np.array(times))
 
 
 def tracking_bench(repeats: int = 3, robot: Robot | None = None) -> dict:

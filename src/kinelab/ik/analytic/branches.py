@@ -529,7 +529,7 @@ def _nearest_rows(robot: Robot, H: np.ndarray, starts: np.ndarray | None, req: R
     deadline = np.inf if req.time_budget is None else t0 + req.time_budget - verdict_reserve(req.time_budget)
     B = len(H)
     q, dp, dr = np.full((B, robot.n), np.nan), np.full(B, np.nan), np.full(B, np.nan)
-    success, status = np.zeros(B, dtype=bool), np.full(B, Status.TIME_BUDGET.value, dtype="<U14")
+    success, code = np.zeros(B, dtype=bool), np.full(B, Status.TIME_BUDGET.code, dtype=np.int8)
     t_rows = time.perf_counter()
     for b in range(B):
         now = time.perf_counter()
@@ -539,8 +539,8 @@ def _nearest_rows(robot: Robot, H: np.ndarray, starts: np.ndarray | None, req: R
         row = analytic_one(robot, pin.SE3(H[b, :3, :3], H[b, :3, 3]),
                            req if req.time_budget is None else replace(req, time_budget=left),
                            None if starts is None else starts[b], model)
-        q[b], success[b], status[b] = row.q, row.success, row.status.value
+        q[b], success[b], code[b] = row.q, row.success, row.status.code
         dp[b], dr[b] = row.position_error, row.rotation_error
-    return BatchIKResult(q=q, success=success, status=status, position_error=dp, rotation_error=dr,
+    return BatchIKResult(q=q, success=success, status_code=code, position_error=dp, rotation_error=dr,
                          iterations=np.zeros(B, dtype=int), restarts=np.zeros(B, dtype=int), seed=0,
                          wall_time=time.perf_counter() - t0, solver="analytic", mode=arm.mode)

@@ -27,17 +27,17 @@ NOT_STARTED, STOPPED = -2, -3  # a row's code when the budget ran out before it 
 
 @dataclass
 class Rows:
-    """Raw batch answers before Pinocchio's verdict: q (B, n), status strings, iterations, restarts."""
+    """Raw batch answers before Pinocchio's verdict: q (B, n), :class:`Status` codes, iterations, restarts."""
 
     Q: np.ndarray
-    status: np.ndarray
+    code: np.ndarray
     iterations: np.ndarray
     restarts: np.ndarray
 
     @classmethod
     def unsolved(cls, count: int, n: int) -> Rows:
         """Rows not reached by the budget: NaN q, status time_budget."""
-        return cls(np.full((count, n), np.nan), np.full(count, Status.TIME_BUDGET.value, dtype="<U14"),
+        return cls(np.full((count, n), np.nan), np.full(count, Status.TIME_BUDGET.code, dtype=np.int8),
                    np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64))
 
 
@@ -83,10 +83,10 @@ def run(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts: np.ndar
                      threads.count())
     started = codes != NOT_STARTED
     rows.Q[started] = Q[started]
-    rows.status[started] = np.where(codes[started] == CONVERGED, Status.CONVERGED.value,
-                                    np.where(codes[started] == STOPPED, Status.TIME_BUDGET.value,
-                                             np.where(stats[started, T_STALLS] > 0, Status.STALLED.value,
-                                                      Status.MAX_ITERATIONS.value)))
+    rows.code[started] = np.where(codes[started] == CONVERGED, Status.CONVERGED.code,
+                                  np.where(codes[started] == STOPPED, Status.TIME_BUDGET.code,
+                                           np.where(stats[started, T_STALLS] > 0, Status.STALLED.code,
+                                                    Status.MAX_ITERATIONS.code)))
     rows.iterations[:] = stats[:, T_SWEEPS]
     rows.restarts[:] = np.maximum(0, stats[:, T_ATTEMPTS] - 1)
     continuous = cm.kind == CONTINUOUS

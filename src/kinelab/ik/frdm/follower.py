@@ -76,8 +76,8 @@ def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: 
                    float(rest_weight), REST_SWEEPS, centre, CENTRE_PULL, LM_ITERATIONS if opts.polish else 0,
                    seed_state(seed), deadline, codes, sweeps)
     dp, dr, ok = _judged(robot, Q, points, rotations, task, tol_pos, tol_rot)
-    status = [Status.CONVERGED.value if ok[k] else _STATUS.get(int(codes[k]), Status.MAX_ITERATIONS).value
-              for k in range(count)]
+    status = np.array([Status.CONVERGED.code if ok[k] else _STATUS.get(int(codes[k]), Status.MAX_ITERATIONS).code
+                       for k in range(count)], dtype=np.int8)
     per_sample = (time.perf_counter() - t0) / count  # the kernel and Pinocchio's check of every answer
     events = [SingularEvent("stall", "not diagnosed (compiled follower)", sample=k)
               for k in range(count) if codes[k] in (kernel.STALL_STEP, kernel.STALL_WINDOW)]

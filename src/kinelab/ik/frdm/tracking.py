@@ -141,7 +141,7 @@ class _Path:
         self._by_active: dict[tuple[str, ...], FRDMOptions] = {}
         self.held: dict[str, int] = {}
         self.rows: list[np.ndarray] = []
-        self.figures: list[tuple[float, float, str, int, float]] = []
+        self.figures: list[tuple[float, float, int, int, float]] = []
         self.events: list[SingularEvent] = []
         self.bypasses: list[BypassRecord] = [BypassRecord(s, sample=0, hold="path") for s in settings.restrict]
         budget = req.time_budget
@@ -174,7 +174,7 @@ class _Path:
         self.held = {s: left - 1 for s, left in self.held.items() if left > 1}
         dp, dr, status = self._judged(att, target)
         self.rows.append(att.q)
-        self.figures.append((dp, dr, status.value, att.iterations, time.perf_counter() - t0))
+        self.figures.append((dp, dr, status.code, att.iterations, time.perf_counter() - t0))
         return att.q
 
     def _judged(self, att: Attempt, target: pin.SE3) -> tuple[float, float, Status]:
@@ -194,5 +194,6 @@ class _Path:
     def result(self) -> TrackResult:
         """The path's TrackResult."""
         dp, dr, status, sweeps, times = zip(*self.figures, strict=True) if self.figures else ([],) * 5
-        return TrackResult(np.array(self.rows), np.array(dp), np.array(dr), list(status), np.array(sweeps),
+        return TrackResult(np.array(self.rows), np.array(dp), np.array(dr), np.array(status, dtype=np.int8),
+                           np.array(sweeps, dtype=np.int64),
                            np.array(times), self.events, self.bypasses)

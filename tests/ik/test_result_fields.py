@@ -1,0 +1,64 @@
+"""One vocabulary on every result type: the same field names, and Status members (integer codes inside)."""
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+
+import kinelab
+from kinelab import load
+from kinelab.ik.batch import BatchIKResult
+from kinelab.ik.result import IKResult, Status, TrackResult
+
+SHARED = ("q", "success", "status", "position_error", "rotation_error", "iterations", "wall_time")
+
+
+def names(cls):
+    return {f.name for f in dataclasses.fields(cls)} | {n for n in dir(cls) if isinstance(getattr(cls, n), property)}
+
+
+@pytest.mark.parametrize("cls", [IKResult, BatchIKResult, TrackResult])
+def test_every_result_type_has_the_shared_fields(cls):
+    assert set(SHARED) <= names(cls)
+
+
+def test_codes_and_members_round_trip_and_print_as_their_names():
+    codes = np.arange(len(Status), dtype=np.int8)
+    members = Status.of_codes(codes)
+    assert [m.code for m in members] == codes.tolist()
+    np.testing.assert_array_equal(Status.codes([m.value for m in members]), codes)
+    assert [f"{m}" for m in members] == [m.value for m in Status] == [str(m) for m in members]
+    assert json.dumps(list(members)) == json.dumps([m.value for m in Status])
+    with pytest.raises(ValueError, match="nonsense"):
+        Status.codes(["nonsense"])
+
+
+def test_batch_rows_carry_the_single_solves_status_member():
+    robot = load("ur5")
+    rng = np.random.default_rng(8)
+    targets = [robot.fk(q) for q in robot.random_qs(6, rng)]
+    far = targets[2].copy()
+    far.translation = np.array([9.0, 0.0, 0.0])
+    targets[2] = far
+    batch = kinelab.solve_batch(robot, targets, seed=4)
+    assert batch.status_code.dtype == np.int8
+    for b, target in enumerate(targets):
+        one = kinelab.solve(robot, target, seed=4 + b, time_budget=60.0)
+        assert batch.status[b] is one.status  # the member itself, not a string that looks like it
+    assert batch.status[2] is Status.UNREACHABLE
+    assert batch.summary()["status"] == {"converged": 5, "unreachable": 1}
+
+
+def test_a_track_carries_status_members_and_iterations():
+    robot = load("panda")
+    rng = np.random.default_rng(3)
+    q0 = robot.random_qs(1, rng)[0]
+    path = [robot.fk(q0 + 0.01 * k) for k in range(12)]
+    track = kinelab.track(robot, path, q0=q0)
+    assert all(isinstance(s, Status) for s in track.status)
+    np.testing.assert_array_equal(track.reached, track.status == Status.CONVERGED)
+    np.testing.assert_array_equal(track.sweeps, track.iterations)
+    assert track.iterations.shape == (12,) and track.iterations.min() >= 0
+    counts = track.summary()["status"]
+    assert sum(counts.values()) == 12 and counts.get("converged", 0) == int(track.reached.sum())
