@@ -195,8 +195,7 @@ def _search(robot: Robot, target: Any, req: Request, max_solutions: int | None, 
     rounds = 0
     # a round costs about ROUND_SECONDS of set-up and verdict whatever its budget: none starts in less
     while (left := budget - (time.perf_counter() - t0)) > ROUND_SECONDS and \
-            (max_solutions is None or len(found) < max_solutions) and \
-            (stop_below is None or rounds < MIN_ROUNDS or unseen([f[3] for f in found]) >= stop_below):
+            _wanting(found, rounds, max_solutions, stop_below):
         # each round gets what is left of the budget: the batch stops its rows there
         rnd = replace(req, seed=seed + rounds * ROUND, max_restarts=0, time_budget=left)
         batch = run_batch(robot, [target] * ROUND, None, rnd)
@@ -204,6 +203,15 @@ def _search(robot: Robot, target: Any, req: Request, max_solutions: int | None, 
             _merge(robot, found, batch.q[b], batch.position_error[b], batch.rotation_error[b])
         rounds += 1
     return found, rounds
+
+
+def _wanting(found: list[tuple[np.ndarray, float, float, int]], rounds: int, max_solutions: int | None,
+             stop_below: float | None) -> bool:
+    """Another round may find more: fewer than ``max_solutions`` found, and the stopping rule's estimate of what is
+    unseen still at or above ``stop_below`` (asked only after MIN_ROUNDS rounds)."""
+    if max_solutions is not None and len(found) >= max_solutions:
+        return False
+    return stop_below is None or rounds < MIN_ROUNDS or unseen([f[3] for f in found]) >= stop_below
 
 
 def _merge(robot: Robot, found: list[tuple[np.ndarray, float, float, int]], q: np.ndarray, dp: float,

@@ -50,13 +50,8 @@ def solve_clear(robot: Robot, target: Any, q0: Any, req: Request, model: Collisi
     seed = fresh_seed() if req.seed is None else req.seed
     collided: IKResult | None = None
     runs = 0
-    while runs <= req.max_restarts:
-        left = None if req.time_budget is None else req.time_budget - (time.perf_counter() - t0)
-        if left is not None and left <= 0 and runs:
-            break
-        first = runs == 0 and req.seed is not None  # the request as given: no copy of it on the common path
-        res = solve_one(robot, target, q0 if runs == 0 else None,
-                        req if first else replace(req, seed=seed + runs * STRIDE, time_budget=left))
+    while (run := _run_request(req, seed, runs, t0)) is not None:
+        res = solve_one(robot, target, q0 if runs == 0 else None, run)
         runs += 1
         if not res.success:
             return res if collided is None else _collided(collided, t0, runs - 1, model)
@@ -67,6 +62,19 @@ def solve_clear(robot: Robot, target: Any, q0: Any, req: Request, model: Collisi
         collided = res
     assert collided is not None
     return _collided(collided, t0, runs, model)
+
+
+def _run_request(req: Request, seed: int, runs: int, t0: float) -> Request | None:
+    """The request of the next run after ``runs`` (its own seeds, what is left of the budget counted from t0), or
+    None when the runs or the budget are spent (the first run always starts)."""
+    if runs > req.max_restarts:
+        return None
+    left = None if req.time_budget is None else req.time_budget - (time.perf_counter() - t0)
+    if left is not None and left <= 0 and runs:
+        return None
+    if runs == 0 and req.seed is not None:  # the request as given: no copy of it on the common path
+        return req
+    return replace(req, seed=seed + runs * STRIDE, time_budget=left)
 
 
 def _from_branches(robot: Robot, target: Any, collided: IKResult, q0: Any, req: Request, model: CollisionModel,

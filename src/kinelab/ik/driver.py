@@ -117,37 +117,59 @@ class Call:
         if not (q.dtype == np.float64 and q.ndim == 1 and q.flags.c_contiguous):
             q = np.ascontiguousarray(q, dtype=float)
         q, dp, dr, within = turned_verdict(self.robot, self.target.homogeneous, q, self.task.axis)
-        task = self.task
-        ok = within and (not task.position or dp <= self.tol_pos) and (not task.rotation or dr <= self.tol_rot)
-        return q, ok, dp, dr
+        return q, within and self.met(dp, dr), dp, dr
+
+    def met(self, dp: float, dr: float) -> bool:
+        """The task's components within the tolerances (position error dp [m], rotation error dr [rad])."""
+        return self.task.met(dp, dr, self.tol_pos, self.tol_rot)
+
+
+@dataclass(slots=True)
+class _Tally:
+    """The attempts of one solve so far: the best (by position error / reach + rotation error), and the sums."""
+
+    score: float = np.inf
+    best: Attempt | None = None
+    ok: bool = False
+    dp: float = np.nan
+    dr: float = np.nan
+    iterations: int = 0
+    restarts: int = 0
+    events: list[SingularEvent] = field(default_factory=list)
+    bypasses: list[BypassRecord] = field(default_factory=list)
+
+    def add(self, att: Attempt, ok: bool, dp: float, dr: float, scale: float) -> None:
+        self.iterations += att.iterations
+        self.events += att.events
+        self.bypasses += att.bypasses
+        score = dp / scale + dr
+        if self.best is None or ok or score < self.score:
+            self.score, self.best, self.ok, self.dp, self.dr = score, att, ok, dp, dr
+
+
+def _attempts(module: Any, pb: Call, start: np.ndarray, max_restarts: int, opts: Any, rng: _LazyRng) -> _Tally:
+    """Attempts from the start, then from seeded random starts, each judged, until one succeeds, the budget runs
+    out or the restarts are spent."""
+    robot, tally = pb.robot, _Tally()
+    scale = robot.characteristic_length()
+    for k in range(max_restarts + 1):
+        att = module.attempt(robot, pb.target, start, pb.tol_pos, pb.tol_rot, pb.deadline, opts)
+        att.q, ok, dp, dr = pb.judge(att.q)
+        tally.add(att, ok, dp, dr, scale)
+        pb.finals.append((att.status, dp))
+        if ok or time.perf_counter() > pb.deadline or k == max_restarts:
+            break
+        tally.restarts += 1
+        start = rng.uniform(robot.lower, robot.upper)
+    return tally
 
 
 def _loop(module: Any, pb: Call, start: np.ndarray, max_restarts: int, opts: Any, rng: _LazyRng,
           beyond: float) -> IKResult:
     """Attempts from the start, then from seeded random starts, each judged by Pinocchio."""
-    robot = pb.robot
-    scale = robot.characteristic_length()
-    best: tuple[float, Attempt, float, float] | None = None
-    best_ok = False
-    iterations = restarts = 0
-    events: list[SingularEvent] = []
-    bypasses: list[BypassRecord] = []
-    for k in range(max_restarts + 1):
-        att = module.attempt(robot, pb.target, start, pb.tol_pos, pb.tol_rot, pb.deadline, opts)
-        iterations += att.iterations
-        events += att.events
-        bypasses += att.bypasses
-        att.q, ok, dp, dr = pb.judge(att.q)
-        score = dp / scale + dr
-        if best is None or ok or score < best[0]:
-            best, best_ok = (score, att, dp, dr), ok
-        pb.finals.append((att.status, dp))
-        if ok or time.perf_counter() > pb.deadline or k == max_restarts:
-            break
-        restarts += 1
-        start = rng.uniform(robot.lower, robot.upper)
-    assert best is not None
-    _, att, dp, dr = best
+    tally = _attempts(module, pb, start, max_restarts, opts, rng)
+    att, best_ok, dp, dr = tally.best, tally.ok, tally.dp, tally.dr
+    assert att is not None
     status, message = _status(best_ok, att, pb.finals, beyond, pb.tol_pos, time.perf_counter() > pb.deadline)
     if not best_ok:
         status, message = _outside_limits(pb, att.q, dp, dr, status, message)
@@ -155,8 +177,8 @@ def _loop(module: Any, pb: Call, start: np.ndarray, max_restarts: int, opts: Any
     diag = replace(att.diagnostics, answer_events=tuple(att.events), answer_bypasses=tuple(att.bypasses))
     return IKResult(
         q=att.q, success=best_ok, status=status, position_error=dp, rotation_error=dr,
-        iterations=iterations, restarts=restarts, wall_time=time.perf_counter() - pb.t_start, solver=pb.solver,
-        mode=att.mode or pb.solver, singular_events=events, bypasses=bypasses,
+        iterations=tally.iterations, restarts=tally.restarts, wall_time=time.perf_counter() - pb.t_start,
+        solver=pb.solver, mode=att.mode or pb.solver, singular_events=tally.events, bypasses=tally.bypasses,
         message=_explained(pb, status, message), diagnostics=diag, task=pb.task_label,
         judge=pb.robot.fk_certificate.judge,
     )
@@ -195,20 +217,25 @@ def _outside_limits(pb: Call, q: np.ndarray, dp: float, dr: float, status: Statu
                     message: str) -> tuple[Status, str]:
     """A failed answer with a joint outside its limits: status OUTSIDE_LIMITS when the task's components are
     met (only the limits fail), the joint named either way."""
-    robot = pb.robot
+    where = _outside_where(pb.robot, q)
+    if where is None:
+        return status, message
+    if pb.met(dp, dr) and status is not Status.UNREACHABLE:  # proved out of reach within the limits: that says more
+        return Status.OUTSIDE_LIMITS, f"the {pb.task.constrained} are met, but only with {where}"
+    return status, f"{message}; the best answer has {where}" if message else f"the best answer has {where}"
+
+
+def _outside_where(robot: Robot, q: np.ndarray) -> str | None:
+    """The first joint of q outside its limits, named with its value and limits (and how many more), or None."""
     lower, upper = robot.check_bounds
     outside = [i for i in range(robot.n) if not lower[i] <= q[i] <= upper[i]]
     if not outside:
-        return status, message
+        return None
     i = outside[0]
     unit = "m" if robot.joint_kinds[i] == "prismatic" else "rad"
-    where = (f"joint {robot.joint_names[i]!r} at {q[i]:.6g} {unit}, outside its limits "
-             f"[{robot.lower[i]:.6g}, {robot.upper[i]:.6g}]"
-             + (f" (and {len(outside) - 1} more)" if len(outside) > 1 else ""))
-    met = (not pb.task.position or dp <= pb.tol_pos) and (not pb.task.rotation or dr <= pb.tol_rot)
-    if met and status is not Status.UNREACHABLE:  # proved out of reach within the limits: that says more
-        return Status.OUTSIDE_LIMITS, f"the {pb.task.constrained} are met, but only with {where}"
-    return status, f"{message}; the best answer has {where}" if message else f"the best answer has {where}"
+    more = f" (and {len(outside) - 1} more)" if len(outside) > 1 else ""
+    return f"joint {robot.joint_names[i]!r} at {q[i]:.6g} {unit}, outside its limits " \
+           f"[{robot.lower[i]:.6g}, {robot.upper[i]:.6g}]{more}"
 
 
 def _explained(pb: Call, status: Status, message: str) -> str:
@@ -223,17 +250,26 @@ def _explained(pb: Call, status: Status, message: str) -> str:
     return f"{message}; {note}" if message else note
 
 
+def _agreed_distance(finals: list[tuple[Status, float]], tol_pos: float) -> float | None:
+    """The distance [m] at which at least three starts, all of them, stopped at a stationary point short of the
+    target and agreeing to 0.1 % (the sign of a target out of the workspace), or None."""
+    stationary = [dp for st, dp in finals if st in (Status.STALLED, Status.SINGULAR)]
+    if len(stationary) < 3 or len(stationary) != len(finals) or min(stationary) <= tol_pos:
+        return None
+    low = min(stationary)
+    return low if max(stationary) - low <= 1e-3 * low + 1e-9 else None
+
+
 def _status(success: bool, att: Attempt, finals: list[tuple[Status, float]], beyond: float, tol_pos: float,
             out_of_time: bool) -> tuple[Status, str]:
     if success:
         return Status.CONVERGED, ""
     if beyond > 0:
         return Status.UNREACHABLE, f"the target position is at least {beyond:.4g} m beyond the robot's reach"
-    stationary = [dp for st, dp in finals if st in (Status.STALLED, Status.SINGULAR)]
-    agree = len(stationary) >= 3 and len(stationary) == len(finals) and min(stationary) > tol_pos
-    if agree and max(stationary) - min(stationary) <= 1e-3 * min(stationary) + 1e-9:
+    agreed = _agreed_distance(finals, tol_pos)
+    if agreed is not None:
         return Status.UNREACHABLE, (
-            f"every one of {len(finals)} starts stopped at a stationary point {min(stationary):.4g} m from the "
+            f"every one of {len(finals)} starts stopped at a stationary point {agreed:.4g} m from the "
             "target: it is very likely out of the workspace"
         )
     if att.status == Status.CONVERGED:  # the solver's own test passed but Pinocchio's or the limits did not

@@ -85,14 +85,18 @@ def positive(name: str, value: object, *, allow_none: bool = False, integer: boo
     """Refuse anything but a finite number > 0 (≥ 0 with ``zero``; an int with ``integer``)."""
     if value is None and allow_none:
         return
-    kind = "an integer" if integer else "a finite number"
-    bound = "≥ 0" if zero else "> 0 (positive)"
-    ok_type = isinstance(value, numbers.Integral if integer else numbers.Real)
-    if isinstance(value, bool) or not ok_type:
+    if not _in_range(value, integer, zero):
+        kind = "an integer" if integer else "a finite number"
+        bound = "≥ 0" if zero else "> 0 (positive)"
         raise OptionError(name, value, f"{kind} {bound}" + (" or None" if allow_none else ""))
-    number = float(value)  # type: ignore[arg-type]
-    if not math.isfinite(number) or number < 0 or (number == 0 and not zero):
-        raise OptionError(name, value, f"{kind} {bound}" + (" or None" if allow_none else ""))
+
+
+def _in_range(value: object, integer: bool, zero: bool) -> bool:
+    """A number (not a bool; an integer with ``integer``), finite and > 0 (≥ 0 with ``zero``)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral if integer else numbers.Real):
+        return False
+    number = float(value)
+    return math.isfinite(number) and (number > 0 or (zero and number == 0))
 
 
 def finite(name: str, value: object) -> None:

@@ -134,6 +134,11 @@ def check_arguments(tol_pos: Any, tol_rot: Any, time_budget: Any, max_restarts: 
     _check_positive("tol_rot", tol_rot, TOL_FLOOR)
     if time_budget is not None:
         _check_positive("time_budget", time_budget, 0.0)
+    _check_counts(max_restarts, seed, start_outside_limits)
+
+
+def _check_counts(max_restarts: Any, seed: Any, start_outside_limits: Any) -> None:
+    """:func:`check_arguments` on the restart count, the seed and the start policy."""
     if not count_ok(max_restarts) or max_restarts > MAX_RESTARTS:
         raise OptionError("max_restarts", max_restarts, f"an integer from 0 to {MAX_RESTARTS:,} (the kernels count "
                           "attempts in 32-bit integers; a time_budget bounds a long search)")

@@ -123,9 +123,7 @@ def as_target_arrays(targets: Any) -> tuple[np.ndarray, np.ndarray]:
 def _stack(targets: Any) -> np.ndarray:
     """The targets as an (N, 4, 4) float array (N ≥ 1), or a TargetError naming the first that is no pose."""
     if isinstance(targets, np.ndarray) and targets.dtype.kind in "fiu":
-        if targets.ndim != 3 or targets.shape[1:] != (4, 4) or targets.shape[0] == 0:
-            raise TargetError(f"targets as an array must have shape (N, 4, 4) with N ≥ 1, got {targets.shape}")
-        return np.asarray(targets, dtype=float)
+        return _array_stack(targets)
     try:
         items = list(targets)
     except TypeError:
@@ -133,13 +131,26 @@ def _stack(targets: Any) -> np.ndarray:
     if not items:
         raise TargetError("targets is empty: give at least one pin.SE3")
     for k, target in enumerate(items):
-        if type(target) is pin.SE3:  # the usual case, first: this loop is most of a large batch's reading
-            continue
-        if isinstance(target, DualQuat):
-            try:
-                items[k] = as_target(target)
-            except TargetError as err:
-                raise TargetError(f"targets[{k}]: {err}") from None
-        elif not isinstance(target, pin.SE3):
-            raise TargetError(f"targets[{k}] must be a pin.SE3 (or a unit DualQuat), got {type(target).__name__}")
+        if type(target) is not pin.SE3:  # the usual case passes at once: this loop is most of a large batch's reading
+            items[k] = _item(k, target)
     return np.array([t.homogeneous for t in items])
+
+
+def _array_stack(targets: np.ndarray) -> np.ndarray:
+    """A numeric array of targets as (N, 4, 4) floats, or a TargetError naming the shape it has."""
+    if targets.ndim != 3 or targets.shape[1:] != (4, 4) or targets.shape[0] == 0:
+        raise TargetError(f"targets as an array must have shape (N, 4, 4) with N ≥ 1, got {targets.shape}")
+    return np.asarray(targets, dtype=float)
+
+
+def _item(k: int, target: Any) -> pin.SE3:
+    """targets[k] that is not exactly a ``pin.SE3``: a subclass as it is, a unit DualQuat as its pose, else a
+    TargetError naming the index."""
+    if isinstance(target, DualQuat):
+        try:
+            return as_target(target)
+        except TargetError as err:
+            raise TargetError(f"targets[{k}]: {err}") from None
+    if not isinstance(target, pin.SE3):
+        raise TargetError(f"targets[{k}] must be a pin.SE3 (or a unit DualQuat), got {type(target).__name__}")
+    return target

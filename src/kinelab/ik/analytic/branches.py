@@ -178,20 +178,24 @@ def judged_roots(robot: Robot, q: np.ndarray, found: np.ndarray, free: np.ndarra
     judge = robot.derived("compiled judge", _compiled_judge)
     m = q.shape[0]
     if judge is None or m == 0:
-        return [(*v, int(found[k]), bool(free[k])) for k in range(m)
-                if (v := judged(robot, q[k], target, req, held)) is not None]
+        return _judged_each(robot, q, found, free, target, req, held)
     dp, dr, inside = np.empty(m), np.empty(m), np.empty(m, dtype=np.uint8)
     lower, upper = robot.check_bounds
     judge.verdicts(target.homogeneous, q, lower, upper, dp, dr, inside)
     answers = []
     for k, (p, r, within) in enumerate(zip(dp.tolist(), dr.tolist(), inside.tolist(), strict=True)):
-        if within and p <= req.tol_pos and r <= req.tol_rot:
-            answers.append((q[k], p, r, False, int(found[k]), bool(free[k])))
-        elif near_enough(p, r, req):
-            v = judged(robot, q[k], target, req, held)
-            if v is not None:
-                answers.append((*v, int(found[k]), bool(free[k])))
+        v = (q[k], p, r, False) if within and p <= req.tol_pos and r <= req.tol_rot else \
+            judged(robot, q[k], target, req, held) if near_enough(p, r, req) else None
+        if v is not None:
+            answers.append((*v, int(found[k]), bool(free[k])))
     return answers
+
+
+def _judged_each(robot: Robot, q: np.ndarray, found: np.ndarray, free: np.ndarray, target: Any, req: Request,
+                 held: dict[str, float] | None) -> list[Answer]:
+    """:func:`judged_roots` root by root with Pinocchio's FK (a robot whose compiled FK is not its judge)."""
+    return [(*v, int(found[k]), bool(free[k])) for k in range(q.shape[0])
+            if (v := judged(robot, q[k], target, req, held)) is not None]
 
 
 def branch_results(robot: Robot, rows: Rows, req: Request, mode: str, elapsed: float, max_solutions: int | None,
@@ -451,7 +455,26 @@ def analytic_one(robot: Robot, target: Any, req: Request, q0: np.ndarray | None,
     t0 = time.perf_counter()
     arm = arm_of(robot, req)
     q, found, free, order = nearest_roots(robot, arm, target, req, q0)
-    mode, collided = arm.mode, None
+    k, verdict, collided = _first_clear(robot, q, order, target, req, model)
+    if verdict is not None:
+        answer, dp, dr, finished = verdict
+        return IKResult(q=answer, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr,
+                        iterations=0, restarts=0, wall_time=time.perf_counter() - t0, solver="analytic",
+                        mode=arm.mode, message=CONTINUUM if free[k] else "", task=req.task_label,
+                        diagnostics=Diagnostics(path="compiled", branches=q.shape[0], found=int(found[k]),
+                                                polished=1 if finished else None,
+                                                clear_after=None if model is None else 0))
+    contact = None if collided is None or model is None else model.contact(collided[0])
+    if collided is None and arm.searched and not beyond_reach(robot, target.translation):
+        return _numeric_check(robot, target, req, q0, t0)
+    return _no_branch(robot, target, req, q0, q.shape[0], (collided, contact), arm.mode, t0)
+
+
+def _first_clear(robot: Robot, q: np.ndarray, order: Any, target: Any, req: Request,
+                 model: CollisionModel | None) -> tuple[int, Any, Any]:
+    """(index, verdict) of the first root in ``order`` the judge confirms and ``model`` finds clear ((−1, None)
+    when none is), and the verdict of the first confirmed one that collides (None when none did)."""
+    collided = None
     for k in order:
         verdict = judged(robot, q[k], target, req)
         if verdict is None:
@@ -459,17 +482,8 @@ def analytic_one(robot: Robot, target: Any, req: Request, q0: np.ndarray | None,
         if model is not None and model.colliding_pair(verdict[0]) is not None:
             collided = collided or verdict
             continue
-        answer, dp, dr, finished = verdict
-        return IKResult(q=answer, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr,
-                        iterations=0, restarts=0, wall_time=time.perf_counter() - t0, solver="analytic", mode=mode,
-                        message=CONTINUUM if free[k] else "", task=req.task_label,
-                        diagnostics=Diagnostics(path="compiled", branches=q.shape[0], found=int(found[k]),
-                                                polished=1 if finished else None,
-                                                clear_after=None if model is None else 0))
-    contact = None if collided is None or model is None else model.contact(collided[0])
-    if collided is None and arm.searched and not beyond_reach(robot, target.translation):
-        return _numeric_check(robot, target, req, q0, t0)
-    return _no_branch(robot, target, req, q0, q.shape[0], (collided, contact), mode, t0)
+        return int(k), verdict, collided
+    return -1, None, collided
 
 
 def _numeric_check(robot: Robot, target: Any, req: Request, q0: np.ndarray | None, t0: float) -> IKResult:

@@ -115,21 +115,31 @@ def classify_vectors(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarra
     for searched in (False, True):
         for mirrored in (False, True):
             hh, oo, RR, NN = reverse(h, o, R0, N0) if mirrored else (h, o, R0, N0)
-            misses = []
-            for kind, name, test in CLASSES[h.shape[0]]:
-                if (kind >= SEARCH_6R) != searched:
-                    continue
-                missed = test(hh, oo)
-                if isinstance(missed, np.ndarray):  # in the class: the points it solves with
-                    name += " (mirrored: read from the tool)" if mirrored else ""
-                    return Classification(ArmClass(name, kind, mirrored, hh, missed, RR, NN), "")
-                misses.append(missed)
+            arm, misses = _first_class(hh, oo, RR, NN, searched, mirrored)
+            if arm is not None:
+                return Classification(arm, "")
             if not searched:
                 failed.append(("read from the tool: " if mirrored else "") + " / ".join(misses))
     if h.shape[0] == 6:
         failed.append("nor a 1-D search class (two consecutive wrist axes meeting, with axes 2, 3 parallel or axes "
                       "1, 2 or 2, 3 meeting, read either way)")
     return Classification(None, " | ".join(failed))
+
+
+def _first_class(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray, searched: bool,
+                 mirrored: bool) -> tuple[ArmClass | None, list[str]]:
+    """The first class of the chain (h, o, R0, N0) among the closed forms (or, with ``searched``, the search
+    classes), and the tests each class before it failed."""
+    misses: list[str] = []
+    for kind, name, test in CLASSES[h.shape[0]]:
+        if (kind >= SEARCH_6R) != searched:
+            continue
+        missed = test(h, o)
+        if isinstance(missed, np.ndarray):  # in the class: the points it solves with
+            label = name + (" (mirrored: read from the tool)" if mirrored else "")
+            return ArmClass(label, kind, mirrored, h, missed, R0, N0), misses
+        misses.append(missed)
+    return None, misses
 
 
 def _parallel(h: np.ndarray, o: np.ndarray) -> np.ndarray | str:

@@ -61,28 +61,51 @@ def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: 
     count = points.shape[0]
     Q, codes, sweeps = np.empty((count, robot.n)), np.empty(count, dtype=np.int64), np.empty(count, dtype=np.int64)
     order = ORDERS[opts.order if opts.order != "mixed" else "tip2base"]
-    bounded = np.isfinite(cm.lower) & np.isfinite(cm.upper)
-    centre = np.where(bounded, (np.where(bounded, cm.lower, 0.0) + np.where(bounded, cm.upper, 0.0)) / 2, q0)
-    lower, upper = (cm.lower, cm.upper) if opts.use_limits else (np.full(cm.n, -np.inf), np.full(cm.n, np.inf))
     t0 = time.perf_counter()
-    # the kernel stops early enough to leave time for the verdict on every sample (≈ 2 µs each, cold)
-    deadline = np.inf if time_budget is None else (t0 if t_start is None else t_start) + float(time_budget) - \
-        verdict_reserve(float(time_budget)) - 2e-6 * count
-    shared = kernel.Objective(lower, upper, np.ones(cm.n, dtype=np.bool_), np.zeros(3), np.eye(3),
-                              opts.position_weight(cm.length), opts.axis_weights(), float(tol_pos), float(tol_rot),
-                              opts.mode != "orientation", opts.mode != "position", kernel.no_rest(cm.n), 0.0, -1)
-    _follow.follow(Q, np.array(q0, dtype=float), cm.chain, shared, np.ascontiguousarray(points, dtype=float),
-                   np.ascontiguousarray(rotations, dtype=float), opts.settings(), order, int(max_sweeps),
-                   float(rest_weight), REST_SWEEPS, centre, CENTRE_PULL, LM_ITERATIONS if opts.polish else 0,
-                   seed_state(seed), deadline, codes, sweeps)
+    deadline = _deadline(time_budget, t0 if t_start is None else t_start, count)
+    _follow.follow(Q, np.array(q0, dtype=float), cm.chain, _objective(cm, opts, tol_pos, tol_rot),
+                   np.ascontiguousarray(points, dtype=float), np.ascontiguousarray(rotations, dtype=float),
+                   opts.settings(), order, int(max_sweeps), float(rest_weight), REST_SWEEPS, _centre(cm, q0),
+                   CENTRE_PULL, LM_ITERATIONS if opts.polish else 0, seed_state(seed), deadline, codes, sweeps)
     dp, dr, ok = _judged(robot, Q, points, rotations, task, tol_pos, tol_rot)
-    status = np.array([Status.CONVERGED.code if ok[k] else _STATUS.get(int(codes[k]), Status.MAX_ITERATIONS).code
-                       for k in range(count)], dtype=np.int8)
     per_sample = (time.perf_counter() - t0) / count  # the kernel and Pinocchio's check of every answer
-    events = [SingularEvent("stall", "not diagnosed (compiled follower)", sample=k)
-              for k in range(count) if codes[k] in (kernel.STALL_STEP, kernel.STALL_WINDOW)]
-    return TrackResult(Q, dp, dr, status, sweeps, np.full(count, per_sample), events, [],
+    return TrackResult(Q, dp, dr, _statuses(ok, codes), sweeps, np.full(count, per_sample), _stall_events(codes), [],
                        mode=opts.label + ("+lm" if opts.polish else "") + " (compiled follower)")
+
+
+def _deadline(time_budget: float | None, t_start: float, count: int) -> float:
+    """When the kernel stops: early enough to leave time for the verdict on every sample (≈ 2 µs each, cold)."""
+    if time_budget is None:
+        return float(np.inf)
+    return t_start + float(time_budget) - verdict_reserve(float(time_budget)) - 2e-6 * count
+
+
+def _statuses(ok: np.ndarray, codes: np.ndarray) -> np.ndarray:
+    """Each sample's Status code: converged where the judge confirmed it, else why the kernel stopped."""
+    return np.array([Status.CONVERGED.code if ok[k] else _STATUS.get(int(codes[k]), Status.MAX_ITERATIONS).code
+                     for k in range(codes.shape[0])], dtype=np.int8)
+
+
+def _stall_events(codes: np.ndarray) -> list[SingularEvent]:
+    """One undiagnosed stall event per sample at which the follower's monitor fired."""
+    return [SingularEvent("stall", "not diagnosed (compiled follower)", sample=k)
+            for k in range(codes.shape[0]) if codes[k] in (kernel.STALL_STEP, kernel.STALL_WINDOW)]
+
+
+def _centre(cm: Any, q0: np.ndarray) -> np.ndarray:
+    """The middle of each bounded joint's limits (q0's value for an unbounded joint) [rad or m]."""
+    bounded = np.isfinite(cm.lower) & np.isfinite(cm.upper)
+    middle = (np.where(bounded, cm.lower, 0.0) + np.where(bounded, cm.upper, 0.0)) / 2
+    centre: np.ndarray = np.where(bounded, middle, q0)
+    return centre
+
+
+def _objective(cm: Any, opts: FRDMOptions, tol_pos: float, tol_rot: float) -> Any:
+    """The follower's objective shared by every sample (the target set per sample by the kernel)."""
+    lower, upper = (cm.lower, cm.upper) if opts.use_limits else (np.full(cm.n, -np.inf), np.full(cm.n, np.inf))
+    return kernel.Objective(lower, upper, np.ones(cm.n, dtype=np.bool_), np.zeros(3), np.eye(3),
+                            opts.position_weight(cm.length), opts.axis_weights(), float(tol_pos), float(tol_rot),
+                            opts.mode != "orientation", opts.mode != "position", kernel.no_rest(cm.n), 0.0, -1)
 
 
 def _judged(robot: Robot, Q: np.ndarray, points: np.ndarray, rotations: np.ndarray, task: Task, tol_pos: float,

@@ -167,19 +167,26 @@ class Runner:
                 if time.perf_counter() > deadline:
                     return Status.TIME_BUDGET
                 continue
-            diagnosis = self._event(code)
-            if len(self.bypass_log) >= max_events or self.next_bypass >= len(policy):
-                return Status.SINGULAR if diagnosis == "singular" else Status.STALLED
-            step = policy[self.next_bypass]
-            if step == "auto_kick" and diagnosis != "singular":
-                return Status.STALLED  # a kick does not leave a local minimum; a restart does
-            self.next_bypass += 1
-            self.q = self.apply(bypass, step, self.q)
-            self.reset_history()
-            # leaving a singularity starts slowly (the kick grows by a factor per sweep): judge it patiently
-            self.settings = self.settings._replace(window=max(self.settings.window, 100),
-                                                   window_rel=min(self.settings.window_rel, 1e-6))
-            self.max_sweeps = max(self.max_sweeps, self.sweeps + 1000)
+            ended = self._bypassed(self._event(code), bypass, policy, max_events)
+            if ended is not None:
+                return ended
+
+    def _bypassed(self, diagnosis: str, bypass: Bypass, policy: tuple[str, ...], max_events: int) -> Status | None:
+        """The policy's next bypass applied after a monitor event (None: the run goes on), or the status the run
+        ends with when the policy has no answer to it."""
+        if len(self.bypass_log) >= max_events or self.next_bypass >= len(policy):
+            return Status.SINGULAR if diagnosis == "singular" else Status.STALLED
+        step = policy[self.next_bypass]
+        if step == "auto_kick" and diagnosis != "singular":
+            return Status.STALLED  # a kick does not leave a local minimum; a restart does
+        self.next_bypass += 1
+        self.q = self.apply(bypass, step, self.q)
+        self.reset_history()
+        # leaving a singularity starts slowly (the kick grows by a factor per sweep): judge it patiently
+        self.settings = self.settings._replace(window=max(self.settings.window, 100),
+                                               window_rel=min(self.settings.window_rel, 1e-6))
+        self.max_sweeps = max(self.max_sweeps, self.sweeps + 1000)
+        return None
 
     def _event(self, code: int) -> str:
         sigma = _scaled_sigma_min(self.robot, self.q, self.vm.length)

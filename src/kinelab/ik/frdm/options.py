@@ -150,18 +150,11 @@ class FRDMOptions:
             table = getattr(self, name)
             if table is not None and not isinstance(table, dict):
                 raise OptionError(name, table, "a dict joint name → value")
-        for name, delta in (self.kicks or {}).items():
-            if not _nonzero_finite(delta):
-                raise OptionError("kicks", {name: delta}, "a finite non-zero δ per joint [rad or m]")
-        for name, window in (self.intervals or {}).items():
-            if not _interval(window):
-                raise OptionError("intervals", {name: window}, "a non-empty (lower, upper) per joint",
-                                  f"bypass interval for {name!r} is empty or malformed: {window!r}")
-        for name, value in (self.freeze or {}).items():
-            if value is not None and not (isinstance(value, numbers.Real) and not isinstance(value, bool)
-                                          and math.isfinite(value)):
-                raise OptionError("freeze", {name: value}, "a finite value per joint [rad or m], or None (where "
-                                  "the joint is)")
+        _check_entries("kicks", self.kicks, _nonzero_finite, "a finite non-zero δ per joint [rad or m]")
+        _check_entries("intervals", self.intervals, _interval, "a non-empty (lower, upper) per joint",
+                       "bypass interval for {name!r} is empty or malformed: {value!r}")
+        _check_entries("freeze", self.freeze, _held_value,
+                       "a finite value per joint [rad or m], or None (where the joint is)")
         for name in ("policy", "active"):
             steps = getattr(self, name)
             if steps is not None:
@@ -271,6 +264,21 @@ def _hashable(value: object) -> object:
     if isinstance(value, dict):
         return tuple(sorted((k, tuple(v) if isinstance(v, list) else v) for k, v in value.items()))
     return value
+
+
+def _check_entries(option: str, table: dict[str, Any] | None, ok: Any, valid: str, message: str | None = None) -> None:
+    """Refuse the first entry of a bypass table that ``ok`` rejects (``message`` formatted with its name and value,
+    or the usual one naming the option)."""
+    for name, value in (table or {}).items():
+        if not ok(value):
+            raise OptionError(option, {name: value}, valid,
+                              None if message is None else message.format(name=name, value=value))
+
+
+def _held_value(value: object) -> bool:
+    """A frozen joint's value: a finite real [rad or m], or None (where the joint is)."""
+    return value is None or (isinstance(value, numbers.Real) and not isinstance(value, bool)
+                             and math.isfinite(value))
 
 
 def _nonzero_finite(value: object) -> bool:

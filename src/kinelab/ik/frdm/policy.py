@@ -28,13 +28,18 @@ def bypass_plan(tables: dict[str, Any], on_singular: tuple[str, ...] = ()) -> di
     Raises:
         OptionError: a name in ``on_singular`` that is not a bypass, or one whose table was not given.
     """
+    _check_switched(tables, on_singular)
+    switched = tuple(SWITCHABLE[name] for name in on_singular)
+    held = tuple(key for key in ("intervals", "freeze") if key in tables and key not in switched)
+    policy = switched + (("kicks",) if "kicks" in tables and "kicks" not in switched else ())
+    return {**({"active": held} if held else {}), "policy": policy or ("auto_kick",)}
+
+
+def _check_switched(tables: dict[str, Any], on_singular: tuple[str, ...]) -> None:
+    """Refuse a name in ``on_singular`` that is no bypass, or one whose table was not given."""
     for name in on_singular:
         if name not in SWITCHABLE:
             raise OptionError("on_singular", name, ", ".join(SWITCHABLE))
         if SWITCHABLE[name] not in tables:
             raise OptionError("on_singular", name, f"a bypass with its table: {name!r} needs its joints "
                               f"(--{name} JOINT=... on the command line, {SWITCHABLE[name]}= in Python)")
-    switched = tuple(SWITCHABLE[name] for name in on_singular)
-    held = tuple(key for key in ("intervals", "freeze") if key in tables and key not in switched)
-    policy = switched + (("kicks",) if "kicks" in tables and "kicks" not in switched else ())
-    return {**({"active": held} if held else {}), "policy": policy or ("auto_kick",)}

@@ -50,7 +50,12 @@ def revolute_step(e, o, p, R, pstar, Rstar, w_p, w_ax, window=(-np.inf, np.inf))
     C = e @ (w_p * np.cross(r, d) + sum(w_ax[j] * np.cross(R[:, j], Rstar[:, j]) for j in range(3)))
     if B == 0 and C == 0:
         return 0.0
-    best = np.arctan2(C, B)
+    return _within_window(np.arctan2(C, B), window)
+
+
+def _within_window(best: float, window: tuple[float, float]) -> float:
+    """The copy of the angle ``best`` [rad] (modulo 2π) inside ``window`` nearest 0, or the window's edge where E
+    is least when no copy is inside (E is a cosine in the angle)."""
     lo, hi = window
     if np.isinf(lo) and np.isinf(hi):
         return best

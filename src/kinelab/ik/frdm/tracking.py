@@ -156,26 +156,42 @@ class _Path:
     def sample(self, k: int, target: pin.SE3, q_prev: np.ndarray) -> np.ndarray:
         """Solve sample k warm-started from q_prev, switching a restriction on if a monitor fires."""
         t0 = time.perf_counter()
-        restrict, hold = self.settings.restrict, self.settings.hold
-        active = (*restrict, *(s for s, left in self.held.items() if left > 0 and s not in restrict))
+        active = self._active()
         att = self._solve(target, q_prev, active)
-        step = float(np.max(np.abs(att.q - q_prev)))
-        jump_limit = self.settings.jump_limit
-        jumped = jump_limit is not None and step > jump_limit
+        jumped = self._jumped(k, att, q_prev)
         self.events += [ev.at_sample(k) for ev in att.events]
-        if jumped:
-            self.events.append(SingularEvent("jump", sample=k, max_joint_step=step))
-        pending = [s for s in self.restrictions if s not in active]
-        if (att.events or jumped) and (att.status != Status.CONVERGED or jumped) and pending:
-            self.held[pending[0]] = hold
-            self.bypasses.append(BypassRecord(pending[0], sample=k, hold=hold))
-            att = self._solve(target, q_prev, (*active, pending[0]))
+        if jumped or (att.events and att.status != Status.CONVERGED):
+            att = self._restricted(k, target, q_prev, active) or att
         self.bypasses += [b.at_sample(k) for b in att.bypasses if b.bypass not in RESTRICTIONS]
         self.held = {s: left - 1 for s, left in self.held.items() if left > 1}
         dp, dr, status = self._judged(att, target)
         self.rows.append(att.q)
         self.figures.append((dp, dr, status.code, att.iterations, time.perf_counter() - t0))
         return att.q
+
+    def _active(self) -> tuple[str, ...]:
+        """The restrictions on for the next sample: those asked for, then those a monitor switched on and still held."""
+        restrict = self.settings.restrict
+        return (*restrict, *(s for s, left in self.held.items() if left > 0 and s not in restrict))
+
+    def _restricted(self, k: int, target: pin.SE3, q_prev: np.ndarray, active: tuple[str, ...]) -> Attempt | None:
+        """Sample k solved again with the next restriction not yet active switched on (held for ``hold`` samples,
+        logged), or None when every one is active."""
+        pending = [s for s in self.restrictions if s not in active]
+        if not pending:
+            return None
+        self.held[pending[0]] = self.settings.hold
+        self.bypasses.append(BypassRecord(pending[0], sample=k, hold=self.settings.hold))
+        return self._solve(target, q_prev, (*active, pending[0]))
+
+    def _jumped(self, k: int, att: Attempt, q_prev: np.ndarray) -> bool:
+        """Sample k's answer moved a joint more than the jump limit from q_prev (the event logged when it did)."""
+        step = float(np.max(np.abs(att.q - q_prev)))
+        limit = self.settings.jump_limit
+        if limit is None or step <= limit:
+            return False
+        self.events.append(SingularEvent("jump", sample=k, max_joint_step=step))
+        return True
 
     def _judged(self, att: Attempt, target: pin.SE3) -> tuple[float, float, Status]:
         """Pinocchio's verdict on the sample: the task's components within tolerance and q within the limits
