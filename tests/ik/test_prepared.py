@@ -1,5 +1,5 @@
-"""The prepared solver's lean call (kinelab.ik.lean) gives kinelab.solve's results: same q, verdict, status,
-counts and diagnostics for the same seed, on the usual call and on every input it hands to the general path."""
+"""The prepared solver's lean call (kinelab.ik.prepared.LeanFRDM) gives kinelab.solve's results: same q, verdict,
+status, counts and diagnostics for the same seed, on the usual call and on every input it hands to the general path."""
 
 from __future__ import annotations
 

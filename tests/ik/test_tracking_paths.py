@@ -9,7 +9,7 @@ import pytest
 
 import kinelab
 from kinelab.core._follow import pose_between_of as pose_between
-from kinelab.ik.workspace import out_of_reach
+from kinelab.ik.targets import out_of_reach
 from kinelab.report.bench.protocol import path_set
 from kinelab.studies import paper000_era as ep
 

@@ -35,7 +35,7 @@ def test_fk_points_are_reachable_and_points_beyond_the_reach_are_not(ur5):
     points = np.array([ur5.fk(ur5.random_q(rng)).translation for _ in range(40)])
     values = reach.compute_chunk(ur5, spec, points, 0)
     assert (values["reachability"] > 0).mean() >= 0.9  # measured: 40 of 40
-    from kinelab.ik.workspace import reach_bound
+    from kinelab.ik.targets import reach_bound
 
     anchor, radius = reach_bound(ur5)
     far = np.asarray(anchor) + 1.05 * radius * grid.axis_rotations(16)[:, :, 2]

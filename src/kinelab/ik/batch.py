@@ -26,8 +26,7 @@ from kinelab.ik.multistart import seed_states
 from kinelab.ik.registry import capabilities
 from kinelab.ik.request import Request
 from kinelab.ik.result import Status, status_counts
-from kinelab.ik.targets import as_target_arrays
-from kinelab.ik.workspace import reach_bound
+from kinelab.ik.targets import as_target_arrays, reach_bound
 from kinelab.robot import Robot
 
 # [s] kept out of the solvers' share of a budget: Pinocchio's FK and error per row (about 7 µs on a busy 2-core

@@ -24,8 +24,7 @@ from kinelab.ik.limits import distance as distance  # exported: the branch dista
 from kinelab.ik.registry import Capabilities
 from kinelab.ik.request import Request, check_seed, count_ok, make_request
 from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
-from kinelab.ik.targets import as_target
-from kinelab.ik.workspace import beyond_reach
+from kinelab.ik.targets import as_target, beyond_reach
 from kinelab.robot import Robot
 
 SAME = 1e-3  # [rad or m] two answers closer than this, joint by joint, are one solution (answers met to 1e-6 m

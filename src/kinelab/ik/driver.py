@@ -19,9 +19,8 @@ import pinocchio as pin
 from kinelab.ik.limits import turned_verdict, wrap_q
 from kinelab.ik.request import Request, verdict_reserve
 from kinelab.ik.result import Attempt, BypassRecord, IKResult, SingularEvent, Status
-from kinelab.ik.targets import as_target
+from kinelab.ik.targets import as_target, out_of_reach
 from kinelab.ik.tasks import COMPONENTS, POSE, Task
-from kinelab.ik.workspace import out_of_reach
 from kinelab.robot import Robot
 
 

@@ -1,16 +1,19 @@
-"""Targets for IK: a ``pin.SE3`` of the tool in the robot's base frame, and helpers that build one."""
+"""Targets for IK: a ``pin.SE3`` of the tool in the robot's base frame, helpers that build one, the checks a target
+meets, and the reach bound (a cheap, certain test that a target position is out of reach)."""
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from kinelab.core._verdict import NOT_A_ROTATION, NOT_FINITE, NOT_HOMOGENEOUS, first_defect, pose_defect
 from kinelab.dq.algebra import DualQuat
 from kinelab.errors import TargetError
-from kinelab.ik.verdict import NOT_A_ROTATION, NOT_FINITE, NOT_HOMOGENEOUS, first_defect, pose_defect
+from kinelab.robot import Robot
 
 
 def from_xyz_rpy(xyz: ArrayLike, rpy: ArrayLike = (0.0, 0.0, 0.0), *, degrees: bool = False) -> pin.SE3:
@@ -154,3 +157,35 @@ def _item(k: int, target: Any) -> pin.SE3:
     if not isinstance(target, pin.SE3):
         raise TargetError(f"targets[{k}] must be a pin.SE3 (or a unit DualQuat), got {type(target).__name__}")
     return target
+
+
+# -- the reach bound: a cheap, certain test that a target position is out of reach ---------------------------
+def _reach(robot: Robot) -> tuple[tuple[float, float, float], float]:
+    q = robot.neutral()
+    oMi = list(robot.joint_placements(q).values())
+    anchor = robot.model.jointPlacements[1].translation  # where joint 1 sits, fixed in the base
+    points = [anchor] + [m.translation for m in oMi] + [robot.fk(q).translation]
+    # each distance between consecutive points is rigid, except along a prismatic joint's slide
+    rigid = sum(float(np.linalg.norm(b - a)) for a, b in zip(points, points[1:], strict=False))
+    slides = sum(
+        max(abs(j.upper - q[i]), abs(j.lower - q[i])) for i, j in enumerate(robot.joints) if j.kind == "prismatic"
+    )
+    return tuple(np.asarray(anchor, dtype=float).tolist()), rigid + slides
+
+
+def reach_bound(robot: Robot) -> tuple[tuple[float, float, float], float]:
+    """(anchor [m], radius [m]): every reachable tool position lies within the radius of the anchor."""
+    return robot.derived("reach_bound", _reach)
+
+
+def out_of_reach(robot: Robot, position: np.ndarray) -> float:
+    """How far [m] a position lies beyond the reach bound (≤ 0 when it may be reachable)."""
+    anchor, radius = robot.derived("reach_bound", _reach)
+    return math.dist(np.asarray(position, dtype=float).tolist(), anchor) - radius
+
+
+def beyond_reach(robot: Robot, position: np.ndarray) -> str:
+    """Why no configuration can reach ``position`` [m] (base frame) when it lies beyond the reach bound, in words;
+    "" when it may be reachable."""
+    beyond = out_of_reach(robot, position)
+    return f"the target point is at least {beyond:.4g} m beyond the robot's reach" if beyond > 0 else ""

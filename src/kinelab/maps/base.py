@@ -25,8 +25,7 @@ from kinelab.ik.analytic.branches import all_branches_batch
 from kinelab.ik.analytic.classify import classify
 from kinelab.ik.api import solve_batch
 from kinelab.ik.request import check_seed
-from kinelab.ik.targets import as_target
-from kinelab.ik.workspace import reach_bound
+from kinelab.ik.targets import as_target, reach_bound
 from kinelab.robot import Robot, load
 
 PLATFORM = ("platform_x", "platform_y", "platform_yaw")

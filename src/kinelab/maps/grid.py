@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from kinelab.errors import KinelabError
-from kinelab.ik.workspace import reach_bound
+from kinelab.ik.targets import reach_bound
 from kinelab.robot import Robot
 
 PHI = np.sqrt(2.0)

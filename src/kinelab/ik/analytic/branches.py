@@ -32,8 +32,7 @@ from kinelab.ik.driver import solve_one
 from kinelab.ik.limits import distance
 from kinelab.ik.request import Request, make_request, verdict_reserve
 from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
-from kinelab.ik.targets import as_target_arrays
-from kinelab.ik.workspace import beyond_reach
+from kinelab.ik.targets import as_target_arrays, beyond_reach
 from kinelab.robot import Robot
 from kinelab.robot.model import _compiled_judge
 

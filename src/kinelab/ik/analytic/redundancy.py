@@ -28,7 +28,7 @@ from kinelab.ik.chain import PRISMATIC, chain_model
 from kinelab.ik.limits import distance
 from kinelab.ik.request import Request
 from kinelab.ik.result import Branches
-from kinelab.ik.workspace import beyond_reach
+from kinelab.ik.targets import beyond_reach
 from kinelab.robot import Robot
 
 
