@@ -111,6 +111,36 @@ def test_a_result_s_diagnostics_are_built_only_when_read(monkeypatch):
     assert copy.deepcopy(ik.solve(robot.fk(q), q0=q, seed=0)).diagnostics == res.diagnostics and len(built) == 3
 
 
+@pytest.mark.parametrize("name", ["ur5", "kinova", "crx10ia"])
+def test_every_branch_in_one_call_holds_the_compiled_form_s_rows_and_builds_them_when_read(name, monkeypatch):
+    """solve_all's usual call hands the compiled form's arrays straight to a lazily built set: the rows equal
+    ``ClosedForm.solve``'s, the results equal the general route's, and none is built before the set is read."""
+    from kinelab.ik.analytic import branches as analytic
+
+    robot = kinelab.load(name)
+    rng = np.random.default_rng(11)
+    built = []
+    filled = analytic._filled
+    monkeypatch.setattr(analytic, "_filled", lambda *a, **k: built.append(1) or filled(*a, **k))
+    for _ in range(20):
+        target = robot.fk(robot.random_q(rng))
+        fast = kinelab.solve_all(robot, target)
+        (entry,) = robot.derived("usual closed forms", None).values()  # the one kept for solve_all's defaults
+        form = entry.form
+        q, dp, dr, merged, continuum, _ = form.solve(target.homogeneous, None)
+        assert built == [] and fast.method == ("search" if name == "crx10ia" else "closed form")
+        np.testing.assert_array_equal(fast.q, q)
+        np.testing.assert_array_equal(fast.position_error, dp)
+        np.testing.assert_array_equal(fast.rotation_error, dr)
+        general = kinelab.solve_all(robot, target, q_ref=np.zeros(robot.n) + 1e-300)  # takes the general route
+        assert len(general) == len(fast) > 0
+        for res in fast:
+            dp_k, dr_k = robot.tool_error(res.q, target)
+            assert dp_k <= 1e-6 and dr_k <= 1e-6 and robot.within_limits(res.q) and res.diagnostics.branches == len(q)
+        assert len(built) == len(fast)
+        built.clear()
+
+
 @pytest.mark.parametrize(("name", "solver"), [("ur5", "auto"), ("kinova", "analytic"), ("stanford", "frdm"),
                                               ("ur5", "dls")])
 def test_every_branch_from_a_prepared_solver_is_kinelab_s(name, solver):

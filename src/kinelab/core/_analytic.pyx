@@ -31,13 +31,17 @@ numbers and rotations of 9 (row by row): they live in registers.
 """
 
 import numpy as np
+cimport numpy as cnp
 
 from libc.math cimport acos, atan2, cos, fabs, hypot, rint, sin, M_PI, NAN
 from libc.stdlib cimport free as release, malloc
 from cython.parallel cimport prange
 
 from kinelab.core._chain cimport Judge
-from kinelab.core._verdict cimport pose_defect_of, pose_errors
+from kinelab.core._frdm cimport now
+from kinelab.core._verdict cimport pose_defect_of, pose_defect_row_major, pose_errors
+
+cnp.import_array()
 
 ctypedef (double, double, double) V3
 ctypedef (double, double, double, double, double, double, double, double, double) M9
@@ -748,6 +752,48 @@ cdef class ClosedForm:
             pv[i], rv[i], fv[i], cv[i] = errors[2 * i], errors[2 * i + 1], found[i], loose[i]
         return q, position_error, rotation_error, merged, continuum, m
 
+    def every(self, target, made):
+        """:meth:`solve` of a ``pin.SE3`` target with no reference, its arrays handed to ``made(q, position_error,
+        rotation_error, merged, continuum, wall_time)`` (the call's wall time [s]), which builds the caller's
+        result; None where :meth:`solve` gives None or no branch."""
+        cdef double t_start = now()
+        cdef double out[MAX_ROWS * 6]
+        cdef double errors[MAX_ROWS * 2]
+        cdef long long found[MAX_ROWS]
+        cdef unsigned char loose[MAX_ROWS]
+        cdef double T[16]
+        cdef bint near = False
+        cdef int m = 0, kept
+        if not _row_major(target.homogeneous, T) or pose_defect_row_major(T) != 0:
+            return None
+        with nogil:
+            kept = self._pose(T, out, False, out, errors, found, loose, &near, &m)
+        if near or kept == 0:
+            return None
+        return self._arrays(made, kept, out, errors, found, loose, t_start)
+
+    cdef object _arrays(self, object made, int kept, const double* out, const double* errors,
+                        const long long* found, const unsigned char* loose, double t_start):
+        """The kept rows as arrays, handed to ``made``."""
+        cdef cnp.npy_intp rows = kept, i
+        cdef cnp.npy_intp dims[2]
+        dims[0], dims[1] = kept, self.n
+        cdef cnp.ndarray q = cnp.PyArray_EMPTY(2, dims, cnp.NPY_FLOAT64, 0)
+        cdef cnp.ndarray dp = cnp.PyArray_EMPTY(1, &rows, cnp.NPY_FLOAT64, 0)
+        cdef cnp.ndarray dr = cnp.PyArray_EMPTY(1, &rows, cnp.NPY_FLOAT64, 0)
+        cdef cnp.ndarray merged = cnp.PyArray_EMPTY(1, &rows, cnp.NPY_INT64, 0)
+        cdef cnp.ndarray continuum = cnp.PyArray_EMPTY(1, &rows, cnp.NPY_BOOL, 0)
+        cdef double* qp = <double*> cnp.PyArray_DATA(q)
+        cdef double* dpp = <double*> cnp.PyArray_DATA(dp)
+        cdef double* drp = <double*> cnp.PyArray_DATA(dr)
+        cdef long long* mp = <long long*> cnp.PyArray_DATA(merged)
+        cdef unsigned char* cp = <unsigned char*> cnp.PyArray_DATA(continuum)
+        for i in range(kept * self.n):
+            qp[i] = out[i]
+        for i in range(kept):
+            dpp[i], drp[i], mp[i], cp[i] = errors[2 * i], errors[2 * i + 1], found[i], loose[i] != 0
+        return made(q, dp, dr, merged, continuum, now() - t_start)
+
     def solve_batch(self, const double[:, :, ::1] H, double[:, :, ::1] q, double[:, :, ::1] errors,
                     long long[:, ::1] merged, unsigned char[:, ::1] continuum, long long[::1] count,
                     unsigned char[::1] near, int threads):
@@ -830,3 +876,20 @@ cdef class ClosedForm:
         if dp[0] <= 1e3 * self.tol_pos + 1e-6 and dr[0] <= 1e3 * self.tol_rot + 1e-6:
             return NEAR
         return DROPPED
+
+
+cdef bint _row_major(object H, double* T):
+    """Copy a 4 × 4 float64 array (any strides) into T row by row; False for anything else."""
+    if type(H) is not np.ndarray:
+        return False
+    cdef cnp.ndarray a = H
+    if cnp.PyArray_NDIM(a) != 2 or cnp.PyArray_TYPE(a) != cnp.NPY_FLOAT64 or a.shape[0] != 4 or a.shape[1] != 4:
+        return False
+    cdef char* base = <char*> cnp.PyArray_DATA(a)
+    cdef cnp.npy_intp s0 = cnp.PyArray_STRIDES(a)[0], s1 = cnp.PyArray_STRIDES(a)[1]
+    cdef int i, j
+    for i in range(4):
+        for j in range(4):
+            T[4 * i + j] = (<double*> (base + i * s0 + j * s1))[0]
+    return True
+

@@ -16,22 +16,22 @@ from kinelab.core._verdict cimport pose_errors, verdict_of
 cdef int PRISMATIC = 1
 
 
-cdef inline void _compose(double[3][3] R, double[3] t, const double[:, ::1] dR, const double[::1] dt) noexcept nogil:
-    """(R, t) ← (R, t) · (dR, dt)."""
+cdef inline void _compose(double[3][3] R, double[3] t, const double* dR, const double* dt) noexcept nogil:
+    """(R, t) ← (R, t) · (dR, dt) (dR 3 × 3 row-major)."""
     cdef double out[3][3]
     cdef double v[3]
     cdef int i, j
     for i in range(3):
         v[i] = t[i] + R[i][0] * dt[0] + R[i][1] * dt[1] + R[i][2] * dt[2]
         for j in range(3):
-            out[i][j] = R[i][0] * dR[0, j] + R[i][1] * dR[1, j] + R[i][2] * dR[2, j]
+            out[i][j] = R[i][0] * dR[j] + R[i][1] * dR[3 + j] + R[i][2] * dR[6 + j]
     for i in range(3):
         t[i] = v[i]
         for j in range(3):
             R[i][j] = out[i][j]
 
 
-cdef inline void _turn(double[3][3] R, const double[::1] a, double angle) noexcept nogil:
+cdef inline void _turn(double[3][3] R, const double* a, double angle) noexcept nogil:
     """R ← R · Rot(a, angle) (Rodrigues)."""
     cdef double c = cos(angle), s = sin(angle)
     cdef double C = 1.0 - c
@@ -60,20 +60,32 @@ cdef void fk_row(const double[:, :, ::1] placement_R, const double[:, ::1] place
                  const double[:, ::1] axis, const long long[::1] kind, const double[:, ::1] tool_R,
                  const double[::1] tool_t, const double* q, double* out) noexcept nogil:
     """oMtool at q (one value per joint of ``kind``) into out (4 × 4, row-major)."""
+    cdef int n = kind.shape[0]
+    if n == 0:
+        fk_chain(n, NULL, NULL, NULL, NULL, &tool_R[0, 0], &tool_t[0], q, out)
+    else:
+        fk_chain(n, &placement_R[0, 0, 0], &placement_t[0, 0], &axis[0, 0], &kind[0], &tool_R[0, 0], &tool_t[0], q,
+                 out)
+
+
+cdef void fk_chain(int n, const double* placement_R, const double* placement_t, const double* axis,
+                   const long long* kind, const double* tool_R, const double* tool_t, const double* q,
+                   double* out) noexcept nogil:
+    """:func:`fk_row` on the arrays' data (n joints: placement_R n × 3 × 3, placement_t and axis n × 3, row-major)."""
     cdef double R[3][3]
     cdef double t[3]
-    cdef int i, j, n = kind.shape[0]
+    cdef int i, j
     for i in range(3):
         t[i] = 0.0
         for j in range(3):
             R[i][j] = 1.0 if i == j else 0.0
     for i in range(n):
-        _compose(R, t, placement_R[i], placement_t[i])
+        _compose(R, t, placement_R + 9 * i, placement_t + 3 * i)
         if kind[i] == PRISMATIC:
             for j in range(3):
-                t[j] += (R[j][0] * axis[i, 0] + R[j][1] * axis[i, 1] + R[j][2] * axis[i, 2]) * q[i]
+                t[j] += (R[j][0] * axis[3 * i] + R[j][1] * axis[3 * i + 1] + R[j][2] * axis[3 * i + 2]) * q[i]
         else:
-            _turn(R, axis[i], q[i])
+            _turn(R, axis + 3 * i, q[i])
     _compose(R, t, tool_R, tool_t)
     for i in range(3):
         for j in range(3):
@@ -114,6 +126,10 @@ cdef class Judge:
             raise ValueError("Judge: a chain of n joints (placements, axes, kinds) and a tool placement")
         self.placement_R, self.placement_t, self.axis, self.kind = placement_R, placement_t, axis, kind
         self.tool_R, self.tool_t = tool_R, tool_t
+        self.n = <int> n
+        if n:
+            self.pR, self.pt, self.pa, self.pk = &placement_R[0, 0, 0], &placement_t[0, 0], &axis[0, 0], &kind[0]
+        self.tR, self.tt = &tool_R[0, 0], &tool_t[0]
 
     def verdict(self, const double[:, :] H_target, const double[::1] q, const double[::1] lower,
                 const double[::1] upper, int rot_axis) -> tuple:
@@ -157,4 +173,4 @@ cdef class Judge:
 
     cdef void pose(self, const double* q, double* T) noexcept nogil:
         """oMtool at q (n values) into T (4 × 4, row-major)."""
-        fk_row(self.placement_R, self.placement_t, self.axis, self.kind, self.tool_R, self.tool_t, q, T)
+        fk_chain(self.n, self.pR, self.pt, self.pa, self.pk, self.tR, self.tt, q, T)

@@ -22,22 +22,30 @@ OK, NOT_USUAL = C_OK, C_NOT_USUAL
 
 cdef int pose_defect_of(const double[:, :] H) noexcept nogil:
     """0, NOT_FINITE or NOT_A_ROTATION (see :func:`pose_defect`)."""
-    cdef double total = 0.0, gram = 0.0, d, det
-    cdef int i, j, a, b
-    for i in range(3):
+    cdef double T[16]
+    cdef int i, j
+    for i in range(4):
         for j in range(4):
-            total += H[i, j]
+            T[4 * i + j] = H[i, j]
+    return pose_defect_row_major(T)
+
+
+cdef int pose_defect_row_major(const double* T) noexcept nogil:
+    """:func:`pose_defect_of` of a 4 × 4 matrix stored row by row (its first three rows read)."""
+    cdef double total = 0.0, gram = 0.0, d, det
+    cdef int i, a, b
+    for i in range(12):
+        total += T[i]
     if not isfinite(total):  # NaN and ±inf poison the sum; so does an overflow of huge finite entries
-        for i in range(3):
-            for j in range(4):
-                if not isfinite(H[i, j]):
-                    return C_NOT_FINITE
+        for i in range(12):
+            if not isfinite(T[i]):
+                return C_NOT_FINITE
     for a in range(3):
         for b in range(a, 3):
-            d = H[0, a] * H[0, b] + H[1, a] * H[1, b] + H[2, a] * H[2, b] - (1.0 if a == b else 0.0)
+            d = T[a] * T[b] + T[4 + a] * T[4 + b] + T[8 + a] * T[8 + b] - (1.0 if a == b else 0.0)
             gram = gram if gram >= fabs(d) else fabs(d)
-    det = (H[0, 0] * (H[1, 1] * H[2, 2] - H[1, 2] * H[2, 1]) - H[0, 1] * (H[1, 0] * H[2, 2] - H[1, 2] * H[2, 0])
-           + H[0, 2] * (H[1, 0] * H[2, 1] - H[1, 1] * H[2, 0]))
+    det = (T[0] * (T[5] * T[10] - T[6] * T[9]) - T[1] * (T[4] * T[10] - T[6] * T[8])
+           + T[2] * (T[4] * T[9] - T[5] * T[8]))
     return C_NOT_A_ROTATION if gram > 1e-6 or det < 0.0 else 0
 
 

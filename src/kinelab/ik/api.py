@@ -323,11 +323,12 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
         TargetError, ConfigurationError, OptionError: bad input, named.
     """
     check_entry(robot, "solve_all", positional)
-    kind, given = capabilities(solver), options is not None or bool(solver_options)
-    if kind.picks and not given and _usual_all(q_ref, max_solutions, collisions, redundancy, task, axis):
-        found = usual_closed_form(robot, target, seed, (tol_pos, tol_rot, time_budget, stop_below))
+    if options is None and not solver_options and _usual_all(q_ref, max_solutions, collisions, redundancy, task,
+                                                             axis):
+        found = usual_closed_form(robot, target, seed, (solver, tol_pos, tol_rot, time_budget, stop_below))
         if found is not None:
             return found
+    kind, given = capabilities(solver), options is not None or bool(solver_options)
     if kind.closed_form and given:  # refusing says so rather than ignoring them
         refuse_options(options or solver_options)
     req = make_request(kind.request_solver(solver), seed, tol_pos, tol_rot, time_budget, 0, "refuse", options, task,

@@ -21,7 +21,7 @@ from kinelab.ik.analytic.branches import EveryBranch, analytic_all, arm_of, has_
 from kinelab.ik.analytic.redundancy import redundant_all
 from kinelab.ik.batch import fresh_seed, prepare, run_batch
 from kinelab.ik.limits import distance as distance  # exported: the branch distance users sort by
-from kinelab.ik.registry import Capabilities
+from kinelab.ik.registry import Capabilities, capabilities
 from kinelab.ik.request import Request, check_seed, count_ok, make_request
 from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target, beyond_reach
@@ -110,17 +110,22 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
     return _multistart_all(robot, target, req, ref, max_solutions, stop_below)
 
 
+USUAL_PER_ROBOT = 16  # a caller sweeping settings: the prepared closed forms kept stay bounded
+
+
 def usual_closed_form(robot: Robot, target: Any, seed: Any, settings: tuple[Any, ...]) -> Branches | None:
-    """Every branch of ``target`` in one compiled call for the usual call of :func:`kinelab.solve_all` — solver
-    "auto" on a chain with a closed form and a certified compiled FK, a ``pin.SE3`` target, no options, references,
-    collisions or sweeps — with ``settings`` = (tol_pos, tol_rot, time_budget, stop_below) checked once per robot;
-    None otherwise (the general route then answers, or names what is wrong)."""
+    """Every branch of ``target`` in one compiled call for the usual call of :func:`kinelab.solve_all` — a solver
+    that picks its route ("auto") on a chain with a closed form and a certified compiled FK, a ``pin.SE3`` target,
+    no options, references, collisions or sweeps — with ``settings`` = (solver, tol_pos, tol_rot, time_budget,
+    stop_below) checked once per robot; None otherwise (the general route then answers, or names what is wrong)."""
     kept: dict[tuple[Any, ...], EveryBranch | Literal[False]] = robot.derived("usual closed forms", _new_kept)
     try:
         entry = kept.get(settings)
     except TypeError:  # an unhashable setting: the general route names it
         return None
     if entry is None:
+        if len(kept) >= USUAL_PER_ROBOT:
+            kept.clear()
         entry = kept[settings] = _usual_entry(robot, settings)
     if entry is False:
         return None
@@ -135,7 +140,9 @@ def _usual_entry(robot: Robot, settings: tuple[Any, ...]) -> EveryBranch | Liter
     Raises:
         OptionError: a bad setting, named (as the general route would).
     """
-    tol_pos, tol_rot, time_budget, stop_below = settings
+    solver, tol_pos, tol_rot, time_budget, stop_below = settings
+    if not capabilities(solver).picks:
+        return False
     req = make_request("frdm", None, tol_pos, tol_rot, time_budget, 0, "refuse", None, "pose", "z", {})
     _check_search(Route.EITHER, None, stop_below)
     if not has_closed_form(robot, req):

@@ -421,14 +421,21 @@ class EveryBranch(OneCall):
 
     def solve(self, target: Any) -> Branches | None:
         """Every branch of ``target``, or None where the general route must answer."""
-        got = self.found(target, None)
-        if got is None:
+        if type(target) is not pin.SE3:
             return None
-        rows, t0 = got
-        make = partial(_filled, self.fields, rows, wall_time=time.perf_counter() - t0, branches=len(rows.q),
-                       unseen=self.unseen)
-        return Branches.from_arrays(rows.q, rows.position_error, rows.rotation_error, make, None, "", self.method,
-                                    self.unseen)
+        return self.form.every(target, self._made)  # type: ignore[no-any-return]
+
+    def _made(self, q: np.ndarray, dp: np.ndarray, dr: np.ndarray, merged: np.ndarray, continuum: np.ndarray,
+              wall_time: float) -> Branches:
+        """The set of one pose's branches from the compiled form's arrays (q (k, n) [rad], errors [m, rad])."""
+        return Branches.of_rows(q, dp, dr, self._row, (q, dp, dr, merged, continuum, wall_time), self.method,
+                                self.unseen)
+
+    def _row(self, data: tuple[Any, ...], i: int) -> IKResult:
+        """Row i of a set :meth:`_made` made, as :func:`branch_results` builds it."""
+        q, dp, dr, merged, continuum, wall_time = data
+        rows = Rows(q, dp, dr, self.unfinished[:len(q)], merged, continuum)
+        return _filled(self.fields, rows, i, wall_time, len(q), self.unseen)
 
 
 def analytic_one(robot: Robot, target: Any, req: Request, q0: np.ndarray | None,
