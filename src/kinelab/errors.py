@@ -122,8 +122,11 @@ class OptionError(KinelabError):
 class SolverNotFoundError(KinelabError):
     """A solver name that is not registered."""
 
-    def __init__(self, name: str, valid: Iterable[str]):
+    def __init__(self, name: str, valid: Iterable[str], why: str = ""):
         self.name = name
         self.valid = sorted(valid)
-        super().__init__(f"unknown solver {name!r}{did_you_mean(name, self.valid)}; solvers are: "
-                         f"{', '.join(self.valid)}")
+        if why:  # a known solver this entry point cannot run
+            super().__init__(f"solver {name!r} {why}; solvers here are: {', '.join(self.valid)}")
+        else:
+            super().__init__(f"unknown solver {name!r}{did_you_mean(name, self.valid)}; solvers are: "
+                             f"{', '.join(self.valid)}")

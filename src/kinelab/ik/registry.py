@@ -106,7 +106,9 @@ def one_answer(name: str) -> Capabilities:
     """
     kind = capabilities(name)
     if kind.picks:
-        raise SolverNotFoundError(str(name), [*names(), "analytic"])
+        raise SolverNotFoundError(str(name), [*names(), "analytic"],
+                                  "chooses among every branch of a pose, which is solve_all's work "
+                                  "(kinelab.solve_all, kinelab branches); for one answer name the solver")
     return kind
 
 
