@@ -5,7 +5,6 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import asdict, dataclass, field, fields, replace
 from enum import Enum
-from functools import partial
 from typing import Any, overload
 
 import numpy as np
@@ -326,8 +325,7 @@ class Branches(Sequence[IKResult]):
                  method: str = "", unseen: float | None = None):
         results = list(found)
         self._results: list[IKResult] | None = results
-        self._make: Callable[[int], IKResult] | None = None
-        self._make_row: Callable[[Any, int], IKResult] | None = None
+        self._make_row: Callable[[Any, int], IKResult] = _called
         self._data: Any = None
         self.q = np.array([r.q for r in results], dtype=float) if results else np.empty((0, 0))
         self.position_error = np.array([r.position_error for r in results], dtype=float)
@@ -343,7 +341,7 @@ class Branches(Sequence[IKResult]):
         first indexed or iterated."""
         made = cls.__new__(cls)
         made.q, made.position_error, made.rotation_error = q, position_error, rotation_error
-        made._results, made._make, made._make_row, made._data = None, make, None, None
+        made._results, made._make_row, made._data = None, _called, make
         made.status = status if status is not None else Status.CONVERGED if len(q) else Status.TIME_BUDGET
         made.message, made.method, made.unseen = message, method, unseen
         return made
@@ -356,17 +354,14 @@ class Branches(Sequence[IKResult]):
         data: nothing is built per call that a reader may never ask for)."""
         made = cls.__new__(cls)
         made.q, made.position_error, made.rotation_error = q, position_error, rotation_error
-        made._results, made._make, made._make_row, made._data = None, None, make_row, data
+        made._results, made._make_row, made._data = None, make_row, data
         made.status, made.message, made.method, made.unseen = Status.CONVERGED, "", method, unseen
         return made
 
     def _built(self) -> list[IKResult]:
         if self._results is None:
-            make = self._make
-            if make is None:
-                assert self._make_row is not None  # a set is made with one maker or the other
-                make = partial(self._make_row, self._data)
-            self._results = [make(i) for i in range(self.q.shape[0])]
+            make_row, data = self._make_row, self._data
+            self._results = [make_row(data, i) for i in range(self.q.shape[0])]
         return self._results
 
     def __len__(self) -> int:
@@ -398,7 +393,12 @@ class Branches(Sequence[IKResult]):
     def __getstate__(self) -> dict[str, Any]:
         """The arrays and the results, built (a pickle never carries the maker)."""
         self._built()
-        return {**self.__dict__, "_make": None, "_make_row": None, "_data": None}
+        return {**self.__dict__, "_make_row": _called, "_data": None}
+
+
+def _called(make: Callable[[int], IKResult], i: int) -> IKResult:
+    """The row maker of a set made by :meth:`Branches.from_arrays`: its ``make(i)``."""
+    return make(i)
 
 
 @dataclass
