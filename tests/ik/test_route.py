@@ -58,7 +58,7 @@ def test_the_biquaternion_solver_takes_one_route_too():
         assert plain.diagnostics.attempts == prepared.diagnostics.attempts
 
 
-def _general_route(robot, target, q0, seed):
+def _general_route(robot, target, q0, seed, solver="frdm"):
     """The driver's route (checks, the compiled multistart, Pinocchio-side verdict in Python): what every solve
     took before the one compiled call."""
     from dataclasses import replace
@@ -66,23 +66,28 @@ def _general_route(robot, target, q0, seed):
     from kinelab.ik.driver import solve_one
     from kinelab.ik.request import make_request
 
-    req = make_request("frdm", None, 1e-6, 1e-6, None, 1000, "project", None, "pose", "z", {})
+    req = make_request(solver, None, 1e-6, 1e-6, None, 1000, "project", None, "pose", "z", {})
     return solve_one(robot, target, q0, replace(req, seed=seed))
 
 
-@pytest.mark.parametrize("name", ["ur5", "panda", "kinova", "stanford", "youbot"])
-def test_the_one_compiled_call_gives_the_driver_s_answers(name):
+ENGINES = [("frdm", name) for name in ("ur5", "panda", "kinova", "stanford", "youbot")] + \
+    [("biquat", name) for name in ("ur5", "panda", "kinova", "stanford", "z1")]
+
+
+@pytest.mark.parametrize(("solver", "name"), ENGINES)
+def test_the_one_compiled_call_gives_the_driver_s_answers(solver, name):
     """Same q, status, counters, errors and diagnostics as the general route, on seeded targets from random,
-    warm and no starts (kinova has continuous joints: the wrap happens inside the compiled call too)."""
+    warm and no starts (kinova has continuous joints: FRDM's wrap happens inside the compiled call too), for each
+    solver with an engine."""
     robot = kinelab.load(name)
-    ik = kinelab.IK(robot, time_budget=None)
+    ik = kinelab.IK(robot, solver=solver, time_budget=None)
     assert ik.engine is not None, "the robot's compiled FK is certified: the one-call engine serves it"
     rng = np.random.default_rng(40)
     for k in range(24):
         q = robot.random_q(rng)
         target = robot.fk(q)
         q0 = [None, robot.random_q(rng), np.clip(q + rng.normal(0, 0.2, q.size), robot.lower, robot.upper)][k % 3]
-        one, general = ik.solve(target, q0=q0, seed=k), _general_route(robot, target, q0, k)
+        one, general = ik.solve(target, q0=q0, seed=k), _general_route(robot, target, q0, k, solver)
         np.testing.assert_array_equal(one.q, general.q)
         assert (one.status, one.success, one.iterations, one.restarts, one.message) == \
             (general.status, general.success, general.iterations, general.restarts, general.message)
@@ -201,3 +206,16 @@ def test_no_entry_point_compares_a_solver_s_name():
                     if names & {v for v in literals if isinstance(v, str)}:
                         found.append(f"{path.name}:{node.lineno}")
     assert found == []
+
+
+def test_a_mobile_base_s_biquaternion_solve_takes_the_general_route():
+    """The youBot's base joints draw their restarts near the target (a window per call): no engine, same answers."""
+    robot = kinelab.load("youbot")
+    ik = kinelab.IK(robot, solver="biquat", time_budget=None)
+    assert ik.engine is None
+    rng = np.random.default_rng(8)
+    for k in range(6):
+        target = robot.fk(robot.random_q(rng))
+        a, b = ik.solve(target, seed=k), _general_route(robot, target, None, k, "biquat")
+        np.testing.assert_array_equal(a.q, b.q)
+        assert (a.status, a.iterations, a.restarts) == (b.status, b.iterations, b.restarts)

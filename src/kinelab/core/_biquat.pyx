@@ -17,34 +17,7 @@ from kinelab.core._frdm cimport CONTINUOUS, PRISMATIC, Chain, Packed, chain_fk, 
 
 from kinelab.core._frdm import pack_chain
 
-cdef enum:
-    CONVERGED = 0
-    SINGULAR = 1
-    MAX_STEPS = 2
-    OUTSIDE_LIMITS = 3
-    BUDGET = 4
-    T_ATTEMPTS = 0
-    T_STEPS = 1
-    T_MODEL_TIME = 2
-    T_OUTSIDE = 3
-    T_SINGULAR = 4
-    T_CUT = 5
-    T_ATTEMPT_STEPS = 6
-    T_ATTEMPT_TIME = 7
-
 cdef double TWO_PI = 2.0 * M_PI
-
-
-cdef struct Control:
-    const double* pstar  # (3,) target point [m], base frame
-    const double* Rstar  # (3, 3) target rotation, row-major
-    double k  # gain [1/s]
-    double h  # step [s]
-    double max_step  # largest joint change per step [rad or m]
-    int max_steps  # steps per attempt
-    double eps_rot  # stop when |m⃗| < eps_rot
-    double eps_dual  # and |m0⃗| < eps_dual [m]
-    double damping  # λ of the damped pseudo-inverse (0: exact solve when n = 6)
 
 
 cdef void quat_wxyz(const double* R, double* q) noexcept nogil:

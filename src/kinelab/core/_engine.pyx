@@ -2,8 +2,9 @@
 """A prepared solver's usual call in one compiled call: check the target and the start, run the kernel, judge the
 answer with the certified compiled FK (turned into the limits by whole turns where that is needed).
 
-The prepared solver (:class:`kinelab.IK`) builds an engine once; per call only the target, the start, the seed
-and the clock change. An unusual call (a target that is not a ``pin.SE3``, a start that is not n float64 values
+One engine interface (:class:`Engine`: the checks, the verdict and the result, written once) over the kernels'
+timed multistarts: :class:`FRDMEngine` and :class:`BiquatEngine` each supply only their run. The prepared solver
+(:class:`kinelab.IK`) builds an engine once; per call only the target, the start, the seed and the clock change. An unusual call (a target that is not a ``pin.SE3``, a start that is not n float64 values
 within the limits, a target beyond the reach bound, a seed that is not a whole number in [0, 2⁶⁴)) gets None, and
 the caller takes the general route, which names what is wrong: the engine changes the cost, never the answer.
 """
@@ -18,15 +19,18 @@ from libc.math cimport M_PI, atan2, ceil, cos, sin
 from libc.stdlib cimport free, malloc
 from libc.string cimport memcpy
 
+cimport kinelab.core._biquat as bq
 from kinelab.core._chain cimport Judge
-from kinelab.core._frdm cimport (CONTINUOUS, CONVERGED, STATS_SIZE, T_ATTEMPTS, T_STALLS, T_SWEEPS, Packed, now,
-                                 random_configuration, timed)
+from kinelab.core._frdm cimport CONTINUOUS, CONVERGED, STATS_SIZE, T_STALLS, Packed, now, random_configuration, timed
 from kinelab.core._verdict cimport pose_errors, take_target
 
 cnp.import_array()
 
 cdef double TWO_PI = 2.0 * M_PI
 cdef int REVOLUTE = 0
+# the statistics slots every kernel's multistart shares: its attempts, and its iterations (FRDM's sweeps, the
+# biquaternion preset's steps)
+cdef int T_ATTEMPTS = 0, T_ITERATIONS = 1
 SEED_LIMIT = 1 << 64
 
 
@@ -38,62 +42,63 @@ cdef unsigned long long splitmix(unsigned long long x) noexcept nogil:
     return (x ^ (x >> 31)) | 1ULL
 
 
-cdef class FRDMEngine:
-    """Compiled FRDM's usual call for one prepared solver (see the module's docstring).
+if <int> bq.STATS_SIZE != <int> STATS_SIZE:
+    raise ImportError("kinelab.core._engine: the kernels' statistics arrays differ in size; rebuild the core")
+
+
+cdef class Engine:
+    """A prepared solver's usual call (see the module's docstring): the checks, the verdict and the result, written
+    once; a kernel's engine supplies ``_run`` (its timed multistart) and, where it has them, ``_events``.
 
     Args:
-        packed: the kernel's chain, problem (its ``pstar`` and ``Rstar`` are the arrays given here), settings and
-            memory.
         judge: the robot's certified compiled FK.
         spec: the call's constants, read once: ``kind`` (n,) joint codes; ``draw_lower``, ``draw_upper`` the
             window random starts are drawn in; ``check_lower``, ``check_upper`` the limits a start and an answer
             must lie within; ``turn_lower``, ``turn_upper`` the limits a whole turn brings a revolute answer into;
-            ``anchor`` (3,) and ``radius`` [m] the reach bound (inf: none); ``pstar`` (3,), ``Rstar`` (3, 3) the
-            problem's target arrays; ``order``, ``cap``, ``attempts``, ``first_chunk``, ``later_chunk`` as the
-            timed multistart takes them; ``budget`` [s] (inf: none); ``tol_pos`` [m], ``tol_rot`` [rad],
-            ``check_pos``, ``check_rot``, ``axis`` (−1, or 0, 1, 2 for task "axis") the verdict's; ``se3`` the
-            target type of a usual call; ``result`` the result type, ``fields`` the values every converged
+            ``wrap_continuous`` (continuous joints of an answer wrapped into (−π, π] before the verdict, as the
+            solver's general route does); ``anchor`` (3,) and ``radius`` [m] the reach bound (inf: none); ``pstar``
+            (3,), ``Rstar`` (3, 3) the arrays a call's target is copied into (the kernel reads them);
+            ``attempts`` (the first and the restarts); ``budget`` [s] (inf: none); ``tol_pos`` [m], ``tol_rot``
+            [rad], ``check_pos``, ``check_rot``, ``axis`` (−1, or 0, 1, 2 for task "axis") the verdict's; ``se3``
+            the target type of a usual call; ``result`` the result type, ``fields`` the values every converged
             result shares (a dict), ``diagnostics`` (stats → the diagnostics, called when a result's are first
-            read), ``stall_events`` (stalls → the events) and ``unmet`` (the general result of any other outcome:
-            ``unmet(target, code, q, stats, position error, rotation error, met, t_start, deadline, seed)``).
+            read) and ``unmet`` (the general result of any other outcome: ``unmet(target, code, q, stats, position
+            error, rotation error, met, t_start, deadline, seed)``).
     """
 
-    cdef Packed packed
     cdef Judge judge
     cdef const long long[::1] kind
     cdef const double[::1] draw_lower, draw_upper, check_lower, check_upper, turn_lower, turn_upper, anchor
     cdef double[::1] pstar
     cdef double[:, ::1] Rstar
-    cdef double radius, first_chunk, later_chunk, budget, tol_pos, tol_rot
-    cdef int n, order, cap, attempts, check_pos, check_rot, axis, continuous
+    cdef double radius, budget, tol_pos, tol_rot
+    cdef int n, attempts, check_pos, check_rot, axis, continuous
     cdef double* q  # the kernel's working configuration
-    cdef object se3, result, fields, diagnostics, stall_events, unmet
+    cdef object se3, result, fields, diagnostics, unmet
 
-    def __init__(self, Packed packed, Judge judge, spec):
-        self.packed, self.judge = packed, judge
-        self.kind = spec.kind
-        self.n = packed.n
+    def __init__(self, Judge judge, spec):
+        self.judge, self.kind, self.n = judge, spec.kind, len(spec.kind)
         self.draw_lower, self.draw_upper = spec.draw_lower, spec.draw_upper
         self.check_lower, self.check_upper = spec.check_lower, spec.check_upper
         self.turn_lower, self.turn_upper = spec.turn_lower, spec.turn_upper
         self.anchor, self.radius = spec.anchor, spec.radius
         self.pstar, self.Rstar = spec.pstar, spec.Rstar
-        self.order, self.cap, self.attempts = spec.order, spec.cap, spec.attempts
-        self.first_chunk, self.later_chunk, self.budget = spec.first_chunk, spec.later_chunk, spec.budget
+        self.attempts, self.budget = spec.attempts, spec.budget
         self.tol_pos, self.tol_rot, self.axis = spec.tol_pos, spec.tol_rot, spec.axis
         self.check_pos, self.check_rot = spec.check_pos, spec.check_rot
         self.se3, self.result, self.fields = spec.se3, spec.result, dict(spec.fields)
-        self.diagnostics, self.stall_events, self.unmet = spec.diagnostics, spec.stall_events, spec.unmet
-        for name in ("kind", "draw_lower", "draw_upper", "check_lower", "check_upper", "turn_lower", "turn_upper"):
+        self.diagnostics, self.unmet = spec.diagnostics, spec.unmet
+        for name in ("draw_lower", "draw_upper", "check_lower", "check_upper", "turn_lower", "turn_upper"):
             if len(getattr(spec, name)) != self.n:
-                raise ValueError(f"FRDMEngine: {name} needs one value per joint ({self.n})")
+                raise ValueError(f"{type(self).__name__}: {name} needs one value per joint ({self.n})")
         if self.anchor.shape[0] != 3 or self.pstar.shape[0] != 3 or self.Rstar.shape[0] != 3 \
                 or self.Rstar.shape[1] != 3 or judge.kind.shape[0] != self.n or not -1 <= self.axis <= 2:
-            raise ValueError("FRDMEngine: a 3-vector anchor and target point, a 3 × 3 rotation, a judge of the chain")
-        self.continuous = any(k == CONTINUOUS for k in spec.kind)
+            raise ValueError(f"{type(self).__name__}: a 3-vector anchor and target point, a 3 × 3 rotation, a judge "
+                             "of the chain")
+        self.continuous = bool(spec.wrap_continuous) and any(k == CONTINUOUS for k in spec.kind)
         self.q = <double*> malloc(sizeof(double) * max(1, self.n))
         if self.q == NULL:
-            raise MemoryError("FRDMEngine: no memory for one configuration")
+            raise MemoryError(f"{type(self).__name__}: no memory for one configuration")
 
     def solve(self, target, q0, seed):
         """The usual call (see the module's docstring), or None for the general route.
@@ -127,12 +132,30 @@ cdef class FRDMEngine:
         cdef double* q = <double*> cnp.PyArray_DATA(best)
         cdef double deadline = t_start + self.budget
         cdef double stats[STATS_SIZE]
-        cdef int code = self._run(q, stats, start, <unsigned long long> seed, deadline)
+        cdef unsigned long long rng = splitmix(<unsigned long long> seed)
+        cdef int i
+        if start == NULL:
+            random_configuration(self.q, &self.kind[0], &self.draw_lower[0], &self.draw_upper[0], self.n, &rng)
+        else:
+            memcpy(self.q, start, sizeof(double) * self.n)
+        for i in range(STATS_SIZE):
+            stats[i] = 0.0
+        cdef int code = self._run(q, stats, &rng, deadline)
         cdef double dp, dr
         cdef bint met = self._judged(q, &dp, &dr)
         if not met or code != CONVERGED:
             return self.unmet(target, code, best, _array(stats, STATS_SIZE), dp, dr, met, t_start, deadline, seed)
         return self._converged(best, stats, dp, dr, t_start)
+
+    cdef int _run(self, double* best, double* stats, unsigned long long* rng, double deadline):
+        """The kernel's timed multistart from ``self.q`` (the first start); its answer in ``best``, its statistics
+        in ``stats`` (zeroed; attempts and iterations in the shared slots). Returns the kernel's code (its
+        convergence is CONVERGED)."""
+        raise NotImplementedError
+
+    cdef object _events(self, const double* stats):
+        """The result's ``singular_events`` of a converged answer (none unless a kernel reports them)."""
+        return []
 
     cdef const double* _start(self, object q0):
         """The start's values when q0 is n float64 values in one C-contiguous run, else NULL."""
@@ -162,29 +185,10 @@ cdef class FRDMEngine:
                 return False
         return True
 
-    cdef int _run(self, double* best, double* stats, const double* start, unsigned long long seed, double deadline):
-        """The timed multistart from ``start`` (NULL: a drawn one), the best answer in ``best``."""
-        cdef unsigned long long rng = splitmix(seed)
-        cdef int i, code, n = self.n
-        cdef Packed pk = self.packed
-        cdef double* q = self.q
-        if start == NULL:
-            random_configuration(q, &self.kind[0], &self.draw_lower[0], &self.draw_upper[0], n, &rng)
-        else:
-            for i in range(n):
-                q[i] = start[i]
-        for i in range(n):
-            best[i] = q[i]
-        for i in range(STATS_SIZE):
-            stats[i] = 0.0
-        with nogil:
-            code = timed(q, &pk.ch, &pk.pb, &pk.st, self.order, self.cap, &rng, self.attempts, self.first_chunk,
-                         self.later_chunk, deadline, 0, best, stats, &pk.mem)
-        return code
-
     cdef bint _judged(self, double* q, double* dp, double* dr):
-        """The judge's word on q (continuous joints wrapped into (−π, π], then the whole turn into the limits
-        where one exists): True when the task's components are met and q is within the limits."""
+        """The judge's word on q (continuous joints wrapped into (−π, π] where the engine wraps them, then the
+        whole turn into the limits where one exists): True when the task's components are met and q is within the
+        limits."""
         cdef int i, n = self.n
         cdef bint turned = False
         cdef double lowest
@@ -211,13 +215,13 @@ cdef class FRDMEngine:
 
     cdef object _converged(self, object best, const double* stats, double dp, double dr, double t_start):
         """The result of a converged answer the judge confirmed."""
-        cdef int stalls = <int> stats[T_STALLS]
         made = self.result.__new__(self.result)
         values = made.__dict__
         values.update(self.fields)
         values["q"], values["position_error"], values["rotation_error"] = best, dp, dr
-        values["iterations"], values["restarts"] = <int> stats[T_SWEEPS], max(0, <int> stats[T_ATTEMPTS] - 1)
-        values["singular_events"] = self.stall_events(stalls) if stalls else []
+        values["iterations"] = <int> stats[T_ITERATIONS]
+        values["restarts"] = max(0, <int> stats[T_ATTEMPTS] - 1)
+        values["singular_events"] = self._events(stats)
         values["bypasses"] = []
         values["_make_diagnostics"] = partial(self.diagnostics, _array(stats, STATS_SIZE))
         values["wall_time"] = now() - t_start
@@ -225,6 +229,93 @@ cdef class FRDMEngine:
 
     def __dealloc__(self):
         free(self.q)
+
+
+cdef class FRDMEngine(Engine):
+    """Compiled FRDM's usual call (see :class:`Engine`).
+
+    Args:
+        packed: the kernel's chain, problem (its ``pstar`` and ``Rstar`` are the spec's arrays), settings and
+            memory.
+        judge: the robot's certified compiled FK.
+        spec: :class:`Engine`'s, and ``order``, ``cap``, ``first_chunk``, ``later_chunk`` as the timed multistart
+            takes them, ``stall_events`` (stalls → the events).
+    """
+
+    cdef Packed packed
+    cdef double first_chunk, later_chunk
+    cdef int order, cap
+    cdef object stall_events
+
+    def __init__(self, Packed packed, Judge judge, spec):
+        super().__init__(judge, spec)
+        if packed.n != self.n:
+            raise ValueError(f"FRDMEngine: the kernel's chain has {packed.n} joints, the spec {self.n}")
+        self.packed = packed
+        self.order, self.cap = spec.order, spec.cap
+        self.first_chunk, self.later_chunk = spec.first_chunk, spec.later_chunk
+        self.stall_events = spec.stall_events
+
+    cdef int _run(self, double* best, double* stats, unsigned long long* rng, double deadline):
+        cdef int code
+        cdef Packed pk = self.packed
+        memcpy(best, self.q, sizeof(double) * self.n)
+        with nogil:
+            code = timed(self.q, &pk.ch, &pk.pb, &pk.st, self.order, self.cap, rng, self.attempts, self.first_chunk,
+                         self.later_chunk, deadline, 0, best, stats, &pk.mem)
+        return code
+
+    cdef object _events(self, const double* stats):
+        cdef int stalls = <int> stats[T_STALLS]
+        return self.stall_events(stalls) if stalls else []
+
+
+cdef class BiquatEngine(Engine):
+    """The biquaternion preset's usual call (see :class:`Engine`): law (9), newton Euler, seeded restarts in the
+    joint limits, the clock looked at between chunks of steps as :func:`kinelab.ik.biquat.solver.multistart` does.
+
+    Args:
+        packed: the chain (its problem and settings unused).
+        judge: the robot's certified compiled FK.
+        spec: :class:`Engine`'s (``draw_lower``, ``draw_upper`` also the windows of the restarts and the limits a
+            converged answer is wrapped into), and the control's ``k`` [1/s], ``max_step`` [rad or m],
+            ``max_steps``, ``eps_rot``, ``eps_dual`` [m], ``damping``; ``first_chunk``, ``later_chunk`` the steps
+            before the first look at the clock and between two.
+    """
+
+    cdef Packed packed
+    cdef bq.Control control
+    cdef int first_chunk, later_chunk
+
+    def __init__(self, Packed packed, Judge judge, spec):
+        super().__init__(judge, spec)
+        if packed.n != self.n:
+            raise ValueError(f"BiquatEngine: the chain has {packed.n} joints, the spec {self.n}")
+        self.packed = packed
+        self.control.pstar, self.control.Rstar = &self.pstar[0], &self.Rstar[0, 0]
+        self.control.k, self.control.h = spec.k, 1.0 / spec.k
+        self.control.max_step, self.control.max_steps = spec.max_step, spec.max_steps
+        self.control.eps_rot, self.control.eps_dual, self.control.damping = spec.eps_rot, spec.eps_dual, spec.damping
+        self.first_chunk, self.later_chunk = spec.first_chunk, spec.later_chunk
+
+    cdef int _run(self, double* best, double* stats, unsigned long long* rng, double deadline):
+        cdef int code = -1, attempts = self.attempts, size
+        cdef double before
+        cdef const double* lower = &self.draw_lower[0]
+        cdef const double* upper = &self.draw_upper[0]
+        cdef Packed pk = self.packed
+        cdef bq.Control* control = &self.control
+        with nogil:
+            while attempts > 0:
+                before = stats[T_ATTEMPTS]
+                size = self.first_chunk if stats[T_ITERATIONS] == 0.0 else self.later_chunk
+                code = bq.multistart(self.q, &pk.ch, lower, upper, control, rng, attempts,
+                                     stats[T_ITERATIONS] + size, stats, lower, upper)
+                attempts -= <int> (stats[T_ATTEMPTS] - before)
+                if code == bq.CONVERGED or now() > deadline:
+                    break
+        memcpy(best, self.q, sizeof(double) * self.n)
+        return code
 
 
 cdef cnp.ndarray _array(const double* values, cnp.npy_intp size):

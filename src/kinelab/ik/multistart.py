@@ -60,15 +60,22 @@ def restart_windows(cm: ChainModel, q_start: np.ndarray, pstar: np.ndarray) -> t
         (lower, upper) of the restarts [rad or m].
     """
     lower, upper, L = cm.lower, cm.upper, cm.length
-    rotary = np.flatnonzero(cm.kind != PRISMATIC)
-    before_arm = np.arange(cm.n) < (rotary[0] if rotary.size else cm.n)  # a base's joints come first
-    wide = (cm.kind == PRISMATIC) & (upper - lower > 2.0 * L) & before_arm
+    wide = wide_base(cm)
     if not wide.any():
         return lower, upper
     v = cm.vectors(q_start)
     centre = q_start + v["e"] @ (np.asarray(pstar, dtype=float) - v["N"])
     return (np.where(wide, np.clip(centre - L, lower, upper), lower),
             np.where(wide, np.clip(centre + L, lower, upper), upper))
+
+
+def wide_base(cm: ChainModel) -> np.ndarray:
+    """(n,) True at a prismatic joint ahead of every rotary joint whose range exceeds twice the chain's length:
+    the joints whose restart window follows the target (:func:`restart_windows`)."""
+    rotary = np.flatnonzero(cm.kind != PRISMATIC)
+    before_arm = np.arange(cm.n) < (rotary[0] if rotary.size else cm.n)  # a base's joints come first
+    wide: np.ndarray = (cm.kind == PRISMATIC) & (cm.upper - cm.lower > 2.0 * cm.length) & before_arm
+    return wide
 
 
 def run_in_chunks(chunk: Callable[[int], int], attempts: int, stats: np.ndarray, deadline: float,

@@ -6,13 +6,14 @@ kernels before it returns; ``ik.solve(target, q0=...)`` then checks only what ch
 the start), so a call pays no argument validation or option building. Its answers are those of
 :func:`kinelab.solve` with the same settings and seed (tested), and every one is judged.
 
-For compiled FRDM the prepared solver owns its engine (:class:`LeanFRDM`). The usual call — a ``pin.SE3`` target,
-a float64 start of the right length (or none), an integer seed or none — on a robot whose compiled FK is certified
-is one compiled call (:class:`kinelab.core._engine.FRDMEngine`): it checks both (finite, a proper rotation, the start
-within the limits, the target within the reach bound), runs the multistart and judges the answer; the result is
-built directly, its diagnostics only when read. On a robot judged by Pinocchio's FK the same steps run as three
-compiled calls with Pinocchio's verdict between them. Anything else (a point target, a list start, a start outside
-the limits, a target beyond reach) takes the general driver, which names the problem, warns or answers UNREACHABLE
+The prepared solver owns its solver's engine (:class:`kinelab.core._engine.Engine`; compiled FRDM's comes with
+:class:`LeanFRDM`, the biquaternion preset's from its module's ``engine``). The usual call — a ``pin.SE3`` target, a
+float64 start of the right length (or none), an integer seed or none — on a robot whose compiled FK is certified
+is one compiled call: it checks both (finite, a proper rotation, the start within the limits, the target within
+the reach bound), runs the multistart and judges the answer; the result is built directly, its diagnostics only
+when read. On a robot judged by Pinocchio's FK, FRDM's usual call runs as three compiled calls with Pinocchio's
+verdict between them. Anything else (a point target, a list start, a start outside the limits, a target beyond
+reach) takes the general driver, which names the problem, warns or answers UNREACHABLE
 exactly as :func:`kinelab.solve` does: the engine changes the cost, never the answer.
 """
 
@@ -28,7 +29,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.collision.model import as_collisions, collision_model
-from kinelab.core._engine import FRDMEngine
+from kinelab.core._engine import Engine, FRDMEngine
 from kinelab.core._verdict import usual_inputs
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.analytic.branches import (
@@ -92,7 +93,8 @@ class LeanFRDM:
         spec = SimpleNamespace(
             kind=cm.kind, draw_lower=cm.lower, draw_upper=cm.upper, check_lower=self.lower, check_upper=self.upper,
             turn_lower=np.asarray(self.robot.lower, dtype=float), turn_upper=np.asarray(self.robot.upper, dtype=float),
-            anchor=self.anchor, radius=self.radius, pstar=ctx.pstar, Rstar=ctx.Rstar, order=ctx.order, cap=ctx.cap,
+            wrap_continuous=True, anchor=self.anchor, radius=self.radius, pstar=ctx.pstar, Rstar=ctx.Rstar,
+            order=ctx.order, cap=ctx.cap,
             attempts=self.attempts, first_chunk=ctx.chunk, later_chunk=ctx.later_chunk, budget=self.budget,
             tol_pos=float(self.tol_pos), tol_rot=float(self.tol_rot), check_pos=bool(self.check_pos),
             check_rot=bool(self.check_rot), axis=self.axis, se3=pin.SE3, result=IKResult, fields=dict(
@@ -223,9 +225,15 @@ class IK:
         self._nearest: NearestBranch | None = None
         self._lean = self._prepare()
         # the usual call's one compiled call (kinelab.core._engine), where the solver has one
-        self.engine: FRDMEngine | None = None
-        if self._lean is not None and self.collisions is None:
-            self.engine = self._lean.engine
+        self.engine: Engine | None = None if self.collisions is not None or self.analytic else self._engine()
+
+    def _engine(self) -> Engine | None:
+        """The solver's one-call engine: compiled FRDM's (its lean call's), or what the solver module's ``engine``
+        (where it has one) makes for this robot and request."""
+        if self._lean is not None:
+            return self._lean.engine
+        make = getattr(self.request.module, "engine", None)
+        return None if make is None else make(self.robot, self.request)
 
     def _prepare(self) -> LeanFRDM | None:
         """Everything a call would otherwise build first: the closed form's class (a chain without one refused

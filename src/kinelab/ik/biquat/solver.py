@@ -10,11 +10,15 @@ compiled (:mod:`kinelab.ik.biquat.kernel`) with its restarts when the options al
 from __future__ import annotations
 
 import time
+from functools import partial
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
+from kinelab.core._engine import BiquatEngine
+from kinelab.core._frdm import pack_chain
 from kinelab.dq import kinematics as biquat_kinematics
 from kinelab.dq.algebra import DualQuat, same_pose
 from kinelab.errors import BiquaternionError, KinelabError
@@ -23,10 +27,14 @@ from kinelab.ik.biquat import kernel, laws
 from kinelab.ik.biquat.integrators import Stop, System, Trajectory, adaptive, fixed
 from kinelab.ik.biquat.options import BiquatOptions
 from kinelab.ik.chain import chain_model
+from kinelab.ik.driver import Call, compiled_result
 from kinelab.ik.limits import wrap_q
 from kinelab.ik.multistart import clock_chunk
-from kinelab.ik.result import Attempt, Diagnostics, Status
+from kinelab.ik.request import Request, verdict_reserve
+from kinelab.ik.result import Attempt, Diagnostics, IKResult, Status
+from kinelab.ik.targets import reach_bound
 from kinelab.robot import Robot
+from kinelab.robot.model import _compiled_judge
 
 Options = BiquatOptions
 # integration steps × joints before the first look at the clock (most solves end within them), then between
@@ -140,9 +148,8 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: 
     k = opts.gain
     damping = opts.damping_for(robot.n)
     cm = chain_model(robot)
-    max_steps = 30 if opts.max_time is None else max(1, int(np.ceil(float(opts.max_time) * k)))
     prob = kernel.Control(np.array(oMtarget.translation), np.ascontiguousarray(oMtarget.rotation), float(k), 1.0 / k,
-                          0.5, int(max_steps), 0.5 * float(tol_rot), 0.5 * float(tol_pos), float(damping))
+                          0.5, _max_steps(opts), 0.5 * float(tol_rot), 0.5 * float(tol_pos), float(damping))
     rng_state = restarts.seed_state(seed)
     q = restarts.first_start(q0, cm.kind, cm.lower, cm.upper, rng_state)
     stats = np.zeros(kernel.STATS_SIZE)
@@ -156,18 +163,80 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: 
                            float(stats[kernel.T_STEPS] + size), stats, restart_lower, restart_upper)
 
     code = restarts.run_in_chunks(chunk, max_restarts + 1, stats, deadline, kernel.CONVERGED)
+    return compiled_attempt(code, q, stats, deadline, damping, k), max(0, int(stats[kernel.T_ATTEMPTS]) - 1)
+
+
+def compiled_attempt(code: int, q: np.ndarray, stats: np.ndarray, deadline: float, damping: float,
+                     k: float) -> Attempt:
+    """The attempt of the compiled preset's multistart: its code (the kernel's), last q and statistics (slots
+    ``kernel.T_*``); TIME_BUDGET when the deadline has passed without a convergence."""
     if code == kernel.CONVERGED:
         status = Status.CONVERGED
     elif time.perf_counter() > deadline:
         status = Status.TIME_BUDGET
     else:
         status = Status.SINGULAR if code == kernel.SINGULAR else Status.MAX_ITERATIONS
-    diag = Diagnostics(model_time=float(stats[kernel.T_MODEL_TIME]), steps=int(stats[kernel.T_STEPS]),
+    return Attempt(q, status, int(stats[kernel.T_STEPS]), diagnostics=compiled_diagnostics(stats, damping),
+                   mode=compiled_mode(k))
+
+
+def compiled_diagnostics(stats: np.ndarray, damping: float) -> Diagnostics:
+    """The diagnostics of the compiled preset's multistart from its statistics (slots ``kernel.T_*``)."""
+    return Diagnostics(model_time=float(stats[kernel.T_MODEL_TIME]), steps=int(stats[kernel.T_STEPS]),
                        damping=damping, law="simple", integrator="euler", attempts=int(stats[kernel.T_ATTEMPTS]),
                        outside_limits=int(stats[kernel.T_OUTSIDE]), path="compiled")
-    mode = f"biquat (simple, newton euler, h={1.0 / k:g}, k={k:g}, compiled)"
-    restarts_run = max(0, int(stats[kernel.T_ATTEMPTS]) - 1)
-    return Attempt(q, status, int(stats[kernel.T_STEPS]), diagnostics=diag, mode=mode), restarts_run
+
+
+def compiled_mode(k: float) -> str:
+    """The compiled preset's mode string at gain k [1/s]."""
+    return f"biquat (simple, newton euler, h={1.0 / k:g}, k={k:g}, compiled)"
+
+
+def engine(robot: Robot, req: Request) -> BiquatEngine | None:
+    """The prepared solver's one-call engine (:class:`kinelab.core._engine.BiquatEngine`): the compiled preset with
+    its restarts, judged by the robot's certified compiled FK, the result filled in C. None where the general route
+    must serve: options the preset does not run, a robot judged by Pinocchio's FK, a mobile base whose restart
+    windows follow the target.
+
+    Args:
+        robot: the robot.
+        req: the prepared solver's request (solver "biquat").
+    """
+    opts = req.options
+    judge = robot.derived("compiled judge", _compiled_judge)
+    cm = chain_model(robot)
+    if not opts.compiled or judge is None or restarts.wide_base(cm).any():
+        return None
+    k, damping = opts.gain, opts.damping_for(robot.n)
+    budget = np.inf if req.time_budget is None else float(req.time_budget) - verdict_reserve(float(req.time_budget))
+    anchor, radius = reach_bound(robot)
+    task, tol_pos, tol_rot = req.task, float(req.tol_pos), float(req.tol_rot)
+
+    def unmet(target: Any, code: int, q: np.ndarray, stats: np.ndarray, dp: float, dr: float, ok: bool,
+              t_start: float, deadline: float, seed: int) -> IKResult:
+        call = Call(robot, target, req.solver, tol_pos, tol_rot, t_start, deadline, seed, task, req.task_label)
+        return compiled_result(call, compiled_attempt(code, q, stats, deadline, damping, k),
+                               max(0, int(stats[kernel.T_ATTEMPTS]) - 1), ok, dp, dr)
+
+    lower, upper = robot.check_bounds
+    spec = SimpleNamespace(
+        kind=cm.kind, draw_lower=cm.lower, draw_upper=cm.upper, check_lower=lower, check_upper=upper,
+        turn_lower=np.asarray(robot.lower, dtype=float), turn_upper=np.asarray(robot.upper, dtype=float),
+        wrap_continuous=False, anchor=np.array(anchor, dtype=float),
+        radius=float(radius) if task.position else np.inf, pstar=np.zeros(3), Rstar=np.eye(3),
+        attempts=req.max_restarts + 1, budget=budget, tol_pos=tol_pos, tol_rot=tol_rot, check_pos=task.position,
+        check_rot=task.rotation, axis=task.axis, se3=pin.SE3, result=IKResult,
+        fields=dict(success=True, status=Status.CONVERGED, solver=req.solver, mode=compiled_mode(k), message="",
+                    task=req.task_label, judge=robot.fk_certificate.judge),
+        diagnostics=partial(compiled_diagnostics, damping=damping), unmet=unmet, k=float(k), max_step=0.5,
+        max_steps=_max_steps(opts), eps_rot=0.5 * tol_rot, eps_dual=0.5 * tol_pos, damping=float(damping),
+        first_chunk=clock_chunk(JOINT_STEPS_PER_LOOK, cm.n), later_chunk=clock_chunk(JOINT_STEPS_PER_LATER_LOOK, cm.n))
+    return BiquatEngine(pack_chain(cm.chain), judge, spec)
+
+
+def _max_steps(opts: BiquatOptions) -> int:
+    """Steps of one attempt of the compiled preset: 30, or ceil(max_time·k)."""
+    return 30 if opts.max_time is None else max(1, int(np.ceil(float(opts.max_time) * opts.gain)))
 
 
 def prepare(robot: Robot, options: BiquatOptions | None = None) -> None:

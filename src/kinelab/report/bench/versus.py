@@ -1,10 +1,11 @@
-"""``kinelab bench --versus``: kinelab's two calls against roboticstoolbox's ``ik_LM`` where users measure.
+"""``kinelab bench --versus``: kinelab's calls against roboticstoolbox's ``ik_LM`` where users measure.
 
 Per arm and protocol (floor: the start is the answer; warm: the answer plus N(0, σ) per joint, σ = 0.02 and
 0.2 rad, clipped to the limits; random: a uniform start), the same n seeded problems go to the prepared
-solver (``kinelab.IK(...).solve``), the plain call (``kinelab.solve``) and ``ets.ik_LM`` (its C++
+solver (``kinelab.IK(...).solve``), the plain call (``kinelab.solve``), the prepared biquaternion solver, the
+closed form's nearest branch where the arm has one, and ``ets.ik_LM`` (its C++
 Levenberg–Marquardt with its own restarts). Every answer is judged here by Pinocchio (1e-6 m, 1e-6 rad,
-within the limits). Rounds alternate two schedules — interleaved (the three solvers on each problem in turn,
+within the limits). Rounds alternate two schedules — interleaved (the solvers on each problem in turn,
 the order rotating) and blocked (each solver over the whole set) — and kinelab's seeds change with the round,
 as ik_LM's own restarts do. A ratio is kinelab's median time over ik_LM's, per round; the figures are the
 median over rounds and the spread (lowest, highest round).
@@ -48,12 +49,14 @@ def problems(robot: Robot, n: int, seed: int, start: str, sigma: float) -> list[
 
 
 def solvers(robot: Robot) -> dict[str, Solver]:
-    """The contenders: the prepared call, the plain call, the closed form where the arm has one (the branch
-    nearest the start) and (if installed) ik_LM."""
+    """The contenders: the prepared call, the plain call, the prepared biquaternion solver, the closed form where the
+    arm has one (the branch nearest the start) and (if installed) ik_LM."""
     ik = IK(robot, time_budget=BUDGET)
+    biquat = IK(robot, solver="biquat", time_budget=BUDGET)
     out: dict[str, Solver] = {
         "IK.solve": lambda t, q0, seed: ik.solve(t, q0=q0, seed=seed).q,
         "kinelab.solve": lambda t, q0, seed: solve(robot, t, q0=q0, seed=seed, time_budget=BUDGET).q,
+        "IK.solve biquat": lambda t, q0, seed: biquat.solve(t, q0=q0, seed=seed).q,
     }
     if classify(robot).arm is not None:
         out["solve analytic"] = lambda t, q0, seed: solve(robot, t, solver="analytic", q0=q0).q
