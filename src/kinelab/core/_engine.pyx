@@ -21,7 +21,8 @@ from libc.string cimport memcpy
 
 cimport kinelab.core._biquat as bq
 from kinelab.core._chain cimport Judge
-from kinelab.core._frdm cimport CONTINUOUS, CONVERGED, STATS_SIZE, T_STALLS, Packed, now, random_configuration, timed
+from kinelab.core._frdm cimport (CONTINUOUS, CONVERGED, STATS_SIZE, T_STALLS, Packed, chain_fk, now,
+                                 random_configuration, timed)
 from kinelab.core._verdict cimport pose_errors, take_target
 
 cnp.import_array()
@@ -271,51 +272,89 @@ cdef class FRDMEngine(Engine):
 
 
 cdef class BiquatEngine(Engine):
-    """The biquaternion preset's usual call (see :class:`Engine`): law (9), newton Euler, seeded restarts in the
-    joint limits, the clock looked at between chunks of steps as :func:`kinelab.ik.biquat.solver.multistart` does.
+    """The biquaternion preset's usual call (see :class:`Engine`): law (9), newton Euler, seeded restarts, the clock
+    looked at between chunks of steps, as :func:`kinelab.ik.biquat.solver.multistart` does.
 
     Args:
         packed: the chain (its problem and settings unused).
         judge: the robot's certified compiled FK.
-        spec: :class:`Engine`'s (``draw_lower``, ``draw_upper`` also the windows of the restarts and the limits a
-            converged answer is wrapped into), and the control's ``k`` [1/s], ``max_step`` [rad or m],
-            ``max_steps``, ``eps_rot``, ``eps_dual`` [m], ``damping``; ``first_chunk``, ``later_chunk`` the steps
-            before the first look at the clock and between two.
+        spec: :class:`Engine`'s (``draw_lower``, ``draw_upper`` also the limits a converged answer is wrapped into
+            and the restarts' windows), and the control's ``k`` [1/s], ``max_step`` [rad or m], ``max_steps``,
+            ``eps_rot``, ``eps_dual`` [m], ``damping``; ``first_chunk``, ``later_chunk`` the steps before the first
+            look at the clock and between two; ``wide`` (n,) the base joints whose restart window follows the
+            target (:func:`kinelab.ik.multistart.restart_windows`), ``length`` [m] the chain's length.
     """
 
     cdef Packed packed
     cdef bq.Control control
-    cdef int first_chunk, later_chunk
+    cdef int first_chunk, later_chunk, any_wide
+    cdef const unsigned char[::1] wide
+    cdef double length
+    cdef double* scratch  # the restarts' windows (2n), and the chain's axes, points, tool point and rotation
 
     def __init__(self, Packed packed, Judge judge, spec):
         super().__init__(judge, spec)
-        if packed.n != self.n:
+        if packed.n != self.n or len(spec.wide) != self.n:
             raise ValueError(f"BiquatEngine: the chain has {packed.n} joints, the spec {self.n}")
-        self.packed = packed
+        self.packed, self.wide, self.length = packed, spec.wide, spec.length
+        self.any_wide = any(spec.wide)
         self.control.pstar, self.control.Rstar = &self.pstar[0], &self.Rstar[0, 0]
         self.control.k, self.control.h = spec.k, 1.0 / spec.k
         self.control.max_step, self.control.max_steps = spec.max_step, spec.max_steps
         self.control.eps_rot, self.control.eps_dual, self.control.damping = spec.eps_rot, spec.eps_dual, spec.damping
         self.first_chunk, self.later_chunk = spec.first_chunk, spec.later_chunk
+        self.scratch = <double*> malloc(sizeof(double) * (8 * self.n + 12))
+        if self.scratch == NULL:
+            raise MemoryError("BiquatEngine: no memory for the restarts' windows")
 
     cdef int _run(self, double* best, double* stats, unsigned long long* rng, double deadline):
         cdef int code = -1, attempts = self.attempts, size
         cdef double before
         cdef const double* lower = &self.draw_lower[0]
         cdef const double* upper = &self.draw_upper[0]
+        cdef const double* restart_lower = lower
+        cdef const double* restart_upper = upper
         cdef Packed pk = self.packed
         cdef bq.Control* control = &self.control
+        if self.any_wide:
+            self._windows()
+            restart_lower, restart_upper = self.scratch, self.scratch + self.n
         with nogil:
             while attempts > 0:
                 before = stats[T_ATTEMPTS]
                 size = self.first_chunk if stats[T_ITERATIONS] == 0.0 else self.later_chunk
                 code = bq.multistart(self.q, &pk.ch, lower, upper, control, rng, attempts,
-                                     stats[T_ITERATIONS] + size, stats, lower, upper)
+                                     stats[T_ITERATIONS] + size, stats, restart_lower, restart_upper)
                 attempts -= <int> (stats[T_ATTEMPTS] - before)
                 if code == bq.CONVERGED or now() > deadline:
                     break
         memcpy(best, self.q, sizeof(double) * self.n)
         return code
+
+    cdef void _windows(self) noexcept:
+        """The restarts' windows from the first start (``self.q``) and the target, into the scratch's first 2n:
+        a wide base joint within the chain's length of the value that carries the tool to the target point along
+        its axis, clipped to the limits (:func:`kinelab.ik.multistart.restart_windows`, the same arithmetic)."""
+        cdef int i, n = self.n
+        cdef double* e = self.scratch + 2 * n
+        cdef double* p = e + 6 * n
+        chain_fk(&self.packed.ch, self.q, e, e + 3 * n, p, p + 3)
+        cdef double d0 = self.pstar[0] - p[0], d1 = self.pstar[1] - p[1], d2 = self.pstar[2] - p[2], centre
+        for i in range(n):
+            self.scratch[i], self.scratch[n + i] = self.draw_lower[i], self.draw_upper[i]
+            if self.wide[i]:
+                centre = self.q[i] + (e[3 * i] * d0 + e[3 * i + 1] * d1 + e[3 * i + 2] * d2)
+                self.scratch[i] = _clip(centre - self.length, self.draw_lower[i], self.draw_upper[i])
+                self.scratch[n + i] = _clip(centre + self.length, self.draw_lower[i], self.draw_upper[i])
+
+    def __dealloc__(self):
+        free(self.scratch)
+
+
+cdef inline double _clip(double x, double lower, double upper) noexcept:
+    """x within [lower, upper] (numpy's clip: the larger of x and lower, then the smaller of that and upper)."""
+    x = lower if x < lower else x
+    return upper if x > upper else x
 
 
 cdef cnp.ndarray _array(const double* values, cnp.npy_intp size):

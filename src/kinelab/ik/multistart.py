@@ -64,7 +64,8 @@ def restart_windows(cm: ChainModel, q_start: np.ndarray, pstar: np.ndarray) -> t
     if not wide.any():
         return lower, upper
     v = cm.vectors(q_start)
-    centre = q_start + v["e"] @ (np.asarray(pstar, dtype=float) - v["N"])
+    e, d = v["e"], np.asarray(pstar, dtype=float) - v["N"]
+    centre = q_start + (e[:, 0] * d[0] + e[:, 1] * d[1] + e[:, 2] * d[2])  # the engine's order of the sum
     return (np.where(wide, np.clip(centre - L, lower, upper), lower),
             np.where(wide, np.clip(centre + L, lower, upper), upper))
 

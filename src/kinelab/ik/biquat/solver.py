@@ -195,8 +195,7 @@ def compiled_mode(k: float) -> str:
 def engine(robot: Robot, req: Request) -> BiquatEngine | None:
     """The prepared solver's one-call engine (:class:`kinelab.core._engine.BiquatEngine`): the compiled preset with
     its restarts, judged by the robot's certified compiled FK, the result filled in C. None where the general route
-    must serve: options the preset does not run, a robot judged by Pinocchio's FK, a mobile base whose restart
-    windows follow the target.
+    must serve: options the preset does not run, a robot judged by Pinocchio's FK.
 
     Args:
         robot: the robot.
@@ -205,7 +204,7 @@ def engine(robot: Robot, req: Request) -> BiquatEngine | None:
     opts = req.options
     judge = robot.derived("compiled judge", _compiled_judge)
     cm = chain_model(robot)
-    if not opts.compiled or judge is None or restarts.wide_base(cm).any():
+    if not opts.compiled or judge is None:
         return None
     k, damping = opts.gain, opts.damping_for(robot.n)
     budget = np.inf if req.time_budget is None else float(req.time_budget) - verdict_reserve(float(req.time_budget))
@@ -230,7 +229,8 @@ def engine(robot: Robot, req: Request) -> BiquatEngine | None:
                     task=req.task_label, judge=robot.fk_certificate.judge),
         diagnostics=partial(compiled_diagnostics, damping=damping), unmet=unmet, k=float(k), max_step=0.5,
         max_steps=_max_steps(opts), eps_rot=0.5 * tol_rot, eps_dual=0.5 * tol_pos, damping=float(damping),
-        first_chunk=clock_chunk(JOINT_STEPS_PER_LOOK, cm.n), later_chunk=clock_chunk(JOINT_STEPS_PER_LATER_LOOK, cm.n))
+        first_chunk=clock_chunk(JOINT_STEPS_PER_LOOK, cm.n), later_chunk=clock_chunk(JOINT_STEPS_PER_LATER_LOOK, cm.n),
+        wide=restarts.wide_base(cm).astype(np.uint8), length=float(cm.length))
     return BiquatEngine(pack_chain(cm.chain), judge, spec)
 
 
