@@ -1,5 +1,6 @@
-"""The prepared solver's lean call (kinelab.ik.prepared.LeanFRDM) gives kinelab.solve's results: same q, verdict,
-status, counts and diagnostics for the same seed, on the usual call and on every input it hands to the general path."""
+"""The prepared solver's one compiled call (its solver's engine) gives the general route's results: same q, verdict,
+status, counts and diagnostics for the same seed, on the usual call and on every input it hands to the general path;
+and kinelab.solve gives the prepared solver's."""
 
 from __future__ import annotations
 
@@ -21,6 +22,17 @@ SAME = ("success", "status", "position_error", "rotation_error", "iterations", "
         "message", "task")
 
 
+def _general(robot, target, q0, seed, task="pose", max_restarts=1000, tol=1e-6, **solver_options):
+    """The driver's general route with these settings (no budget)."""
+    from dataclasses import replace
+
+    from kinelab.ik.driver import solve_one
+    from kinelab.ik.request import make_request
+
+    req = make_request("frdm", None, tol, tol, None, max_restarts, "project", None, task, "z", solver_options)
+    return solve_one(robot, target, q0, replace(req, seed=seed))
+
+
 def _same(a: kinelab.IKResult, b: kinelab.IKResult) -> None:
     np.testing.assert_array_equal(a.q, b.q)
     for name in SAME:
@@ -31,18 +43,20 @@ def _same(a: kinelab.IKResult, b: kinelab.IKResult) -> None:
 
 @pytest.mark.parametrize("name", ["ur5", "kinova", "stanford", "youbot"])
 @pytest.mark.parametrize("task", ["pose", "position", "axis"])
-def test_the_lean_call_equals_kinelab_solve(name, task):
+def test_the_one_call_equals_the_general_route_and_kinelab_solve(name, task):
     robot = kinelab.load(name)
     settings = dict(task=task, time_budget=None, max_restarts=30)
     ik = kinelab.IK(robot, **settings)
+    assert ik.engine is not None  # the usual call is served by the engine (pose-like targets, float starts)
     rng = np.random.default_rng(3)
     for k in range(8):
         q = robot.random_q(rng)
         target = robot.fk(q)
         warm = np.clip(q + rng.normal(0, 0.1, q.size), robot.lower, robot.upper)
         for q0 in (warm, None):
-            _same(ik.solve(target, q0=q0, seed=k), kinelab.solve(robot, target, q0=q0, seed=k, **settings))
-    assert ik._lean is not None  # the lean path served these calls (pose-like targets, float starts)
+            one = ik.solve(target, q0=q0, seed=k)
+            _same(one, _general(robot, target, q0, k, task, 30))
+            _same(one, kinelab.solve(robot, target, q0=q0, seed=k, **settings))
 
 
 def test_every_unusual_input_gets_the_general_path_s_answer_or_error(ur5):
@@ -79,8 +93,8 @@ def test_every_unusual_input_gets_the_general_path_s_answer_or_error(ur5):
             ik.solve(target, q0=q, seed=seed)
 
 
-def test_a_lean_failure_reports_as_the_general_path_does(ur5, no_tolerance_floor):
-    """Tolerances no answer meets (1e-300): the lean call builds the failure through the driver's helpers."""
+def test_a_failure_of_the_one_call_reports_as_the_general_path_does(ur5, no_tolerance_floor):
+    """Tolerances no answer meets (1e-300): the engine builds the failure through the driver's helpers."""
     ik = kinelab.IK(ur5, time_budget=None, max_restarts=3, tol_pos=1e-300, tol_rot=1e-300, finish="none")
     target = ur5.fk(ur5.random_q(4))
     a = ik.solve(target, q0=ur5.random_q(5), seed=1)
@@ -88,3 +102,4 @@ def test_a_lean_failure_reports_as_the_general_path_does(ur5, no_tolerance_floor
                       tol_rot=1e-300, finish="none")
     assert not a.success and a.restarts == 3 and "none of 4 starts" in a.message
     _same(a, b)
+    _same(a, _general(ur5, target, ur5.random_q(5), 1, max_restarts=3, tol=1e-300, finish="none"))

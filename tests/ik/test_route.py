@@ -101,11 +101,12 @@ def test_a_result_s_diagnostics_are_built_only_when_read(monkeypatch):
     import copy
     import pickle
 
+    from kinelab.ik.frdm.solver import _Context
+
     robot = kinelab.load("panda")
     ik = kinelab.IK(robot, time_budget=None)
-    ctx, built = ik._lean.ctx, []
-    made_by = ctx.diagnostics
-    monkeypatch.setattr(ctx, "diagnostics", lambda st: built.append(1) or made_by(st))
+    built, made_by = [], _Context.diagnostics
+    monkeypatch.setattr(_Context, "diagnostics", lambda ctx, st: built.append(1) or made_by(ctx, st))
     q = robot.random_q(3)
     res = ik.solve(robot.fk(q), q0=q, seed=0)
     assert res.success and built == []
@@ -169,8 +170,8 @@ def test_every_branch_from_a_prepared_solver_is_kinelab_s(name, solver):
 
 def test_a_registered_solver_gets_no_capability_it_did_not_declare(monkeypatch):
     """The entry points read what a solver can do, not its name: a copy of FRDM registered under another name
-    answers ``solve`` (through the driver, not the one-call engine), but ``track`` (FRDM's path follower) refuses
-    it until it declares that it follows paths."""
+    answers ``solve`` (through the one-call engine its module offers, the result named after it), but ``track``
+    (FRDM's path follower) refuses it until it declares that it follows paths."""
     from kinelab.ik import register, registry
     from kinelab.ik.frdm import solver as frdm
 
@@ -180,7 +181,7 @@ def test_a_registered_solver_gets_no_capability_it_did_not_declare(monkeypatch):
     q = robot.random_q(3)
     register("twin", frdm)
     res = kinelab.solve(robot, robot.fk(q), solver="twin", seed=1, time_budget=None)
-    assert res.success and kinelab.IK(robot, solver="twin").engine is None  # no one-call engine undeclared
+    assert res.success and res.solver == "twin" and kinelab.IK(robot, solver="twin").engine is not None
     with pytest.raises(kinelab.OptionError, match="solver"):
         kinelab.track(robot, [robot.fk(q)], q0=q, solver="twin")
     register("twin", frdm, registry.Capabilities(follows_paths=True))

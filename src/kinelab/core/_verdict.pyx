@@ -13,11 +13,8 @@ cdef enum:
     C_NOT_FINITE = 1
     C_NOT_A_ROTATION = 2
     C_NOT_HOMOGENEOUS = 3
-    C_OK = 0
-    C_NOT_USUAL = 1
 
 NOT_FINITE, NOT_A_ROTATION, NOT_HOMOGENEOUS = C_NOT_FINITE, C_NOT_A_ROTATION, C_NOT_HOMOGENEOUS
-OK, NOT_USUAL = C_OK, C_NOT_USUAL
 
 
 cdef int pose_defect_of(const double[:, :] H) noexcept nogil:
@@ -132,25 +129,6 @@ def pose_verdict(const double[:, :] H_target, const double[:, :] H_tool, const d
         for j in range(4):
             T[4 * i + j] = H_tool[i, j]
     return verdict_of(T, H_target, q, lower, upper, axis)
-
-
-def usual_inputs(const double[:, :] H, const double[::1] q0, int n, const double[::1] lower,
-                 const double[::1] upper, const double[::1] anchor, double radius, double[::1] pstar,
-                 double[:, ::1] Rstar) -> int:
-    """OK when H is a proper pose whose point lies within ``radius`` [m] of ``anchor`` and q0 is empty (no start)
-    or n finite values within [lower, upper]: then H's point and rotation are copied into pstar and Rstar (the
-    kernel's target). NOT_USUAL otherwise (the general path then names what is wrong)."""
-    if H.shape[0] != 4 or H.shape[1] != 4 or anchor.shape[0] != 3 or pstar.shape[0] != 3 or Rstar.shape[0] != 3 \
-            or Rstar.shape[1] != 3 or lower.shape[0] != n or upper.shape[0] != n:
-        raise ValueError("usual_inputs: inconsistent shapes")
-    cdef int i
-    if q0.shape[0] != 0:
-        if q0.shape[0] != n:
-            return NOT_USUAL
-        for i in range(n):
-            if not lower[i] <= q0[i] <= upper[i]:  # also False for NaN; ±inf never lies within finite limits
-                return NOT_USUAL
-    return OK if take_target(H, anchor, radius, pstar, Rstar) else NOT_USUAL
 
 
 cdef bint take_target(const double[:, :] H, const double[::1] anchor, double radius, double[::1] pstar,

@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import time
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -19,7 +21,7 @@ import pinocchio as pin
 from kinelab.ik.limits import turned_verdict, wrap_q
 from kinelab.ik.request import Request, verdict_reserve
 from kinelab.ik.result import Attempt, BypassRecord, IKResult, SingularEvent, Status
-from kinelab.ik.targets import as_target, out_of_reach
+from kinelab.ik.targets import as_target, out_of_reach, reach_bound
 from kinelab.ik.tasks import COMPONENTS, POSE, Task
 from kinelab.robot import Robot
 
@@ -210,6 +212,47 @@ def compiled_result(pb: Call, att: Attempt, restarts: int, success: bool, dp: fl
         singular_events=att.events, message=_explained(pb, status, message), diagnostics=att.diagnostics,
         task=pb.task_label, judge=pb.robot.fk_certificate.judge,
     )
+
+
+def engine_spec(robot: Robot, req: Request, cm: Any,
+                attempt_of: Callable[[int, np.ndarray, np.ndarray, float], Attempt], mode: str,
+                diagnostics: Callable[[np.ndarray], Any], **kernel: Any) -> SimpleNamespace:
+    """What a solver's one-call engine (:class:`kinelab.core._engine.Engine`) reads from its prepared solver: the
+    checks' bounds, the reach bound, the budget, the verdict's tolerances and components, the converged result's
+    shared fields, and ``unmet``, which builds any other outcome's result exactly as the general route does.
+
+    Args:
+        robot: the robot.
+        req: the prepared solver's request.
+        cm: the robot's chain model.
+        attempt_of: (the kernel's code, q, statistics, deadline [s]) → the :class:`Attempt` the general route builds.
+        mode: the converged result's ``mode``.
+        diagnostics: statistics → the result's diagnostics (called when they are first read).
+        kernel: the engine's own settings (its kernel's arrays and constants).
+    """
+    task, tol_pos, tol_rot = req.task, float(req.tol_pos), float(req.tol_rot)
+
+    def unmet(target: Any, code: int, q: np.ndarray, stats: np.ndarray, dp: float, dr: float, ok: bool,
+              t_start: float, deadline: float, seed: int) -> IKResult:
+        call = Call(robot, target, req.solver, tol_pos, tol_rot, t_start, deadline, seed, task, req.task_label)
+        return compiled_result(call, attempt_of(code, q, stats, deadline), max(0, int(stats[ATTEMPTS]) - 1), ok, dp, dr)
+
+    anchor, radius = reach_bound(robot)
+    lower, upper = robot.check_bounds
+    budget = np.inf if req.time_budget is None else float(req.time_budget) - verdict_reserve(float(req.time_budget))
+    fields = dict(success=True, status=Status.CONVERGED, solver=req.solver, mode=mode, message="",
+                  task=req.task_label, judge=robot.fk_certificate.judge)
+    radius = float(radius) if task.position else np.inf  # a point the task ignores is never out of reach
+    return SimpleNamespace(
+        kind=cm.kind, draw_lower=cm.lower, draw_upper=cm.upper, check_lower=lower, check_upper=upper,
+        turn_lower=np.asarray(robot.lower, dtype=float), turn_upper=np.asarray(robot.upper, dtype=float),
+        anchor=np.array(anchor, dtype=float), radius=radius, attempts=req.max_restarts + 1, budget=budget,
+        tol_pos=tol_pos, tol_rot=tol_rot,
+        check_pos=task.position, check_rot=task.rotation, axis=task.axis, se3=pin.SE3, result=IKResult,
+        fields=fields, diagnostics=diagnostics, unmet=unmet, **kernel)
+
+
+ATTEMPTS = 0  # the statistics slot in which every compiled multistart counts its attempts
 
 
 def _outside_limits(pb: Call, q: np.ndarray, dp: float, dr: float, status: Status,

@@ -30,8 +30,8 @@ class Capabilities:
         runs: the solver whose request (tolerances, task, options) a closed-form or picking solver's call is
             built with; None: itself.
         stands_in: with no options, ``solve(prefer=)`` may take every branch from the closed form for it.
-        compiled: options with ``compiled`` set run kinelab's compiled kernels: one compiled call per solve, the
-            threaded batch.
+        compiled: options with ``compiled`` set run the threaded compiled batch of FRDM's kernel (a solve's one
+            compiled call is the module's: its ``engine``).
         follows_paths: ``track`` follows a path with it (warm-started sweeps).
         monitored: its results carry the singularity monitor's events and bypasses.
     """
@@ -61,8 +61,9 @@ CAPABILITIES: dict[str, Capabilities] = {}
 
 class SolverModule(Protocol):
     """What a solver provides: an options class with ``of(options, **kwargs)``, and ``attempt``; optionally
-    ``prepare(robot, options)`` (compilation of what those options run, outside the timed region) and a compiled
-    ``multistart``."""
+    ``prepare(robot, options)`` (compilation of what those options run, outside the timed region), a compiled
+    ``multistart`` (the general route's restarts in one kernel call) and ``engine(robot, request)`` (the prepared
+    solver's one-call engine, :class:`kinelab.core._engine.Engine`, or None where the general route must serve)."""
 
     Options: Any
 

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import time
 from functools import partial
-from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -27,12 +26,11 @@ from kinelab.ik.biquat import kernel, laws
 from kinelab.ik.biquat.integrators import Stop, System, Trajectory, adaptive, fixed
 from kinelab.ik.biquat.options import BiquatOptions
 from kinelab.ik.chain import chain_model
-from kinelab.ik.driver import Call, compiled_result
+from kinelab.ik.driver import engine_spec
 from kinelab.ik.limits import wrap_q
 from kinelab.ik.multistart import clock_chunk
-from kinelab.ik.request import Request, verdict_reserve
-from kinelab.ik.result import Attempt, Diagnostics, IKResult, Status
-from kinelab.ik.targets import reach_bound
+from kinelab.ik.request import Request
+from kinelab.ik.result import Attempt, Diagnostics, Status
 from kinelab.robot import Robot
 from kinelab.robot.model import _compiled_judge
 
@@ -203,34 +201,18 @@ def engine(robot: Robot, req: Request) -> BiquatEngine | None:
     """
     opts = req.options
     judge = robot.derived("compiled judge", _compiled_judge)
-    cm = chain_model(robot)
     if not opts.compiled or judge is None:
         return None
+    cm = chain_model(robot)
     k, damping = opts.gain, opts.damping_for(robot.n)
-    budget = np.inf if req.time_budget is None else float(req.time_budget) - verdict_reserve(float(req.time_budget))
-    anchor, radius = reach_bound(robot)
-    task, tol_pos, tol_rot = req.task, float(req.tol_pos), float(req.tol_rot)
-
-    def unmet(target: Any, code: int, q: np.ndarray, stats: np.ndarray, dp: float, dr: float, ok: bool,
-              t_start: float, deadline: float, seed: int) -> IKResult:
-        call = Call(robot, target, req.solver, tol_pos, tol_rot, t_start, deadline, seed, task, req.task_label)
-        return compiled_result(call, compiled_attempt(code, q, stats, deadline, damping, k),
-                               max(0, int(stats[kernel.T_ATTEMPTS]) - 1), ok, dp, dr)
-
-    lower, upper = robot.check_bounds
-    spec = SimpleNamespace(
-        kind=cm.kind, draw_lower=cm.lower, draw_upper=cm.upper, check_lower=lower, check_upper=upper,
-        turn_lower=np.asarray(robot.lower, dtype=float), turn_upper=np.asarray(robot.upper, dtype=float),
-        wrap_continuous=False, anchor=np.array(anchor, dtype=float),
-        radius=float(radius) if task.position else np.inf, pstar=np.zeros(3), Rstar=np.eye(3),
-        attempts=req.max_restarts + 1, budget=budget, tol_pos=tol_pos, tol_rot=tol_rot, check_pos=task.position,
-        check_rot=task.rotation, axis=task.axis, se3=pin.SE3, result=IKResult,
-        fields=dict(success=True, status=Status.CONVERGED, solver=req.solver, mode=compiled_mode(k), message="",
-                    task=req.task_label, judge=robot.fk_certificate.judge),
-        diagnostics=partial(compiled_diagnostics, damping=damping), unmet=unmet, k=float(k), max_step=0.5,
-        max_steps=_max_steps(opts), eps_rot=0.5 * tol_rot, eps_dual=0.5 * tol_pos, damping=float(damping),
-        first_chunk=clock_chunk(JOINT_STEPS_PER_LOOK, cm.n), later_chunk=clock_chunk(JOINT_STEPS_PER_LATER_LOOK, cm.n),
-        wide=restarts.wide_base(cm).astype(np.uint8), length=float(cm.length))
+    tol_pos, tol_rot = float(req.tol_pos), float(req.tol_rot)
+    spec = engine_spec(
+        robot, req, cm, partial(compiled_attempt, damping=damping, k=k), compiled_mode(k),
+        partial(compiled_diagnostics, damping=damping), wrap_continuous=False, pstar=np.zeros(3), Rstar=np.eye(3),
+        k=float(k), max_step=0.5, max_steps=_max_steps(opts), eps_rot=0.5 * tol_rot, eps_dual=0.5 * tol_pos,
+        damping=float(damping), first_chunk=clock_chunk(JOINT_STEPS_PER_LOOK, cm.n),
+        later_chunk=clock_chunk(JOINT_STEPS_PER_LATER_LOOK, cm.n), wide=restarts.wide_base(cm).astype(np.uint8),
+        length=float(cm.length))
     return BiquatEngine(pack_chain(cm.chain), judge, spec)
 
 

@@ -17,16 +17,20 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.core import _frdm
+from kinelab.core._engine import FRDMEngine
 from kinelab.ik import dls
 from kinelab.ik import multistart as restarts
 from kinelab.ik.chain import CONTINUOUS, ChainModel, chain_model
+from kinelab.ik.driver import engine_spec
 from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm.kernel import no_rest
 from kinelab.ik.frdm.monitor import Bypass, Goal, Runner
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.multistart import clock_chunk
+from kinelab.ik.request import Request
 from kinelab.ik.result import Attempt, Diagnostics, SingularEvent, Status
 from kinelab.robot import Robot
+from kinelab.robot.model import _compiled_judge
 
 Options = FRDMOptions
 # joint steps before the first look at the clock (most solves end within them: one kernel call), and then
@@ -103,6 +107,27 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: 
     return ctx.attempt(code, q, stats, deadline), max(0, int(stats[kernel.T_ATTEMPTS]) - 1)
 
 
+def engine(robot: Robot, req: Request) -> FRDMEngine | None:
+    """The prepared solver's one-call engine (:class:`kinelab.core._engine.FRDMEngine`): the compiled multistart,
+    judged by the robot's certified compiled FK, the result filled in C. It owns its context (the kernel's problem,
+    settings and memory). None where the general route must serve: options the compiled multistart does not run
+    (a bypass, a policy, polish, a trace), a robot judged by Pinocchio's FK.
+
+    Args:
+        robot: the robot.
+        req: the prepared solver's request (solver "frdm").
+    """
+    opts = req.options
+    judge = robot.derived("compiled judge", _compiled_judge)
+    if not opts.compiled or judge is None:
+        return None
+    ctx = _Context(robot, opts, float(req.tol_pos), float(req.tol_rot))
+    spec = engine_spec(robot, req, ctx.cm, ctx.attempt, ctx.mode, ctx.diagnostics_of, wrap_continuous=True,
+                       pstar=ctx.pstar, Rstar=ctx.Rstar, order=ctx.order, cap=ctx.cap, first_chunk=ctx.chunk,
+                       later_chunk=ctx.later_chunk, stall_events=ctx.stall_events)
+    return FRDMEngine(ctx.packed, judge, spec)
+
+
 class _Context:
     """Everything a compiled FRDM solve on one robot with one set of options and tolerances passes to the
     kernel, built once: per call only the target (copied into the problem's own arrays), the start, the
@@ -167,6 +192,10 @@ class _Context:
                                  attempts=int(st[kernel.T_ATTEMPTS]), stalls=int(st[kernel.T_STALLS]),
                                  polished=int(st[kernel.T_POLISHED]), newton_steps=int(st[kernel.T_NEWTON]),
                                  path="compiled")
+
+    def diagnostics_of(self, stats: np.ndarray) -> Diagnostics:
+        """:meth:`diagnostics` from the statistics array."""
+        return self.diagnostics(stats.tolist())
 
     @staticmethod
     def stall_events(stalls: int) -> list[SingularEvent]:
