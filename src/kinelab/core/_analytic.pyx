@@ -39,6 +39,7 @@ from cython.parallel cimport prange
 
 from kinelab.core._chain cimport Judge
 from kinelab.core._frdm cimport now
+from kinelab.core._geometry cimport rotm
 from kinelab.core._verdict cimport pose_defect_of, pose_defect_row_major, pose_errors
 
 cnp.import_array()
@@ -114,12 +115,9 @@ cdef inline M9 transpose(M9 M) noexcept nogil:
 
 cdef inline M9 rotation(V3 k, double theta) noexcept nogil:
     """R(k, θ): rotation by θ [rad] about the unit axis k (Rodrigues), row by row."""
-    cdef double c = cos(theta), s = sin(theta)
-    cdef double C = 1.0 - c
-    cdef double x = k[0], y = k[1], z = k[2]
-    return (c + x * x * C, x * y * C - z * s, x * z * C + y * s,
-            y * x * C + z * s, c + y * y * C, y * z * C - x * s,
-            z * x * C - y * s, z * y * C + x * s, c + z * z * C)
+    cdef double m[9]
+    rotm(k[0], k[1], k[2], theta, m)
+    return (m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8])
 
 
 cdef inline double wrap(double theta) noexcept nogil:

@@ -9,8 +9,7 @@ Pinocchio's ``forwardKinematics`` + ``updateFramePlacement`` on a serial model: 
 on each robot (:mod:`kinelab.robot.certificate`).
 """
 
-from libc.math cimport cos, sin
-
+from kinelab.core._geometry cimport rotm
 from kinelab.core._verdict cimport pose_errors, verdict_of
 
 cdef int PRISMATIC = 1
@@ -33,21 +32,10 @@ cdef inline void _compose(double[3][3] R, double[3] t, const double* dR, const d
 
 cdef inline void _turn(double[3][3] R, const double* a, double angle) noexcept nogil:
     """R ← R · Rot(a, angle) (Rodrigues)."""
-    cdef double c = cos(angle), s = sin(angle)
-    cdef double C = 1.0 - c
-    cdef double x = a[0], y = a[1], z = a[2]
     cdef double M[3][3]
     cdef double out[3][3]
     cdef int i, j
-    M[0][0] = c + x * x * C
-    M[0][1] = x * y * C - z * s
-    M[0][2] = x * z * C + y * s
-    M[1][0] = y * x * C + z * s
-    M[1][1] = c + y * y * C
-    M[1][2] = y * z * C - x * s
-    M[2][0] = z * x * C - y * s
-    M[2][1] = z * y * C + x * s
-    M[2][2] = c + z * z * C
+    rotm(a[0], a[1], a[2], angle, &M[0][0])
     for i in range(3):
         for j in range(3):
             out[i][j] = R[i][0] * M[0][j] + R[i][1] * M[1][j] + R[i][2] * M[2][j]

@@ -22,8 +22,9 @@ from libc.stdlib cimport calloc, free, malloc
 from kinelab.core._blas cimport ddot, dgemm, dgemv, dgesv, ready
 from kinelab.core._frdm cimport (
     BUDGET, CONVERGED, NOT_STARTED, STATE_SIZE, Chain, Memory, Objective, Packed, Settings, chain_fk, lm_polish, now,
-    rotation_angle, rotm, run, uniform, within, world_error, world_jacobian,
+    rotation_angle, run, uniform, within, world_error, world_jacobian,
 )
+from kinelab.core._geometry cimport rotm
 
 # the Gauss–Newton steps of a sample move no joint by more than TRUST_FLOOR + TRUST_FACTOR × the last sample's
 # largest joint step [rad or m]: a smooth path's answer lies about that far from the last one

@@ -99,7 +99,6 @@ cdef int timed(double* q, const Chain* ch, const Objective* pb, const Settings* 
 cdef void random_configuration(double* q, const long long* kind, const double* lower, const double* upper, int n,
                                unsigned long long* rng_state) noexcept nogil
 cdef double now() noexcept nogil
-cdef void rotm(double x, double y, double z, double angle, double* m) noexcept nogil
 cdef double uniform(unsigned long long* state) noexcept nogil
 cdef void world_error(const double* p, const double* R, const Objective* pb, double* err) noexcept nogil
 cdef void world_jacobian(const double* e, const double* o, const double* p, const double* R, const Chain* ch,

@@ -20,6 +20,7 @@ from posix.time cimport clock_gettime, timespec, CLOCK_MONOTONIC
 from cython.parallel cimport prange
 
 from kinelab.core._blas cimport ddot, dgemm, dgemv, dgesv, ready
+from kinelab.core._geometry cimport rotm
 
 import numpy as np
 
@@ -41,21 +42,6 @@ cdef inline double _max(double a, double b) noexcept nogil:
 cdef inline double _min(double a, double b) noexcept nogil:
     """Python's min(a, b): b only when b < a."""
     return b if b < a else a
-
-
-cdef void rotm(double x, double y, double z, double angle, double* m) noexcept nogil:
-    """Rodrigues' rotation by ``angle`` [rad] about the unit vector (x, y, z), row by row into m[9]."""
-    cdef double c = cos(angle), s = sin(angle)
-    cdef double C = 1.0 - c
-    m[0] = c + x * x * C
-    m[1] = x * y * C - z * s
-    m[2] = x * z * C + y * s
-    m[3] = y * x * C + z * s
-    m[4] = c + y * y * C
-    m[5] = y * z * C - x * s
-    m[6] = z * x * C - y * s
-    m[7] = z * y * C + x * s
-    m[8] = c + z * z * C
 
 
 cdef inline void _mm(const double* A, const double* B, double* out) noexcept nogil:

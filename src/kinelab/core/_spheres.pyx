@@ -7,20 +7,17 @@ its parent's, times its placement, times its motion); the test is conservative b
 against Pinocchio's exact test in the tests.
 """
 
-from libc.math cimport cos, sin, sqrt
+from libc.math cimport sqrt
 from libc.stdlib cimport free, malloc
+
+from kinelab.core._geometry cimport rotm
 
 cdef double PLANE = -1.0  # radius marker of a plane obstacle
 cdef int PRISMATIC = 1
 
 
-cdef void _rot(const double* k, double angle, double* out) noexcept nogil:
-    cdef double c = cos(angle), s = sin(angle)
-    cdef double C = 1.0 - c
-    cdef double x = k[0], y = k[1], z = k[2]
-    out[0], out[1], out[2] = c + x * x * C, x * y * C - z * s, x * z * C + y * s
-    out[3], out[4], out[5] = y * x * C + z * s, c + y * y * C, y * z * C - x * s
-    out[6], out[7], out[8] = z * x * C - y * s, z * y * C + x * s, c + z * z * C
+cdef inline void _rot(const double* k, double angle, double* out) noexcept nogil:
+    rotm(k[0], k[1], k[2], angle, out)
 
 
 cdef void _frames(const double* q, const long long* parents, int J, const double* place_R, const double* place_t,

@@ -1,0 +1,19 @@
+# Geometry written once for every compiled kernel and the judge: the rotation about a unit axis (Rodrigues).
+# Inline here, so each module that cimports it compiles the same arithmetic in place.
+
+from libc.math cimport cos, sin
+
+
+cdef inline void rotm(double x, double y, double z, double angle, double* m) noexcept nogil:
+    """Rodrigues' rotation by ``angle`` [rad] about the unit vector (x, y, z), row by row into m[9]."""
+    cdef double c = cos(angle), s = sin(angle)
+    cdef double C = 1.0 - c
+    m[0] = c + x * x * C
+    m[1] = x * y * C - z * s
+    m[2] = x * z * C + y * s
+    m[3] = y * x * C + z * s
+    m[4] = c + y * y * C
+    m[5] = y * z * C - x * s
+    m[6] = z * x * C - y * s
+    m[7] = z * y * C + x * s
+    m[8] = c + z * z * C
