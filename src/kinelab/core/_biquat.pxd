@@ -2,13 +2,15 @@
 
 from kinelab.core._frdm cimport Chain
 
-# codes of an attempt, and statistics slots of a multistart (the Python side names them too)
-cdef enum:
+# codes of an attempt, and statistics slots of a multistart, written once (kinelab.ik.biquat.kernel imports them)
+cpdef enum Code:
     CONVERGED = 0
     SINGULAR = 1
     MAX_STEPS = 2
     OUTSIDE_LIMITS = 3
     BUDGET = 4
+
+cdef enum:
     T_ATTEMPTS = 0
     T_STEPS = 1
     T_MODEL_TIME = 2

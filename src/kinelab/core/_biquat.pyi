@@ -1,6 +1,14 @@
+from enum import IntEnum
 from typing import Any
 
 import numpy as np
+
+class Code(IntEnum):
+    CONVERGED = 0
+    SINGULAR = 1
+    MAX_STEPS = 2
+    OUTSIDE_LIMITS = 3
+    BUDGET = 4
 
 def run_multistart(q: np.ndarray, chain: Any, lower: np.ndarray, upper: np.ndarray, control: Any,
                    rng_state: np.ndarray, max_attempts: int, step_budget: float, stats: np.ndarray,

@@ -1,12 +1,19 @@
 # The FRDM kernel's C interface, shared by the compiled modules that run it (the batch, the path follower).
 
-cdef enum:
+# Codes written once: Python reads the same enums (kinelab.ik.chain and kinelab.ik.frdm.kernel import them).
+cpdef enum JointKind:
+    REVOLUTE = 0
     PRISMATIC = 1
     CONTINUOUS = 2
+
+cpdef enum Order:
     TIP_TO_BASE = 0
     BASE_TO_TIP = 1
     ALTERNATE = 2
-    MIXED = 3
+    MIXED = 3  # per restart, in turn
+
+# what run() and the multistarts return (NOT_STARTED, STOPPED: a batch row the deadline cut before or while it ran)
+cpdef enum Code:
     CONVERGED = 0
     STALL_STEP = 1
     STALL_WINDOW = 2
@@ -14,7 +21,9 @@ cdef enum:
     NOT_STARTED = -2
     STOPPED = -3
 
-# state slots of an attempt, and statistics slots of a multistart (the Python side names them too)
+# slots of an attempt's state array, named in Python too (kinelab.ik.frdm.kernel; a named enum cannot index a C
+# array in Cython) (S_FINISH: 0 the Newton finish not tried, 1 tried and fell short, 2 converged;
+# S_NEWTON: its Gauss–Newton steps)
 cdef enum:
     S_HISTORY = 0
     S_SWEEPS = 1
@@ -28,6 +37,9 @@ cdef enum:
     S_FINISH = 9
     S_NEWTON = 10
     STATE_SIZE = 11
+
+# slots of a multistart's statistics array (T_NEWTON: Gauss–Newton steps of the finish, every attempt)
+cdef enum:
     T_ATTEMPTS = 0
     T_SWEEPS = 1
     T_STALLS = 2

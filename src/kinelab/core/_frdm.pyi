@@ -1,6 +1,26 @@
+from enum import IntEnum
 from typing import Any
 
 import numpy as np
+
+class JointKind(IntEnum):
+    REVOLUTE = 0
+    PRISMATIC = 1
+    CONTINUOUS = 2
+
+class Order(IntEnum):
+    TIP_TO_BASE = 0
+    BASE_TO_TIP = 1
+    ALTERNATE = 2
+    MIXED = 3
+
+class Code(IntEnum):
+    CONVERGED = 0
+    STALL_STEP = 1
+    STALL_WINDOW = 2
+    BUDGET = 3
+    NOT_STARTED = -2
+    STOPPED = -3
 
 class Packed:
     n: int

@@ -19,11 +19,12 @@ import numpy as np
 
 from kinelab.core import _frdm
 from kinelab.core._biquat import jacobian_local_of
+from kinelab.core._frdm import JointKind
 from kinelab.errors import ChainError
 from kinelab.robot import Robot
 from kinelab.robot.certificate import chain_arrays
 
-REVOLUTE, PRISMATIC, CONTINUOUS = 0, 1, 2
+REVOLUTE, PRISMATIC, CONTINUOUS = (int(k) for k in (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.CONTINUOUS))
 KIND_CODES = {"revolute": REVOLUTE, "prismatic": PRISMATIC, "continuous": CONTINUOUS}
 
 

@@ -11,10 +11,13 @@ from typing import NamedTuple
 
 import numpy as np
 
+from kinelab.core._biquat import Code
 from kinelab.core._biquat import run_integrate as integrate
 from kinelab.core._biquat import run_multistart as multistart
 
-CONVERGED, SINGULAR, MAX_STEPS, OUTSIDE_LIMITS, BUDGET = 0, 1, 2, 3, 4
+# the preset's return codes: the compiled core's enum, as ints
+CONVERGED, SINGULAR, MAX_STEPS = int(Code.CONVERGED), int(Code.SINGULAR), int(Code.MAX_STEPS)
+OUTSIDE_LIMITS, BUDGET = int(Code.OUTSIDE_LIMITS), int(Code.BUDGET)
 # slots of a multistart's statistics array
 T_ATTEMPTS, T_STEPS, T_MODEL_TIME, T_OUTSIDE, T_SINGULAR, T_CUT, T_ATTEMPT_STEPS, T_ATTEMPT_TIME = range(8)
 STATS_SIZE = 8

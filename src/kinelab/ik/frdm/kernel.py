@@ -22,12 +22,14 @@ from typing import NamedTuple
 import numpy as np
 
 from kinelab.core import _frdm
+from kinelab.core._frdm import Code, Order
 from kinelab.ik.chain import Chain
 
-TIP_TO_BASE, BASE_TO_TIP, ALTERNATE, MIXED = 0, 1, 2, 3  # sweep order codes (MIXED: per restart, in turn)
-
-# run() return codes
-CONVERGED, STALL_STEP, STALL_WINDOW, BUDGET = 0, 1, 2, 3
+# sweep order codes (MIXED: per restart, in turn) and run()'s return codes: the compiled core's enums, as ints
+TIP_TO_BASE, BASE_TO_TIP, ALTERNATE, MIXED = (int(o) for o in (Order.TIP_TO_BASE, Order.BASE_TO_TIP, Order.ALTERNATE,
+                                                               Order.MIXED))
+CONVERGED, STALL_STEP, STALL_WINDOW, BUDGET = (int(c) for c in (Code.CONVERGED, Code.STALL_STEP, Code.STALL_WINDOW,
+                                                                Code.BUDGET))
 
 # slots of an attempt's state array (S_FINISH: 0 the Newton finish not tried, 1 tried and fell short, 2 converged;
 # S_NEWTON: its Gauss–Newton steps)
