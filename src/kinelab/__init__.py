@@ -40,6 +40,8 @@ _LAZY = {
     "FRDMOptions": ("kinelab.ik.frdm.options", "FRDMOptions"),
     "IK": ("kinelab.ik.prepared", "IK"),
     "Diagnostics": ("kinelab.ik.result", "Diagnostics"),
+    "FRDMDiagnostics": ("kinelab.ik.result", "FRDMDiagnostics"),
+    "BiquatDiagnostics": ("kinelab.ik.result", "BiquatDiagnostics"),
     "IKResult": ("kinelab.ik.result", "IKResult"),
     "Status": ("kinelab.ik.result", "Status"),
     "TrackResult": ("kinelab.ik.result", "TrackResult"),
@@ -62,13 +64,22 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
     from kinelab.ik.batch import BatchIKResult
     from kinelab.ik.frdm.options import FRDMOptions
     from kinelab.ik.prepared import IK
-    from kinelab.ik.result import Branches, Diagnostics, IKResult, Status, TrackResult
+    from kinelab.ik.result import (
+        BiquatDiagnostics,
+        Branches,
+        Diagnostics,
+        FRDMDiagnostics,
+        IKResult,
+        Status,
+        TrackResult,
+    )
     from kinelab.ik.targets import from_xyz_quat_wxyz as target_from_xyz_quat_wxyz
     from kinelab.ik.targets import from_xyz_rpy as target_from_xyz_rpy
 
 
 __all__ = [
     "BatchIKResult",
+    "BiquatDiagnostics",
     "BiquaternionError",
     "BranchBatch",
     "Branches",
@@ -78,6 +89,7 @@ __all__ = [
     "DescriptionError",
     "Diagnostics",
     "Environment",
+    "FRDMDiagnostics",
     "FRDMOptions",
     "FrameNotFoundError",
     "IK",

@@ -62,3 +62,20 @@ def test_a_track_carries_status_members_and_iterations():
     assert track.iterations.shape == (12,) and track.iterations.min() >= 0
     counts = track.summary()["status"]
     assert sum(counts.values()) == 12 and counts.get("converged", 0) == int(track.reached.sum())
+
+
+def test_each_solver_s_diagnostics_are_its_own_record():
+    """FRDM's and the biquaternion run's fields live on their own records; a closed-form branch has the shared
+    one: no result carries another solver's empty fields."""
+    robot = load("ur5")
+    q = robot.random_q(2)
+    target = robot.fk(q)
+    frdm = kinelab.solve(robot, target, seed=1, time_budget=None).diagnostics
+    biquat = kinelab.solve(robot, target, solver="biquat", seed=1, time_budget=None).diagnostics
+    branch = kinelab.solve_all(robot, target)[0].diagnostics
+    assert type(frdm) is kinelab.FRDMDiagnostics and frdm.sweeps >= 1 and not hasattr(frdm, "model_time")
+    assert type(biquat) is kinelab.BiquatDiagnostics and biquat.steps >= 1 and biquat.model_time > 0
+    assert not hasattr(biquat, "sweeps")
+    assert type(branch) is kinelab.Diagnostics and branch.branches == len(kinelab.solve_all(robot, target))
+    assert not hasattr(branch, "sweeps") and not hasattr(branch, "steps")
+    assert "sweeps" in frdm.to_dict() and "steps" in biquat.to_dict() and repr(biquat).startswith("BiquatDiagnostics(")

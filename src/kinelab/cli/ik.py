@@ -26,7 +26,7 @@ from kinelab.cli.common import (
 from kinelab.errors import KinelabError
 from kinelab.ik.frdm.policy import SWITCHABLE, bypass_plan
 from kinelab.ik.registry import capabilities, names, solver_module
-from kinelab.ik.result import IKResult, Status
+from kinelab.ik.result import BiquatDiagnostics, IKResult, Status
 from kinelab.ik.tasks import AXES, TASKS
 from kinelab.robot import Robot
 
@@ -207,9 +207,10 @@ def _print_ik(robot: Robot, args: argparse.Namespace, result: IKResult) -> None:
     print(f"  {plural(result.iterations, 'iteration')}, {plural(result.restarts, 'restart')}, "
           f"{result.wall_time * 1e3:.2f} ms (one call, first-call costs included; `kinelab bench` times repeated "
           f"calls), mode {result.mode}")
-    if result.diagnostics.model_time:
-        m0 = result.diagnostics.M0
-        print(f"  model time {result.diagnostics.model_time:.4g} s, final M0 = "
+    diag = result.diagnostics
+    if isinstance(diag, BiquatDiagnostics) and diag.model_time:
+        m0 = diag.M0
+        print(f"  model time {diag.model_time:.4g} s, final M0 = "
               + (f"{m0:+.6f}" if m0 is not None else "n/a (give --target-q for the sign of N)"))
     if capabilities(args.solver).monitored:  # only a solver with the singularity monitor has events to tell
         _print_events(result)

@@ -24,7 +24,7 @@ from kinelab.ik.analytic.branches import arm_of, has_closed_form, nearest_roots
 from kinelab.ik.batch import BatchIKResult, fresh_seed
 from kinelab.ik.driver import solve_one
 from kinelab.ik.request import Request
-from kinelab.ik.result import Branches, Diagnostics, IKResult, Status, TrackResult
+from kinelab.ik.result import Branches, IKResult, Status, TrackResult
 from kinelab.robot import Robot
 
 ROW_RUNS = 20  # runs a colliding batch row gets (each a full solve): a row with no clear answer must not take the
@@ -99,7 +99,7 @@ def _from_branches(robot: Robot, target: Any, collided: IKResult, q0: Any, req: 
 def _with(res: IKResult, t0: float, before: int, contact: Any) -> IKResult:
     """res with the whole call's wall time and the collision diagnostics (built by Diagnostics.quick: a
     dataclasses.replace of its thirty fields costs ~13 µs, a fifth of a solve)."""
-    diagnostics = Diagnostics.quick(**{**vars(res.diagnostics), "clear_after": before, "contact": contact})
+    diagnostics = type(res.diagnostics).quick(**{**vars(res.diagnostics), "clear_after": before, "contact": contact})
     return replace(res, wall_time=time.perf_counter() - t0, diagnostics=diagnostics)
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import asdict, dataclass, field, fields, replace
 from enum import Enum
-from typing import Any, overload
+from typing import Any, TypeVar, overload
 
 import numpy as np
 
@@ -125,13 +125,18 @@ class BiquatTrajectory:
     U: np.ndarray
 
 
+_D = TypeVar("_D", bound="Diagnostics")
+
+
 @dataclass(frozen=True, repr=False)
 class Diagnostics:
-    """How a solve ran: each field is set by the solvers it applies to, None (or "") elsewhere.
+    """How a solve ran: the fields every solver's result has, each None (or "", or empty) where it does not apply.
+    A solver with more to say has its own record (:class:`FRDMDiagnostics`, :class:`BiquatDiagnostics`); DLS,
+    the closed form and the branch searches use this one.
 
-    The fields come in groups: every solver's (path to message, outside_limits), FRDM's (order to
-    polish_iterations), the biquaternion run's (law to trajectory), the answer's own attempt (answer_events,
-    answer_bypasses), the search for branches (branches to unseen) and collisions (contact, clear_after).
+    The fields come in groups: the run's (path to outside_limits, polished), the answer's own attempt
+    (answer_events, answer_bypasses), the search for branches (branches to unseen) and collisions (contact,
+    clear_after).
     """
 
     path: str = ""
@@ -144,41 +149,9 @@ class Diagnostics:
     """A solver's own note (a biquaternion run stopped by a singular matrix, say)."""
     outside_limits: int | None = None
     """Compiled attempts restarted because their answer left the limits."""
-    order: str = ""
-    """FRDM's sweep order."""
-    relax: float | None = None
-    """FRDM's relaxation factor."""
-    w_p: float | None = None
-    """FRDM's position weight [1/m²]."""
-    objective: float | None = None
-    """FRDM's objective at the answer."""
-    trace: tuple[float, ...] | None = None
-    """FRDM's objective after every sweep."""
-    sweeps: int | None = None
-    """FRDM sweeps of the answer's run."""
-    accelerated_sweeps: int | None = None
-    """FRDM sweeps whose Anderson extrapolation was kept."""
-    newton_steps: int | None = None
-    """Gauss–Newton steps of FRDM's Newton finish, over every attempt."""
     polished: int | None = None
     """Attempts finished by Gauss–Newton steps after a stall (FRDM), or 1 when a closed-form answer was finished
     by a warm-started FRDM solve."""
-    polish_iterations: int | None = None
-    """DLS steps after FRDM (``polish=True``)."""
-    law: str = ""
-    """The biquaternion control law that ran."""
-    model_time: float | None = None
-    """The biquaternion run's model time [s]."""
-    steps: int | None = None
-    """The biquaternion run's integration steps."""
-    integrator: str = ""
-    """The biquaternion run's integrator."""
-    M0: float | None = None
-    """The scalar of N̄∘Λ at the end of a biquaternion run (±1 at the target)."""
-    damping: float | None = None
-    """The biquaternion run's damping."""
-    trajectory: BiquatTrajectory | None = None
-    """The recorded biquaternion run (``record=True``)."""
     answer_events: tuple[SingularEvent, ...] = ()
     """The monitor events of the answer's own attempt (the result's ``singular_events`` cover every attempt)."""
     answer_bypasses: tuple[BypassRecord, ...] = ()
@@ -201,7 +174,7 @@ class Diagnostics:
     starts)."""
 
     @classmethod
-    def quick(cls, **values: Any) -> Diagnostics:
+    def quick(cls: type[_D], **values: Any) -> _D:
         """Diagnostics with these fields set (names and types the caller's own, unchecked): what a compiled
         solve builds on every call, without the frozen dataclass's per-field setattr (≈ 1 µs, not ≈ 9)."""
         made = object.__new__(cls)
@@ -209,7 +182,7 @@ class Diagnostics:
         return made
 
     def __repr__(self) -> str:
-        return "Diagnostics(" + ", ".join(f"{k}={v!r}" for k, v in self.to_dict().items()) + ")"
+        return f"{type(self).__name__}(" + ", ".join(f"{k}={v!r}" for k, v in self.to_dict().items()) + ")"
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON form: the fields that are set (events as dicts; the recorded trajectory left out)."""
@@ -226,6 +199,50 @@ class Diagnostics:
                 value = list(value)
             out[f.name] = value
         return out
+
+
+@dataclass(frozen=True, repr=False)
+class FRDMDiagnostics(Diagnostics):
+    """How an FRDM solve ran: :class:`Diagnostics`' fields and FRDM's own."""
+
+    order: str = ""
+    """The sweep order."""
+    relax: float | None = None
+    """The relaxation factor."""
+    w_p: float | None = None
+    """The position weight [1/m²]."""
+    objective: float | None = None
+    """The objective at the answer."""
+    trace: tuple[float, ...] | None = None
+    """The objective after every sweep (``trace=True``)."""
+    sweeps: int | None = None
+    """Sweeps of the answer's run."""
+    accelerated_sweeps: int | None = None
+    """Sweeps whose Anderson extrapolation was kept."""
+    newton_steps: int | None = None
+    """Gauss–Newton steps of the Newton finish, over every attempt."""
+    polish_iterations: int | None = None
+    """DLS steps after FRDM (``polish=True``)."""
+
+
+@dataclass(frozen=True, repr=False)
+class BiquatDiagnostics(Diagnostics):
+    """How a biquaternion solve ran: :class:`Diagnostics`' fields and the integration's."""
+
+    law: str = ""
+    """The control law that ran."""
+    model_time: float | None = None
+    """The run's model time [s]."""
+    steps: int | None = None
+    """Integration steps."""
+    integrator: str = ""
+    """The integrator."""
+    M0: float | None = None
+    """The scalar of N̄∘Λ at the end of the run (±1 at the target)."""
+    damping: float | None = None
+    """The damping of the pseudo-inverse."""
+    trajectory: BiquatTrajectory | None = None
+    """The recorded run (``record=True``)."""
 
 
 NO_DIAGNOSTICS = Diagnostics()

@@ -30,7 +30,7 @@ from kinelab.ik.driver import engine_spec
 from kinelab.ik.limits import wrap_q
 from kinelab.ik.multistart import clock_chunk
 from kinelab.ik.request import Request
-from kinelab.ik.result import Attempt, Diagnostics, Status
+from kinelab.ik.result import Attempt, BiquatDiagnostics, Status
 from kinelab.robot import Robot
 from kinelab.robot.model import _compiled_judge
 
@@ -109,7 +109,7 @@ def attempt(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol
         else:
             q_pin, t, steps, status, _ = fixed(system, robot.to_pin_q(q0), stop, opts.integrator, traj)
     except (KinelabError, np.linalg.LinAlgError, FloatingPointError) as exc:
-        return Attempt(robot.neutral(), Status.SINGULAR, 0, diagnostics=Diagnostics(message=str(exc)),
+        return Attempt(robot.neutral(), Status.SINGULAR, 0, diagnostics=BiquatDiagnostics(message=str(exc)),
                        mode=f"biquat ({opts.law})")
     q_end = robot.from_pin_q(q_pin)
     M0 = None
@@ -117,7 +117,7 @@ def attempt(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol
         # Λ by the chain product, continuous in q: the scalar of N̄∘Λ tells which of ±1 was reached
         M0 = float((N.conj() * biquat_kinematics.pose(robot, q_end)).real_wxyz[0])
     preset = "newton " if opts.newton and opts.integrator != "adaptive" else ""
-    diag = Diagnostics(model_time=t, steps=steps, M0=M0, damping=system.damping, law=opts.law,
+    diag = BiquatDiagnostics(model_time=t, steps=steps, M0=M0, damping=system.damping, law=opts.law,
                        integrator=opts.integrator, trajectory=None if traj is None else traj.arrays())
     mode = f"biquat ({opts.law}, {preset}{opts.integrator}, h={opts.h:g}, k={opts.gain:g})"
     return Attempt(wrap_q(robot, robot.wrap_continuous(q_end)), status, steps, diagnostics=diag, mode=mode)
@@ -178,9 +178,9 @@ def compiled_attempt(code: int, q: np.ndarray, stats: np.ndarray, deadline: floa
                    mode=compiled_mode(k))
 
 
-def compiled_diagnostics(stats: np.ndarray, damping: float) -> Diagnostics:
+def compiled_diagnostics(stats: np.ndarray, damping: float) -> BiquatDiagnostics:
     """The diagnostics of the compiled preset's multistart from its statistics (slots ``kernel.T_*``)."""
-    return Diagnostics(model_time=float(stats[kernel.T_MODEL_TIME]), steps=int(stats[kernel.T_STEPS]),
+    return BiquatDiagnostics(model_time=float(stats[kernel.T_MODEL_TIME]), steps=int(stats[kernel.T_STEPS]),
                        damping=damping, law="simple", integrator="euler", attempts=int(stats[kernel.T_ATTEMPTS]),
                        outside_limits=int(stats[kernel.T_OUTSIDE]), path="compiled")
 

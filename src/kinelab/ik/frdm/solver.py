@@ -28,7 +28,7 @@ from kinelab.ik.frdm.monitor import Bypass, Goal, Runner
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.multistart import clock_chunk
 from kinelab.ik.request import Request
-from kinelab.ik.result import Attempt, Diagnostics, SingularEvent, Status
+from kinelab.ik.result import Attempt, FRDMDiagnostics, SingularEvent, Status
 from kinelab.robot import Robot
 from kinelab.robot.model import _compiled_judge
 
@@ -80,7 +80,7 @@ def attempt(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol
     for step in bypass.active:
         q = run.apply(bypass, step, q)
     status = run.solve(q, deadline, bypass, opts.max_bypass_events)
-    diag = Diagnostics(sweeps=run.sweeps, accelerated_sweeps=run.accepted, order=opts.order, w_p=prob.w_p,
+    diag = FRDMDiagnostics(sweeps=run.sweeps, accelerated_sweeps=run.accepted, order=opts.order, w_p=prob.w_p,
                        relax=opts.relax, objective=run.E, newton_steps=run.newton_steps,
                        trace=tuple(run.trace_values()) if opts.trace else None)
     att = Attempt(robot.wrap_continuous(run.q), status, run.sweeps, run.events, run.bypass_log, diag,
@@ -185,15 +185,15 @@ class _Context:
         return Attempt(self.robot.wrap_continuous(q) if self.continuous else q, status, sweeps,
                        self.stall_events(stalls) if stalls else [], [], diag, self.mode)
 
-    def diagnostics(self, st: list[float]) -> Diagnostics:
+    def diagnostics(self, st: list[float]) -> FRDMDiagnostics:
         """The diagnostics of a run from its statistics (``stats.tolist()``: slots T_*)."""
-        return Diagnostics.quick(sweeps=int(st[kernel.T_SWEEPS]), accelerated_sweeps=int(st[kernel.T_ACCEPTED]),
+        return FRDMDiagnostics.quick(sweeps=int(st[kernel.T_SWEEPS]), accelerated_sweeps=int(st[kernel.T_ACCEPTED]),
                                  order=self.order_name, w_p=self.problem.w_p, objective=st[kernel.T_BEST_E],
                                  attempts=int(st[kernel.T_ATTEMPTS]), stalls=int(st[kernel.T_STALLS]),
                                  polished=int(st[kernel.T_POLISHED]), newton_steps=int(st[kernel.T_NEWTON]),
                                  path="compiled")
 
-    def diagnostics_of(self, stats: np.ndarray) -> Diagnostics:
+    def diagnostics_of(self, stats: np.ndarray) -> FRDMDiagnostics:
         """:meth:`diagnostics` from the statistics array."""
         return self.diagnostics(stats.tolist())
 
