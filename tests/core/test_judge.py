@@ -80,3 +80,41 @@ def test_a_stale_compiled_core_is_refused_with_the_rebuild_command(monkeypatch):
     monkeypatch.setattr(_built, "SOURCE_SHA256", "0" * 64)  # as after an edit of a .pyx without a rebuild
     with pytest.raises(kinelab.KinelabError, match=r"older than its sources .*pip install -e \."):
         kinelab.core._check_fresh()
+
+
+def _general_fk(arrays, q):
+    """oMtool by the general products, in plain Python floats (one IEEE operation each, in the compiled FK's order):
+    Rodrigues' matrix of every axis, every joint origin multiplied in."""
+    import math
+
+    R = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    t = [0.0, 0.0, 0.0]
+
+    def compose(dR, dt):
+        nonlocal R, t
+        t = [t[i] + R[i][0] * dt[0] + R[i][1] * dt[1] + R[i][2] * dt[2] for i in range(3)]
+        R = [[R[i][0] * dR[0][j] + R[i][1] * dR[1][j] + R[i][2] * dR[2][j] for j in range(3)] for i in range(3)]
+
+    for k in range(len(q)):
+        compose(arrays.placement_R[k].tolist(), arrays.placement_t[k].tolist())
+        x, y, z = arrays.axis[k].tolist()
+        if arrays.kind[k] == 1:
+            t = [t[j] + (R[j][0] * x + R[j][1] * y + R[j][2] * z) * q[k] for j in range(3)]
+            continue
+        c, s = math.cos(q[k]), math.sin(q[k])
+        C = 1.0 - c
+        compose([[c + x * x * C, x * y * C - z * s, x * z * C + y * s],
+                 [y * x * C + z * s, c + y * y * C, y * z * C - x * s],
+                 [z * x * C - y * s, z * y * C + x * s, c + z * z * C]], [0.0, 0.0, 0.0])
+    compose(arrays.tool_R.tolist(), arrays.tool_t.tolist())
+    return np.array([[*R[i], t[i]] for i in range(3)])
+
+
+@pytest.mark.parametrize("name", ["ur5", "panda", "kinova", "youbot"])
+def test_the_shortcuts_for_coordinate_axes_and_plain_origins_give_the_general_products(name):
+    """The compiled FK skips an identity joint origin and the zero terms of a ±x, ±y or ±z axis's rotation; its
+    values are those of the general products all the same (compared exactly, on the same machine)."""
+    robot = kinelab.load(name)
+    arrays = certificate.chain_arrays(robot)
+    for q in robot.random_qs(20, np.random.default_rng(5)):
+        np.testing.assert_array_equal(arrays.fk_batch(q[None])[0][:3], _general_fk(arrays, q.tolist()))

@@ -9,25 +9,63 @@ Pinocchio's ``forwardKinematics`` + ``updateFramePlacement`` on a serial model: 
 on each robot (:mod:`kinelab.robot.certificate`).
 """
 
+from libc.math cimport cos, sin
+
 from kinelab.core._geometry cimport rotm
 from kinelab.core._verdict cimport pose_errors, verdict_of
 
 cdef int PRISMATIC = 1
 
 
+cdef inline bint _identity(const double* M) noexcept nogil:
+    return M[0] == 1.0 and M[4] == 1.0 and M[8] == 1.0 and M[1] == 0.0 and M[2] == 0.0 and M[3] == 0.0 \
+        and M[5] == 0.0 and M[6] == 0.0 and M[7] == 0.0
+
+
 cdef inline void _compose(double[3][3] R, double[3] t, const double* dR, const double* dt) noexcept nogil:
-    """(R, t) ← (R, t) · (dR, dt) (dR 3 × 3 row-major)."""
+    """(R, t) ← (R, t) · (dR, dt) (dR 3 × 3 row-major). An identity dR (most joint origins) leaves R as the product
+    would: R·I gives R's own values (up to the sign of a zero)."""
     cdef double out[3][3]
     cdef double v[3]
     cdef int i, j
     for i in range(3):
         v[i] = t[i] + R[i][0] * dt[0] + R[i][1] * dt[1] + R[i][2] * dt[2]
+    for i in range(3):
+        t[i] = v[i]
+    if _identity(dR):
+        return
+    for i in range(3):
         for j in range(3):
             out[i][j] = R[i][0] * dR[j] + R[i][1] * dR[3 + j] + R[i][2] * dR[6 + j]
     for i in range(3):
-        t[i] = v[i]
         for j in range(3):
             R[i][j] = out[i][j]
+
+
+cdef inline int _coordinate_axis(const double* a) noexcept nogil:
+    """0, 1 or 2 when a is ±x, ±y or ±z exactly (most URDF joint axes), else −1."""
+    if a[1] == 0.0 and a[2] == 0.0 and (a[0] == 1.0 or a[0] == -1.0):
+        return 0
+    if a[0] == 0.0 and a[2] == 0.0 and (a[1] == 1.0 or a[1] == -1.0):
+        return 1
+    if a[0] == 0.0 and a[1] == 0.0 and (a[2] == 1.0 or a[2] == -1.0):
+        return 2
+    return -1
+
+
+cdef inline void _turn_about(double[3][3] R, int k, double sign, double angle) noexcept nogil:
+    """R ← R · Rot(sign·e_k, angle): the product with Rodrigues' matrix of a coordinate axis, its zero terms left
+    out. Each entry is the general product's value (up to the sign of a zero): the matrix's entries are c, ±s and
+    c + (1 − c) exactly as :func:`rotm` makes them, and a sum of two products does not depend on its order."""
+    cdef double c = cos(angle), s = sign * sin(angle)
+    cdef double diagonal = c + (1.0 - c)
+    cdef int i = (k + 1) % 3, j = (k + 2) % 3, r
+    cdef double ri, rj
+    for r in range(3):
+        ri, rj = R[r][i], R[r][j]
+        R[r][i] = ri * c + rj * s
+        R[r][j] = ri * -s + rj * c
+        R[r][k] = R[r][k] * diagonal
 
 
 cdef inline void _turn(double[3][3] R, const double* a, double angle) noexcept nogil:
@@ -35,6 +73,10 @@ cdef inline void _turn(double[3][3] R, const double* a, double angle) noexcept n
     cdef double M[3][3]
     cdef double out[3][3]
     cdef int i, j
+    cdef int k = _coordinate_axis(a)
+    if k >= 0:
+        _turn_about(R, k, a[k], angle)
+        return
     rotm(a[0], a[1], a[2], angle, &M[0][0])
     for i in range(3):
         for j in range(3):
