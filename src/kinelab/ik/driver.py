@@ -24,6 +24,7 @@ from kinelab.ik.result import Attempt, BypassRecord, IKResult, SingularEvent, St
 from kinelab.ik.targets import as_target, out_of_reach, reach_bound
 from kinelab.ik.tasks import COMPONENTS, POSE, Task
 from kinelab.robot import Robot
+from kinelab.robot.model import _compiled_judge
 
 
 class _LazyRng:
@@ -253,6 +254,12 @@ def engine_spec(robot: Robot, req: Request, cm: Any,
 
 
 ATTEMPTS = 0  # the statistics slot in which every compiled multistart counts its attempts
+
+
+def engine_judge(robot: Robot, options: Any) -> Any:
+    """The judge an engine can use for these options: the robot's certified compiled FK (``kinelab.core._chain.
+    Judge``) when the options run compiled, else None (no engine: the general route serves)."""
+    return robot.derived("compiled judge", _compiled_judge) if getattr(options, "compiled", False) else None
 
 
 def _outside_limits(pb: Call, q: np.ndarray, dp: float, dr: float, status: Status,

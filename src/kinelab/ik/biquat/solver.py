@@ -26,13 +26,12 @@ from kinelab.ik.biquat import kernel, laws
 from kinelab.ik.biquat.integrators import Stop, System, Trajectory, adaptive, fixed
 from kinelab.ik.biquat.options import BiquatOptions
 from kinelab.ik.chain import chain_model
-from kinelab.ik.driver import engine_spec
+from kinelab.ik.driver import engine_judge, engine_spec
 from kinelab.ik.limits import wrap_q
 from kinelab.ik.multistart import clock_chunk
 from kinelab.ik.request import Request
 from kinelab.ik.result import Attempt, BiquatDiagnostics, Status
 from kinelab.robot import Robot
-from kinelab.robot.model import _compiled_judge
 
 Options = BiquatOptions
 # integration steps × joints before the first look at the clock (most solves end within them), then between
@@ -199,9 +198,8 @@ def engine(robot: Robot, req: Request) -> BiquatEngine | None:
         robot: the robot.
         req: the prepared solver's request (solver "biquat").
     """
-    opts = req.options
-    judge = robot.derived("compiled judge", _compiled_judge)
-    if not opts.compiled or judge is None:
+    opts, judge = req.options, engine_judge(robot, req.options)
+    if judge is None:
         return None
     cm = chain_model(robot)
     k, damping = opts.gain, opts.damping_for(robot.n)

@@ -21,7 +21,7 @@ from kinelab.core._engine import FRDMEngine
 from kinelab.ik import dls
 from kinelab.ik import multistart as restarts
 from kinelab.ik.chain import CONTINUOUS, ChainModel, chain_model
-from kinelab.ik.driver import engine_spec
+from kinelab.ik.driver import engine_judge, engine_spec
 from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm.kernel import no_rest
 from kinelab.ik.frdm.monitor import Bypass, Goal, Runner
@@ -30,7 +30,6 @@ from kinelab.ik.multistart import clock_chunk
 from kinelab.ik.request import Request
 from kinelab.ik.result import Attempt, FRDMDiagnostics, SingularEvent, Status
 from kinelab.robot import Robot
-from kinelab.robot.model import _compiled_judge
 
 Options = FRDMOptions
 # joint steps before the first look at the clock (most solves end within them: one kernel call), and then
@@ -117,9 +116,8 @@ def engine(robot: Robot, req: Request) -> FRDMEngine | None:
         robot: the robot.
         req: the prepared solver's request (solver "frdm").
     """
-    opts = req.options
-    judge = robot.derived("compiled judge", _compiled_judge)
-    if not opts.compiled or judge is None:
+    opts, judge = req.options, engine_judge(robot, req.options)
+    if judge is None:
         return None
     ctx = _Context(robot, opts, float(req.tol_pos), float(req.tol_rot))
     spec = engine_spec(robot, req, ctx.cm, ctx.attempt, ctx.mode, ctx.diagnostics_of, wrap_continuous=True,
