@@ -103,3 +103,32 @@ def test_a_failure_of_the_one_call_reports_as_the_general_path_does(ur5, no_tole
     assert not a.success and a.restarts == 3 and "none of 4 starts" in a.message
     _same(a, b)
     _same(a, _general(ur5, target, ur5.random_q(5), 1, max_restarts=3, tol=1e-300, finish="none"))
+
+
+def test_a_start_given_as_a_list_or_another_real_dtype_takes_the_one_call(ur5, monkeypatch):
+    """A list, a tuple, a float32 or an integer start holds the same values as its float64 array: the engine takes
+    them (no general route: 10× the cost) and answers as the general route does; anything else still gets the
+    general route's named error."""
+    from kinelab.ik import prepared
+
+    ik = kinelab.IK(ur5, time_budget=None, max_restarts=5)
+    rng = np.random.default_rng(6)
+    q = ur5.random_q(rng)
+    target = ur5.fk(q)
+    near = np.round(q + rng.normal(0, 0.05, q.size), 3)
+    starts = [near.tolist(), tuple(near.tolist()), near.astype(np.float32), np.zeros(6, dtype=np.int64),
+              np.repeat(near, 2)[::2]]  # the last a strided view, not one contiguous run
+
+    def refused(*args, **kwargs):
+        raise AssertionError("the general route was taken")
+
+    for q0 in starts:
+        expected = _general(ur5, target, np.asarray(q0, dtype=float), 3, max_restarts=5)
+        with monkeypatch.context() as m:
+            m.setattr(prepared, "solve_one", refused)
+            one = ik.solve(target, q0=q0, seed=3)
+        _same(one, expected)
+    for bad, error in ((["a"] * 6, "numbers"), ([True] * 6, "numbers"), ([0.0] * 5, "6 numbers"),
+                       ([[0.0] * 6], "6 numbers")):
+        with pytest.raises(kinelab.ConfigurationError, match=error):
+            ik.solve(target, q0=bad)

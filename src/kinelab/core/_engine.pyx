@@ -121,7 +121,10 @@ cdef class Engine:
         if q0 is not None:
             start = self._start(q0)
             if start == NULL:
-                return None
+                q0 = _as_start(q0, self.n)  # a list, a float32 or integer array: the same values as float64
+                if q0 is None:
+                    return None
+                start = self._start(q0)
         if seed is None:
             seed = int.from_bytes(os.urandom(8), "little")
         elif type(seed) is not int or not 0 <= seed < SEED_LIMIT:
@@ -355,6 +358,19 @@ cdef inline double _clip(double x, double lower, double upper) noexcept:
     """x within [lower, upper] (numpy's clip: the larger of x and lower, then the smaller of that and upper)."""
     x = lower if x < lower else x
     return upper if x > upper else x
+
+
+cdef object _as_start(object q0, int n):
+    """q0 as n float64 values in a new C-contiguous array when it holds n real numbers (a list, a tuple, an array of
+    another real dtype or layout: the values :meth:`kinelab.Robot.check_q` takes from it), else None (the general
+    route names what is wrong)."""
+    try:
+        raw = np.asarray(q0)
+    except (TypeError, ValueError):
+        return None
+    if raw.dtype.kind not in "fiu" or raw.shape != (n,):
+        return None
+    return np.ascontiguousarray(raw, dtype=np.float64)
 
 
 cdef cnp.ndarray _array(const double* values, cnp.npy_intp size):
