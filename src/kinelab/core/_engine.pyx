@@ -4,9 +4,10 @@ answer with the certified compiled FK (turned into the limits by whole turns whe
 
 One engine interface (:class:`Engine`: the checks, the verdict and the result, written once) over the kernels'
 timed multistarts: :class:`FRDMEngine` and :class:`BiquatEngine` each supply only their run. The prepared solver
-(:class:`kinelab.IK`) builds an engine once; per call only the target, the start, the seed and the clock change. An unusual call (a target that is not a ``pin.SE3``, a start that is not n float64 values
-within the limits, a target beyond the reach bound, a seed that is not a whole number in [0, 2⁶⁴)) gets None, and
-the caller takes the general route, which names what is wrong: the engine changes the cost, never the answer.
+(:class:`kinelab.IK`) builds an engine once; per call only the target, the start, the seed and the clock change.
+An unusual call (a target that is not a ``pin.SE3``, a start that is not n real numbers within the limits, a target
+beyond the reach bound, a seed that is not a whole number in [0, 2⁶⁴)) gets None, and the caller takes the general
+route, which names what is wrong: the engine changes the cost, never the answer.
 """
 
 import os

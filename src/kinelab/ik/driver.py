@@ -248,9 +248,8 @@ def engine_spec(robot: Robot, req: Request, cm: Any,
         kind=cm.kind, draw_lower=cm.lower, draw_upper=cm.upper, check_lower=lower, check_upper=upper,
         turn_lower=np.asarray(robot.lower, dtype=float), turn_upper=np.asarray(robot.upper, dtype=float),
         anchor=np.array(anchor, dtype=float), radius=radius, attempts=req.max_restarts + 1, budget=budget,
-        tol_pos=tol_pos, tol_rot=tol_rot,
-        check_pos=task.position, check_rot=task.rotation, axis=task.axis, se3=pin.SE3, result=IKResult,
-        fields=fields, diagnostics=diagnostics, unmet=unmet, **kernel)
+        tol_pos=tol_pos, tol_rot=tol_rot, check_pos=task.position, check_rot=task.rotation, axis=task.axis,
+        se3=pin.SE3, result=IKResult, fields=fields, diagnostics=diagnostics, unmet=unmet, **kernel)
 
 
 ATTEMPTS = 0  # the statistics slot in which every compiled multistart counts its attempts
