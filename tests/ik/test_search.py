@@ -96,6 +96,23 @@ def test_a_crx_pose_has_sixteen_branches_each_a_distinct_configuration_that_pino
     assert contains(found, np.array(CRX_SIXTEEN))
 
 
+# a CRX-10iA pose with two roots of one way of the search 2.3e-5 rad apart (#41): they were once answered as one
+# configuration between them, 1.1e-5 rad from each
+CRX_CLOSE_PAIR = (-1.581103, -0.097642, 2.413881, 1.808203, -3.127557, 1.293746)
+
+
+def test_two_roots_closer_than_a_sample_step_are_two_answers_never_one_between_them():
+    crx = kinelab.load("crx10ia")
+    q = np.array(CRX_CLOSE_PAIR)
+    target = crx.fk(q)
+    found = kinelab.solve_all(crx, target)
+    near = sorted(((np.max(np.abs(wrapped(s.q - q))), s) for s in found), key=lambda pair: pair[0])
+    assert near[0][0] <= 1e-8  # the pose's own configuration, to rounding
+    assert 1e-5 <= near[1][0] <= 1e-4  # and its partner root, a separate answer
+    for _, s in near[:2]:
+        assert max(crx.tool_error(s.q, target)) <= 1e-10
+
+
 @pytest.mark.parametrize("name", ["xarm6", "crx10ia"])
 def test_branch_sets_equal_ssik_s_for_the_same_urdf(name):
     ssik = pytest.importorskip("ssik")

@@ -371,10 +371,11 @@ cdef int _dip(const Search* S, int w, double a, double b, double sign, Rows* row
     cdef double m = _golden(S, w, a, b, sign, False), em = _way(S, m, w), ea, eb
     if em != em:
         return row
-    if fabs(em) <= DOUBLE_ROOT:
+    if sign * em > 0:  # the dip keeps its sign: a double root only where it touches 0 to rounding
+        return _root(S, m, w, rows, row) if sign * em <= DOUBLE_ROOT else row
+    if em == 0.0:
         return _root(S, m, w, rows, row)
-    if sign * em > 0:
-        return row
+    # sign·e dips below 0: two roots, one on each side of the dip, however close (never one answer between them)
     ea, eb = _way(S, a, w), _way(S, b, w)
     row = _root(S, _refine(S, w, a, ea, m, em), w, rows, row)
     return _root(S, _refine(S, w, m, em, b, eb), w, rows, row)
