@@ -101,9 +101,15 @@ def test_a_crx_pose_has_sixteen_branches_each_a_distinct_configuration_that_pino
 CRX_CLOSE_PAIR = (-1.581103, -0.097642, 2.413881, 1.808203, -3.127557, 1.293746)
 
 
-def test_two_roots_closer_than_a_sample_step_are_two_answers_never_one_between_them():
+# a CRX-10iA pose whose close pair of roots (2.3e-5 rad apart) lies just beside a steep crossing of the same way of
+# the search, within one sample step (#41): the pose's own configuration was missed, the nearest answer 0.8 rad off
+CRX_PAIR_BESIDE_A_CROSSING = (0.936771, 0.772248, 0.026567, 1.272459, -1.574314, 0.337826)
+
+
+@pytest.mark.parametrize("q", [CRX_CLOSE_PAIR, CRX_PAIR_BESIDE_A_CROSSING])
+def test_two_roots_closer_than_a_sample_step_are_two_answers_never_one_between_them(q):
     crx = kinelab.load("crx10ia")
-    q = np.array(CRX_CLOSE_PAIR)
+    q = np.array(q)
     target = crx.fk(q)
     found = kinelab.solve_all(crx, target)
     near = sorted(((np.max(np.abs(wrapped(s.q - q))), s) for s in found), key=lambda pair: pair[0])

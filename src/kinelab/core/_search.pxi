@@ -314,6 +314,13 @@ cdef int _span(const Search* S, int w, double ta, double ea, const double* qa, d
         row = _span(S, w, tm, em, &q123[3 * w], tb, eb, qb, depth + 1, rows, row)
         if not _opposite(ea, em) and not _opposite(em, eb) and fabs(em) < fabs(ea) and fabs(em) < fabs(eb):
             row = _dip(S, w, ta, tb, 1.0 if em > 0 else -1.0, rows, row)
+        elif _opposite(ea, em) != _opposite(em, eb) and em != 0.0:
+            # one half crosses 0 (steeply, as a fast sweep does), the other keeps its sign: a close pair of roots
+            # (or a double root) can sit beside the crossing in the other half, searched as a dip
+            if _opposite(ea, em) and eb != 0.0:
+                row = _dip(S, w, tm, tb, 1.0 if em > 0 else -1.0, rows, row)
+            elif _opposite(em, eb) and ea != 0.0:
+                row = _dip(S, w, ta, tm, 1.0 if em > 0 else -1.0, rows, row)
         return row
     if ea == 0.0:
         return _root(S, ta, w, rows, row)
