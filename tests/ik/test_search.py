@@ -106,7 +106,12 @@ CRX_CLOSE_PAIR = (-1.581103, -0.097642, 2.413881, 1.808203, -3.127557, 1.293746)
 CRX_PAIR_BESIDE_A_CROSSING = (0.936771, 0.772248, 0.026567, 1.272459, -1.574314, 0.337826)
 
 
-@pytest.mark.parametrize("q", [CRX_CLOSE_PAIR, CRX_PAIR_BESIDE_A_CROSSING])
+# the same beside a steep crossing in the stretch where a way of the search ends (σ_min of J 1.7e-7): its own
+# configuration was missed, the nearest answer 0.067 rad off
+CRX_PAIR_NEAR_A_WAY_END = (3.116545, 3.12333, 1.607191, -0.017343, 2.607245, -3.608678)
+
+
+@pytest.mark.parametrize("q", [CRX_CLOSE_PAIR, CRX_PAIR_BESIDE_A_CROSSING, CRX_PAIR_NEAR_A_WAY_END])
 def test_two_roots_closer_than_a_sample_step_are_two_answers_never_one_between_them(q):
     crx = kinelab.load("crx10ia")
     q = np.array(q)
@@ -114,7 +119,7 @@ def test_two_roots_closer_than_a_sample_step_are_two_answers_never_one_between_t
     found = kinelab.solve_all(crx, target)
     near = sorted(((np.max(np.abs(wrapped(s.q - q))), s) for s in found), key=lambda pair: pair[0])
     assert near[0][0] <= 1e-8  # the pose's own configuration, to rounding
-    assert 1e-5 <= near[1][0] <= 1e-4  # and its partner root, a separate answer
+    assert 1e-6 <= near[1][0] <= 1e-3  # and its partner root, a separate answer
     for _, s in near[:2]:
         assert max(crx.tool_error(s.q, target)) <= 1e-10
 

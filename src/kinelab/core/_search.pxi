@@ -277,6 +277,12 @@ cdef int _stretch(const Search* S, int w, double a, double ea, double b, double 
             row = _root(S, t[i], w, rows, row)
         elif _opposite(f[i], f[i + 1]):
             row = _root(S, _refine(S, w, t[i], f[i], t[i + 1], f[i + 1]), w, rows, row)
+            # a close pair of roots can sit beside a steep crossing, in a neighbouring piece that keeps its sign
+            if i > 0 and f[i - 1] == f[i - 1] and f[i - 1] != 0.0 and not _opposite(f[i - 1], f[i]):
+                row = _dip(S, w, _min(t[i - 1], t[i]), _max(t[i - 1], t[i]), 1.0 if f[i] > 0 else -1.0, rows, row)
+            if i + 2 <= PIECES and f[i + 2] == f[i + 2] and f[i + 2] != 0.0 and not _opposite(f[i + 1], f[i + 2]):
+                row = _dip(S, w, _min(t[i + 1], t[i + 2]), _max(t[i + 1], t[i + 2]), 1.0 if f[i + 1] > 0 else -1.0,
+                           rows, row)
         elif f[i] != 0.0 and f[i + 1] != 0.0:  # a dip: |e| least at a piece's end, or falling to either end
             sign = 1.0 if f[i] > 0 else -1.0
             if i > 0 and f[i - 1] == f[i - 1] and not _opposite(f[i - 1], f[i]) and fabs(f[i]) < fabs(f[i - 1]) \
