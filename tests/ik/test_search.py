@@ -274,3 +274,24 @@ def test_a_reachable_pose_the_search_misses_is_never_called_unreachable(monkeypa
     assert found and found.status == kinelab.Status.CONVERGED and "multistart" in found[0].mode
     far = kinelab.solve_all(crx, kinelab.target_from_xyz_rpy([5.0, 0.0, 0.0], [0.0, 0.0, 0.0]))
     assert far == [] and far.status == kinelab.Status.UNREACHABLE  # proved by the reach bound: still said
+
+
+def test_a_calibrated_ur10e_fits_no_class_and_says_so_and_the_multistart_still_finds_its_poses(capsys):
+    """The UR10e with a factory-size calibration (urdf/ur10e_calibrated.urdf, #41): its near-parallel and near-meeting
+    axes miss every class by more than the tolerances, which kinelab info states; solve_all answers by the
+    multistart with its estimate of what it missed, every answer judged, the pose's own configuration among them."""
+    from kinelab import cli
+
+    arm = kinelab.load("ur10e_calibrated")
+    with pytest.raises(kinelab.OptionError, match=r"axes 2 and 3 are 0\.0034 rad from parallel \(tolerance 1e-05\)"):
+        kinelab.solve(arm, arm.fk(arm.random_q(0)), solver="analytic")
+    assert cli.main(["info", "ur10e_calibrated"]) == 0
+    assert "no class holds to its tolerances (1e-05 rad between parallel axes, 1e-05 m" in capsys.readouterr().out
+    rng = np.random.default_rng(2)
+    for k in range(4):
+        q = arm.random_q(rng)
+        target = arm.fk(q)
+        found = kinelab.solve_all(arm, target, seed=k)
+        assert found.method == "multistart" and 0 < found.unseen < 0.1
+        assert all(max(arm.tool_error(s.q, target)) <= 1e-6 and arm.within_limits(s.q) for s in found)
+        assert min(np.max(np.abs(wrapped(s.q - q))) for s in found) <= 1e-5

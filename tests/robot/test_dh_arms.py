@@ -1,5 +1,6 @@
-"""The URDFs kinelab writes from published Denavit–Hartenberg tables (urdf/xarm6.urdf, urdf/crx10ia.urdf) are
-those tables: Pinocchio's FK of each file equals the standard DH product at seeded random configurations."""
+"""The URDFs kinelab writes from published Denavit–Hartenberg tables (urdf/xarm6.urdf, urdf/crx10ia.urdf,
+urdf/ur10e_calibrated.urdf) are those tables: Pinocchio's FK of each file equals the standard DH product at seeded
+random configurations."""
 
 import numpy as np
 import pytest
@@ -13,6 +14,11 @@ TABLES = {
               (0, 0.3425, PI / 2, 0), (0, 0, -PI / 2, 0.076), (0, 0.097, 0, 0)],
     "crx10ia": [(0, 0, PI / 2, 0), (PI / 2, 0, 0, 0.54), (0, 0, PI / 2, 0), (0, 0.54, -PI / 2, 0),
                 (0, 0.15, PI / 2, 0), (0, 0.16, 0, 0)],
+    # the UR10e's published table plus the calibration tools/make_calibrated_ur10e.py lists
+    "ur10e_calibrated": [(0, 0.1807 + 0.18e-3, PI / 2 + 0.6e-3, 0.12e-3), (2.1e-3, 0, 3.4e-3, -0.6127 + 0.21e-3),
+                         (-1.7e-3, 0, -2.2e-3, -0.57155 - 0.33e-3),
+                         (0.9e-3, 0.17415 - 0.27e-3, PI / 2 + 1.1e-3, -0.09e-3),
+                         (-1.2e-3, 0.11985 + 0.15e-3, -PI / 2 - 1.9e-3, 0.14e-3), (0, 0.11655 + 0.08e-3, 0, 0)],
 }
 
 

@@ -53,6 +53,8 @@ BUNDLED = (
           "UFACTORY xArm6, 6R without three axes meeting, from the maker's DH table"),
     Entry("crx10ia", "kinelab", "crx10ia.urdf", "flange",
           "FANUC CRX-10iA, 6R cuspidal cobot (up to 16 branches), from its published dimensions"),
+    Entry("ur10e_calibrated", "kinelab", "ur10e_calibrated.urdf", "flange",
+          "UR10e with a factory-size calibration (axes off parallel by mrad): a general 6R, no closed form"),
 )
 
 ERD_ARMS = (
