@@ -97,7 +97,7 @@ def prepare_solver(module: Any, robot: Robot, options: Any) -> None:
 
 @dataclass(slots=True)
 class Call:
-    """What one solve is asked, handed between the driver's helpers (and the prepared solver's lean path)."""
+    """What one solve is asked, handed between the driver's helpers (and to an engine's general result)."""
 
     robot: Robot
     target: pin.SE3
