@@ -35,3 +35,6 @@ cdef struct Control:
 cdef int multistart(double* q, const Chain* ch, const double* lower, const double* upper, const Control* pb,
                     unsigned long long* rng_state, int max_attempts, double step_budget, double* stats,
                     const double* restart_lower, const double* restart_upper) noexcept nogil
+cdef int timed(double* q, const Chain* ch, const double* lower, const double* upper, const Control* pb,
+               unsigned long long* rng_state, int attempts, int first_chunk, int later_chunk, double deadline,
+               const double* restart_lower, const double* restart_upper, double* stats) noexcept nogil

@@ -13,7 +13,7 @@ from libc.math cimport ceil, cos, exp, fabs, isfinite, log, sin, sqrt, atan2, NA
 from libc.stdlib cimport free, malloc
 
 from kinelab.core._blas cimport ddot, dgemm, dgemv, dgesdd, dgesv, dgetrf, ready
-from kinelab.core._frdm cimport CONTINUOUS, PRISMATIC, Chain, Packed, chain_fk, random_configuration
+from kinelab.core._frdm cimport CONTINUOUS, PRISMATIC, Chain, Packed, chain_fk, now, random_configuration
 
 from kinelab.core._frdm import pack_chain
 
@@ -284,6 +284,25 @@ cdef int multistart(double* q, const Chain* ch, const double* lower, const doubl
     return code
 
 
+cdef int timed(double* q, const Chain* ch, const double* lower, const double* upper, const Control* pb,
+               unsigned long long* rng_state, int attempts, int first_chunk, int later_chunk, double deadline,
+               const double* restart_lower, const double* restart_upper, double* stats) noexcept nogil:
+    """The multistart in chunks of steps (``first_chunk`` before the first look at the clock, ``later_chunk``
+    between two), until an attempt converges, the attempts are spent or the deadline (:func:`now`) has passed after
+    a chunk; returns the last chunk's code (-1: no attempt)."""
+    cdef int code = -1, size
+    cdef double before
+    while attempts > 0:
+        before = stats[T_ATTEMPTS]
+        size = first_chunk if stats[T_STEPS] == 0.0 else later_chunk
+        code = multistart(q, ch, lower, upper, pb, rng_state, attempts, stats[T_STEPS] + size, stats, restart_lower,
+                          restart_upper)
+        attempts -= <int> (stats[T_ATTEMPTS] - before)
+        if code == CONVERGED or now() > deadline:
+            break
+    return code
+
+
 # ---- Python's side ----
 
 cdef Control _control(object control, list keep) except *:
@@ -323,6 +342,26 @@ def run_multistart(double[::1] q, chain, const double[::1] lower, const double[:
     with nogil:
         code = multistart(&q[0], &packed.ch, &lower[0], &upper[0], &c, &rng_state[0], max_attempts, step_budget,
                           &stats[0], &restart_lower[0], &restart_upper[0])
+    return code
+
+
+def run_timed(double[::1] q, chain, const double[::1] lower, const double[::1] upper, control,
+              unsigned long long[::1] rng_state, int attempts, int first_chunk, int later_chunk, double deadline,
+              const double[::1] restart_lower, const double[::1] restart_upper, double[::1] stats) -> int:
+    """The preset's multistart in chunks with the clock looked at between them (see ``timed`` in the C part;
+    ``control`` a :class:`kinelab.ik.biquat.kernel.Control`, ``deadline`` a ``time.perf_counter()`` value [s]).
+    Returns its code."""
+    cdef Packed packed = pack_chain(chain)
+    cdef int n = packed.n
+    if q.shape[0] != n or lower.shape[0] != n or upper.shape[0] != n or restart_lower.shape[0] != n \
+            or restart_upper.shape[0] != n or stats.shape[0] < 8 or rng_state.shape[0] < 1:
+        raise ValueError("run_timed: q and the windows one value per joint, stats 8 slots, a generator state")
+    cdef list keep = []
+    cdef Control c = _control(control, keep)
+    cdef int code
+    with nogil:
+        code = timed(&q[0], &packed.ch, &lower[0], &upper[0], &c, &rng_state[0], attempts, first_chunk, later_chunk,
+                     deadline, &restart_lower[0], &restart_upper[0], &stats[0])
     return code
 
 

@@ -22,8 +22,8 @@ from libc.string cimport memcpy
 
 cimport kinelab.core._biquat as bq
 from kinelab.core._chain cimport Judge
-from kinelab.core._frdm cimport (CONTINUOUS, CONVERGED, STATS_SIZE, T_STALLS, Packed, chain_fk, now,
-                                 random_configuration, timed)
+from kinelab.core._frdm cimport (CONTINUOUS, CONVERGED, STATS_SIZE, T_STALLS, Packed, now, random_configuration,
+                                 restart_windows, timed)
 from kinelab.core._verdict cimport pose_errors, take_target
 
 cnp.import_array()
@@ -286,7 +286,7 @@ cdef class BiquatEngine(Engine):
             and the restarts' windows), and the control's ``k`` [1/s], ``max_step`` [rad or m], ``max_steps``,
             ``eps_rot``, ``eps_dual`` [m], ``damping``; ``first_chunk``, ``later_chunk`` the steps before the first
             look at the clock and between two; ``wide`` (n,) the base joints whose restart window follows the
-            target (:func:`kinelab.ik.multistart.restart_windows`), ``length`` [m] the chain's length.
+            target (``restart_windows`` of :mod:`kinelab.core._frdm`), ``length`` [m] the chain's length.
     """
 
     cdef Packed packed
@@ -294,7 +294,7 @@ cdef class BiquatEngine(Engine):
     cdef int first_chunk, later_chunk, any_wide
     cdef const unsigned char[::1] wide
     cdef double length
-    cdef double* scratch  # the restarts' windows (2n), and the chain's axes, points, tool point and rotation
+    cdef double* scratch  # the restarts' windows (2n), then restart_windows' own scratch (6n + 12)
 
     def __init__(self, Packed packed, Judge judge, spec):
         super().__init__(judge, spec)
@@ -312,8 +312,8 @@ cdef class BiquatEngine(Engine):
             raise MemoryError("BiquatEngine: no memory for the restarts' windows")
 
     cdef int _run(self, double* best, double* stats, unsigned long long* rng, double deadline):
-        cdef int code = -1, attempts = self.attempts, size
-        cdef double before
+        cdef int code
+        cdef int n = self.n
         cdef const double* lower = &self.draw_lower[0]
         cdef const double* upper = &self.draw_upper[0]
         cdef const double* restart_lower = lower
@@ -321,44 +321,17 @@ cdef class BiquatEngine(Engine):
         cdef Packed pk = self.packed
         cdef bq.Control* control = &self.control
         if self.any_wide:
-            self._windows()
-            restart_lower, restart_upper = self.scratch, self.scratch + self.n
+            restart_windows(&pk.ch, self.q, &self.pstar[0], lower, upper, &self.wide[0], self.length,
+                            self.scratch + 2 * n, self.scratch, self.scratch + n)
+            restart_lower, restart_upper = self.scratch, self.scratch + n
         with nogil:
-            while attempts > 0:
-                before = stats[T_ATTEMPTS]
-                size = self.first_chunk if stats[T_ITERATIONS] == 0.0 else self.later_chunk
-                code = bq.multistart(self.q, &pk.ch, lower, upper, control, rng, attempts,
-                                     stats[T_ITERATIONS] + size, stats, restart_lower, restart_upper)
-                attempts -= <int> (stats[T_ATTEMPTS] - before)
-                if code == bq.CONVERGED or now() > deadline:
-                    break
-        memcpy(best, self.q, sizeof(double) * self.n)
+            code = bq.timed(self.q, &pk.ch, lower, upper, control, rng, self.attempts, self.first_chunk,
+                            self.later_chunk, deadline, restart_lower, restart_upper, stats)
+        memcpy(best, self.q, sizeof(double) * n)
         return code
-
-    cdef void _windows(self) noexcept:
-        """The restarts' windows from the first start (``self.q``) and the target, into the scratch's first 2n:
-        a wide base joint within the chain's length of the value that carries the tool to the target point along
-        its axis, clipped to the limits (:func:`kinelab.ik.multistart.restart_windows`, the same arithmetic)."""
-        cdef int i, n = self.n
-        cdef double* e = self.scratch + 2 * n
-        cdef double* p = e + 6 * n
-        chain_fk(&self.packed.ch, self.q, e, e + 3 * n, p, p + 3)
-        cdef double d0 = self.pstar[0] - p[0], d1 = self.pstar[1] - p[1], d2 = self.pstar[2] - p[2], centre
-        for i in range(n):
-            self.scratch[i], self.scratch[n + i] = self.draw_lower[i], self.draw_upper[i]
-            if self.wide[i]:
-                centre = self.q[i] + (e[3 * i] * d0 + e[3 * i + 1] * d1 + e[3 * i + 2] * d2)
-                self.scratch[i] = _clip(centre - self.length, self.draw_lower[i], self.draw_upper[i])
-                self.scratch[n + i] = _clip(centre + self.length, self.draw_lower[i], self.draw_upper[i])
 
     def __dealloc__(self):
         free(self.scratch)
-
-
-cdef inline double _clip(double x, double lower, double upper) noexcept:
-    """x within [lower, upper] (numpy's clip: the larger of x and lower, then the smaller of that and upper)."""
-    x = lower if x < lower else x
-    return upper if x > upper else x
 
 
 cdef object _as_start(object q0, int n):

@@ -110,6 +110,9 @@ cdef int timed(double* q, const Chain* ch, const Objective* pb, const Settings* 
                int stop_before, double* best_q, double* stats, Memory* mem) noexcept nogil
 cdef void random_configuration(double* q, const long long* kind, const double* lower, const double* upper, int n,
                                unsigned long long* rng_state) noexcept nogil
+cdef void restart_windows(const Chain* ch, const double* q, const double* pstar, const double* lower,
+                          const double* upper, const unsigned char* wide, double length, double* scratch,
+                          double* out_lower, double* out_upper) noexcept nogil
 cdef double now() noexcept nogil
 cdef double uniform(unsigned long long* state) noexcept nogil
 cdef void world_error(const double* p, const double* R, const Objective* pb, double* err) noexcept nogil

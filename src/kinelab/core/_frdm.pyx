@@ -751,6 +751,32 @@ cdef double uniform(unsigned long long* state) noexcept nogil:
     return <double> ((x * 2685821657736338717ULL) >> 11) / 9007199254740992.0
 
 
+cdef void restart_windows(const Chain* ch, const double* q, const double* pstar, const double* lower,
+                          const double* upper, const unsigned char* wide, double length, double* scratch,
+                          double* out_lower, double* out_upper) noexcept nogil:
+    """Where restarts are drawn (:func:`kinelab.ik.multistart.restart_windows`): [lower, upper], except at a
+    ``wide`` base joint, within ``length`` [m] of the value that carries the tool from where it is at q to the
+    target point pstar along the joint's axis, clipped to the limits. ``scratch``: 6n + 12 doubles."""
+    cdef int i, n = ch.n
+    cdef double* e = scratch
+    cdef double* p = scratch + 6 * n
+    cdef double d0, d1, d2, centre
+    chain_fk(ch, q, e, e + 3 * n, p, p + 3)
+    d0, d1, d2 = pstar[0] - p[0], pstar[1] - p[1], pstar[2] - p[2]
+    for i in range(n):
+        out_lower[i], out_upper[i] = lower[i], upper[i]
+        if wide[i]:
+            centre = q[i] + (e[3 * i] * d0 + e[3 * i + 1] * d1 + e[3 * i + 2] * d2)
+            out_lower[i] = _clip(centre - length, lower[i], upper[i])
+            out_upper[i] = _clip(centre + length, lower[i], upper[i])
+
+
+cdef inline double _clip(double x, double lower, double upper) noexcept nogil:
+    """x within [lower, upper] (numpy's clip: the larger of x and lower, then the smaller of that and upper)."""
+    x = lower if x < lower else x
+    return upper if x > upper else x
+
+
 cdef void random_configuration(double* q, const long long* kind, const double* lower, const double* upper, int n,
                                unsigned long long* rng_state) noexcept nogil:
     """q ← a seeded uniform configuration within the limits; a joint without a finite window draws on [−π, π)
@@ -1059,6 +1085,21 @@ def draw_configuration(double[::1] q, const long long[::1] kind, const double[::
         raise ValueError("draw_configuration: q, kind, lower and upper of one length, and a generator state")
     if n:
         random_configuration(&q[0], &kind[0], &lower[0], &upper[0], n, &rng_state[0])
+
+
+def windows_of(chain, const double[::1] q, const double[::1] pstar, const double[::1] lower,
+               const double[::1] upper, const unsigned char[::1] wide, double length):
+    """(lower, upper) of the restarts from the start q and the target point pstar [m] (see ``restart_windows``)."""
+    cdef Packed packed = pack_chain(chain)
+    cdef int n = packed.n
+    if q.shape[0] != n or lower.shape[0] != n or upper.shape[0] != n or wide.shape[0] != n or pstar.shape[0] != 3:
+        raise ValueError("windows_of: q, the limits and wide one value per joint, pstar (3,)")
+    out_lower, out_upper, scratch = np.empty(n), np.empty(n), np.empty(6 * n + 12)
+    cdef double[::1] lo = out_lower, hi = out_upper, work = scratch
+    if n:
+        restart_windows(&packed.ch, &q[0], &pstar[0], &lower[0], &upper[0], &wide[0], length, &work[0], &lo[0],
+                        &hi[0])
+    return out_lower, out_upper
 
 
 def solve_rows(double[:, ::1] Q, bint draw_start, chain, objective, const double[:, ::1] pstars,

@@ -2,12 +2,9 @@
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable
-
 import numpy as np
 
-from kinelab.core._frdm import draw_configuration
+from kinelab.core._frdm import draw_configuration, windows_of
 from kinelab.ik.chain import PRISMATIC, ChainModel
 
 
@@ -59,15 +56,11 @@ def restart_windows(cm: ChainModel, q_start: np.ndarray, pstar: np.ndarray) -> t
     Returns:
         (lower, upper) of the restarts [rad or m].
     """
-    lower, upper, L = cm.lower, cm.upper, cm.length
     wide = wide_base(cm)
     if not wide.any():
-        return lower, upper
-    v = cm.vectors(q_start)
-    e, d = v["e"], np.asarray(pstar, dtype=float) - v["N"]
-    centre = q_start + (e[:, 0] * d[0] + e[:, 1] * d[1] + e[:, 2] * d[2])  # the engine's order of the sum
-    return (np.where(wide, np.clip(centre - L, lower, upper), lower),
-            np.where(wide, np.clip(centre + L, lower, upper), upper))
+        return cm.lower, cm.upper
+    return windows_of(cm.chain, np.ascontiguousarray(q_start, dtype=float), np.ascontiguousarray(pstar, dtype=float),
+                      cm.lower, cm.upper, wide.astype(np.uint8), float(cm.length))
 
 
 def wide_base(cm: ChainModel) -> np.ndarray:
@@ -77,21 +70,6 @@ def wide_base(cm: ChainModel) -> np.ndarray:
     before_arm = np.arange(cm.n) < (rotary[0] if rotary.size else cm.n)  # a base's joints come first
     wide: np.ndarray = (cm.kind == PRISMATIC) & (cm.upper - cm.lower > 2.0 * cm.length) & before_arm
     return wide
-
-
-def run_in_chunks(chunk: Callable[[int], int], attempts: int, stats: np.ndarray, deadline: float,
-                  converged: int) -> int:
-    """Call ``chunk(attempts_left)`` (a kernel run that adds its attempts to stats[0]) until it returns
-    ``converged``, the attempts are spent or the deadline passes; returns the last code."""
-    code = -1
-    attempts = int(attempts)
-    while attempts > 0:
-        before = stats[0]
-        code = chunk(attempts)
-        attempts -= int(stats[0] - before)
-        if code == converged or time.perf_counter() > deadline:
-            break
-    return code
 
 
 def clock_chunk(joint_steps: int, n: int) -> int:

@@ -150,16 +150,10 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: 
     rng_state = restarts.seed_state(seed)
     q = restarts.first_start(q0, cm.kind, cm.lower, cm.upper, rng_state)
     stats = np.zeros(kernel.STATS_SIZE)
-    steps = [clock_chunk(JOINT_STEPS_PER_LOOK, cm.n), clock_chunk(JOINT_STEPS_PER_LATER_LOOK, cm.n)]
-
     restart_lower, restart_upper = restarts.restart_windows(cm, q, oMtarget.translation)
-
-    def chunk(attempts_left: int) -> int:
-        size = steps[0] if stats[kernel.T_STEPS] == 0 else steps[1]
-        return kernel.multistart(q, cm.chain, cm.lower, cm.upper, prob, rng_state, attempts_left,
-                           float(stats[kernel.T_STEPS] + size), stats, restart_lower, restart_upper)
-
-    code = restarts.run_in_chunks(chunk, max_restarts + 1, stats, deadline, kernel.CONVERGED)
+    code = kernel.timed(q, cm.chain, cm.lower, cm.upper, prob, rng_state, max_restarts + 1,
+                        clock_chunk(JOINT_STEPS_PER_LOOK, cm.n), clock_chunk(JOINT_STEPS_PER_LATER_LOOK, cm.n),
+                        float(deadline), restart_lower, restart_upper, stats)
     return compiled_attempt(code, q, stats, deadline, damping, k), max(0, int(stats[kernel.T_ATTEMPTS]) - 1)
 
 
