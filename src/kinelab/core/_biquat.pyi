@@ -10,9 +10,6 @@ class Code(IntEnum):
     OUTSIDE_LIMITS = 3
     BUDGET = 4
 
-def run_multistart(q: np.ndarray, chain: Any, lower: np.ndarray, upper: np.ndarray, control: Any,
-                   rng_state: np.ndarray, max_attempts: int, step_budget: float, stats: np.ndarray,
-                   restart_lower: np.ndarray, restart_upper: np.ndarray) -> int: ...
 def run_timed(q: np.ndarray, chain: Any, lower: np.ndarray, upper: np.ndarray, control: Any, rng_state: np.ndarray,
               attempts: int, first_chunk: int, later_chunk: int, deadline: float, restart_lower: np.ndarray,
               restart_upper: np.ndarray, stats: np.ndarray) -> int: ...

@@ -326,25 +326,6 @@ cdef object _array(object values, Py_ssize_t size, str name, list keep):
     return a
 
 
-def run_multistart(double[::1] q, chain, const double[::1] lower, const double[::1] upper, control,
-                   unsigned long long[::1] rng_state, int max_attempts, double step_budget, double[::1] stats,
-                   const double[::1] restart_lower, const double[::1] restart_upper) -> int:
-    """One chunk of the preset's multistart (see ``multistart`` in the C part; ``control`` a
-    :class:`kinelab.ik.biquat.kernel.Control`). Returns its code."""
-    cdef Packed packed = pack_chain(chain)
-    cdef int n = packed.n
-    if q.shape[0] != n or lower.shape[0] != n or upper.shape[0] != n or restart_lower.shape[0] != n \
-            or restart_upper.shape[0] != n or stats.shape[0] < 8 or rng_state.shape[0] < 1:
-        raise ValueError("run_multistart: q and the windows one value per joint, stats 8 slots, a generator state")
-    cdef list keep = []
-    cdef Control c = _control(control, keep)
-    cdef int code
-    with nogil:
-        code = multistart(&q[0], &packed.ch, &lower[0], &upper[0], &c, &rng_state[0], max_attempts, step_budget,
-                          &stats[0], &restart_lower[0], &restart_upper[0])
-    return code
-
-
 def run_timed(double[::1] q, chain, const double[::1] lower, const double[::1] upper, control,
               unsigned long long[::1] rng_state, int attempts, int first_chunk, int later_chunk, double deadline,
               const double[::1] restart_lower, const double[::1] restart_upper, double[::1] stats) -> int:

@@ -13,7 +13,6 @@ import numpy as np
 
 from kinelab.core._biquat import Code
 from kinelab.core._biquat import run_integrate as integrate
-from kinelab.core._biquat import run_multistart as multistart
 from kinelab.core._biquat import run_timed as timed
 
 # the preset's return codes: the compiled core's enum, as ints
@@ -23,7 +22,7 @@ OUTSIDE_LIMITS, BUDGET = int(Code.OUTSIDE_LIMITS), int(Code.BUDGET)
 T_ATTEMPTS, T_STEPS, T_MODEL_TIME, T_OUTSIDE, T_SINGULAR, T_CUT, T_ATTEMPT_STEPS, T_ATTEMPT_TIME = range(8)
 STATS_SIZE = 8
 
-__all__ = ["Control", "integrate", "multistart", "timed"]
+__all__ = ["Control", "integrate", "timed"]
 
 
 class Control(NamedTuple):
