@@ -25,7 +25,9 @@ def test_every_branch_of_a_ur5_pose_is_printed_nearest_first_and_each_meets_the_
     target = ur5.fk(np.array(UR5_Q, dtype=float))
     code, out, _ = run(capsys, "branches", "ur5", "--target-q", *UR5_Q, "--ref-q", *UR5_Q, "--json")
     found = json.loads(out)
-    assert code == 0 and len(found["branches"]) == 8 and found["completeness"] == "every branch: closed form"
+    assert code == 0 and len(found["branches"]) == 8
+    assert found["completeness"] == "every branch: closed form (complete: certified)"
+    assert found["complete"] == "certified" and found["complete_reason"] == ""
     qs = np.array([b["q"] for b in found["branches"]])
     assert np.abs(qs[0] - np.array(UR5_Q, dtype=float)).max() <= 1e-9  # the reference itself is a branch: first
     for q in qs:

@@ -55,12 +55,13 @@ def test_info_names_the_closed_form_the_search_or_the_joint_a_7r_arm_holds(capsy
         code, out, _ = run(capsys, "info", name)
         assert code == 0
         lines[name] = next(line for line in out.splitlines() if line.startswith("branches: "))
-    assert lines["ur5"] == "branches: 6R, axes 2, 3, 4 parallel, axes 5 and 6 meeting: every branch in closed form"
-    assert "spherical wrist" in lines["kinova"] and lines["kinova"].endswith("every branch in closed form")
+    assert lines["ur5"] == ("branches: 6R, axes 2, 3, 4 parallel, axes 5 and 6 meeting: every branch in closed form "
+                            "(certified: each branch proved a root, the set every root unless a double root is met)")
+    assert "spherical wrist" in lines["kinova"] and "every branch in closed form (certified" in lines["kinova"]
     assert lines["panda"].startswith("branches: with joint 7 (panda_joint7) held: ")
     assert "redundancy=K" in lines["panda"] and lines["youbot"].startswith("branches: none")
     assert lines["xarm6"] == ("branches: 6R, axes 2, 3 parallel, axes 4, 5 meeting: every branch by a 1-D search "
-                              "over joint 6")
+                              "over joint 6 (measured complete, not proved; 16 proved branches certify a set)")
     assert lines["baxter_left"].startswith("branches: with joint 1 (left_s0) held: ") and "1-D search" in \
         lines["baxter_left"]
 

@@ -195,12 +195,25 @@ def test_arms_are_classified_by_their_axes_and_others_are_refused_by_name(tmp_pa
     assert classify(searched).arm.searched and "1-D search over joint 6" in classify(searched).arm.mode
     o[3] += 0.02 * np.cross(h[3], h[4])
     off = load(write_urdf(tmp_path, chain_urdf(h, o, M, kinova.lower, kinova.upper), "off.urdf"), tool="tool")
-    target = off.fk(off.random_q(0))
-    with pytest.raises(OptionError, match="is not: .*axes 5 and 6 are 0.03 m apart .*axes 4, 5 and 6 miss a "
-                                          "common point by 0.04 m.* nor a 1-D search class"):
-        kinelab.solve_all(off, target, solver="analytic")
-    auto = kinelab.solve_all(off, target, seed=0)  # the numeric search instead, saying so
+    assert classify(off).arm is None and "axes 4, 5 and 6 miss a common point by 0.04 m" in classify(off).reason
+    q = off.random_q(0)
+    target = off.fk(q)
+    found = kinelab.solve_all(off, target, solver="analytic")  # the general 6R elimination takes it, certified
+    assert found.method == "elimination" and found.complete == "certified"
+    assert min(np.abs(np.arctan2(np.sin(s.q - q), np.cos(s.q - q))).max() for s in found) <= 1e-9
+    # six parallel axes (a planar chain: a continuum of answers) is a structure no solver here takes, said by name
+    planar = load(write_urdf(tmp_path, chain_urdf(np.tile([0.0, 0.0, 1.0], (6, 1)),
+                                                  np.array([[0.3 * i, 0.05 * i, 0.1 * i] for i in range(6)]),
+                                                  pin.SE3(np.eye(3), np.array([1.9, 0.3, 0.6])), np.full(6, -3.0),
+                                                  np.full(6, 3.0)), "planar.urdf"), tool="tool")
+    target = planar.fk(planar.random_q(0))
+    with pytest.raises(OptionError, match="is not: .* nor a 1-D search class.*general 6R elimination degenerates "
+                                          "on this chain's structure \\(axes 1 and 2 parallel, axes 1 and 3 "
+                                          "parallel"):
+        kinelab.solve_all(planar, target, solver="analytic")
+    auto = kinelab.solve_all(planar, target, seed=0, time_budget=0.2)  # the numeric search instead, saying so
     assert auto and all(s.solver == "frdm" and "multistart" in s.mode for s in auto)
+    assert auto.complete == "estimate"
     ur5 = load("ur5")
     with pytest.raises(OptionError, match="task"):
         kinelab.solve_all(ur5, ur5.fk(ur5.random_q(0)), solver="analytic", task="position")

@@ -205,8 +205,8 @@ def test_a_held_value_given_by_name_returns_every_branch_there_and_bad_values_ar
         assert contains(found, q) and all(abs(s.q[0] - q[0]) <= 1e-12 for s in found)
         assert f"joint 1 held at {q[0]:.6g} rad" in found[0].mode
     target = baxter.fk(baxter.random_q(rng))
-    for bad in ({"left_s1": 0.1}, {"left_s0": float("nan")}, {"left_s0": 9.0}, {"left_s0": "0.1"},
-                {"left_s0": 0.1, "left_s1": 0.2}):
+    for bad in ({"left_s0": float("nan")}, {"left_s0": 9.0}, {"left_s0": "0.1"}, {"left_s0": 0.1, "left_s1": 0.2},
+                {"nonsense": 0.1}):
         with pytest.raises(kinelab.OptionError, match=r"\{'left_s0': a value in \[-1.70168, 1.70168\] rad\}"):
             kinelab.solve_all(baxter, target, redundancy=bad)
 
@@ -276,22 +276,28 @@ def test_a_reachable_pose_the_search_misses_is_never_called_unreachable(monkeypa
     assert far == [] and far.status == kinelab.Status.UNREACHABLE  # proved by the reach bound: still said
 
 
-def test_a_calibrated_ur10e_fits_no_class_and_says_so_and_the_multistart_still_finds_its_poses(capsys):
+def test_a_calibrated_ur10e_fits_no_class_and_is_solved_by_the_elimination_certified(capsys):
     """The UR10e with a factory-size calibration (urdf/ur10e_calibrated.urdf, #41): its near-parallel and near-meeting
-    axes miss every class by more than the tolerances, which kinelab info states; solve_all answers by the
-    multistart with its estimate of what it missed, every answer judged, the pose's own configuration among them."""
+    axes miss every class by more than the tolerances, which kinelab info states; solve_all answers by the general
+    6R elimination, every answer judged, the set certified, the pose's own configuration among them, and every
+    branch the multistart finds among them."""
     from kinelab import cli
 
     arm = kinelab.load("ur10e_calibrated")
-    with pytest.raises(kinelab.OptionError, match=r"axes 2 and 3 are 0\.0034 rad from parallel \(tolerance 1e-05\)"):
-        kinelab.solve(arm, arm.fk(arm.random_q(0)), solver="analytic")
     assert cli.main(["info", "ur10e_calibrated"]) == 0
-    assert "no class holds to its tolerances (1e-05 rad between parallel axes, 1e-05 m" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "no class holds to its tolerances (1e-05 rad between parallel axes, 1e-05 m" in out
+    assert "general 6R: every branch by algebraic elimination" in out
     rng = np.random.default_rng(2)
     for k in range(4):
         q = arm.random_q(rng)
         target = arm.fk(q)
         found = kinelab.solve_all(arm, target, seed=k)
-        assert found.method == "multistart" and 0 < found.unseen < 0.1
+        assert found.method == "elimination" and found.complete == "certified" and found.complete_reason == ""
         assert all(max(arm.tool_error(s.q, target)) <= 1e-6 and arm.within_limits(s.q) for s in found)
-        assert min(np.max(np.abs(wrapped(s.q - q))) for s in found) <= 1e-5
+        assert min(np.max(np.abs(wrapped(s.q - q))) for s in found) <= FOUND
+        searched = kinelab.solve_all(arm, target, solver="frdm", seed=k, time_budget=0.3)
+        assert searched.method == "multistart" and searched.complete == "estimate"
+        assert all(min(np.max(np.abs(wrapped(s.q - a.q))) for a in found) <= 1e-5 for s in searched)
+        one = kinelab.solve(arm, target, solver="analytic", q0=q)
+        assert one.success and np.max(np.abs(wrapped(one.q - q))) <= FOUND

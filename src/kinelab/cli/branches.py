@@ -56,7 +56,8 @@ def run(args: argparse.Namespace) -> int:
                       redundancy=args.redundancy)
     if args.json:
         print_json({"robot": robot.name, "target": pose_dict(target), "method": _method(found),
-                    "completeness": _completeness(found), "branches": [r.to_dict() for r in found]})
+                    "completeness": _completeness(found), "complete": found.complete,
+                    "complete_reason": found.complete_reason, "branches": [r.to_dict() for r in found]})
     else:
         _print_branches(robot, args, found, ref)
     if args.html:
@@ -72,15 +73,20 @@ COMPLETENESS = {
     "closed form": "every branch: closed form",
     "sweep": "every branch at each value of the swept joint: closed form",
     "search": "every branch the search finds, each root refined to rounding (measured: docs/analytic.md, Completeness)",
+    "elimination": "every branch: general 6R algebraic elimination",
 }
 
 
 def _completeness(found: Branches) -> str:
-    """How sure the list is to hold every branch, in words (none: why, as the result's status says it)."""
+    """How sure the list is to hold every branch, in words (none: why, as the result's status says it): the method,
+    and ``complete`` with its reason."""
     if not found:
         return f"no branch ({found.status.value}): {found.message}"
-    return COMPLETENESS.get(found.method) or ("multistart: chance that one more start finds a new branch estimated "
-                                              f"at {found[0].diagnostics.unseen:.2g}")
+    if found.method == "multistart":
+        return (f"multistart (complete: estimate): chance that one more start finds a new branch estimated at "
+                f"{found[0].diagnostics.unseen:.2g}")
+    how = found.complete + (f" — {found.complete_reason}" if found.complete_reason else "")
+    return f"{COMPLETENESS.get(found.method, found.method)} (complete: {how})"
 
 
 def _print_branches(robot: Robot, args: argparse.Namespace, found: Branches, ref: Any) -> None:

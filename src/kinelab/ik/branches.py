@@ -17,7 +17,14 @@ from typing import Any, Literal
 import numpy as np
 
 from kinelab.errors import OptionError
-from kinelab.ik.analytic.branches import EveryBranch, analytic_all, arm_of, has_closed_form, prepared_form
+from kinelab.ik.analytic.branches import (
+    EveryBranch,
+    analytic_all,
+    arm_of,
+    has_closed_form,
+    has_general_form,
+    prepared_form,
+)
 from kinelab.ik.analytic.redundancy import redundant_all
 from kinelab.ik.batch import fresh_seed, prepare, run_batch
 from kinelab.ik.limits import distance as distance  # exported: the branch distance users sort by
@@ -101,11 +108,13 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
             raise OptionError("redundancy", redundancy, f"None with solver={req.solver!r} and options (redundancy= "
                               "sweeps a joint of the closed form: solver 'auto' or 'analytic', no options)")
         return redundant_all(robot, target, req, redundancy, ref, max_solutions)
-    if method is Route.CLOSED_FORM or (method is Route.EITHER and has_closed_form(robot, req)):
+    if method is Route.CLOSED_FORM or (method is Route.EITHER and (has_closed_form(robot, req)
+                                                                    or has_general_form(robot, req))):
         found = analytic_all(robot, target, req, q_ref=ref, max_solutions=max_solutions)
         # the 1-D search is measured complete, not proved so: a pose within reach it finds nothing for is searched
-        # again by the multistart rather than called unreachable
-        if found or not arm_of(robot, req).searched or beyond_reach(robot, target.translation):
+        # again by the multistart rather than called unreachable (and so is an elimination's uncertified empty set)
+        if found or found.complete == "certified" or not arm_of(robot, req).searched \
+                or beyond_reach(robot, target.translation):
             return found
     return _multistart_all(robot, target, req, ref, max_solutions, stop_below)
 

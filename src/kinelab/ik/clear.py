@@ -121,7 +121,7 @@ def mark_colliding(found: Branches, model: CollisionModel, drop: bool) -> Branch
         elif not drop:
             kept.append(replace(res, success=False, status=Status.COLLISION, message=f"collides: {contact}",
                                 diagnostics=replace(res.diagnostics, contact=contact)))
-    out = Branches(kept, found.status, found.message, found.method, found.unseen)
+    out = Branches(kept, found.status, found.message, found.method, found.unseen).certified_by(found._completeness)
     if found and not any(res.success for res in out):
         out.status, out.message = Status.COLLISION, f"every one of the {len(found)} branches found collides"
     return out

@@ -336,6 +336,12 @@ class Branches(Sequence[IKResult]):
             each sampled value) or "" (unknown).
         unseen: the estimated chance that one more start would find a new branch (multistart), 0 for a closed form
             or a search, None when not known.
+        complete: how complete the set is known to be (computed when first read): "certified" (each branch proved
+            a root by Kantorovich's test, and the set proved to be every root within the limits: the general 6R
+            elimination's eigenvalue count, or a closed form with no double root), "search" (every branch a
+            search or a closed form found, not proved complete: ``complete_reason`` says why), "estimate" (the
+            multistart: ``unseen`` estimates what it missed) or "" (unknown).
+        complete_reason: why the set is not certified ("" when it is).
     """
 
     def __init__(self, found: Iterable[IKResult] = (), status: Status | None = None, message: str = "",
@@ -349,6 +355,7 @@ class Branches(Sequence[IKResult]):
         self.rotation_error = np.array([r.rotation_error for r in results], dtype=float)
         self.status = status if status is not None else Status.CONVERGED if results else Status.TIME_BUDGET
         self.message, self.method, self.unseen = message, method, unseen
+        self._certify: Any = None
 
     @classmethod
     def from_arrays(cls, q: np.ndarray, position_error: np.ndarray, rotation_error: np.ndarray,
@@ -361,6 +368,7 @@ class Branches(Sequence[IKResult]):
         made._results, made._make_row, made._data = None, _called, make
         made.status = status if status is not None else Status.CONVERGED if len(q) else Status.TIME_BUDGET
         made.message, made.method, made.unseen = message, method, unseen
+        made._certify = None
         return made
 
     @classmethod
@@ -373,7 +381,31 @@ class Branches(Sequence[IKResult]):
         made.q, made.position_error, made.rotation_error = q, position_error, rotation_error
         made._results, made._make_row, made._data = None, make_row, data
         made.status, made.message, made.method, made.unseen = Status.CONVERGED, "", method, unseen
+        made._certify = None
         return made
+
+    def certified_by(self, certify: Callable[[], tuple[str, str]] | tuple[str, str]) -> Branches:
+        """This set, its completeness (``complete``, ``complete_reason``) given, or computed by ``certify()`` when
+        first read."""
+        self._certify = certify
+        return self
+
+    @property
+    def complete(self) -> str:
+        """"certified", "search", "estimate" or "" (see the class)."""
+        return self._completeness()[0]
+
+    @property
+    def complete_reason(self) -> str:
+        """Why the set is not certified complete, in words ("" when it is)."""
+        return self._completeness()[1]
+
+    def _completeness(self) -> tuple[str, str]:
+        if callable(self._certify):
+            self._certify = self._certify()
+        if self._certify is None:
+            self._certify = _BY_METHOD.get(self.method, ("", "how the set was found is not known"))
+        return self._certify  # type: ignore[no-any-return]
 
     def _built(self) -> list[IKResult]:
         if self._results is None:
@@ -411,6 +443,15 @@ class Branches(Sequence[IKResult]):
         """The arrays and the results, built (a pickle never carries the maker)."""
         self._built()
         return {**self.__dict__, "_make_row": _called, "_data": None}
+
+
+_BY_METHOD = {
+    "multistart": ("estimate", "seeded starts: unseen estimates the chance that another start finds a new branch"),
+    "search": ("search", "the 1-D search is measured complete, not proved (docs/analytic.md)"),
+    "sweep": ("search", "every branch at each sampled value of the held joint, not between them"),
+    "closed form": ("search", "no certificate was computed for this set"),
+    "elimination": ("search", "no certificate was computed for this set"),
+}
 
 
 def _called(make: Callable[[int], IKResult], i: int) -> IKResult:

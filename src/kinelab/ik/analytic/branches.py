@@ -25,9 +25,12 @@ from kinelab.core._analytic import ClosedForm
 from kinelab.core._joints import turn_distances
 from kinelab.errors import ConfigurationError, OptionError
 from kinelab.geometry import pose_errors, stack_homogeneous
-from kinelab.ik.analytic.classify import ArmClass, classify
-from kinelab.ik.analytic.kernel import MAX_ROWS, branches, branches_batch
+from kinelab.ik.analytic.certify import Loop, loop_of, search_certificate, set_certificate
+from kinelab.ik.analytic.classify import ArmClass, classify, general_class
+from kinelab.ik.analytic.general import roots_within
+from kinelab.ik.analytic.kernel import GENERAL_6R, MAX_ROWS, branches, branches_batch
 from kinelab.ik.batch import BatchIKResult
+from kinelab.ik.chain import chain_model
 from kinelab.ik.driver import solve_one
 from kinelab.ik.limits import distance
 from kinelab.ik.request import Request, make_request, verdict_reserve
@@ -52,18 +55,22 @@ _NO_REF = {n: np.zeros(n) for n in (5, 6)}
 
 
 def arm_of(robot: Robot, req: Request) -> ArmClass:
-    """The robot's analytic class for a pose request.
+    """The robot's analytic class for a pose request: a closed form or a search class, else the general 6R
+    elimination.
 
     Raises:
-        OptionError: the chain is in no analytic class (the tests it failed named), or the task is not "pose".
+        OptionError: the chain is in no analytic class and not a 6R chain the elimination takes (the tests it
+            failed named), or the task is not "pose".
     """
     found = classify(robot)
-    if found.arm is None:
-        raise OptionError("solver", "analytic", "a chain in an analytic class (docs/analytic.md); "
-                          f"{robot.name}'s is not: {found.reason}")
+    arm = found.arm or general_class(robot).arm
+    if arm is None:
+        raise OptionError("solver", "analytic", "a chain in an analytic class or a 6R chain the general "
+                          f"elimination takes (docs/analytic.md); {robot.name}'s is not: {found.reason}; "
+                          f"{general_class(robot).reason}")
     if req.task.name != "pose":
         raise OptionError("task", req.task_label, "'pose' with solver='analytic' (other tasks: solver='frdm')")
-    return found.arm
+    return arm
 
 
 def refuse_options(options: Any) -> None:
@@ -79,6 +86,12 @@ def refuse_options(options: Any) -> None:
 def has_closed_form(robot: Robot, req: Request) -> bool:
     """True when the chain is in an analytic class and the request asks for the whole pose."""
     return req.task.name == "pose" and classify(robot).arm is not None
+
+
+def has_general_form(robot: Robot, req: Request) -> bool:
+    """True when the chain is a 6R chain the general elimination takes (and no class of its own) and the request
+    asks for the whole pose."""
+    return req.task.name == "pose" and general_class(robot).arm is not None
 
 
 def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | None = None,
@@ -105,18 +118,29 @@ def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | No
     arm = arm_of(robot, req)
     form = prepared_form(robot, req)
     compiled = None if form is None else form.solve(target.homogeneous, q_ref)
+    uncertified = "" if arm.kind == GENERAL_6R else None
     if compiled is None:  # no certified compiled FK, or a root to finish: root by root
-        q, found, free = roots(robot, arm, target.homogeneous, q_ref, limit_slack(req.tol_rot))
+        if arm.kind == GENERAL_6R:
+            q, found, free, uncertified = roots_within(arm, target.homogeneous, robot.lower, robot.upper, q_ref,
+                                                       limit_slack(req.tol_rot))
+        else:
+            q, found, free = roots(robot, arm, target.homogeneous, q_ref, limit_slack(req.tol_rot))
         rows = Rows.of(judged_roots(robot, q, found, free, target, req), robot.n)
+        if uncertified == "" and len(rows.q) < len(q):
+            uncertified = "a root the judge does not confirm"
     else:
         q, dp, dr, found, free, _ = compiled
         rows = Rows(q, dp, dr, np.zeros(len(q), dtype=np.bool_), found, free)
     if q_ref is not None:
         rows = rows.taken(sorted(range(len(rows.q)), key=lambda k: distance(robot, rows.q[k], q_ref)))
-    return branch_results(robot, rows, req, arm.mode, time.perf_counter() - t0, max_solutions,
-                          "search" if arm.searched else "closed form",
+    return branch_results(robot, rows, req, arm.mode, time.perf_counter() - t0, max_solutions, _method(arm),
                           beyond_reach(robot, target.translation)
-                          or f"no branch within the joint limits ({arm.method})")
+                          or f"no branch within the joint limits ({arm.method})", uncertified, target.homogeneous)
+
+
+def _method(arm: ArmClass) -> str:
+    """The set's ``method``: "elimination" (general 6R), "search" (the 1-D search) or "closed form"."""
+    return "elimination" if arm.kind == GENERAL_6R else "search" if arm.searched else "closed form"
 
 
 def prepared_form(robot: Robot, req: Request) -> ClosedForm | None:
@@ -126,6 +150,8 @@ def prepared_form(robot: Robot, req: Request) -> ClosedForm | None:
     key = (float(req.tol_pos), float(req.tol_rot))
     if key not in forms:
         judge, arm = robot.derived("compiled judge", _compiled_judge), arm_of(robot, req)
+        if arm.kind == GENERAL_6R:  # not compiled yet: root by root
+            judge = None
         if len(forms) >= 16:  # a caller sweeping tolerances: keep the memory bounded
             forms.clear()
         lower, upper = robot.check_bounds
@@ -198,17 +224,43 @@ def _judged_each(robot: Robot, q: np.ndarray, found: np.ndarray, free: np.ndarra
 
 
 def branch_results(robot: Robot, rows: Rows, req: Request, mode: str, elapsed: float, max_solutions: int | None,
-                   method: str, empty: str) -> Branches:
+                   method: str, empty: str, uncertified: str | None = None, H: np.ndarray | None = None) -> Branches:
     """The closed form's judged rows as :class:`Branches`, the first ``max_solutions``: arrays, and an IKResult per
     row built when the set is first read; ``diagnostics.branches`` counts them all. With no row the set's status is
     ``unreachable`` for the reason ``empty``: the closed form and the search compute every branch, so finding none
-    proves it. ``method``: "closed form", "search" or "sweep"."""
+    proves it (the general 6R elimination: when its set is certified). ``method``: "closed form", "search",
+    "elimination" or "sweep"; ``uncertified``: the elimination's reason its set is not certified ("" when it is);
+    ``H``: the pose, for a closed form's certificate (computed when the set's completeness is first read)."""
     total = len(rows.q)
     kept = rows if max_solutions is None or max_solutions >= total else rows.taken(slice(max_solutions))
     unseen = 0.0 if method == "closed form" else None
     make = partial(_filled, _constant_fields(robot, req, mode), kept, wall_time=elapsed, branches=total, unseen=unseen)
-    return Branches.from_arrays(kept.q, kept.position_error, kept.rotation_error, make,
-                                None if total else Status.UNREACHABLE, "" if total else empty, method, unseen)
+    proved = uncertified in (None, "")
+    status = None if total else Status.UNREACHABLE if proved else Status.TIME_BUDGET
+    message = "" if total else empty if proved else f"no branch found, and the set is not certified: {uncertified}"
+    made = Branches.from_arrays(kept.q, kept.position_error, kept.rotation_error, make, status, message, method,
+                                unseen)
+    if uncertified is not None:
+        return made.certified_by(("certified", "") if uncertified == "" else ("search", uncertified))
+    if method in _CERTIFICATES and H is not None:
+        return made.certified_by(partial(_CERTIFICATES[method], robot_loop(robot), H, rows.q, rows.merged,
+                                         rows.continuum))
+    return made
+
+
+_CERTIFICATES = {"closed form": set_certificate, "search": search_certificate}
+
+
+def robot_loop(robot: Robot) -> Loop | None:
+    """The loop equations of a 6R robot's chain (:mod:`kinelab.ik.analytic.certify`), built once; None otherwise."""
+    return robot.derived("loop equations", _loop)
+
+
+def _loop(robot: Robot) -> Loop | None:
+    if robot.n != 6:
+        return None
+    v = chain_model(robot).vectors(np.zeros(6))
+    return loop_of(v["e"].copy(), v["o"].copy(), v["R"].copy(), v["N"].copy())
 
 
 def nearest_roots(robot: Robot, arm: ArmClass, target: Any, req: Request,
@@ -231,6 +283,8 @@ def roots(robot: Robot, arm: ArmClass, H: np.ndarray, q_ref: np.ndarray | None,
 def arm_roots(arm: ArmClass, H: np.ndarray, lower: np.ndarray, upper: np.ndarray,
               q_ref: np.ndarray | None, slack: float = LIMIT_SLACK) -> tuple[np.ndarray, ...]:
     """:func:`roots` of the arm ``arm`` with joint limits ``lower``, ``upper`` (arm.n each, rad)."""
+    if arm.kind == GENERAL_6R:
+        return roots_within(arm, H, lower, upper, q_ref, slack)[:3]
     n = arm.n
     out, found, free = np.empty((MAX_ROWS, n)), np.zeros(MAX_ROWS, dtype=np.int64), np.zeros(MAX_ROWS, dtype=np.bool_)
     ref = _NO_REF[n] if q_ref is None else np.ascontiguousarray(q_ref, dtype=float)
@@ -323,8 +377,7 @@ def all_branches_batch(robot: Robot, targets: Any, tol_pos: float = 1e-6, tol_ro
         q[b, :k], errors[b, :k, 0], errors[b, :k, 1] = one.q, one.position_error, one.rotation_error
         found[b, :k] = [int(r.diagnostics.found or 0) for r in one]
         free[b, :k] = [r.message == CONTINUUM for r in one]
-    return BranchBatch(q, count, found, free, errors[..., 0], errors[..., 1],
-                       "search" if arm.searched else "closed form", robot.fk_certificate.judge)
+    return BranchBatch(q, count, found, free, errors[..., 0], errors[..., 1], _method(arm), robot.fk_certificate.judge)
 
 
 def _pinocchio_batch(robot: Robot, arm: ArmClass, H: np.ndarray, req: Request) -> BranchBatch:
@@ -334,8 +387,14 @@ def _pinocchio_batch(robot: Robot, arm: ArmClass, H: np.ndarray, req: Request) -
     out = np.full((B, MAX_ROWS, n), np.nan)
     found, free = np.zeros((B, MAX_ROWS), dtype=np.int64), np.zeros((B, MAX_ROWS), dtype=np.bool_)
     count = np.zeros(B, dtype=np.int64)
-    branches_batch(arm.kind, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, H, robot.lower, robot.upper, SAME,
-                   limit_slack(req.tol_rot), out, found, free, count)
+    if arm.kind == GENERAL_6R:  # not compiled yet: pose by pose
+        for b in range(B):
+            q, merged, loose, _ = roots_within(arm, H[b], robot.lower, robot.upper, None, limit_slack(req.tol_rot))
+            k = count[b] = len(q)
+            out[b, :k], found[b, :k], free[b, :k] = q, merged, loose
+    else:
+        branches_batch(arm.kind, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, H, robot.lower, robot.upper, SAME,
+                       limit_slack(req.tol_rot), out, found, free, count)
     pose, row = np.nonzero(np.arange(MAX_ROWS)[None, :] < count[:, None])
     dp, dr = pose_errors(H[pose], robot.fk_batch(out[pose, row]))
     ok = (dp <= req.tol_pos) & (dr <= req.tol_rot)
@@ -346,8 +405,7 @@ def _pinocchio_batch(robot: Robot, arm: ArmClass, H: np.ndarray, req: Request) -
     errors[pose[ok], rank, 0], errors[pose[ok], rank, 1] = dp[ok], dr[ok]
     f, loose = np.zeros_like(found), np.zeros_like(free)
     f[pose[ok], rank], loose[pose[ok], rank] = found[pose[ok], row[ok]], free[pose[ok], row[ok]]
-    return BranchBatch(q, kept, f, loose, errors[..., 0], errors[..., 1],
-                       "search" if arm.searched else "closed form", robot.fk_certificate.judge)
+    return BranchBatch(q, kept, f, loose, errors[..., 0], errors[..., 1], _method(arm), robot.fk_certificate.judge)
 
 
 def _constant_fields(robot: Robot, req: Request, mode: str) -> dict[str, Any]:
@@ -387,6 +445,7 @@ class OneCall:
         self.method = "search" if arm.searched else "closed form"
         self.unseen = 0.0 if self.method == "closed form" else None
         self.unfinished = np.zeros(MAX_ROWS, dtype=np.bool_)  # the compiled form finishes no root
+        self.loop, self.pose = robot_loop(robot), np.eye(4)
 
     def found(self, target: Any, ref: np.ndarray | None) -> tuple[Rows, float] | None:
         """(the compiled closed form's rows, the start of the clock [s]), or None where the general route must
@@ -423,13 +482,16 @@ class EveryBranch(OneCall):
         """Every branch of ``target``, or None where the general route must answer."""
         if type(target) is not pin.SE3:
             return None
+        self.pose = target.homogeneous
         return self.form.every(target, self._made)  # type: ignore[no-any-return]
 
     def _made(self, q: np.ndarray, dp: np.ndarray, dr: np.ndarray, merged: np.ndarray, continuum: np.ndarray,
               wall_time: float) -> Branches:
         """The set of one pose's branches from the compiled form's arrays (q (k, n) [rad], errors [m, rad])."""
-        return Branches.of_rows(q, dp, dr, self._row, (q, dp, dr, merged, continuum, wall_time), self.method,
+        made = Branches.of_rows(q, dp, dr, self._row, (q, dp, dr, merged, continuum, wall_time), self.method,
                                 self.unseen)
+        made.certified_by(partial(_CERTIFICATES[self.method], self.loop, self.pose, q, merged, continuum))
+        return made
 
     def _row(self, data: tuple[Any, ...], i: int) -> IKResult:
         """Row i of a set :meth:`_made` made, as :func:`branch_results` builds it."""

@@ -21,13 +21,21 @@ POINT_TOL; a chain that misses a test by more gets the numeric path, with the te
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from kinelab.errors import ChainError
-from kinelab.ik.analytic.kernel import MEETING_6R, PARALLEL_5R, PARALLEL_6R, SEARCH_6R, SPHERICAL_6R, TWO_THREE_6R
+from kinelab.ik.analytic.kernel import (
+    GENERAL_6R,
+    MEETING_6R,
+    PARALLEL_5R,
+    PARALLEL_6R,
+    SEARCH_6R,
+    SPHERICAL_6R,
+    TWO_THREE_6R,
+)
 from kinelab.ik.chain import PRISMATIC, chain_model
 from kinelab.robot import Robot
 
@@ -44,6 +52,8 @@ class ArmClass:
             chain is solved read from the tool back (inverse pose, joints reversed and negated).
         h, o: (n, 3) unit axes and points on them at q = 0 [m], in the solved orientation's base frame.
         R0, N0: the tool's rotation and point at q = 0 in that frame.
+        solver: for the general 6R class, its prepared elimination (:mod:`kinelab.ik.analytic.general`) and
+            loop equations (:mod:`kinelab.ik.analytic.certify`); None for the others.
     """
 
     name: str
@@ -53,6 +63,7 @@ class ArmClass:
     o: np.ndarray
     R0: np.ndarray
     N0: np.ndarray
+    solver: Any = field(default=None, repr=False)  # the general 6R class's prepared elimination and loop equations
 
     @property
     def n(self) -> int:
@@ -69,6 +80,8 @@ class ArmClass:
         """How the branches are found, in words (``kinelab info``)."""
         if not self.searched:
             return "every branch in closed form"
+        if self.kind == GENERAL_6R:
+            return "every branch by algebraic elimination"
         joint = 4 if (self.kind - SEARCH_6R) // 3 else 6
         if self.mirrored:
             joint = 7 - joint
@@ -77,6 +90,8 @@ class ArmClass:
     @property
     def mode(self) -> str:
         """The answers' ``mode``: the class, and the search joint when searched."""
+        if self.kind == GENERAL_6R:
+            return f"analytic ({self.name}; algebraic elimination)"
         return f"analytic ({self.name}; {self.method.removeprefix('every branch by a ')})" if self.searched \
             else f"analytic ({self.name})"
 
@@ -92,6 +107,60 @@ class Classification:
 def classify(robot: Robot) -> Classification:
     """The analytic class of ``robot``'s chain, built once per Robot (see the module's docstring)."""
     return robot.derived("analytic_class", _classify)
+
+
+def general_class(robot: Robot) -> Classification:
+    """The general 6R class of ``robot``'s chain (the algebraic elimination, :mod:`kinelab.ik.analytic.general`), or
+    None with the reason: not 6R, a prismatic joint, or a structure the elimination cannot take. Built once per
+    Robot; an arm in a closed-form or search class has its own (:func:`classify`) and is not offered this one."""
+    return robot.derived("general_class", _general)
+
+
+def _general(robot: Robot) -> Classification:
+    if classify(robot).arm is not None:
+        return Classification(None, "the chain has a class of its own: " + classify(robot).arm.name)  # type: ignore[union-attr]
+    try:
+        cm = chain_model(robot)
+    except ChainError as err:
+        return Classification(None, str(err))
+    if (cm.kind == PRISMATIC).any() or cm.n != 6:
+        return Classification(None, "the general solver takes 6R chains (this one: "
+                              f"{cm.n} joints{', a prismatic one' if (cm.kind == PRISMATIC).any() else ''})")
+    v = cm.vectors(np.zeros(cm.n))
+    return general_vectors(v["e"].copy(), v["o"].copy(), v["R"].copy(), v["N"].copy())
+
+
+def general_vectors(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray) -> Classification:
+    """The general 6R class of the chain (h, o, R0, N0) at q = 0 (base frame, metres), read from the base or else
+    from the tool (the elimination's joints 1 and 2 are then the last two), or None with the structure the
+    elimination cannot take either way (it misses seeded configurations of the chain)."""
+    from kinelab.ik.analytic.certify import loop_of
+    from kinelab.ik.analytic.general import prepare, usable
+
+    failed = []
+    for mirrored in (False, True):
+        hh, oo, RR, NN = reverse(h, o, R0, N0) if mirrored else (h, o, R0, N0)
+        solver = (prepare(hh, oo, RR, NN), loop_of(hh, oo, RR, NN))
+        why = usable(*solver)
+        if not why:
+            name = "general 6R" + (" (mirrored: read from the tool)" if mirrored else "")
+            return Classification(ArmClass(name, GENERAL_6R, mirrored, hh, oo, RR, NN, solver), "")
+        failed.append(("read from the tool: " if mirrored else "") + why)
+    return Classification(None, f"the general 6R elimination degenerates on this chain's structure ({special(h, o)}): "
+                          + " | ".join(failed))
+
+
+def special(h: np.ndarray, o: np.ndarray) -> str:
+    """The special structure of a chain's axes, in words: which pairs of axes are parallel or meet, to the class
+    tolerances ("no two axes parallel or meeting" when none)."""
+    n, found = h.shape[0], []
+    for i in range(n):
+        for j in range(i + 1, n):
+            if _angle(h[i], h[j]) < AXIS_TOL:
+                found.append(f"axes {i + 1} and {j + 1} parallel")
+            elif line_distance(o[i], h[i], o[j], h[j]) < POINT_TOL:
+                found.append(f"axes {i + 1} and {j + 1} meeting")
+    return ", ".join(found) or "no two axes parallel or meeting"
 
 
 def _classify(robot: Robot) -> Classification:

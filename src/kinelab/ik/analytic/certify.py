@@ -1,0 +1,169 @@
+"""Proofs that an answer is a root, and that a set of branches is every root: Newton–Kantorovich on the loop
+equations, and the eigenvalue count of the general 6R elimination (docs/analytic.md, "Certificates").
+
+The loop equations of a 6R chain (h, o, R0, N0) at a target (R*, p*) are six: F(q) = ((p(q) − p*)/ℓ,
+½ Σ_k R*e_k × R(q)e_k), ℓ a length scale (the reach bound). Their Jacobian's columns are (ω_j × (p − o_j)/ℓ,
+½(ω_j tr(R*ᵀR) − R R*ᵀ ω_j)) and, turning joint i moving ω_j by ω_i × ω_j (i < j) and p by ω_i × (p − o_i),
+change by at most 2D_j/ℓ or D_i/ℓ (position, i < j or i ≥ j) and 3.5 or 1.5 (rotation), D_j the distance from
+axis j's point to the tool point bounded by the sum of the fixed segments between them. So F′ is Lipschitz with
+L = ‖(those bounds)‖_F over all of R⁶, and Kantorovich's theorem applies: with β ≥ ‖F′(q)⁻¹‖ and
+η ≥ ‖F′(q)⁻¹F(q)‖, h = βLη ≤ ½ proves exactly one root in the ball of radius (1 − √(1 − 2h))/(βL) about q and
+no other within (1 + √(1 − 2h))/(βL). Floating-point evaluation is covered by a margin of 1e-12 on each
+component of F and on ‖F′‖.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+F_MARGIN = 1e-12  # rounding allowance on each component of F (scaled units) and on F′'s singular values
+MAX_STEPS = 6  # Newton steps at most when polishing
+
+
+@dataclass(frozen=True, eq=False)
+class Loop:
+    """A 6R chain's loop equations for certificates: the chain (h, o, R0, N0) at q = 0 (base frame, metres),
+    ``scale`` ℓ [m] and ``lipschitz`` L (scaled units)."""
+
+    h: np.ndarray
+    o: np.ndarray
+    R0: np.ndarray
+    N0: np.ndarray
+    scale: float
+    lipschitz: float
+
+
+def loop_of(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray) -> Loop:
+    """The loop equations of the chain (h (n, 3) unit axes, o (n, 3) points on them, R0, N0 the tool at q = 0)."""
+    n = h.shape[0]
+    segments = np.linalg.norm(np.diff(np.vstack([o, N0]), axis=0), axis=1)
+    D = np.cumsum(segments[::-1])[::-1]  # D[j]: bound on ‖p − o_j‖ over every configuration
+    scale = max(float(D[0]), 1e-3)
+    i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
+    position = np.where(i < j, 2 * D[j], D[i]) / scale
+    rotation = np.where(i < j, 3.5, 1.5)
+    return Loop(h, o, R0, N0, scale, float(np.sqrt((position**2).sum() + (rotation**2).sum())))
+
+
+def kinematics(loop: Loop, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The tool's rotation (m, 3, 3) and point (m, 3), and each joint's axis ω (m, n, 3) and point (m, n, 3), at the
+    configurations q (m, n) [rad]: the product of exponentials (base frame)."""
+    m, n = q.shape
+    R = np.broadcast_to(np.eye(3), (m, 3, 3)).copy()
+    t = np.zeros((m, 3))
+    axes, points = np.empty((m, n, 3)), np.empty((m, n, 3))
+    for k in range(n):
+        axes[:, k] = R @ loop.h[k]
+        points[:, k] = R @ loop.o[k] + t
+        turn = _rodrigues(loop.h[k], q[:, k])
+        t = t + np.einsum("mij,mj->mi", R, loop.o[k] - turn @ loop.o[k])
+        R = R @ turn
+    return R @ loop.R0, (R @ loop.N0) + t, axes, points
+
+
+def _rodrigues(h: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """Rotations (m, 3, 3) by ``angles`` [rad] about the unit axis h."""
+    K = np.array([[0.0, -h[2], h[1]], [h[2], 0.0, -h[0]], [-h[1], h[0], 0.0]])
+    return np.eye(3) + np.sin(angles)[:, None, None] * K + (1 - np.cos(angles))[:, None, None] * (K @ K)
+
+
+def equations(loop: Loop, q: np.ndarray, H: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """F (m, 6) and F′ (m, 6, n) of the loop equations at q (m, n) for the target H (4 × 4, base frame)."""
+    R, p, w, o = kinematics(loop, q)
+    Rt, pt = H[:3, :3], H[:3, 3]
+    g = 0.5 * np.cross(Rt.T[None], np.swapaxes(R, 1, 2)).sum(axis=1)  # ½ Σ_k R*e_k × R e_k
+    F = np.concatenate([(p - pt) / loop.scale, g], axis=1)
+    trace = np.einsum("ij,mij->m", Rt, R)
+    RRt = R @ Rt.T
+    Jp = np.cross(w, p[:, None, :] - o) / loop.scale
+    Jg = 0.5 * (w * trace[:, None, None] - np.einsum("mab,mjb->mja", RRt, w))
+    return F, np.swapaxes(np.concatenate([Jp, Jg], axis=2), 1, 2)
+
+
+def polish(loop: Loop, q: np.ndarray, H: np.ndarray) -> np.ndarray:
+    """Newton's method on the loop equations from q (m, n) [rad], at most MAX_STEPS steps, each row kept at its
+    smallest residual ‖F‖ (beside a double root F′ is nearly singular and a step can run along the valley)."""
+    best = np.array(q, dtype=float)
+    if best.shape[0] == 0:
+        return best
+    F, J = equations(loop, best, H)
+    low = np.linalg.norm(F, axis=1)
+    x = best.copy()
+    for _ in range(MAX_STEPS):
+        if not np.isfinite(F).all() or low.max() < 1e-15:
+            break
+        x = x - _steps(J, F)
+        F, J = equations(loop, x, H)
+        size = np.linalg.norm(F, axis=1)
+        better = size < low
+        best[better], low[better] = x[better], size[better]
+    return best
+
+
+def _steps(J: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """Newton's steps J⁻¹F row by row (least squares where J is singular)."""
+    try:
+        return np.linalg.solve(J, F[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        return np.array([np.linalg.lstsq(J[k], F[k], rcond=None)[0] for k in range(F.shape[0])])
+
+
+@dataclass(frozen=True, eq=False)
+class Proof:
+    """Kantorovich's test at each row of q: ``proved`` (m,) h ≤ ½; ``inside`` (m,) [rad] the radius of the ball
+    about q holding exactly one root; ``alone`` (m,) [rad] the radius within which it is the only root."""
+
+    proved: np.ndarray
+    inside: np.ndarray
+    alone: np.ndarray
+
+
+def kantorovich(loop: Loop, q: np.ndarray, H: np.ndarray) -> Proof:
+    """Kantorovich's test of each configuration q (m, 6) [rad] as a root of the pose H's loop equations."""
+    F, J = equations(loop, q, H)
+    sigma = np.linalg.svd(J, compute_uv=False)
+    smallest = sigma[:, -1] - F_MARGIN * (1 + sigma[:, 0])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        beta = np.where(smallest > 0, 1 / smallest, np.inf)
+        eta = beta * (np.linalg.norm(F, axis=1) + np.sqrt(6) * F_MARGIN)
+        bl = beta * loop.lipschitz
+        h = bl * eta
+        root = np.sqrt(np.clip(1 - 2 * h, 0, None))
+        inside = np.where(h <= 0.5, (1 - root) / bl, np.inf)
+        alone = np.where(h <= 0.5, (1 + root) / bl, 0.0)
+    return Proof(np.isfinite(h) & (h <= 0.5), inside, alone)
+
+
+def set_certificate(loop: Loop | None, H: np.ndarray, q: np.ndarray, merged: np.ndarray,
+                    continuum: np.ndarray) -> tuple[str, str]:
+    """("certified", "") when a closed form's branches q (k, 6) [rad] of the pose H are each proved a root, apart
+    from one another, none a double root (``merged``) or one of a continuum: the closed form gives every root of
+    its subproblems, so the set is every root within the limits; else ("search", why not)."""
+    if loop is None:
+        return "search", "a chain that is not 6R: its answers are not a square system Kantorovich's test takes"
+    if (np.asarray(merged) > 1).any() or np.asarray(continuum).any():
+        return "search", "a double root or a continuum of answers (a singular pose)"
+    if q.shape[0] == 0:
+        return "certified", ""
+    proof = kantorovich(loop, q, H)
+    if not proof.proved.all():
+        return "search", "a branch Kantorovich's test does not prove (a singular configuration)"
+    gap = np.abs(np.arctan2(np.sin(q[:, None] - q[None]), np.cos(q[:, None] - q[None])))
+    apart = np.linalg.norm(gap, axis=2) > proof.inside[:, None] + proof.inside[None]
+    np.fill_diagonal(apart, True)
+    return ("certified", "") if apart.all() else ("search", "two branches whose balls meet")
+
+
+MOST_ROOTS = 16  # the most isolated roots a 6R pose has (Raghavan and Roth)
+
+
+def search_certificate(loop: Loop | None, H: np.ndarray, q: np.ndarray, merged: np.ndarray,
+                       continuum: np.ndarray) -> tuple[str, str]:
+    """A 1-D search's set of branches q (k, 6) [rad] of the pose H: ("certified", "") when it holds MOST_ROOTS
+    branches each proved a root and apart (no pose has more), else ("search", why not)."""
+    if q.shape[0] < MOST_ROOTS:
+        return "search", (f"the 1-D search is measured complete, not proved ({q.shape[0]} branches; {MOST_ROOTS} "
+                          "proved ones would be)")
+    return set_certificate(loop, H, q, merged, continuum)

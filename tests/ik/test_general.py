@@ -1,0 +1,179 @@
+"""Every branch of any 6R arm by the general algebraic elimination, with a certificate (docs/analytic.md, "Any 6R
+arm" and "Certificates").
+
+The oracles: the configuration each pose is made from (it must be among the branches), Pinocchio's FK (every
+answer meets the pose), and the multistart, which solves the same poses its own way (every branch it finds must be
+among the elimination's). Hard poses are built on purpose: a root at a half-angle of ±π, a double root on the
+singular surface and close pairs beside it, a wrist-singular pose, the CRX's 16-branch pose.
+"""
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from helpers import chain_urdf, write_urdf
+
+import kinelab
+from kinelab.ik.analytic.certify import kantorovich, loop_of
+from kinelab.ik.analytic.classify import general_class
+from kinelab.report.bench.completeness import random_general_arm
+
+TOL = 1e-6  # [m, rad] the judge's tolerances
+FOUND = 1e-9  # [rad] the pose's own configuration is a branch to this, joint by joint, modulo 2π
+
+
+def wrapped(d):
+    return np.arctan2(np.sin(d), np.cos(d))
+
+
+def gap(a, b):
+    return float(np.max(np.abs(wrapped(np.asarray(a) - np.asarray(b)))))
+
+
+def general_robot(tmp_path, seed):
+    h, o, tool = random_general_arm(np.random.default_rng(seed))
+    path = write_urdf(tmp_path, chain_urdf(h, o, tool, np.full(6, -np.pi), np.full(6, np.pi)), f"g{seed}.urdf")
+    return kinelab.load(path, tool="tool")
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3, 4])
+def test_random_general_arms_give_the_pose_s_own_configuration_among_certified_judged_branches(tmp_path, seed):
+    robot = general_robot(tmp_path, seed)
+    rng = np.random.default_rng(seed)
+    for _ in range(25):
+        q = robot.random_q(rng)
+        target = robot.fk(q)
+        found = kinelab.solve_all(robot, target)
+        assert found.method == "elimination" and "general 6R" in found[0].mode
+        assert found.complete == "certified" and found.complete_reason == ""
+        assert 2 <= len(found) <= 16 and len(found) % 2 == 0  # real roots of a real degree-16 polynomial pair up
+        assert min(gap(s.q, q) for s in found) <= FOUND
+        for s in found:  # Pinocchio's FK, independently of the judge's verdict
+            oMtool = robot.fk(s.q)
+            assert np.linalg.norm(oMtool.translation - target.translation) <= TOL
+            assert np.linalg.norm(pin.log3(oMtool.rotation.T @ target.rotation)) <= TOL
+        assert min((gap(a.q, b.q) for i, a in enumerate(found) for b in found[i + 1:]), default=1.0) > 1e-6
+
+
+def test_every_branch_the_multistart_finds_is_among_the_elimination_s(tmp_path):
+    robot = general_robot(tmp_path, 7)
+    rng = np.random.default_rng(7)
+    for k in range(4):
+        target = robot.fk(robot.random_q(rng))
+        ours = kinelab.solve_all(robot, target)
+        theirs = kinelab.solve_all(robot, target, solver="frdm", seed=k, time_budget=0.5, stop_below=None)
+        assert len(theirs) >= 1 and all(min(gap(s.q, a.q) for a in ours) <= 1e-5 for s in theirs)
+
+
+def test_a_root_at_a_half_angle_of_pi_is_found_and_certified(tmp_path):
+    """The elimination's variable is x₃ = tan((q₃ − φ₃)/2): at q₃ = φ₃ + π it is infinite (an eigenvalue at ∞)."""
+    robot = general_robot(tmp_path, 11)
+    arm = general_class(robot).arm
+    g = arm.solver[0]
+    q = robot.random_q(np.random.default_rng(11))
+    joint = 2 if not arm.mirrored else 3  # the mirrored chain's third joint is the robot's fourth
+    q[joint] = wrapped((g.phi[2] + np.pi) * (1 if not arm.mirrored else -1))
+    found = kinelab.solve_all(robot, robot.fk(q))
+    assert min(gap(s.q, q) for s in found) <= FOUND and found.complete == "certified"
+
+
+def _singular_q(robot, q, joint=2):
+    """q with joint ``joint`` moved onto the singular surface (det J = 0), found by bisection on a sign change."""
+    def det(x):
+        qq = q.copy()
+        qq[joint] = x
+        return np.linalg.det(robot.jacobian_world(qq))
+    xs = np.linspace(-np.pi, np.pi, 721)
+    d = np.array([det(x) for x in xs])
+    k = int(np.flatnonzero(np.sign(d[:-1]) != np.sign(d[1:]))[0])
+    a, b = xs[k], xs[k + 1]
+    for _ in range(60):
+        m = 0.5 * (a + b)
+        a, b = (m, b) if np.sign(det(m)) == np.sign(det(a)) else (a, m)
+    out = q.copy()
+    out[joint] = 0.5 * (a + b)
+    return out
+
+
+@pytest.mark.parametrize("offset", [0.0, 1e-7, 1e-4])
+def test_on_and_beside_the_singular_surface_the_set_holds_the_pose_s_configuration_or_says_it_is_uncertified(
+        tmp_path, offset):
+    """On the surface det J = 0 two roots meet (a double root): Kantorovich cannot prove it, and the set says so.
+    Beside it, two close roots: both are answered, or the set is marked uncertified — never one answer for two
+    roots with a certificate."""
+    robot = general_robot(tmp_path, 5)
+    rng = np.random.default_rng(5)
+    for _ in range(3):
+        q = _singular_q(robot, robot.random_q(rng))
+        q[2] += offset
+        found = kinelab.solve_all(robot, robot.fk(q))
+        assert min(gap(s.q, q) for s in found) <= (1e-6 if offset == 0 else 1e-7)
+        if offset == 0:
+            assert found.complete == "search" and found.complete_reason
+        if found.complete == "certified":
+            own = [s for s in found if gap(s.q, q) <= 1e-7]
+            assert len(own) == 1
+
+
+def test_kantorovich_proves_a_root_and_refuses_a_point_that_is_not_one():
+    ur5 = kinelab.load("ur5")
+    q = ur5.random_q(np.random.default_rng(3))
+    from kinelab.ik.chain import chain_model
+    v = chain_model(ur5).vectors(np.zeros(6))
+    loop = loop_of(v["e"].copy(), v["o"].copy(), v["R"].copy(), v["N"].copy())
+    H = ur5.fk(q).homogeneous
+    proof = kantorovich(loop, np.array([q, q + 1e-3]), H)
+    assert proof.proved.tolist() == [True, False]
+    assert proof.inside[0] < 1e-9 < 1e-3 < proof.alone[0]  # a tiny ball holds the root, a wide one holds no other
+
+
+def test_closed_form_sets_are_certified_and_a_wrist_singular_pose_is_said_not_to_be():
+    ur5 = kinelab.load("ur5")
+    rng = np.random.default_rng(4)
+    for _ in range(10):
+        found = kinelab.solve_all(ur5, ur5.fk(ur5.random_q(rng)))
+        assert found.method == "closed form" and found.complete == "certified"
+    q = ur5.random_q(rng)
+    q[4] = 0.0  # axes 4 and 6 aligned: q4 + q6 is a continuum
+    found = kinelab.solve_all(ur5, ur5.fk(q))
+    assert found.complete == "search" and "continuum" in found.complete_reason
+
+
+def test_the_crx_sixteen_branch_pose_is_certified_by_its_count():
+    from test_search import CRX_SIXTEEN
+
+    crx = kinelab.load("crx10ia")
+    found = kinelab.solve_all(crx, crx.fk(np.array(CRX_SIXTEEN)))
+    assert len(found) == 16 and found.method == "search" and found.complete == "certified"
+    fewer = kinelab.solve_all(crx, crx.fk(crx.random_q(np.random.default_rng(1))))
+    assert len(fewer) < 16 and fewer.complete == "search" and "measured complete" in fewer.complete_reason
+
+
+def test_the_elimination_on_the_xarm6_chain_agrees_with_its_1d_search():
+    """The xArm6 is a 1-D search class; the elimination takes its chain read from the tool, certified: the two sets
+    are equal on every pose where the elimination's is certified."""
+    from kinelab.ik.analytic.classify import general_vectors
+    from kinelab.ik.analytic.general import roots_within
+    from kinelab.ik.chain import chain_model
+
+    xarm = kinelab.load("xarm6")
+    v = chain_model(xarm).vectors(np.zeros(6))
+    arm = general_vectors(v["e"].copy(), v["o"].copy(), v["R"].copy(), v["N"].copy()).arm
+    assert arm is not None and arm.mirrored
+    rng = np.random.default_rng(8)
+    for _ in range(20):
+        q = xarm.random_q(rng)
+        searched = kinelab.solve_all(xarm, xarm.fk(q))
+        roots, _, _, reason = roots_within(arm, xarm.fk(q).homogeneous, xarm.lower, xarm.upper, None, 1e-6)
+        if reason:
+            continue
+        assert len(roots) == len(searched)
+        assert all(min(gap(r, s.q) for s in searched) <= 1e-6 for r in roots)
+
+
+def test_a_planar_or_special_chain_is_refused_with_its_structure_named():
+    from kinelab.ik.analytic.classify import general_vectors
+
+    h = np.tile([0.0, 0.0, 1.0], (6, 1))
+    o = np.array([[0.3 * i, 0.0, 0.0] for i in range(6)])
+    out = general_vectors(h, o, np.eye(3), np.array([1.9, 0.0, 0.0]))
+    assert out.arm is None and "axes 1 and 2 parallel" in out.reason and "degenerates" in out.reason
