@@ -4,6 +4,7 @@ closed form of the 6R arm Pinocchio builds with the swept joint locked."""
 import numpy as np
 import pinocchio as pin
 import pytest
+from helpers import chain_urdf, write_urdf
 
 import kinelab
 from kinelab.ik.analytic.redundancy import samples, swept_arm
@@ -119,10 +120,16 @@ def test_holding_the_last_joint_solves_the_same_poses(era):
         assert _contains(answers, q)
 
 
-def test_arms_that_cannot_be_swept_are_refused_by_name(era):
-    tiago_pro, ur5 = kinelab.load("tiago_pro"), kinelab.load("ur5")
-    with pytest.raises(kinelab.OptionError, match=r"tiago_pro's is not: joint 1 held .*joint 7 held"):
-        kinelab.solve_all(tiago_pro, tiago_pro.fk(tiago_pro.random_q(1)), redundancy=8)
+def test_arms_that_cannot_be_swept_are_refused_by_name(era, tmp_path):
+    # seven parallel axes: holding an end joint leaves a planar six that nothing here solves
+    planar = kinelab.load(write_urdf(tmp_path, chain_urdf(np.tile([0.0, 0.0, 1.0], (7, 1)),
+                                                          np.array([[0.2 * i, 0.03 * i, 0.1 * i] for i in range(7)]),
+                                                          pin.SE3(np.eye(3), np.array([1.5, 0.2, 0.7])),
+                                                          np.full(7, -3.0), np.full(7, 3.0))), tool="tool")
+    ur5 = kinelab.load("ur5")
+    with pytest.raises(kinelab.OptionError, match=r"t's is not: joint 1 held .*joint 7 held.*general 6R elimination "
+                                                  r"degenerates"):
+        kinelab.solve_all(planar, planar.fk(planar.random_q(1)), redundancy=8)
     with pytest.raises(kinelab.OptionError, match="6 joints"):
         kinelab.solve_all(ur5, ur5.fk(ur5.random_q(1)), redundancy=8)
     target = era.fk(era.random_q(1))
@@ -169,3 +176,19 @@ def test_frdm_answers_on_the_era_are_closed_form_branches_and_the_kick_does_not_
                 at_limit += 1
     assert solved >= 150 and at_limit <= 0.03 * solved and 0.35 <= agree / solved <= 0.65
     assert np.mean(counts) > 2  # several branches at each answer's own q1
+
+
+@pytest.mark.parametrize(("name", "joint"), [("tiago_pro", 0), ("tiago_pro", 3), ("xarm7", 3), ("baxter_left", 2)])
+def test_any_joint_of_a_7r_arm_held_gives_every_branch_with_the_pose_s_own_configuration(name, joint):
+    """#41 item 4: with one joint held at a value, the six left are solved by a class or the general 6R elimination
+    (TIAGo Pro's six are in no class at either end; the middle joints leave no class either)."""
+    robot = kinelab.load(name)
+    held = robot.joints[joint].name
+    rng = np.random.default_rng(joint)
+    for q in robot.random_qs(6, rng):
+        target = robot.fk(q)
+        found = kinelab.solve_all(robot, target, redundancy={held: float(q[joint])})
+        assert f"joint {joint + 1} held at {q[joint]:.6g} rad" in found[0].mode
+        assert all(abs(s.q[joint] - q[joint]) <= 1e-12 and max(robot.tool_error(s.q, target)) <= 1e-6
+                   and robot.within_limits(s.q) for s in found)
+        assert min(np.abs(np.arctan2(np.sin(s.q - q), np.cos(s.q - q))).max() for s in found) <= 1e-6

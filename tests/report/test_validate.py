@@ -131,7 +131,11 @@ def test_the_closed_form_checks_hold_on_ur5_and_fail_when_a_branch_is_missing(mo
                                       "completeness: the pose's own configuration among the branches, to 1e-06 rad"]
     assert all(r.passed for r in rows) and "on the branch nearest its start" in rows[1].detail
     assert "2000 poses, 0 missed" in rows[-1].detail
-    assert validate.analytic_checks(kinelab.load("tiago_pro"), 40, 0) == []  # no class, not even swept
+    # TIAGo Pro: no class, not even with an end joint held; the general elimination sweeps its joint 1
+    swept = validate.analytic_checks(kinelab.load("tiago_pro"), 40, 0)
+    assert swept[0].name == "elimination, joint 1 swept: every branch met (Pinocchio-checked)"
+    assert swept[0].passed and swept[-1].passed and "0 missed" in swept[-1].detail  # (DLS's answers at a limit whose
+    # root lies 1e-6 rad beyond it are not branches within the limits: 1 of 9 here, below the 95 % of 10 targets)
     real = ik.solve_all
     monkeypatch.setattr(ik, "solve_all", lambda *a, **kw: real(*a, **kw)[1:])
     assert not all(r.passed for r in validate.analytic_checks(ur5, 40, 0)[1:])

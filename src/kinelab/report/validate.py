@@ -156,13 +156,15 @@ def analytic_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     """Where the arm has a closed form: its branches confirmed by Pinocchio, and every FRDM, biquaternion and DLS
     answer from a random start is one of them (with the share of FRDM answers on the branch nearest the start)."""
     from kinelab.ik import solve_all
-    from kinelab.ik.analytic.classify import classify
+    from kinelab.ik.analytic.classify import classify, general_class
+    from kinelab.ik.analytic.kernel import GENERAL_6R
     from kinelab.ik.branches import SAME
     from kinelab.ik.limits import distance
 
-    if classify(robot).arm is None:
+    arm = classify(robot).arm or general_class(robot).arm
+    if arm is None:
         return _swept_checks(robot, n, seed) + completeness_checks(robot, seed)
-    form = "1-D search" if classify(robot).arm.searched else "closed form"  # type: ignore[union-attr]
+    form = "elimination" if arm.kind == GENERAL_6R else "1-D search" if arm.searched else "closed form"
     targets = _closed_form_targets(robot, n, seed)
     branches = [solve_all(robot, t, solver="analytic") for t in targets]
     rows = [Check(robot.name, f"{form}: every branch met (Pinocchio-checked)", _worst(robot, targets, branches),
@@ -190,11 +192,11 @@ def completeness_checks(robot: Robot, seed: int) -> list[Check]:
     """Where the arm has every branch (a closed form or a 1-D search, at a held joint for a 7R arm): the share of
     COMPLETENESS_POSES seeded poses whose own configuration is among the branches Pinocchio confirms, 99.9 % at
     least (a double root is met to the square root of rounding only: its misses are counted apart)."""
-    from kinelab.ik.analytic.classify import classify
+    from kinelab.ik.analytic.classify import classify, general_class
     from kinelab.ik.analytic.redundancy import has_swept_form
     from kinelab.report.bench.completeness import FOUND, own_configuration
 
-    if classify(robot).arm is None and not has_swept_form(robot):
+    if classify(robot).arm is None and general_class(robot).arm is None and not has_swept_form(robot):
         return []
     r = own_configuration(robot, COMPLETENESS_POSES, seed)
     return [Check(robot.name, f"completeness: the pose's own configuration among the branches, to {FOUND:g} rad",
@@ -209,6 +211,7 @@ def _swept_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     value of that joint, to SAME (95 % at least: an answer within the tolerances can sit at a limit whose exact
     root lies just beyond it, or near a singular shoulder several 1e-3 rad along the near-continuum)."""
     from kinelab.ik import solve_all
+    from kinelab.ik.analytic.kernel import GENERAL_6R
     from kinelab.ik.analytic.redundancy import at_value, has_swept_form, swept_arm
     from kinelab.ik.branches import SAME
     from kinelab.ik.limits import distance
@@ -217,9 +220,10 @@ def _swept_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     if not has_swept_form(robot):
         return []
     held = swept_arm(robot).joint
+    form = "elimination" if swept_arm(robot).arm.kind == GENERAL_6R else "closed form"
     targets = _closed_form_targets(robot, n, seed)
     found = [solve_all(robot, t, redundancy=16) for t in targets]
-    rows = [Check(robot.name, f"closed form, joint {held + 1} swept: every branch met (Pinocchio-checked)",
+    rows = [Check(robot.name, f"{form}, joint {held + 1} swept: every branch met (Pinocchio-checked)",
                   _worst(robot, targets, found), 1e-6, "m or rad",
                   f"{len(targets)} targets, {np.mean([len(f) for f in found]):.1f} answers each at 16 samples")]
     req = make_request("frdm")
@@ -229,7 +233,7 @@ def _swept_checks(robot: Robot, n: int, seed: int) -> list[Check]:
             solved += 1
             branches = [a[0] for a in at_value(robot, targets[k], req, float(res.q[held]))]
             on_branch += any(distance(robot, b, res.q) <= SAME for b in branches)
-        rows.append(Check(robot.name, f"{solver}: every answer is a closed-form branch at its own joint {held + 1}",
+        rows.append(Check(robot.name, f"{solver}: every answer is a {form} branch at its own joint {held + 1}",
                           on_branch / max(solved, 1), 0.95, "%", f"{solved} of {len(targets)} solved from random "
                           "starts", at_least=True))
     return rows

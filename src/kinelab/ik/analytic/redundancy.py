@@ -23,7 +23,17 @@ import pinocchio as pin
 
 from kinelab.errors import ChainError, OptionError
 from kinelab.ik.analytic.branches import Answer, Rows, arm_roots, branch_results, judged_roots, limit_slack
-from kinelab.ik.analytic.classify import AXIS_TOL, POINT_TOL, ArmClass, classify, classify_vectors
+from kinelab.ik.analytic.certify import kinematics, loop_of
+from kinelab.ik.analytic.classify import (
+    AXIS_TOL,
+    POINT_TOL,
+    ArmClass,
+    classify,
+    classify_vectors,
+    general_class,
+    general_vectors,
+)
+from kinelab.ik.analytic.kernel import GENERAL_6R
 from kinelab.ik.chain import PRISMATIC, chain_model
 from kinelab.ik.limits import distance
 from kinelab.ik.request import Request
@@ -77,35 +87,99 @@ def has_swept_form(robot: Robot) -> bool:
 
 
 def _swept(robot: Robot) -> SweptArm | str:
+    v = _chain7(robot)
+    if isinstance(v, str):
+        return v
+    reasons, held = [], []
+    for general in (False, True):  # a class at either end before the general elimination at either
+        for joint in (0, 6):
+            found = holding(v["e"], v["o"], v["R"], v["N"], joint, general)
+            if isinstance(found, SweptArm):
+                held.append(found)
+            else:
+                reasons.append(f"joint {joint + 1} held (the other six's axes numbered 1 to 6): {found}")
+        if held:  # a closed form at either end before a search
+            return min(held, key=lambda sw: (sw.arm.searched, sw.arm.kind == GENERAL_6R))
+    return "; ".join(reasons)
+
+
+def _chain7(robot: Robot) -> dict[str, np.ndarray] | str:
+    """The 7R chain's vectors at q = 0 (``e`` axes, ``o`` points, ``R``, ``N`` the tool), or why it is not one."""
     try:
         cm = chain_model(robot)
     except ChainError as err:
         return str(err)
     if cm.n != 7 or (cm.kind == PRISMATIC).any():
         return f"{cm.n} joints{', one prismatic' if (cm.kind == PRISMATIC).any() else ''} (a 7R chain is swept)"
-    v = cm.vectors(np.zeros(7))
-    reasons, held = [], []
-    for joint in (0, 6):
-        found = holding(v["e"], v["o"], v["R"], v["N"], joint)
-        if isinstance(found, SweptArm):
-            held.append(found)
-        else:
-            reasons.append(f"joint {joint + 1} held (the other six's axes numbered 1 to 6): {found}")
-    if held:  # a closed form at either end before a search
-        return min(held, key=lambda sw: sw.arm.searched)
-    return "; ".join(reasons)
+    return {k: np.array(a, dtype=float) for k, a in cm.vectors(np.zeros(7)).items()}
 
 
-def holding(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray, joint: int) -> SweptArm | str:
+def holding(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray, joint: int,
+            general: bool = False) -> SweptArm | str:
     """The 7R chain (axes h, points o at q = 0, tool R0, N0; base frame) swept at its end joint ``joint``
-    (0 or 6), or why the other six are in no class."""
+    (0 or 6), or why the other six are in no class (with ``general``: nor taken by the general elimination)."""
     keep = slice(1, 7) if joint == 0 else slice(0, 6)
-    c = classify_vectors(h[keep].copy(), o[keep].copy(), R0.copy(), N0.copy())
+    c = (general_vectors if general else classify_vectors)(h[keep].copy(), o[keep].copy(), R0.copy(), N0.copy())
     if c.arm is None:
         return c.reason
     if joint == 0:
         return SweptArm(0, c.arm, h[0].copy(), o[0].copy())
     return SweptArm(6, c.arm, R0.T @ h[6], R0.T @ (o[6] - N0))
+
+
+def fold(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray, joint: int,
+         theta: float) -> tuple[np.ndarray, ...]:
+    """The six-joint chain left when joint ``joint`` of the chain (h, o, R0, N0) is held at ``theta`` [rad]: the
+    turn M about its line moves every later axis and the tool (M·E_j(q)·M⁻¹ is the turn about M's image of line
+    j), so the six are the earlier axes as they are and the later ones, and the tool, carried by M."""
+    R = pin.exp3(theta * h[joint])
+    t = o[joint] - R @ o[joint]
+    after = np.arange(h.shape[0]) > joint
+    h6, o6 = h.copy(), o.copy()
+    h6[after], o6[after] = h[after] @ R.T, o[after] @ R.T + t
+    keep = np.arange(h.shape[0]) != joint
+    return h6[keep], o6[keep], R @ R0, R @ N0 + t
+
+
+HELD_KEPT = 64  # held (joint, value) arms kept per robot: a sweep over a middle joint builds one arm per value
+
+
+def arm_holding(robot: Robot, joint: int, theta: float) -> ArmClass | str:
+    """The arm of the six joints left when the 7R robot's joint ``joint`` is held at ``theta`` [rad] — a class,
+    else the general elimination — or why there is none."""
+    kept: dict[tuple[int, float], ArmClass | str] = robot.derived("held arms", _new_held)
+    key = (joint, float(theta))
+    if key not in kept:
+        v = _chain7(robot)
+        if isinstance(v, str):
+            return v
+        h, o, R0, N0 = fold(v["e"], v["o"], v["R"], v["N"], joint, theta)
+        found = classify_vectors(h, o, R0, N0)
+        if found.arm is None or not recovers(found.arm, h, o, R0, N0):
+            found = general_vectors(h, o, R0, N0)
+        if len(kept) >= HELD_KEPT:
+            kept.clear()
+        kept[key] = found.arm if found.arm is not None else found.reason
+    return kept[key]
+
+
+def recovers(arm: ArmClass, h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray, trials: int = 3) -> bool:
+    """True when the arm's solver finds seeded configurations of the chain (h, o, R0, N0) among the roots of their
+    own poses (to 1e-6 rad): a class whose test holds on a chain it degenerates on (a search's shoulder with a
+    third axis through its point) is caught here."""
+    loop, wide = loop_of(h, o, R0, N0), np.full(h.shape[0], np.pi)
+    for q in np.random.default_rng(1).uniform(-np.pi, np.pi, (trials, h.shape[0])):
+        R, p, _, _ = kinematics(loop, q[None])
+        H = np.eye(4)
+        H[:3, :3], H[:3, 3] = R[0], p[0]
+        roots = arm_roots(arm, H, -wide, wide, None)[0]
+        if not len(roots) or np.abs(np.arctan2(np.sin(roots - q), np.cos(roots - q))).max(axis=1).min() > 1e-6:
+            return False
+    return True
+
+
+def _new_held(_: Robot) -> dict[tuple[int, float], ArmClass | str]:
+    return {}
 
 
 def samples(lower: float, upper: float, k: int) -> np.ndarray:
@@ -129,54 +203,71 @@ def check_redundancy(k: object) -> int:
     return int(k)
 
 
-def held_values(robot: Robot, redundancy: object) -> tuple[np.ndarray, str]:
-    """The values [rad] of the swept joint that ``redundancy`` asks for, and how they read in ``mode``: K samples
-    (:func:`samples`), or the one value of ``{joint name: value}``.
+def held_values(robot: Robot, redundancy: object) -> tuple[np.ndarray, str, int]:
+    """The values [rad] of the held joint that ``redundancy`` asks for, how they read in ``mode``, and the joint's
+    index: K samples of the swept end joint (:func:`samples`), or the one value of ``{joint name: value}`` for any
+    joint of the 7R chain.
 
     Raises:
-        OptionError: K out of range, or a mapping that does not name the swept joint once with a finite value
-            within its limits (the joint and its limits named), or a chain that cannot be swept.
+        OptionError: K out of range, or a mapping that does not name one joint with a finite value within its
+            limits (the joint and its limits named), or a chain that cannot be swept (K samples) or is not 7R.
     """
-    sw = swept_arm(robot, redundancy)
-    joint = robot.joints[sw.joint]
     if not isinstance(redundancy, Mapping):
+        sw = swept_arm(robot, redundancy)
         k = check_redundancy(redundancy)
-        return samples(float(robot.lower[sw.joint]), float(robot.upper[sw.joint]), k), f"swept over {k} samples"
-    value = redundancy.get(joint.name) if len(redundancy) == 1 else None
-    lo, hi = float(robot.lower[sw.joint]), float(robot.upper[sw.joint])
+        return samples(float(robot.lower[sw.joint]), float(robot.upper[sw.joint]), k), f"swept over {k} samples", \
+            sw.joint
+    chain = _chain7(robot)
+    if isinstance(chain, str):
+        raise OptionError("redundancy", dict(redundancy), f"{{joint name: value}} for a 7R chain; {robot.name}'s is "
+                          f"not: {chain}")
+    names = [j.name for j in robot.joints]
+    named = [names.index(n) for n in redundancy if n in names] if len(redundancy) == 1 else []
+    index = named[0] if named else (swept_arm(robot).joint if has_swept_form(robot) else 0)
+    value = redundancy.get(names[index]) if named else None
+    lo, hi = float(robot.lower[index]), float(robot.upper[index])
     if isinstance(value, bool) or not isinstance(value, int | float | np.number) or not lo <= float(value) <= hi:
-        raise OptionError("redundancy", dict(redundancy), f"{{{joint.name!r}: a value in [{lo:.6g}, {hi:.6g}] rad}}, "
-                          "the joint the closed form holds, or an integer K")
-    return np.array([float(value)]), f"held at {float(value):.6g} rad"
+        raise OptionError("redundancy", dict(redundancy), f"{{{names[index]!r}: a value in [{lo:.6g}, {hi:.6g}] rad}}"
+                          " (any one joint, held at a value within its limits), or an integer K")
+    return np.array([float(value)]), f"held at {float(value):.6g} rad", index
 
 
 def at_value(robot: Robot, target: pin.SE3, req: Request, theta: float,
-             q_ref: np.ndarray | None = None) -> list[Answer]:
-    """Every branch of ``target`` with the swept joint at ``theta`` [rad] that Pinocchio confirms within the
-    limits: (q, position error [m], rotation error [rad], finished by FRDM, roots merged, one of a continuum).
+             q_ref: np.ndarray | None = None, joint: int | None = None) -> list[Answer]:
+    """Every branch of ``target`` with joint ``joint`` (None: the swept one) held at ``theta`` [rad] that Pinocchio
+    confirms within the limits: (q, position error [m], rotation error [rad], finished by FRDM, roots merged, one
+    of a continuum).
 
     Raises:
-        OptionError: the chain cannot be swept.
+        OptionError: the chain cannot be swept (``joint`` None), or the six left are solved by nothing here.
     """
-    sw = swept_arm(robot)
-    keep = np.arange(7) != sw.joint
+    if joint is None or (has_swept_form(robot) and joint == swept_arm(robot).joint):
+        sw = swept_arm(robot)
+        joint, arm, H = sw.joint, sw.arm, sw.sub_target(target.homogeneous, theta)
+    else:
+        found = arm_holding(robot, joint, theta)
+        if isinstance(found, str):
+            raise OptionError("redundancy", {robot.joints[joint].name: theta}, "a joint whose holding leaves six "
+                              f"joints kinelab solves; holding {robot.joints[joint].name} leaves: {found}")
+        arm, H = found, target.homogeneous
+    keep = np.arange(7) != joint
     ref = None if q_ref is None else q_ref[keep]
-    q6, found, free = arm_roots(sw.arm, sw.sub_target(target.homogeneous, theta), robot.lower[keep],
-                                robot.upper[keep], ref, limit_slack(req.tol_rot))
-    q = np.ascontiguousarray(np.insert(q6, sw.joint, theta, axis=1))
-    return judged_roots(robot, q, found, free, target, req, {robot.joints[sw.joint].name: theta})
+    q6, found_, free = arm_roots(arm, H, robot.lower[keep], robot.upper[keep], ref, limit_slack(req.tol_rot))
+    q = np.ascontiguousarray(np.insert(q6, joint, theta, axis=1))
+    return judged_roots(robot, q, found_, free, target, req, {robot.joints[joint].name: theta})
 
 
 def redundant_all(robot: Robot, target: pin.SE3, req: Request, redundancy: object,
                   q_ref: np.ndarray | None = None, max_solutions: int | None = None) -> Branches:
-    """Every branch of ``target`` (oMtarget, base frame) at the values of the swept joint ``redundancy`` asks for
+    """Every branch of ``target`` (oMtarget, base frame) at the values of the held joint ``redundancy`` asks for
     (:func:`held_values`), each judged by Pinocchio within the limits.
 
     Args:
-        robot: a 7R robot that :func:`swept_arm` accepts.
+        robot: a 7R robot.
         target: the pose.
         req: the validated request (task "pose").
-        redundancy: K samples of the swept joint (:func:`samples`), or ``{joint name: value}`` for one value.
+        redundancy: K samples of the swept end joint (:func:`samples`; a robot :func:`swept_arm` accepts), or
+            ``{joint name: value}`` for any one joint held at one value.
         q_ref: sort the answers by distance to this configuration; each angle's copy is picked nearest it.
         max_solutions: at most this many answers (the nearest ``q_ref`` first when given).
 
@@ -189,30 +280,49 @@ def redundant_all(robot: Robot, target: pin.SE3, req: Request, redundancy: objec
     t0 = time.perf_counter()
     if req.task.name != "pose":
         raise OptionError("task", req.task_label, "'pose' with redundancy= (other tasks: solver='frdm')")
-    values, how = held_values(robot, redundancy)
-    sw = swept_arm(robot)
+    values, how, joint = held_values(robot, redundancy)
     answers = []
     for theta in values:
-        answers += at_value(robot, target, req, float(theta), q_ref)
+        answers += at_value(robot, target, req, float(theta), q_ref, joint)
     if q_ref is not None:
         answers.sort(key=lambda a: distance(robot, a[0], q_ref))
-    search = f"; {sw.arm.method.removeprefix('every branch by a ')} of the other six" if sw.arm.searched else ""
-    mode = f"analytic ({sw.arm.name}{search}; joint {sw.joint + 1} {how})"
+    arm = swept_arm(robot).arm if has_swept_form(robot) and joint == swept_arm(robot).joint else \
+        arm_holding(robot, joint, float(values[0]))
+    mode = f"analytic ({_arm_words(arm)}; joint {joint + 1} {how})"
     return branch_results(robot, Rows.of(answers, robot.n), req, mode, time.perf_counter() - t0, max_solutions, "sweep",
                           beyond_reach(robot, target.translation)
-                          or f"no branch within the joint limits with joint {sw.joint + 1} {how}")
+                          or f"no branch within the joint limits with joint {joint + 1} {how}")
+
+
+def _arm_words(arm: ArmClass | str) -> str:
+    """The six joints' arm in ``mode``: its class and, when searched, how."""
+    if isinstance(arm, str):
+        return "the other six"
+    if arm.kind == GENERAL_6R:
+        return f"{arm.name}; algebraic elimination of the other six"
+    return arm.name + (f"; {arm.method.removeprefix('every branch by a ')} of the other six" if arm.searched else "")
 
 
 def closed_form_summary(robot: Robot) -> str:
-    """One line on the robot's closed form (``kinelab info``): its class, the joint a 7R arm holds, or none."""
+    """One line on the robot's every-branch method and how complete its sets are (``kinelab info``): its class,
+    the joint a 7R arm holds, the general 6R elimination, or none."""
     arm = classify(robot).arm
     if arm is not None:
-        return f"{arm.name}: {arm.method}"
+        return f"{arm.name}: {arm.method} ({COMPLETE['search' if arm.searched else 'closed form']})"
     if has_swept_form(robot):
         sw = swept_arm(robot)
         return (f"with joint {sw.joint + 1} ({robot.joints[sw.joint].name}) held: {sw.arm.name}, {sw.arm.method} of "
                 "the other six (solve_all(..., redundancy=K))")
-    return (f"none: no class holds to its tolerances ({AXIS_TOL:g} rad between parallel axes, {POINT_TOL:g} m between "
-            "meeting ones; a calibrated arm misses them by more) — the numeric multistart; solver='analytic' names "
-            "the failed tests")
+    none = (f"none: no class holds to its tolerances ({AXIS_TOL:g} rad between parallel axes, {POINT_TOL:g} m between "
+            "meeting ones; a calibrated arm misses them by more)")
+    general = general_class(robot).arm
+    if general is not None:
+        return f"{none}; {general.name}: {general.method} ({COMPLETE['elimination']})"
+    return f"{none} — the numeric multistart; solver='analytic' names the failed tests"
 
+
+COMPLETE = {  # how complete each method's sets are, in words (kinelab info)
+    "closed form": "certified: each branch proved a root, the set every root unless a double root is met",
+    "search": "measured complete, not proved; 16 proved branches certify a set",
+    "elimination": "certified: each branch proved a root, the eigenvalues counting every root",
+}
