@@ -50,11 +50,11 @@ HEADER = """<?xml version="1.0"?>
 
   No two axes are exactly parallel (axes 2 and 3 of the nominal arm are off by 3.4 mrad, 3 and 4 by 2.2 mrad)
   and none meet (axes 1 and 2, 4 and 5, 5 and 6 pass 0.09-0.14 mm apart): neither a closed form nor the 1-D
-  search fits; kinelab answers it by the multistart until the general 6R solver exists (#41).
+  search fits; kinelab answers it by the general 6R elimination, certified (docs/analytic.md).
   tests/robot/test_dh_arms.py checks Pinocchio's FK of this file against the table. Limits: +-360 deg, the elbow
   +-180 deg. No meshes, no inertias.
 -->
-<robot name="ur10e_calibrated">
+<robot name="{name}">
   <link name="base_link"/>
 """
 JOINT = """  <link name="link{i}"/>
@@ -77,13 +77,15 @@ def _numbers(values: np.ndarray) -> str:
     return " ".join(repr(float(v)) for v in values)
 
 
-def urdf() -> str:
-    """The file's text."""
-    rows = table()
+def urdf(rows: list[tuple[float, float, float, float]] | None = None, header: str = HEADER,
+         limits: list[tuple[float, float]] = LIMITS, name: str = "ur10e_calibrated") -> str:
+    """The text of a URDF file of the standard DH table ``rows`` (default: the calibrated UR10e), its comment
+    ``header`` (a format with {rows} and {name}), joint limits [rad] and robot name."""
+    rows = table() if rows is None else rows
     lines = "\n".join(f"    {i}   {t:+.6f}   {d:.5f}   {al:+.7f}   {a:+.5f}" for i, (t, d, al, a) in enumerate(rows, 1))
-    text = HEADER.format(rows=lines)
+    text = header.format(rows=lines, name=name)
     previous = (0.0, 0.0, 0.0, 0.0)
-    for i, (row, (lower, upper)) in enumerate(zip(rows, LIMITS, strict=True)):
+    for i, (row, (lower, upper)) in enumerate(zip(rows, limits, strict=True)):
         xyz, rpy = origin(previous, row[0])
         text += JOINT.format(i=i + 1, parent="base_link" if i == 0 else f"link{i}", xyz=_numbers(xyz),
                              rpy=_numbers(rpy), lower=lower, upper=upper)

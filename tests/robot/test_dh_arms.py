@@ -1,6 +1,6 @@
-"""The URDFs kinelab writes from published Denavit–Hartenberg tables (urdf/xarm6.urdf, urdf/crx10ia.urdf,
-urdf/ur10e_calibrated.urdf) are those tables: Pinocchio's FK of each file equals the standard DH product at seeded
-random configurations."""
+"""The URDFs kinelab writes from Denavit–Hartenberg tables (urdf/xarm6.urdf, urdf/crx10ia.urdf and
+urdf/ur10e_calibrated.urdf from published ones, urdf/general6r.urdf from its own) are those tables: Pinocchio's FK
+of each file equals the standard DH product at seeded random configurations."""
 
 import numpy as np
 import pytest
@@ -19,6 +19,9 @@ TABLES = {
                          (-1.7e-3, 0, -2.2e-3, -0.57155 - 0.33e-3),
                          (0.9e-3, 0.17415 - 0.27e-3, PI / 2 + 1.1e-3, -0.09e-3),
                          (-1.2e-3, 0.11985 + 0.15e-3, -PI / 2 - 1.9e-3, 0.14e-3), (0, 0.11655 + 0.08e-3, 0, 0)],
+    # kinelab's own general 6R arm (tools/make_general_6r.py)
+    "general6r": [(0, 0.30, 1.10, 0.08), (0.35, 0.06, -0.55, 0.52), (-0.20, -0.04, 0.80, 0.42),
+                  (0, 0.24, -1.25, 0.05), (0.10, 0.07, 0.95, 0.06), (0, 0.11, 0, 0.02)],
 }
 
 

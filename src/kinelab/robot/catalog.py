@@ -55,6 +55,8 @@ BUNDLED = (
           "FANUC CRX-10iA, 6R cuspidal cobot (up to 16 branches), from its published dimensions"),
     Entry("ur10e_calibrated", "kinelab", "ur10e_calibrated.urdf", "flange",
           "UR10e with a factory-size calibration (axes off parallel by mrad): a general 6R, no closed form"),
+    Entry("general6r", "kinelab", "general6r.urdf", "flange",
+          "kinelab's own general 6R arm: no two axes parallel or meeting (every branch by the elimination)"),
 )
 
 ERD_ARMS = (
