@@ -43,9 +43,10 @@ def add(sub: Any) -> None:
                         "multistart, the ERA, Baxter and "
                         "the Panda swept)")
     s.add_argument("--completeness", action="store_true",
-                   help="also every-branch completeness: each arm with a class on 10,000 seeded poses (its own "
-                        "configuration among the branches), against ssik's branch sets on 1,000 (pip install ssik), "
-                        "and random arms of each 1-D search class")
+                   help="also every-branch completeness: each arm with a class or the general 6R elimination on "
+                        "10,000 seeded poses (its own configuration among the branches, the certified share), against "
+                        "ssik's branch sets on 1,000 (pip install ssik), random arms of each 1-D search class and "
+                        "random general 6R arms, and 1,000 hard poses per arm (on and beside det J = 0, at a limit)")
     s.add_argument("--collisions", action="store_true",
                    help="also solve with and without collisions= around a floor and a table (panda, ur5, kinova): "
                         "time ratio with its spread, clear success, the check's own cost")

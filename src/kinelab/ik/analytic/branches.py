@@ -328,8 +328,11 @@ class BranchBatch:
         free: (B, MAX_ROWS) the branch is one of a continuum (a singular pose).
         position_error: (B, MAX_ROWS) [m] and rotation_error: (B, MAX_ROWS) [rad] of each branch, by the FK
             ``judge`` names; NaN after ``count``.
-        method: "closed form" (every branch) or "search" (the 1-D search: every branch, measured complete).
+        method: "closed form" (every branch), "search" (the 1-D search: every branch, measured complete) or
+            "elimination" (the general 6R elimination).
         judge: whose FK judged the branches.
+        uncertified: the elimination's reason per pose that its set is not certified ("" where it is); None for
+            the other methods.
     """
 
     q: np.ndarray
@@ -340,6 +343,7 @@ class BranchBatch:
     rotation_error: np.ndarray
     method: str = "closed form"
     judge: str = "Pinocchio FK"
+    uncertified: list[str] | None = None
 
 
 def all_branches_batch(robot: Robot, targets: Any, tol_pos: float = 1e-6, tol_rot: float = 1e-6) -> BranchBatch:
@@ -387,11 +391,14 @@ def _pinocchio_batch(robot: Robot, arm: ArmClass, H: np.ndarray, req: Request) -
     out = np.full((B, MAX_ROWS, n), np.nan)
     found, free = np.zeros((B, MAX_ROWS), dtype=np.int64), np.zeros((B, MAX_ROWS), dtype=np.bool_)
     count = np.zeros(B, dtype=np.int64)
+    reasons = None
     if arm.kind == GENERAL_6R:  # not compiled yet: pose by pose
+        reasons = []
         for b in range(B):
-            q, merged, loose, _ = roots_within(arm, H[b], robot.lower, robot.upper, None, limit_slack(req.tol_rot))
+            q, merged, loose, why = roots_within(arm, H[b], robot.lower, robot.upper, None, limit_slack(req.tol_rot))
             k = count[b] = len(q)
             out[b, :k], found[b, :k], free[b, :k] = q, merged, loose
+            reasons.append(why)
     else:
         branches_batch(arm.kind, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, H, robot.lower, robot.upper, SAME,
                        limit_slack(req.tol_rot), out, found, free, count)
@@ -405,7 +412,11 @@ def _pinocchio_batch(robot: Robot, arm: ArmClass, H: np.ndarray, req: Request) -
     errors[pose[ok], rank, 0], errors[pose[ok], rank, 1] = dp[ok], dr[ok]
     f, loose = np.zeros_like(found), np.zeros_like(free)
     f[pose[ok], rank], loose[pose[ok], rank] = found[pose[ok], row[ok]], free[pose[ok], row[ok]]
-    return BranchBatch(q, kept, f, loose, errors[..., 0], errors[..., 1], _method(arm), robot.fk_certificate.judge)
+    if reasons is not None:  # a root the judge refuses leaves the set uncertified
+        reasons = [why or ("" if kept[b] == count[b] else "a root the judge does not confirm")
+                   for b, why in enumerate(reasons)]
+    return BranchBatch(q, kept, f, loose, errors[..., 0], errors[..., 1], _method(arm), robot.fk_certificate.judge,
+                       reasons)
 
 
 def _constant_fields(robot: Robot, req: Request, mode: str) -> dict[str, Any]:

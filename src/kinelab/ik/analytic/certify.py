@@ -98,6 +98,8 @@ def polish(loop: Loop, q: np.ndarray, H: np.ndarray) -> np.ndarray:
         F, J = equations(loop, x, H)
         size = np.linalg.norm(F, axis=1)
         better = size < low
+        if not better.any():  # rounding reached on every row
+            break
         best[better], low[better] = x[better], size[better]
     return best
 

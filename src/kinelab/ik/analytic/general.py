@@ -213,14 +213,11 @@ def chordal_to_real(alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
 def solve(g: General6R, H: np.ndarray) -> tuple[np.ndarray, Eigen]:
     """The real roots of the pose H (4 × 4, base frame) before polishing: (m, 6) joint angles [rad] in (−π, π]
     (m ≤ 16), one per eigenvalue that may be real, and the eigenproblem."""
-    import scipy.linalg  # here: its import costs ~0.3 s, which only a general arm's first pose should pay
-
     r0, Q, Tp = _right(g, H)
     A, B, rank, pinv = _pencil(g, r0, Q)
     if rank < RANK_TOL:
         return np.empty((0, 6)), Eigen(np.empty(0), np.empty(0), np.empty(0), 0.0, rank, np.empty(0, dtype=int))
-    (alpha, beta), vl, vr = scipy.linalg.eig(A, B, left=True, right=True, homogeneous_eigvals=True,
-                                             check_finite=False)
+    alpha, beta, vl, vr = _ggev(A, B)
     kappa = _conditions(A, B, vl, vr)
     scale = float(np.hypot(np.linalg.norm(A, 2), np.linalg.norm(B, 2)))
     real = np.flatnonzero(real_root(alpha, beta, kappa, scale))
@@ -236,6 +233,27 @@ def solve(g: General6R, H: np.ndarray) -> tuple[np.ndarray, Eigen]:
     t4, t5 = _wrist(vr[:, real], x3)
     q = _shoulder_and_tool(g, r0, pinv, Tp, t3, t4, t5) + g.phi
     return np.arctan2(np.sin(q), np.cos(q)), eigen
+
+
+def _ggev(A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """LAPACK's QZ (``dggev``) of the pencil (A, B): homogeneous eigenvalues α (complex), β (real) and the left and
+    right eigenvectors as complex columns (LAPACK packs a complex pair's as two real ones)."""
+    from scipy.linalg.lapack import dggev  # here: scipy.linalg's import costs ~0.3 s, paid at a first general pose
+
+    alphar, alphai, beta, vl, vr, _, info = dggev(A, B, 1, 1)
+    if info != 0:
+        raise np.linalg.LinAlgError(f"dggev failed (info {info})")
+    return alphar + 1j * alphai, beta.astype(complex), _unpacked(vl, alphai), _unpacked(vr, alphai)
+
+
+def _unpacked(v: np.ndarray, alphai: np.ndarray) -> np.ndarray:
+    """LAPACK's real eigenvector columns as complex ones: a pair (α_j, α_j+1) with α_j's imaginary part > 0 holds
+    the real and imaginary parts of the first vector; the second is its conjugate."""
+    out = v.astype(complex)
+    for j in np.flatnonzero(alphai > 0):
+        out[:, j] = v[:, j] + 1j * v[:, j + 1]
+        out[:, j + 1] = v[:, j] - 1j * v[:, j + 1]
+    return out
 
 
 def _conditions(A: np.ndarray, B: np.ndarray, vl: np.ndarray, vr: np.ndarray) -> np.ndarray:

@@ -26,7 +26,7 @@ from tqdm import tqdm
 
 from kinelab.geometry import wrap_to_pi
 from kinelab.ik.analytic.branches import all_branches_batch, arm_roots
-from kinelab.ik.analytic.classify import classify, classify_vectors
+from kinelab.ik.analytic.classify import classify, classify_vectors, general_class
 from kinelab.ik.analytic.redundancy import at_value, has_swept_form, swept_arm
 from kinelab.ik.request import make_request
 from kinelab.robot import Robot, load
@@ -34,38 +34,70 @@ from kinelab.robot import Robot, load
 FOUND = 1e-6  # [rad] the pose's own configuration is a branch to this
 NEAR = 1e-4  # [rad] a miss nearer than this is a double root met to rounding's square root
 SAME_SET = 1e-6  # [rad] two answers this close are one
-ROBOTS = ("ur5", "ur10", "kinova", "z1", "xarm6", "crx10ia", "panda", "baxter_left")
+ROBOTS = ("ur5", "ur10", "kinova", "z1", "xarm6", "crx10ia", "ur10e_calibrated", "general6r", "panda", "baxter_left")
+HARD = ("xarm6", "crx10ia", "ur10e_calibrated", "general6r")  # the arms the hard poses are built for
+HELD = (("tiago_pro", (0, 1, 2, 3, 4, 5, 6)), ("panda", (3,)), ("xarm7", (3,)))  # 7R arms and the joints held
 
 
 def own_configuration(robot: Robot, n: int, seed: int) -> dict[str, Any]:
     """The share of n seeded poses whose own configuration is among the branches (6R arms: the batch; 7R arms:
-    the branches at the held joint's own value), and the misses' nearest distances."""
+    the branches at the held joint's own value), the share whose set is certified complete, the misses' nearest
+    distances, and every missed pose's q."""
     Q = robot.random_qs(n, np.random.default_rng(seed))
     t0 = time.perf_counter()
-    if classify(robot).arm is not None:
+    if (arm := _six(robot)) is not None:
         batch = all_branches_batch(robot, robot.fk_batch(Q))
         gaps = np.nanmin(np.abs(wrap_to_pi(batch.q - Q[:, None, :])).max(axis=2), axis=1, initial=np.inf,
                          where=~np.isnan(batch.q[:, :, 0]))
         counts = batch.count
+        elapsed = time.perf_counter() - t0
+        certified = _certified(robot, arm, Q, batch)
     else:
         sw, req = swept_arm(robot), make_request("frdm")
         found = [at_value(robot, robot.fk(q), req, float(q[sw.joint])) for q in Q]
         gaps = np.array([min((float(np.abs(wrap_to_pi(a[0] - q)).max()) for a in f), default=np.inf)
                          for f, q in zip(found, Q, strict=True)])
         counts = np.array([len(f) for f in found])
-    elapsed = time.perf_counter() - t0
+        elapsed, certified = time.perf_counter() - t0, None
     missed = gaps > FOUND
     return {"robot": robot.name, "method": _method(robot), "poses": n, "found": float(1 - missed.mean()),
             "misses": int(missed.sum()), "near_misses": int((missed & (gaps <= NEAR)).sum()),
+            "certified": certified, "missed": [{"q": Q[k].tolist(), "nearest": float(gaps[k])}
+                                               for k in np.flatnonzero(missed)],
             "branches_mean": float(np.mean(counts)), "branches_max": int(np.max(counts)), "seconds": elapsed}
 
 
+def _six(robot: Robot) -> Any:
+    """The 6R arm's class or general elimination, None for a 7R arm swept."""
+    return classify(robot).arm or (general_class(robot).arm if not has_swept_form(robot) else None)
+
+
+def _certified(robot: Robot, arm: Any, Q: np.ndarray, batch: Any) -> float:
+    """The share of the poses of Q whose set of branches (``batch``) is certified complete, by the arm's own
+    certificate (docs/analytic.md, Certificates)."""
+    from kinelab.ik.analytic.branches import robot_loop
+    from kinelab.ik.analytic.certify import search_certificate, set_certificate
+
+    if batch.uncertified is not None:  # the elimination said it per pose
+        return sum(why == "" for why in batch.uncertified) / Q.shape[0]
+    loop, certified = robot_loop(robot), 0
+    H = robot.fk_batch(Q)
+    for b in range(Q.shape[0]):
+        k = int(batch.count[b])
+        check = search_certificate if arm.searched else set_certificate
+        certified += check(loop, H[b], batch.q[b, :k], batch.found[b, :k], batch.free[b, :k])[0] == "certified"
+    return certified / Q.shape[0]
+
+
 def _method(robot: Robot) -> str:
-    arm = classify(robot).arm
+    arm = _six(robot)
     if arm is not None:
-        return arm.mode
+        return str(arm.mode)
     sw = swept_arm(robot)
     return f"joint {sw.joint + 1} held: {sw.arm.mode}"
+
+
+SSIK_GENERAL = 100  # poses against ssik for an arm of the general elimination: ssik's own route there takes seconds
 
 
 def against_ssik(robot: Robot, n: int, seed: int) -> dict[str, Any] | None:
@@ -75,8 +107,12 @@ def against_ssik(robot: Robot, n: int, seed: int) -> dict[str, Any] | None:
         import ssik
     except ImportError:
         return None
-    if classify(robot).arm is None or robot.urdf_path is None:
+    if _six(robot) is None or robot.urdf_path is None:
         return None
+    from kinelab.ik.analytic.kernel import GENERAL_6R
+
+    if _six(robot).kind == GENERAL_6R:
+        n = min(n, SSIK_GENERAL)
     peer = ssik.Manipulator.from_urdf(str(robot.urdf_path), base=robot.base, ee=robot.tool)
     rng = np.random.default_rng(seed + 1)
     equal, differences, t_ours, t_peer = 0, [], 0.0, 0.0
@@ -147,6 +183,22 @@ def random_search_arm(rng: np.random.Generator, pair: int, shoulder: int) -> tup
     return h, o, pin.SE3(pin.exp3(rng.normal(size=3)), rng.uniform(-0.4, 0.4, 3))
 
 
+def random_general_arm(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, pin.SE3]:
+    """Axes (6, 3), points on them (6, 3) [m] at q = 0 and a tool pose of a random general 6R arm: every axis
+    direction uniform on the sphere, every point uniform in a 0.8 m cube, no two axes parallel or meeting (to
+    1e-3 rad and 1e-3 m: redrawn otherwise), the tool at a random pose."""
+    from kinelab.ik.analytic.classify import line_distance
+
+    while True:
+        h = rng.normal(size=(6, 3))
+        h /= np.linalg.norm(h, axis=1)[:, None]
+        o = rng.uniform(-0.4, 0.4, (6, 3))
+        pairs = [(i, j) for i in range(6) for j in range(i + 1, 6)]
+        if all(np.linalg.norm(np.cross(h[i], h[j])) > 1e-3 and line_distance(o[i], h[i], o[j], h[j]) > 1e-3
+               for i, j in pairs):
+            return h, o, pin.SE3(pin.exp3(rng.normal(size=3)), rng.uniform(-0.4, 0.4, 3))
+
+
 def poe(h: np.ndarray, o: np.ndarray, tool: pin.SE3, q: np.ndarray) -> np.ndarray:
     """The 4 × 4 tool pose of the chain (axes h through points o at q = 0, tool pose ``tool``) at q [rad]."""
     M = np.eye(4)
@@ -158,27 +210,90 @@ def poe(h: np.ndarray, o: np.ndarray, tool: pin.SE3, q: np.ndarray) -> np.ndarra
     return np.asarray(M @ tool.homogeneous)
 
 
+def held_joint(robot: Robot, joint: int, n: int, seed: int) -> dict[str, Any]:
+    """n seeded poses of a 7R arm with joint ``joint`` held at the pose's own value: the share whose own
+    configuration is among the branches, the poses refused (the six left solved by nothing here at that value),
+    and every miss's q."""
+    from kinelab.errors import OptionError
+
+    Q, req = robot.random_qs(n, np.random.default_rng(seed + joint)), make_request("frdm")
+    found = refused = 0
+    missed: list[dict[str, Any]] = []
+    t0 = time.perf_counter()
+    for q in Q:
+        try:
+            answers = at_value(robot, robot.fk(q), req, float(q[joint]), None, joint)
+        except OptionError:
+            refused += 1
+            continue
+        gap = min((float(np.abs(wrap_to_pi(a[0] - q)).max()) for a in answers), default=np.inf)
+        found += gap <= FOUND
+        if gap > FOUND:
+            missed.append({"q": q.tolist(), "nearest": gap})
+    return {"robot": robot.name, "joint": joint + 1, "poses": n, "found": found / n, "refused": refused,
+            "missed": missed, "seconds": time.perf_counter() - t0}
+
+
+def random_general(arms: int, poses: int, seed: int) -> dict[str, Any]:
+    """``arms`` random general 6R arms (:func:`random_general_arm`) × ``poses`` seeded configurations in (−π, π]⁶:
+    the share whose own configuration is among the elimination's roots (no limits), the certified share, the arms
+    the elimination refuses, and every missed pose (arm index, q)."""
+    from kinelab.ik.analytic.classify import general_vectors
+    from kinelab.ik.analytic.general import roots_within
+
+    rng = np.random.default_rng(seed + 100)
+    found = certified = total = refused = 0
+    missed: list[dict[str, Any]] = []
+    wide = np.full(6, 10.0)
+    for index in range(arms):
+        h, o, tool = random_general_arm(rng)
+        arm = general_vectors(h, o, tool.rotation, tool.translation).arm
+        if arm is None:
+            refused += 1
+            continue
+        for _ in range(poses):
+            q = rng.uniform(-np.pi, np.pi, 6)
+            Q, _, _, reason = roots_within(arm, poe(h, o, tool, q), -wide, wide, None, 1e-6)
+            gap = float(np.abs(wrap_to_pi(Q - q)).max(axis=1).min()) if len(Q) else np.inf
+            total, found, certified = total + 1, found + (gap <= FOUND), certified + (reason == "")
+            if gap > FOUND:
+                missed.append({"arm": index, "q": q.tolist(), "nearest": gap, "reason": reason})
+    return {"arms": arms, "refused": refused, "poses": total, "found": found / max(total, 1),
+            "certified": certified / max(total, 1), "missed": missed}
+
+
 def run(robots: list[str] | None = None, n: int = 10_000, peer_n: int = 1000, arms: int = 30, arm_poses: int = 300,
-        seed: int = 0, progress: bool = False) -> dict[str, Any]:
-    """Every measure for the arms asked for (default ROBOTS) and the random arms."""
+        seed: int = 0, progress: bool = False, hard: int = 1000, general_poses: int = 1000,
+        held_poses: int = 1000) -> dict[str, Any]:
+    """Every measure for the arms asked for (default ROBOTS), the random arms of each search class and random
+    general arms, ``hard`` poses per arm of HARD (:mod:`kinelab.report.bench.hard_poses`) and ``held_poses`` per
+    joint of HELD."""
+    from kinelab.report.bench import hard_poses
+
     names = list(robots or ROBOTS)
-    own, peers = [], []
+    own, peers, built = [], [], []
     for name in tqdm(names, desc="bench --completeness", disable=not progress, unit="arm"):
         robot = load(name)
-        if classify(robot).arm is None and not has_swept_form(robot):
+        if _six(robot) is None and not has_swept_form(robot):
             continue
         own.append(own_configuration(robot, n, seed))
         if peer_n and (found := against_ssik(robot, peer_n, seed)) is not None:
             peers.append(found)
-    return {"own": own, "ssik": peers, "random": random_arms(arms, arm_poses, seed)}
+        if hard and name in HARD:
+            built.append(hard_poses.measure(robot, hard, seed))
+    held = [held_joint(load(name), joint, held_poses, seed) for name, joints in HELD for joint in joints
+            if held_poses and (robots is None or name in robots)]
+    return {"own": own, "ssik": peers, "random": random_arms(arms, arm_poses, seed),
+            "general": random_general(arms, general_poses, seed), "hard": built, "held": held}
 
 
 def markdown(result: dict[str, Any]) -> str:
     """The three tables."""
-    lines = ["| arm | method | poses | own configuration found | misses (double roots) | branches mean / max |",
-             "|---|---|---|---|---|---|"]
+    lines = ["| arm | method | poses | own configuration found | misses (double roots) | certified complete | "
+             "branches mean / max |", "|---|---|---|---|---|---|---|"]
     lines += [f"| {r['robot']} | {r['method']} | {r['poses']:,} | {100 * r['found']:.3f} % | {r['misses']} "
-              f"({r['near_misses']}) | {r['branches_mean']:.2f} / {r['branches_max']} |" for r in result["own"]]
+              f"({r['near_misses']}) | {_share(r.get('certified'))} | {r['branches_mean']:.2f} / "
+              f"{r['branches_max']} |" for r in result["own"]]
     if result["ssik"]:
         lines += ["", "| arm | poses | branch sets equal to ssik's | differences (kinelab, ssik) | kinelab | ssik |",
                   "|---|---|---|---|---|---|"]
@@ -190,4 +305,42 @@ def markdown(result: dict[str, Any]) -> str:
               "|---|---|---|---|"]
     lines += [f"| {r['class']} | {r['poses']:,} | {100 * r['found']:.3f} % | {r['misses']} ({r['near_misses']}) |"
               for r in result["random"]]
+    if result.get("general"):
+        g = result["general"]
+        lines += ["", "| random general 6R arms | poses | own configuration found | certified complete | refused |",
+                  "|---|---|---|---|---|",
+                  f"| {g['arms']} arms | {g['poses']:,} | {100 * g['found']:.3f} % | {100 * g['certified']:.2f} % | "
+                  f"{g['refused']} |"]
+    lines += _hard_lines(result.get("hard", []))
+    if result.get("held"):
+        lines += ["", "| 7R arm | joint held | poses | own configuration found | refused (no solver for the six) |",
+                  "|---|---|---|---|---|"]
+        lines += [f"| {r['robot']} | {r['joint']} | {r['poses']:,} | {100 * r['found']:.3f} % | {r['refused']} |"
+                  for r in result["held"]]
+    missed = [(r["robot"], m) for r in result["own"] for m in r.get("missed", [])]
+    if missed:
+        lines += ["", "Missed poses (arm: own configuration q, nearest branch):"]
+        lines += [f"- {name}: q = ({', '.join(f'{v:.6f}' for v in m['q'])}), {m['nearest']:.1e} rad"
+                  for name, m in missed[:50]]
     return "\n".join(lines)
+
+
+def _share(value: float | None) -> str:
+    return "—" if value is None else f"{100 * value:.2f} %"
+
+
+def _hard_lines(rows: list[dict[str, Any]]) -> list[str]:
+    """The hard poses' table: per arm and kind, the own configuration found, answered by a neighbouring root only,
+    certified and uncertified sets, and the failures (not found, certified or a neighbour's)."""
+    if not rows:
+        return []
+    lines = ["", "| arm | hard poses | own configuration found | only a neighbour root | certified | said "
+             "uncertified |", "|---|---|---|---|---|---|"]
+    for r in rows:
+        lines += [f"| {r['robot']} | {kind}: {k['poses']} | {k['own']} | {k['neighbour']} | {k['certified']} | "
+                  f"{k['uncertified']} |" for kind, k in r["kinds"].items()]
+    for r in rows:
+        lines += [f"- {r['robot']} ({f['kind']}): q = ({', '.join(f'{v:.6f}' for v in f['q'])}), nearest answer "
+                  f"{f['nearest']:.1e} rad, {'certified' if f['certified'] else 'uncertified'}"
+                  for f in r["failures"][:20]]
+    return lines
