@@ -24,8 +24,8 @@ from kinelab.core import threads
 from kinelab.core._analytic import ClosedForm
 from kinelab.core._joints import turn_distances
 from kinelab.errors import ConfigurationError, OptionError
-from kinelab.geometry import pose_errors, stack_homogeneous
-from kinelab.ik.analytic.certify import Loop, loop_of, search_certificate, set_certificate
+from kinelab.geometry import pose_errors, stack_homogeneous, turns_into
+from kinelab.ik.analytic.certify import Loop, loop_of, search_certificate, set_certificate, split_merged
 from kinelab.ik.analytic.classify import ArmClass, classify, general_class
 from kinelab.ik.analytic.general import roots_within
 from kinelab.ik.analytic.kernel import GENERAL_6R, MAX_ROWS, branches, branches_batch
@@ -118,13 +118,17 @@ def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | No
     arm = arm_of(robot, req)
     form = prepared_form(robot, req)
     compiled = None if form is None else form.solve(target.homogeneous, q_ref)
+    if compiled is not None and ((compiled[3] > 1) & ~compiled[4]).any():
+        compiled = None  # roots merged: perhaps two beside a fold, which the root-by-root route splits
     uncertified = "" if arm.kind == GENERAL_6R else None
-    if compiled is None:  # no certified compiled FK, or a root to finish: root by root
+    if compiled is None:  # no certified compiled FK, a root to finish or roots merged: root by root
         if arm.kind == GENERAL_6R:
             q, found, free, uncertified = roots_within(arm, target.homogeneous, robot.lower, robot.upper, q_ref,
                                                        limit_slack(req.tol_rot))
         else:
-            q, found, free = roots(robot, arm, target.homogeneous, q_ref, limit_slack(req.tol_rot))
+            q, found, free = split_merged(robot_loop(robot), target.homogeneous,
+                                          *roots(robot, arm, target.homogeneous, q_ref, limit_slack(req.tol_rot)))
+            q, found, free = _inside(robot, q, found, free, limit_slack(req.tol_rot))
         rows = Rows.of(judged_roots(robot, q, found, free, target, req), robot.n)
         if uncertified == "" and len(rows.q) < len(q):
             uncertified = "a root the judge does not confirm"
@@ -136,6 +140,17 @@ def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | No
     return branch_results(robot, rows, req, arm.mode, time.perf_counter() - t0, max_solutions, _method(arm),
                           beyond_reach(robot, target.translation)
                           or f"no branch within the joint limits ({arm.method})", uncertified, target.homogeneous)
+
+
+def _inside(robot: Robot, q: np.ndarray, found: np.ndarray, free: np.ndarray,
+            slack: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The rows of q within the limits, each angle turned into them where it can be and clipped when ``slack`` [rad]
+    past a limit (a root split beside a fold can land a hair past one); the others dropped."""
+    if not len(q):
+        return q, found, free
+    x = turns_into(q, np.broadcast_to(robot.lower, q.shape), np.broadcast_to(robot.upper, q.shape))
+    keep = ((x >= robot.lower - slack) & (x <= robot.upper + slack)).all(axis=1)
+    return np.clip(x[keep], robot.lower, robot.upper), found[keep], free[keep]
 
 
 def _method(arm: ArmClass) -> str:
@@ -498,7 +513,10 @@ class EveryBranch(OneCall):
 
     def _made(self, q: np.ndarray, dp: np.ndarray, dr: np.ndarray, merged: np.ndarray, continuum: np.ndarray,
               wall_time: float) -> Branches:
-        """The set of one pose's branches from the compiled form's arrays (q (k, n) [rad], errors [m, rad])."""
+        """The set of one pose's branches from the compiled form's arrays (q (k, n) [rad], errors [m, rad]); None
+        where roots were merged (perhaps two beside a fold: the general route splits them)."""
+        if ((merged > 1) & ~continuum).any():
+            return None  # type: ignore[return-value]
         made = Branches.of_rows(q, dp, dr, self._row, (q, dp, dr, merged, continuum, wall_time), self.method,
                                 self.unseen)
         made.certified_by(partial(_CERTIFICATES[self.method], self.loop, self.pose, q, merged, continuum))

@@ -20,6 +20,9 @@ import numpy as np
 
 F_MARGIN = 1e-12  # rounding allowance on each component of F (scaled units) and on F′'s singular values
 MAX_STEPS = 6  # Newton steps at most when polishing
+SPLIT = 5e-8  # [rad] two roots beside a fold at least this far apart are two
+F_ROUNDING = 1e-14  # a bound on the rounding of F's components (scaled units): beside a fold of curvature c the two
+# roots are told apart only when σ² > 2|c|·F_ROUNDING, i.e. farther apart than ~2√(2·F_ROUNDING/|c|)
 
 
 @dataclass(frozen=True, eq=False)
@@ -169,3 +172,47 @@ def search_certificate(loop: Loop | None, H: np.ndarray, q: np.ndarray, merged: 
         return "search", (f"the 1-D search is measured complete, not proved ({q.shape[0]} branches; {MOST_ROOTS} "
                           "proved ones would be)")
     return set_certificate(loop, H, q, merged, continuum)
+
+
+def beside_fold(loop: Loop, x: np.ndarray, H: np.ndarray,
+                within: float = 1e-5) -> tuple[np.ndarray, np.ndarray] | None:
+    """The two real roots beside x (6,) [rad] along F′'s most nearly singular direction, polished and SPLIT apart,
+    or None (x is a double root to rounding, or the pair beside it is complex). With J v = σ u the smallest singular
+    pair, the equations along v are, on u, uᵀF(x + t·v) ≈ uᵀF(x) + σt + ½ct² with c = uᵀF″(v, v) (a central
+    difference): its two roots t give the two starting points (one is x itself when x is already one of them).
+    Where σ² ≤ 2|c|·F_ROUNDING the two are closer than rounding can tell (about 3e-6 rad at c = 0.01): None; so
+    is a pair not both within ``within`` [rad] of x (the model led to a root elsewhere)."""
+    F, J = equations(loop, x[None], H)
+    U, sigma, Vt = np.linalg.svd(J[0])
+    u, v, s = U[:, -1], Vt[-1], float(sigma[-1])
+    step = 1e-3
+    ahead, back = equations(loop, np.array([x + step * v, x - step * v]), H)[0]
+    c = float(u @ (ahead - 2 * F[0] + back)) / step**2
+    disc = s * s - 2 * c * float(u @ F[0])
+    if c == 0 or disc < 0 or s * s <= 2 * abs(c) * F_ROUNDING:  # complex, or closer than rounding can tell
+        return None
+    t = (-s + np.array([1.0, -1.0]) * np.sqrt(disc)) / c
+    two = polish(loop, x + t[:, None] * v, H)
+    apart = _gap(two[0], two[1]) > SPLIT
+    return (two[0], two[1]) if apart and max(_gap(two[0], x), _gap(two[1], x)) <= within else None
+
+
+def _gap(a: np.ndarray, b: np.ndarray) -> float:
+    """The largest joint difference [rad] of two configurations, modulo 2π."""
+    return float(np.abs(np.arctan2(np.sin(a - b), np.cos(a - b))).max())
+
+
+def split_merged(loop: Loop | None, H: np.ndarray, q: np.ndarray, merged: np.ndarray,
+                 continuum: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A closed form's or a search's roots (q (m, 6) [rad], roots merged into each, one-of-a-continuum flags) with
+    each merged row that is two close real roots (:func:`beside_fold`) given back as those two: roots closer than
+    the kernels' merging distance are merged there, which beside a fold is two roots answered as one."""
+    if loop is None or not ((merged > 1) & ~continuum).any():
+        return q, merged, continuum
+    rows, counts, flags = [], [], []
+    for k in range(q.shape[0]):
+        pair = beside_fold(loop, q[k], H) if merged[k] > 1 and not continuum[k] else None
+        rows += [q[k]] if pair is None else list(pair)
+        counts += [int(merged[k])] if pair is None else [1, 1]
+        flags += [bool(continuum[k])] * (1 if pair is None else 2)
+    return np.array(rows), np.array(counts, dtype=np.int64), np.array(flags, dtype=np.bool_)

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinelab.geometry import turns_into
-from kinelab.ik.analytic.certify import Loop, Proof, equations, kantorovich, kinematics, polish
+from kinelab.ik.analytic.certify import Loop, Proof, beside_fold, kantorovich, kinematics, polish
 
 SPURIOUS = 8  # eigenvalues at x₃ = ±i that every pose's determinant carries: (1 + x₃²)⁴
 SPURIOUS_TOL = 1e-6  # [chordal] an eigenvalue this close to ±i is one of them (found within ~1e-13; a root nearer
@@ -351,37 +351,20 @@ def every_root(g: General6R, loop: Loop, H: np.ndarray) -> Found:
 
 
 def split_pairs(loop: Loop, q: np.ndarray, H: np.ndarray) -> np.ndarray:
-    """q (m, 6) [rad] with each pair of rows that coincide (to 1e-9 rad) where F′ is nearly singular moved to the two
-    real roots beside them when there are two: a close pair that the eigenvalues saw as a complex pair gives one
-    point between its roots. Along F′'s null direction v the equations are F(x + t·v) ≈ F(x) + ½t²·F″(v, v) on
-    the left null direction u, so t = ±√(−2uᵀF / uᵀF″(v, v)); both are polished by Newton's method and kept when
-    they come out distinct."""
+    """q (m, 6) [rad] with each pair of rows that coincide (to 1e-9 rad) moved to the two real roots beside them when
+    there are two (:func:`~kinelab.ik.analytic.certify.beside_fold`): a close pair that the eigenvalues saw as a
+    complex pair gives one point between its roots."""
     out = np.array(q, dtype=float)
     used: set[int] = set()
     for i in range(out.shape[0]):
         for j in range(i + 1, out.shape[0]):
             if i in used or j in used or np.abs(_wrapped(out[i] - out[j])).max() > 1e-9:
                 continue
-            pair = _beside_fold(loop, out[i], H)
+            pair = beside_fold(loop, out[i], H)
             if pair is not None:
                 out[i], out[j] = pair
                 used |= {i, j}
     return out
-
-
-def _beside_fold(loop: Loop, x: np.ndarray, H: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-    """The two real roots either side of x along F′'s null direction (polished, distinct), or None."""
-    F, J = equations(loop, x[None], H)
-    U, sigma, Vt = np.linalg.svd(J[0])
-    u, v = U[:, -1], Vt[-1]
-    step = 1e-3
-    ahead, back = equations(loop, np.array([x + step * v, x - step * v]), H)[0]
-    curve = float(u @ (ahead - 2 * F[0] + back)) / step**2
-    if curve == 0 or -2 * float(u @ F[0]) / curve <= 0:
-        return None
-    t = np.sqrt(-2 * float(u @ F[0]) / curve)
-    two = polish(loop, np.array([x + t * v, x - t * v]), H)
-    return (two[0], two[1]) if np.abs(_wrapped(two[0] - two[1])).max() > 1e-9 else None
 
 
 def _wrapped(d: np.ndarray) -> np.ndarray:

@@ -334,11 +334,11 @@ def _hard_lines(rows: list[dict[str, Any]]) -> list[str]:
     certified and uncertified sets, and the failures (not found, certified or a neighbour's)."""
     if not rows:
         return []
-    lines = ["", "| arm | hard poses | own configuration found | only a neighbour root | certified | said "
-             "uncertified |", "|---|---|---|---|---|---|"]
+    lines = ["", "| arm | hard poses | own configuration found | answered by a merged root (found ≥ 2) | silently "
+             "by a neighbour | certified | said uncertified |", "|---|---|---|---|---|---|---|"]
     for r in rows:
-        lines += [f"| {r['robot']} | {kind}: {k['poses']} | {k['own']} | {k['neighbour']} | {k['certified']} | "
-                  f"{k['uncertified']} |" for kind, k in r["kinds"].items()]
+        lines += [f"| {r['robot']} | {kind}: {k['poses']} | {k['own']} | {k['merged']} | {k['neighbour']} | "
+                  f"{k['certified']} | {k['uncertified']} |" for kind, k in r["kinds"].items()]
     for r in rows:
         lines += [f"- {r['robot']} ({f['kind']}): q = ({', '.join(f'{v:.6f}' for v in f['q'])}), nearest answer "
                   f"{f['nearest']:.1e} rad, {'certified' if f['certified'] else 'uncertified'}"

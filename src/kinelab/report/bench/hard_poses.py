@@ -11,8 +11,9 @@ Each pose is solved by :func:`kinelab.solve_all`. The pose's own configuration m
 FOUND_EXACT rad beside the surface and at a limit (its roots are simple there), to FOUND_HARD on it (a double root
 is met to about the square root of rounding) — or the set must say it is not certified
 (``complete`` other than "certified", with its reason). A certified set that lacks it is a failure. An own
-configuration answered only by a neighbouring root (within FOUND_HARD but not FOUND_EXACT: two roots returned as
-one) is counted apart, certified or not.
+configuration answered only by a neighbouring root (within FOUND_HARD but not FOUND_EXACT) is counted apart: as
+"merged" when that answer says it stands for two roots (``diagnostics.found`` ≥ 2: a pair closer than rounding can
+tell apart, docs/analytic.md), else as a failure (two roots silently returned as one).
 """
 
 from __future__ import annotations
@@ -88,19 +89,22 @@ def measure(robot: Robot, n: int, seed: int) -> dict[str, Any]:
     t0 = time.perf_counter()
     for kind, q in poses(robot, n, seed):
         found = solve_all(robot, robot.fk(q))
-        row = kinds.setdefault(kind, {"poses": 0, "own": 0, "neighbour": 0, "certified": 0, "uncertified": 0,
-                                      "reasons": {}})
+        row = kinds.setdefault(kind, {"poses": 0, "own": 0, "merged": 0, "neighbour": 0, "certified": 0,
+                                      "uncertified": 0, "reasons": {}})
         row["poses"] += 1
-        gap = float(np.abs(wrap_to_pi(found.q - q)).max(axis=1).min()) if len(found) else np.inf
+        gaps = np.abs(wrap_to_pi(found.q - q)).max(axis=1) if len(found) else np.array([np.inf])
+        gap = float(gaps.min())
         own = gap <= (FOUND_HARD if kind.startswith("0 rad") else FOUND_EXACT)
         row["own"] += own
-        row["neighbour"] += not own and gap <= FOUND_HARD
+        said = not own and gap <= FOUND_HARD and (found[int(np.argmin(gaps))].diagnostics.found or 1) > 1
+        row["merged"] += said  # answered by a root that says it stands for two (diagnostics.found)
+        row["neighbour"] += not own and gap <= FOUND_HARD and not said  # and silently
         certified = found.complete == "certified"
         row["certified" if certified else "uncertified"] += 1
         if not certified:
             reason = found.complete_reason.split(" (")[0]
             row["reasons"][reason] = row["reasons"].get(reason, 0) + 1
-        if not own and (certified or gap <= FOUND_HARD):
+        if not own and (certified or (gap <= FOUND_HARD and not said)):
             failures.append({"kind": kind, "q": q.tolist(), "nearest": gap, "certified": certified})
     return {"robot": robot.name, "poses": n, "kinds": kinds, "failures": failures,
             "seconds": time.perf_counter() - t0}
