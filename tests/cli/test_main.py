@@ -61,7 +61,8 @@ def test_info_names_the_closed_form_the_search_or_the_joint_a_7r_arm_holds(capsy
     assert lines["panda"].startswith("branches: with joint 7 (panda_joint7) held: ")
     assert "redundancy=K" in lines["panda"] and lines["youbot"].startswith("branches: none")
     assert lines["xarm6"] == ("branches: 6R, axes 2, 3 parallel, axes 4, 5 meeting: every branch by a 1-D search "
-                              "over joint 6 (measured complete, not proved; 16 proved branches certify a set)")
+                              "over joint 6 (measured complete; certified by 16 proved branches, or where the general "
+                              "elimination takes the chain by its certified set)")
     assert lines["baxter_left"].startswith("branches: with joint 1 (left_s0) held: ") and "1-D search" in \
         lines["baxter_left"]
 

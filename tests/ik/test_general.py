@@ -148,6 +148,18 @@ def test_the_crx_sixteen_branch_pose_is_certified_by_its_count():
     assert len(fewer) < 16 and fewer.complete == "search" and "measured complete" in fewer.complete_reason
 
 
+def test_the_xarm6_search_sets_are_certified_by_the_elimination_and_the_crx_ones_are_not():
+    """Where the general elimination takes a search class's chain (the xArm6's, read from the tool) a search's set
+    is certified when the elimination's certified set is the same; the CRX's chain it does not take."""
+    xarm, crx = kinelab.load("xarm6"), kinelab.load("crx10ia")
+    rng = np.random.default_rng(12)
+    for q in xarm.random_qs(8, rng):
+        found = kinelab.solve_all(xarm, xarm.fk(q))
+        assert found.method == "search" and found.complete == "certified"
+    found = kinelab.solve_all(crx, crx.fk(crx.random_q(rng)))
+    assert found.complete == "search" and "measured complete" in found.complete_reason
+
+
 def test_the_elimination_on_the_xarm6_chain_agrees_with_its_1d_search():
     """The xArm6 is a 1-D search class; the elimination takes its chain read from the tool, certified: the two sets
     are equal on every pose where the elimination's is certified."""

@@ -24,9 +24,16 @@ from kinelab.core import threads
 from kinelab.core._analytic import ClosedForm
 from kinelab.core._joints import turn_distances
 from kinelab.errors import ConfigurationError, OptionError
-from kinelab.geometry import pose_errors, stack_homogeneous, turns_into
-from kinelab.ik.analytic.certify import Loop, loop_of, search_certificate, set_certificate, split_merged
-from kinelab.ik.analytic.classify import ArmClass, classify, general_class
+from kinelab.geometry import pose_errors, stack_homogeneous, turns_into, wrap_to_pi
+from kinelab.ik.analytic.certify import (
+    Loop,
+    kantorovich,
+    loop_of,
+    search_certificate,
+    set_certificate,
+    split_merged,
+)
+from kinelab.ik.analytic.classify import ArmClass, classify, general_class, general_vectors
 from kinelab.ik.analytic.general import roots_within
 from kinelab.ik.analytic.kernel import GENERAL_6R, MAX_ROWS, branches, branches_batch
 from kinelab.ik.batch import BatchIKResult
@@ -257,13 +264,44 @@ def branch_results(robot: Robot, rows: Rows, req: Request, mode: str, elapsed: f
                                 unseen)
     if uncertified is not None:
         return made.certified_by(("certified", "") if uncertified == "" else ("search", uncertified))
-    if method in _CERTIFICATES and H is not None:
-        return made.certified_by(partial(_CERTIFICATES[method], robot_loop(robot), H, rows.q, rows.merged,
-                                         rows.continuum))
+    if method in ("closed form", "search") and H is not None:
+        return made.certified_by(partial(certificate_of, robot, method, H, rows.q, rows.merged, rows.continuum))
     return made
 
 
-_CERTIFICATES = {"closed form": set_certificate, "search": search_certificate}
+def certificate_of(robot: Robot, method: str, H: np.ndarray, q: np.ndarray, merged: np.ndarray,
+                   continuum: np.ndarray) -> tuple[str, str]:
+    """(complete, reason) of a closed form's or a search's set q (k, 6) [rad] of the pose H (docs/analytic.md,
+    Certificates). A search's set short of 16 proved branches is certified when the general elimination takes the
+    chain (the xArm6's, read from the tool) and its set, certified, is the same to 1e-6 rad."""
+    loop = robot_loop(robot)
+    if method == "closed form":
+        return set_certificate(loop, H, q, merged, continuum)
+    level, reason = search_certificate(loop, H, q, merged, continuum)
+    check = robot.derived("elimination cross-check", _elimination)
+    if level == "certified" or check is None:
+        return level, reason
+    theirs, _, _, why = roots_within(check, H, robot.lower, robot.upper, None, LIMIT_SLACK)
+    if why:
+        return "search", f"{reason}; the general elimination's set is not certified either: {why}"
+    if len(theirs) != len(q) or not all(np.abs(wrap_to_pi(theirs - row)).max(axis=1).min() <= 1e-6 for row in q):
+        return "search", f"the general elimination finds {len(theirs)} branches, the 1-D search {len(q)}"
+    return proved_each(loop, H, q)
+
+
+def proved_each(loop: Loop | None, H: np.ndarray, q: np.ndarray) -> tuple[str, str]:
+    """("certified", "") when Kantorovich's test proves each row of q a root of H, else ("search", why not)."""
+    if loop is None or (len(q) and not kantorovich(loop, q, H).proved.all()):
+        return "search", "a branch Kantorovich's test does not prove (a singular configuration)"
+    return "certified", ""
+
+
+def _elimination(robot: Robot) -> ArmClass | None:
+    """The general elimination of a 6R robot's chain where it takes it, to cross-check a 1-D search's sets."""
+    if robot.n != 6:
+        return None
+    v = chain_model(robot).vectors(np.zeros(6))
+    return general_vectors(v["e"].copy(), v["o"].copy(), v["R"].copy(), v["N"].copy()).arm
 
 
 def robot_loop(robot: Robot) -> Loop | None:
@@ -471,7 +509,7 @@ class OneCall:
         self.method = "search" if arm.searched else "closed form"
         self.unseen = 0.0 if self.method == "closed form" else None
         self.unfinished = np.zeros(MAX_ROWS, dtype=np.bool_)  # the compiled form finishes no root
-        self.loop, self.pose = robot_loop(robot), np.eye(4)
+        self.robot, self.pose = robot, np.eye(4)
 
     def found(self, target: Any, ref: np.ndarray | None) -> tuple[Rows, float] | None:
         """(the compiled closed form's rows, the start of the clock [s]), or None where the general route must
@@ -519,7 +557,7 @@ class EveryBranch(OneCall):
             return None  # type: ignore[return-value]
         made = Branches.of_rows(q, dp, dr, self._row, (q, dp, dr, merged, continuum, wall_time), self.method,
                                 self.unseen)
-        made.certified_by(partial(_CERTIFICATES[self.method], self.loop, self.pose, q, merged, continuum))
+        made.certified_by(partial(certificate_of, self.robot, self.method, self.pose, q, merged, continuum))
         return made
 
     def _row(self, data: tuple[Any, ...], i: int) -> IKResult:
