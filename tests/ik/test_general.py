@@ -114,6 +114,33 @@ def test_on_and_beside_the_singular_surface_the_set_holds_the_pose_s_configurati
             assert len(own) == 1
 
 
+def test_the_loop_equations_are_pinocchio_s_pose_error_and_their_jacobian_its_derivative():
+    """The compiled loop equations F = ((p − p*)/ℓ, ½ Σ_k R*e_k × R e_k) against the same quantities from Pinocchio's
+    FK, and F′ against central differences of them (seeded configurations of two arms)."""
+    from kinelab.ik.analytic.branches import robot_loop
+    from kinelab.ik.analytic.certify import equations
+
+    def pinocchio_F(robot, q, target, scale):
+        oM = robot.fk(q)
+        g = 0.5 * sum(np.cross(target.rotation[:, k], oM.rotation[:, k]) for k in range(3))
+        return np.concatenate([(oM.translation - target.translation) / scale, g])
+
+    for name in ("general6r", "ur5"):
+        robot = kinelab.load(name)
+        loop = robot_loop(robot)
+        rng = np.random.default_rng(6)
+        for _ in range(10):
+            q, target = robot.random_q(rng), robot.fk(robot.random_q(rng))
+            F, J = equations(loop, q[None], target.homogeneous)
+            np.testing.assert_allclose(F[0], pinocchio_F(robot, q, target, loop.scale), atol=1e-12)
+            step = 1e-6
+            for j in range(6):
+                dq = np.eye(6)[j] * step
+                central = (pinocchio_F(robot, q + dq, target, loop.scale)
+                           - pinocchio_F(robot, q - dq, target, loop.scale)) / (2 * step)
+                np.testing.assert_allclose(J[0, :, j], central, atol=1e-8)
+
+
 def test_kantorovich_proves_a_root_and_refuses_a_point_that_is_not_one():
     ur5 = kinelab.load("ur5")
     q = ur5.random_q(np.random.default_rng(3))

@@ -18,6 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kinelab.core import _loop
+
 F_MARGIN = 1e-12  # rounding allowance on each component of F (scaled units) and on F′'s singular values
 MAX_STEPS = 6  # Newton steps at most when polishing
 SPLIT = 5e-8  # [rad] two roots beside a fold at least this far apart are two
@@ -47,6 +49,7 @@ def loop_of(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray) -> Loo
     i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="ij")
     position = np.where(i < j, 2 * D[j], D[i]) / scale
     rotation = np.where(i < j, 3.5, 1.5)
+    h, o, R0, N0 = (np.ascontiguousarray(a, dtype=float) for a in (h, o, R0, N0))
     return Loop(h, o, R0, N0, scale, float(np.sqrt((position**2).sum() + (rotation**2).sum())))
 
 
@@ -73,16 +76,12 @@ def _rodrigues(h: np.ndarray, angles: np.ndarray) -> np.ndarray:
 
 
 def equations(loop: Loop, q: np.ndarray, H: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """F (m, 6) and F′ (m, 6, n) of the loop equations at q (m, n) for the target H (4 × 4, base frame)."""
-    R, p, w, o = kinematics(loop, q)
-    Rt, pt = H[:3, :3], H[:3, 3]
-    g = 0.5 * np.cross(Rt.T[None], np.swapaxes(R, 1, 2)).sum(axis=1)  # ½ Σ_k R*e_k × R e_k
-    F = np.concatenate([(p - pt) / loop.scale, g], axis=1)
-    trace = np.einsum("ij,mij->m", Rt, R)
-    RRt = R @ Rt.T
-    Jp = np.cross(w, p[:, None, :] - o) / loop.scale
-    Jg = 0.5 * (w * trace[:, None, None] - np.einsum("mab,mjb->mja", RRt, w))
-    return F, np.swapaxes(np.concatenate([Jp, Jg], axis=2), 1, 2)
+    """F (m, 6) and F′ (m, 6, n) of the loop equations at q (m, n) for the target H (4 × 4, base frame), compiled
+    (:mod:`kinelab.core._loop`)."""
+    q = np.ascontiguousarray(q, dtype=float)
+    F, J = np.empty((q.shape[0], 6)), np.empty((q.shape[0], 6, q.shape[1]))
+    _loop.equations(loop.h, loop.o, loop.R0, loop.N0, loop.scale, q, np.ascontiguousarray(H, dtype=float), F, J)
+    return F, J
 
 
 def polish(loop: Loop, q: np.ndarray, H: np.ndarray) -> np.ndarray:

@@ -250,9 +250,9 @@ def _unpacked(v: np.ndarray, alphai: np.ndarray) -> np.ndarray:
     """LAPACK's real eigenvector columns as complex ones: a pair (α_j, α_j+1) with α_j's imaginary part > 0 holds
     the real and imaginary parts of the first vector; the second is its conjugate."""
     out = v.astype(complex)
-    for j in np.flatnonzero(alphai > 0):
-        out[:, j] = v[:, j] + 1j * v[:, j + 1]
-        out[:, j + 1] = v[:, j] - 1j * v[:, j + 1]
+    first = np.flatnonzero(alphai > 0)
+    out[:, first] = v[:, first] + 1j * v[:, first + 1]
+    out[:, first + 1] = np.conj(out[:, first])
     return out
 
 
