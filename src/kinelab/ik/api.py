@@ -251,13 +251,16 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
 
 def solve_all_batch(robot: Robot, targets: Any, *positional: Any, tol_pos: float = 1e-6,
                     tol_rot: float = 1e-6) -> BranchBatch:
-    """Every branch of each target, in closed form, on all cores: arrays in, arrays out.
+    """Every branch of each target, arrays in, arrays out: in closed form or by the 1-D search on all cores, by
+    the general 6R elimination target by target (not compiled yet).
 
-    Row b holds what ``solve_all(robot, targets[b])`` returns for a chain with a closed form (each angle's copy
-    within the limits nearest 0), every branch judged within the limits by the FK the result's ``judge`` names.
+    Row b holds what ``solve_all(robot, targets[b])`` returns for a chain with a closed form, a 1-D search or the
+    general elimination (each angle's copy within the limits nearest 0), every branch judged within the limits by
+    the FK the result's ``judge`` names.
 
     Args:
-        robot: a robot whose chain is in an analytic class (docs/analytic.md).
+        robot: a robot whose chain is in an analytic class or a 6R chain the general elimination takes
+            (docs/analytic.md).
         targets: a sequence of ``pin.SE3`` or a (B, 4, 4) array of oMtarget, base frame.
         positional: nothing: the tolerances are keyword-only.
         tol_pos: position tolerance [m].
@@ -266,12 +269,13 @@ def solve_all_batch(robot: Robot, targets: Any, *positional: Any, tol_pos: float
     Returns:
         The :class:`~kinelab.ik.analytic.branches.BranchBatch`: ``q`` (B, 16, n) [rad] with the first ``count[b]``
         rows of target b set (NaN after them), their errors, roots merged and continuum flags, and how complete each
-        set is (``method``: "closed form" or "search").
+        set is (``method``: "closed form", "search" or "elimination"; ``uncertified``: the elimination's reason per
+        target, "" where its set is certified).
 
     Raises:
         TypeError: a tolerance given positionally.
         ChainError, TargetError, OptionError: not a robot, a bad target (its index named), a bad tolerance, or a
-            chain without a closed form (named: its branches come from ``solve_all`` one target at a time).
+            chain none of those take (named: its branches come from ``solve_all`` one target at a time).
     """
     check_entry(robot, "solve_all_batch", positional)
     return all_branches_batch(robot, targets, tol_pos, tol_rot)

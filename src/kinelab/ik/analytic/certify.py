@@ -8,8 +8,8 @@ change by at most 2D_j/ℓ or D_i/ℓ (position, i < j or i ≥ j) and 3.5 or 1.
 axis j's point to the tool point bounded by the sum of the fixed segments between them. So F′ is Lipschitz with
 L = ‖(those bounds)‖_F over all of R⁶, and Kantorovich's theorem applies: with β ≥ ‖F′(q)⁻¹‖ and
 η ≥ ‖F′(q)⁻¹F(q)‖, h = βLη ≤ ½ proves exactly one root in the ball of radius (1 − √(1 − 2h))/(βL) about q and
-no other within (1 + √(1 − 2h))/(βL). Floating-point evaluation is covered by a margin of 1e-12 on each
-component of F and on ‖F′‖.
+no other within (1 + √(1 − 2h))/(βL). Floating-point evaluation is covered by a margin of 1e-13 on each
+component of F and on F′'s singular values (ten times a bound on the FK's rounding).
 """
 
 from __future__ import annotations
@@ -20,8 +20,10 @@ import numpy as np
 
 from kinelab.core import _loop
 
-F_MARGIN = 1e-12  # rounding allowance on each component of F (scaled units) and on F′'s singular values
-MAX_STEPS = 6  # Newton steps at most when polishing
+F_MARGIN = 1e-13  # rounding allowance on each component of F (scaled units) and on F′'s singular values: ten times
+# a bound on the FK's rounding (six rotation products, entries of order one: ~1e-14)
+MAX_STEPS = 60  # Newton steps at most when polishing: beside a double root Newton's method only halves the error a
+# step; the steps stop as soon as no row's residual shrinks
 SPLIT = 5e-8  # [rad] two roots beside a fold at least this far apart are two
 F_ROUNDING = 1e-14  # a bound on the rounding of F's components (scaled units): beside a fold of curvature c the two
 # roots are told apart only when σ² > 2|c|·F_ROUNDING, i.e. farther apart than ~2√(2·F_ROUNDING/|c|)

@@ -312,7 +312,7 @@ def closed_form_summary(robot: Robot) -> str:
     if has_swept_form(robot):
         sw = swept_arm(robot)
         return (f"with joint {sw.joint + 1} ({robot.joints[sw.joint].name}) held: {sw.arm.name}, {sw.arm.method} of "
-                "the other six (solve_all(..., redundancy=K))")
+                "the other six (solve_all(..., redundancy=K); any one joint held: redundancy={joint name: value})")
     none = (f"none: no class holds to its tolerances ({AXIS_TOL:g} rad between parallel axes, {POINT_TOL:g} m between "
             "meeting ones; a calibrated arm misses them by more)")
     general = general_class(robot).arm
