@@ -216,3 +216,13 @@ def test_a_planar_or_special_chain_is_refused_with_its_structure_named():
     o = np.array([[0.3 * i, 0.0, 0.0] for i in range(6)])
     out = general_vectors(h, o, np.eye(3), np.array([1.9, 0.0, 0.0]))
     assert out.arm is None and "axes 1 and 2 parallel" in out.reason and "degenerates" in out.reason
+
+
+def test_a_pickled_set_keeps_its_completeness():
+    import pickle
+
+    for name in ("general6r", "ur5"):
+        robot = kinelab.load(name)
+        found = kinelab.solve_all(robot, robot.fk(robot.random_q(np.random.default_rng(2))))
+        again = pickle.loads(pickle.dumps(found))
+        assert (again.complete, again.complete_reason) == (found.complete, found.complete_reason) == ("certified", "")

@@ -753,7 +753,7 @@ cdef class ClosedForm:
     def every(self, target, made):
         """:meth:`solve` of a ``pin.SE3`` target with no reference, its arrays handed to ``made(q, position_error,
         rotation_error, merged, continuum, wall_time)`` (the call's wall time [s]), which builds the caller's
-        result; None where :meth:`solve` gives None or no branch."""
+        result; None where :meth:`solve` gives None or no branch, or roots were merged outside a continuum."""
         cdef double t_start = now()
         cdef double out[MAX_ROWS * 6]
         cdef double errors[MAX_ROWS * 2]
@@ -761,13 +761,16 @@ cdef class ClosedForm:
         cdef unsigned char loose[MAX_ROWS]
         cdef double T[16]
         cdef bint near = False
-        cdef int m = 0, kept
+        cdef int m = 0, kept, i
         if not _row_major(target.homogeneous, T) or pose_defect_row_major(T) != 0:
             return None
         with nogil:
             kept = self._pose(T, out, False, out, errors, found, loose, &near, &m)
         if near or kept == 0:
             return None
+        for i in range(kept):
+            if found[i] > 1 and not loose[i]:
+                return None  # roots merged: perhaps two beside a fold, which the general route splits
         return self._arrays(made, kept, out, errors, found, loose, t_start)
 
     cdef object _arrays(self, object made, int kept, const double* out, const double* errors,

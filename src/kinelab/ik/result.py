@@ -440,9 +440,10 @@ class Branches(Sequence[IKResult]):
         return f"Branches({len(self)} branches, status={self.status.value!r}, method={self.method!r})"
 
     def __getstate__(self) -> dict[str, Any]:
-        """The arrays and the results, built (a pickle never carries the maker)."""
+        """The arrays, the results and the completeness, built (a pickle never carries the maker or the
+        certifier)."""
         self._built()
-        return {**self.__dict__, "_make_row": _called, "_data": None}
+        return {**self.__dict__, "_make_row": _called, "_data": None, "_certify": self._completeness()}
 
 
 _BY_METHOD = {

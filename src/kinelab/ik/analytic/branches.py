@@ -551,10 +551,8 @@ class EveryBranch(OneCall):
 
     def _made(self, q: np.ndarray, dp: np.ndarray, dr: np.ndarray, merged: np.ndarray, continuum: np.ndarray,
               wall_time: float) -> Branches:
-        """The set of one pose's branches from the compiled form's arrays (q (k, n) [rad], errors [m, rad]); None
-        where roots were merged (perhaps two beside a fold: the general route splits them)."""
-        if ((merged > 1) & ~continuum).any():
-            return None  # type: ignore[return-value]
+        """The set of one pose's branches from the compiled form's arrays (q (k, n) [rad], errors [m, rad]; the
+        compiled form hands none with merged roots outside a continuum: the general route splits them)."""
         made = Branches.of_rows(q, dp, dr, self._row, (q, dp, dr, merged, continuum, wall_time), self.method,
                                 self.unseen)
         made.certified_by(partial(certificate_of, self.robot, self.method, self.pose, q, merged, continuum))

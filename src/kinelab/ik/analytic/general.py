@@ -394,7 +394,8 @@ TRIALS = 4  # seeded configurations the elimination must recover before a chain 
 
 def usable(g: General6R, loop: Loop) -> str:
     """"" when the elimination recovers TRIALS seeded configurations of the chain (each among the roots of its own
-    pose, to 1e-9 rad); else the structure it cannot take, in words."""
+    pose, to 1e-9 rad); else the structure it cannot take, in words. (A chain whose pencil is singular can still
+    pass: its sets then say they are not certified.)"""
     rng = np.random.default_rng(OFFSET_SEED)
     for q in rng.uniform(-np.pi, np.pi, (TRIALS, 6)):
         R, p, _, _ = kinematics(loop, q[None])
