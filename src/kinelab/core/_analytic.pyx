@@ -752,8 +752,9 @@ cdef class ClosedForm:
 
     def every(self, target, made):
         """:meth:`solve` of a ``pin.SE3`` target with no reference, its arrays handed to ``made(q, position_error,
-        rotation_error, merged, continuum, wall_time)`` (the call's wall time [s]), which builds the caller's
-        result; None where :meth:`solve` gives None or no branch, or roots were merged outside a continuum."""
+        rotation_error, merged, continuum, wall_time, H)`` (the call's wall time [s], the target's 4 × 4 array),
+        which builds the caller's result; None where :meth:`solve` gives None or no branch, or roots were merged
+        outside a continuum."""
         cdef double t_start = now()
         cdef double out[MAX_ROWS * 6]
         cdef double errors[MAX_ROWS * 2]
@@ -762,7 +763,8 @@ cdef class ClosedForm:
         cdef double T[16]
         cdef bint near = False
         cdef int m = 0, kept, i
-        if not _row_major(target.homogeneous, T) or pose_defect_row_major(T) != 0:
+        H = target.homogeneous
+        if not _row_major(H, T) or pose_defect_row_major(T) != 0:
             return None
         with nogil:
             kept = self._pose(T, out, False, out, errors, found, loose, &near, &m)
@@ -771,10 +773,10 @@ cdef class ClosedForm:
         for i in range(kept):
             if found[i] > 1 and not loose[i]:
                 return None  # roots merged: perhaps two beside a fold, which the general route splits
-        return self._arrays(made, kept, out, errors, found, loose, t_start)
+        return self._arrays(made, kept, out, errors, found, loose, t_start, H)
 
     cdef object _arrays(self, object made, int kept, const double* out, const double* errors,
-                        const long long* found, const unsigned char* loose, double t_start):
+                        const long long* found, const unsigned char* loose, double t_start, object H):
         """The kept rows as arrays, handed to ``made``."""
         cdef cnp.npy_intp rows = kept, i
         cdef cnp.npy_intp dims[2]
@@ -793,7 +795,7 @@ cdef class ClosedForm:
             qp[i] = out[i]
         for i in range(kept):
             dpp[i], drp[i], mp[i], cp[i] = errors[2 * i], errors[2 * i + 1], found[i], loose[i] != 0
-        return made(q, dp, dr, merged, continuum, now() - t_start)
+        return made(q, dp, dr, merged, continuum, now() - t_start, H)
 
     def solve_batch(self, const double[:, :, ::1] H, double[:, :, ::1] q, double[:, :, ::1] errors,
                     long long[:, ::1] merged, unsigned char[:, ::1] continuum, long long[::1] count,

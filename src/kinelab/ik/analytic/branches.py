@@ -509,7 +509,7 @@ class OneCall:
         self.method = "search" if arm.searched else "closed form"
         self.unseen = 0.0 if self.method == "closed form" else None
         self.unfinished = np.zeros(MAX_ROWS, dtype=np.bool_)  # the compiled form finishes no root
-        self.robot, self.pose = robot, np.eye(4)
+        self.robot = robot
 
     def found(self, target: Any, ref: np.ndarray | None) -> tuple[Rows, float] | None:
         """(the compiled closed form's rows, the start of the clock [s]), or None where the general route must
@@ -546,16 +546,15 @@ class EveryBranch(OneCall):
         """Every branch of ``target``, or None where the general route must answer."""
         if type(target) is not pin.SE3:
             return None
-        self.pose = target.homogeneous
         return self.form.every(target, self._made)  # type: ignore[no-any-return]
 
     def _made(self, q: np.ndarray, dp: np.ndarray, dr: np.ndarray, merged: np.ndarray, continuum: np.ndarray,
-              wall_time: float) -> Branches:
+              wall_time: float, H: np.ndarray) -> Branches:
         """The set of one pose's branches from the compiled form's arrays (q (k, n) [rad], errors [m, rad]; the
         compiled form hands none with merged roots outside a continuum: the general route splits them)."""
         made = Branches.of_rows(q, dp, dr, self._row, (q, dp, dr, merged, continuum, wall_time), self.method,
                                 self.unseen)
-        made.certified_by(partial(certificate_of, self.robot, self.method, self.pose, q, merged, continuum))
+        made.certified_by(partial(certificate_of, self.robot, self.method, H, q, merged, continuum))
         return made
 
     def _row(self, data: tuple[Any, ...], i: int) -> IKResult:

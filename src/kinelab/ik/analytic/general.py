@@ -63,9 +63,9 @@ class General6R:
 @dataclass(frozen=True, eq=False)
 class Eigen:
     """The pose's eigenproblem, kept for the certificate: ``alpha``, ``beta`` (24,) homogeneous eigenvalues
-    (x₃ = α/β), ``kappa`` (24,) their condition numbers (chordal metric), ``scale`` the pencil's norm, ``rank``
-    Q's smallest singular value relative to its largest, ``picked`` the indices of the eigenvalues that may be
-    real, one root each."""
+    (x₃ = α/β), ``kappa`` (24,) their condition numbers (chordal metric), ``scale`` the pencil's Frobenius norm
+    (a bound on its 2-norm), ``rank`` Q's smallest singular value relative to its largest, ``picked`` the indices
+    of the eigenvalues that may be real, one root each."""
 
     alpha: np.ndarray
     beta: np.ndarray
@@ -219,7 +219,7 @@ def solve(g: General6R, H: np.ndarray) -> tuple[np.ndarray, Eigen]:
         return np.empty((0, 6)), Eigen(np.empty(0), np.empty(0), np.empty(0), 0.0, rank, np.empty(0, dtype=int))
     alpha, beta, vl, vr = _ggev(A, B)
     kappa = _conditions(A, B, vl, vr)
-    scale = float(np.hypot(np.linalg.norm(A, 2), np.linalg.norm(B, 2)))
+    scale = float(np.hypot(np.linalg.norm(A), np.linalg.norm(B)))  # Frobenius: a bound on the 2-norm, and no SVD
     real = np.flatnonzero(real_root(alpha, beta, kappa, scale))
     eigen = Eigen(alpha, beta, kappa, scale, rank, real)
     if real.size == 0:
