@@ -30,6 +30,15 @@ def wrap_and_clip(x: np.ndarray, lower: np.ndarray, upper: np.ndarray, revolute:
     return np.clip(turns_into(x, lower, upper, where=revolute), lower, upper)
 
 
+def inside_limits(q: np.ndarray, lower: np.ndarray, upper: np.ndarray,
+                  slack: float) -> tuple[np.ndarray, np.ndarray]:
+    """Rows of revolute angles q (m, n) [rad] turned by whole turns into [lower, upper] where they can be, and those
+    within ``slack`` [rad] of it clipped: (the kept rows, clipped; which rows were kept (m,))."""
+    x = turns_into(q, np.broadcast_to(lower, q.shape), np.broadcast_to(upper, q.shape))
+    keep = np.asarray(((x >= lower - slack) & (x <= upper + slack)).all(axis=1))
+    return np.clip(x[keep], lower, upper), keep
+
+
 def wrap_q(robot: Robot, q: np.ndarray) -> np.ndarray:
     """q with each out-of-limit revolute joint shifted by a multiple of 2π into its limits, where one
     exists (the pose is unchanged); other values are returned as they are."""

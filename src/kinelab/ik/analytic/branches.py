@@ -24,7 +24,7 @@ from kinelab.core import threads
 from kinelab.core._analytic import ClosedForm
 from kinelab.core._joints import turn_distances
 from kinelab.errors import ConfigurationError, OptionError
-from kinelab.geometry import pose_errors, stack_homogeneous, turns_into, wrap_to_pi
+from kinelab.geometry import pose_errors, stack_homogeneous, wrap_to_pi
 from kinelab.ik.analytic.certify import (
     Loop,
     kantorovich,
@@ -39,7 +39,7 @@ from kinelab.ik.analytic.kernel import GENERAL_6R, MAX_ROWS, branches, branches_
 from kinelab.ik.batch import BatchIKResult
 from kinelab.ik.chain import chain_model
 from kinelab.ik.driver import solve_one
-from kinelab.ik.limits import distance
+from kinelab.ik.limits import distance, inside_limits
 from kinelab.ik.request import Request, make_request, verdict_reserve
 from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target_arrays, beyond_reach
@@ -155,9 +155,8 @@ def _inside(robot: Robot, q: np.ndarray, found: np.ndarray, free: np.ndarray,
     past a limit (a root split beside a fold can land a hair past one); the others dropped."""
     if not len(q):
         return q, found, free
-    x = turns_into(q, np.broadcast_to(robot.lower, q.shape), np.broadcast_to(robot.upper, q.shape))
-    keep = ((x >= robot.lower - slack) & (x <= robot.upper + slack)).all(axis=1)
-    return np.clip(x[keep], robot.lower, robot.upper), found[keep], free[keep]
+    x, keep = inside_limits(q, robot.lower, robot.upper, slack)
+    return x, found[keep], free[keep]
 
 
 def _method(arm: ArmClass) -> str:
@@ -298,10 +297,8 @@ def proved_each(loop: Loop | None, H: np.ndarray, q: np.ndarray) -> tuple[str, s
 
 def _elimination(robot: Robot) -> ArmClass | None:
     """The general elimination of a 6R robot's chain where it takes it, to cross-check a 1-D search's sets."""
-    if robot.n != 6:
-        return None
-    v = chain_model(robot).vectors(np.zeros(6))
-    return general_vectors(v["e"].copy(), v["o"].copy(), v["R"].copy(), v["N"].copy()).arm
+    six = _six_vectors(robot)
+    return None if six is None else general_vectors(*six).arm
 
 
 def robot_loop(robot: Robot) -> Loop | None:
@@ -310,10 +307,16 @@ def robot_loop(robot: Robot) -> Loop | None:
 
 
 def _loop(robot: Robot) -> Loop | None:
+    six = _six_vectors(robot)
+    return None if six is None else loop_of(*six)
+
+
+def _six_vectors(robot: Robot) -> tuple[np.ndarray, ...] | None:
+    """A 6-joint robot's chain at q = 0 (axes, points, tool rotation and point; base frame), None otherwise."""
     if robot.n != 6:
         return None
     v = chain_model(robot).vectors(np.zeros(6))
-    return loop_of(v["e"].copy(), v["o"].copy(), v["R"].copy(), v["N"].copy())
+    return v["e"].copy(), v["o"].copy(), v["R"].copy(), v["N"].copy()
 
 
 def nearest_roots(robot: Robot, arm: ArmClass, target: Any, req: Request,

@@ -17,8 +17,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 
 from kinelab.core import _loop
+from kinelab.geometry import wrap_to_pi
 
 F_MARGIN = 1e-13  # rounding allowance on each component of F (scaled units) and on F′'s singular values: ten times
 # a bound on the FK's rounding (six rotation products, entries of order one: ~1e-14)
@@ -55,26 +57,18 @@ def loop_of(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray) -> Loo
     return Loop(h, o, R0, N0, scale, float(np.sqrt((position**2).sum() + (rotation**2).sum())))
 
 
-def kinematics(loop: Loop, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The tool's rotation (m, 3, 3) and point (m, 3), and each joint's axis ω (m, n, 3) and point (m, n, 3), at the
-    configurations q (m, n) [rad]: the product of exponentials (base frame)."""
-    m, n = q.shape
-    R = np.broadcast_to(np.eye(3), (m, 3, 3)).copy()
-    t = np.zeros((m, 3))
-    axes, points = np.empty((m, n, 3)), np.empty((m, n, 3))
-    for k in range(n):
-        axes[:, k] = R @ loop.h[k]
-        points[:, k] = R @ loop.o[k] + t
-        turn = _rodrigues(loop.h[k], q[:, k])
-        t = t + np.einsum("mij,mj->mi", R, loop.o[k] - turn @ loop.o[k])
-        R = R @ turn
-    return R @ loop.R0, (R @ loop.N0) + t, axes, points
-
-
-def _rodrigues(h: np.ndarray, angles: np.ndarray) -> np.ndarray:
-    """Rotations (m, 3, 3) by ``angles`` [rad] about the unit axis h."""
-    K = np.array([[0.0, -h[2], h[1]], [h[2], 0.0, -h[0]], [-h[1], h[0], 0.0]])
-    return np.eye(3) + np.sin(angles)[:, None, None] * K + (1 - np.cos(angles))[:, None, None] * (K @ K)
+def chain_pose(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """The 4 × 4 tool pose of the chain (unit axes h through points o at q = 0, the tool at (R0, N0); base frame)
+    at q [rad]: the product of exponentials."""
+    M = np.eye(4)
+    for k in range(len(q)):
+        turn = np.eye(4)
+        turn[:3, :3] = pin.exp3(h[k] * q[k])
+        turn[:3, 3] = o[k] - turn[:3, :3] @ o[k]
+        M = M @ turn
+    tool = np.eye(4)
+    tool[:3, :3], tool[:3, 3] = R0, N0
+    return M @ tool
 
 
 def equations(loop: Loop, q: np.ndarray, H: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -156,7 +150,7 @@ def set_certificate(loop: Loop | None, H: np.ndarray, q: np.ndarray, merged: np.
     proof = kantorovich(loop, q, H)
     if not proof.proved.all():
         return "search", "a branch Kantorovich's test does not prove (a singular configuration)"
-    gap = np.abs(np.arctan2(np.sin(q[:, None] - q[None]), np.cos(q[:, None] - q[None])))
+    gap = np.abs(wrap_to_pi(q[:, None] - q[None]))
     apart = np.linalg.norm(gap, axis=2) > proof.inside[:, None] + proof.inside[None]
     np.fill_diagonal(apart, True)
     return ("certified", "") if apart.all() else ("search", "two branches whose balls meet")
@@ -200,7 +194,7 @@ def beside_fold(loop: Loop, x: np.ndarray, H: np.ndarray,
 
 def _gap(a: np.ndarray, b: np.ndarray) -> float:
     """The largest joint difference [rad] of two configurations, modulo 2π."""
-    return float(np.abs(np.arctan2(np.sin(a - b), np.cos(a - b))).max())
+    return float(np.abs(wrap_to_pi(a - b)).max())
 
 
 def split_merged(loop: Loop | None, H: np.ndarray, q: np.ndarray, merged: np.ndarray,

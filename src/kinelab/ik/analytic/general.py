@@ -20,15 +20,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from kinelab.geometry import turns_into
-from kinelab.ik.analytic.certify import Loop, Proof, beside_fold, kantorovich, kinematics, polish
+from kinelab.geometry import wrap_to_pi
+from kinelab.ik.analytic.certify import Loop, Proof, beside_fold, chain_pose, kantorovich, polish
+from kinelab.ik.limits import inside_limits
 
 SPURIOUS = 8  # eigenvalues at x₃ = ±i that every pose's determinant carries: (1 + x₃²)⁴
 SPURIOUS_TOL = 1e-6  # [chordal] an eigenvalue this close to ±i is one of them (found within ~1e-13; a root nearer
 # is rare and leaves the set uncertified, never wrong)
-ROOTS = 16  # the roots of a general 6R pose, complex ones counted
 RANK_TOL = 1e-9  # Q's smallest kept singular value relative to its largest: below it the elimination is refused
-NEWTON_STEPS = 4  # polishing steps at most (a root from the eigenvector is within ~1e-10 rad; two steps finish it)
 _ANGLES = np.array([0.0, 2 * np.pi / 3, 4 * np.pi / 3])
 _FOURIER = np.linalg.inv(np.stack([np.ones(3), np.cos(_ANGLES), np.sin(_ANGLES)]).T)  # samples → (1, cos, sin)
 _HALF = np.array([[1.0, 0.0, 1.0], [1.0, 0.0, -1.0], [0.0, 2.0, 0.0]])  # (1, c, s)·(1 + x²) over (1, x, x²)
@@ -200,7 +199,7 @@ def real_root(alpha: np.ndarray, beta: np.ndarray, kappa: np.ndarray, scale: flo
     """Which eigenvalues α/β may be real: their distance to the real line (:func:`chordal_to_real`) is within their
     perturbation bound (a few roundings times the condition number) or within 1e-6 (a close pair's imaginary
     part: Newton's method then settles it)."""
-    return chordal_to_real(alpha, beta) <= np.maximum(1e-6, 64 * np.finfo(float).eps * kappa * scale)
+    return chordal_to_real(alpha, beta) <= np.maximum(1e-6, _radius(kappa, scale))
 
 
 def chordal_to_real(alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
@@ -232,7 +231,7 @@ def solve(g: General6R, H: np.ndarray) -> tuple[np.ndarray, Eigen]:
         x3 = np.where(np.abs(b) > 0, np.abs(a) / np.abs(b), np.inf)
     t4, t5 = _wrist(vr[:, real], x3)
     q = _shoulder_and_tool(g, r0, pinv, Tp, t3, t4, t5) + g.phi
-    return np.arctan2(np.sin(q), np.cos(q)), eigen
+    return wrap_to_pi(q), eigen
 
 
 def _ggev(A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -266,8 +265,14 @@ def _conditions(A: np.ndarray, B: np.ndarray, vl: np.ndarray, vr: np.ndarray) ->
 
 
 def radii(eigen: Eigen) -> np.ndarray:
-    """Each eigenvalue's perturbation bound in the chordal metric: 64 roundings of the pencil times its condition."""
-    return 64 * np.finfo(float).eps * eigen.kappa * eigen.scale
+    """Each eigenvalue's perturbation bound in the chordal metric (:func:`_radius`)."""
+    return _radius(eigen.kappa, eigen.scale)
+
+
+def _radius(kappa: np.ndarray, scale: float) -> np.ndarray:
+    """The chordal perturbation bound of eigenvalues of condition ``kappa`` in a pencil of norm ``scale``: 64
+    roundings of the pencil times the condition."""
+    return 64 * np.finfo(float).eps * kappa * scale
 
 
 def _unit(alpha: np.ndarray, beta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -342,7 +347,7 @@ def every_root(g: General6R, loop: Loop, H: np.ndarray) -> Found:
     q, eigen = solve(g, H)
     q = split_pairs(loop, polish(loop, q, H), H)
     proof = kantorovich(loop, q, H)
-    q = np.arctan2(np.sin(q), np.cos(q))
+    q = wrap_to_pi(q)
     keep, merged = _distinct(q, proof)
     reason = counted(eigen, q[keep], proof.proved[keep], float(g.phi[2]))
     if not reason and not proof.proved[keep].all():
@@ -358,17 +363,13 @@ def split_pairs(loop: Loop, q: np.ndarray, H: np.ndarray) -> np.ndarray:
     used: set[int] = set()
     for i in range(out.shape[0]):
         for j in range(i + 1, out.shape[0]):
-            if i in used or j in used or np.abs(_wrapped(out[i] - out[j])).max() > 1e-9:
+            if i in used or j in used or np.abs(wrap_to_pi(out[i] - out[j])).max() > 1e-9:
                 continue
             pair = beside_fold(loop, out[i], H)
             if pair is not None:
                 out[i], out[j] = pair
                 used |= {i, j}
     return out
-
-
-def _wrapped(d: np.ndarray) -> np.ndarray:
-    return np.arctan2(np.sin(d), np.cos(d))
 
 
 def _distinct(q: np.ndarray, proof: Proof) -> tuple[list[int], np.ndarray]:
@@ -379,8 +380,7 @@ def _distinct(q: np.ndarray, proof: Proof) -> tuple[list[int], np.ndarray]:
     merged: list[int] = []
     for k in range(q.shape[0]):
         for n, j in enumerate(keep):
-            gap = np.abs(np.arctan2(np.sin(q[k] - q[j]), np.cos(q[k] - q[j])))
-            if float(np.linalg.norm(gap)) < max(proof.alone[j], 1e-9):
+            if float(np.linalg.norm(wrap_to_pi(q[k] - q[j]))) < max(proof.alone[j], 1e-9):
                 merged[n] += 1
                 break
         else:
@@ -398,13 +398,10 @@ def usable(g: General6R, loop: Loop) -> str:
     pass: its sets then say they are not certified.)"""
     rng = np.random.default_rng(OFFSET_SEED)
     for q in rng.uniform(-np.pi, np.pi, (TRIALS, 6)):
-        R, p, _, _ = kinematics(loop, q[None])
-        H = np.eye(4)
-        H[:3, :3], H[:3, 3] = R[0], p[0]
-        found = every_root(g, loop, H)
+        found = every_root(g, loop, chain_pose(loop.h, loop.o, loop.R0, loop.N0, q))
         if found.reason.startswith("the elimination is degenerate"):
             return "joints 1 and 2's invariants are dependent"
-        gaps = np.abs(np.arctan2(np.sin(found.q - q), np.cos(found.q - q))).max(axis=1, initial=0.0)
+        gaps = np.abs(wrap_to_pi(found.q - q)).max(axis=1, initial=0.0)
         if found.q.shape[0] == 0 or gaps.min() > 1e-9:
             return f"it misses the chain's own configurations: {found.reason or 'roots lost'}"
     return ""
@@ -423,8 +420,5 @@ def roots_within(arm: object, H: np.ndarray, lower: np.ndarray, upper: np.ndarra
     else:
         found = every_root(g, loop, H)
     base = np.zeros(6) if ref is None else ref
-    q = found.q + 2 * np.pi * np.round((base - found.q) / (2 * np.pi))
-    q = turns_into(q, np.broadcast_to(lower, q.shape), np.broadcast_to(upper, q.shape))
-    keep = ((q >= lower - slack) & (q <= upper + slack)).all(axis=1)
-    q = np.clip(q[keep], lower, upper)
+    q, keep = inside_limits(found.q + 2 * np.pi * np.round((base - found.q) / (2 * np.pi)), lower, upper, slack)
     return q, found.merged[keep], np.zeros(int(keep.sum()), dtype=np.bool_), found.reason

@@ -22,8 +22,9 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.errors import ChainError, OptionError
+from kinelab.geometry import wrap_to_pi
 from kinelab.ik.analytic.branches import Answer, Rows, arm_roots, branch_results, judged_roots, limit_slack
-from kinelab.ik.analytic.certify import kinematics, loop_of
+from kinelab.ik.analytic.certify import chain_pose
 from kinelab.ik.analytic.classify import (
     AXIS_TOL,
     POINT_TOL,
@@ -167,13 +168,10 @@ def recovers(arm: ArmClass, h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np
     """True when the arm's solver finds seeded configurations of the chain (h, o, R0, N0) among the roots of their
     own poses (to 1e-6 rad): a class whose test holds on a chain it degenerates on (a search's shoulder with a
     third axis through its point) is caught here."""
-    loop, wide = loop_of(h, o, R0, N0), np.full(h.shape[0], np.pi)
+    wide = np.full(h.shape[0], np.pi)
     for q in np.random.default_rng(1).uniform(-np.pi, np.pi, (trials, h.shape[0])):
-        R, p, _, _ = kinematics(loop, q[None])
-        H = np.eye(4)
-        H[:3, :3], H[:3, 3] = R[0], p[0]
-        roots = arm_roots(arm, H, -wide, wide, None)[0]
-        if not len(roots) or np.abs(np.arctan2(np.sin(roots - q), np.cos(roots - q))).max(axis=1).min() > 1e-6:
+        roots = arm_roots(arm, chain_pose(h, o, R0, N0, q), -wide, wide, None)[0]
+        if not len(roots) or np.abs(wrap_to_pi(roots - q)).max(axis=1).min() > 1e-6:
             return False
     return True
 
@@ -241,7 +239,7 @@ def at_value(robot: Robot, target: pin.SE3, req: Request, theta: float,
     Raises:
         OptionError: the chain cannot be swept (``joint`` None), or the six left are solved by nothing here.
     """
-    if joint is None or (has_swept_form(robot) and joint == swept_arm(robot).joint):
+    if joint is None or _is_swept(robot, joint):
         sw = swept_arm(robot)
         joint, arm, H = sw.joint, sw.arm, sw.sub_target(target.homogeneous, theta)
     else:
@@ -255,6 +253,11 @@ def at_value(robot: Robot, target: pin.SE3, req: Request, theta: float,
     q6, found_, free = arm_roots(arm, H, robot.lower[keep], robot.upper[keep], ref, limit_slack(req.tol_rot))
     q = np.ascontiguousarray(np.insert(q6, joint, theta, axis=1))
     return judged_roots(robot, q, found_, free, target, req, {robot.joints[joint].name: theta})
+
+
+def _is_swept(robot: Robot, joint: int) -> bool:
+    """True when ``joint`` is the end joint the robot's swept form holds."""
+    return has_swept_form(robot) and joint == swept_arm(robot).joint
 
 
 def redundant_all(robot: Robot, target: pin.SE3, req: Request, redundancy: object,
@@ -286,8 +289,7 @@ def redundant_all(robot: Robot, target: pin.SE3, req: Request, redundancy: objec
         answers += at_value(robot, target, req, float(theta), q_ref, joint)
     if q_ref is not None:
         answers.sort(key=lambda a: distance(robot, a[0], q_ref))
-    arm = swept_arm(robot).arm if has_swept_form(robot) and joint == swept_arm(robot).joint else \
-        arm_holding(robot, joint, float(values[0]))
+    arm = swept_arm(robot).arm if _is_swept(robot, joint) else arm_holding(robot, joint, float(values[0]))
     mode = f"analytic ({_arm_words(arm)}; joint {joint + 1} {how})"
     return branch_results(robot, Rows.of(answers, robot.n), req, mode, time.perf_counter() - t0, max_solutions, "sweep",
                           beyond_reach(robot, target.translation)
@@ -295,12 +297,10 @@ def redundant_all(robot: Robot, target: pin.SE3, req: Request, redundancy: objec
 
 
 def _arm_words(arm: ArmClass | str) -> str:
-    """The six joints' arm in ``mode``: its class and, when searched, how."""
+    """The six joints' arm in ``mode``: its own mode's words and, when searched, of which joints."""
     if isinstance(arm, str):
         return "the other six"
-    if arm.kind == GENERAL_6R:
-        return f"{arm.name}; algebraic elimination of the other six"
-    return arm.name + (f"; {arm.method.removeprefix('every branch by a ')} of the other six" if arm.searched else "")
+    return arm.mode.removeprefix("analytic (").removesuffix(")") + (" of the other six" if arm.searched else "")
 
 
 def closed_form_summary(robot: Robot) -> str:

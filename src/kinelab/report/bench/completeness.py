@@ -26,6 +26,7 @@ from tqdm import tqdm
 
 from kinelab.geometry import wrap_to_pi
 from kinelab.ik.analytic.branches import all_branches_batch, arm_roots
+from kinelab.ik.analytic.certify import chain_pose
 from kinelab.ik.analytic.classify import classify, classify_vectors, general_class
 from kinelab.ik.analytic.redundancy import at_value, has_swept_form, swept_arm
 from kinelab.ik.request import make_request
@@ -159,7 +160,8 @@ def random_arms(arms: int, poses: int, seed: int) -> list[dict[str, Any]]:
                 name = arm.mode
                 for _ in range(poses):
                     q = rng.uniform(-np.pi, np.pi, 6)
-                    Q, _, _ = arm_roots(arm, poe(h, o, tool, q), np.full(6, -10.0), np.full(6, 10.0), None)
+                    H = chain_pose(h, o, tool.rotation, tool.translation, q)
+                    Q, _, _ = arm_roots(arm, H, np.full(6, -10.0), np.full(6, 10.0), None)
                     gaps.append(float(np.abs(wrap_to_pi(Q - q)).max(axis=1).min()) if len(Q) else np.inf)
             g = np.array(gaps)
             rows.append({"class": name, "poses": g.size, "found": float((g <= FOUND).mean()),
@@ -197,17 +199,6 @@ def random_general_arm(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray
         if all(np.linalg.norm(np.cross(h[i], h[j])) > 1e-3 and line_distance(o[i], h[i], o[j], h[j]) > 1e-3
                for i, j in pairs):
             return h, o, pin.SE3(pin.exp3(rng.normal(size=3)), rng.uniform(-0.4, 0.4, 3))
-
-
-def poe(h: np.ndarray, o: np.ndarray, tool: pin.SE3, q: np.ndarray) -> np.ndarray:
-    """The 4 × 4 tool pose of the chain (axes h through points o at q = 0, tool pose ``tool``) at q [rad]."""
-    M = np.eye(4)
-    for i in range(len(q)):
-        T = np.eye(4)
-        T[:3, :3] = pin.exp3(h[i] * q[i])
-        T[:3, 3] = o[i] - T[:3, :3] @ o[i]
-        M = M @ T
-    return np.asarray(M @ tool.homogeneous)
 
 
 def held_joint(robot: Robot, joint: int, n: int, seed: int) -> dict[str, Any]:
@@ -253,7 +244,8 @@ def random_general(arms: int, poses: int, seed: int) -> dict[str, Any]:
             continue
         for _ in range(poses):
             q = rng.uniform(-np.pi, np.pi, 6)
-            Q, _, _, reason = roots_within(arm, poe(h, o, tool, q), -wide, wide, None, 1e-6)
+            H = chain_pose(h, o, tool.rotation, tool.translation, q)
+            Q, _, _, reason = roots_within(arm, H, -wide, wide, None, 1e-6)
             gap = float(np.abs(wrap_to_pi(Q - q)).max(axis=1).min()) if len(Q) else np.inf
             total, found, certified = total + 1, found + (gap <= FOUND), certified + (reason == "")
             if gap > FOUND:
