@@ -46,13 +46,13 @@ def own_configuration(robot: Robot, n: int, seed: int) -> dict[str, Any]:
     distances, and every missed pose's q."""
     Q = robot.random_qs(n, np.random.default_rng(seed))
     t0 = time.perf_counter()
-    if (arm := _six(robot)) is not None:
+    if _six(robot) is not None:
         batch = all_branches_batch(robot, robot.fk_batch(Q))
         gaps = np.nanmin(np.abs(wrap_to_pi(batch.q - Q[:, None, :])).max(axis=2), axis=1, initial=np.inf,
                          where=~np.isnan(batch.q[:, :, 0]))
         counts = batch.count
         elapsed = time.perf_counter() - t0
-        certified = _certified(robot, arm, Q, batch)
+        certified = _certified(robot, Q, batch)
     else:
         sw, req = swept_arm(robot), make_request("frdm")
         found = [at_value(robot, robot.fk(q), req, float(q[sw.joint])) for q in Q]
@@ -73,20 +73,18 @@ def _six(robot: Robot) -> Any:
     return classify(robot).arm or (general_class(robot).arm if not has_swept_form(robot) else None)
 
 
-def _certified(robot: Robot, arm: Any, Q: np.ndarray, batch: Any) -> float:
-    """The share of the poses of Q whose set of branches (``batch``) is certified complete, by the arm's own
-    certificate (docs/analytic.md, Certificates)."""
-    from kinelab.ik.analytic.branches import robot_loop
-    from kinelab.ik.analytic.certify import search_certificate, set_certificate
+def _certified(robot: Robot, Q: np.ndarray, batch: Any) -> float:
+    """The share of the poses of Q whose set of branches (``batch``) is certified complete, by the certificate
+    ``Branches.complete`` gives the same set (docs/analytic.md, Certificates)."""
+    from kinelab.ik.analytic.branches import certificate_of
 
     if batch.uncertified is not None:  # the elimination said it per pose
         return sum(why == "" for why in batch.uncertified) / Q.shape[0]
-    loop, certified = robot_loop(robot), 0
-    H = robot.fk_batch(Q)
+    H, certified = robot.fk_batch(Q), 0
     for b in range(Q.shape[0]):
         k = int(batch.count[b])
-        check = search_certificate if arm.searched else set_certificate
-        certified += check(loop, H[b], batch.q[b, :k], batch.found[b, :k], batch.free[b, :k])[0] == "certified"
+        certified += certificate_of(robot, batch.method, H[b], batch.q[b, :k], batch.found[b, :k],
+                                    batch.free[b, :k])[0] == "certified"
     return certified / Q.shape[0]
 
 
