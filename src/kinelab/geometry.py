@@ -55,9 +55,12 @@ def pose_errors(H_a: np.ndarray, H_b: np.ndarray) -> tuple[np.ndarray, np.ndarra
 
 
 def wrap_to_pi(angles: np.ndarray) -> np.ndarray:
-    """Angles [rad] wrapped into (−π, π] (the same rotations)."""
+    """Angles [rad] wrapped into (−π, π] (the same rotations) by whole turns: exact for an angle already inside,
+    and no trigonometry — the compiled kernels wrap with the same arithmetic, so both agree to the last bit on any
+    processor (NumPy's and the C library's sine and arctangent differ by an ulp on some)."""
     angles = np.asarray(angles, dtype=float)
-    return np.arctan2(np.sin(angles), np.cos(angles))
+    t = angles - TWO_PI * np.rint(angles / TWO_PI)
+    return np.where(t <= -np.pi, t + TWO_PI, np.where(t > np.pi, t - TWO_PI, t))[()]
 
 
 def turns_into(x: np.ndarray, lower: np.ndarray, upper: np.ndarray, where: np.ndarray | None = None) -> np.ndarray:

@@ -16,7 +16,7 @@ from functools import partial
 import numpy as np
 
 cimport numpy as cnp
-from libc.math cimport M_PI, atan2, ceil, cos, sin
+from libc.math cimport M_PI, ceil, rint
 from libc.stdlib cimport free, malloc
 from libc.string cimport memcpy
 
@@ -47,6 +47,16 @@ cdef unsigned long long splitmix(unsigned long long x) noexcept nogil:
 if <int> bq.STATS_SIZE != <int> STATS_SIZE:
     raise ImportError("kinelab.core._engine: the kernels' statistics arrays differ in size; rebuild the core")
 
+
+
+cdef inline double _wrapped(double theta) noexcept nogil:
+    """θ [rad] wrapped into (−π, π] by whole turns, as kinelab.geometry.wrap_to_pi does it, to the last bit."""
+    cdef double t = theta - TWO_PI * rint(theta / TWO_PI)
+    if t <= -M_PI:
+        return t + TWO_PI
+    if t > M_PI:
+        return t - TWO_PI
+    return t
 
 cdef class Engine:
     """A prepared solver's usual call (see the module's docstring): the checks, the verdict and the result, written
@@ -200,7 +210,7 @@ cdef class Engine:
         if self.continuous:
             for i in range(n):
                 if self.kind[i] == CONTINUOUS:
-                    q[i] = atan2(sin(q[i]), cos(q[i]))
+                    q[i] = _wrapped(q[i])
         cdef bint within = self._verdict(q, dp, dr)
         if not within:
             for i in range(n):

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from kinelab.geometry import TWO_PI, turns_into
+from kinelab.geometry import TWO_PI, turns_into, wrap_to_pi
 from kinelab.robot import Robot
 
 
@@ -69,5 +69,5 @@ def distance(robot: Robot, q: np.ndarray, ref: np.ndarray) -> float:
     """max |q_i − ref_i| over the joints [rad or m], revolute and continuous joints modulo 2π."""
     d = np.asarray(q, dtype=float) - np.asarray(ref, dtype=float)
     revolute = np.array([k != "prismatic" for k in robot.joint_kinds])
-    d[revolute] = np.arctan2(np.sin(d[revolute]), np.cos(d[revolute]))
+    d[revolute] = wrap_to_pi(d[revolute])
     return float(np.max(np.abs(d)))
