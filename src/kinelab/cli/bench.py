@@ -39,9 +39,9 @@ def add(sub: Any) -> None:
                         "and random starts, interleaved and blocked rounds, ratios with their spread")
     s.add_argument("--branches", action="store_true",
                    help="also every branch of a pose: the closed form against the multistart and EAIK, the batch's "
-                        "poses per second (the arms with a closed form or a 1-D search, the Stanford arm's "
-                        "multistart, the ERA, Baxter and "
-                        "the Panda swept)")
+                        "poses per second (the arms with a closed form or a 1-D search, the general 6R arms against "
+                        "their Python route and ssik, the Stanford arm's multistart, the ERA, Baxter and the Panda "
+                        "swept; --robots picks)")
     s.add_argument("--completeness", action="store_true",
                    help="also every-branch completeness: each arm with a class or the general 6R elimination on "
                         "10,000 seeded poses (its own configuration among the branches, the certified share), against "
@@ -88,7 +88,8 @@ def run(args: argparse.Namespace) -> int:
     if args.branches:
         from kinelab.report.bench import branches
 
-        result["branches"] = branches.run(None, seed=args.seed, repeats=max(args.repeats, 2), progress=not args.json)
+        result["branches"] = branches.run(args.robots, seed=args.seed, repeats=max(args.repeats, 2),
+                                          progress=not args.json)
     if args.completeness:
         from kinelab.report.bench import completeness
 

@@ -459,6 +459,7 @@ cdef int two_three_6r(const double* h, const double* o, M9 R0, V3 N0, M9 Rt, V3 
 
 
 include "_search.pxi"
+include "_general.pxi"
 
 
 cdef bint _placed(const double* row, int n, const double* lower, const double* upper, const double* ref,
@@ -505,6 +506,7 @@ cdef struct Arm:
     const double* upper
     double same
     double slack
+    const double* general  # the general elimination's packed data (_general.pxi), NULL for the other classes
 
 
 cdef int _branches(const Arm* arm, M9 Rt, V3 pt, const double* ref, bint use_ref, double* out, long long* found,
@@ -552,6 +554,8 @@ cdef int _placed_rows(const Arm* arm, M9 Rt, V3 pt, const double* ref, bint use_
         count = meeting_6r(arm.h, arm.o, arm.R0, arm.N0, Rt, pt, rows)
     elif arm.kind == TWO_THREE_6R:
         count = two_three_6r(arm.h, arm.o, arm.R0, arm.N0, Rt, pt, rows)
+    elif arm.kind == GENERAL_6R:
+        count = general_6r(arm, Rt, pt, rows)
     elif arm.kind >= SEARCH_PAR23_45:
         count = search_6r(arm.h, arm.o, arm.kind, arm.R0, arm.N0, Rt, pt, rows)
     else:
@@ -578,18 +582,19 @@ cdef inline M9 _rotation_of(const double[:, :] H) noexcept nogil:
 
 cdef Arm _arm(int kind, bint mirrored, const double[:, ::1] h, const double[:, ::1] o, const double[:, :] R0,
               const double[:] N0, const double[::1] lower, const double[::1] upper, double same,
-              double slack) except *:
+              double slack, const double* general=NULL) except *:
     cdef int n = h.shape[0]
     if n not in (5, 6) or h.shape[1] != 3 or o.shape[0] != n or o.shape[1] != 3 or R0.shape[0] != 3 \
             or R0.shape[1] != 3 or N0.shape[0] != 3 or lower.shape[0] != n or upper.shape[0] != n \
-            or not 0 <= kind <= SEARCH_MEET23_56 or (n == 5) != (kind == PARALLEL_5R):
+            or not (0 <= kind <= SEARCH_MEET23_56 or kind == GENERAL_6R and general != NULL) \
+            or (n == 5) != (kind == PARALLEL_5R):
         raise ValueError("an analytic arm: 5 or 6 axes and points (n, 3), R0 (3, 3), N0 (3,), limits (n,), "
-                         "and a class code that fits n")
+                         "and a class code that fits n (the general class's with its prepared data)")
     cdef Arm arm
     arm.kind, arm.mirrored, arm.n, arm.h, arm.o = kind, mirrored, n, &h[0, 0], &o[0, 0]
     arm.R0 = _rotation_of(R0)
     arm.N0 = (N0[0], N0[1], N0[2])
-    arm.lower, arm.upper, arm.same, arm.slack = &lower[0], &upper[0], same, slack
+    arm.lower, arm.upper, arm.same, arm.slack, arm.general = &lower[0], &upper[0], same, slack, general
     return arm
 
 
@@ -678,7 +683,7 @@ cdef class ClosedForm:
     Args:
         judge: the robot's certified compiled FK.
         spec: read once: ``kind``, ``mirrored``, ``h``, ``o``, ``R0``, ``N0`` the class (as :func:`branches`
-            takes them); ``lower``, ``upper`` the joint limits [rad] the roots are placed within, ``same`` [rad] and
+            takes them; the general class also ``general``, its packed data, kinelab.ik.analytic.general.packed); ``lower``, ``upper`` the joint limits [rad] the roots are placed within, ``same`` [rad] and
             ``slack`` [rad] as :func:`branches`; ``check_lower``, ``check_upper`` the limits an answer must lie within;
             ``tol_pos`` [m], ``tol_rot`` [rad] the tolerances.
     """
@@ -693,8 +698,18 @@ cdef class ClosedForm:
     def __init__(self, Judge judge, spec):
         c = [np.ascontiguousarray(getattr(spec, name), dtype=np.float64)
              for name in ("h", "o", "R0", "N0", "lower", "upper", "check_lower", "check_upper")]
+        cdef const double[::1] general
+        cdef const double* data = NULL
+        if spec.kind == GENERAL_6R:
+            packed = np.ascontiguousarray(spec.general, dtype=np.float64)
+            general = packed
+            if general.shape[0] != GENERAL_SIZE:
+                raise ValueError(f"ClosedForm: the general class's packed data has {GENERAL_SIZE} numbers")
+            c.append(packed)
+            data = &general[0]
+            ready()
         self.keep = c
-        self.arm = _arm(spec.kind, spec.mirrored, c[0], c[1], c[2], c[3], c[4], c[5], spec.same, spec.slack)
+        self.arm = _arm(spec.kind, spec.mirrored, c[0], c[1], c[2], c[3], c[4], c[5], spec.same, spec.slack, data)
         self.n = self.arm.n
         self.check_lower, self.check_upper = c[6], c[7]
         if judge.kind.shape[0] != self.n or self.check_lower.shape[0] != self.n or self.check_upper.shape[0] != self.n:

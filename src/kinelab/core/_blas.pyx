@@ -19,6 +19,12 @@ ctypedef void (*dgesv_t)(int*, int*, double*, int*, int*, double*, int*, int*) n
 ctypedef void (*dgetrf_t)(int*, int*, double*, int*, int*, int*) noexcept nogil
 ctypedef void (*dgesdd_t)(char*, int*, int*, double*, int*, double*, double*, int*, double*, int*, double*, int*,
                           int*, int*) noexcept nogil
+ctypedef void (*dgetrs_t)(char*, int*, int*, double*, int*, int*, double*, int*, int*) noexcept nogil
+ctypedef void (*dgecon_t)(char*, int*, double*, int*, double*, double*, double*, int*, int*) noexcept nogil
+ctypedef void (*dgeev_t)(char*, char*, int*, double*, int*, double*, double*, double*, int*, double*, int*, double*,
+                         int*, int*) noexcept nogil
+ctypedef void (*dggev_t)(char*, char*, int*, double*, int*, double*, int*, double*, double*, double*, double*, int*,
+                         double*, int*, double*, int*, int*) noexcept nogil
 
 cdef dgemm_t _dgemm = NULL
 cdef dgemv_t _dgemv = NULL
@@ -26,6 +32,10 @@ cdef ddot_t _ddot = NULL
 cdef dgesv_t _dgesv = NULL
 cdef dgetrf_t _dgetrf = NULL
 cdef dgesdd_t _dgesdd = NULL
+cdef dgetrs_t _dgetrs = NULL
+cdef dgecon_t _dgecon = NULL
+cdef dgeev_t _dgeev = NULL
+cdef dggev_t _dggev = NULL
 
 
 cdef void dgemm(char* transa, char* transb, int* m, int* n, int* k, double* alpha, double* a, int* lda, double* b,
@@ -53,6 +63,27 @@ cdef void dgetrf(int* m, int* n, double* a, int* lda, int* ipiv, int* info) noex
 cdef void dgesdd(char* jobz, int* m, int* n, double* a, int* lda, double* s, double* u, int* ldu, double* vt,
                  int* ldvt, double* work, int* lwork, int* iwork, int* info) noexcept nogil:
     _dgesdd(jobz, m, n, a, lda, s, u, ldu, vt, ldvt, work, lwork, iwork, info)
+
+
+cdef void dgetrs(char* trans, int* n, int* nrhs, double* a, int* lda, int* ipiv, double* b, int* ldb,
+                 int* info) noexcept nogil:
+    _dgetrs(trans, n, nrhs, a, lda, ipiv, b, ldb, info)
+
+
+cdef void dgecon(char* norm, int* n, double* a, int* lda, double* anorm, double* rcond, double* work, int* iwork,
+                 int* info) noexcept nogil:
+    _dgecon(norm, n, a, lda, anorm, rcond, work, iwork, info)
+
+
+cdef void dgeev(char* jobvl, char* jobvr, int* n, double* a, int* lda, double* wr, double* wi, double* vl, int* ldvl,
+                double* vr, int* ldvr, double* work, int* lwork, int* info) noexcept nogil:
+    _dgeev(jobvl, jobvr, n, a, lda, wr, wi, vl, ldvl, vr, ldvr, work, lwork, info)
+
+
+cdef void dggev(char* jobvl, char* jobvr, int* n, double* a, int* lda, double* b, int* ldb, double* alphar,
+                double* alphai, double* beta, double* vl, int* ldvl, double* vr, int* ldvr, double* work, int* lwork,
+                int* info) noexcept nogil:
+    _dggev(jobvl, jobvr, n, a, lda, b, ldb, alphar, alphai, beta, vl, ldvl, vr, ldvr, work, lwork, info)
 
 
 def _module(name):
@@ -87,8 +118,8 @@ cdef void* _pointer(dict table, str name) except NULL:
 
 cpdef void ready() except *:
     """Take BLAS and LAPACK from SciPy, once per process (a no-op afterwards)."""
-    global _dgemm, _dgemv, _ddot, _dgesv, _dgetrf, _dgesdd
-    if _dgesdd != NULL:
+    global _dgemm, _dgemv, _ddot, _dgesv, _dgetrf, _dgesdd, _dgetrs, _dgecon, _dgeev, _dggev
+    if _dggev != NULL:
         return
     blas, lapack = _module("cython_blas").__pyx_capi__, _module("cython_lapack").__pyx_capi__
     _dgemm = <dgemm_t> _pointer(blas, "dgemm")
@@ -97,3 +128,7 @@ cpdef void ready() except *:
     _dgesv = <dgesv_t> _pointer(lapack, "dgesv")
     _dgetrf = <dgetrf_t> _pointer(lapack, "dgetrf")
     _dgesdd = <dgesdd_t> _pointer(lapack, "dgesdd")
+    _dgetrs = <dgetrs_t> _pointer(lapack, "dgetrs")
+    _dgecon = <dgecon_t> _pointer(lapack, "dgecon")
+    _dgeev = <dgeev_t> _pointer(lapack, "dgeev")
+    _dggev = <dggev_t> _pointer(lapack, "dggev")

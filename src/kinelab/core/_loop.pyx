@@ -10,25 +10,25 @@ before it carry them.
 
 from kinelab.core._geometry cimport rotm
 
-cdef enum:
-    MAX_JOINTS = 8
-
 
 def equations(const double[:, ::1] h, const double[:, ::1] o, const double[:, ::1] R0, const double[::1] N0,
               double scale, const double[:, ::1] q, const double[:, ::1] H, double[:, ::1] F,
               double[:, :, ::1] J):
     """F (m, 6) and J (m, 6, n) of the loop equations at the rows of q (m, n ≤ 8) [rad], written in place."""
     cdef Py_ssize_t m = q.shape[0], n = q.shape[1], row
-    if n > MAX_JOINTS:
-        raise ValueError(f"at most {MAX_JOINTS} joints (got {n})")
+    if n > MAX_JOINTS or h.shape[0] != n or o.shape[0] != n or H.shape[0] != 4 or H.shape[1] != 4 \
+            or F.shape[0] != m or F.shape[1] != 6 or J.shape[0] != m or J.shape[1] != 6 or J.shape[2] != n:
+        raise ValueError(f"equations: at most {MAX_JOINTS} joints, h and o (n, 3), H (4, 4), F (m, 6), J (m, 6, n)")
     with nogil:
         for row in range(m):
-            _row(h, o, R0, N0, scale, q[row], H, F[row], J[row], n)
+            loop_row(&h[0, 0], &o[0, 0], &R0[0, 0], &N0[0], scale, &q[row, 0], &H[0, 0], &F[row, 0], &J[row, 0, 0],
+                     <int> n)
 
 
-cdef void _row(const double[:, ::1] h, const double[:, ::1] o, const double[:, ::1] R0, const double[::1] N0,
-               double scale, const double[::1] q, const double[:, ::1] H, double[::1] F, double[:, ::1] J,
-               Py_ssize_t n) noexcept nogil:
+cdef void loop_row(const double* h, const double* o, const double* R0, const double* N0, double scale,
+                   const double* q, const double* H, double* F, double* J, int n) noexcept nogil:
+    """F (6,) and J (6 × n, row-major) of the chain (h, o: n × 3 row-major; R0 3 × 3; N0) at q for the target H
+    (4 × 4, row-major)."""
     cdef double R[9]
     cdef double turn[9]
     cdef double nxt[9]
@@ -39,18 +39,16 @@ cdef void _row(const double[:, ::1] h, const double[:, ::1] o, const double[:, :
     cdef double Rt[9]
     cdef double p[3]
     cdef double M[9]
-    cdef Py_ssize_t k, a, b
+    cdef int k, a, b
     cdef double trace = 0.0
     for a in range(9):
         R[a] = 1.0 if a % 4 == 0 else 0.0
     t[0] = t[1] = t[2] = 0.0
     for k in range(n):
-        for a in range(3):
-            w[k][a] = R[3 * a] * h[k, 0] + R[3 * a + 1] * h[k, 1] + R[3 * a + 2] * h[k, 2]
-            at[k][a] = R[3 * a] * o[k, 0] + R[3 * a + 1] * o[k, 1] + R[3 * a + 2] * o[k, 2] + t[a]
-        rotm(h[k, 0], h[k, 1], h[k, 2], q[k], turn)
+        _carried(R, t, h + 3 * k, o + 3 * k, w[k], at[k])
+        rotm(h[3 * k], h[3 * k + 1], h[3 * k + 2], q[k], turn)
         for a in range(3):  # o_k − turn·o_k, carried by R
-            d[a] = o[k, a] - (turn[3 * a] * o[k, 0] + turn[3 * a + 1] * o[k, 1] + turn[3 * a + 2] * o[k, 2])
+            d[a] = o[3 * k + a] - (turn[3 * a] * o[3 * k] + turn[3 * a + 1] * o[3 * k + 1] + turn[3 * a + 2] * o[3 * k + 2])
         for a in range(3):
             t[a] += R[3 * a] * d[0] + R[3 * a + 1] * d[1] + R[3 * a + 2] * d[2]
         for a in range(3):
@@ -60,30 +58,39 @@ cdef void _row(const double[:, ::1] h, const double[:, ::1] o, const double[:, :
             R[a] = nxt[a]
     for a in range(3):
         for b in range(3):
-            Rt[3 * a + b] = R[3 * a] * R0[0, b] + R[3 * a + 1] * R0[1, b] + R[3 * a + 2] * R0[2, b]
+            Rt[3 * a + b] = R[3 * a] * R0[b] + R[3 * a + 1] * R0[3 + b] + R[3 * a + 2] * R0[6 + b]
         p[a] = R[3 * a] * N0[0] + R[3 * a + 1] * N0[1] + R[3 * a + 2] * N0[2] + t[a]
-        F[a] = (p[a] - H[a, 3]) / scale
+        F[a] = (p[a] - H[4 * a + 3]) / scale
     _half_cross_sum(Rt, H, F)
     for a in range(3):
         for b in range(3):
-            trace += H[a, b] * Rt[3 * a + b]
-            M[3 * a + b] = Rt[3 * a] * H[b, 0] + Rt[3 * a + 1] * H[b, 1] + Rt[3 * a + 2] * H[b, 2]
+            trace += H[4 * a + b] * Rt[3 * a + b]
+            M[3 * a + b] = Rt[3 * a] * H[4 * b] + Rt[3 * a + 1] * H[4 * b + 1] + Rt[3 * a + 2] * H[4 * b + 2]
     for k in range(n):
         for a in range(3):
             d[a] = p[a] - at[k][a]
-        J[0, k] = (w[k][1] * d[2] - w[k][2] * d[1]) / scale
-        J[1, k] = (w[k][2] * d[0] - w[k][0] * d[2]) / scale
-        J[2, k] = (w[k][0] * d[1] - w[k][1] * d[0]) / scale
+        J[k] = (w[k][1] * d[2] - w[k][2] * d[1]) / scale
+        J[n + k] = (w[k][2] * d[0] - w[k][0] * d[2]) / scale
+        J[2 * n + k] = (w[k][0] * d[1] - w[k][1] * d[0]) / scale
         for a in range(3):
-            J[3 + a, k] = 0.5 * (w[k][a] * trace - (M[3 * a] * w[k][0] + M[3 * a + 1] * w[k][1]
-                                                    + M[3 * a + 2] * w[k][2]))
+            J[(3 + a) * n + k] = 0.5 * (w[k][a] * trace - (M[3 * a] * w[k][0] + M[3 * a + 1] * w[k][1]
+                                                          + M[3 * a + 2] * w[k][2]))
 
 
-cdef inline void _half_cross_sum(const double* Rt, const double[:, ::1] H, double[::1] F) noexcept nogil:
+cdef inline void _carried(const double* R, const double* t, const double* h, const double* o, double* w,
+                          double* at) noexcept nogil:
+    """Axis h and its point o as the joints before carry them (rotation R, translation t)."""
+    cdef int a
+    for a in range(3):
+        w[a] = R[3 * a] * h[0] + R[3 * a + 1] * h[1] + R[3 * a + 2] * h[2]
+        at[a] = R[3 * a] * o[0] + R[3 * a + 1] * o[1] + R[3 * a + 2] * o[2] + t[a]
+
+
+cdef inline void _half_cross_sum(const double* Rt, const double* H, double* F) noexcept nogil:
     """F[3:6] = ½ Σ_k (column k of H's rotation) × (column k of Rt)."""
-    cdef Py_ssize_t k
+    cdef int k
     F[3] = F[4] = F[5] = 0.0
     for k in range(3):
-        F[3] += 0.5 * (H[1, k] * Rt[6 + k] - H[2, k] * Rt[3 + k])
-        F[4] += 0.5 * (H[2, k] * Rt[k] - H[0, k] * Rt[6 + k])
-        F[5] += 0.5 * (H[0, k] * Rt[3 + k] - H[1, k] * Rt[k])
+        F[3] += 0.5 * (H[4 + k] * Rt[6 + k] - H[8 + k] * Rt[3 + k])
+        F[4] += 0.5 * (H[8 + k] * Rt[k] - H[k] * Rt[6 + k])
+        F[5] += 0.5 * (H[k] * Rt[3 + k] - H[4 + k] * Rt[k])

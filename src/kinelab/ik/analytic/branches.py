@@ -34,7 +34,7 @@ from kinelab.ik.analytic.certify import (
     split_merged,
 )
 from kinelab.ik.analytic.classify import ArmClass, classify, general_class, general_vectors
-from kinelab.ik.analytic.general import roots_within
+from kinelab.ik.analytic.general import packed, roots_within
 from kinelab.ik.analytic.kernel import GENERAL_6R, MAX_ROWS, branches, branches_batch
 from kinelab.ik.batch import BatchIKResult
 from kinelab.ik.chain import chain_model
@@ -127,7 +127,9 @@ def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | No
     compiled = None if form is None else form.solve(target.homogeneous, q_ref)
     if compiled is not None and ((compiled[3] > 1) & ~compiled[4]).any():
         compiled = None  # roots merged: perhaps two beside a fold, which the root-by-root route splits
-    uncertified = "" if arm.kind == GENERAL_6R else None
+    if compiled is not None and arm.kind == GENERAL_6R and not len(compiled[0]):
+        compiled = None  # no root: whether that is proved, the root-by-root route says
+    uncertified = "" if arm.kind == GENERAL_6R and compiled is None else None
     if compiled is None:  # no certified compiled FK, a root to finish or roots merged: root by root
         if arm.kind == GENERAL_6R:
             q, found, free, uncertified = roots_within(arm, target.homogeneous, robot.lower, robot.upper, q_ref,
@@ -171,15 +173,13 @@ def prepared_form(robot: Robot, req: Request) -> ClosedForm | None:
     key = (float(req.tol_pos), float(req.tol_rot))
     if key not in forms:
         judge, arm = robot.derived("compiled judge", _compiled_judge), arm_of(robot, req)
-        if arm.kind == GENERAL_6R:  # not compiled yet: root by root
-            judge = None
         if len(forms) >= 16:  # a caller sweeping tolerances: keep the memory bounded
             forms.clear()
         lower, upper = robot.check_bounds
         forms[key] = None if judge is None else ClosedForm(judge, SimpleNamespace(
             kind=arm.kind, mirrored=arm.mirrored, h=arm.h, o=arm.o, R0=arm.R0, N0=arm.N0, lower=robot.lower,
             upper=robot.upper, same=SAME, slack=limit_slack(req.tol_rot), check_lower=lower, check_upper=upper,
-            tol_pos=key[0], tol_rot=key[1]))
+            tol_pos=key[0], tol_rot=key[1], general=packed(*arm.solver) if arm.kind == GENERAL_6R else None))
     return forms[key]
 
 
@@ -251,7 +251,8 @@ def branch_results(robot: Robot, rows: Rows, req: Request, mode: str, elapsed: f
     ``unreachable`` for the reason ``empty``: the closed form and the search compute every branch, so finding none
     proves it (the general 6R elimination: when its set is certified). ``method``: "closed form", "search",
     "elimination" or "sweep"; ``uncertified``: the elimination's reason its set is not certified ("" when it is);
-    ``H``: the pose, for a closed form's certificate (computed when the set's completeness is first read)."""
+    ``H``: the pose, for the set's certificate when ``uncertified`` is None (computed when the set's completeness
+    is first read)."""
     total = len(rows.q)
     kept = rows if max_solutions is None or max_solutions >= total else rows.taken(slice(max_solutions))
     unseen = 0.0 if method == "closed form" else None
@@ -263,28 +264,34 @@ def branch_results(robot: Robot, rows: Rows, req: Request, mode: str, elapsed: f
                                 unseen)
     if uncertified is not None:
         return made.certified_by(("certified", "") if uncertified == "" else ("search", uncertified))
-    if method in ("closed form", "search") and H is not None:
+    if H is not None:
         return made.certified_by(partial(certificate_of, robot, method, H, rows.q, rows.merged, rows.continuum))
     return made
 
 
 def certificate_of(robot: Robot, method: str, H: np.ndarray, q: np.ndarray, merged: np.ndarray,
                    continuum: np.ndarray) -> tuple[str, str]:
-    """(complete, reason) of a closed form's or a search's set q (k, 6) [rad] of the pose H (docs/analytic.md,
-    Certificates). A search's set short of 16 proved branches is certified when the general elimination takes the
-    chain (the xArm6's, read from the tool) and its set, certified, is the same to 1e-6 rad."""
+    """(complete, reason) of a closed form's, a search's or the compiled elimination's set q (k, 6) [rad] of the
+    pose H (docs/analytic.md, Certificates). A search's set short of 16 proved branches is certified when the
+    general elimination takes the chain (the xArm6's, read from the tool) and its set, certified, is the same to
+    1e-6 rad; the compiled elimination's set when the elimination's certified set (computed again with the
+    eigenvalues' condition numbers, :func:`~kinelab.ik.analytic.general.roots_within`) is the same."""
     loop = robot_loop(robot)
     if method == "closed form":
         return set_certificate(loop, H, q, merged, continuum)
-    level, reason = search_certificate(loop, H, q, merged, continuum)
-    check = robot.derived("elimination cross-check", _elimination)
+    if method == "elimination":
+        level, reason = "search", "the compiled elimination's set"
+        check: ArmClass | None = general_class(robot).arm
+    else:
+        level, reason = search_certificate(loop, H, q, merged, continuum)
+        check = robot.derived("elimination cross-check", _elimination)
     if level == "certified" or check is None:
         return level, reason
     theirs, _, _, why = roots_within(check, H, robot.lower, robot.upper, None, LIMIT_SLACK)
     if why:
-        return "search", f"{reason}; the general elimination's set is not certified either: {why}"
+        return "search", f"{reason}; the general elimination's set is not certified: {why}"
     if len(theirs) != len(q) or not all(np.abs(wrap_to_pi(theirs - row)).max(axis=1).min() <= 1e-6 for row in q):
-        return "search", f"the general elimination finds {len(theirs)} branches, the 1-D search {len(q)}"
+        return "search", f"the general elimination's certified set has {len(theirs)} branches, this one {len(q)}"
     return proved_each(loop, H, q)
 
 
@@ -431,6 +438,8 @@ def all_branches_batch(robot: Robot, targets: Any, tol_pos: float = 1e-6, tol_ro
     found, free = np.zeros((B, MAX_ROWS), dtype=np.int64), np.zeros((B, MAX_ROWS), dtype=np.bool_)
     count, near = np.zeros(B, dtype=np.int64), np.zeros(B, dtype=np.uint8)
     form.solve_batch(H, q, errors, found, free.view(np.uint8), count, near, threads.count())
+    if arm.kind == GENERAL_6R:  # no root, or roots merged: the root-by-root route says why, or splits them
+        near |= (count == 0) | ((found > 1) & ~free).any(axis=1)
     for b in np.flatnonzero(near):
         one = analytic_all(robot, pin.SE3(H[b]), req)
         k = count[b] = len(one)
@@ -509,7 +518,7 @@ class OneCall:
     def __init__(self, robot: Robot, req: Request, form: ClosedForm):
         arm = arm_of(robot, req)
         self.form, self.fields = form, _constant_fields(robot, req, arm.mode)
-        self.method = "search" if arm.searched else "closed form"
+        self.method = _method(arm)
         self.unseen = 0.0 if self.method == "closed form" else None
         self.unfinished = np.zeros(MAX_ROWS, dtype=np.bool_)  # the compiled form finishes no root
         self.robot = robot

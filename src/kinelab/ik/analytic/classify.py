@@ -133,19 +133,26 @@ def _general(robot: Robot) -> Classification:
 def general_vectors(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray) -> Classification:
     """The general 6R class of the chain (h, o, R0, N0) at q = 0 (base frame, metres), read from the base or else
     from the tool (the elimination's joints 1 and 2 are then the last two), or None with the structure the
-    elimination cannot take either way (it misses seeded configurations of the chain)."""
+    elimination cannot take either way (it misses seeded configurations of the chain). A reading whose pencil is
+    regular is preferred; one whose pencil is singular is taken only when neither is regular (its sets are then
+    never certified)."""
     from kinelab.ik.analytic.certify import loop_of
     from kinelab.ik.analytic.general import prepare, usable
 
-    failed = []
+    failed, singular = [], []
     for mirrored in (False, True):
         hh, oo, RR, NN = reverse(h, o, R0, N0) if mirrored else (h, o, R0, N0)
         solver = (prepare(hh, oo, RR, NN), loop_of(hh, oo, RR, NN))
-        why = usable(*solver)
+        why, regular = usable(*solver)
+        name = "general 6R" + (" (mirrored: read from the tool)" if mirrored else "")
+        arm = ArmClass(name, GENERAL_6R, mirrored, hh, oo, RR, NN, solver)
+        if not why and regular:
+            return Classification(arm, "")
         if not why:
-            name = "general 6R" + (" (mirrored: read from the tool)" if mirrored else "")
-            return Classification(ArmClass(name, GENERAL_6R, mirrored, hh, oo, RR, NN, solver), "")
-        failed.append(("read from the tool: " if mirrored else "") + why)
+            singular.append(arm)
+        failed.append(("read from the tool: " if mirrored else "") + (why or "its pencil is singular"))
+    if singular:
+        return Classification(singular[0], "")
     return Classification(None, f"the general 6R elimination degenerates on this chain's structure ({special(h, o)}): "
                           + " | ".join(failed))
 

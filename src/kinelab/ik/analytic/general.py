@@ -27,6 +27,7 @@ from kinelab.ik.limits import inside_limits
 SPURIOUS = 8  # eigenvalues at x₃ = ±i that every pose's determinant carries: (1 + x₃²)⁴
 SPURIOUS_TOL = 1e-6  # [chordal] an eigenvalue this close to ±i is one of them (found within ~1e-13; a root nearer
 # is rare and leaves the set uncertified, never wrong)
+SINGULAR_PENCIL = "the pencil is singular or nearly so"
 RANK_TOL = 1e-9  # Q's smallest kept singular value relative to its largest: below it the elimination is refused
 _ANGLES = np.array([0.0, 2 * np.pi / 3, 4 * np.pi / 3])
 _FOURIER = np.linalg.inv(np.stack([np.ones(3), np.cos(_ANGLES), np.sin(_ANGLES)]).T)  # samples → (1, cos, sin)
@@ -127,6 +128,21 @@ def prepare(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray) -> Gen
     pairs = rz(-_ANGLES)[None, :] @ G1i @ rz(-_ANGLES)[:, None]  # [a, b] = Rz(−b)·G₁⁻¹·Rz(−a)
     return General6R(h, o, R0, N0, phi, G, left, half[0].copy(), pairs[..., :3, :3].reshape(9, 3, 3),
                      pairs[..., :3, 3].reshape(9, 3))
+
+
+PACKED_SIZE = 776  # the compiled elimination's packed data (kinelab/core/_general.pxi, layout G_*)
+
+
+def packed(g: General6R, loop: Loop) -> np.ndarray:
+    """The prepared chain ``g`` and its loop equations' length scale as the compiled elimination reads them
+    (kinelab/core/_general.pxi): φ, G₀⁻¹, G₆⁻¹, G₁ … G₅, P's coefficients, the constant monomial's row, the right
+    side's sample frames, the two Fourier matrices, ℓ."""
+    out = np.concatenate([g.phi, _inverse(g.frames[0]).ravel(), _inverse(g.frames[6]).ravel(), g.frames[1:6].ravel(),
+                          g.left.ravel(), g.one, g.right_R.ravel(), g.right_t.ravel(),
+                          np.kron(_FOURIER, _FOURIER).ravel(), _FROM_TRIG.ravel(), [loop.scale]])
+    if out.size != PACKED_SIZE:
+        raise AssertionError(f"the packed elimination has {out.size} numbers, the compiled one reads {PACKED_SIZE}")
+    return out
 
 
 def _right(g: General6R, H: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -292,7 +308,7 @@ def counted(eigen: Eigen, q: np.ndarray, proved: np.ndarray, phi3: float) -> str
     a, b = _unit(eigen.alpha, eigen.beta)
     at_i = np.minimum(np.abs(a - 1j * b), np.abs(a + 1j * b)) / np.sqrt(2) < SPURIOUS_TOL
     if at_i.sum() != SPURIOUS:
-        return f"{int(at_i.sum())} eigenvalues near ±i, not {SPURIOUS}: the pencil is singular or nearly so"
+        return f"{int(at_i.sum())} eigenvalues near ±i, not {SPURIOUS}: {SINGULAR_PENCIL}"
     r = radii(eigen)
     if not np.isfinite(r[~at_i]).all():
         return "a defective eigenvalue (a double root the eigenvalues cannot separate)"
@@ -392,19 +408,22 @@ def _distinct(q: np.ndarray, proof: Proof) -> tuple[list[int], np.ndarray]:
 TRIALS = 4  # seeded configurations the elimination must recover before a chain is accepted
 
 
-def usable(g: General6R, loop: Loop) -> str:
-    """"" when the elimination recovers TRIALS seeded configurations of the chain (each among the roots of its own
-    pose, to 1e-9 rad); else the structure it cannot take, in words. (A chain whose pencil is singular can still
-    pass: its sets then say they are not certified.)"""
+def usable(g: General6R, loop: Loop) -> tuple[str, bool]:
+    """("", regular) when the elimination recovers TRIALS seeded configurations of the chain (each among the roots of
+    its own pose, to 1e-9 rad), ``regular`` False when its pencil was singular at any of them (its eigenvalues are
+    then whatever rounding makes them: a root found on one machine may be missed on another, and no set is
+    certified); else (the structure it cannot take, in words, False)."""
     rng = np.random.default_rng(OFFSET_SEED)
+    regular = True
     for q in rng.uniform(-np.pi, np.pi, (TRIALS, 6)):
         found = every_root(g, loop, chain_pose(loop.h, loop.o, loop.R0, loop.N0, q))
         if found.reason.startswith("the elimination is degenerate"):
-            return "joints 1 and 2's invariants are dependent"
+            return "joints 1 and 2's invariants are dependent", False
+        regular = regular and not found.reason.endswith(SINGULAR_PENCIL)
         gaps = np.abs(wrap_to_pi(found.q - q)).max(axis=1, initial=0.0)
         if found.q.shape[0] == 0 or gaps.min() > 1e-9:
-            return f"it misses the chain's own configurations: {found.reason or 'roots lost'}"
-    return ""
+            return f"it misses the chain's own configurations: {found.reason or 'roots lost'}", False
+    return "", regular
 
 
 def roots_within(arm: object, H: np.ndarray, lower: np.ndarray, upper: np.ndarray, ref: np.ndarray | None,

@@ -7,16 +7,17 @@ closed form, unchecked). Rounds alternate interleaved (each solver on each pose 
 and blocked schedules; the multistart's seeds change with the round. Figures: the median time per call per
 round, reported as the median over rounds with the spread (lowest, highest round); how often the multistart
 found every closed-form branch; the batch's poses per second on all cores, with and without Pinocchio's check.
-Arms without a closed form (the Stanford arm by default) get the multistart against a dense reference: the
-same search without its stopping rule for 0.5 s. A 7R arm with a swept closed form (the ERA) gets
-``solve_all(..., redundancy=K)`` against the multistart, timed alike (its answers are a continuum: no
-completeness).
+The general 6R arms (the calibrated UR10e and ``general6r``) get their own table
+(:mod:`kinelab.report.bench.general`). Arms without a closed form (the Stanford arm by default) get the
+multistart against a dense reference: the same search without its stopping rule for 0.5 s. A 7R arm with a
+swept closed form (the ERA) gets ``solve_all(..., redundancy=K)`` against the multistart, timed alike (its
+answers are a continuum: no completeness).
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -24,20 +25,20 @@ import pinocchio as pin
 from tqdm import tqdm
 
 from kinelab.ik.analytic.branches import SAME as CLOSED_SAME
-from kinelab.ik.analytic.branches import all_branches_batch
+from kinelab.ik.analytic.branches import all_branches_batch, has_general_form
 from kinelab.ik.analytic.classify import classify
 from kinelab.ik.analytic.redundancy import has_swept_form
 from kinelab.ik.api import solve_all
 from kinelab.ik.branches import SAME
 from kinelab.ik.limits import distance
-from kinelab.report.bench.protocol import round_plan
+from kinelab.ik.request import make_request
+from kinelab.report.bench.protocol import Call, figures, warmed_rounds
 from kinelab.robot import Robot, load
 
 ANALYTIC_ROBOTS = ("ur3", "ur5", "ur10", "z1", "kinova", "so101", "xarm6", "crx10ia")
 NUMERIC_ROBOTS = ("stanford",)
 REDUNDANT_ROBOTS = ("era", "panda", "baxter_left")
 K = 16  # samples of a 7R arm's swept joint
-Call = Callable[[pin.SE3, int], Any]
 
 
 def _eaik(robot: Robot) -> Call | None:
@@ -61,22 +62,6 @@ def _eaik(robot: Robot) -> Call | None:
         return bot.IK(H)
 
     return call
-
-
-def rounds(poses: list[pin.SE3], calls: dict[str, Call], repeats: int) -> dict[str, list[float]]:
-    """Per solver, the median time per call [s] of each round (:func:`~kinelab.report.bench.protocol.round_plan`:
-    interleaved and blocked rounds alternating)."""
-    medians: dict[str, list[float]] = {name: [] for name in calls}
-    names = list(calls)
-    for r in range(repeats):
-        times: dict[str, list[float]] = {name: [] for name in calls}
-        for k, name in round_plan(len(poses), names, r):
-            t0 = time.perf_counter()
-            calls[name](poses[k], r * len(poses) + k)
-            times[name].append(time.perf_counter() - t0)
-        for name in names:
-            medians[name].append(float(np.median(times[name])))
-    return medians
 
 
 def _complete(robot: Robot, found: Sequence[Any], reference: Sequence[Any], same: float) -> bool:
@@ -158,28 +143,19 @@ def _timed(poses: list[pin.SE3], calls: dict[str, Call], repeats: int) -> dict[s
     return figures(warmed_rounds(poses, calls, repeats))
 
 
-def warmed_rounds(poses: list[pin.SE3], calls: dict[str, Call], repeats: int) -> dict[str, list[float]]:
-    """Each call once on the first pose (compilation, not timed), then :func:`rounds`."""
-    for call in calls.values():
-        call(poses[0], 0)
-    return rounds(poses, calls, repeats)
-
-
-def figures(medians: dict[str, list[float]]) -> dict[str, Any]:
-    """{"us": the median over rounds [µs], "spread_us": (lowest, highest round) [µs]} per call."""
-    return {"us": {k: 1e6 * float(np.median(v)) for k, v in medians.items()},
-            "spread_us": {k: (1e6 * min(v), 1e6 * max(v)) for k, v in medians.items()}}
-
-
 def run(robots: list[str] | None = None, n: int = 100, seed: int = 0, repeats: int = 4,
         progress: bool = False) -> list[dict[str, Any]]:
     """Every arm asked for (default: the arms with a closed form or a 1-D search, the Stanford arm, the ERA, the
     Panda and Baxter), a row each."""
-    names = list(robots or (*ANALYTIC_ROBOTS, *NUMERIC_ROBOTS, *REDUNDANT_ROBOTS))
+    from kinelab.report.bench.general import GENERAL_ROBOTS, general_arm
+
+    names = list(robots or (*ANALYTIC_ROBOTS, *GENERAL_ROBOTS, *NUMERIC_ROBOTS, *REDUNDANT_ROBOTS))
     rows = []
     for name in tqdm(names, desc="bench --branches", disable=not progress, unit="arm"):
         robot = load(name)
-        if classify(robot).arm is not None:
+        if classify(robot).arm is None and has_general_form(robot, make_request("frdm")):
+            rows.append({"general": True, **general_arm(robot, n, seed, repeats)})
+        elif classify(robot).arm is not None:
             rows.append(analytic_arm(robot, n, seed, repeats))
         elif has_swept_form(robot):
             rows.append(redundant_arm(robot, max(10, n // 5), seed, repeats))
@@ -189,7 +165,13 @@ def run(robots: list[str] | None = None, n: int = 100, seed: int = 0, repeats: i
 
 
 def markdown(rows: list[dict[str, Any]]) -> str:
-    """The rows as a Markdown table (times: median over rounds [lowest–highest round])."""
+    """The rows as Markdown tables (times: median over rounds [lowest–highest round]): the arms with a class, the
+    multistart's and the swept ones; then the general 6R arms' (:mod:`kinelab.report.bench.general`)."""
+    from kinelab.report.bench import general
+
+    generals = [r for r in rows if r.get("general")]
+    rows = [r for r in rows if not r.get("general")]
+
     def shown(row: dict[str, Any], name: str, scale: float, unit: str) -> str:
         if name not in row["us"]:
             return "–"
@@ -212,4 +194,4 @@ def markdown(rows: list[dict[str, Any]]) -> str:
             f"{r['batch_kernel_per_s']:,.0f}/s |" if closed else
             f"| {r['robot']} | – | – | {shown(r, 'multistart', 1e3, 'ms')} | – | "
             f"{100 * r['multistart_complete']:.1f} % (vs dense) | – | – |")
-    return "\n".join(lines)
+    return "\n".join(lines) + ("\n\n" + general.markdown(generals) if generals else "")

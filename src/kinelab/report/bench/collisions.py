@@ -2,7 +2,7 @@
 
 Per arm (panda, ur5, kinova by default), around a floor and a table (:data:`FLOOR_AND_TABLE`): n targets, each
 the FK of a random configuration clear of both and of the arm itself. Each target goes to ``solve`` without and
-with ``collisions=``, interleaved and blocked rounds alternating (:func:`kinelab.report.bench.branches.rounds`),
+with ``collisions=``, interleaved and blocked rounds alternating (:func:`kinelab.report.bench.protocol.rounds`),
 seeds changing with the round. Figures: the median time per call of each (median over rounds, the spread
 lowest–highest round) and their ratio; how many answers of the plain solve collide; how many targets the
 collision-aware solve reaches clear; and the check's own cost per configuration (random configurations, and
@@ -19,7 +19,7 @@ from tqdm import tqdm
 
 from kinelab.collision import Collisions, Environment, Obstacle, collision_model
 from kinelab.ik.api import solve
-from kinelab.report.bench.branches import figures, warmed_rounds
+from kinelab.report.bench.protocol import figures, warmed_rounds
 from kinelab.robot import Robot, load
 
 ROBOTS = ("panda", "ur5", "kinova")

@@ -13,8 +13,10 @@ targets live here, never in timed tests.
 """
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -124,3 +126,35 @@ def path_set(robot: Robot, seed: int, count: int, samples: int = 200) -> list[np
     """``count`` seeded joint-space paths, cosine blends and sinusoids in turn (path k from seed + k): the set
     the tracking protocol and its test follow."""
     return [(blend_path if k % 2 == 0 else smooth_path)(robot, seed + k, samples) for k in range(count)]
+
+
+Call = Callable[[pin.SE3, int], Any]  # a solver timed on (target, seed)
+
+
+def rounds(poses: list[pin.SE3], calls: dict[str, Call], repeats: int) -> dict[str, list[float]]:
+    """Per solver, the median time per call [s] of each round (:func:`~kinelab.report.bench.protocol.round_plan`:
+    interleaved and blocked rounds alternating)."""
+    medians: dict[str, list[float]] = {name: [] for name in calls}
+    names = list(calls)
+    for r in range(repeats):
+        times: dict[str, list[float]] = {name: [] for name in calls}
+        for k, name in round_plan(len(poses), names, r):
+            t0 = time.perf_counter()
+            calls[name](poses[k], r * len(poses) + k)
+            times[name].append(time.perf_counter() - t0)
+        for name in names:
+            medians[name].append(float(np.median(times[name])))
+    return medians
+
+
+def warmed_rounds(poses: list[pin.SE3], calls: dict[str, Call], repeats: int) -> dict[str, list[float]]:
+    """Each call once on the first pose (compilation, not timed), then :func:`rounds`."""
+    for call in calls.values():
+        call(poses[0], 0)
+    return rounds(poses, calls, repeats)
+
+
+def figures(medians: dict[str, list[float]]) -> dict[str, Any]:
+    """{"us": the median over rounds [µs], "spread_us": (lowest, highest round) [µs]} per call."""
+    return {"us": {k: 1e6 * float(np.median(v)) for k, v in medians.items()},
+            "spread_us": {k: (1e6 * min(v), 1e6 * max(v)) for k, v in medians.items()}}
