@@ -124,9 +124,10 @@ USUAL_PER_ROBOT = 16  # a caller sweeping settings: the prepared closed forms ke
 
 def usual_closed_form(robot: Robot, target: Any, seed: Any, settings: tuple[Any, ...]) -> Branches | None:
     """Every branch of ``target`` in one compiled call for the usual call of :func:`kinelab.solve_all` — a solver
-    that picks its route ("auto") on a chain with a closed form and a certified compiled FK, a ``pin.SE3`` target,
-    no options, references, collisions or sweeps — with ``settings`` = (solver, tol_pos, tol_rot, time_budget,
-    stop_below) checked once per robot; None otherwise (the general route then answers, or names what is wrong)."""
+    that picks its route ("auto") on a chain with a closed form or the general elimination and a certified compiled
+    FK, a ``pin.SE3`` target, no options, references, collisions or sweeps — with ``settings`` = (solver, tol_pos,
+    tol_rot, time_budget, stop_below) checked once per robot; None otherwise (the general route then answers, or
+    names what is wrong)."""
     kept: dict[tuple[Any, ...], EveryBranch | Literal[False]] = robot.derived("usual closed forms", _new_kept)
     try:
         entry = kept.get(settings)
@@ -154,7 +155,7 @@ def _usual_entry(robot: Robot, settings: tuple[Any, ...]) -> EveryBranch | Liter
         return False
     req = make_request("frdm", None, tol_pos, tol_rot, time_budget, 0, "refuse", None, "pose", "z", {})
     _check_search(Route.EITHER, None, stop_below)
-    if not has_closed_form(robot, req):
+    if not (has_closed_form(robot, req) or has_general_form(robot, req)):
         return False
     form = prepared_form(robot, req)
     return False if form is None else EveryBranch(robot, req, form)
