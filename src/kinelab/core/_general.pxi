@@ -35,6 +35,7 @@ cdef enum:
 cdef double CLOSE_PAIR = 1e-6  # [chordal] an eigenvalue this near the real line may be a real root (general.py)
 cdef double RANK_MARGIN = 1e-9  # Q's smallest singular value over its largest below which no root is given
 cdef double SEPARATION = 1e-3  # [chordal] eigenvalues closer than this: their null vectors from QZ's eigenvectors
+cdef double NEAR_REAL = 1e-3  # [chordal] the eigenvalues :func:`_crowded` looks at: within this of the real line
 cdef double COMPANION_RCOND = 1e-6  # the x₃² coefficient's reciprocal condition above which the companion serves
 
 
@@ -366,9 +367,9 @@ cdef int _real_eigenvalues(const double* M, double* x3, double* w) noexcept nogi
     returns how many (none when LAPACK fails). Where the x₃² coefficient is well conditioned (:func:`_companion`)
     the eigenvalues are the companion matrix's (LAPACK ``dgeev``, a third faster), else the pencil's by QZ
     (``dggev``, infinite eigenvalues included), no eigenvectors; each null vector by inverse iteration
-    (:func:`_null_vector`). Where two eigenvalues lie within SEPARATION of each other, inverse iteration at one
-    cannot tell its null vector from the other's (the computed eigenvalue is off by more than they are apart,
-    relatively): the pose is solved again by QZ with right eigenvectors (:func:`_with_vectors`)."""
+    (:func:`_null_vector`). Where an eigenvalue near the real line lies within SEPARATION of another (:func:`_crowded`),
+    inverse iteration at one cannot tell its null vector from the other's (the computed eigenvalue is off by more
+    than they are apart, relatively): the pose is solved again by QZ with right eigenvectors (:func:`_with_vectors`)."""
     cdef double A[PENCIL * PENCIL]
     cdef double B[PENCIL * PENCIL]
     cdef double alphar[PENCIL]
@@ -389,7 +390,7 @@ cdef int _real_eigenvalues(const double* M, double* x3, double* w) noexcept nogi
     if info != 0:
         return 0
     m = _near_real(alphar, alphai, beta, x3, picked)
-    if _crowded(alphar, alphai, beta, picked, m):
+    if _crowded(alphar, alphai, beta):
         return _with_vectors(M, x3, w)
     for j in range(m):
         if _null_vector(M, x3[2 * j], x3[2 * j + 1], w + 12 * kept):
@@ -443,15 +444,17 @@ cdef void _real_vector(const double* VR, const double* alphai, int j, int off, d
         w[k] = (re[k] * re[big] + im[k] * im[big]) / best
 
 
-cdef bint _crowded(const double* alphar, const double* alphai, const double* beta, const int* picked,
-                   int m) noexcept nogil:
-    """Whether an eigenvalue among the ``picked`` lies within SEPARATION (chordal: |a_j b_k − a_k b_j| of unit
-    pairs) of another eigenvalue."""
-    cdef int i, j, k
+cdef bint _crowded(const double* alphar, const double* alphai, const double* beta) noexcept nogil:
+    """Whether an eigenvalue within NEAR_REAL of the real line (chordal) lies within SEPARATION (chordal:
+    |a_j b_k − a_k b_j| of unit pairs) of another eigenvalue: two close real roots, which the companion matrix may
+    even give as a complex pair farther than CLOSE_PAIR from the real line (its rounding is amplified by the
+    leading coefficient's condition number; QZ on the pencil is not)."""
+    cdef int j, k
     cdef double nj, nk, re, im
-    for i in range(m):
-        j = picked[i]
+    for j in range(PENCIL):
         nj = hypot(hypot(alphar[j], alphai[j]), beta[j])
+        if not nj > 0.0 or fabs(alphai[j] * beta[j]) / (nj * nj) > NEAR_REAL:
+            continue
         for k in range(PENCIL):
             if k == j:
                 continue

@@ -251,8 +251,8 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
 
 def solve_all_batch(robot: Robot, targets: Any, *positional: Any, tol_pos: float = 1e-6,
                     tol_rot: float = 1e-6) -> BranchBatch:
-    """Every branch of each target, arrays in, arrays out: in closed form or by the 1-D search on all cores, by
-    the general 6R elimination target by target (not compiled yet).
+    """Every branch of each target, arrays in, arrays out: in closed form, by the 1-D search or by the general 6R
+    elimination, compiled, on all cores.
 
     Row b holds what ``solve_all(robot, targets[b])`` returns for a chain with a closed form, a 1-D search or the
     general elimination (each angle's copy within the limits nearest 0), every branch judged within the limits by

@@ -457,7 +457,7 @@ def _pinocchio_batch(robot: Robot, arm: ArmClass, H: np.ndarray, req: Request) -
     found, free = np.zeros((B, MAX_ROWS), dtype=np.int64), np.zeros((B, MAX_ROWS), dtype=np.bool_)
     count = np.zeros(B, dtype=np.int64)
     reasons = None
-    if arm.kind == GENERAL_6R:  # not compiled yet: pose by pose
+    if arm.kind == GENERAL_6R:  # no certified compiled FK: the elimination pose by pose, Pinocchio judging
         reasons = []
         for b in range(B):
             q, merged, loose, why = roots_within(arm, H[b], robot.lower, robot.upper, None, limit_slack(req.tol_rot))
