@@ -11,7 +11,7 @@
 
 from kinelab.core._blas cimport dgecon, dgeev, dgesdd, dgetrf, dggev, ready
 from kinelab.core._loop cimport loop_row
-from libc.math cimport sqrt
+from libc.math cimport isfinite, sqrt
 
 cdef enum:
     GENERAL_6R = 100  # the class code (kinelab.ik.analytic.kernel.GENERAL_6R)
@@ -31,6 +31,7 @@ cdef enum:
     GGEV_WORK = 1536
     SVD_WORK = 1024
     POLISH_STEPS = 60  # as kinelab.ik.analytic.certify.MAX_STEPS
+    STALLS = 3  # Newton steps in a row that do not shrink the residual before the polish stops
 
 cdef double CLOSE_PAIR = 1e-6  # [chordal] an eigenvalue this near the real line may be a real root (general.py)
 cdef double RANK_MARGIN = 1e-9  # Q's smallest singular value over its largest below which no root is given
@@ -295,17 +296,19 @@ cdef double _residual(const Chain* c, const double* H, const double* q, double* 
 
 cdef void _polish(const Chain* c, const double* H, double* q) noexcept nogil:
     """Newton's method on the loop equations from q (6) [rad], kept at its smallest residual, at most POLISH_STEPS
-    steps, stopping when a step no longer shrinks the residual (certify.polish)."""
+    steps, stopping at a residual below 1e-15 or after STALLS steps in a row that do not shrink it (beside a double
+    root Newton's method only halves the error a step, and rounding can stall it for a step: certify.polish
+    steps on while any root of the pose improves)."""
     cdef double x[6]
     cdef double F[6]
     cdef double J[36]
     cdef int pivots[6]
-    cdef int six = 6, info = 0, step, k
+    cdef int six = 6, info = 0, step, k, stalled = 0
     cdef double low = _residual(c, H, q, F, J), size
     for k in range(6):
         x[k] = q[k]
     for step in range(POLISH_STEPS):
-        if not low >= 1e-15:  # converged to rounding, or not finite
+        if not low >= 1e-15 or not isfinite(F[0]):  # converged to rounding, or lost
             return
         dgetrf(&six, &six, J, &six, pivots, &info)
         if info != 0:
@@ -314,11 +317,14 @@ cdef void _polish(const Chain* c, const double* H, double* q) noexcept nogil:
         for k in range(6):
             x[k] -= F[k]
         size = _residual(c, H, x, F, J)
-        if not size < low:
-            return
-        low = size
-        for k in range(6):
-            q[k] = x[k]
+        if size < low:
+            low, stalled = size, 0
+            for k in range(6):
+                q[k] = x[k]
+        else:
+            stalled += 1
+            if stalled >= STALLS:
+                return
 
 
 cdef int general_6r(const Arm* arm, M9 Rt, V3 pt, Rows* rows) noexcept nogil:
@@ -389,7 +395,7 @@ cdef int _real_eigenvalues(const double* M, double* x3, double* w) noexcept nogi
         dggev(&no, &no, &n, A, &n, B, &n, alphar, alphai, beta, dummy, &one, dummy, &one, work, &lwork, &info)
     if info != 0:
         return 0
-    m = _near_real(alphar, alphai, beta, x3, picked)
+    m = _near_real(alphar, alphai, beta, x3, picked, CLOSE_PAIR)
     if _crowded(alphar, alphai, beta):
         return _with_vectors(M, x3, w)
     for j in range(m):
@@ -401,7 +407,10 @@ cdef int _real_eigenvalues(const double* M, double* x3, double* w) noexcept nogi
 
 cdef int _with_vectors(const double* M, double* x3, double* w) noexcept nogil:
     """:func:`_real_eigenvalues` by QZ with right eigenvectors (``dggev``): each null vector is its eigenvector's
-    first or second half (the one nearer in scale: x₃ times the first), turned real by its largest entry's phase."""
+    first or second half (the one nearer in scale: x₃ times the first), turned real by its largest entry's phase.
+    Eigenvalues as far as NEAR_REAL from the real line are taken: at a double root the pair comes out complex by
+    more than CLOSE_PAIR (the Python route takes it by its perturbation bound); both start Newton from the same
+    point, and the two merged answers send the pose to the Python route, which splits or flags them."""
     cdef double A[PENCIL * PENCIL]
     cdef double B[PENCIL * PENCIL]
     cdef double VR[PENCIL * PENCIL]
@@ -417,7 +426,7 @@ cdef int _with_vectors(const double* M, double* x3, double* w) noexcept nogil:
     dggev(&no, &yes, &n, A, &n, B, &n, alphar, alphai, beta, dummy, &one, VR, &n, work, &lwork, &info)
     if info != 0:
         return 0
-    m = _near_real(alphar, alphai, beta, x3, picked)
+    m = _near_real(alphar, alphai, beta, x3, picked, NEAR_REAL)
     for j in range(m):
         _real_vector(VR, alphai, picked[j], 0 if fabs(x3[2 * j]) <= fabs(x3[2 * j + 1]) else 12, w + 12 * j)
     return m
@@ -467,15 +476,15 @@ cdef bint _crowded(const double* alphar, const double* alphai, const double* bet
 
 
 cdef int _near_real(const double* alphar, const double* alphai, const double* beta, double* x3,
-                    int* picked) noexcept nogil:
-    """The homogeneous eigenvalues (α, β) within CLOSE_PAIR of the real line, turned real by the larger one's phase
-    and scaled to unit length, into x3, their indices into ``picked``; returns how many."""
+                    int* picked, double within) noexcept nogil:
+    """The homogeneous eigenvalues (α, β) within ``within`` of the real line (chordal), turned real by the larger
+    one's phase and scaled to unit length, into x3, their indices into ``picked``; returns how many."""
     cdef int j, m = 0
     cdef double norm, size, a, b
     for j in range(PENCIL):
         size = hypot(alphar[j], alphai[j])
         norm = hypot(size, beta[j])
-        if not norm > 0.0 or fabs(alphai[j] * beta[j]) / (norm * norm) > CLOSE_PAIR:
+        if not norm > 0.0 or fabs(alphai[j] * beta[j]) / (norm * norm) > within:
             continue
         if size > fabs(beta[j]):
             a, b = size, beta[j] * alphar[j] / size
