@@ -25,6 +25,7 @@ from kinelab.core._analytic import ClosedForm
 from kinelab.core._joints import turn_distances
 from kinelab.errors import ConfigurationError, OptionError
 from kinelab.geometry import pose_errors, stack_homogeneous, wrap_to_pi
+from kinelab.ik.analytic import pieper
 from kinelab.ik.analytic.certify import (
     Loop,
     kantorovich,
@@ -35,7 +36,7 @@ from kinelab.ik.analytic.certify import (
 )
 from kinelab.ik.analytic.classify import ArmClass, classify, general_class, general_vectors
 from kinelab.ik.analytic.general import packed, roots_within
-from kinelab.ik.analytic.kernel import GENERAL_6R, MAX_ROWS, branches, branches_batch
+from kinelab.ik.analytic.kernel import GENERAL_6R, MAX_ROWS, PIEPER_6R, branches, branches_batch
 from kinelab.ik.batch import BatchIKResult
 from kinelab.ik.chain import chain_model
 from kinelab.ik.driver import solve_one
@@ -173,6 +174,8 @@ def prepared_form(robot: Robot, req: Request) -> ClosedForm | None:
     key = (float(req.tol_pos), float(req.tol_rot))
     if key not in forms:
         judge, arm = robot.derived("compiled judge", _compiled_judge), arm_of(robot, req)
+        if arm.kind == PIEPER_6R:  # Pieper's decoupling is not compiled: root by root
+            judge = None
         if len(forms) >= 16:  # a caller sweeping tolerances: keep the memory bounded
             forms.clear()
         lower, upper = robot.check_bounds
@@ -303,9 +306,11 @@ def proved_each(loop: Loop | None, H: np.ndarray, q: np.ndarray) -> tuple[str, s
 
 
 def _elimination(robot: Robot) -> ArmClass | None:
-    """The general elimination of a 6R robot's chain where it takes it, to cross-check a 1-D search's sets."""
+    """The general elimination of a 6R robot's chain where it takes it, to cross-check a 1-D search's sets (None
+    where the chain is taken otherwise, e.g. by Pieper's decoupling)."""
     six = _six_vectors(robot)
-    return None if six is None else general_vectors(*six).arm
+    arm = None if six is None else general_vectors(*six).arm
+    return arm if arm is not None and arm.kind == GENERAL_6R else None
 
 
 def robot_loop(robot: Robot) -> Loop | None:
@@ -348,6 +353,8 @@ def arm_roots(arm: ArmClass, H: np.ndarray, lower: np.ndarray, upper: np.ndarray
     """:func:`roots` of the arm ``arm`` with joint limits ``lower``, ``upper`` (arm.n each, rad)."""
     if arm.kind == GENERAL_6R:
         return roots_within(arm, H, lower, upper, q_ref, slack)[:3]
+    if arm.kind == PIEPER_6R:
+        return pieper.roots_within(arm, H, lower, upper, q_ref, slack)
     n = arm.n
     out, found, free = np.empty((MAX_ROWS, n)), np.zeros(MAX_ROWS, dtype=np.int64), np.zeros(MAX_ROWS, dtype=np.bool_)
     ref = _NO_REF[n] if q_ref is None else np.ascontiguousarray(q_ref, dtype=float)
@@ -464,6 +471,11 @@ def _pinocchio_batch(robot: Robot, arm: ArmClass, H: np.ndarray, req: Request) -
             k = count[b] = len(q)
             out[b, :k], found[b, :k], free[b, :k] = q, merged, loose
             reasons.append(why)
+    elif arm.kind == PIEPER_6R:  # not compiled: pose by pose
+        for b in range(B):
+            q, merged, loose = pieper.roots_within(arm, H[b], robot.lower, robot.upper, None, limit_slack(req.tol_rot))
+            k = count[b] = len(q)
+            out[b, :k], found[b, :k], free[b, :k] = q, merged, loose
     else:
         branches_batch(arm.kind, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, H, robot.lower, robot.upper, SAME,
                        limit_slack(req.tol_rot), out, found, free, count)

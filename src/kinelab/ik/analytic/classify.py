@@ -32,6 +32,7 @@ from kinelab.ik.analytic.kernel import (
     MEETING_6R,
     PARALLEL_5R,
     PARALLEL_6R,
+    PIEPER_6R,
     SEARCH_6R,
     SPHERICAL_6R,
     TWO_THREE_6R,
@@ -53,7 +54,8 @@ class ArmClass:
         h, o: (n, 3) unit axes and points on them at q = 0 [m], in the solved orientation's base frame.
         R0, N0: the tool's rotation and point at q = 0 in that frame.
         solver: for the general 6R class, its prepared elimination (:mod:`kinelab.ik.analytic.general`) and
-            loop equations (:mod:`kinelab.ik.analytic.certify`); None for the others.
+            loop equations (:mod:`kinelab.ik.analytic.certify`); for Pieper's, its prepared decoupling
+            (:mod:`kinelab.ik.analytic.pieper`); None for the others.
     """
 
     name: str
@@ -72,12 +74,14 @@ class ArmClass:
 
     @property
     def searched(self) -> bool:
-        """True when the branches come from the 1-D search (a root finder), not a closed form."""
-        return self.kind >= SEARCH_6R
+        """True when the branches come from the 1-D search (a root finder) or the elimination, not a closed form."""
+        return SEARCH_6R <= self.kind <= GENERAL_6R
 
     @property
     def method(self) -> str:
         """How the branches are found, in words (``kinelab info``)."""
+        if self.kind == PIEPER_6R:
+            return "every branch in closed form (Pieper's decoupling, a quartic)"
         if not self.searched:
             return "every branch in closed form"
         if self.kind == GENERAL_6R:
@@ -134,8 +138,8 @@ def general_vectors(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray
     """The general 6R class of the chain (h, o, R0, N0) at q = 0 (base frame, metres), read from the base or else
     from the tool (the elimination's joints 1 and 2 are then the last two), or None with the structure the
     elimination cannot take either way (it misses seeded configurations of the chain). A reading whose pencil is
-    regular is preferred; one whose pencil is singular is taken only when neither is regular (its sets are then
-    never certified)."""
+    regular is preferred, then Pieper's decoupling where three axes at an end meet (:func:`pieper_vectors`); a
+    reading whose pencil is singular is taken only when nothing else is (its sets are then never certified)."""
     from kinelab.ik.analytic.certify import loop_of
     from kinelab.ik.analytic.general import prepare, usable
 
@@ -151,10 +155,38 @@ def general_vectors(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray
         if not why:
             singular.append(arm)
         failed.append(("read from the tool: " if mirrored else "") + (why or "its pencil is singular"))
+    decoupled = pieper_vectors(h, o, R0, N0)
+    if decoupled.arm is not None:
+        return decoupled
     if singular:
         return Classification(singular[0], "")
     return Classification(None, f"the general 6R elimination degenerates on this chain's structure ({special(h, o)}): "
-                          + " | ".join(failed))
+                          + " | ".join(failed) + f"; Pieper's decoupling: {decoupled.reason}")
+
+
+def pieper_vectors(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray) -> Classification:
+    """Pieper's class of the chain (h, o, R0, N0) at q = 0 (base frame, metres): axes 1, 2, 3 through one point
+    (read from the base) or axes 4, 5, 6 (read from the tool), the decoupling recovering seeded configurations;
+    or None with why not."""
+    from kinelab.ik.analytic.pieper import prepare, usable
+
+    failed = []
+    for mirrored in (False, True):
+        hh, oo, RR, NN = reverse(h, o, R0, N0) if mirrored else (h, o, R0, N0)
+        where = "read from the tool: " if mirrored else ""
+        if max(line_distance(oo[i], hh[i], oo[j], hh[j]) for i, j in ((0, 1), (0, 2), (1, 2))) >= POINT_TOL \
+                or _angle(hh[0], hh[1]) < AXIS_TOL or _angle(hh[1], hh[2]) < AXIS_TOL:
+            failed.append(where + "axes 1, 2, 3 do not meet in one point")
+            continue
+        meets = line_distance(oo[3], hh[3], oo[4], hh[4]) < POINT_TOL and _angle(hh[3], hh[4]) >= AXIS_TOL
+        prepared = prepare(hh, oo, RR, NN, meeting_point(oo[0], hh[0], oo[1], hh[1]),
+                           meeting_point(oo[3], hh[3], oo[4], hh[4]) if meets else None)
+        why = prepared if isinstance(prepared, str) else usable(prepared)
+        if not why:
+            name = "spherical shoulder, general 3R" + (" (mirrored: read from the tool)" if mirrored else "")
+            return Classification(ArmClass(name, PIEPER_6R, mirrored, hh, oo, RR, NN, prepared), "")
+        failed.append(where + why)
+    return Classification(None, " | ".join(failed))
 
 
 def special(h: np.ndarray, o: np.ndarray) -> str:
@@ -186,12 +218,15 @@ def _classify(robot: Robot) -> Classification:
 def classify_vectors(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray) -> Classification:
     """The analytic class of a revolute chain given by its (n, 3) unit axes h and points o at q = 0 and its
     tool's rotation R0 and point N0 there (base frame, metres), n = 5 or 6: a closed form in either orientation
-    before a search class in either."""
+    before a search class in either — except where three axes at an end meet: Pieper's decoupling, a closed form,
+    takes the chain (a search whose shoulder has a third axis through its point misses roots)."""
     failed = []
     for searched in (False, True):
         for mirrored in (False, True):
             hh, oo, RR, NN = reverse(h, o, R0, N0) if mirrored else (h, o, R0, N0)
             arm, misses = _first_class(hh, oo, RR, NN, searched, mirrored)
+            if arm is not None and searched and (decoupled := pieper_vectors(h, o, R0, N0)).arm is not None:
+                return decoupled
             if arm is not None:
                 return Classification(arm, "")
             if not searched:

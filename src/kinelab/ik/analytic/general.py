@@ -28,6 +28,7 @@ SPURIOUS = 8  # eigenvalues at x₃ = ±i that every pose's determinant carries:
 SPURIOUS_TOL = 1e-6  # [chordal] an eigenvalue this close to ±i is one of them (found within ~1e-13; a root nearer
 # is rare and leaves the set uncertified, never wrong)
 SINGULAR_PENCIL = "the pencil is singular or nearly so"
+QZ_FAILED = -1.0  # Eigen.rank when LAPACK's QZ did not converge
 RANK_TOL = 1e-9  # Q's smallest kept singular value relative to its largest: below it the elimination is refused
 _ANGLES = np.array([0.0, 2 * np.pi / 3, 4 * np.pi / 3])
 _FOURIER = np.linalg.inv(np.stack([np.ones(3), np.cos(_ANGLES), np.sin(_ANGLES)]).T)  # samples → (1, cos, sin)
@@ -232,7 +233,10 @@ def solve(g: General6R, H: np.ndarray) -> tuple[np.ndarray, Eigen]:
     A, B, rank, pinv = _pencil(g, r0, Q)
     if rank < RANK_TOL:
         return np.empty((0, 6)), Eigen(np.empty(0), np.empty(0), np.empty(0), 0.0, rank, np.empty(0, dtype=int))
-    alpha, beta, vl, vr = _ggev(A, B)
+    try:
+        alpha, beta, vl, vr = _ggev(A, B)
+    except np.linalg.LinAlgError:  # QZ did not converge (seen on a singular pencil): no root, and said so
+        return np.empty((0, 6)), Eigen(np.empty(0), np.empty(0), np.empty(0), 0.0, QZ_FAILED, np.empty(0, dtype=int))
     kappa = _conditions(A, B, vl, vr)
     scale = float(np.hypot(np.linalg.norm(A), np.linalg.norm(B)))  # Frobenius: a bound on the 2-norm, and no SVD
     real = np.flatnonzero(real_root(alpha, beta, kappa, scale))
@@ -303,6 +307,8 @@ def counted(eigen: Eigen, q: np.ndarray, proved: np.ndarray, phi3: float) -> str
     stay off the real line holds no real root; any other, of k eigenvalues, must hold k proved roots (their x₃ on
     its disks): a real pencil's k eigenvalues there are then all real, and all found. Every root must lie on a
     cluster's disks."""
+    if eigen.rank == QZ_FAILED:
+        return f"LAPACK's QZ did not converge at this pose: {SINGULAR_PENCIL}"
     if eigen.rank < RANK_TOL:
         return f"the elimination is degenerate at this pose (Q's rank margin {eigen.rank:.1e})"
     a, b = _unit(eigen.alpha, eigen.beta)

@@ -35,6 +35,7 @@ PARALLEL_5R, PARALLEL_6R, SPHERICAL_6R, MEETING_6R, TWO_THREE_6R = 0, 1, 2, 3, 4
 SEARCH_6R = 5  # the search classes' first code: 5 + 3·pair + shoulder (pair 0: axes 4, 5 meet, t = q6; 1: axes
 # 5, 6 meet, t = q4; shoulder 0: h₂ ∥ h₃, 1: axes 1, 2 meet, 2: axes 2, 3 meet), core/_search.pxi
 GENERAL_6R = 100  # any other 6R chain: the algebraic elimination (kinelab.ik.analytic.general; compiled: _general.pxi)
+PIEPER_6R = 101  # axes 1, 2, 3 (or 4, 5, 6) through a point, the rest general: Pieper's decoupling (pieper.py)
 
 
 def branches(kind: int, mirrored: bool, h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray, H: np.ndarray,

@@ -147,7 +147,8 @@ HELD_KEPT = 64  # held (joint, value) arms kept per robot: a sweep over a middle
 
 def arm_holding(robot: Robot, joint: int, theta: float) -> ArmClass | str:
     """The arm of the six joints left when the 7R robot's joint ``joint`` is held at ``theta`` [rad] — a class,
-    else the general elimination — or why there is none."""
+    else the general elimination or Pieper's decoupling (:func:`~kinelab.ik.analytic.classify.general_vectors`) —
+    or why there is none."""
     kept: dict[tuple[int, float], ArmClass | str] = robot.derived("held arms", _new_held)
     key = (joint, float(theta))
     if key not in kept:
