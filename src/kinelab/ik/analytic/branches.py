@@ -280,6 +280,8 @@ def certificate_of(robot: Robot, method: str, H: np.ndarray, q: np.ndarray, merg
     1e-6 rad; the compiled elimination's set when the elimination's certified set (computed again with the
     eigenvalues' condition numbers, :func:`~kinelab.ik.analytic.general.roots_within`) is the same."""
     loop = robot_loop(robot)
+    if method == "closed form" and _decoupled(robot):  # its subproblems can lose roots near its own singularities
+        return search_certificate(loop, H, q, merged, continuum, pieper.MOST_ROOTS, "Pieper's decoupling")
     if method == "closed form":
         return set_certificate(loop, H, q, merged, continuum)
     if method == "elimination":
@@ -296,6 +298,12 @@ def certificate_of(robot: Robot, method: str, H: np.ndarray, q: np.ndarray, merg
     if len(theirs) != len(q) or not all(np.abs(wrap_to_pi(theirs - row)).max(axis=1).min() <= 1e-6 for row in q):
         return "search", f"the general elimination's certified set has {len(theirs)} branches, this one {len(q)}"
     return proved_each(loop, H, q)
+
+
+def _decoupled(robot: Robot) -> bool:
+    """True when the robot's chain is solved by Pieper's decoupling."""
+    arm = classify(robot).arm or general_class(robot).arm
+    return arm is not None and arm.kind == PIEPER_6R
 
 
 def proved_each(loop: Loop | None, H: np.ndarray, q: np.ndarray) -> tuple[str, str]:

@@ -160,12 +160,12 @@ MOST_ROOTS = 16  # the most isolated roots a 6R pose has (Raghavan and Roth)
 
 
 def search_certificate(loop: Loop | None, H: np.ndarray, q: np.ndarray, merged: np.ndarray,
-                       continuum: np.ndarray) -> tuple[str, str]:
-    """A 1-D search's set of branches q (k, 6) [rad] of the pose H: ("certified", "") when it holds MOST_ROOTS
-    branches each proved a root and apart (no pose has more), else ("search", why not)."""
-    if q.shape[0] < MOST_ROOTS:
-        return "search", (f"the 1-D search is measured complete, not proved ({q.shape[0]} branches; {MOST_ROOTS} "
-                          "proved ones would be)")
+                       continuum: np.ndarray, most: int = MOST_ROOTS, who: str = "the 1-D search") -> tuple[str, str]:
+    """A search's set of branches q (k, 6) [rad] of the pose H: ("certified", "") when it holds ``most`` branches
+    each proved a root and apart (no pose has more), else ("search", why not)."""
+    if q.shape[0] < most:
+        return "search", (f"{who} is measured complete, not proved ({q.shape[0]} branches; {most} proved ones would "
+                          "be)")
     return set_certificate(loop, H, q, merged, continuum)
 
 

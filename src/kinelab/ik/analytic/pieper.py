@@ -28,6 +28,9 @@ from kinelab.ik.limits import inside_limits
 
 SAME = 1e-5  # [rad] roots closer than this joint by joint are one branch (as the closed forms merge them)
 NEAR_REAL = 1e-4  # a quartic root with |Im t| below this times (1 + |t|) is taken (a double root comes out complex)
+MOST_ROOTS = 8  # the most branches the decoupling gives (4 positions × 2 shoulders): a set of 8 proved is complete
+TANGENT = 1e-6  # a subproblem 4 whose |ratio| is within this of 1 is treated as tangent (its roots near a double one)
+PROBE = 1e-3  # [rad] where the two roots of a tangent subproblem 4 start, either side of it
 OFFSET_SEED = 20261205  # the fixed offset of q₆'s half-angle
 _FIVE = 2 * np.pi * np.arange(5) / 5  # samples of a degree-2 trigonometric polynomial
 
@@ -116,8 +119,8 @@ def _angle(k: np.ndarray, u: np.ndarray, v: np.ndarray) -> float:
 
 
 def _sub4(h: np.ndarray, k: np.ndarray, u: np.ndarray, d: float) -> tuple[list[float], bool]:
-    """Subproblem 4: the angles θ with hᵀR(k, θ)u = d (two, one at a double root, none), and whether every θ
-    serves (hᵀR(k, θ)u does not depend on θ)."""
+    """Subproblem 4: the angles θ with hᵀR(k, θ)u = d (two starts, the two roots or either side of a double one;
+    none), and whether every θ serves (hᵀR(k, θ)u does not depend on θ)."""
     a = float(h @ u - (h @ k) * (k @ u))
     b = float(h @ np.cross(k, u))
     rest = d - float((h @ k) * (k @ u))
@@ -125,10 +128,14 @@ def _sub4(h: np.ndarray, k: np.ndarray, u: np.ndarray, d: float) -> tuple[list[f
     if size < 1e-12:
         return [0.0], True
     ratio = rest / size
-    if abs(ratio) > 1 + 1e-9:
+    if abs(ratio) > 1 + TANGENT:
         return [], False
-    base, spread = float(np.arctan2(b, a)), float(np.arccos(np.clip(ratio, -1.0, 1.0)))
-    return ([base] if spread < 1e-9 else [base + spread, base - spread]), False
+    base = float(np.arctan2(b, a))
+    # near tangency the two roots are closer than rounding places them (the ratio may even pass ±1): start
+    # Newton's method PROBE to either side, and let it find them (or the double root, then merged and said so)
+    spread = max(float(np.arccos(np.clip(ratio, -1.0, 1.0))), PROBE) if abs(ratio) > 1 - TANGENT else \
+        float(np.arccos(ratio))
+    return [base + spread, base - spread], False
 
 
 def _wrist_general(p: Pieper, point: np.ndarray) -> list[tuple[float, float, float]]:
