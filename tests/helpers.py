@@ -133,3 +133,22 @@ def chain_urdf(h, o, M, lower, upper, mount=None):
              f'<child link="tool"/><origin xyz="{" ".join(map(repr, (M.translation - at).tolist()))}" '
              f'rpy="{" ".join(map(repr, rpy.tolist()))}"/></joint>']
     return "\n".join(rows)
+
+
+def multistart_within(robot, seed, poses=4, within=1e-5):
+    """Every branch a dense multistart (0.5 s, no stopping rule) finds at ``poses`` seeded poses is among
+    ``solve_all``'s, to ``within`` rad joint by joint modulo 2π; returns ``solve_all``'s sets for more checks."""
+    import kinelab
+
+    rng = np.random.default_rng(seed)
+    sets = []
+    for k in range(poses):
+        target = robot.fk(robot.random_q(rng))
+        ours = kinelab.solve_all(robot, target)
+        theirs = kinelab.solve_all(robot, target, solver="frdm", seed=k, time_budget=0.5, stop_below=None)
+        assert len(theirs) >= 1
+        for s in theirs:
+            d = [np.abs(np.arctan2(np.sin(s.q - a.q), np.cos(s.q - a.q))).max() for a in ours]
+            assert min(d) <= within
+        sets.append(ours)
+    return sets

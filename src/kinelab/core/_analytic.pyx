@@ -39,7 +39,7 @@ from cython.parallel cimport prange
 
 from kinelab.core._chain cimport Judge
 from kinelab.core._frdm cimport now
-from kinelab.core._geometry cimport rotm
+from kinelab.core._geometry cimport rotm, wrap
 from kinelab.core._verdict cimport pose_defect_of, pose_defect_row_major, pose_errors
 
 cnp.import_array()
@@ -118,17 +118,6 @@ cdef inline M9 rotation(V3 k, double theta) noexcept nogil:
     cdef double m[9]
     rotm(k[0], k[1], k[2], theta, m)
     return (m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8])
-
-
-cdef inline double wrap(double theta) noexcept nogil:
-    """θ wrapped into (−π, π] by whole turns: exact for an angle already inside, and no trigonometry (the rows'
-    wraps cost as much as solving them)."""
-    cdef double t = theta - TWO_PI * rint(theta / TWO_PI)
-    if t <= -M_PI:
-        return t + TWO_PI
-    if t > M_PI:
-        return t - TWO_PI
-    return t
 
 
 cdef inline double _max(double a, double b) noexcept nogil:

@@ -16,10 +16,11 @@ from functools import partial
 import numpy as np
 
 cimport numpy as cnp
-from libc.math cimport M_PI, ceil, rint
+from libc.math cimport M_PI, ceil
 from libc.stdlib cimport free, malloc
 from libc.string cimport memcpy
 
+from kinelab.core._geometry cimport wrap
 cimport kinelab.core._biquat as bq
 from kinelab.core._chain cimport Judge
 from kinelab.core._frdm cimport (CONTINUOUS, CONVERGED, STATS_SIZE, T_STALLS, Packed, now, random_configuration,
@@ -48,15 +49,6 @@ if <int> bq.STATS_SIZE != <int> STATS_SIZE:
     raise ImportError("kinelab.core._engine: the kernels' statistics arrays differ in size; rebuild the core")
 
 
-
-cdef inline double _wrapped(double theta) noexcept nogil:
-    """θ [rad] wrapped into (−π, π] by whole turns, as kinelab.geometry.wrap_to_pi does it, to the last bit."""
-    cdef double t = theta - TWO_PI * rint(theta / TWO_PI)
-    if t <= -M_PI:
-        return t + TWO_PI
-    if t > M_PI:
-        return t - TWO_PI
-    return t
 
 cdef class Engine:
     """A prepared solver's usual call (see the module's docstring): the checks, the verdict and the result, written
@@ -210,7 +202,7 @@ cdef class Engine:
         if self.continuous:
             for i in range(n):
                 if self.kind[i] == CONTINUOUS:
-                    q[i] = _wrapped(q[i])
+                    q[i] = wrap(q[i])
         cdef bint within = self._verdict(q, dp, dr)
         if not within:
             for i in range(n):

@@ -1,7 +1,8 @@
-# Geometry written once for every compiled kernel and the judge: the rotation about a unit axis (Rodrigues).
+# Geometry written once for every compiled kernel and the judge: the rotation about a unit axis (Rodrigues), and
+# the wrap of an angle by whole turns.
 # Inline here, so each module that cimports it compiles the same arithmetic in place.
 
-from libc.math cimport cos, sin
+from libc.math cimport M_PI, cos, rint, sin
 
 
 cdef inline void rotm(double x, double y, double z, double angle, double* m) noexcept nogil:
@@ -17,3 +18,15 @@ cdef inline void rotm(double x, double y, double z, double angle, double* m) noe
     m[6] = z * x * C - y * s
     m[7] = z * y * C + x * s
     m[8] = c + z * z * C
+
+
+cdef inline double wrap(double theta) noexcept nogil:
+    """θ [rad] wrapped into (−π, π] by whole turns, as kinelab.geometry.wrap_to_pi does it, to the last bit: exact for
+    an angle already inside, and no trigonometry (NumPy's and the C library's differ by an ulp on some processors)."""
+    cdef double turn = 2.0 * M_PI
+    cdef double t = theta - turn * rint(theta / turn)
+    if t <= -M_PI:
+        return t + turn
+    if t > M_PI:
+        return t - turn
+    return t
