@@ -362,7 +362,10 @@ def arm_roots(arm: ArmClass, H: np.ndarray, lower: np.ndarray, upper: np.ndarray
     if arm.kind == GENERAL_6R:
         return roots_within(arm, H, lower, upper, q_ref, slack)[:3]
     if arm.kind == PIEPER_6R:
-        return pieper.roots_within(arm, H, lower, upper, q_ref, slack)
+        decoupled = pieper.roots_within(arm, H, lower, upper, q_ref, slack)
+        also = arm.solver.also
+        return decoupled if also is None else \
+            pieper.merged_sets(decoupled, arm_roots(also, H, lower, upper, q_ref, slack))
     n = arm.n
     out, found, free = np.empty((MAX_ROWS, n)), np.zeros(MAX_ROWS, dtype=np.int64), np.zeros(MAX_ROWS, dtype=np.bool_)
     ref = _NO_REF[n] if q_ref is None else np.ascontiguousarray(q_ref, dtype=float)
@@ -481,7 +484,7 @@ def _pinocchio_batch(robot: Robot, arm: ArmClass, H: np.ndarray, req: Request) -
             reasons.append(why)
     elif arm.kind == PIEPER_6R:  # not compiled: pose by pose
         for b in range(B):
-            q, merged, loose = pieper.roots_within(arm, H[b], robot.lower, robot.upper, None, limit_slack(req.tol_rot))
+            q, merged, loose = arm_roots(arm, H[b], robot.lower, robot.upper, None, limit_slack(req.tol_rot))
             k = count[b] = len(q)
             out[b, :k], found[b, :k], free[b, :k] = q, merged, loose
     else:

@@ -40,7 +40,7 @@ class Pieper:
     """A chain prepared for :func:`roots`: its axes h, points o (6, 3) at q = 0 [m], tool (R0, N0), the shoulder
     point s, the plane across h₅ (e1, e2), the fixed 2 × 2 matrix's inverse (None when axes 4 and 5 meet, at
     ``meet``: then turning about either keeps the distance from that point, and the position is two subproblems),
-    q₆'s offset [rad] and the loop equations."""
+    q₆'s offset [rad], the loop equations, and a 1-D search class the chain also fits (``also``, or None)."""
 
     h: np.ndarray
     o: np.ndarray
@@ -52,6 +52,7 @@ class Pieper:
     meet: np.ndarray | None
     phi: float
     loop: Loop
+    also: object = None  # a 1-D search class the chain also fits: its roots are added (each method loses some)
 
 
 def prepare(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray, s: np.ndarray,
@@ -237,3 +238,12 @@ def roots_within(arm: object, H: np.ndarray, lower: np.ndarray, upper: np.ndarra
     base = np.zeros(6) if ref is None else ref
     q, keep = inside_limits(q + 2 * np.pi * np.round((base - q) / (2 * np.pi)), lower, upper, slack)
     return q, merged[keep], free[keep]
+
+
+def merged_sets(a: tuple[np.ndarray, ...], b: tuple[np.ndarray, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Two solvers' roots of one pose (q (m, 6) [rad], roots merged into each, one-of-a-continuum flags), placed
+    alike: their union, a root of b within SAME of one of a (joint by joint, modulo 2π) counted as that one."""
+    q, merged, free = (np.array(x) for x in a)
+    extra = [k for k in range(len(b[0])) if not len(q) or np.abs(wrap_to_pi(q - b[0][k])).max(axis=1).min() >= SAME]
+    return (np.vstack([q.reshape(-1, 6), b[0][extra]]), np.concatenate([merged, b[1][extra]]).astype(np.int64),
+            np.concatenate([free, b[2][extra]]).astype(np.bool_))
