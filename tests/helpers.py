@@ -135,20 +135,18 @@ def chain_urdf(h, o, M, lower, upper, mount=None):
     return "\n".join(rows)
 
 
-def multistart_within(robot, seed, poses=4, within=1e-5):
-    """Every branch a dense multistart (0.5 s, no stopping rule) finds at ``poses`` seeded poses is among
-    ``solve_all``'s, to ``within`` rad joint by joint modulo 2π; returns ``solve_all``'s sets for more checks."""
+def multistart_gaps(robot, seed, poses=4):
+    """At ``poses`` seeded poses: (``solve_all``'s set, how many branches a dense multistart (0.5 s, no stopping
+    rule) found, and the largest distance [rad] from one of them to the nearest branch of the set, joint by joint
+    modulo 2π)."""
     import kinelab
 
     rng = np.random.default_rng(seed)
-    sets = []
+    out = []
     for k in range(poses):
         target = robot.fk(robot.random_q(rng))
         ours = kinelab.solve_all(robot, target)
         theirs = kinelab.solve_all(robot, target, solver="frdm", seed=k, time_budget=0.5, stop_below=None)
-        assert len(theirs) >= 1
-        for s in theirs:
-            d = [np.abs(np.arctan2(np.sin(s.q - a.q), np.cos(s.q - a.q))).max() for a in ours]
-            assert min(d) <= within
-        sets.append(ours)
-    return sets
+        gaps = [min(np.abs(np.arctan2(np.sin(s.q - a.q), np.cos(s.q - a.q))).max() for a in ours) for s in theirs]
+        out.append((ours, len(theirs), max(gaps, default=np.inf)))
+    return out

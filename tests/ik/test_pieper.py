@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 import pytest
-from helpers import chain_urdf, multistart_within, write_urdf
+from helpers import chain_urdf, multistart_gaps, write_urdf
 
 import kinelab
 from kinelab.ik.analytic.branches import arm_of
@@ -61,7 +61,8 @@ def test_random_pieper_arms_give_the_pose_s_own_configuration_among_judged_branc
 
 
 def test_every_branch_the_multistart_finds_is_among_the_decoupling_s(tmp_path):
-    for ours in multistart_within(pieper_robot(tmp_path, 5), 5):
+    for ours, found, farthest in multistart_gaps(pieper_robot(tmp_path, 5), 5):
+        assert found >= 1 and farthest <= 1e-5
         assert ours.complete == "certified" or ours.complete_reason
 
 

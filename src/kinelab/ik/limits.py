@@ -39,6 +39,14 @@ def inside_limits(q: np.ndarray, lower: np.ndarray, upper: np.ndarray,
     return np.clip(x[keep], lower, upper), keep
 
 
+def nearest_inside(q: np.ndarray, lower: np.ndarray, upper: np.ndarray, ref: np.ndarray | None,
+                   slack: float) -> tuple[np.ndarray, np.ndarray]:
+    """Rows of revolute angles q (m, n) [rad], each angle's copy nearest ``ref`` (None: nearest 0), then
+    :func:`inside_limits`."""
+    base = np.zeros(q.shape[-1]) if ref is None else ref
+    return inside_limits(q + TWO_PI * np.round((base - q) / TWO_PI), lower, upper, slack)
+
+
 def wrap_q(robot: Robot, q: np.ndarray) -> np.ndarray:
     """q with each out-of-limit revolute joint shifted by a multiple of 2π into its limits, where one
     exists (the pose is unchanged); other values are returned as they are."""

@@ -71,6 +71,14 @@ def chain_pose(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray, q: 
     return M @ tool
 
 
+def inverse_pose(T: np.ndarray) -> np.ndarray:
+    """The inverse of a rigid transform T (4 × 4)."""
+    out = np.eye(4)
+    out[:3, :3] = T[:3, :3].T
+    out[:3, 3] = -T[:3, :3].T @ T[:3, 3]
+    return out
+
+
 def equations(loop: Loop, q: np.ndarray, H: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """F (m, 6) and F′ (m, 6, n) of the loop equations at q (m, n) for the target H (4 × 4, base frame), compiled
     (:mod:`kinelab.core._loop`)."""

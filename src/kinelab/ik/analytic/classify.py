@@ -21,7 +21,7 @@ POINT_TOL; a chain that misses a test by more gets the numeric path, with the te
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -191,8 +191,6 @@ def pieper_vectors(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray)
 
 def with_search(decoupled: ArmClass, search: ArmClass) -> ArmClass:
     """Pieper's class ``decoupled`` with the 1-D search class the chain also fits, whose roots it adds."""
-    from dataclasses import replace
-
     return replace(decoupled, name=decoupled.name + " and a 1-D search", solver=replace(decoupled.solver, also=search))
 
 

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinelab.geometry import wrap_to_pi
-from kinelab.ik.analytic.certify import Loop, Proof, beside_fold, chain_pose, kantorovich, polish
-from kinelab.ik.limits import inside_limits
+from kinelab.ik.analytic.certify import Loop, Proof, beside_fold, chain_pose, inverse_pose, kantorovich, polish
+from kinelab.ik.limits import nearest_inside
 
 SPURIOUS = 8  # eigenvalues at x₃ = ±i that every pose's determinant carries: (1 + x₃²)⁴
 SPURIOUS_TOL = 1e-6  # [chordal] an eigenvalue this close to ±i is one of them (found within ~1e-13; a root nearer
@@ -85,13 +85,6 @@ def rz(theta: np.ndarray | float) -> np.ndarray:
     return out
 
 
-def _inverse(T: np.ndarray) -> np.ndarray:
-    out = np.eye(4)
-    out[:3, :3] = T[:3, :3].T
-    out[:3, 3] = -T[:3, :3].T @ T[:3, 3]
-    return out
-
-
 def _frame(h: np.ndarray, o: np.ndarray) -> np.ndarray:
     """A frame at o whose z axis is h."""
     helper = np.array([1.0, 0.0, 0.0]) if abs(h[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
@@ -115,8 +108,8 @@ def prepare(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray) -> Gen
     Z = [_frame(h[i] / np.linalg.norm(h[i]), o[i]) for i in range(6)]
     tool = np.eye(4)
     tool[:3, :3], tool[:3, 3] = R0, N0
-    G = np.array([Z[0] @ rz(phi[0])] + [_inverse(Z[i]) @ Z[i + 1] @ rz(phi[i + 1]) for i in range(5)]
-                 + [_inverse(Z[5]) @ tool])
+    G = np.array([Z[0] @ rz(phi[0])] + [inverse_pose(Z[i]) @ Z[i + 1] @ rz(phi[i + 1]) for i in range(5)]
+                 + [inverse_pose(Z[5]) @ tool])
     turns = rz(_ANGLES)
     chain = np.einsum("ij,ajk->aik", G[2], turns) @ G[3]
     chain = np.einsum("aij,bjk->abik", chain, turns) @ G[4]
@@ -125,7 +118,7 @@ def prepare(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray) -> Gen
     coeff = np.einsum("ia,jb,kc,abce->ijke", _FOURIER, _FOURIER, _FOURIER, samples)
     half = np.kron(_HALF, _HALF)
     left = np.einsum("ime,mn->ien", coeff.reshape(3, 9, 14), half)
-    G1i = _inverse(G[1])
+    G1i = inverse_pose(G[1])
     pairs = rz(-_ANGLES)[None, :] @ G1i @ rz(-_ANGLES)[:, None]  # [a, b] = Rz(−b)·G₁⁻¹·Rz(−a)
     return General6R(h, o, R0, N0, phi, G, left, half[0].copy(), pairs[..., :3, :3].reshape(9, 3, 3),
                      pairs[..., :3, 3].reshape(9, 3))
@@ -138,8 +131,8 @@ def packed(g: General6R, loop: Loop) -> np.ndarray:
     """The prepared chain ``g`` and its loop equations' length scale as the compiled elimination reads them
     (kinelab/core/_general.pxi): φ, G₀⁻¹, G₆⁻¹, G₁ … G₅, P's coefficients, the constant monomial's row, the right
     side's sample frames, the two Fourier matrices, ℓ."""
-    out = np.concatenate([g.phi, _inverse(g.frames[0]).ravel(), _inverse(g.frames[6]).ravel(), g.frames[1:6].ravel(),
-                          g.left.ravel(), g.one, g.right_R.ravel(), g.right_t.ravel(),
+    out = np.concatenate([g.phi, inverse_pose(g.frames[0]).ravel(), inverse_pose(g.frames[6]).ravel(),
+                          g.frames[1:6].ravel(), g.left.ravel(), g.one, g.right_R.ravel(), g.right_t.ravel(),
                           np.kron(_FOURIER, _FOURIER).ravel(), _FROM_TRIG.ravel(), [loop.scale]])
     if out.size != PACKED_SIZE:
         raise AssertionError(f"the packed elimination has {out.size} numbers, the compiled one reads {PACKED_SIZE}")
@@ -148,7 +141,7 @@ def packed(g: General6R, loop: Loop) -> np.ndarray:
 
 def _right(g: General6R, H: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The right side of the pose H: r₀ (14,), Q (14, 8) over (c₂, s₂, c₁, c₁c₂, c₁s₂, s₁, s₁c₂, s₁s₂), and T'."""
-    Tp = _inverse(g.frames[0]) @ H @ _inverse(g.frames[6])
+    Tp = inverse_pose(g.frames[0]) @ H @ inverse_pose(g.frames[6])
     line = g.right_R @ Tp[:3, 2]
     point = g.right_R @ Tp[:3, 3] + g.right_t
     coeff = np.kron(_FOURIER, _FOURIER) @ invariants(line, point)  # (9, 14)
@@ -440,10 +433,9 @@ def roots_within(arm: object, H: np.ndarray, lower: np.ndarray, upper: np.ndarra
     it is)."""
     g, loop = arm.solver  # type: ignore[attr-defined]
     if arm.mirrored:  # type: ignore[attr-defined]
-        found = every_root(g, loop, _inverse(H))
+        found = every_root(g, loop, inverse_pose(H))
         found = Found(-found.q[:, ::-1], found.proved, found.merged, found.reason)
     else:
         found = every_root(g, loop, H)
-    base = np.zeros(6) if ref is None else ref
-    q, keep = inside_limits(found.q + 2 * np.pi * np.round((base - found.q) / (2 * np.pi)), lower, upper, slack)
+    q, keep = nearest_inside(found.q, lower, upper, ref, slack)
     return q, found.merged[keep], np.zeros(int(keep.sum()), dtype=np.bool_), found.reason

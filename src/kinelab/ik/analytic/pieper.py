@@ -23,8 +23,8 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.geometry import wrap_to_pi
-from kinelab.ik.analytic.certify import Loop, chain_pose, loop_of, polish
-from kinelab.ik.limits import inside_limits
+from kinelab.ik.analytic.certify import Loop, chain_pose, inverse_pose, loop_of, polish
+from kinelab.ik.limits import nearest_inside
 
 SAME = 1e-5  # [rad] roots closer than this joint by joint are one branch (as the closed forms merge them)
 NEAR_REAL = 1e-4  # a quartic root with |Im t| below this times (1 + |t|) is taken (a double root comes out complex)
@@ -229,14 +229,11 @@ def roots_within(arm: object, H: np.ndarray, lower: np.ndarray, upper: np.ndarra
     into each and one-of-a-continuum flags."""
     p: Pieper = arm.solver  # type: ignore[attr-defined]
     if arm.mirrored:  # type: ignore[attr-defined]
-        Hi = np.eye(4)
-        Hi[:3, :3], Hi[:3, 3] = H[:3, :3].T, -H[:3, :3].T @ H[:3, 3]
-        q, merged, free = roots(p, Hi)
+        q, merged, free = roots(p, inverse_pose(H))
         q = -q[:, ::-1]
     else:
         q, merged, free = roots(p, H)
-    base = np.zeros(6) if ref is None else ref
-    q, keep = inside_limits(q + 2 * np.pi * np.round((base - q) / (2 * np.pi)), lower, upper, slack)
+    q, keep = nearest_inside(q, lower, upper, ref, slack)
     return q, merged[keep], free[keep]
 
 
