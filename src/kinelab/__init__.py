@@ -39,6 +39,8 @@ _LAZY = {
     "Branches": ("kinelab.ik.result", "Branches"),
     "FRDMOptions": ("kinelab.ik.frdm.options", "FRDMOptions"),
     "IK": ("kinelab.ik.prepared", "IK"),
+    "SEW": ("kinelab.ik.analytic.sew", "SEW"),
+    "sew_angle": ("kinelab.ik.analytic.sew", "sew_angle"),
     "Diagnostics": ("kinelab.ik.result", "Diagnostics"),
     "FRDMDiagnostics": ("kinelab.ik.result", "FRDMDiagnostics"),
     "BiquatDiagnostics": ("kinelab.ik.result", "BiquatDiagnostics"),
@@ -60,6 +62,7 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
     from kinelab.collision.model import Collisions
     from kinelab.collision.obstacles import Environment, Obstacle
     from kinelab.ik.analytic.branches import BranchBatch
+    from kinelab.ik.analytic.sew import SEW, sew_angle
     from kinelab.ik.api import solve, solve_all, solve_all_batch, solve_batch, track
     from kinelab.ik.batch import BatchIKResult
     from kinelab.ik.frdm.options import FRDMOptions
@@ -103,6 +106,7 @@ __all__ = [
     "Robot",
     "RobotNotFoundError",
     "SolverNotFoundError",
+    "SEW",
     "SRDFError",
     "Status",
     "TargetError",
@@ -111,6 +115,7 @@ __all__ = [
     "__version__",
     "load",
     "robots",
+    "sew_angle",
     "solve",
     "solve_all",
     "solve_all_batch",

@@ -51,12 +51,34 @@ def test_a_crx_pose_prints_its_sixteen_searched_branches(capsys):
     assert all(max(crx.tool_error(np.array(b["q"]), target)) <= 1e-9 for b in found["branches"])
 
 
+PANDA_Q = ["0.4", "-0.6", "0.3", "-2.0", "0.5", "1.6", "0.7"]
+
+
+def test_every_branch_at_a_panda_poses_own_sew_angle_includes_its_configuration(capsys):
+    panda = kinelab.load("panda")
+    q = np.array(PANDA_Q, dtype=float)
+    psi = kinelab.sew_angle(panda, q)
+    degrees = [f"{v:.12f}" for v in np.degrees(q)]
+    code, out, _ = run(capsys, "branches", "panda", "--target-q", *degrees, "--sew", f"{np.degrees(psi):.12f}",
+                       "--deg", "--json")
+    found = json.loads(out)
+    assert code == 0 and "SEW angle" in found["method"] and found["complete"] == "search"
+    qs = np.array([b["q"] for b in found["branches"]])  # the JSON is in radians
+    assert np.abs(qs - q).max(axis=1).min() < 1e-6
+    for row in qs:
+        assert max(panda.tool_error(row, panda.fk(q))) <= 1e-6
+        assert abs(kinelab.sew_angle(panda, row) - psi) <= 1e-6
+
+
 def test_an_unreachable_pose_exits_1_and_bad_input_exits_2_with_one_line(capsys):
     code, out, _ = run(capsys, "branches", "ur5", "--target-xyz", "5", "0", "0")
     assert code == 1 and out.startswith("ur5: 0 branches") and "no branch (unreachable)" in out \
         and "beyond the robot's reach" in out
     for argv in (("branches", "ur5"), ("branches", "ur5", "--target-q", "1", "2"),
                  ("branches", "ur5", "--target-q", *UR5_Q, "--redundancy", "8"),
+                 ("branches", "ur5", "--target-q", *UR5_Q, "--sew", "0.5"),
+                 ("branches", "panda", "--target-q", *PANDA_Q, "--sew", "0.5", "--redundancy", "8"),
+                 ("branches", "panda", "--target-q", *PANDA_Q, "--sew", "nan"),
                  ("branches", "stanford", "--target-q", "0", "0", "0.3", "0", "0", "0", "--solver", "analytic")):
         code, out, err = run(capsys, *argv)
         assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, argv

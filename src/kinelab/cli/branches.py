@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import math
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -18,9 +19,12 @@ from kinelab.cli.common import (
     source_arguments,
     target_arguments,
 )
-from kinelab.errors import KinelabError
+from kinelab.errors import KinelabError, OptionError
 from kinelab.ik.result import Branches, IKResult
 from kinelab.robot import Robot
+
+if TYPE_CHECKING:
+    from kinelab.ik.analytic.sew import SEW
 
 
 def add(sub: Any) -> None:
@@ -35,6 +39,9 @@ def add(sub: Any) -> None:
                         "analytic (refused, with the reason, where there is none), frdm or dls (the multistart)")
     s.add_argument("--redundancy", type=int, metavar="K",
                    help="a 7R arm with a joint held (docs/analytic.md): every branch at K values of that joint")
+    s.add_argument("--sew", type=float, metavar="PSI",
+                   help="a 7R arm: every branch with the elbow at this SEW angle (rad, degrees with --deg; "
+                        "docs/analytic.md, The SEW angle)")
     seed_argument(s)
     s.add_argument("--time-budget", type=float, default=0.05,
                    help="the multistart's wall-clock budget [s] (default 0.05); the closed form needs none")
@@ -53,7 +60,7 @@ def run(args: argparse.Namespace) -> int:
     target = target_of(robot, args)
     ref = None if args.ref_q is None else q_from_cli(robot, args.ref_q, args.deg, "--ref-q")
     found = solve_all(robot, target, solver=args.solver, seed=args.seed, time_budget=args.time_budget, q_ref=ref,
-                      redundancy=args.redundancy)
+                      redundancy=_redundancy(args))
     if args.json:
         print_json({"robot": robot.name, "target": pose_dict(target), "method": _method(found),
                     "completeness": _completeness(found), "complete": found.complete,
@@ -63,6 +70,21 @@ def run(args: argparse.Namespace) -> int:
     if args.html:
         _write_page(robot, found, args.html, ref is not None)
     return 0 if found else 1
+
+
+def _redundancy(args: argparse.Namespace) -> int | SEW | None:
+    """--redundancy K or --sew PSI (one of them) as solve_all's ``redundancy``.
+
+    Raises:
+        OptionError: both given.
+    """
+    from kinelab.ik.analytic.sew import SEW
+
+    if args.sew is None:
+        return args.redundancy
+    if args.redundancy is not None:
+        raise OptionError("--sew", args.sew, "either --sew PSI or --redundancy K, not both")
+    return SEW(math.radians(args.sew) if args.deg else args.sew)
 
 
 def _method(found: Sequence[IKResult]) -> str:

@@ -23,6 +23,7 @@ from kinelab.collision.model import CollisionModel, as_collisions, collision_mod
 from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.analytic.branches import BranchBatch, all_branches_batch, analytic_one, nearest_batch, refuse_options
+from kinelab.ik.analytic.sew import SEW
 from kinelab.ik.batch import BatchIKResult, prepare, prepare_robot, run_batch
 from kinelab.ik.branches import UNSEEN, Route, find_all, route_of, usual_closed_form
 from kinelab.ik.chain import chain_model
@@ -285,7 +286,7 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
               tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float = 0.05, options: Any = None,
               task: str = "pose", axis: str = "z", q_ref: Any = None, max_solutions: int | None = None,
               stop_below: float | None = UNSEEN, collisions: Any = None, drop_colliding: bool = False,
-              redundancy: int | dict[str, float] | None = None, **solver_options: Any) -> Branches:
+              redundancy: int | dict[str, float] | SEW | None = None, **solver_options: Any) -> Branches:
     """The distinct solutions (branches) of ``target``: every one in closed form where the chain's geometry
     allows it (docs/analytic.md), else those that seeded starts find, in rounds of 64, until the estimated
     chance that one more start finds a new branch falls below ``stop_below`` or ``time_budget`` is spent.
@@ -315,7 +316,9 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
         drop_colliding: leave colliding branches out instead of marking them.
         redundancy: K, for a 7R arm analytic with its first or last joint held: every branch at K values of that
             joint spread over its range (docs/analytic.md), or ``{joint name: value}`` [rad]: every branch with it
-            at that value; solver "auto" or "analytic". None: a 7R arm gets the multistart.
+            at that value, or :class:`~kinelab.ik.analytic.sew.SEW` (ψ): every branch the search finds with the
+            elbow's SEW angle ψ [rad] (docs/analytic.md, The SEW angle); solver "auto" or "analytic". None: a 7R
+            arm gets the multistart.
 
     Returns:
         The :class:`~kinelab.ik.result.Branches`: one :class:`IKResult` per distinct solution, nearest ``q_ref``

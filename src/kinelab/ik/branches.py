@@ -26,6 +26,7 @@ from kinelab.ik.analytic.branches import (
     prepared_form,
 )
 from kinelab.ik.analytic.redundancy import redundant_all
+from kinelab.ik.analytic.sew import SEW
 from kinelab.ik.batch import fresh_seed, prepare, run_batch
 from kinelab.ik.limits import distance as distance  # exported: the branch distance users sort by
 from kinelab.ik.registry import Capabilities, capabilities
@@ -69,7 +70,7 @@ def route_of(kind: Capabilities, options_given: bool) -> Route:
 
 def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_solutions: int | None = None,
              stop_below: float | None = UNSEEN, method: Route = Route.MULTISTART,
-             redundancy: int | dict[str, float] | None = None) -> Branches:
+             redundancy: int | dict[str, float] | SEW | None = None) -> Branches:
     """The distinct solutions of ``target``, each checked by Pinocchio: every branch in closed form where the
     chain's class allows it (:mod:`kinelab.ik.analytic`), else those seeded starts find within the request's
     time budget.
@@ -87,8 +88,8 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
             below this, after MIN_ROUNDS rounds (None: spend the whole budget).
         method: the :class:`Route`.
         redundancy: K samples of a 7R arm's swept end joint (:mod:`kinelab.ik.analytic.redundancy`), or
-            ``{joint name: value}`` [rad] for that joint held at one value, on a route with the closed form;
-            None: no sweep.
+            ``{joint name: value}`` [rad] for that joint held at one value, or a :class:`SEW` angle, on a route with
+            the closed form; None: no sweep.
 
     Returns:
         One :class:`IKResult` per distinct solution. Multistart: ``diagnostics.found``, how many starts reached

@@ -35,6 +35,7 @@ from kinelab.ik.analytic.classify import (
     general_vectors,
 )
 from kinelab.ik.analytic.kernel import GENERAL_6R
+from kinelab.ik.analytic.sew import SEW, sew_all
 from kinelab.ik.chain import PRISMATIC, chain_model
 from kinelab.ik.limits import distance
 from kinelab.ik.request import Request
@@ -113,6 +114,18 @@ def _chain7(robot: Robot) -> dict[str, np.ndarray] | str:
     if cm.n != 7 or (cm.kind == PRISMATIC).any():
         return f"{cm.n} joints{', one prismatic' if (cm.kind == PRISMATIC).any() else ''} (a 7R chain is swept)"
     return {k: np.array(a, dtype=float) for k, a in cm.vectors(np.zeros(7)).items()}
+
+
+def chain7_vectors(robot: Robot) -> dict[str, np.ndarray]:
+    """The 7R chain's vectors at q = 0 (:func:`_chain7`).
+
+    Raises:
+        OptionError: the robot's chain is not 7R (why named).
+    """
+    v = _chain7(robot)
+    if isinstance(v, str):
+        raise OptionError("redundancy", "SEW", f"a 7R chain; {robot.name}'s is not: {v}")
+    return v
 
 
 def holding(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray, joint: int,
@@ -270,8 +283,9 @@ def redundant_all(robot: Robot, target: pin.SE3, req: Request, redundancy: objec
         robot: a 7R robot.
         target: the pose.
         req: the validated request (task "pose").
-        redundancy: K samples of the swept end joint (:func:`samples`; a robot :func:`swept_arm` accepts), or
-            ``{joint name: value}`` for any one joint held at one value.
+        redundancy: K samples of the swept end joint (:func:`samples`; a robot :func:`swept_arm` accepts),
+            ``{joint name: value}`` for any one joint held at one value, or a :class:`SEW` angle
+            (:func:`~kinelab.ik.analytic.sew.sew_all`).
         q_ref: sort the answers by distance to this configuration; each angle's copy is picked nearest it.
         max_solutions: at most this many answers (the nearest ``q_ref`` first when given).
 
@@ -284,6 +298,8 @@ def redundant_all(robot: Robot, target: pin.SE3, req: Request, redundancy: objec
     t0 = time.perf_counter()
     if req.task.name != "pose":
         raise OptionError("task", req.task_label, "'pose' with redundancy= (other tasks: solver='frdm')")
+    if isinstance(redundancy, SEW):
+        return sew_all(robot, target, req, redundancy, q_ref, max_solutions)
     values, how, joint = held_values(robot, redundancy)
     answers = []
     for theta in values:

@@ -254,11 +254,11 @@ def random_general(arms: int, poses: int, seed: int) -> dict[str, Any]:
 
 def run(robots: list[str] | None = None, n: int = 10_000, peer_n: int = 1000, arms: int = 30, arm_poses: int = 300,
         seed: int = 0, progress: bool = False, hard: int = 1000, general_poses: int = 1000,
-        held_poses: int = 1000) -> dict[str, Any]:
+        held_poses: int = 1000, sew_poses: int = 200) -> dict[str, Any]:
     """Every measure for the arms asked for (default ROBOTS), the random arms of each search class and random
-    general arms, ``hard`` poses per arm of HARD (:mod:`kinelab.report.bench.hard_poses`) and ``held_poses`` per
-    joint of HELD."""
-    from kinelab.report.bench import hard_poses
+    general arms, ``hard`` poses per arm of HARD (:mod:`kinelab.report.bench.hard_poses`), ``held_poses`` per
+    joint of HELD and ``sew_poses`` per 7R arm at its SEW angle (:mod:`kinelab.report.bench.sew`)."""
+    from kinelab.report.bench import hard_poses, sew
 
     names = list(robots or ROBOTS)
     own, peers, built = [], [], []
@@ -273,12 +273,16 @@ def run(robots: list[str] | None = None, n: int = 10_000, peer_n: int = 1000, ar
             built.append(hard_poses.measure(robot, hard, seed))
     held = [held_joint(load(name), joint, held_poses, seed) for name, joints in HELD for joint in joints
             if held_poses and (robots is None or name in robots)]
+    angles = [sew.measure(load(name), sew_poses, seed) for name in sew.ARMS
+              if sew_poses and (robots is None or name in robots)]
     return {"own": own, "ssik": peers, "random": random_arms(arms, arm_poses, seed),
-            "general": random_general(arms, general_poses, seed), "hard": built, "held": held}
+            "general": random_general(arms, general_poses, seed), "hard": built, "held": held, "sew": angles}
 
 
 def markdown(result: dict[str, Any]) -> str:
-    """The three tables."""
+    """The tables."""
+    from kinelab.report.bench import sew
+
     lines = ["| arm | method | poses | own configuration found | misses (double roots) | certified complete | "
              "branches mean / max |", "|---|---|---|---|---|---|---|"]
     lines += [f"| {r['robot']} | {r['method']} | {r['poses']:,} | {100 * r['found']:.3f} % | {r['misses']} "
@@ -308,6 +312,7 @@ def markdown(result: dict[str, Any]) -> str:
                   "|---|---|---|---|---|"]
         lines += [f"| {r['robot']} | {r['joint']} | {r['poses']:,} | {100 * r['found']:.3f} % | {r['refused']} |"
                   for r in result["held"]]
+    lines += sew.markdown(result.get("sew", []))
     missed = [(r["robot"], m) for r in result["own"] for m in r.get("missed", [])]
     if missed:
         lines += ["", "Missed poses (arm: own configuration q, nearest branch):"]
