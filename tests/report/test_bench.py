@@ -244,3 +244,17 @@ def test_the_collisions_bench_reports_each_arm_with_and_without_the_check():
     assert row["clear_success"] == 1.0 and 0 < row["random_colliding"] < 1 and row["check_clear_us"] > 0
     table = collisions.markdown([row])
     assert table.count("\n") == 2 and "| panda | 107 |" in table
+
+
+def test_the_throughput_bench_reports_both_start_modes_each_round_and_the_published_rows():
+    from kinelab.report.bench import throughput
+
+    row = throughput.measure(kinelab.load("ur5"), rounds=2, seed=3)
+    assert set(row["modes"]) == {"table", "random"} and row["targets"] == throughput.TARGETS
+    for m in row["modes"].values():
+        assert len(m["per_second"]) == 2 and all(v > 0 for v in m["per_second"])
+        assert all(s == 1.0 for s in m["success"]) and all(s == 1.0 for s in m["success_loose"])
+        assert all(abs(1e6 / p - us) < 1e-6 * us for p, us in zip(m["per_second"], m["us_per_target"], strict=True))
+    text = throughput.markdown([row])
+    assert "| ur5 (6) | table |" in text and "| ur5 (6) | random |" in text
+    assert "Published, not measured here" in text and "| PyRoki | RTX 4090 |" in text

@@ -47,6 +47,9 @@ def add(sub: Any) -> None:
                         "10,000 seeded poses (its own configuration among the branches, the certified share), against "
                         "ssik's branch sets on 1,000 (pip install ssik), random arms of each 1-D search class and "
                         "random general 6R arms, and 1,000 hard poses per arm (on and beside det J = 0, at a limit)")
+    s.add_argument("--throughput", action="store_true",
+                   help="also targets/s of one solve_batch call on 2,000 random targets (panda, ur5, xarm7, youbot; "
+                        "first starts from the start table and random), with the GPU libraries' published figures")
     s.add_argument("--collisions", action="store_true",
                    help="also solve with and without collisions= around a floor and a table (panda, ur5, kinova): "
                         "time ratio with its spread, clear success, the check's own cost")
@@ -94,6 +97,11 @@ def run(args: argparse.Namespace) -> int:
         from kinelab.report.bench import completeness
 
         result["completeness"] = completeness.run(seed=args.seed, progress=not args.json)
+    if args.throughput:
+        from kinelab.report.bench import throughput
+
+        result["throughput"] = throughput.run(args.robots, seed=args.seed, repeats=args.repeats,
+                                              progress=not args.json)
     if args.collisions:
         from kinelab.report.bench import collisions
 
@@ -134,6 +142,10 @@ def _print_tables(result: dict[str, Any]) -> None:
         from kinelab.report.bench import branches
 
         print(branches.markdown(result["branches"]))
+    if "throughput" in result:
+        from kinelab.report.bench import throughput
+
+        print(throughput.markdown(result["throughput"]))
     if "collisions" in result:
         from kinelab.report.bench import collisions
 

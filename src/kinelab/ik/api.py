@@ -217,8 +217,9 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
         task: the components to meet, as :func:`solve`.
         axis: the tool axis of task "axis".
         solver_options: the solver's option fields as keyword arguments.
-        q0: starts: None (each row draws its own from its seed), one configuration for every row, or (B, n)
-            [rad or m]; within the joint limits.
+        q0: starts: None or "random" (each row draws its own from its seed), "table" (each row's first start the
+            stored configuration whose tool pose is nearest its target: :mod:`kinelab.ik.starts`; FRDM and DLS,
+            task "pose"), one configuration for every row, or (B, n) [rad or m]; within the joint limits.
         time_budget: wall-clock budget [s] of the whole batch (None, the default: none); rows not started
             when it runs out are left unsolved with status ``time_budget`` and NaN in q.
         start_outside_limits: "refuse" (the default here: a batch of starts is data, checked row by row).

@@ -1,0 +1,84 @@
+"""``kinelab bench --throughput``: targets per second of one ``solve_batch`` call, in the GPU libraries' protocol.
+
+Per arm and round, TARGETS random targets (the tool poses of configurations drawn within the limits from the
+round's seed), solved by :func:`kinelab.solve_batch` on every core with no start given, twice — the first starts
+from the robot's start table (:mod:`kinelab.ik.starts`) and from random draws — in an order that alternates
+between rounds; every answer judged by the batch's own judge (Pinocchio's FK or the compiled FK certified equal
+to it). Reported: targets/s and the time per target (the call's wall time, judging included, over the targets),
+median and spread over the rounds, and the success rate at kinelab's tolerance (1e-6 m, 1e-6 rad) and at the GPU
+libraries' (5 mm, 0.05 rad); the table's build time and memory. The peers' published figures are reference rows,
+not measured here.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+from tqdm import tqdm
+
+from kinelab.ik.api import solve_batch
+from kinelab.ik.starts import start_table
+from kinelab.robot import Robot, load
+
+TARGETS = 2000
+ARMS = ("panda", "ur5", "xarm7", "youbot")
+LOOSE = (5e-3, 0.05)  # [m, rad] the GPU libraries' success thresholds
+PUBLISHED = (  # (library, hardware, what, targets/s): their own papers' figures, not measured here
+    ("PyRoki", "RTX 4090", "2,000 random Franka targets in 28.6–29.8 ms, 5 mm / 0.05 rad", "67,000–70,000"),
+    ("cuRobo v2", "RTX 4090", "100 Franka targets in 2.60 ms, 100 % solved", "≈ 38,000"),
+    ("cuRobo", "RTX 4090", "collision-free IK queries", "> 7,000"),
+)
+
+
+def _round(robot: Robot, seed: int, first: str) -> dict[str, dict[str, float]]:
+    """One round: the two start modes on one set of targets, ``first`` first."""
+    targets = robot.fk_batch(robot.random_qs(TARGETS, np.random.default_rng(seed)))
+    found = {}
+    for mode in (first, "random" if first == "table" else "table"):
+        t0 = time.perf_counter()
+        res = solve_batch(robot, targets, q0=mode, seed=seed)
+        seconds = time.perf_counter() - t0
+        loose = (res.position_error <= LOOSE[0]) & (res.rotation_error <= LOOSE[1])
+        found[mode] = {"per_second": TARGETS / seconds, "us_per_target": 1e6 * seconds / TARGETS,
+                       "success": float(res.success.mean()), "success_loose": float(np.nanmean(loose))}
+    return found
+
+
+def measure(robot: Robot, rounds: int, seed: int) -> dict[str, Any]:
+    """The arm's row: per start mode, each round's figures; the table's build time [ms] and size [MB]."""
+    t0 = time.perf_counter()
+    table = start_table(robot)
+    build_ms = 1e3 * (time.perf_counter() - t0)
+    solve_batch(robot, robot.fk_batch(robot.random_qs(50, np.random.default_rng(seed))), seed=seed)  # warm-up
+    per_round = [_round(robot, seed + 1000 * r, "table" if r % 2 == 0 else "random") for r in range(rounds)]
+    modes = {mode: {key: [r[mode][key] for r in per_round] for key in per_round[0][mode]} for mode in per_round[0]}
+    return {"robot": robot.name, "dof": robot.n, "targets": TARGETS, "rounds": rounds, "table_ms": build_ms,
+            "table_mb": table.nbytes / 2**20, "modes": modes}
+
+
+def run(robots: list[str] | None, seed: int = 0, repeats: int = 3, progress: bool = False) -> list[dict[str, Any]]:
+    """Every arm's row (default ARMS)."""
+    names = list(robots or ARMS)
+    return [measure(load(name), max(repeats, 1), seed)
+            for name in tqdm(names, desc="bench --throughput", disable=not progress, unit="arm")]
+
+
+def _spread(values: list[float], digits: str = ",.0f") -> str:
+    return f"{np.median(values):{digits}} [{min(values):{digits}}–{max(values):{digits}}]"
+
+
+def markdown(rows: list[dict[str, Any]]) -> str:
+    """The table (median [lowest–highest round]) and the published reference rows."""
+    lines = ["| arm (DoF) | first starts | targets/s | µs per target | solved at 1e-6 | solved at 5 mm / 0.05 rad "
+             "| table build, size |", "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        for mode, m in r["modes"].items():
+            lines.append(f"| {r['robot']} ({r['dof']}) | {mode} | {_spread(m['per_second'])} | "
+                         f"{_spread(m['us_per_target'], '.1f')} | {100 * min(m['success']):.2f} % | "
+                         f"{100 * min(m['success_loose']):.2f} % | "
+                         f"{r['table_ms']:.0f} ms, {r['table_mb']:.1f} MB |")
+    lines += ["", "Published, not measured here:", "", "| library | hardware | what | targets/s |", "|---|---|---|---|"]
+    lines += [f"| {name} | {hw} | {what} | {rate} |" for name, hw, what, rate in PUBLISHED]
+    return "\n".join(lines)
