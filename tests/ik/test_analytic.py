@@ -574,3 +574,32 @@ def test_the_nearest_branch_in_one_compiled_call_is_the_general_route_s(name):
             # 5R arm's candidates that are no root of the pose)
             assert fast.diagnostics.branches == len(kinelab.solve_all(robot, target)) <= general.diagnostics.branches
     assert one_call >= 25
+
+
+@pytest.mark.parametrize("name", ["ur5", "crx10ia", "general6r", "kinova"])
+def test_the_compiled_nearest_batch_is_each_single_closed_form_solve(name):
+    """solve_batch(solver="analytic") answers its rows in one compiled call: each row is what the single call gives
+    its pose and start, on any thread count; a row with no branch (beyond reach) is the single call's failure."""
+    from kinelab.core import threads
+
+    robot = load(name)
+    rng = np.random.default_rng(31)
+    Q = robot.random_qs(60, rng)
+    H = robot.fk_batch(Q)
+    H[7, :3, 3] = [9.0, 0.0, 0.0]  # beyond reach
+    starts = np.clip(Q + rng.normal(0.0, 0.3, Q.shape), robot.lower, robot.upper)
+    for q0 in (starts, None):
+        batch = kinelab.solve_batch(robot, H, solver="analytic", q0=q0)
+        try:
+            threads.set_count(1)
+            single_thread = kinelab.solve_batch(robot, H, solver="analytic", q0=q0)
+        finally:
+            threads.set_count(None)
+        assert np.array_equal(batch.q, single_thread.q, equal_nan=True)
+        for b in range(60):
+            one = kinelab.solve(robot, pin.SE3(H[b]), solver="analytic", q0=None if q0 is None else q0[b])
+            assert batch.success[b] == one.success and batch.status[b] == one.status.value
+            if one.success:
+                assert np.array_equal(batch.q[b], one.q)
+                assert batch.position_error[b] == one.position_error and batch.rotation_error[b] == one.rotation_error
+        assert not batch.success[7] and batch.success.sum() == 59

@@ -250,7 +250,7 @@ def test_the_throughput_bench_reports_both_start_modes_each_round_and_the_publis
     from kinelab.report.bench import throughput
 
     row = throughput.measure(kinelab.load("ur5"), rounds=2, seed=3)
-    assert set(row["modes"]) == {"table", "random"} and row["targets"] == throughput.TARGETS
+    assert set(row["modes"]) == {"table", "random", "closed form"} and row["targets"] == throughput.TARGETS
     for m in row["modes"].values():
         assert len(m["per_second"]) == 2 and all(v > 0 for v in m["per_second"])
         assert all(s == 1.0 for s in m["success"]) and all(s == 1.0 for s in m["success_loose"])

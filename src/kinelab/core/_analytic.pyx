@@ -33,7 +33,7 @@ numbers and rotations of 9 (row by row): they live in registers.
 import numpy as np
 cimport numpy as cnp
 
-from libc.math cimport acos, atan2, cos, fabs, hypot, rint, sin, M_PI, NAN
+from libc.math cimport acos, atan2, cos, fabs, hypot, remainder, rint, sin, INFINITY, M_PI, NAN
 from libc.stdlib cimport free as release, malloc
 from cython.parallel cimport prange
 
@@ -826,6 +826,60 @@ cdef class ClosedForm:
             for b in prange(B, num_threads=max(1, threads), schedule="dynamic", chunksize=32):
                 count[b] = self._pose_row(&H[b, 0, 0], zero, &q[b, 0, 0], &errors[b, 0, 0], &merged[b, 0],
                                           &continuum[b, 0], &near[b])
+
+    def nearest_batch(self, const double[:, :, ::1] H, const double[:, ::1] refs, double[:, ::1] q,
+                      double[:, ::1] errors, long long[::1] count, unsigned char[::1] near, int threads):
+        """:meth:`solve` and the pick of ``NearestBranch`` for every pose of the (B, 4, 4) stack H (proper poses,
+        checked by the caller) on ``threads`` OpenMP threads: per pose b, with ``refs`` (B, n) [rad], the branch
+        nearest refs[b] (each angle's copy nearest it; the first of the nearest by the largest joint difference
+        modulo 2π), with ``refs`` of no rows the first branch (copies nearest 0), in q[b] [rad] and its errors in
+        errors[b] ([m, rad]); count[b] the branches the judge confirms (0: none, q[b] left as given); near[b] = 1
+        (count 0) where a root fell short of the tolerances but near them: the caller's general route."""
+        cdef Py_ssize_t B = H.shape[0], b
+        cdef bint use_ref = refs.shape[0] > 0
+        cdef int n = self.n, m
+        cdef double zero[6]
+        if H.shape[1] != 4 or H.shape[2] != 4 or q.shape[0] != B or q.shape[1] != n or errors.shape[0] != B \
+                or errors.shape[1] != 2 or count.shape[0] != B or near.shape[0] != B \
+                or (use_ref and (refs.shape[0] != B or refs.shape[1] != n)):
+            raise ValueError("ClosedForm.nearest_batch: H (B, 4, 4), refs (B, n) or (0, n), q (B, n), errors (B, 2), "
+                             "count and near (B,)")
+        for m in range(6):
+            zero[m] = 0.0
+        if B == 0:
+            return
+        with nogil:
+            for b in prange(B, num_threads=max(1, threads), schedule="dynamic", chunksize=32):
+                count[b] = self._nearest_row(&H[b, 0, 0], &refs[b, 0] if use_ref else zero, use_ref, &q[b, 0],
+                                             &errors[b, 0], &near[b])
+
+    cdef int _nearest_row(self, const double* T, const double* aim, bint use_ref, double* q, double* errors,
+                          unsigned char* near) noexcept nogil:
+        """One pose of :meth:`nearest_batch`: how many branches the judge confirms."""
+        cdef double out[MAX_ROWS * 6]
+        cdef double errs[MAX_ROWS * 2]
+        cdef long long found[MAX_ROWS]
+        cdef unsigned char loose[MAX_ROWS]
+        cdef bint short = False
+        cdef int m = 0, kept, k, j, best = 0, n = self.n
+        cdef double worst, d, least = INFINITY
+        kept = self._pose(T, aim, use_ref, out, errs, found, loose, &short, &m)
+        near[0] = short
+        if short or kept == 0:
+            return 0
+        if use_ref:  # as kinelab.core._joints.turn_distances measures, and np.argmin picks: the first nearest
+            for k in range(kept):
+                worst = 0.0
+                for j in range(n):
+                    d = fabs(remainder(out[k * n + j] - aim[j], 2.0 * M_PI))
+                    if d > worst:
+                        worst = d
+                if worst < least:
+                    least, best = worst, k
+        for j in range(n):
+            q[j] = out[best * n + j]
+        errors[0], errors[1] = errs[2 * best], errs[2 * best + 1]
+        return kept
 
     cdef int _pose_row(self, const double* T, const double* zero, double* q, double* errors, long long* merged,
                        unsigned char* continuum, unsigned char* near) noexcept nogil:

@@ -698,7 +698,32 @@ def nearest_batch(robot: Robot, targets: Any, q0: Any, req: Request, model: Coll
         raise ConfigurationError(f"q0 must be None, {robot.n} numbers or ({len(H)}, {robot.n}) for {len(H)} targets of "
                                  f"{robot.name}, got shape {np.shape(q0)}")
     starts = None if starts is None else np.broadcast_to(starts, (len(H), robot.n))
+    form = prepared_form(robot, req) if model is None and req.time_budget is None else None
+    if form is not None:
+        return _compiled_nearest(robot, form, np.ascontiguousarray(H), starts, req, t0)
     return _nearest_rows(robot, H, starts, req, model, t0)
+
+
+def _compiled_nearest(robot: Robot, form: ClosedForm, H: np.ndarray, starts: np.ndarray | None, req: Request,
+                      t0: float) -> BatchIKResult:
+    """:func:`nearest_batch` in one compiled call on all cores (no collision model, no budget): each row the branch
+    ``NearestBranch`` gives its pose alone; a row the compiled form leaves (no branch, or a root to finish) by
+    :func:`analytic_one`."""
+    B, n = len(H), robot.n
+    q, errors = np.full((B, n), np.nan), np.full((B, 2), np.nan)
+    count, near = np.zeros(B, dtype=np.int64), np.zeros(B, dtype=np.uint8)
+    refs = np.empty((0, n)) if starts is None else np.ascontiguousarray(starts, dtype=float)
+    form.nearest_batch(H, refs, q, errors, count, near, threads.count())
+    success = count > 0
+    code = np.where(success, Status.CONVERGED.code, Status.UNREACHABLE.code).astype(np.int8)
+    for b in np.flatnonzero(~success):
+        row = analytic_one(robot, pin.SE3(H[b]), req, None if starts is None else starts[b], None)
+        q[b], success[b], code[b] = row.q, row.success, row.status.code
+        errors[b] = row.position_error, row.rotation_error
+    none = np.zeros(B, dtype=int)
+    return BatchIKResult(q=q, success=success, status_code=code, position_error=errors[:, 0],
+                         rotation_error=errors[:, 1], iterations=none, restarts=none.copy(), seed=0,
+                         wall_time=time.perf_counter() - t0, solver="analytic", mode=arm_of(robot, req).mode)
 
 
 def _nearest_rows(robot: Robot, H: np.ndarray, starts: np.ndarray | None, req: Request, model: CollisionModel | None,

@@ -1,13 +1,14 @@
 """``kinelab bench --throughput``: targets per second of one ``solve_batch`` call, in the GPU libraries' protocol.
 
 Per arm and round, TARGETS random targets (the tool poses of configurations drawn within the limits from the
-round's seed), solved by :func:`kinelab.solve_batch` on every core with no start given, twice — the first starts
-from the robot's start table (:mod:`kinelab.ik.starts`) and from random draws — in an order that alternates
-between rounds; every answer judged by the batch's own judge (Pinocchio's FK or the compiled FK certified equal
-to it). Reported: targets/s and the time per target (the call's wall time, judging included, over the targets),
-median and spread over the rounds, and the success rate at kinelab's tolerance (1e-6 m, 1e-6 rad) and at the GPU
-libraries' (5 mm, 0.05 rad); the table's build time and memory. The peers' published figures are reference rows,
-not measured here.
+round's seed), solved by :func:`kinelab.solve_batch` (FRDM) on every core, twice — the first starts from the
+robot's start table (:mod:`kinelab.ik.starts`) and from random draws — in an order that alternates between
+rounds; an arm with a closed form also by ``solve_batch(..., solver="analytic")``, each row the branch nearest a
+random start, one compiled call on every core. Every answer is judged by the batch's own judge (Pinocchio's FK or
+the compiled FK certified equal to it). Reported: targets/s and the time per target (the call's wall time,
+judging included, over the targets), median and spread over the rounds, and the success rate at kinelab's
+tolerance (1e-6 m, 1e-6 rad) and at the GPU libraries' (5 mm, 0.05 rad); the table's build time and memory. The
+peers' published figures are reference rows, not measured here.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from typing import Any
 import numpy as np
 from tqdm import tqdm
 
+from kinelab.ik.analytic.classify import classify
 from kinelab.ik.api import solve_batch
 from kinelab.ik.starts import start_table
 from kinelab.robot import Robot, load
@@ -32,13 +34,17 @@ PUBLISHED = (  # (library, hardware, what, targets/s): their own papers' figures
 )
 
 
-def _round(robot: Robot, seed: int, first: str) -> dict[str, dict[str, float]]:
-    """One round: the two start modes on one set of targets, ``first`` first."""
-    targets = robot.fk_batch(robot.random_qs(TARGETS, np.random.default_rng(seed)))
+def _round(robot: Robot, seed: int, first: str, closed: bool) -> dict[str, dict[str, float]]:
+    """One round: the two start modes on one set of targets, ``first`` first, then (``closed``) the closed form's
+    branch nearest a random start per target."""
+    rng = np.random.default_rng(seed)
+    targets = robot.fk_batch(robot.random_qs(TARGETS, rng))
+    starts = robot.random_qs(TARGETS, rng)
     found = {}
-    for mode in (first, "random" if first == "table" else "table"):
+    for mode in (first, "random" if first == "table" else "table", *(("closed form",) if closed else ())):
         t0 = time.perf_counter()
-        res = solve_batch(robot, targets, q0=mode, seed=seed)
+        res = solve_batch(robot, targets, solver="analytic", q0=starts) if mode == "closed form" else \
+            solve_batch(robot, targets, q0=mode, seed=seed)
         seconds = time.perf_counter() - t0
         loose = (res.position_error <= LOOSE[0]) & (res.rotation_error <= LOOSE[1])
         found[mode] = {"per_second": TARGETS / seconds, "us_per_target": 1e6 * seconds / TARGETS,
@@ -52,7 +58,8 @@ def measure(robot: Robot, rounds: int, seed: int) -> dict[str, Any]:
     table = start_table(robot)
     build_ms = 1e3 * (time.perf_counter() - t0)
     solve_batch(robot, robot.fk_batch(robot.random_qs(50, np.random.default_rng(seed))), seed=seed)  # warm-up
-    per_round = [_round(robot, seed + 1000 * r, "table" if r % 2 == 0 else "random") for r in range(rounds)]
+    closed = classify(robot).arm is not None
+    per_round = [_round(robot, seed + 1000 * r, "table" if r % 2 == 0 else "random", closed) for r in range(rounds)]
     modes = {mode: {key: [r[mode][key] for r in per_round] for key in per_round[0][mode]} for mode in per_round[0]}
     return {"robot": robot.name, "dof": robot.n, "targets": TARGETS, "rounds": rounds, "table_ms": build_ms,
             "table_mb": table.nbytes / 2**20, "modes": modes}
