@@ -4,6 +4,7 @@ exact test finds), and solves whose successes are clear of the robot itself and 
 import json
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
 import kinelab
@@ -328,3 +329,40 @@ def test_the_map_command_counts_only_clear_answers_with_an_obstacle_file(tmp_pat
     walled = json.loads(capsys.readouterr().out)
     assert walled["voxels"] == free["voxels"] and walled["reached_voxels"] < free["reached_voxels"]
     assert walled["mean_reachability"] < free["mean_reachability"]
+
+
+def _nearest_distance(robot, geom, q):
+    """The least distance [m] between the geometry's pairs at q, by Pinocchio on geometry data of its own."""
+    data, gdata = robot.model.createData(), pin.GeometryData(geom)
+    pin.computeDistances(robot.model, data, geom, gdata, robot.to_pin_q(q))
+    return min(r.min_distance for r in gdata.distanceResults)
+
+
+def _at_distance(robot, geom, clear, touching, wanted):
+    """A configuration on the segment from ``clear`` to ``touching`` whose least pair distance is ``wanted`` [m]
+    (to 5 %), by bisection on the segment's parameter."""
+    lo, hi = 0.0, 1.0
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        d = _nearest_distance(robot, geom, clear + mid * (touching - clear))
+        if abs(d - wanted) < 0.05 * wanted:
+            return clear + mid * (touching - clear), d
+        lo, hi = (mid, hi) if d > wanted else (lo, mid)
+    raise AssertionError("no configuration at that distance on the segment")
+
+
+def test_a_pair_within_a_micrometre_of_contact_counts_as_colliding_and_one_beyond_it_is_clear():
+    """Two shapes touching are a collision or none by the exact test's starting guess: kinelab calls a pair
+    colliding within TOUCH = 1e-6 m, so that an answer it calls clear is clear by Pinocchio at margin 0."""
+    from kinelab.collision.model import TOUCH
+
+    panda = kinelab.load("panda")
+    model = collision_model(panda, Collisions())
+    qs = panda.random_qs(400, np.random.default_rng(12))
+    clear = next(q for q in qs if _nearest_distance(panda, model.geom, q) > 0.02)
+    touching = next(q for q in qs if model.colliding_pair(q) is not None)
+    assert model.checked_margin == TOUCH == 1e-6
+    near, d = _at_distance(panda, model.geom, clear, touching, 0.4 * TOUCH)
+    assert 0 < d < TOUCH and model.colliding_pair(near) is not None
+    apart, d = _at_distance(panda, model.geom, clear, touching, 20 * TOUCH)
+    assert d > TOUCH and model.colliding_pair(apart) is None

@@ -255,6 +255,16 @@ def test_the_throughput_bench_reports_both_start_modes_each_round_and_the_publis
         assert len(m["per_second"]) == 2 and all(v > 0 for v in m["per_second"])
         assert all(s == 1.0 for s in m["success"]) and all(s == 1.0 for s in m["success_loose"])
         assert all(abs(1e6 / p - us) < 1e-6 * us for p, us in zip(m["per_second"], m["us_per_target"], strict=True))
-    text = throughput.markdown([row])
+    clear = {"robot": "panda", "pairs": 107, "targets": 2000, "per_second": [9000.0, 8000.0, 10000.0],
+             "success": [1.0, 0.999, 1.0], "colliding": 0}
+    text = throughput.markdown({"arms": [row], "collision_free": clear})
+    assert "| panda, self and a floor and a table | 107 | 9,000 [8,000–10,000] | 99.90 % | 0 |" in text
     assert "| ur5 (6) | table |" in text and "| ur5 (6) | random |" in text
     assert "Published, not measured here" in text and "| PyRoki | RTX 4090 |" in text
+
+
+def test_the_collision_free_batch_has_no_colliding_success_by_pinocchio():
+    from kinelab.report.bench import throughput
+
+    clear = throughput.collision_free(kinelab.load("panda"), rounds=1, seed=0)
+    assert clear["colliding"] == 0 and clear["success"][0] >= 0.99 and clear["pairs"] > 50

@@ -31,6 +31,8 @@ from kinelab.robot import Robot
 from kinelab.robot.meshes import mesh_package_dirs, missing_meshes
 from kinelab.robot.mjcf import is_mjcf
 
+TOUCH = 1e-6  # [m] pairs this near contact count as colliding (CollisionModel.checked_margin)
+
 
 class CollisionError(KinelabError):
     """Collisions asked of a robot that has no collision geometry, or a bad collision setting; says which."""
@@ -120,7 +122,15 @@ class CollisionModel:
         self.data, self.gdata = self.robot.model.createData(), pin.GeometryData(self.geom)
         self._found = np.empty(len(self.pairs), dtype=np.int64)
         for req in self.gdata.collisionRequests:
-            req.security_margin = self.margin
+            req.security_margin = self.checked_margin
+
+    @property
+    def checked_margin(self) -> float:
+        """The clearance the checks ask of every pair [m]: ``margin`` and TOUCH (two shapes that touch are one
+        collision or none by the exact test's starting guess, which its previous calls leave: a pair is called
+        colliding within TOUCH of contact, the same way every time, so that an answer called clear is clear by
+        Pinocchio's ``computeCollisions`` at the user's margin)."""
+        return self.margin + TOUCH
 
     def _hull_data(self) -> Any:
         """The convex hulls' geometry data, the hulls computed on the first check (a model built only to say
@@ -129,7 +139,7 @@ class CollisionModel:
             self.hulls = _hulls(self.geom)
             self.hdata = pin.GeometryData(self.hulls)
             for req in self.hdata.collisionRequests:
-                req.security_margin = self.margin
+                req.security_margin = self.checked_margin
         return self.hdata
 
     def contact(self, q: Any, first_test: bool = True) -> Contact | None:
@@ -184,7 +194,8 @@ class CollisionModel:
         if f is None:  # a mimic follower in the chain: no sphere test, the hulls take every pair
             return np.arange(len(self.pairs))
         count = sphere_candidates(q, f.parents, f.place_R, f.place_t, f.axis, f.kind, f.q_index, self.joints,
-                                  self.centres, self.radii, self.normals, self.pairs, self.margin, self._found)
+                                  self.centres, self.radii, self.normals, self.pairs, self.checked_margin,
+                                  self._found)
         return self._found[:count]
 
     def contact_of(self, k: int) -> Contact:

@@ -26,7 +26,7 @@ from kinelab.ik.analytic.branches import (
     prepared_form,
 )
 from kinelab.ik.analytic.redundancy import redundant_all
-from kinelab.ik.analytic.sew import SEW
+from kinelab.ik.analytic.sew import SEW, sew_all
 from kinelab.ik.batch import fresh_seed, prepare, run_batch
 from kinelab.ik.limits import distance as distance  # exported: the branch distance users sort by
 from kinelab.ik.registry import Capabilities, capabilities
@@ -108,6 +108,8 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
         if method is Route.MULTISTART:
             raise OptionError("redundancy", redundancy, f"None with solver={req.solver!r} and options (redundancy= "
                               "sweeps a joint of the closed form: solver 'auto' or 'analytic', no options)")
+        if isinstance(redundancy, SEW):
+            return sew_all(robot, target, req, redundancy, ref, max_solutions)
         return redundant_all(robot, target, req, redundancy, ref, max_solutions)
     if method is Route.CLOSED_FORM or (method is Route.EITHER and (has_closed_form(robot, req)
                                                                     or has_general_form(robot, req))):

@@ -35,7 +35,6 @@ from kinelab.ik.analytic.classify import (
     general_vectors,
 )
 from kinelab.ik.analytic.kernel import GENERAL_6R
-from kinelab.ik.analytic.sew import SEW, sew_all
 from kinelab.ik.chain import PRISMATIC, chain_model
 from kinelab.ik.limits import distance
 from kinelab.ik.request import Request
@@ -284,8 +283,8 @@ def redundant_all(robot: Robot, target: pin.SE3, req: Request, redundancy: objec
         target: the pose.
         req: the validated request (task "pose").
         redundancy: K samples of the swept end joint (:func:`samples`; a robot :func:`swept_arm` accepts),
-            ``{joint name: value}`` for any one joint held at one value, or a :class:`SEW` angle
-            (:func:`~kinelab.ik.analytic.sew.sew_all`).
+            ``{joint name: value}`` for any one joint held at one value (a SEW angle:
+            :func:`~kinelab.ik.analytic.sew.sew_all`).
         q_ref: sort the answers by distance to this configuration; each angle's copy is picked nearest it.
         max_solutions: at most this many answers (the nearest ``q_ref`` first when given).
 
@@ -298,8 +297,6 @@ def redundant_all(robot: Robot, target: pin.SE3, req: Request, redundancy: objec
     t0 = time.perf_counter()
     if req.task.name != "pose":
         raise OptionError("task", req.task_label, "'pose' with redundancy= (other tasks: solver='frdm')")
-    if isinstance(redundancy, SEW):
-        return sew_all(robot, target, req, redundancy, q_ref, max_solutions)
     values, how, joint = held_values(robot, redundancy)
     answers = []
     for theta in values:

@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -33,13 +33,11 @@ from kinelab.errors import OptionError
 from kinelab.geometry import wrap_to_pi
 from kinelab.ik.analytic.branches import Answer, Rows, arm_roots, branch_results, judged_roots
 from kinelab.ik.analytic.certify import Loop, equations, loop_of
+from kinelab.ik.analytic.redundancy import SweptArm, chain7_vectors, samples, swept_arm
 from kinelab.ik.request import Request
 from kinelab.ik.result import Branches
 from kinelab.ik.targets import beyond_reach
 from kinelab.robot import Robot
-
-if TYPE_CHECKING:
-    from kinelab.ik.analytic.redundancy import SweptArm
 
 MATCH = 1.0  # rad: a branch at one sample and its nearest at the next are one branch followed when this close
 NEWTON_STEPS = 30
@@ -195,8 +193,6 @@ def arm7(robot: Robot) -> Arm7:
 
 
 def _arm7(robot: Robot) -> Arm7:
-    from kinelab.ik.analytic.redundancy import chain7_vectors
-
     v = chain7_vectors(robot)
     h, o = v["e"], v["o"]
     return Arm7(loop_of(h, o, v["R"], v["N"]), nearest_on(h[0], o[0], h[1], o[1]), nearest_on(h[3], o[3], h[2], o[2]),
@@ -210,8 +206,6 @@ def sew_angle(robot: Robot, q: Any, sew: SEW | None = None) -> float:
         OptionError: the robot is not a 7R chain.
         ConfigurationError: q is not a valid configuration.
     """
-    from kinelab.ik.analytic.redundancy import chain7_vectors
-
     chain7_vectors(robot)
     arm = arm7(robot)
     return (sew or SEW(0.0)).of(*arm.points(robot.check_q(q)))
@@ -314,8 +308,6 @@ def sampled(robot: Robot, arm: Arm7, sew: SEW, H: np.ndarray,
     the answers), their ψ − ψ₀ [rad], and whether the swept joint's range is a whole turn: ``sew.samples`` values
     spread over its range (its ends included unless it is a whole turn), and midpoints added, REFINE times over,
     in every cell :func:`_refined` names."""
-    from kinelab.ik.analytic.redundancy import samples
-
     lo, hi = float(robot.lower[sw.joint]), float(robot.upper[sw.joint])
     around = hi - lo >= 2 * math.pi
     values = list(samples(lo, hi, sew.samples) if around else np.linspace(lo, hi, sew.samples))
@@ -357,9 +349,9 @@ def sew_all(robot: Robot, target: pin.SE3, req: Request, sew: SEW, q_ref: np.nda
         OptionError: the robot is not a 7R arm with a swept form (:func:`~kinelab.ik.analytic.redundancy.swept_arm`),
             or the task is not "pose".
     """
-    from kinelab.ik.analytic.redundancy import swept_arm
-
     t0 = time.perf_counter()
+    if req.task.name != "pose":
+        raise OptionError("task", req.task_label, "'pose' with redundancy= (other tasks: solver='frdm')")
     sw = swept_arm(robot, sew)
     arm, H = arm7(robot), target.homogeneous
     sets, gaps, around = sampled(robot, arm, sew, H, sw)

@@ -65,19 +65,52 @@ def measure(robot: Robot, rounds: int, seed: int) -> dict[str, Any]:
             "table_mb": table.nbytes / 2**20, "modes": modes}
 
 
-def run(robots: list[str] | None, seed: int = 0, repeats: int = 3, progress: bool = False) -> list[dict[str, Any]]:
-    """Every arm's row (default ARMS)."""
+def collision_free(robot: Robot, rounds: int, seed: int) -> dict[str, Any]:
+    """Collision-free batches: per round TARGETS targets, each the tool pose of a random configuration clear of the
+    arm itself and of a floor and a table, solved by ``solve_batch(..., collisions=)``; targets/s, the success rate,
+    and how many successes Pinocchio's ``computeCollisions`` finds colliding (:func:`_by_pinocchio`)."""
+    from kinelab.collision import Collisions, collision_model
+    from kinelab.report.bench.collisions import FLOOR_AND_TABLE
+
+    model = collision_model(robot, Collisions(environment=FLOOR_AND_TABLE))
+    per_second, success, colliding = [], [], 0
+    for r in range(rounds):
+        Q = robot.random_qs(4 * TARGETS, np.random.default_rng(seed + 7000 + r))
+        clear = np.array([q for q in Q if model.colliding_pair(q) is None])[:TARGETS]
+        targets = robot.fk_batch(clear)
+        t0 = time.perf_counter()
+        res = solve_batch(robot, targets, seed=seed + r, collisions=FLOOR_AND_TABLE)
+        per_second.append(len(targets) / (time.perf_counter() - t0))
+        success.append(float(res.success.mean()))
+        colliding += _by_pinocchio(robot, model.geom, res.q[res.success])
+    return {"robot": robot.name, "pairs": len(model.pairs), "targets": TARGETS, "per_second": per_second,
+            "success": success, "colliding": int(colliding)}
+
+
+def _by_pinocchio(robot: Robot, geom: Any, Q: np.ndarray) -> int:
+    """How many configurations of Q Pinocchio's ``computeCollisions`` finds colliding: the geometry's pairs on
+    geometry data of its own (no margin, none of the batch's checks' history)."""
+    import pinocchio as pin
+
+    data, gdata = robot.model.createData(), pin.GeometryData(geom)
+    return sum(bool(pin.computeCollisions(robot.model, data, geom, gdata, robot.to_pin_q(q), True)) for q in Q)
+
+
+def run(robots: list[str] | None, seed: int = 0, repeats: int = 3, progress: bool = False) -> dict[str, Any]:
+    """Every arm's row (default ARMS), and the Panda's collision-free batches."""
     names = list(robots or ARMS)
-    return [measure(load(name), max(repeats, 1), seed)
+    rows = [measure(load(name), max(repeats, 1), seed)
             for name in tqdm(names, desc="bench --throughput", disable=not progress, unit="arm")]
+    return {"arms": rows, "collision_free": collision_free(load("panda"), max(repeats, 1), seed)}
 
 
 def _spread(values: list[float], digits: str = ",.0f") -> str:
     return f"{np.median(values):{digits}} [{min(values):{digits}}–{max(values):{digits}}]"
 
 
-def markdown(rows: list[dict[str, Any]]) -> str:
-    """The table (median [lowest–highest round]) and the published reference rows."""
+def markdown(result: dict[str, Any]) -> str:
+    """The tables (median [lowest–highest round]) and the published reference rows."""
+    rows, clear = result["arms"], result.get("collision_free")
     lines = ["| arm (DoF) | first starts | targets/s | µs per target | solved at 1e-6 | solved at 5 mm / 0.05 rad "
              "| table build, size |", "|---|---|---|---|---|---|---|"]
     for r in rows:
@@ -86,6 +119,11 @@ def markdown(rows: list[dict[str, Any]]) -> str:
                          f"{_spread(m['us_per_target'], '.1f')} | {100 * min(m['success']):.2f} % | "
                          f"{100 * min(m['success_loose']):.2f} % | "
                          f"{r['table_ms']:.0f} ms, {r['table_mb']:.1f} MB |")
+    if clear:
+        lines += ["", "| collision-free batch | pairs checked | targets/s | solved | successes colliding |",
+                  "|---|---|---|---|---|",
+                  f"| {clear['robot']}, self and a floor and a table | {clear['pairs']} | "
+                  f"{_spread(clear['per_second'])} | {100 * min(clear['success']):.2f} % | {clear['colliding']} |"]
     lines += ["", "Published, not measured here:", "", "| library | hardware | what | targets/s |", "|---|---|---|---|"]
     lines += [f"| {name} | {hw} | {what} | {rate} |" for name, hw, what, rate in PUBLISHED]
     return "\n".join(lines)
