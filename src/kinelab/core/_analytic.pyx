@@ -665,6 +665,9 @@ cdef enum:
     DROPPED = 2  # not this pose's root
 
 
+cdef double NO_AIM[6]  # the reference of a call without one (never read; a C global is zeroed)
+
+
 cdef class ClosedForm:
     """One robot's closed form with one pair of tolerances, prepared: every branch of a pose, each judged by the
     robot's certified compiled FK, in one compiled call (and a batch of poses on all cores).
@@ -810,21 +813,16 @@ cdef class ClosedForm:
         ``view(np.uint8)``); rows after count[b] are left as given. near[b] = 1 (and count[b] = 0) where a root
         fell short of the tolerances but near them: the caller solves that pose by the general route."""
         cdef Py_ssize_t B = H.shape[0], b
-        cdef int n = self.n, m
-        cdef double zero[6]
+        cdef int n = self.n
         if H.shape[1] != 4 or H.shape[2] != 4 or q.shape[0] != B or q.shape[1] < MAX_ROWS or q.shape[2] != n \
                 or errors.shape[0] != B or errors.shape[1] < MAX_ROWS or errors.shape[2] != 2 \
                 or merged.shape[0] != B or merged.shape[1] < MAX_ROWS or continuum.shape[0] != B \
                 or continuum.shape[1] < MAX_ROWS or count.shape[0] != B or near.shape[0] != B:
             raise ValueError("ClosedForm.solve_batch: H (B, 4, 4), q (B, MAX_ROWS, n), errors (B, MAX_ROWS, 2), "
                              "merged and continuum (B, MAX_ROWS), count and near (B,)")
-        for m in range(6):
-            zero[m] = 0.0
-        if B == 0:
-            return
         with nogil:
             for b in prange(B, num_threads=max(1, threads), schedule="dynamic", chunksize=32):
-                count[b] = self._pose_row(&H[b, 0, 0], zero, &q[b, 0, 0], &errors[b, 0, 0], &merged[b, 0],
+                count[b] = self._pose_row(&H[b, 0, 0], NO_AIM, &q[b, 0, 0], &errors[b, 0, 0], &merged[b, 0],
                                           &continuum[b, 0], &near[b])
 
     def nearest_batch(self, const double[:, :, ::1] H, const double[:, ::1] refs, double[:, ::1] q,
@@ -837,20 +835,14 @@ cdef class ClosedForm:
         (count 0) where a root fell short of the tolerances but near them: the caller's general route."""
         cdef Py_ssize_t B = H.shape[0], b
         cdef bint use_ref = refs.shape[0] > 0
-        cdef int n = self.n, m
-        cdef double zero[6]
-        if H.shape[1] != 4 or H.shape[2] != 4 or q.shape[0] != B or q.shape[1] != n or errors.shape[0] != B \
+        if H.shape[1] != 4 or H.shape[2] != 4 or q.shape[0] != B or q.shape[1] != self.n or errors.shape[0] != B \
                 or errors.shape[1] != 2 or count.shape[0] != B or near.shape[0] != B \
-                or (use_ref and (refs.shape[0] != B or refs.shape[1] != n)):
+                or (use_ref and (refs.shape[0] != B or refs.shape[1] != self.n)):
             raise ValueError("ClosedForm.nearest_batch: H (B, 4, 4), refs (B, n) or (0, n), q (B, n), errors (B, 2), "
                              "count and near (B,)")
-        for m in range(6):
-            zero[m] = 0.0
-        if B == 0:
-            return
         with nogil:
             for b in prange(B, num_threads=max(1, threads), schedule="dynamic", chunksize=32):
-                count[b] = self._nearest_row(&H[b, 0, 0], &refs[b, 0] if use_ref else zero, use_ref, &q[b, 0],
+                count[b] = self._nearest_row(&H[b, 0, 0], &refs[b, 0] if use_ref else NO_AIM, use_ref, &q[b, 0],
                                              &errors[b, 0], &near[b])
 
     cdef int _nearest_row(self, const double* T, const double* aim, bint use_ref, double* q, double* errors,

@@ -315,11 +315,9 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
         collisions: as :func:`solve`: a colliding branch is marked (``success`` False, status ``collision``,
             ``diagnostics.contact`` naming the pair), or left out with ``drop_colliding``.
         drop_colliding: leave colliding branches out instead of marking them.
-        redundancy: K, for a 7R arm analytic with its first or last joint held: every branch at K values of that
-            joint spread over its range (docs/analytic.md), or ``{joint name: value}`` [rad]: every branch with it
-            at that value, or :class:`~kinelab.ik.analytic.sew.SEW` (ψ): every branch the search finds with the
-            elbow's SEW angle ψ [rad] (docs/analytic.md, The SEW angle); solver "auto" or "analytic". None: a 7R
-            arm gets the multistart.
+        redundancy: a 7R arm's (docs/analytic.md; solver "auto" or "analytic"): K, every branch at K values of
+            its swept end joint; ``{joint name: value}`` [rad], every branch with that joint there; ``SEW(ψ)``, every
+            branch the search finds with the elbow's SEW angle ψ [rad]. None: a 7R arm gets the multistart.
 
     Returns:
         The :class:`~kinelab.ik.result.Branches`: one :class:`IKResult` per distinct solution, nearest ``q_ref``
