@@ -109,7 +109,7 @@ def test_ik_says_what_its_time_measured_and_prints_frdm_s_monitor_for_frdm_alone
     q = ["0.3", "-1.2", "1.0", "-0.5", "0.8", "0.2"]
     code, out, _ = run(capsys, "ik", "ur5", "--target-q", *q, "--solver", "analytic")
     assert code == 0 and "ms (one call, first-call costs included" in out and "monitor" not in out
-    code, out, _ = run(capsys, "ik", "ur5", "--target-q", *q, "--seed", "0")
+    code, out, _ = run(capsys, "ik", "ur5", "--target-q", *q, "--seed", "0", "--start-q", "random")
     assert code == 0 and "ms (one call, first-call costs included" in out and "monitor did not fire" in out
 
 
@@ -349,7 +349,7 @@ def test_freeze_and_interval_hold_from_the_start_and_the_text_says_so(capsys):
 
 def test_on_singular_keeps_the_papers_monitor_switched_policy_and_says_what_the_answer_used(capsys):
     code, out, _ = run(capsys, "ik", "era", "--target-xyz", "4", "2", "6", "--freeze", "joint1=0",
-                       "--on-singular", "freeze", "--seed", "0")
+                       "--on-singular", "freeze", "--seed", "0", "--start-q", "random")
     assert code == 0 and "the answer's attempt: monitor" in out and "over all" in out
     code, _, err = run(capsys, "ik", "era", "--target-xyz", "4", "2", "6", "--on-singular", "freeze")
     assert code == 2 and "--on-singular" in err
@@ -457,7 +457,8 @@ def test_kinelab_ik_and_branches_print_the_api_s_answers(capsys, name):
     for seed in range(3):
         q_target = robot.random_q(rng)
         words = [repr(v) for v in q_target.tolist()]
-        code, out, _ = run(capsys, "ik", name, "--target-q", *words, "--seed", str(seed), "--json")
+        code, out, _ = run(capsys, "ik", name, "--target-q", *words, "--seed", str(seed), "--json",
+                           "--start-q", "random")
         printed = json.loads(out)
         res = kinelab.solve(robot, robot.fk(q_target), seed=seed)
         assert code == (0 if res.success else 1)
@@ -470,3 +471,40 @@ def test_kinelab_ik_and_branches_print_the_api_s_answers(capsys, name):
             assert len(json.loads(out)["branches"]) > 0
             continue
         assert [b["q"] for b in json.loads(out)["branches"]] == found.q.tolist()
+
+
+def test_ik_starts_from_the_middle_of_the_limits_and_answers_the_turn_nearest_it(capsys):
+    """#43 item 7: a random default start gave the UR5 a shoulder lift of 4.91 rad (−1.37 rad is the same pose,
+    inside the limits); the default start is now the reference configuration, every revolute answer the turn
+    nearest it within the limits, and the output says which start was used."""
+    ur5 = kinelab.load("ur5")
+    words = ["0", "-1.57", "1.57", "0", "0", "0"]
+    target = ur5.fk(np.array(words, dtype=float))
+    start = 0.5 * (ur5.lower + ur5.upper)
+    for seed in range(5):
+        code, out, _ = run(capsys, "ik", "ur5", "--target-q", *words, "--seed", str(seed), "--json")
+        res = json.loads(out)
+        q = np.array(res["q"])
+        assert code == 0 and res["success"] and res["start"]["q"] == start.tolist()
+        assert res["start"]["from"].startswith("the middle of the joint limits")
+        assert np.all(np.abs(q - start) <= np.pi + 1e-12) and ur5.within_limits(q, slack=0.0)
+        assert max(ur5.tool_error(q, target)) <= 1e-6
+        assert res["position_error_m"] == pytest.approx(ur5.tool_error(q, target)[0], abs=1e-12)
+    code, out, _ = run(capsys, "ik", "ur5", "--target-q", *words)
+    assert code == 0 and "start: the middle of the joint limits" in out
+    code, out, _ = run(capsys, "ik", "ur5", "--target-q", *words, "--start-q", "random", "--seed", "1")
+    assert code == 0 and "start: drawn at random from the seed" in out
+
+
+def test_a_robot_with_an_srdf_home_starts_from_it(tmp_path):
+    ur5 = kinelab.load("ur5")
+    home = [0.4, -1.0, 1.2, -0.3, 0.5, 0.1]
+    joints = "".join(f'<joint name="{n}" value="{v}"/>' for n, v in zip(ur5.joint_names, home, strict=True))
+    srdf = tmp_path / "ur5.srdf"
+    srdf.write_text(f'<robot name="ur5"><group name="arm"><chain base_link="{ur5.base}" tip_link="{ur5.tool}"/>'
+                    f'</group><group_state name="home" group="arm">{joints}</group_state></robot>')
+    robot = kinelab.load(str(ur5.urdf_path), tool=ur5.tool, srdf=str(srdf))
+    q, how = robot.reference_q()
+    assert q.tolist() == home and how == "the SRDF's 'home' configuration"
+    q, how = ur5.reference_q()
+    assert np.allclose(q, 0.5 * (ur5.lower + ur5.upper)) and how == "the middle of the joint limits"

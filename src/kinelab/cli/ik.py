@@ -58,7 +58,9 @@ def add(sub: Any) -> None:
                    help="the components to meet: pose (all, the default), position, axis (point and one tool axis, "
                         "roll free), orientation")
     s.add_argument("--axis", choices=AXES, default="z", help="the tool axis of --task axis (default z)")
-    s.add_argument("--start-q", nargs="+", help="first start (default: seeded random), or an SRDF name")
+    s.add_argument("--start-q", nargs="+",
+                   help="first start, an SRDF name, or 'random' (drawn from the seed); default: the robot's SRDF "
+                        "home, else the middle of the limits (revolute answers then the turn nearest it)")
     s.add_argument("--deg", action="store_true", help="angles in degrees (revolute/continuous joints, rpy)")
     seed_argument(s)
     s.add_argument("--tol-pos", type=float, default=1e-6, help="position tolerance [m] (default 1e-6)")
@@ -91,7 +93,7 @@ def run(args: argparse.Namespace) -> int:
 
     robot = load_robot(args)
     target, options = _target(robot, args)
-    q0 = None if args.start_q is None else q_from_cli(robot, args.start_q, args.deg, "--start-q")
+    q0, start = _start(robot, args)
     _refuse_other_solvers_flags(args)
     options.update(_bypass_options(robot, args))
     options.update({field: getattr(args, dest) for _, dest, field in SOLVER_FLAGS
@@ -99,11 +101,50 @@ def run(args: argparse.Namespace) -> int:
     result = solve(robot, target, solver=args.solver, q0=q0, seed=args.seed, tol_pos=args.tol_pos,
                    tol_rot=args.tol_rot, time_budget=args.time_budget, task=args.task, axis=args.axis,
                    collisions=collisions_of(args), **options)
+    result = nearest_turns(robot, result, q0, target, args)
     if args.json:
-        print_json({"robot": robot.name, "target": pose_dict(target), **result.to_dict()})
+        print_json({"robot": robot.name, "target": pose_dict(target),
+                    "start": {"q": None if q0 is None else q0.tolist(), "from": start},
+                    **result.to_dict()})
     else:
         _print_ik(robot, args, result)
+        print(f"  start: {start}" + ("" if q0 is None else "; each revolute angle is the turn of it nearest the start "
+                                                          "within the limits"))
     return 0 if result.success else 1
+
+
+def _start(robot: Robot, args: argparse.Namespace) -> tuple[np.ndarray | None, str]:
+    """The first start [rad, m] and where it comes from: --start-q (``random``: drawn from the seed, None), else
+    the robot's reference configuration (:meth:`~kinelab.robot.Robot.reference_q`)."""
+    if args.start_q == ["random"]:
+        return None, "drawn at random from the seed (--start-q random)"
+    if args.start_q is not None:
+        return q_from_cli(robot, args.start_q, args.deg, "--start-q"), "--start-q"
+    q0, how = robot.reference_q()
+    return q0, f"{how} (give --start-q for another)"
+
+
+def nearest_turns(robot: Robot, result: IKResult, q0: np.ndarray | None, target: Any,
+                  args: argparse.Namespace) -> IKResult:
+    """The result with each revolute angle moved by whole turns to the copy nearest ``q0`` within the limits (the
+    same pose), judged again as the solve was (its task, axis and tolerances); unchanged when no angle moves, the
+    answer failed, or the moved one would not pass (rounding of q + 2πk could, in principle, tip it over)."""
+    from dataclasses import replace
+
+    from kinelab.ik.limits import nearest_inside
+
+    revolute = np.array([k != "prismatic" for k in robot.joint_kinds])
+    if q0 is None or not result.success or not revolute.any():
+        return result
+    moved, kept = nearest_inside(result.q[None, :], robot.lower, robot.upper, q0, 0.0)
+    q = np.where(revolute, moved[0], result.q) if kept[0] else result.q
+    if np.array_equal(q, result.q):
+        return result
+    axis = "xyz".index(args.axis) if args.task == "axis" else -1
+    dp, dr, within = robot.verdict(target.homogeneous, np.ascontiguousarray(q, dtype=float), axis)
+    met = within and (dp <= args.tol_pos or args.task == "orientation") \
+        and (dr <= args.tol_rot or args.task == "position")
+    return replace(result, q=q, position_error=dp, rotation_error=dr) if met else result
 
 
 def target_of(robot: Robot, args: argparse.Namespace) -> Any:

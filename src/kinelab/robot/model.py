@@ -277,6 +277,18 @@ class Robot:
             return np.array(self.display_pose, dtype=float)
         return np.array(self.derived("display_q", _best_conditioned), dtype=float)
 
+    def reference_q(self) -> tuple[np.ndarray, str]:
+        """The configuration a command starts from when given none [rad, m], and where it comes from in words: the
+        SRDF's configuration named "home" (or "ready") when the robot was loaded with an SRDF that has one, else
+        the middle of each joint's limits (0 for a continuous joint, and for a revolute joint whose limits span
+        more turns than :meth:`random_q` draws from)."""
+        if self.srdf is not None:
+            for name in ("home", "ready"):
+                if name in self.srdf.states:
+                    return self.named_q(name), f"the SRDF's {name!r} configuration"
+        lower, upper = self.sample_bounds
+        return 0.5 * (lower + upper), "the middle of the joint limits"
+
     def random_q(self, rng: np.random.Generator | int | None = None) -> np.ndarray:
         """A configuration drawn uniformly within the limits (continuous joints on [−π, π]; a revolute joint
         whose limits lie beyond ±SAMPLE_TURNS turns, such as a rotor declared with ±1e16 rad, on ±SAMPLE_TURNS
