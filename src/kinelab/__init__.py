@@ -34,6 +34,8 @@ _LAZY = {
     "solve_all_batch": ("kinelab.ik.api", "solve_all_batch"),
     "BranchBatch": ("kinelab.ik.analytic.branches", "BranchBatch"),
     "solve_batch": ("kinelab.ik.api", "solve_batch"),
+    "solve_batch_on_cluster": ("kinelab.ik.distributed", "solve_batch_on_cluster"),
+    "BatchSpec": ("kinelab.ik.distributed", "BatchSpec"),
     "track": ("kinelab.ik.api", "track"),
     "BatchIKResult": ("kinelab.ik.batch", "BatchIKResult"),
     "Branches": ("kinelab.ik.result", "Branches"),
@@ -65,6 +67,7 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
     from kinelab.ik.analytic.sew import SEW, sew_angle
     from kinelab.ik.api import solve, solve_all, solve_all_batch, solve_batch, track
     from kinelab.ik.batch import BatchIKResult
+    from kinelab.ik.distributed import BatchSpec, solve_batch_on_cluster
     from kinelab.ik.frdm.options import FRDMOptions
     from kinelab.ik.prepared import IK
     from kinelab.ik.result import (
@@ -82,6 +85,7 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
 
 __all__ = [
     "BatchIKResult",
+    "BatchSpec",
     "BiquatDiagnostics",
     "BiquaternionError",
     "BranchBatch",
@@ -120,6 +124,7 @@ __all__ = [
     "solve_all",
     "solve_all_batch",
     "solve_batch",
+    "solve_batch_on_cluster",
     "target_from_xyz_quat_wxyz",
     "target_from_xyz_rpy",
     "track",

@@ -43,7 +43,8 @@ def recipe(robot: Robot) -> dict:
             "trust_xacro": robot.trust_xacro, "sha256": model_sha256(robot)}
 
 
-def _worker_robot(how: dict) -> Robot:
+def worker_robot(how: dict) -> Robot:
+    """The robot ``how`` (:func:`recipe`) names, loaded once per worker process and checked to be the client's."""
     from kinelab.robot import load
 
     key = (how["source"], how["tool"], how["base"], how["sha256"], how["trust_xacro"],
@@ -66,7 +67,7 @@ def chunk_task(how: dict, spec: Any, centres: np.ndarray, index: int) -> tuple[i
     from kinelab.maps.chunk import compute_chunk
 
     threads.set_count(1)
-    return index, compute_chunk(_worker_robot(how), spec, centres, index)
+    return index, compute_chunk(worker_robot(how), spec, centres, index)
 
 
 def client_for(scheduler: str | None, workers: int | None) -> Any:
