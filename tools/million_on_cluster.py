@@ -30,7 +30,7 @@ def targets():
 
 
 def child(store):
-    from kinelab.ik.distributed import BatchSpec, solve_batch_on_cluster
+    from kinelab.maps.batch import BatchSpec, solve_batch_on_cluster
 
     panda, T = targets()
     run = solve_batch_on_cluster(panda, T, store, BatchSpec(seed=7), workers=2, progress=False)

@@ -34,8 +34,8 @@ _LAZY = {
     "solve_all_batch": ("kinelab.ik.api", "solve_all_batch"),
     "BranchBatch": ("kinelab.ik.analytic.branches", "BranchBatch"),
     "solve_batch": ("kinelab.ik.api", "solve_batch"),
-    "solve_batch_on_cluster": ("kinelab.ik.distributed", "solve_batch_on_cluster"),
-    "BatchSpec": ("kinelab.ik.distributed", "BatchSpec"),
+    "solve_batch_on_cluster": ("kinelab.maps.batch", "solve_batch_on_cluster"),
+    "BatchSpec": ("kinelab.maps.batch", "BatchSpec"),
     "track": ("kinelab.ik.api", "track"),
     "BatchIKResult": ("kinelab.ik.batch", "BatchIKResult"),
     "Branches": ("kinelab.ik.result", "Branches"),
@@ -67,7 +67,6 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
     from kinelab.ik.analytic.sew import SEW, sew_angle
     from kinelab.ik.api import solve, solve_all, solve_all_batch, solve_batch, track
     from kinelab.ik.batch import BatchIKResult
-    from kinelab.ik.distributed import BatchSpec, solve_batch_on_cluster
     from kinelab.ik.frdm.options import FRDMOptions
     from kinelab.ik.prepared import IK
     from kinelab.ik.result import (
@@ -81,6 +80,7 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
     )
     from kinelab.ik.targets import from_xyz_quat_wxyz as target_from_xyz_quat_wxyz
     from kinelab.ik.targets import from_xyz_rpy as target_from_xyz_rpy
+    from kinelab.maps.batch import BatchSpec, solve_batch_on_cluster
 
 
 __all__ = [

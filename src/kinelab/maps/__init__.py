@@ -7,6 +7,7 @@
 - :mod:`~kinelab.maps.base`: inverse reachability of a mobile base; :mod:`~kinelab.maps.singular`: σ over
   joint space.
 - :mod:`~kinelab.maps.store`: the map on disk (Zarr), its metadata, and resuming an interrupted run.
+- :mod:`~kinelab.maps.batch`: the same chunked, resumable way for a batch of IK targets on a Dask cluster.
 """
 
 from kinelab.maps.base import BaseMap, base_map

@@ -1,4 +1,4 @@
-"""solve_batch over a local two-worker Dask cluster (kinelab.ik.distributed): the rows are the in-process batch's,
+"""solve_batch over a local two-worker Dask cluster (kinelab.maps.batch): the rows are the in-process batch's,
 a stopped run resumes computing only what it had not written, and a store of another run is refused."""
 
 import numpy as np
@@ -8,8 +8,8 @@ import kinelab
 from kinelab import KinelabError, OptionError
 
 pytest.importorskip("dask.distributed")
-from kinelab.ik.distributed import BatchSpec, solve_batch_on_cluster  # noqa: E402
 from kinelab.maps import cluster  # noqa: E402
+from kinelab.maps.batch import BatchSpec, solve_batch_on_cluster  # noqa: E402
 
 FIELDS = ("q", "success", "status_code", "position_error", "rotation_error", "iterations", "restarts")
 
