@@ -1,4 +1,5 @@
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -190,3 +191,43 @@ def test_the_swept_closed_form_checks_hold_on_the_era_and_fail_when_its_branches
     monkeypatch.setattr(redundancy, "at_value", lambda *a, **k: [(q + 0.01, *rest) for q, *rest in real(*a, **k)])
     rows = validate.analytic_checks(era, 40, 0)
     assert not any(r.passed for r in rows[:3])  # the moved branches miss the pose, and every answer misses them
+
+
+def test_a_unit_wider_than_its_column_keeps_a_space_before_the_verdict():
+    """#43 item 5: the console table printed "m or radPASS"."""
+    check = validate.Check("ur5", "judge: compiled FK vs Pinocchio (certificate)", 1e-16, 1e-12, "m or rad")
+    row = render.validate_table(validate.Report(robots=["ur5"], checks=[check])).splitlines()[1]
+    assert "m or rad PASS" in row and row.endswith("PASS")
+
+
+def test_the_report_says_when_with_what_code_libraries_processor_and_command_it_ran(tmp_path, monkeypatch):
+    """#43 item 5: the report names its date, kinelab's version and commit, the libraries, the compiled core,
+    the processor and the command; the commit is the checkout's HEAD (as git itself says) or None outside one."""
+    import re
+    import shutil
+    import subprocess
+    import sys
+    from datetime import datetime
+
+    import numpy as np
+    import pinocchio as pin
+
+    import kinelab
+    from kinelab.report.provenance import commit_of
+
+    monkeypatch.setattr(sys, "argv", ["kinelab", "validate", "--robots", "ur5"])
+    report = validate.Report(robots=["ur5"], checks=[], n=10)
+    p = report.to_dict()["provenance"]
+    assert abs((datetime.fromisoformat(p["date"]) - datetime.now(datetime.fromisoformat(p["date"]).tzinfo))
+               .total_seconds()) < 60
+    assert p["command"] == "kinelab validate --robots ur5" and p["kinelab"] == kinelab.__version__
+    assert (p["pinocchio"], p["numpy"]) == (pin.__version__, np.__version__)
+    assert re.fullmatch(r"[0-9a-f]{12}", p["core"]) and p["processor"]
+    here = Path(kinelab.__file__).resolve().parent
+    git = shutil.which("git")
+    if git is not None and commit_of(here) is not None:
+        head = subprocess.run([git, "rev-parse", "HEAD"], cwd=here, capture_output=True, text=True, check=True)
+        assert p["commit"] == head.stdout.strip()
+    assert commit_of(tmp_path) is None
+    line = render.provenance_line(p)
+    assert p["date"] in line and "kinelab validate --robots ur5" in line and p["processor"] in line

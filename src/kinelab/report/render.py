@@ -26,18 +26,23 @@ def validate_table(report: Report, width: int = 120) -> str:
     """The checks as a text table whose columns fit ``width`` characters (long check names wrap within their
     column), with a closing 'N passed, M failed' line."""
     robot_w = max(5, *(len(c.robot) for c in report.checks)) if report.checks else 5
-    fixed = robot_w + 2 + 2 + 10 + 2 + 12 + 1 + 6 + 6  # the columns and gaps around the check name
+    unit_w = max(6, *(1 + len(_unit(c)) for c in report.checks))  # six, or the longest unit and a space
+    fixed = robot_w + 2 + 2 + 10 + 2 + 12 + 1 + unit_w + 6  # the columns and gaps around the check name
     name_w = max(24, min(max((len(c.name) for c in report.checks), default=24), width - fixed))
-    lines = [f"{'robot':<{robot_w}}  {'check':<{name_w}}  {'measured':>10}  {'limit':<12} {'unit':<6}result"]
+    lines = [f"{'robot':<{robot_w}}  {'check':<{name_w}}  {'measured':>10}  {'limit':<12} {'unit':<{unit_w}}result"]
     for c in report.checks:
         wrapped = textwrap.wrap(c.name, name_w) or [""]
-        unit = "" if c.unit in ("yes/no", "%") else c.unit
-        lines.append(f"{c.robot:<{robot_w}}  {wrapped[0]:<{name_w}}  {c.measured:>10}  {c.limit:<12} {unit:<6}"
-                     f"{'PASS' if c.passed else 'FAIL'}")
+        lines.append(f"{c.robot:<{robot_w}}  {wrapped[0]:<{name_w}}  {c.measured:>10}  {c.limit:<12} "
+                     f"{_unit(c):<{unit_w}}{'PASS' if c.passed else 'FAIL'}")
         lines += [f"{'':<{robot_w}}  {more}" for more in wrapped[1:]]
     failed = sum(not c.passed for c in report.checks)
     lines.append(f"{len(report.checks) - failed} passed, {failed} failed")
     return "\n".join(lines)
+
+
+def _unit(c: Any) -> str:
+    """A check's unit as the table shows it (none for yes/no and percentages, which say theirs)."""
+    return "" if c.unit in ("yes/no", "%") else str(c.unit)
 
 
 def _passage_figure(run: Any, name: str, joints: tuple[int, ...], folder: Path) -> str:
@@ -85,10 +90,19 @@ def write_validate_report(report: Report, out: str | Path) -> Path:
     return Path(out)
 
 
+def provenance_line(p: dict[str, Any]) -> str:
+    """What the run ran on, in one sentence (:func:`kinelab.report.provenance.provenance`)."""
+    commit = f", commit {p['commit'][:12]}" if p.get("commit") else ""
+    return (f"Run {p['date']} with kinelab {p['kinelab']}{commit} (compiled core {p['core']}), Pinocchio "
+            f"{p['pinocchio']}, numpy {p['numpy']}, Python {p['python']}, on {p['processor']}; command: "
+            f"`{p['command']}`.")
+
+
 def _write_validate_files(report: Report, folder: Path) -> None:
     figures = validate_figures(report, folder)
     (folder / "report.json").write_text(json.dumps(report.to_dict(), indent=2))
     md = ["# kinelab validate", "", f"Robots: {', '.join(report.robots)}; n = {report.n}; seed = {report.seed}.", "",
+          provenance_line(report.provenance), "",
           "| robot | check | measured | limit | result |", "|---|---|---|---|---|"]
     md += [f"| {c.robot} | {c.name} | {c.measured} {c.unit if c.unit not in ('yes/no', '%') else ''} | {c.limit} | "
            f"{'PASS' if c.passed else 'FAIL'} |" for c in report.checks]

@@ -18,6 +18,7 @@ from kinelab.analysis import oracles as checks
 from kinelab.errors import KinelabError
 from kinelab.geometry import quat_wxyz_from_matrix
 from kinelab.ik.request import check_seed
+from kinelab.report.provenance import provenance
 from kinelab.robot import Robot, load
 from kinelab.studies import paper001_stanford as seed001
 
@@ -68,6 +69,7 @@ class Report:
     robots: list[str] = field(default_factory=list)
     n: int = DEFAULT_N
     seed: int = 0
+    provenance: dict = field(default_factory=provenance)
 
     @property
     def passed(self) -> bool:
@@ -82,6 +84,7 @@ class Report:
             "n": self.n,
             "seed": self.seed,
             "versions": {"pinocchio": pin.__version__, "numpy": np.__version__},
+            "provenance": self.provenance,
             "checks": [{**asdict(c), "passed": c.passed} for c in self.checks],
         }
 
