@@ -231,3 +231,22 @@ def test_the_report_says_when_with_what_code_libraries_processor_and_command_it_
     assert commit_of(tmp_path) is None
     line = render.provenance_line(p)
     assert p["date"] in line and "kinelab validate --robots ur5" in line and p["processor"] in line
+
+
+def test_shares_carry_their_wilson_interval_and_sample_in_every_form_of_the_report(tmp_path):
+    """#43 item 5: success rates had no interval and the headline one sample size for every check. The Wilson
+    interval of 50 successes in 100 is 40.4–59.6 % and of 50 in 50 is 92.9–100 % (n / (n + z²) for no failure)."""
+    assert validate.wilson(0.5, 100) == pytest.approx((0.40383, 0.59617), abs=1e-5)
+    assert validate.wilson(1.0, 50) == pytest.approx((50 / (50 + 1.959963984540054**2), 1.0), abs=1e-12)
+    share = validate.Check("ur5", "frdm: targets solved (Pinocchio-checked)", 1.0, 0.95, "%", "50 targets",
+                           at_least=True, samples=50)
+    error = validate.Check("ur5", "FK position: yourdfpy vs Pinocchio", 2e-16, 1e-9, "m", "200 random q")
+    report = validate.Report(robots=["ur5"], checks=[share, error], n=200)
+    assert report.to_dict()["checks"][0]["interval_95"] == pytest.approx(validate.wilson(1.0, 50))
+    assert report.to_dict()["checks"][1]["interval_95"] is None
+    render._write_validate_files(report, tmp_path)
+    md = (tmp_path / "report.md").read_text()
+    assert "| 100.0 % (95 %: 92.9–100.0 %, n = 50) | ≥ 95 % | PASS |" in md
+    assert "each other check stating its own sample" in md
+    page = (tmp_path / "report.html").read_text()
+    assert "(95 %: 92.9–100.0 %, n = 50)" in page and "configurations per check" not in page

@@ -11,9 +11,6 @@ import base64
 import html
 import platform
 
-import numpy as np
-import pinocchio as pin
-
 from kinelab.report.validate import Check, Report
 
 CAPTIONS = {
@@ -51,7 +48,8 @@ def validate_html(report: Report, figures: dict[str, bytes]) -> str:
     verdict = "PASS" if report.passed else "FAIL"
     failed = [c for c in report.checks if not c.passed]
     summary = (f"{len(report.checks) - len(failed)} of {len(report.checks)} checks passed on "
-               f"{', '.join(report.robots)} ({report.n} configurations per check, seed {report.seed}).")
+               f"{', '.join(report.robots)} ({report.n} configurations for the FK checks, each other check its own "
+               f"sample; shares with their 95 % Wilson interval; seed {report.seed}).")
     if failed:
         summary += " Failed: " + "; ".join(f"{c.robot}: {c.name}" for c in failed) + "."
     parts = [f"<!doctype html><html><head><meta charset='utf-8'><title>kinelab validate: {verdict}</title>",
@@ -63,7 +61,7 @@ def validate_html(report: Report, figures: dict[str, bytes]) -> str:
         checks = [c for c in report.checks if c.name.startswith(key)]
         if checks:
             parts.append(_section(title, checks, {n: b for n, b in figures.items() if n.startswith(prefix)}))
-    parts.append(_machine())
+    parts.append(_machine(report.provenance))
     return "".join(parts) + "</body></html>"
 
 
@@ -71,7 +69,7 @@ def _section(title: str, checks: list[Check], figures: dict[str, bytes]) -> str:
     rows = "".join(
         f"<tr class='{'' if c.passed else 'failed'}'><td>{html.escape(c.robot)}</td><td>{html.escape(c.name)}"
         + (f"<div class='detail'>{html.escape(c.detail)}</div>" if c.detail else "")
-        + f"</td><td class='num'>{html.escape(c.measured)} {html.escape(_unit(c))}</td>"
+        + f"</td><td class='num'>{html.escape(c.measured)} {html.escape(_unit(c))}{html.escape(c.interval_shown)}</td>"
         f"<td class='num'>{html.escape(c.limit)}</td>"
         f"<td class='{'ok' if c.passed else 'bad'}'>{'PASS' if c.passed else 'FAIL'}</td></tr>"
         for c in checks)
@@ -88,10 +86,11 @@ def _unit(c: Check) -> str:
     return "" if c.unit in ("yes/no", "%") else c.unit
 
 
-def _machine() -> str:
-    from kinelab import __version__
-
-    rows = {"machine": f"{platform.platform()} ({platform.machine()})", "Python": platform.python_version(),
-            "kinelab": __version__, "Pinocchio": pin.__version__, "NumPy": np.__version__}
+def _machine(p: dict) -> str:
+    """What the run ran on (:func:`kinelab.report.provenance.provenance`), as a table."""
+    rows = {"date (UTC)": p["date"], "command": p["command"], "kinelab": p["kinelab"],
+            "commit": p.get("commit") or "not a git checkout", "compiled core": p["core"],
+            "machine": f"{platform.platform()} ({platform.machine()})", "processor": p["processor"],
+            "Python": p["python"], "Pinocchio": p["pinocchio"], "NumPy": p["numpy"]}
     items = "".join(f"<tr><th>{html.escape(k)}</th><td>{html.escape(v)}</td></tr>" for k, v in rows.items())
     return f"<h2>Machine and versions</h2><table class='meta'>{items}</table>"

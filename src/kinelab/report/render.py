@@ -101,11 +101,13 @@ def provenance_line(p: dict[str, Any]) -> str:
 def _write_validate_files(report: Report, folder: Path) -> None:
     figures = validate_figures(report, folder)
     (folder / "report.json").write_text(json.dumps(report.to_dict(), indent=2))
-    md = ["# kinelab validate", "", f"Robots: {', '.join(report.robots)}; n = {report.n}; seed = {report.seed}.", "",
+    md = ["# kinelab validate", "", f"Robots: {', '.join(report.robots)}; n = {report.n} configurations for the FK "
+          f"checks, each other check stating its own sample; seed = {report.seed}. Shares carry their 95 % Wilson "
+          "interval.", "",
           provenance_line(report.provenance), "",
           "| robot | check | measured | limit | result |", "|---|---|---|---|---|"]
-    md += [f"| {c.robot} | {c.name} | {c.measured} {c.unit if c.unit not in ('yes/no', '%') else ''} | {c.limit} | "
-           f"{'PASS' if c.passed else 'FAIL'} |" for c in report.checks]
+    md += [f"| {c.robot} | {c.name} | {' '.join(filter(None, (c.measured, _unit(c))))}{c.interval_shown} | "
+           f"{c.limit} | {'PASS' if c.passed else 'FAIL'} |" for c in report.checks]
     complete = [c for c in report.checks if c.name.startswith("completeness")]
     if complete:
         md += ["", "## Completeness", "", "| robot | own configuration found | poses, misses, branches |",

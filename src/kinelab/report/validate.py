@@ -38,6 +38,7 @@ class Check:
     unit: str
     detail: str = ""
     at_least: bool = False
+    samples: int | None = None  # the trials a share ("%") counts over: its 95 % interval is Wilson's
 
     @property
     def passed(self) -> bool:
@@ -54,12 +55,38 @@ class Check:
         return f"{100 * self.value:.1f} %" if self.unit == "%" else f"{self.value:.2e}"
 
     @property
+    def interval(self) -> tuple[float, float] | None:
+        """The share's 95 % Wilson score interval (``unit`` "%" with ``samples``), else None."""
+        if self.unit != "%" or not self.samples:
+            return None
+        return wilson(self.value, self.samples)
+
+    @property
+    def interval_shown(self) -> str:
+        """The share's 95 % interval and sample as the reports show it (" (95 %: lo–hi %, n = N)"), else ""."""
+        if self.interval is None:
+            return ""
+        low, high = self.interval
+        return f" (95 %: {100 * low:.1f}–{100 * high:.1f} %, n = {self.samples})"
+
+    @property
     def limit(self) -> str:
         """The tolerance as shown, with ≤ or ≥."""
         if self.unit == "yes/no":
             return "yes"
         shown = f"{100 * self.tolerance:g} %" if self.unit == "%" else f"{self.tolerance:.3g}"
         return ("≥ " if self.at_least else "≤ ") + shown
+
+
+Z95 = 1.959963984540054  # the standard normal's 97.5 % quantile
+
+
+def wilson(share: float, n: int, z: float = Z95) -> tuple[float, float]:
+    """The Wilson score interval of a share observed in n trials (95 % by default): (low, high), each in [0, 1]."""
+    scale = 1.0 + z * z / n
+    centre = (share + z * z / (2 * n)) / scale
+    half = z * np.sqrt(share * (1.0 - share) / n + z * z / (4 * n * n)) / scale
+    return max(0.0, float(centre - half)), min(1.0, float(centre + half))
 
 
 @dataclass
@@ -85,7 +112,7 @@ class Report:
             "seed": self.seed,
             "versions": {"pinocchio": pin.__version__, "numpy": np.__version__},
             "provenance": self.provenance,
-            "checks": [{**asdict(c), "passed": c.passed} for c in self.checks],
+            "checks": [{**asdict(c), "passed": c.passed, "interval_95": c.interval} for c in self.checks],
         }
 
 
@@ -151,7 +178,8 @@ def solver_checks(robot: Robot, n: int, seed: int) -> list[Check]:
             worst = max(worst, dp if ok else 0.0)
         rows.append(Check(robot.name, f"{solver}: targets solved (Pinocchio-checked)", 1 - failures / count,
                           1 - allowed, "%", f"{count} targets, median {np.median(times) * 1e3:.2f} ms, median "
-                          f"{np.median(iters):.0f} iterations, worst solved error {worst:.1e} m", at_least=True))
+                          f"{np.median(iters):.0f} iterations, worst solved error {worst:.1e} m", at_least=True,
+                          samples=count))
     return rows
 
 
@@ -184,7 +212,7 @@ def analytic_checks(robot: Robot, n: int, seed: int) -> list[Check]:
         if solver == "frdm" and solved:
             detail += f"; on the branch nearest its start in {100 * nearest / solved:.0f} %"
         rows.append(Check(robot.name, f"{solver}: every answer is one of the {form}'s branches",
-                          on_branch / max(solved, 1), 1.0, "%", detail, at_least=True))
+                          on_branch / max(solved, 1), 1.0, "%", detail, at_least=True, samples=solved))
     return rows + completeness_checks(robot, seed)
 
 
@@ -205,7 +233,7 @@ def completeness_checks(robot: Robot, seed: int) -> list[Check]:
     return [Check(robot.name, f"completeness: the pose's own configuration among the branches, to {FOUND:g} rad",
                   r["found"], 0.999, "%", f"{r['method']}; {r['poses']} poses, {r['misses']} missed "
                   f"({r['near_misses']} at a double root), {r['branches_mean']:.2f} branches each within the limits "
-                  f"(at most {r['branches_max']})", at_least=True)]
+                  f"(at most {r['branches_max']})", at_least=True, samples=r["poses"])]
 
 
 def _swept_checks(robot: Robot, n: int, seed: int) -> list[Check]:
@@ -238,7 +266,7 @@ def _swept_checks(robot: Robot, n: int, seed: int) -> list[Check]:
             on_branch += any(distance(robot, b, res.q) <= SAME for b in branches)
         rows.append(Check(robot.name, f"{solver}: every answer is a {form} branch at its own joint {held + 1}",
                           on_branch / max(solved, 1), 0.95, "%", f"{solved} of {len(targets)} solved from random "
-                          "starts", at_least=True))
+                          "starts", at_least=True, samples=solved))
     return rows
 
 
@@ -302,9 +330,10 @@ def collision_checks(robot: Robot, n: int, seed: int) -> list[Check]:
         solved += res.success
         clear += res.success and model.contact(res.q, first_test=False) is None
     return [Check(robot.name, "collisions: the check agrees with Pinocchio's distances", agree / count, 1.0, "%",
-                  f"{count} random configurations, floor and table; {model.summary}", at_least=True),
+                  f"{count} random configurations, floor and table; {model.summary}", at_least=True,
+                  samples=count),
             Check(robot.name, "collisions: no success collides", clear / max(solved, 1), 1.0, "%",
-                  f"{solved} targets solved clear of the floor and table", at_least=True)]
+                  f"{solved} targets solved clear of the floor and table", at_least=True, samples=solved)]
 
 
 def seed001_run_checks(robot: Robot, n: int, seed: int) -> list[Check]:
@@ -345,11 +374,11 @@ def youbot_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     return [
         Check(robot.name, "seed 003: paper's J vs finite differences of X(Q)", J_fd, 1e-6, ""),
         Check(robot.name, "seed 003: paper's J has rank 5 at θ2 = θ3 = 0", 1 - off_paper / count, 1.0, "%",
-              f"{count} Q", at_least=True),
+              f"{count} Q", at_least=True, samples=count),
         Check(robot.name, "seed 003: Pinocchio's SVD gives rank 5 at θ2 = θ3 = 0", 1 - off_pin / count, 1.0, "%",
-              f"{count} Q", at_least=True),
+              f"{count} Q", at_least=True, samples=count),
         Check(robot.name, "seed 003: paper's J has rank 6 over the limit box", 1 - box / count, 1.0, "%",
-              f"{count} Q", at_least=True),
+              f"{count} Q", at_least=True, samples=count),
         Check(robot.name, "seed 003: the sweep finds θ2 = θ3 = 0", 1.0 if found else 0.0, 1.0, "yes/no",
               "families: " + "; ".join(texts), at_least=True),
     ]
@@ -375,7 +404,8 @@ def _elbow_checks(robot: Robot, ep) -> list[Check]:
               f"without bypass {wo.position_error[reach].max():.2f} m, "
               f"reached {wo.reached[reach].sum()}/{reach.sum()}"),
         Check(robot.name, "seed 000 elbow, bypass: samples keeping the fold in its quadrants",
-              1 - ep.quadrant_violations(w, passage) / passage.samples, 1.0, "%", at_least=True),
+              1 - ep.quadrant_violations(w, passage) / passage.samples, 1.0, "%", at_least=True,
+              samples=passage.samples),
     ]
 
 
