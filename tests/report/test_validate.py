@@ -1,4 +1,5 @@
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -49,6 +50,9 @@ def test_era_checks_cover_the_three_passages_and_print_tolerances_exactly():
     table = render.validate_table(validate.Report(robots=["era"], checks=checks))
     step_row = next(line for line in table.splitlines() if "elbow, bypass: largest joint step" in line)
     assert "≤ 0.25" in step_row and " rad " in step_row  # a 0.25 rad bound printed as such, not "2e-01"
+    drifts = [c.detail for c in checks if "the paper's drift shows" in c.name]
+    degrees = [float(v) for d in drifts for v in re.findall(r"-?\d+\.\d", d)]
+    assert len(drifts) == 2 and degrees and all(-180 < v <= 180 for v in degrees)  # #43 item 5: it read −278.6°
 
 
 def test_json_alone_writes_no_report_folder(tmp_path, monkeypatch, capsys):

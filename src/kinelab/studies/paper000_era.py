@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from kinelab.geometry import wrap_to_pi
 from kinelab.ik.api import track
 from kinelab.ik.frdm import solver
 from kinelab.ik.result import TrackResult
@@ -171,9 +172,11 @@ def run(passage: Passage, robot: Robot | None = None, **options) -> PassageRun:
 
 
 def lap_changes(result: TrackResult, passage: Passage) -> np.ndarray:
-    """q at the end of each lap minus q at its start, one row per lap [rad]: zero rows = a closed path."""
+    """q at the end of each lap minus q at its start, one row per lap, each taken modulo 2π into (−π, π] [rad]:
+    zero rows = a closed path. (A joint climbing past its ±π limit is turned back by a whole turn: its raw
+    difference would read 81.4° − 360° = −278.6°.)"""
     ends = result.q[:: passage.lap]
-    return np.diff(ends, axis=0)
+    return wrap_to_pi(np.diff(ends, axis=0))
 
 
 def quadrant_violations(result: TrackResult, passage: Passage) -> int:
