@@ -101,10 +101,25 @@ def interruptible(argv, **kwargs) -> subprocess.Popen:
     return subprocess.Popen(argv, preexec_fn=_default_sigint, **kwargs)
 
 
-def pinocchio_axes(robot):
-    """Unit axes, points on them and the tool pose at q = 0, read from Pinocchio's model and Jacobians."""
+def turn_gap(a, b):
+    """The largest joint difference between a and b [rad], each modulo 2π (by trigonometry, not kinelab's wrap)."""
+    d = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
+    return float(np.max(np.abs(np.arctan2(np.sin(d), np.cos(d)))))
+
+
+def assert_meets_pose(robot, qs, target, tol):
+    """Each configuration of qs meets the target pose by Pinocchio's FK to ``tol`` [m, rad], independently of the
+    judge's verdict."""
+    for q in qs:
+        oMtool = robot.fk(q)
+        assert np.linalg.norm(oMtool.translation - target.translation) <= tol
+        assert np.linalg.norm(pin.log3(oMtool.rotation.T @ target.rotation)) <= tol
+
+
+def pinocchio_axes(robot, q=None):
+    """Unit axes, points on them and the tool pose at q (None: q = 0), read from Pinocchio's model and Jacobians."""
     model, data = robot.model, robot.model.createData()
-    q0 = pin.neutral(model)
+    q0 = pin.neutral(model) if q is None else robot.to_pin_q(q)
     pin.computeJointJacobians(model, data, q0)
     pin.framesForwardKinematics(model, data, q0)
     h = np.array([pin.getJointJacobian(model, data, j, pin.WORLD)[3:, model.joints[j].idx_v]

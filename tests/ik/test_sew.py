@@ -9,6 +9,7 @@ import math
 import numpy as np
 import pinocchio as pin
 import pytest
+from helpers import pinocchio_axes, turn_gap
 
 import kinelab
 from kinelab.errors import OptionError
@@ -18,21 +19,7 @@ TOL = 1e-6  # [m, rad] the judge's tolerances, and the SEW angle's
 FOUND = 1e-6  # [rad] the pose's own configuration is an answer to this, joint by joint, modulo 2π
 
 
-def gap(a, b):
-    d = np.asarray(a, dtype=float) - np.asarray(b, dtype=float)
-    return float(np.max(np.abs(np.arctan2(np.sin(d), np.cos(d)))))
-
-
-def axes_by_pinocchio(robot, q):
-    """Each chain joint's world axis and a point on it at q, from Pinocchio's world-frame joint Jacobian (a
-    revolute joint's column is the twist (p × ω, ω) of a turn about its line; p = ω × v on the line)."""
-    model, data = robot.model, robot.data
-    qp = robot.to_pin_q(q)
-    pin.computeJointJacobians(model, data, qp)
-    J = pin.getJointJacobian(model, data, model.njoints - 1, pin.ReferenceFrame.WORLD)
-    columns = [model.joints[model.getJointId(j.name)].idx_v for j in robot.joints]
-    w, v = J[3:, columns].T, J[:3, columns].T
-    return w, np.cross(w, v)
+gap = turn_gap
 
 
 def nearest(h_a, o_a, h_b, o_b):
@@ -46,7 +33,7 @@ def psi_by_pinocchio(robot, q, singular=(0.0, 0.0, -1.0), reference=(1.0, 0.0, 0
     """The stereographic SEW angle written out from its definition with Pinocchio's axes: S on axis 1 nearest
     axis 2, E on axis 4 nearest axis 3, W on axis 7 nearest axis 6; the reference plane's normal (ŵ − e_t) × e_r,
     the angle about ŵ from it to the plane SEW's normal (W − S) × (E − S)."""
-    h, o = axes_by_pinocchio(robot, q)
+    h, o, _ = pinocchio_axes(robot, q)
     S, E, W = nearest(h[0], o[0], h[1], o[1]), nearest(h[3], o[3], h[2], o[2]), nearest(h[6], o[6], h[5], o[5])
     w = (W - S) / np.linalg.norm(W - S)
     e_t, e_r = np.array(singular), np.array(reference)

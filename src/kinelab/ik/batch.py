@@ -103,7 +103,7 @@ def run_batch(robot: Robot, targets: Any, q0: Any, req: Request) -> BatchIKResul
     compiled = prepare(robot, req)
     t0 = time.perf_counter()
     points, rotations = as_target_arrays(targets)
-    tabled = isinstance(q0, str) and _table_pays(robot, req, q0)
+    tabled = isinstance(q0, str) and _from_table(robot, req, q0)
     starts = start_table(robot).nearest(stack_homogeneous(points, rotations)) if tabled else \
         _starts(robot, None if isinstance(q0, str) else q0, points.shape[0])
     seed = fresh_seed() if req.seed is None else req.seed
@@ -150,7 +150,7 @@ def fresh_seed() -> int:
     return int(np.random.SeedSequence().generate_state(1, np.uint64)[0] >> np.uint64(2))
 
 
-def _table_pays(robot: Robot, req: Request, q0: str | None) -> bool:
+def _from_table(robot: Robot, req: Request, q0: str | None) -> bool:
     """True when the batch's first starts come from the robot's start table (:mod:`kinelab.ik.starts`): ``q0``
     "table" for a pose task. Not the default: measured on 2,000 random targets it saves FRDM a fifth of its sweeps
     on the Panda and a tenth on the UR5, less than the look-up costs on the UR5 (docs/bench/throughput-2026-12-04.md).

@@ -69,7 +69,8 @@ def _section(title: str, checks: list[Check], figures: dict[str, bytes]) -> str:
     rows = "".join(
         f"<tr class='{'' if c.passed else 'failed'}'><td>{html.escape(c.robot)}</td><td>{html.escape(c.name)}"
         + (f"<div class='detail'>{html.escape(c.detail)}</div>" if c.detail else "")
-        + f"</td><td class='num'>{html.escape(c.measured)} {html.escape(_unit(c))}{html.escape(c.interval_shown)}</td>"
+        + f"</td><td class='num'>{html.escape(c.measured)} {html.escape(c.unit_shown)}"
+        f"{html.escape(c.interval_shown)}</td>"
         f"<td class='num'>{html.escape(c.limit)}</td>"
         f"<td class='{'ok' if c.passed else 'bad'}'>{'PASS' if c.passed else 'FAIL'}</td></tr>"
         for c in checks)
@@ -80,10 +81,6 @@ def _section(title: str, checks: list[Check], figures: dict[str, bytes]) -> str:
         f"<figcaption>Figure: {html.escape(CAPTIONS.get(name, name))}</figcaption></figure>"
         for name, data in figures.items())
     return f"<h2>{html.escape(title)}</h2>{table}{figs}"
-
-
-def _unit(c: Check) -> str:
-    return "" if c.unit in ("yes/no", "%") else c.unit
 
 
 def _machine(p: dict) -> str:

@@ -26,23 +26,18 @@ def validate_table(report: Report, width: int = 120) -> str:
     """The checks as a text table whose columns fit ``width`` characters (long check names wrap within their
     column), with a closing 'N passed, M failed' line."""
     robot_w = max(5, *(len(c.robot) for c in report.checks)) if report.checks else 5
-    unit_w = max(6, *(1 + len(_unit(c)) for c in report.checks))  # six, or the longest unit and a space
+    unit_w = max(6, *(1 + len(c.unit_shown) for c in report.checks))  # six, or the longest unit and a space
     fixed = robot_w + 2 + 2 + 10 + 2 + 12 + 1 + unit_w + 6  # the columns and gaps around the check name
     name_w = max(24, min(max((len(c.name) for c in report.checks), default=24), width - fixed))
     lines = [f"{'robot':<{robot_w}}  {'check':<{name_w}}  {'measured':>10}  {'limit':<12} {'unit':<{unit_w}}result"]
     for c in report.checks:
         wrapped = textwrap.wrap(c.name, name_w) or [""]
         lines.append(f"{c.robot:<{robot_w}}  {wrapped[0]:<{name_w}}  {c.measured:>10}  {c.limit:<12} "
-                     f"{_unit(c):<{unit_w}}{'PASS' if c.passed else 'FAIL'}")
+                     f"{c.unit_shown:<{unit_w}}{'PASS' if c.passed else 'FAIL'}")
         lines += [f"{'':<{robot_w}}  {more}" for more in wrapped[1:]]
     failed = sum(not c.passed for c in report.checks)
     lines.append(f"{len(report.checks) - failed} passed, {failed} failed")
     return "\n".join(lines)
-
-
-def _unit(c: Any) -> str:
-    """A check's unit as the table shows it (none for yes/no and percentages, which say theirs)."""
-    return "" if c.unit in ("yes/no", "%") else str(c.unit)
 
 
 def _passage_figure(run: Any, name: str, joints: tuple[int, ...], folder: Path) -> str:
@@ -106,7 +101,7 @@ def _write_validate_files(report: Report, folder: Path) -> None:
           "interval.", "",
           provenance_line(report.provenance), "",
           "| robot | check | measured | limit | result |", "|---|---|---|---|---|"]
-    md += [f"| {c.robot} | {c.name} | {' '.join(filter(None, (c.measured, _unit(c))))}{c.interval_shown} | "
+    md += [f"| {c.robot} | {c.name} | {' '.join(filter(None, (c.measured, c.unit_shown)))}{c.interval_shown} | "
            f"{c.limit} | {'PASS' if c.passed else 'FAIL'} |" for c in report.checks]
     complete = [c for c in report.checks if c.name.startswith("completeness")]
     if complete:

@@ -55,6 +55,11 @@ class Check:
         return f"{100 * self.value:.1f} %" if self.unit == "%" else f"{self.value:.2e}"
 
     @property
+    def unit_shown(self) -> str:
+        """The unit as the reports show it: none for yes/no and shares, which say theirs."""
+        return "" if self.unit in ("yes/no", "%") else self.unit
+
+    @property
     def interval(self) -> tuple[float, float] | None:
         """The share's 95 % Wilson score interval (``unit`` "%" with ``samples``), else None."""
         if self.unit != "%" or not self.samples:

@@ -30,10 +30,11 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.errors import OptionError
-from kinelab.geometry import wrap_to_pi
+from kinelab.geometry import wrap_angle, wrap_to_pi
 from kinelab.ik.analytic.branches import Answer, Rows, arm_roots, branch_results, judged_roots
 from kinelab.ik.analytic.certify import Loop, equations, loop_of
 from kinelab.ik.analytic.redundancy import SweptArm, chain7_vectors, samples, swept_arm
+from kinelab.ik.limits import distance, nearest_inside
 from kinelab.ik.request import Request
 from kinelab.ik.result import Branches
 from kinelab.ik.targets import beyond_reach
@@ -124,13 +125,8 @@ class SEW:
         for k in range(3):
             step = np.zeros(3)
             step[k] = 1e-7
-            g_W[k] = turn(self.of(S, E, W + step) - self.of(S, E, W - step)) / 2e-7
+            g_W[k] = wrap_angle(self.of(S, E, W + step) - self.of(S, E, W - step)) / 2e-7
         return g_E, g_W
-
-
-def turn(angle: float) -> float:
-    """``angle`` [rad] moved by whole turns into [−π, π] (NaN stays NaN)."""
-    return angle - 2 * math.pi * round(angle / (2 * math.pi)) if math.isfinite(angle) else angle
 
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -217,7 +213,7 @@ def _residual(arm: Arm7, sew: SEW, q: np.ndarray, H: np.ndarray) -> tuple[np.nda
     F, J = equations(arm.loop, q[None, :], H)
     S, E, W, dE, dW = arm.moved(q)
     g_E, g_W = sew.gradient(S, E, W)
-    return np.append(F[0], turn(sew.of(S, E, W) - sew.angle)), np.vstack([J[0], g_E @ dE + g_W @ dW])
+    return np.append(F[0], wrap_angle(sew.of(S, E, W) - sew.angle)), np.vstack([J[0], g_E @ dE + g_W @ dW])
 
 
 def finish(arm: Arm7, sew: SEW, q: np.ndarray, H: np.ndarray) -> np.ndarray | None:
@@ -318,7 +314,7 @@ def sampled(robot: Robot, arm: Arm7, sew: SEW, H: np.ndarray,
         if len(q):
             F, _ = equations(arm.loop, q, H)  # an uncertified elimination may offer candidates that are not roots
             q = q[np.linalg.norm(F, axis=1) <= ROOT]
-        return q, np.array([turn(sew.of(*arm.points(x)) - sew.angle) for x in q])
+        return q, np.array([wrap_angle(sew.of(*arm.points(x)) - sew.angle) for x in q])
 
     found = [at(float(v)) for v in values]
     for _ in range(REFINE):
@@ -368,13 +364,11 @@ def _judged(robot: Robot, q: np.ndarray, target: pin.SE3, req: Request, sew: SEW
             q_ref: np.ndarray | None) -> list[Answer]:
     """The roots q (m, 7) turned into the limits (each angle's copy nearest ``q_ref``), judged by Pinocchio, and
     kept where the SEW angle of the judged q is within ``req.tol_rot`` of ψ₀; nearest ``q_ref`` first."""
-    from kinelab.ik.limits import distance, nearest_inside
-
     q, _ = nearest_inside(q, robot.lower, robot.upper, q_ref, 0.0)
     m = q.shape[0]
     arm = arm7(robot)
     answers = [a for a in judged_roots(robot, q, np.ones(m, dtype=np.int64), np.zeros(m, dtype=np.bool_), target, req)
-               if abs(turn(sew.of(*arm.points(a[0])) - sew.angle)) <= req.tol_rot]
+               if abs(wrap_angle(sew.of(*arm.points(a[0])) - sew.angle)) <= req.tol_rot]
     if q_ref is not None:
         answers.sort(key=lambda a: distance(robot, a[0], q_ref))
     return answers
