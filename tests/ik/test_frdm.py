@@ -42,6 +42,26 @@ def test_compiled_vector_model_matches_pinocchio(robots, name):
         np.testing.assert_allclose(np.cross(diff, mine["e"])[revolute_rows], 0, atol=1e-11)
 
 
+def test_compiled_fk_matches_pinocchio_about_negative_and_oblique_axes(tmp_path):
+    """The compiled FK turns about ±x, ±y, ±z by the two columns they move and about any other axis by Rodrigues'
+    product: a chain with every kind of axis (negative, oblique, not unit in the file) against Pinocchio."""
+    axes = ("0 0 -1", "0 -1 0", "-1 0 0", "1 0 0", "0 1 0", "0.6 0 0.8", "1 2 -2")
+    links = "".join(f'<link name="l{i}"/>' for i in range(len(axes) + 1))
+    joints = "".join(revolute(f"j{i}", f"l{i}", f"l{i + 1}", axis=a, xyz="0.1 0.05 0.3")
+                     for i, a in enumerate(axes))
+    robot = kinelab.load(write_urdf(tmp_path, links + joints))
+    vm = vector_model(robot)
+    for q in robot.random_qs(20, 5):
+        mine, oMtool = vm.vectors(q), robot.fk(q)
+        np.testing.assert_allclose(mine["N"], oMtool.translation, atol=1e-12)
+        np.testing.assert_allclose(mine["R"], oMtool.rotation, atol=1e-12)
+        data = robot.model.createData()
+        pin.computeJointJacobians(robot.model, data, q)
+        for i in range(robot.n):  # each world axis: the angular rows of Pinocchio's Jacobian column
+            axis = pin.getJointJacobian(robot.model, data, i + 1, pin.ReferenceFrame.WORLD)[3:, i]
+            np.testing.assert_allclose(mine["e"][i], axis, atol=1e-12)
+
+
 @pytest.mark.parametrize("name", ROBOTS)
 def test_exact_step_is_the_minimum_of_the_true_objective_on_a_dense_grid(name):
     robot = kinelab.load(name)

@@ -5,9 +5,8 @@
 from libc.math cimport M_PI, cos, rint, sin
 
 
-cdef inline void rotm(double x, double y, double z, double angle, double* m) noexcept nogil:
-    """Rodrigues' rotation by ``angle`` [rad] about the unit vector (x, y, z), row by row into m[9]."""
-    cdef double c = cos(angle), s = sin(angle)
+cdef inline void rotm_cs(double x, double y, double z, double c, double s, double* m) noexcept nogil:
+    """Rodrigues' rotation about the unit vector (x, y, z) by the angle whose cosine and sine are c and s."""
     cdef double C = 1.0 - c
     m[0] = c + x * x * C
     m[1] = x * y * C - z * s
@@ -18,6 +17,11 @@ cdef inline void rotm(double x, double y, double z, double angle, double* m) noe
     m[6] = z * x * C - y * s
     m[7] = z * y * C + x * s
     m[8] = c + z * z * C
+
+
+cdef inline void rotm(double x, double y, double z, double angle, double* m) noexcept nogil:
+    """Rodrigues' rotation by ``angle`` [rad] about the unit vector (x, y, z), row by row into m[9]."""
+    rotm_cs(x, y, z, cos(angle), sin(angle), m)
 
 
 cdef inline double wrap(double theta) noexcept nogil:
