@@ -267,3 +267,28 @@ def test_obstacles_are_drawn_each_in_its_own_colour_and_named_with_it_in_the_cap
             colours[cmd["path"]] = cmd["object"]["materials"][0]["color"]
     assert len(colours) == 3 and len(set(colours.values())) == 3
     assert 0xE6194B not in colours.values()  # red stays the contacts' colour
+
+
+def test_a_meshless_arm_s_pages_draw_one_figure_per_configuration_and_no_phantom():
+    """#43 item 1: a robot whose file has nothing to draw is shown as a stick figure at its display configuration;
+    a page that draws it its own way (branches side by side, a map's stick figure) must drop that one. The README's
+    CRX-10iA pose has 8 branches: 8 figures, not 9; the xArm6's map page: one figure, not two."""
+    from kinelab import maps
+    from kinelab.maps.chunk import MapSpec
+    from kinelab.view.maps import reachability_cloud
+
+    robot = kinelab.load("crx10ia")
+    found = kinelab.solve_all(robot, robot.fk(np.array([0.3, 0.5, 0.2, 0.4, 0.6, 0.1])))
+    s = viz.side_by_side(robot, [b.q for b in found])
+    paths = browser.scene_paths(s.static_html())
+    s.close()
+    figures = {p.split("/")[3] for p in paths if p.startswith("/meshcat/branches/")}
+    assert len(found) == 8 and figures == {str(k) for k in range(8)}
+    assert not [p for p in paths if p.startswith("/meshcat/stick")]
+
+    xarm6 = kinelab.load("xarm6")
+    page = reachability_cloud(xarm6, maps.reachability(xarm6, MapSpec(voxel=0.4, orientations=2)), meshes=False)
+    paths = browser.scene_paths(page.static_html())
+    page.close()
+    joints = [p for p in paths if p.rsplit("/", 1)[-1].startswith("joint")]
+    assert len(joints) == xarm6.n + 1 and all(p.startswith("/meshcat/robot/") for p in joints)

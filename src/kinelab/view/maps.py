@@ -33,7 +33,7 @@ def reachability_cloud(robot: Robot, rmap: Any, q: Any = None, viewer: Any = Non
     q = robot.display_q() if q is None else q
     scene = Scene(robot, viewer=viewer).show(q)
     if not meshes:
-        scene.viewer[scene.root].delete()
+        scene.drop_robot()
         _stick_figure(scene.viewer["robot"], chain_points(robot, q), scene.frame_length)
     reach = rmap.array("reachability")
     keep = reach > 0

@@ -129,6 +129,12 @@ class Scene:
         self.legend["tool"] = f"tool frame {self.robot.tool!r}: x red, y green, z blue"
         return self.look_at_robot(q)
 
+    def drop_robot(self) -> None:
+        """Remove the robot as :meth:`show` draws it — its meshes, or its stick figure where the file has none to
+        draw — for a page that draws the robot its own way (side by side, over a map)."""
+        self.viewer[self.root].delete()
+        self.viewer["stick"].delete()
+
     def frame(self, name: str, oMframe: pin.SE3, length: float | None = None) -> Scene:
         """A triad (x red, y green, z blue) at a pose in the base frame, under ``frames/<name>``."""
         import meshcat.geometry as g
@@ -298,7 +304,7 @@ def side_by_side(robot: Robot, qs: list, spacing: float | None = None, viewer: A
     if labels is not None and len(labels) != len(checked):
         raise ValueError(f"side_by_side: {len(labels)} labels for {len(checked)} configurations")
     scene = Scene(robot, viewer=viewer)
-    scene.viewer[scene.root].delete()
+    scene.drop_robot()
     scene.viewer["frames"].delete()
     spacing = spacing or 0.9 * scene._reach
     columns = int(np.ceil(np.sqrt(len(checked))))
