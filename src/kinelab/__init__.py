@@ -24,11 +24,14 @@ from kinelab.errors import (
     URDFError,
 )
 from kinelab.lazy import loader
-from kinelab.robot import Joint, Robot, load
-from kinelab.robot.catalog import names as robots
 
-# the solvers load on first use (kinelab.lazy)
+# the robot (and with it Pinocchio) and the solvers load on first use (kinelab.lazy): ``kinelab --help`` and
+# ``kinelab robots`` need neither
 _LAZY = {
+    "load": ("kinelab.robot.model", "load"),
+    "Robot": ("kinelab.robot.model", "Robot"),
+    "Joint": ("kinelab.robot.model", "Joint"),
+    "robots": ("kinelab.robot.catalog", "names"),
     "solve": ("kinelab.ik.api", "solve"),
     "solve_all": ("kinelab.ik.api", "solve_all"),
     "solve_all_batch": ("kinelab.ik.api", "solve_all_batch"),
@@ -81,6 +84,8 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
     from kinelab.ik.targets import from_xyz_quat_wxyz as target_from_xyz_quat_wxyz
     from kinelab.ik.targets import from_xyz_rpy as target_from_xyz_rpy
     from kinelab.maps.batch import BatchSpec, solve_batch_on_cluster
+    from kinelab.robot.catalog import names as robots
+    from kinelab.robot.model import Joint, Robot, load
 
 
 __all__ = [

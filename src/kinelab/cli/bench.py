@@ -6,7 +6,7 @@ import argparse
 from typing import Any
 
 from kinelab.cli.common import print_json, seed_argument
-from kinelab.ik.tasks import TASKS
+from kinelab.ik.words import TASKS
 from kinelab.report.outfolder import check_output_folder
 
 
@@ -53,6 +53,9 @@ def add(sub: Any) -> None:
     s.add_argument("--collisions", action="store_true",
                    help="also solve with and without collisions= around a floor and a table (panda, ur5, kinova): "
                         "time ratio with its spread, clear success, the check's own cost")
+    s.add_argument("--startup", action="store_true",
+                   help="also how long --help, robots, fk, info and ik take from the shell against python -c "
+                        "\"import pinocchio\" (best of --repeats + 4 rounds, interleaved)")
     s.add_argument("--out", help="write bench.json, bench.md and bench.png here")
     s.add_argument("--json", action="store_true", help="print the results as JSON instead of tables")
     s.set_defaults(func=run)
@@ -65,7 +68,11 @@ def run(args: argparse.Namespace) -> int:
 
     if args.out:
         check_output_folder(args.out, "bench")
-    scaled = None
+    scaled, started = None, None
+    if args.startup:  # first, on a quiet process: nothing of the bench's own yet competes for the cores
+        from kinelab.report.bench import startup
+
+        started = startup.run(rounds=args.repeats + 4)
     if args.scaling:  # first: the peers' solver threads and caches would disturb this timing afterwards
         from kinelab.report.bench import scaling
 
@@ -75,6 +82,8 @@ def run(args: argparse.Namespace) -> int:
                        sigma=args.sigma, schedule=args.schedule, task=args.task)
     if scaled is not None:
         result["scaling"] = scaled
+    if started is not None:
+        result["startup"] = started
     if args.tracking:
         from kinelab.studies import paper000_era
 
@@ -126,6 +135,10 @@ def _print_tables(result: dict[str, Any]) -> None:
         from kinelab.report.bench import scaling
 
         print(scaling.markdown(result["scaling"]))
+    if "startup" in result:
+        from kinelab.report.bench import startup
+
+        print(startup.markdown(result["startup"]))
     if "tracking" in result:
         from kinelab.studies import paper000_era
 

@@ -7,8 +7,6 @@ import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from kinelab.cli.common import (
     json_flag,
     load_robot,
@@ -20,11 +18,11 @@ from kinelab.cli.common import (
     target_arguments,
 )
 from kinelab.errors import KinelabError, OptionError
-from kinelab.ik.result import Branches, IKResult
-from kinelab.robot import Robot
 
 if TYPE_CHECKING:
     from kinelab.ik.analytic.sew import SEW
+    from kinelab.ik.result import Branches, IKResult
+    from kinelab.robot import Robot
 
 
 def add(sub: Any) -> None:
@@ -113,6 +111,8 @@ def _completeness(found: Branches) -> str:
 
 def _print_branches(robot: Robot, args: argparse.Namespace, found: Branches, ref: Any) -> None:
     """One line per branch: its configuration and Pinocchio's errors (nearest ``ref`` first when given)."""
+    import numpy as np
+
     unit = " [deg, m]" if args.deg else " [rad, m]"
     print(f"{robot.name}: {len(found)} branch{'es' if len(found) != 1 else ''}, {_method(found)}")
     print(f"  {_completeness(found)}")

@@ -2,20 +2,24 @@
 
 Angles on the command line are radians unless ``--deg`` is given; ``--deg`` applies to revolute and
 continuous joints only (prismatic joints stay in metres).
+
+The parsers import nothing heavy: NumPy, Pinocchio, the robot and the solvers load in the handlers that use them,
+so ``kinelab --help`` and ``kinelab robots`` start without them.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-from typing import Any, NoReturn
-
-import numpy as np
-import pinocchio as pin
+from typing import TYPE_CHECKING, Any, NoReturn
 
 from kinelab.errors import ConfigurationError, KinelabError
-from kinelab.geometry import quat_wxyz_from_matrix
-from kinelab.robot import Robot, load
+
+if TYPE_CHECKING:
+    import numpy as np
+    import pinocchio as pin
+
+    from kinelab.robot import Robot
 
 
 class Parser(argparse.ArgumentParser):
@@ -48,6 +52,8 @@ def q_from_cli(robot: Robot, values: list[str], deg: bool, what: str = "q") -> n
     Raises:
         ConfigurationError: a value that is not a number, or the wrong count.
     """
+    import numpy as np
+
     if len(values) == 1 and not _is_number(values[0]):
         return robot.named_q(values[0])
     numbers = []
@@ -79,6 +85,8 @@ def _is_number(text: str) -> bool:
 def load_robot(args: argparse.Namespace) -> Robot:
     """The robot a per-robot command names, with its --tool, --base, --srdf, --group, --package-dir and
     --xacro-arg."""
+    from kinelab.robot import load
+
     return load(args.robot, tool=args.tool, base=args.base, srdf=args.srdf, group=args.group,
                 package_dirs=args.package_dir, xacro_args=_pairs(args.xacro_arg, "--xacro-arg"),
                 trust_xacro=args.trust_xacro, locked=_locked(args.lock))
@@ -173,6 +181,10 @@ def seed_argument(s: argparse.ArgumentParser) -> None:
 
 def pose_dict(oMtool: pin.SE3) -> dict[str, Any]:
     """The JSON form of a pose: position [m], rotation matrix, quat_wxyz, rpy [rad]."""
+    import pinocchio as pin
+
+    from kinelab.geometry import quat_wxyz_from_matrix
+
     return {
         "position_m": oMtool.translation.tolist(),
         "rotation_matrix": oMtool.rotation.tolist(),
@@ -188,6 +200,8 @@ def print_json(obj: Any) -> None:
 
 def rounded(values: Any, digits: int) -> list[float]:
     """Rounded for printing, without the −0.0 that rounding a tiny negative number leaves."""
+    import numpy as np
+
     out: list[float] = (np.round(np.asarray(values, dtype=float), digits) + 0.0).tolist()
     return out
 
@@ -200,6 +214,8 @@ def plural(count: int, word: str, plural_form: str | None = None) -> str:
 def shown(values: Any, precision: int = 6, prefix: str = "") -> str:
     """Numbers as the CLI prints them: ``precision`` digits, rounding noise below 1e-12 as 0, no "-0", one line
     per row however many joints (``prefix``: the text before the array, for the rows after the first)."""
+    import numpy as np
+
     clean = np.round(np.asarray(values, dtype=float), precision) + 0.0  # + 0.0 turns the −0 of rounding into 0
     return np.array2string(clean, precision=precision, suppress_small=True, max_line_width=10_000, prefix=prefix)
 

@@ -5,9 +5,7 @@ from __future__ import annotations
 import argparse
 import re
 from dataclasses import fields
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from kinelab.cli.common import (
     collision_arguments,
@@ -25,10 +23,13 @@ from kinelab.cli.common import (
 )
 from kinelab.errors import KinelabError
 from kinelab.ik.frdm.policy import SWITCHABLE, bypass_plan
-from kinelab.ik.registry import capabilities, names, solver_module
-from kinelab.ik.result import BiquatDiagnostics, IKResult, Status
-from kinelab.ik.tasks import AXES, TASKS
-from kinelab.robot import Robot
+from kinelab.ik.words import AXES, TASKS
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from kinelab.ik.result import IKResult
+    from kinelab.robot import Robot
 
 SOLVER_FLAGS = (("--polish", "polish", "polish"), ("--law", "law", "law"), ("--integrator", "integrator", "integrator"),
                 ("--step", "step", "step"), ("--gain", "gain", "k"))  # (flag, its argparse name, the option field)
@@ -40,6 +41,8 @@ def option_fields(solver: str) -> frozenset[str]:
     Raises:
         SolverNotFoundError: an unknown solver, the valid ones named.
     """
+    from kinelab.ik.registry import capabilities, solver_module
+
     kind = capabilities(solver)
     if kind.closed_form:
         return frozenset()
@@ -131,6 +134,8 @@ def nearest_turns(robot: Robot, result: IKResult, q0: np.ndarray | None, target:
     answer failed, or the moved one would not pass (rounding of q + 2πk could, in principle, tip it over)."""
     from dataclasses import replace
 
+    import numpy as np
+
     from kinelab.ik.limits import nearest_inside
 
     revolute = np.array([k != "prismatic" for k in robot.joint_kinds])
@@ -154,6 +159,8 @@ def target_of(robot: Robot, args: argparse.Namespace) -> Any:
 
 def _target(robot: Robot, args: argparse.Namespace) -> tuple[Any, dict[str, Any]]:
     """The target pose, and the biquaternion solver's signed target when it is given as a configuration."""
+    import numpy as np
+
     from kinelab.ik import target_from_xyz_rpy
     from kinelab.ik.targets import DEGREES_LIKELY
 
@@ -176,6 +183,8 @@ def _target(robot: Robot, args: argparse.Namespace) -> tuple[Any, dict[str, Any]
 
 
 def _bypass_value(robot: Robot, joint: str, text: str, deg: bool, flag: str) -> float:
+    import numpy as np
+
     try:
         value = float(text)
     except ValueError:
@@ -187,6 +196,8 @@ def _bypass_value(robot: Robot, joint: str, text: str, deg: bool, flag: str) -> 
 def _refuse_other_solvers_flags(args: argparse.Namespace) -> None:
     """A flag of another solver's is a mistake, said (it used to be dropped without a word); --axis goes with
     --task axis only."""
+    from kinelab.ik.registry import names
+
     mine = option_fields(args.solver)
     given = [(flag, field) for flag, dest, field in SOLVER_FLAGS
              if getattr(args, dest) not in (None, False) and field not in mine]
@@ -207,6 +218,8 @@ def _bypass_options(robot: Robot, args: argparse.Namespace) -> dict[str, Any]:
             raise KinelabError("--on-singular switches bypasses given by --kick, --interval or --freeze; none is")
         return {}
     if "kicks" not in option_fields(args.solver):
+        from kinelab.ik.registry import names
+
         owners = " or ".join(name for name in names() if "kicks" in option_fields(name))
         raise KinelabError(f"--kick, --interval and --freeze are bypasses of --solver {owners}, not of "
                            f"--solver {args.solver}")
@@ -237,6 +250,11 @@ def _split_spec(spec: str, flag: str, form: str) -> tuple[str, str]:
 
 def _print_ik(robot: Robot, args: argparse.Namespace, result: IKResult) -> None:
     """The text form of an IK result: status, q, Pinocchio's errors on the task's components, effort."""
+    import numpy as np
+
+    from kinelab.ik.registry import capabilities
+    from kinelab.ik.result import BiquatDiagnostics, Status
+
     q_show = np.where([k != "prismatic" for k in robot.joint_kinds], np.rad2deg(result.q), result.q) \
         if args.deg else result.q
     print(f"{robot.name} {args.solver}, task {result.task}: {result.status.value} (success: {result.success})")

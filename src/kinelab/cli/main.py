@@ -10,16 +10,20 @@ with 130. Every command that prints results takes ``--json`` for a stable machin
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import sys
 import warnings
+from collections.abc import Sequence
 from typing import Any
 
-from kinelab.cli import bench, branches, fk, ik, maps, robots, singular, validate, view
 from kinelab.cli.common import Parser
 from kinelab.errors import KinelabError
 
-COMMANDS = (robots, fk, ik, branches, singular, view, bench, maps, validate)
+# each command → the module with its parser and handler, in the order ``kinelab --help`` lists them
+COMMANDS = {"robots": "robots", "info": "robots", "fk": "fk", "ik": "ik", "branches": "branches",
+            "singular": "singular", "view": "view", "animate": "view", "bench": "bench", "map": "maps",
+            "validate": "validate"}
 
 
 class _Version(argparse.Action):
@@ -33,13 +37,21 @@ class _Version(argparse.Action):
         parser.exit()
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The ``kinelab`` command line: one subparser per command."""
+def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
+    """The ``kinelab`` command line: one subparser per command.
+
+    Args:
+        argv: the arguments about to be parsed: when their first word names a command, only that command's module
+            is imported and its parser built (a command starts without the others' imports); otherwise (None,
+            ``--help``, a mistyped command) every command's, so that help and errors list them all.
+    """
     p = Parser(prog="kinelab", description="Kinematics of serial arms, checked against Pinocchio.")
     p.add_argument("--version", action=_Version, nargs=0, help="show kinelab's version and exit")
     sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
-    for command in COMMANDS:
-        command.add(sub)
+    named = COMMANDS.get(argv[0]) if argv else None
+    modules = [named] if named else list(dict.fromkeys(COMMANDS.values()))
+    for module in modules:
+        importlib.import_module(f"kinelab.cli.{module}").add(sub)
     return p
 
 
@@ -52,8 +64,9 @@ def _one_line(message: Warning | str, category: type[Warning], filename: str, li
 def main(argv: list[str] | None = None) -> int:
     """Run one command; a user error prints one line and returns 2, Ctrl-C returns 130."""
     warnings.formatwarning = _one_line
-    args = build_parser().parse_args(argv)
-    args.command_line = list(sys.argv[1:] if argv is None else argv)  # what resumes an interrupted command
+    words = list(sys.argv[1:] if argv is None else argv)
+    args = build_parser(words).parse_args(words)
+    args.command_line = words  # what resumes an interrupted command
     try:
         code: int = args.func(args)
         return code

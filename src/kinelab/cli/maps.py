@@ -8,8 +8,6 @@ import time
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from kinelab.cli import common
 from kinelab.cli.common import Interrupted, Parser, load_robot, plural, print_json, seed_argument, source_arguments
 from kinelab.errors import KinelabError
@@ -104,6 +102,8 @@ def run_base(args: argparse.Namespace) -> int:
 
 def run_singular(args: argparse.Namespace) -> int:
     """σ_min/σ_max over samples: how many near-singular, how many rank-deficient."""
+    import numpy as np
+
     from kinelab import maps
     from kinelab.analysis.singular import NEAR_SINGULAR
 
@@ -138,6 +138,8 @@ def _kept(args: argparse.Namespace) -> str:
 
 def run_reach(args: argparse.Namespace) -> int:
     """Build (or resume) the reachability map and print its summary."""
+    import numpy as np
+
     from kinelab import maps
 
     robot = load_robot(args)

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import argparse
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from kinelab.cli.common import json_flag, load_robot, print_json, robot_arguments
-from kinelab.robot import Joint, catalog
+from kinelab.robot import catalog
+
+if TYPE_CHECKING:
+    from kinelab.robot import Joint
 
 
 def add(sub: Any) -> None:
@@ -18,6 +19,8 @@ def add(sub: Any) -> None:
     s.set_defaults(func=run_robots)
     s = sub.add_parser("info", help="joints, types, limits, DOF and tool frame of a robot")
     robot_arguments(s, limits=False)
+    s.add_argument("--collisions", action="store_true",
+                   help="also build the self-collision model (loads the collision meshes) and say what it checks")
     json_flag(s)
     s.set_defaults(func=run_info)
 
@@ -40,6 +43,8 @@ def run_robots(args: argparse.Namespace) -> int:
 
 
 def _joint_row(j: Joint) -> dict[str, Any]:
+    import numpy as np
+
     row: dict[str, Any] = {"name": j.name, "type": j.kind, "lower": j.lower, "upper": j.upper, "unit": j.unit}
     if j.kind != "prismatic":
         row["lower_deg"], row["upper_deg"] = float(np.rad2deg(j.lower)), float(np.rad2deg(j.upper))
@@ -48,13 +53,15 @@ def _joint_row(j: Joint) -> dict[str, Any]:
 
 def run_info(args: argparse.Namespace) -> int:
     """The robot's chain: base, tool, joints with their limits, the locked joints."""
+    import numpy as np
+
     from kinelab.ik.analytic.redundancy import closed_form_summary  # the solvers load for info only, not for --help
 
     robot = load_robot(args)
     info = {"robot": robot.name, "urdf": str(robot.urdf_path), "base": robot.base, "tool": robot.tool,
             "dof": robot.n, "nq": robot.nq, "nv": robot.nv, "joints": [_joint_row(j) for j in robot.joints],
             "locked": robot.locked, "mimics": {name: m.leader for name, m in robot.mimics.items()},
-            "format": robot.source_format, "collisions": _collision_summary(robot),
+            "format": robot.source_format, "collisions": _collision_summary(robot) if args.collisions else None,
             "closed_form": closed_form_summary(robot), "judge": str(robot.fk_certificate)}
     if args.json:
         print_json(info)
@@ -74,7 +81,7 @@ def run_info(args: argparse.Namespace) -> int:
         print(f"locked: {', '.join(f'{k}={v:g}' for k, v in robot.locked.items())}")
     print(f"branches: {info['closed_form']}")
     print(f"answers judged by: {info['judge']}")
-    print(f"collisions: {info['collisions']}")
+    print(f"collisions: {info['collisions'] or 'not built (add --collisions: loads the meshes, counts the pairs)'}")
     return 0
 
 

@@ -9,7 +9,6 @@ from typing import Any
 
 from kinelab.cli.common import collision_arguments, collisions_of, load_robot, plural, q_from_cli, robot_arguments
 from kinelab.errors import KinelabError
-from kinelab.robot import load
 
 MIN_DT, MAX_DT = 1e-3, 60.0  # [s] per animation sample
 
@@ -54,6 +53,7 @@ def run_view(args: argparse.Namespace) -> int:
 
 def run_animate(args: argparse.Namespace) -> int:
     """Animate one ERA passage with or without the paper's bypass."""
+    from kinelab.robot import load
     from kinelab.studies import paper000_era
     from kinelab.view import scene as viz
 

@@ -14,28 +14,30 @@ from __future__ import annotations
 import time
 from collections.abc import Sequence
 from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
 
-from kinelab.collision.model import CollisionModel, as_collisions, collision_model
 from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
-from kinelab.ik.analytic.branches import BranchBatch, all_branches_batch, analytic_one, nearest_batch, refuse_options
-from kinelab.ik.analytic.sew import SEW
 from kinelab.ik.batch import BatchIKResult, prepare, prepare_robot, run_batch
 from kinelab.ik.branches import UNSEEN, Route, find_all, route_of, usual_closed_form
 from kinelab.ik.chain import chain_model
 from kinelab.ik.clear import clear_batch, clear_track, mark_colliding, solve_clear
 from kinelab.ik.driver import solve_one
 from kinelab.ik.frdm.tracking import PathSettings, path_options, run_track
-from kinelab.ik.prepared import kept_solver, prepared
+from kinelab.ik.prepared import collision_check, kept_solver, prepared
 from kinelab.ik.registry import Capabilities, capabilities, one_answer
 from kinelab.ik.request import Request, check_robot, make_request
 from kinelab.ik.result import Branches, IKResult, TrackResult
 from kinelab.ik.targets import as_target, as_target_arrays
 from kinelab.robot import Robot
+
+if TYPE_CHECKING:  # the collision model and the closed forms load when a call asks for them
+    from kinelab.collision.model import CollisionModel
+    from kinelab.ik.analytic.branches import BranchBatch
+    from kinelab.ik.analytic.sew import SEW
 
 # The order of the arguments after (robot, target) in kinelab 0.1's positional signatures: a call that still
 # passes them positionally is told which keyword its value was
@@ -148,7 +150,7 @@ def _solve_preferring(robot: Robot, target: Any, q0: Any, seed: int | None, pref
                            axis, None)
         return _closed_form_one(robot, target, q0, prefer, collisions, options or rest, req)
     req = make_request(solver, seed, tol_pos, tol_rot, budget, restarts, outside, options, task, axis, rest)
-    check = _collision_model(robot, collisions)
+    check = collision_check(robot, collisions)
     if q0 is not None:
         raise OptionError("q0", "given", "None with prefer= (the branch search draws its own starts)")
     closed = kind.stands_in and options is None and not rest
@@ -179,18 +181,14 @@ def _preferred(robot: Robot, target: Any, req: Request, prefer: Any, check: Coll
 def _closed_form_one(robot: Robot, target: Any, q0: Any, prefer: Any, collisions: Any, options: Any,
                      req: Request) -> IKResult:
     """``solve(solver="analytic")``: the branch nearest q0 (or ``prefer``), from the closed form."""
+    from kinelab.ik.analytic.branches import analytic_one, refuse_options
+
     refuse_options(options)
     if q0 is not None and prefer is not None:
         raise OptionError("prefer", "given with q0", "one reference: q0 or prefer, with solver='analytic'")
     ref = q0 if q0 is not None else prefer
     return analytic_one(robot, as_target(target, req.task.name), req,
-                        None if ref is None else robot.check_q(ref, what="q0"), _collision_model(robot, collisions))
-
-
-def _collision_model(robot: Robot, collisions: Any) -> CollisionModel | None:
-    """The collision model for ``collisions=`` (None: no check)."""
-    spec = as_collisions(collisions)
-    return None if spec is None else collision_model(robot, spec)
+                        None if ref is None else robot.check_q(ref, what="q0"), collision_check(robot, collisions))
 
 
 def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frdm", q0: Any = None,
@@ -237,13 +235,15 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
     check_entry(robot, "solve_batch", positional)
     kind = one_answer(solver)
     if kind.closed_form:
+        from kinelab.ik.analytic.branches import nearest_batch, refuse_options
+
         refuse_options(options or solver_options)
         return nearest_batch(robot, targets, q0, make_request(kind.request_solver(solver), seed, tol_pos, tol_rot,
                                                               time_budget, max_restarts, start_outside_limits, None,
-                                                              task, axis, None), _collision_model(robot, collisions))
+                                                              task, axis, None), collision_check(robot, collisions))
     req = make_request(solver, seed, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options,
                        task, axis, solver_options)
-    check = _collision_model(robot, collisions)
+    check = collision_check(robot, collisions)
     t0 = time.perf_counter()
     res = run_batch(robot, targets, q0, req)
     if check is None:
@@ -280,6 +280,8 @@ def solve_all_batch(robot: Robot, targets: Any, *positional: Any, tol_pos: float
             chain none of those take (named: its branches come from ``solve_all`` one target at a time).
     """
     check_entry(robot, "solve_all_batch", positional)
+    from kinelab.ik.analytic.branches import all_branches_batch
+
     return all_branches_batch(robot, targets, tol_pos, tol_rot)
 
 
@@ -336,10 +338,12 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
             return found
     kind, given = capabilities(solver), options is not None or bool(solver_options)
     if kind.closed_form and given:  # refusing says so rather than ignoring them
+        from kinelab.ik.analytic.branches import refuse_options
+
         refuse_options(options or solver_options)
     req = make_request(kind.request_solver(solver), seed, tol_pos, tol_rot, time_budget, 0, "refuse", options, task,
                        axis, solver_options)
-    check = _collision_model(robot, collisions)
+    check = collision_check(robot, collisions)
     found = find_all(robot, target, req, q_ref=q_ref, max_solutions=max_solutions, stop_below=stop_below,
                      method=route_of(kind, given), redundancy=redundancy)
     return found if check is None else mark_colliding(found, check, drop=bool(drop_colliding))
@@ -407,7 +411,7 @@ def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
     req = make_request(solver, seed, tol_pos, tol_rot, time_budget, 0, "refuse", options, task, axis,
                        path_options(options, solver_options))
     points, rotations = as_target_arrays(targets)
-    return _follow_path(robot, points, rotations, q0, req, settings, _collision_model(robot, collisions), t_start)
+    return _follow_path(robot, points, rotations, q0, req, settings, collision_check(robot, collisions), t_start)
 
 
 def _follow_path(robot: Robot, points: np.ndarray, rotations: np.ndarray, q0: Any, req: Request,

@@ -12,21 +12,11 @@ from __future__ import annotations
 import time
 from dataclasses import replace
 from enum import Enum
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
 from kinelab.errors import OptionError
-from kinelab.ik.analytic.branches import (
-    EveryBranch,
-    analytic_all,
-    arm_of,
-    has_closed_form,
-    has_general_form,
-    prepared_form,
-)
-from kinelab.ik.analytic.redundancy import redundant_all
-from kinelab.ik.analytic.sew import SEW, sew_all
 from kinelab.ik.batch import fresh_seed, prepare, run_batch
 from kinelab.ik.limits import distance as distance  # exported: the branch distance users sort by
 from kinelab.ik.registry import Capabilities, capabilities
@@ -34,6 +24,10 @@ from kinelab.ik.request import Request, check_seed, count_ok, make_request
 from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target, beyond_reach
 from kinelab.robot import Robot
+
+if TYPE_CHECKING:  # the closed forms load when a route asks for them: a multistart solve does without
+    from kinelab.ik.analytic.branches import EveryBranch
+    from kinelab.ik.analytic.sew import SEW
 
 SAME = 1e-3  # [rad or m] two answers closer than this, joint by joint, are one solution (answers met to 1e-6 m
 # near a singular point differ by up to ~2e-4 rad; distinct branches by far more)
@@ -108,9 +102,25 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
         if method is Route.MULTISTART:
             raise OptionError("redundancy", redundancy, f"None with solver={req.solver!r} and options (redundancy= "
                               "sweeps a joint of the closed form: solver 'auto' or 'analytic', no options)")
+        from kinelab.ik.analytic.redundancy import redundant_all
+        from kinelab.ik.analytic.sew import SEW, sew_all
+
         if isinstance(redundancy, SEW):
             return sew_all(robot, target, req, redundancy, ref, max_solutions)
         return redundant_all(robot, target, req, redundancy, ref, max_solutions)
+    if method is not Route.MULTISTART:
+        found = _closed_form_all(robot, target, req, ref, max_solutions, method)
+        if found is not None:
+            return found
+    return _multistart_all(robot, target, req, ref, max_solutions, stop_below)
+
+
+def _closed_form_all(robot: Robot, target: Any, req: Request, ref: Any, max_solutions: int | None,
+                     method: Route) -> Branches | None:
+    """Every branch in closed form (or by the 1-D search or the general elimination) where the route and the chain
+    allow it; None where the multistart is to answer instead."""
+    from kinelab.ik.analytic.branches import analytic_all, arm_of, has_closed_form, has_general_form
+
     if method is Route.CLOSED_FORM or (method is Route.EITHER and (has_closed_form(robot, req)
                                                                     or has_general_form(robot, req))):
         found = analytic_all(robot, target, req, q_ref=ref, max_solutions=max_solutions)
@@ -119,7 +129,7 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
         if found or found.complete == "certified" or not arm_of(robot, req).searched \
                 or beyond_reach(robot, target.translation):
             return found
-    return _multistart_all(robot, target, req, ref, max_solutions, stop_below)
+    return None
 
 
 USUAL_PER_ROBOT = 16  # a caller sweeping settings: the prepared closed forms kept stay bounded
@@ -153,6 +163,8 @@ def _usual_entry(robot: Robot, settings: tuple[Any, ...]) -> EveryBranch | Liter
     Raises:
         OptionError: a bad setting, named (as the general route would).
     """
+    from kinelab.ik.analytic.branches import EveryBranch, has_closed_form, has_general_form, prepared_form
+
     solver, tol_pos, tol_rot, time_budget, stop_below = settings
     if not capabilities(solver).picks:
         return False

@@ -21,19 +21,10 @@ from __future__ import annotations
 
 import time
 from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from kinelab.collision.model import as_collisions, collision_model
 from kinelab.core._engine import Engine
 from kinelab.geometry import stack_homogeneous
-from kinelab.ik.analytic.branches import (
-    NearestBranch,
-    analytic_one,
-    arm_of,
-    nearest_batch,
-    prepared_form,
-    refuse_options,
-)
 from kinelab.ik.batch import BatchIKResult, run_batch
 from kinelab.ik.branches import UNSEEN, find_all, route_of
 from kinelab.ik.clear import clear_batch, mark_colliding, solve_clear
@@ -43,6 +34,10 @@ from kinelab.ik.request import Request, check_robot, check_seed, make_request
 from kinelab.ik.result import Branches, IKResult
 from kinelab.ik.targets import as_target, as_target_arrays
 from kinelab.robot import Robot
+
+if TYPE_CHECKING:
+    from kinelab.collision.model import CollisionModel
+    from kinelab.ik.analytic.branches import NearestBranch
 
 
 class IK:
@@ -86,12 +81,13 @@ class IK:
         kind = capabilities(solver)
         self.analytic = kind.closed_form
         self.route = route_of(kind, options is not None or bool(solver_options))  # of solve_all, as kinelab's
-        if self.analytic:
+        if self.analytic:  # the closed forms load for the solver that uses them
+            from kinelab.ik.analytic.branches import refuse_options
+
             refuse_options(options or solver_options)
         self.request: Request = make_request(kind.request_solver(solver), None, tol_pos, tol_rot, time_budget,
                                              max_restarts, start_outside_limits, options, task, axis, solver_options)
-        spec = as_collisions(collisions)
-        self.collisions = None if spec is None else collision_model(robot, spec)
+        self.collisions = collision_check(robot, collisions)
         self._nearest: NearestBranch | None = None
         self._prepare()
         # the usual call's one compiled call (kinelab.core._engine), where the solver has one
@@ -102,6 +98,8 @@ class IK:
         here, by name) and its one-call form, or the solver's model."""
         robot, req = self.robot, self.request
         if self.analytic:
+            from kinelab.ik.analytic.branches import NearestBranch, arm_of, prepared_form
+
             arm_of(robot, req)
             if self.collisions is None:  # the usual call's one compiled call: branches found and judged together
                 form = prepared_form(robot, req)
@@ -147,6 +145,8 @@ class IK:
 
     def _nearest_branch(self, target: Any, q0: Any) -> IKResult:
         """Solver "analytic": the branch nearest q0 in one compiled call where that serves, else root by root."""
+        from kinelab.ik.analytic.branches import analytic_one
+
         ref = None if q0 is None else self.robot.check_q(q0, what="q0")
         found = None if self._nearest is None else self._nearest.solve(target, ref)
         return found or analytic_one(self.robot, as_target(target, self.request.task.name), self.request, ref,
@@ -169,6 +169,8 @@ class IK:
         req = replace(self._request(seed), start_outside_limits="refuse")
         t0 = time.perf_counter()
         if self.analytic:
+            from kinelab.ik.analytic.branches import nearest_batch
+
             return nearest_batch(self.robot, targets, q0, self.request, self.collisions)
         res = run_batch(self.robot, targets, q0, req)
         if self.collisions is None:
@@ -196,6 +198,17 @@ class IK:
                          max_solutions=max_solutions, stop_below=stop_below,
                          method=self.route)
         return found if self.collisions is None else mark_colliding(found, self.collisions, drop=False)
+
+
+def collision_check(robot: Robot, collisions: Any) -> CollisionModel | None:
+    """The collision model a ``collisions=`` argument asks for (None, "self", an Environment or a Collisions), or
+    None: the collision package (coal's geometry, the robot's meshes) loads only for a solve that checks."""
+    if collisions is None:
+        return None
+    from kinelab.collision.model import as_collisions, collision_model
+
+    spec = as_collisions(collisions)
+    return None if spec is None else collision_model(robot, spec)
 
 
 PREPARED_PER_ROBOT = 16  # a caller sweeping settings: the prepared solvers kept stay bounded

@@ -13,11 +13,14 @@ Nothing about an answer's judgement changes: a start is only where the solver be
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from kinelab.robot import Robot
+
+if TYPE_CHECKING:  # SciPy's spatial module costs 0.3 s to import: it loads when a table is first built
+    from scipy.spatial import cKDTree
 
 SIZE = 8192  # configurations in a table
 SEED = 20261204  # the table's draws: the same table everywhere
@@ -53,6 +56,8 @@ def start_table(robot: Robot) -> StartTable:
 
 
 def _build(robot: Robot) -> StartTable:
+    from scipy.spatial import cKDTree
+
     q = robot.random_qs(SIZE, np.random.default_rng(SEED))
     length = max(robot.characteristic_length(), 1e-3)
     H = robot.fk_batch(q)

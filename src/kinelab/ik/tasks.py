@@ -17,9 +17,9 @@ import pinocchio as pin
 
 from kinelab.errors import OptionError
 from kinelab.geometry import pose_errors
+from kinelab.ik.words import AXES, TASKS
 
-TASKS = ("pose", "position", "axis", "orientation")
-AXES = ("x", "y", "z")
+__all__ = ["AXES", "COMPONENTS", "POSE", "TASKS", "Task"]
 COMPONENTS = {"pose": 6, "position": 3, "axis": 5, "orientation": 3}
 
 

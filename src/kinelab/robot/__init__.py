@@ -6,6 +6,15 @@
 - :mod:`~kinelab.robot.meshes`: mesh paths for the viewer (kinematics never read meshes).
 """
 
-from kinelab.robot.model import LIMIT_SLACK, Joint, Mimic, Robot, load
+from typing import TYPE_CHECKING
+
+from kinelab.lazy import loader
+
+# the model (and with it Pinocchio) loads on first use: the catalog's names alone need neither
+__getattr__ = loader(__name__, globals(), {name: ("kinelab.robot.model", name)
+                                           for name in ("LIMIT_SLACK", "Joint", "Mimic", "Robot", "load")})
+
+if TYPE_CHECKING:
+    from kinelab.robot.model import LIMIT_SLACK, Joint, Mimic, Robot, load
 
 __all__ = ["LIMIT_SLACK", "Joint", "Mimic", "Robot", "load"]

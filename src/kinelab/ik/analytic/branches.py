@@ -14,12 +14,11 @@ import time
 from dataclasses import dataclass, replace
 from functools import partial
 from types import SimpleNamespace
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 import pinocchio as pin
 
-from kinelab.collision.model import CollisionModel
 from kinelab.core import threads
 from kinelab.core._analytic import ClosedForm
 from kinelab.core._joints import turn_distances
@@ -46,6 +45,9 @@ from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target_arrays, beyond_reach
 from kinelab.robot import Robot
 from kinelab.robot.model import _compiled_judge
+
+if TYPE_CHECKING:
+    from kinelab.collision.model import CollisionModel
 
 SAME = 1e-5  # [rad] roots closer than this joint by joint are one branch (a double root split by rounding:
 # the two roots of arccos(1 − ε) are √(2ε) apart, 1.4e-6 rad at ε = 1e-12)
