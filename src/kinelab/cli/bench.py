@@ -68,22 +68,11 @@ def run(args: argparse.Namespace) -> int:
 
     if args.out:
         check_output_folder(args.out, "bench")
-    scaled, started = None, None
-    if args.startup:  # first, on a quiet process: nothing of the bench's own yet competes for the cores
-        from kinelab.report.bench import startup
-
-        started = startup.run(rounds=args.repeats + 4)
-    if args.scaling:  # first: the peers' solver threads and caches would disturb this timing afterwards
-        from kinelab.report.bench import scaling
-
-        scaled = scaling.run(progress=not args.json)
+    first = _before_the_peers(args)
     result = bench.run(robots=args.robots, n=args.n, seed=args.seed, solvers=args.solvers,
                        budget=args.budget_ms / 1e3, progress=not args.json, repeats=args.repeats, start=args.start,
                        sigma=args.sigma, schedule=args.schedule, task=args.task)
-    if scaled is not None:
-        result["scaling"] = scaled
-    if started is not None:
-        result["startup"] = started
+    result.update(first)
     if args.tracking:
         from kinelab.studies import paper000_era
 
@@ -125,6 +114,20 @@ def run(args: argparse.Namespace) -> int:
     if args.out:
         print(f"results written to {args.out}")
     return 0
+
+
+def _before_the_peers(args: argparse.Namespace) -> dict[str, Any]:
+    """The timings that run before the main bench: the peers' solver threads and caches would disturb them."""
+    first: dict[str, Any] = {}
+    if args.startup:  # on a quiet process: nothing of the bench's own yet competes for the cores
+        from kinelab.report.bench import startup
+
+        first["startup"] = startup.run(rounds=args.repeats + 4)
+    if args.scaling:
+        from kinelab.report.bench import scaling
+
+        first["scaling"] = scaling.run(progress=not args.json)
+    return first
 
 
 def _print_tables(result: dict[str, Any]) -> None:

@@ -28,7 +28,7 @@ from kinelab.ik.clear import clear_batch, clear_track, mark_colliding, solve_cle
 from kinelab.ik.driver import solve_one
 from kinelab.ik.frdm.tracking import PathSettings, path_options, run_track
 from kinelab.ik.prepared import collision_check, kept_solver, prepared
-from kinelab.ik.registry import Capabilities, capabilities, one_answer
+from kinelab.ik.registry import Capabilities, capabilities, one_answer, refuse_options
 from kinelab.ik.request import Request, check_robot, make_request
 from kinelab.ik.result import Branches, IKResult, TrackResult
 from kinelab.ik.targets import as_target, as_target_arrays
@@ -181,12 +181,17 @@ def _preferred(robot: Robot, target: Any, req: Request, prefer: Any, check: Coll
 def _closed_form_one(robot: Robot, target: Any, q0: Any, prefer: Any, collisions: Any, options: Any,
                      req: Request) -> IKResult:
     """``solve(solver="analytic")``: the branch nearest q0 (or ``prefer``), from the closed form."""
-    from kinelab.ik.analytic.branches import analytic_one, refuse_options
+    from kinelab.ik.analytic import held
+    from kinelab.ik.analytic.branches import analytic_one
 
     refuse_options(options)
     if q0 is not None and prefer is not None:
         raise OptionError("prefer", "given with q0", "one reference: q0 or prefer, with solver='analytic'")
     ref = q0 if q0 is not None else prefer
+    if held.applies(robot) and collisions is None:
+        return held.nearest_held_one(robot, as_target(target, req.task.name),
+                                     None if ref is None else robot.check_q(ref, what="q0"), req)
+    held.refuse_7r(robot)
     return analytic_one(robot, as_target(target, req.task.name), req,
                         None if ref is None else robot.check_q(ref, what="q0"), collision_check(robot, collisions))
 
@@ -235,12 +240,9 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
     check_entry(robot, "solve_batch", positional)
     kind = one_answer(solver)
     if kind.closed_form:
-        from kinelab.ik.analytic.branches import nearest_batch, refuse_options
-
-        refuse_options(options or solver_options)
-        return nearest_batch(robot, targets, q0, make_request(kind.request_solver(solver), seed, tol_pos, tol_rot,
-                                                              time_budget, max_restarts, start_outside_limits, None,
-                                                              task, axis, None), collision_check(robot, collisions))
+        return _closed_form_batch(robot, targets, q0, collisions, options or solver_options,
+                                  make_request(kind.request_solver(solver), seed, tol_pos, tol_rot, time_budget,
+                                               max_restarts, start_outside_limits, None, task, axis, None))
     req = make_request(solver, seed, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options,
                        task, axis, solver_options)
     check = collision_check(robot, collisions)
@@ -249,6 +251,23 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
     if check is None:
         return res
     return clear_batch(robot, stack_homogeneous(*as_target_arrays(targets)), res, req, check, t0)
+
+
+def _closed_form_batch(robot: Robot, targets: Any, q0: Any, collisions: Any, options: Any,
+                       req: Request) -> BatchIKResult:
+    """``solve_batch(solver="analytic")``: each row the branch nearest its start, from the closed form (a 7R arm's
+    with its swept joint held at the start's value, :mod:`kinelab.ik.analytic.held`)."""
+    from kinelab.ik.analytic import held
+    from kinelab.ik.analytic.branches import nearest_batch
+
+    refuse_options(options)
+    if held.applies(robot):
+        if collisions is not None:
+            raise OptionError("collisions", collisions, "None with solver='analytic' on a 7R arm (solver='frdm' "
+                              "takes collisions=)")
+        return held.nearest_held(robot, targets, q0, req)
+    held.refuse_7r(robot)
+    return nearest_batch(robot, targets, q0, req, collision_check(robot, collisions))
 
 
 def solve_all_batch(robot: Robot, targets: Any, *positional: Any, tol_pos: float = 1e-6,
@@ -338,8 +357,6 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
             return found
     kind, given = capabilities(solver), options is not None or bool(solver_options)
     if kind.closed_form and given:  # refusing says so rather than ignoring them
-        from kinelab.ik.analytic.branches import refuse_options
-
         refuse_options(options or solver_options)
     req = make_request(kind.request_solver(solver), seed, tol_pos, tol_rot, time_budget, 0, "refuse", options, task,
                        axis, solver_options)

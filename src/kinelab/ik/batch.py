@@ -119,7 +119,7 @@ def run_batch(robot: Robot, targets: Any, q0: Any, req: Request) -> BatchIKResul
     else:
         rows = _per_target(robot, points, rotations, starts, replace(req, seed=seed), deadline)
         mode = f"{req.solver} (per target)"
-    return _judged(robot, rows, points, rotations, req, seed, t0, mode)
+    return judged_rows(robot, rows, points, rotations, req, seed, t0, mode)
 
 
 def prepare(robot: Robot, req: Request) -> bool:
@@ -209,7 +209,7 @@ def _per_target(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts:
     return rows
 
 
-def _judged(robot: Robot, rows: Rows, points: np.ndarray, rotations: np.ndarray, req: Request, seed: int,
+def judged_rows(robot: Robot, rows: Rows, points: np.ndarray, rotations: np.ndarray, req: Request, seed: int,
             t0: float, mode: str) -> BatchIKResult:
     """Pinocchio's verdict on every solved row; statuses as :func:`kinelab.solve` gives them."""
     count, task = points.shape[0], req.task

@@ -24,12 +24,13 @@ from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 from kinelab.core._engine import Engine
+from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.batch import BatchIKResult, run_batch
 from kinelab.ik.branches import UNSEEN, find_all, route_of
 from kinelab.ik.clear import clear_batch, mark_colliding, solve_clear
 from kinelab.ik.driver import prepare_solver, solve_one
-from kinelab.ik.registry import capabilities
+from kinelab.ik.registry import capabilities, refuse_options
 from kinelab.ik.request import Request, check_robot, check_seed, make_request
 from kinelab.ik.result import Branches, IKResult
 from kinelab.ik.targets import as_target, as_target_arrays
@@ -81,14 +82,13 @@ class IK:
         kind = capabilities(solver)
         self.analytic = kind.closed_form
         self.route = route_of(kind, options is not None or bool(solver_options))  # of solve_all, as kinelab's
-        if self.analytic:  # the closed forms load for the solver that uses them
-            from kinelab.ik.analytic.branches import refuse_options
-
+        if self.analytic:
             refuse_options(options or solver_options)
         self.request: Request = make_request(kind.request_solver(solver), None, tol_pos, tol_rot, time_budget,
                                              max_restarts, start_outside_limits, options, task, axis, solver_options)
         self.collisions = collision_check(robot, collisions)
         self._nearest: NearestBranch | None = None
+        self.held = False  # solver "analytic" on a 7R arm: its six at the held joint's start value (_prepare)
         self._prepare()
         # the usual call's one compiled call (kinelab.core._engine), where the solver has one
         self.engine: Engine | None = None if self.collisions is not None or self.analytic else self._engine()
@@ -98,8 +98,17 @@ class IK:
         here, by name) and its one-call form, or the solver's model."""
         robot, req = self.robot, self.request
         if self.analytic:
+            from kinelab.ik.analytic import held
             from kinelab.ik.analytic.branches import NearestBranch, arm_of, prepared_form
 
+            self.held = held.applies(robot)
+            if self.held:  # a 7R arm: its six in closed form at the held joint's start value
+                if self.collisions is not None:
+                    raise OptionError("collisions", "given", "None with solver='analytic' on a 7R arm "
+                                      "(solver='frdm' takes collisions=)")
+                arm_of(held.held_robot(robot), req)  # the task is "pose" (named otherwise)
+                return
+            held.refuse_7r(robot)
             arm_of(robot, req)
             if self.collisions is None:  # the usual call's one compiled call: branches found and judged together
                 form = prepared_form(robot, req)
@@ -148,6 +157,10 @@ class IK:
         from kinelab.ik.analytic.branches import analytic_one
 
         ref = None if q0 is None else self.robot.check_q(q0, what="q0")
+        if self.held:
+            from kinelab.ik.analytic.held import nearest_held_one
+
+            return nearest_held_one(self.robot, as_target(target, self.request.task.name), ref, self.request)
         found = None if self._nearest is None else self._nearest.solve(target, ref)
         return found or analytic_one(self.robot, as_target(target, self.request.task.name), self.request, ref,
                                      self.collisions)
@@ -168,6 +181,10 @@ class IK:
         """
         req = replace(self._request(seed), start_outside_limits="refuse")
         t0 = time.perf_counter()
+        if self.held:
+            from kinelab.ik.analytic.held import nearest_held
+
+            return nearest_held(self.robot, targets, q0, req)
         if self.analytic:
             from kinelab.ik.analytic.branches import nearest_batch
 

@@ -10,7 +10,7 @@ from typing import Any, Protocol
 import numpy as np
 import pinocchio as pin
 
-from kinelab.errors import SolverNotFoundError
+from kinelab.errors import OptionError, SolverNotFoundError
 from kinelab.ik.result import Attempt
 from kinelab.robot import Robot
 
@@ -130,3 +130,13 @@ def solver_module(name: str) -> Any:
             raise SolverNotFoundError(str(name), [*names(), "analytic"])  # the closed form: by the entry points
         module = SOLVERS[name] = importlib.import_module(BUILTIN[name])
     return module
+
+
+def refuse_options(options: Any) -> None:
+    """The closed form has no settings: options given with solver="analytic" are refused by name.
+
+    Raises:
+        OptionError: ``options`` (an options object or option keywords) is not empty.
+    """
+    if options:
+        raise OptionError("options", options, "none with solver='analytic' (the closed form has no settings)")

@@ -83,16 +83,6 @@ def arm_of(robot: Robot, req: Request) -> ArmClass:
     return arm
 
 
-def refuse_options(options: Any) -> None:
-    """The closed form has no settings: options given with solver="analytic" are refused by name.
-
-    Raises:
-        OptionError: ``options`` (an options object or option keywords) is not empty.
-    """
-    if options:
-        raise OptionError("options", options, "none with solver='analytic' (the closed form has no settings)")
-
-
 def has_closed_form(robot: Robot, req: Request) -> bool:
     """True when the chain is in an analytic class and the request asks for the whole pose."""
     return req.task.name == "pose" and classify(robot).arm is not None
@@ -695,15 +685,24 @@ def nearest_batch(robot: Robot, targets: Any, q0: Any, req: Request, model: Coll
     """
     t0 = time.perf_counter()
     H = stack_homogeneous(*as_target_arrays(targets))
-    starts = None if q0 is None else robot.check_qs(np.atleast_2d(q0), what="q0")
-    if starts is not None and starts.shape[0] not in (1, len(H)):
-        raise ConfigurationError(f"q0 must be None, {robot.n} numbers or ({len(H)}, {robot.n}) for {len(H)} targets of "
-                                 f"{robot.name}, got shape {np.shape(q0)}")
-    starts = None if starts is None else np.broadcast_to(starts, (len(H), robot.n))
+    starts = batch_starts(robot, q0, len(H))
     form = prepared_form(robot, req) if model is None and req.time_budget is None else None
     if form is not None:
         return _compiled_nearest(robot, form, np.ascontiguousarray(H), starts, req, t0)
     return _nearest_rows(robot, H, starts, req, model, t0)
+
+
+def batch_starts(robot: Robot, q0: Any, count: int) -> np.ndarray | None:
+    """A batch's starts as (count, n) [rad or m] (None: none given; one start serves every row).
+
+    Raises:
+        ConfigurationError: q0 of another shape, not finite or outside the limits (its row named).
+    """
+    starts = None if q0 is None else robot.check_qs(np.atleast_2d(q0), what="q0")
+    if starts is not None and starts.shape[0] not in (1, count):
+        raise ConfigurationError(f"q0 must be None, {robot.n} numbers or ({count}, {robot.n}) for {count} targets of "
+                                 f"{robot.name}, got shape {np.shape(q0)}")
+    return None if starts is None else np.broadcast_to(starts, (count, robot.n))
 
 
 def _compiled_nearest(robot: Robot, form: ClosedForm, H: np.ndarray, starts: np.ndarray | None, req: Request,

@@ -1,14 +1,15 @@
 """``kinelab bench --throughput``: targets per second of one ``solve_batch`` call, in the GPU libraries' protocol.
 
-Per arm and round, TARGETS random targets (the tool poses of configurations drawn within the limits from the
-round's seed), solved by :func:`kinelab.solve_batch` (FRDM) on every core, twice — the first starts from the
-robot's start table (:mod:`kinelab.ik.starts`) and from random draws — in an order that alternates between
-rounds; an arm with a closed form also by ``solve_batch(..., solver="analytic")``, each row the branch nearest a
-random start, one compiled call on every core. Every answer is judged by the batch's own judge (Pinocchio's FK or
-the compiled FK certified equal to it). Reported: targets/s and the time per target (the call's wall time,
-judging included, over the targets), median and spread over the rounds, and the success rate at kinelab's
-tolerance (1e-6 m, 1e-6 rad) and at the GPU libraries' (5 mm, 0.05 rad); the table's build time and memory. The
-peers' published figures are reference rows, not measured here.
+Per arm and round, TARGETS random targets (the tool poses of configurations drawn within the limits from the round's
+seed), solved by :func:`kinelab.solve_batch` (FRDM) on every core, twice — the first starts from the robot's start
+table (:mod:`kinelab.ik.starts`) and from random draws — in an order that alternates between rounds; an arm with a
+closed form also by ``solve_batch(..., solver="analytic")``, each row the branch nearest a random start, one
+compiled call on every core (a 7R arm with a swept form, the Panda: its six in closed form with the swept joint held
+at the start's value, else at samples of its range, :mod:`kinelab.ik.analytic.held`). Every answer is judged by the
+batch's own judge (Pinocchio's FK or the compiled FK certified equal to it). Reported: targets/s and the time per
+target (the call's wall time, judging included, over the targets), median and spread over the rounds, and the
+success rate at kinelab's tolerance (1e-6 m, 1e-6 rad) and at the GPU libraries' (5 mm, 0.05 rad); the table's build
+time and memory. The peers' published figures are reference rows, not measured here.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from typing import Any
 import numpy as np
 from tqdm import tqdm
 
+from kinelab.ik.analytic import held
 from kinelab.ik.analytic.classify import classify
 from kinelab.ik.api import solve_batch
 from kinelab.ik.starts import start_table
@@ -58,7 +60,7 @@ def measure(robot: Robot, rounds: int, seed: int) -> dict[str, Any]:
     table = start_table(robot)
     build_ms = 1e3 * (time.perf_counter() - t0)
     solve_batch(robot, robot.fk_batch(robot.random_qs(50, np.random.default_rng(seed))), seed=seed)  # warm-up
-    closed = classify(robot).arm is not None
+    closed = classify(robot).arm is not None or held.applies(robot)  # a 7R arm: its six at the start's held value
     per_round = [_round(robot, seed + 1000 * r, "table" if r % 2 == 0 else "random", closed) for r in range(rounds)]
     modes = {mode: {key: [r[mode][key] for r in per_round] for key in per_round[0][mode]} for mode in per_round[0]}
     return {"robot": robot.name, "dof": robot.n, "targets": TARGETS, "rounds": rounds, "table_ms": build_ms,
