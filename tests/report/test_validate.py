@@ -254,3 +254,23 @@ def test_shares_carry_their_wilson_interval_and_sample_in_every_form_of_the_repo
     assert "each other check stating its own sample" in md
     page = (tmp_path / "report.html").read_text()
     assert "(95 %: 92.9–100.0 %, n = 50)" in page and "configurations per check" not in page
+
+
+def test_every_joint_of_the_era_passage_figures_can_be_seen(tmp_path):
+    """#43 item 5: along the elbow passage θ3 = θ5, and θ3's curve was drawn exactly under θ5's: not one of its
+    pixels showed in the right panel. Each panel of the picture must show every joint's colour along the path."""
+    from PIL import Image
+
+    from kinelab import load
+    from kinelab.studies import paper000_era as ep
+
+    era = load("era")
+    png = tmp_path / render._passage_figure(ep.run(ep.elbow_passage(era), era), "elbow", (2, 3, 4), tmp_path)
+    rgb = np.asarray(Image.open(png).convert("RGB"), dtype=int)
+    r, g, b = rgb[..., 0], rgb[..., 1], rgb[..., 2]
+    hues = {"θ3 (blue)": (b > r + 30) & (b > g + 10), "θ4 (orange)": (r > g + 40) & (g > b + 40),
+            "θ5 (green)": (g > r + 40) & (g > b + 40)}
+    half = rgb.shape[1] // 2
+    for panel, columns in (("without bypass", slice(0, half)), ("with bypass", slice(half, None))):
+        for joint, mask in hues.items():
+            assert mask[:, columns].sum() >= 400, (panel, joint, int(mask[:, columns].sum()))  # a legend swatch: < 100

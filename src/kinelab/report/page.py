@@ -15,7 +15,8 @@ from kinelab.report.validate import Check, Report
 
 CAPTIONS = {
     "era_elbow.png": "Seed 000, ERA elbow passage: joint angles θ3–θ5 along the path without the bypass (left: the "
-                     "elbow folds the wrong way at the stretched configuration) and with the paper's kick (right).",
+                     "elbow folds the wrong way at the stretched configuration) and with the paper's kick (right). "
+                     "θ3 and θ5 stay equal along the passage: θ3 is the wide pale band under θ5's dashed line.",
     "era_wrist.png": "Seed 000, ERA wrist passage: θ5 and θ7 lap after lap without the bypass (left: they drift "
                      "apart, the paper's spinning) and with q5, q6 < 80° held (right: every lap closes).",
     "era_shoulder.png": "Seed 000, ERA shoulder passage: θ1 and θ7 without the bypass (left: they climb together) "

@@ -40,13 +40,18 @@ def validate_table(report: Report, width: int = 120) -> str:
     return "\n".join(lines)
 
 
+# each joint's curve drawn narrower and on top of the one before, so that curves which coincide (the elbow
+# passage keeps θ3 = θ5) all stay visible: a wide pale band, a line, a dashed line
+CURVE_STYLES = ({"linewidth": 6.0, "alpha": 0.4}, {"linewidth": 2.0}, {"linewidth": 1.6, "linestyle": (0, (4, 2))})
+
+
 def _passage_figure(run: Any, name: str, joints: tuple[int, ...], folder: Path) -> str:
     fig = Figure(figsize=(10, 3.2))
     axes = fig.subplots(1, 2, sharey=True)
     for ax, res, title in ((axes[0], run.without, f"ERA {name}, without bypass"),
                            (axes[1], run.with_bypass, f"ERA {name}, with bypass")):
-        for j in joints:
-            ax.plot(np.rad2deg(res.q[:, j]), "--" if j == 6 else "-", label=f"θ{j + 1}")
+        for j, style in zip(joints, CURVE_STYLES, strict=False):
+            ax.plot(np.rad2deg(res.q[:, j]), label=f"θ{j + 1}", **style)
         ax.set_title(title)
         ax.set_xlabel("path sample")
     axes[0].set_ylabel("deg")
