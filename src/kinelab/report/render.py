@@ -42,7 +42,8 @@ def validate_table(report: Report, width: int = 120) -> str:
 
 # each joint's curve drawn narrower and on top of the one before, so that curves which coincide (the elbow
 # passage keeps θ3 = θ5) all stay visible: a wide pale band, a line, a dashed line
-CURVE_STYLES = ({"linewidth": 6.0, "alpha": 0.4}, {"linewidth": 2.0}, {"linewidth": 1.6, "linestyle": (0, (4, 2))})
+CURVE_STYLES: tuple[dict[str, Any], ...] = ({"linewidth": 6.0, "alpha": 0.4}, {"linewidth": 2.0},
+                                             {"linewidth": 1.6, "linestyle": (0, (4, 2))})
 
 
 def _passage_figure(run: Any, name: str, joints: tuple[int, ...], folder: Path) -> str:
