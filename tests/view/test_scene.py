@@ -155,7 +155,7 @@ def test_the_singular_overlay_explains_its_marks_in_the_caption():
     s.close()
     caption = html[html.index('id="kinelab-caption"'):]
     assert "σ_min/σ_max = " in caption and "rank 5 of 6" in caption
-    assert "magenta line: a tool direction the arm cannot move in" in caption
+    assert "magenta arrow: a tool direction the arm cannot move in" in caption
 
 
 def test_a_mobile_robot_far_from_the_origin_is_framed_where_it_stands():
@@ -292,3 +292,29 @@ def test_a_meshless_arm_s_pages_draw_one_figure_per_configuration_and_no_phantom
     page.close()
     joints = [p for p in paths if p.rsplit("/", 1)[-1].startswith("joint")]
     assert len(joints) == xarm6.n + 1 and all(p.startswith("/meshcat/robot/") for p in joints)
+
+
+@pytest.mark.browser
+@needs_browser
+@pytest.mark.parametrize("name", ["ur5", "xarm6"])
+def test_the_singular_marks_are_seen_over_the_robot(name, tmp_path):
+    """#43 item 2: at a wrist singularity the σ sphere sat inside the UR5's wrist mesh and the xArm6's joint ball,
+    and the lost axis was a one-pixel line. The page with the marks against the same page without them: the
+    pixels that change must show the sphere's red and the lost axis's cyan, each over a visible area."""
+    robot = kinelab.load(name)
+    q = np.array([0.0, -1.2, 1.2, 0.0, 0.0, 0.0]) if name == "ur5" else np.zeros(6)
+    pages = {}
+    for marked in (False, True):
+        s = viz.Scene(robot).show(q)
+        if marked:
+            s.singular_directions(q)
+        (tmp_path / f"{marked}.html").write_text(s.static_html())
+        s.close()
+        pages[marked] = np.asarray(browser.Image.open(browser.screenshot(tmp_path / f"{marked}.html",
+                                                                          tmp_path / f"{marked}.png",
+                                                                          size=(1000, 750))).convert("RGB"), dtype=int)
+    changed = np.abs(pages[True] - pages[False]).max(axis=2) > 40
+    r, g, b = (pages[True][..., k] for k in range(3))
+    red = changed & (r > 180) & (g < 90) & (b < 90)
+    cyan = changed & (g > 150) & (b > 180) & (r < 130)
+    assert red.sum() >= 300 and cyan.sum() >= 300, (int(red.sum()), int(cyan.sum()))

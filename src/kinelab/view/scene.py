@@ -194,8 +194,9 @@ class Scene:
 
     # -- singularities --------------------------------------------------------------------------
     def singular_directions(self, q, scale: float | None = None) -> Scene:
-        """At q: the lost tool directions as arrows from the tool (translation magenta, rotation axis cyan)
-        and a sphere at the tool coloured by σ_min/σ_max (red: singular, green: far from it)."""
+        """At q: the lost tool directions as arrows from the tool (translation magenta, rotation axis cyan) and a
+        sphere at the tool coloured by σ_min/σ_max (red: singular, green: far from it). The marks are drawn over
+        the robot (no depth test): a wrist's mesh or a joint's ball would otherwise hide them."""
         import meshcat.geometry as g
 
         from kinelab.analysis.singular import analyze
@@ -204,30 +205,26 @@ class Scene:
         oMtool = self.robot.fk(q)
         scale = scale or 2 * self.frame_length
         self.viewer["singular"].delete()
+        kinds = set()
         for k, d in enumerate(a.lost_directions):
-            for kind, axis, share, color in (("translation", d.translation_axis, d.translation_share, 0xF032E6),
-                                             ("rotation", d.rotation_axis, d.rotation_share, 0x42D4F4)):
-                if axis is None or share < 1e-3:
-                    continue
-                seg = np.column_stack([oMtool.translation, oMtool.translation + scale * share * np.array(axis)])
-                self.viewer["singular"][f"lost{k}_{kind}"].set_object(
-                    g.Line(g.PointsGeometry(seg), g.MeshBasicMaterial(color=color, linewidth=6)))
+            for kind, axis, share, color in (("translation", d.translation_axis, d.translation_share, LOST_MOVE),
+                                             ("rotation", d.rotation_axis, d.rotation_share, LOST_TURN)):
+                if axis is not None and share >= 1e-3:
+                    kinds.add(kind)
+                    _arrow(self.viewer["singular"][f"lost{k}_{kind}"], oMtool.translation, np.array(axis),
+                           scale * share, 0.04 * self.frame_length, color)
         ratio = float(a.singular_values[a.full_rank - 1] / a.singular_values[0])
         level = min(1.0, max(0.0, (np.log10(max(ratio, 1e-12)) + 6) / 5))  # 1e-6 → red, 0.1 → green
         color = int(255 * (1 - level)) << 16 | int(255 * level) << 8
-        self.viewer["singular"]["sigma"].set_object(g.Sphere(0.15 * self.frame_length),
-                                                    g.MeshLambertMaterial(color=color))
+        self.viewer["singular"]["sigma"].set_object(g.Sphere(0.3 * self.frame_length), _on_top(color, 0.75))
         self.viewer["singular"]["sigma"].set_transform(pin.SE3(np.eye(3), oMtool.translation).homogeneous)
         self.legend["sigma"] = (f"sphere at the tool: σ_min/σ_max = {ratio:.3g} (red at 1e-6 and below, green at 0.1 "
                                 f"and above); rank {a.rank} of {a.full_rank}")
-        kinds = {kind for k, d in enumerate(a.lost_directions)
-                 for kind, share in (("translation", d.translation_share), ("rotation", d.rotation_share))
-                 if share >= 1e-3}
         if "translation" in kinds:
-            self.legend["lost_translation"] = ("magenta line: a tool direction the arm cannot move in "
+            self.legend["lost_translation"] = ("magenta arrow: a tool direction the arm cannot move in "
                                                "(length: its share)")
         if "rotation" in kinds:
-            self.legend["lost_rotation"] = "cyan line: an axis the tool cannot turn about (length: its share)"
+            self.legend["lost_rotation"] = "cyan arrow: an axis the tool cannot turn about (length: its share)"
         if not a.lost_directions:
             self.legend["lost"] = "no direction is lost at this q (full rank)"
         return self
@@ -337,6 +334,28 @@ def chain_points(robot: Robot, q: Any) -> list[np.ndarray]:
 
 
 JOINTS, HIGHLIGHT = 0x4363D8, 0xF58231  # blue, orange
+LOST_MOVE, LOST_TURN = 0xF032E6, 0x42D4F4  # magenta, cyan: a lost tool direction, a lost turning axis
+
+
+def _on_top(color: int, opacity: float) -> Any:
+    """A material drawn over everything else (no depth test; three.js draws transparent objects last)."""
+    import meshcat.geometry as g
+
+    return g.MeshLambertMaterial(color=color, opacity=opacity, transparent=True, depthTest=False)
+
+
+def _arrow(node: Any, origin: np.ndarray, axis: np.ndarray, length: float, radius: float, color: int) -> None:
+    """An arrow of ``length`` [m] from ``origin`` along the unit ``axis`` (base frame): a shaft and a cone, drawn
+    over the robot. WebGL draws lines one pixel wide whatever their width, so the marks are solids."""
+    import meshcat.geometry as g
+
+    head = min(0.35 * length, 6 * radius)
+    turn = pin.Quaternion.FromTwoVectors(np.array([0.0, 1.0, 0.0]), axis).matrix()  # three.js cylinders lie along y
+    for part, height, shape in (("shaft", length - head, g.Cylinder(length - head, radius)),
+                                ("head", head, g.Cylinder(head, radiusTop=0.0, radiusBottom=2.5 * radius))):
+        start = 0.0 if part == "shaft" else length - head
+        node[part].set_object(shape, _on_top(color, 0.9))
+        node[part].set_transform(pin.SE3(turn, origin + (start + height / 2) * axis).homogeneous)
 
 
 def _stick_figure(node, points: list[np.ndarray], size: float, colour: int = JOINTS) -> list[float]:
