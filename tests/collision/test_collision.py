@@ -2,7 +2,9 @@
 exact test finds), and solves whose successes are clear of the robot itself and of the obstacles."""
 
 import json
+import os
 
+import browser
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -366,3 +368,60 @@ def test_a_pair_within_a_micrometre_of_contact_counts_as_colliding_and_one_beyon
     assert 0 < d < TOUCH and model.colliding_pair(near) is not None
     apart, d = _at_distance(panda, model.geom, clear, touching, 20 * TOUCH)
     assert d > TOUCH and model.colliding_pair(apart) is None
+
+
+CONTACT_Q = [-0.256, 0.549, -1.908, 6.235, -3.227, -3.055]  # the UR5 through a table onto the floor: six pairs
+
+
+def test_fk_names_every_pair_in_contact_as_pinocchio_finds_them(tmp_path, capsys):
+    """#43 item 3: ``kinelab fk --obstacles`` named one pair of the six the view coloured. Every pair Pinocchio's
+    computeCollisions finds (fresh geometry data, the model's own pairs) is named, and no other."""
+    from kinelab import cli
+
+    scene = tmp_path / "scene.json"
+    scene.write_text(json.dumps({"obstacles": [{"shape": "plane", "name": "floor"},
+                                               {"shape": "box", "size": [0.6, 0.8, 0.05], "xyz": [0.5, 0, 0.2],
+                                                "name": "table"}]}))
+    code = cli.main(["fk", "ur5", *map(str, CONTACT_Q), "--obstacles", str(scene), "--json"])
+    out = json.loads(capsys.readouterr().out)
+    ur5 = kinelab.load("ur5")
+    model = collision_model(ur5, Collisions(environment=Environment.from_file(scene)))
+    data, gdata = ur5.model.createData(), pin.GeometryData(model.geom)
+    pin.computeCollisions(ur5.model, data, model.geom, gdata, ur5.to_pin_q(np.array(CONTACT_Q)), False)
+    names = [o.name for o in model.geom.geometryObjects]
+    pinocchio = {frozenset((names[p.first], names[p.second])) for k, p in enumerate(model.geom.collisionPairs)
+                 if gdata.collisionResults[k].isCollision()}
+    assert code == 0 and len(pinocchio) == 6
+    assert {frozenset((c["first"], c["second"])) for c in out["contacts"]} == pinocchio
+    assert cli.main(["fk", "ur5", *map(str, CONTACT_Q), "--obstacles", str(scene)]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if "collision" in x)
+    assert "6 pairs in contact" in line and all(f"{a} and {b}" in line or f"{b} and {a}" in line
+                                                for a, b in map(sorted, pinocchio))
+
+
+@pytest.mark.browser
+@pytest.mark.skipif(browser.find_chromium() is None and not os.environ.get("CI"),
+                    reason="Debian's chromium is not installed here (.ci/run installs it)")
+def test_the_links_in_contact_are_drawn_red_without_stripes_through_the_obstacles(tmp_path):
+    """#43 item 3: the red copy of a link in contact fought for depth with the link's mesh (red and black stripes)
+    and read teal or brown under the translucent floor and table. Against the same page without the red copies,
+    the pixels that change are red, not dark."""
+    from kinelab.view import scene as viz
+    from kinelab.view.collisions import draw_collisions
+
+    ur5 = kinelab.load("ur5")
+    model = collision_model(ur5, Collisions(environment=FLOOR_AND_TABLE))
+    pages = {}
+    for red in (True, False):
+        s = viz.Scene(ur5)
+        draw_collisions(s, model, np.array(CONTACT_Q))
+        if not red:
+            s.viewer["contacts"].delete()
+        (tmp_path / f"{red}.html").write_text(s.static_html())
+        s.close()
+        png = browser.screenshot(tmp_path / f"{red}.html", tmp_path / f"{red}.png", size=(1000, 750))
+        pages[red] = np.asarray(browser.Image.open(png).convert("RGB"), dtype=int)
+    changed = np.abs(pages[True] - pages[False]).max(axis=2) > 40
+    r, g, b = (pages[True][..., k] for k in range(3))
+    reddish = changed & (r > 150) & (r > g + 60) & (r > b + 40)
+    assert changed.sum() > 5000 and reddish.sum() / changed.sum() >= 0.8, (int(changed.sum()), int(reddish.sum()))

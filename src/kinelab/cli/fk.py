@@ -25,14 +25,15 @@ def run(args: argparse.Namespace) -> int:
     oMtool = robot.fk(q)  # FK is defined at any q: a q outside the limits is computed and said, not refused
     out = {"robot": robot.name, "base": robot.base, "tool": robot.tool, "q": q.tolist(), **common.pose_dict(oMtool),
            "outside_limits": outside}
-    spec, contact = common.collisions_of(args), None
+    spec, contacts = common.collisions_of(args), []
     if spec is not None:
         from dataclasses import asdict
 
         from kinelab.collision import collision_model
 
-        contact = collision_model(robot, spec).contact(q)
-        out["collision"] = None if contact is None else asdict(contact)
+        contacts = collision_model(robot, spec).contacts(q)  # every pair in contact, as the view colours them
+        out["collision"] = asdict(contacts[0]) if contacts else None
+        out["contacts"] = [asdict(c) for c in contacts]
     if args.json:
         common.print_json(out)
         return 0
@@ -44,5 +45,6 @@ def run(args: argparse.Namespace) -> int:
     print(f"  rpy [rad]      {common.shown(out['rpy_rad'])}")
     print("  rotation       " + common.shown(oMtool.rotation, prefix="  rotation       "))
     if "collision" in out:
-        print(f"  collision      {contact or 'none'}")
+        pairs = f"{len(contacts)} pair{'s' if len(contacts) != 1 else ''} in contact: " if contacts else "none"
+        print(f"  collision      {pairs}{'; '.join(str(c) for c in contacts)}")
     return 0

@@ -39,8 +39,11 @@ def draw_obstacles(scene: Any, environment: Environment) -> Any:
     for k, obstacle in enumerate(obstacles):
         colour, word = OBSTACLE_COLOURS[k % len(OBSTACLE_COLOURS)]
         node = scene.viewer["obstacles"][f"{k}"]
-        opacity = 0.25 if obstacle.shape == "plane" else 0.6
-        node.set_object(_shape(obstacle), g.MeshLambertMaterial(color=colour, opacity=opacity, transparent=True))
+        # faint enough that a red link seen through an obstacle still reads red; no depth writes, so that one
+        # translucent surface never hides another (or the robot) behind it
+        opacity = 0.15 if obstacle.shape == "plane" else 0.35
+        node.set_object(_shape(obstacle), g.MeshLambertMaterial(color=colour, opacity=opacity, transparent=True,
+                                                                depthWrite=False))
         node.set_transform(_placement(obstacle).homogeneous)
         named.append(f"{word}: {obstacle.name or 'obstacle ' + str(k + 1)} ({obstacle.shape})")
     if obstacles:
@@ -50,7 +53,8 @@ def draw_obstacles(scene: Any, environment: Environment) -> Any:
 
 def _overlay(scene: Any, model: CollisionModel, names: set[str]) -> None:
     """The robot's collision objects in contact, drawn red over its visuals at the placements of the last check
-    (unlit: a mesh without normals would draw black under a lit material)."""
+    (unlit: a mesh without normals would draw black under a lit material; no depth test: drawn at the mesh's own
+    depth, the copy and the mesh would fight pixel by pixel, red and black stripes, and a table would hide it)."""
     import meshcat.geometry as g
 
     scene.viewer["contacts"].delete()  # the contacts of an earlier q
@@ -61,7 +65,8 @@ def _overlay(scene: Any, model: CollisionModel, names: set[str]) -> None:
         if shape is None:
             continue
         node = scene.viewer["contacts"][f"{k}"]
-        node.set_object(shape, g.MeshBasicMaterial(color=CONTACT_COLOR, opacity=0.55, transparent=True))
+        node.set_object(shape, g.MeshBasicMaterial(color=CONTACT_COLOR, opacity=0.7, transparent=True,
+                                                   depthTest=False))
         node.set_transform(model.gdata.oMg[k].homogeneous)
 
 
