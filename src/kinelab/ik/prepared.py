@@ -154,16 +154,17 @@ class IK:
 
     def _nearest_branch(self, target: Any, q0: Any) -> IKResult:
         """Solver "analytic": the branch nearest q0 in one compiled call where that serves, else root by root."""
-        from kinelab.ik.analytic.branches import analytic_one
-
         ref = None if q0 is None else self.robot.check_q(q0, what="q0")
         if self.held:
             from kinelab.ik.analytic.held import nearest_held_one
 
             return nearest_held_one(self.robot, as_target(target, self.request.task.name), ref, self.request)
         found = None if self._nearest is None else self._nearest.solve(target, ref)
-        return found or analytic_one(self.robot, as_target(target, self.request.task.name), self.request, ref,
-                                     self.collisions)
+        if found is not None:  # the usual call: nothing imported on its way (an import costs 8 % of a 13 µs call)
+            return found
+        from kinelab.ik.analytic.branches import analytic_one
+
+        return analytic_one(self.robot, as_target(target, self.request.task.name), self.request, ref, self.collisions)
 
     def solve_batch(self, targets: Any, *, q0: Any = None, seed: int | None = None) -> BatchIKResult:
         """Every target of a batch, as :func:`kinelab.solve_batch` with these settings (row b: seed + b).
