@@ -4,12 +4,15 @@ second to import, which ``kinelab fk``, ``info`` and ``robots`` (and a user who 
 from __future__ import annotations
 
 import importlib
+import importlib.util
 from collections.abc import Callable
 from typing import Any
 
 
 def loader(package: str, namespace: dict[str, Any], table: dict[str, tuple[str, str]]) -> Callable[[str], Any]:
-    """A module ``__getattr__`` that imports ``table[name] = (module, attribute)`` on first access and keeps it.
+    """A module ``__getattr__`` that imports ``table[name] = (module, attribute)`` on first access and keeps it; a
+    name that is none of the table's but one of the package's subpackages or modules imports that (``kinelab.robot``
+    after ``import kinelab``, as when the package imported it eagerly).
 
     Args:
         package: the package's name (for the AttributeError of an unknown name).
@@ -21,10 +24,13 @@ def loader(package: str, namespace: dict[str, Any], table: dict[str, tuple[str, 
     """
 
     def module_getattr(name: str) -> Any:
-        if name not in table:
+        if name in table:
+            module, attribute = table[name]
+            value = getattr(importlib.import_module(module), attribute)
+        elif not name.startswith("_") and importlib.util.find_spec(f"{package}.{name}") is not None:
+            value = importlib.import_module(f"{package}.{name}")  # a subpackage read as an attribute (kinelab.robot)
+        else:
             raise AttributeError(f"module {package!r} has no attribute {name!r}")
-        module, attribute = table[name]
-        value = getattr(importlib.import_module(module), attribute)
         namespace[name] = value
         return value
 

@@ -84,3 +84,17 @@ def test_the_startup_table_calls_met_only_what_every_round_meets():
 def test_a_command_that_fails_is_an_error_not_a_time():
     with pytest.raises(KinelabError, match="exited with 3"):
         startup._seconds([sys.executable, "-c", "import sys; sys.exit(3)"], {})
+
+
+def test_the_subpackages_are_attributes_of_the_package_as_before():
+    """``import kinelab`` then ``kinelab.robot.catalog`` (or ``kinelab.ik``, ``kinelab.maps``) worked while the
+    package imported the robot eagerly; lazily, each is imported when first read."""
+    probe = ("import kinelab, sys; assert 'pinocchio' not in sys.modules; "
+             "print(kinelab.robot.catalog.names()[0], kinelab.ik.__name__, kinelab.maps.__name__, "
+             "kinelab.robot.model.Robot.__name__)")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=120, check=True)
+    assert done.stdout.split() == ["stanford", "kinelab.ik", "kinelab.maps", "Robot"]
+    with pytest.raises(AttributeError, match="has no attribute 'nosuch'"):
+        import kinelab
+
+        kinelab.nosuch  # noqa: B018
