@@ -34,3 +34,10 @@ def bar(iterable: Iterable[Any] | None = None, *, progress: bool | None, **optio
 
     show = interactive() if progress is None else bool(progress)
     return tqdm(iterable, disable=not show, **options)
+
+
+def step(message: str, progress: bool | None = None) -> None:
+    """Say what a command is about to do that takes a while (a page's meshes, its writing): one line on stderr,
+    shown as ``progress`` says (None: when :func:`interactive`), so that a terminal is never silent for seconds."""
+    if interactive() if progress is None else progress:
+        print(f"kinelab: {message} ...", file=sys.stderr, flush=True)

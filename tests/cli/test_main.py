@@ -510,3 +510,52 @@ def test_a_robot_with_an_srdf_home_starts_from_it(tmp_path):
     assert q.tolist() == home and how == "the SRDF's 'home' configuration"
     q, how = ur5.reference_q()
     assert np.allclose(q, 0.5 * (ur5.lower + ur5.upper)) and how == "the middle of the joint limits"
+
+
+def _told_before(capsys, monkeypatch, argv, slow):
+    """Run a command where someone watches (a terminal) and return, for each slow step in ``slow`` ((owner,
+    attribute) pairs, wrapped), what the command had said on stderr just before that step began."""
+    from kinelab import progress
+
+    monkeypatch.setattr(progress, "interactive", lambda: True)
+    said = []
+
+    def announced(real, name):
+        def wrapped(*args, **kwargs):
+            said.append((name, capsys.readouterr().err))
+            return real(*args, **kwargs)
+        return wrapped
+
+    for owner, name in slow:
+        monkeypatch.setattr(owner, name, announced(getattr(owner, name), name))
+    code = cli.main(argv)
+    return code, said
+
+
+def test_a_page_command_says_what_it_is_doing_before_each_slow_step(capsys, monkeypatch, tmp_path):
+    """#43 item 6: `view --html`, `animate --html`, `branches --html` and `map view` were silent for seconds while
+    meshes loaded, passages ran and pages were written. In a terminal each slow step is announced on stderr before
+    it starts; to a pipe nothing is added (stderr stays empty)."""
+    from kinelab.studies import paper000_era
+    from kinelab.view import maps as map_view
+    from kinelab.view import scene
+
+    page = str(tmp_path / "p.html")
+    cases = [(["view", "ur5", "--html", page], [(scene.Scene, "__init__"), (scene.Scene, "save_html")]),
+             (["animate", "era-elbow", "--html", page], [(paper000_era, "run"), (scene.Scene, "__init__"),
+                                                          (scene.Scene, "save_html")]),
+             (["branches", "ur5", "--target-q", "0", "-1.57", "1.57", "0", "0.5", "0", "--html", page],
+              [(scene, "side_by_side")])]
+    for argv, slow in cases:
+        code, said = _told_before(capsys, monkeypatch, argv, slow)
+        assert code == 0 and [name for name, _ in said] == [name for _, name in slow], argv
+        for name, err in said:
+            assert err.strip().splitlines()[-1].startswith("kinelab: ") and err.rstrip().endswith("..."), (argv, name)
+        monkeypatch.undo()
+    stored = tmp_path / "map.zarr"
+    kinelab.maps.reachability(kinelab.load("ur5"), kinelab.maps.MapSpec(voxel=0.4, orientations=2), out=str(stored))
+    code, said = _told_before(capsys, monkeypatch, ["map", "view", str(stored), "--html", page],
+                              [(map_view, "map_page")])
+    assert code == 0 and said and "kinelab: drawing the map" in said[0][1]
+    monkeypatch.undo()
+    assert cli.main(["view", "ur5", "--html", page]) == 0 and capsys.readouterr().err == ""  # not a terminal

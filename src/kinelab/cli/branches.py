@@ -18,6 +18,7 @@ from kinelab.cli.common import (
     target_arguments,
 )
 from kinelab.errors import KinelabError, OptionError
+from kinelab.progress import step
 
 if TYPE_CHECKING:
     from kinelab.ik.analytic.sew import SEW
@@ -136,6 +137,7 @@ def _write_page(robot: Robot, found: Sequence[IKResult], path: str, nearest_firs
         raise KinelabError("no branch to draw: the pose has none within the joint limits")
     labels = [f"branch {k + 1}" + (" (nearest --ref-q)" if nearest_first and k == 0 else "")
               for k in range(len(found))]
+    step(f"drawing {len(found)} branches side by side and writing {path}")
     scene = side_by_side(robot, [r.q for r in found], labels=labels, highlight=0 if nearest_first else None)
     scene.title = f"{robot.name}: {len(found)} branch{'es' if len(found) != 1 else ''} of one pose, {_method(found)}"
     try:

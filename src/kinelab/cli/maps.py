@@ -11,6 +11,7 @@ from typing import Any
 from kinelab.cli import common
 from kinelab.cli.common import Interrupted, Parser, load_robot, plural, print_json, seed_argument, source_arguments
 from kinelab.errors import KinelabError
+from kinelab.progress import step
 
 
 def add(sub: Any) -> None:
@@ -204,6 +205,7 @@ def run_view(args: argparse.Namespace) -> int:
     if model_sha256(robot) != meta["source_sha256"]:
         raise KinelabError(f"{robot.name}'s model file is not the one the map at {args.store} was computed for: "
                            "give that robot with --robot")
+    step(f"drawing the map of {robot.name} and its slices")
     page = map_page(robot, rmap)
     try:
         Path(args.html).write_text(page)

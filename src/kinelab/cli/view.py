@@ -9,6 +9,7 @@ from typing import Any
 
 from kinelab.cli.common import collision_arguments, collisions_of, load_robot, plural, q_from_cli, robot_arguments
 from kinelab.errors import KinelabError
+from kinelab.progress import step
 
 MIN_DT, MAX_DT = 1e-3, 60.0  # [s] per animation sample
 
@@ -38,6 +39,7 @@ def run_view(args: argparse.Namespace) -> int:
     if not args.ignore_limits:
         for note in robot.outside_limits(q):  # drawn all the same: a view is defined at any q
             print(f"kinelab: note: {note}", file=sys.stderr)
+    step(f"drawing {robot.name} (its meshes load)")
     scene = viz.Scene(robot).show(q)
     if args.singular:
         scene.singular_directions(q)
@@ -64,8 +66,10 @@ def run_animate(args: argparse.Namespace) -> int:
         raise KinelabError(f"--dt {args.dt} is not valid: seconds per sample, between {MIN_DT:g} and {MAX_DT:g}")
     robot = load("era")
     passage = passages[args.passage](robot)
+    step(f"solving {args.passage} with and without the paper's bypass")
     run = paper000_era.run(passage, robot)
     result = run.without if args.without_bypass else run.with_bypass
+    step(f"drawing {len(result.q)} configurations of era")
     scene = viz.Scene(robot, name=f"era ({'without' if args.without_bypass else 'with'} bypass)")
     scene.animate(result.q, dt=args.dt)
     one_lap = passage.targets[: (passage.lap or passage.samples) + 1]
@@ -82,6 +86,7 @@ def _publish(scene: Any, html: str | None) -> int:
     """Write the scene as a static page (its caption in the page), or serve it live until interrupted (the
     caption printed under the address: the live page has none)."""
     if html:
+        step(f"writing {html}")
         scene.save_html(html)
         scene.close()
         print(f"wrote {html}")
