@@ -89,8 +89,8 @@ def test_the_page_draws_every_branch_and_names_the_nearest(capsys, tmp_path):
     code, out, _ = run(capsys, "branches", "ur5", "--target-q", *UR5_Q, "--ref-q", *UR5_Q, "--html", str(page))
     assert code == 0 and f"wrote {page}" in out
     html = page.read_text()
-    assert "orange joints: branch 1 (nearest --ref-q)" in html and "row 3, column 2: branch 8" in html
-    assert {f"/meshcat/branches/{k}/joint0" for k in range(8)} <= scene_paths(html)
+    assert "orange joints: branch 1 (nearest --ref-q)" in html
+    assert {f"/meshcat/branches/{k}/joint0" for k in range(1, 9)} <= scene_paths(html)
 
 
 @pytest.mark.browser
@@ -110,7 +110,8 @@ def test_the_nearest_branch_is_orange_in_the_browser(capsys, tmp_path):
         rgb = np.asarray(Image.open(png).convert("RGB"), dtype=int)
         return int(((rgb[..., 0] > 180) & (rgb[..., 1] > 80) & (rgb[..., 1] < 170) & (rgb[..., 2] < 90)).sum())
 
-    assert orange(a) > 200 and orange(b) == 0
+    # the gold target mark over a tool frame's red axis blends to a few orange pixels; a highlighted copy, hundreds
+    assert orange(a) > 200 and orange(b) < 60
 
 
 @pytest.mark.parametrize("name", ["baxter_left", "tiago_pro"])
@@ -126,3 +127,62 @@ def test_the_wording_of_no_branch_follows_the_status(capsys, name):
         assert max(robot.tool_error(np.array(b["q"]), robot.fk(np.array(q, dtype=float)))) <= 1e-6
     code, out, _ = run(capsys, "branches", name, "--target-q", *q, "--seed", "0", "--time-budget", "0.0001")
     assert code == 1 and "no branch (time_budget)" in out and "unreachable" not in out
+
+
+def test_the_page_numbers_each_branch_in_the_scene_marks_the_target_and_tables_the_joints(capsys, tmp_path):
+    """#43 item 4: the page numbers each copy in the scene as the caption's table does (from 1), marks the
+    target's point at every copy, spaces the copies so that no two footprints meet, and tables every branch's
+    joints (degrees with --deg), the nearest --ref-q first and marked with its distance."""
+    import html as markup
+    import re
+
+    page = tmp_path / "b.html"
+    q_target = np.array(UR5_Q, dtype=float)
+    deg = [f"{v:.12g}" for v in np.rad2deg(q_target)]
+    code, _, _ = run(capsys, "branches", "ur5", "--target-q", *deg, "--ref-q", *deg, "--deg", "--html", str(page))
+    text = page.read_text()
+    paths = scene_paths(text)
+    ur5 = kinelab.load("ur5")
+    found = kinelab.solve_all(ur5, ur5.fk(q_target), q_ref=q_target)
+    count = len(found)
+    assert code == 0 and count >= 4
+    numbered = {str(k) for k in range(1, count + 1)}
+    assert {p.split("/")[3] for p in paths if p.startswith("/meshcat/numbers/")} == numbered
+    assert {p.split("/")[3] for p in paths if p.startswith("/meshcat/targets/")} == numbered
+    table = text[text.index('id="kinelab-table"'):text.index("</table>")]
+    rows = [[markup.unescape(c) for c in re.findall(r"<td[^>]*>(.*?)</td>", row)]
+            for row in re.findall(r"<tr[^>]*>(.*?)</tr>", table)[1:]]
+    assert len(rows) == count and [r[0] for r in rows] == [str(k) for k in range(1, count + 1)]
+    assert "q1 [deg]" in table and 'background:#fbd3b0' in table.split("</tr>")[1]  # row 1 marked
+    for r, branch in zip(rows, found, strict=True):
+        assert np.allclose([float(v) for v in r[1:7]], np.rad2deg(branch.q), atol=1e-4)
+    assert float(rows[0][-1]) == pytest.approx(0.0, abs=1e-4) and all(float(r[-1]) > 0 for r in rows[1:])
+
+
+def test_copies_side_by_side_never_overlap():
+    """No joint of one copy comes near a joint of another (horizontally, as seen from above): read from the
+    transforms the page itself carries."""
+    import base64
+    import re
+
+    import umsgpack
+
+    from kinelab.view import scene as viz
+
+    ur5 = kinelab.load("ur5")
+    found = kinelab.solve_all(ur5, ur5.fk(np.array([0.3, -1.0, 1.2, 0.2, 0.9, 0.1])))
+    s = viz.side_by_side(ur5, [b.q for b in found])
+    page = s.static_html()
+    s.close()
+    copies: dict[str, list] = {}
+    for blob in re.findall(r"data:application/octet-binary;base64,([A-Za-z0-9+/=]+)", page):
+        cmd = umsgpack.unpackb(base64.b64decode(blob))
+        if not isinstance(cmd, dict) or cmd.get("type") != "set_transform":
+            continue
+        match = re.fullmatch(r"/meshcat/branches/(\d+)/joint\d+", cmd.get("path", ""))
+        if match:
+            copies.setdefault(match.group(1), []).append(np.asarray(cmd["matrix"], dtype=float)[12:14])
+    assert len(copies) == len(found) >= 4
+    nearest = min(float(np.min(np.linalg.norm(np.array(a)[:, None] - np.array(b)[None], axis=2)))
+                  for i, a in copies.items() for j, b in copies.items() if i < j)
+    assert nearest > 0.1 * s._reach, (nearest, s._reach)

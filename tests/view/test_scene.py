@@ -92,7 +92,7 @@ def test_side_by_side_draws_one_stick_figure_and_tool_frame_per_configuration():
     html = s.static_html()
     s.close()
     paths = browser.scene_paths(html)
-    for k in range(5):
+    for k in range(1, 6):  # numbered from 1, as the caption and the table number them
         joints = {p for p in paths if p.startswith(f"/meshcat/branches/{k}/joint")}
         assert len(joints) == robot.n + 1  # every joint origin and the tool point
         assert f"/meshcat/frames/tool_{k}/axis2" in paths
@@ -283,7 +283,7 @@ def test_a_meshless_arm_s_pages_draw_one_figure_per_configuration_and_no_phantom
     paths = browser.scene_paths(s.static_html())
     s.close()
     figures = {p.split("/")[3] for p in paths if p.startswith("/meshcat/branches/")}
-    assert len(found) == 8 and figures == {str(k) for k in range(8)}
+    assert len(found) == 8 and figures == {str(k) for k in range(1, 9)}
     assert not [p for p in paths if p.startswith("/meshcat/stick")]
 
     xarm6 = kinelab.load("xarm6")

@@ -13,6 +13,7 @@ from kinelab.cli.common import (
     pose_dict,
     print_json,
     q_from_cli,
+    rounded,
     seed_argument,
     source_arguments,
     target_arguments,
@@ -67,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         _print_branches(robot, args, found, ref)
     if args.html:
-        _write_page(robot, found, args.html, ref is not None)
+        _write_page(robot, found, args.html, target, ref, args.deg)
     return 0 if found else 1
 
 
@@ -129,19 +130,45 @@ def _print_branches(robot: Robot, args: argparse.Namespace, found: Branches, ref
               "loads the solver)")
 
 
-def _write_page(robot: Robot, found: Sequence[IKResult], path: str, nearest_first: bool) -> None:
-    """The branches side by side, each copy labelled in the caption by its number (nearest first when sorted)."""
+def _write_page(robot: Robot, found: Sequence[IKResult], path: str, target: Any, ref: Any, deg: bool) -> None:
+    """The branches side by side, numbered in the scene as in the table of their joints under the caption (the
+    target's point marked at each; with ``ref``, the nearest first, orange, its distance in the table)."""
     from kinelab.view.scene import side_by_side
 
     if not found:
         raise KinelabError("no branch to draw: the pose has none within the joint limits")
-    labels = [f"branch {k + 1}" + (" (nearest --ref-q)" if nearest_first and k == 0 else "")
+    labels = [f"branch {k + 1}" + (" (nearest --ref-q)" if ref is not None and k == 0 else "")
               for k in range(len(found))]
     step(f"drawing {len(found)} branches side by side and writing {path}")
-    scene = side_by_side(robot, [r.q for r in found], labels=labels, highlight=0 if nearest_first else None)
+    scene = side_by_side(robot, [r.q for r in found], labels=labels, highlight=None if ref is None else 0,
+                         target=target)
     scene.title = f"{robot.name}: {len(found)} branch{'es' if len(found) != 1 else ''} of one pose, {_method(found)}"
+    scene.table = _joint_table(robot, found, ref, deg)
+    scene.legend.pop("copies")  # the table numbers the branches as the scene does
     try:
         scene.save_html(path)
     finally:
         scene.close()
     print(f"wrote {path}")
+
+
+def _joint_table(robot: Robot, found: Sequence[IKResult], ref: Any, deg: bool) -> Any:
+    """Every branch's joints (rad and m; degrees and m with ``deg``), and with ``ref`` each one's distance to it
+    (the largest joint difference, revolute joints modulo 2π), the nearest marked."""
+    import numpy as np
+
+    from kinelab.ik.limits import distance
+    from kinelab.view.caption import Table
+
+    angular = np.array([k != "prismatic" for k in robot.joint_kinds])
+    unit = "deg" if deg else "rad"
+    header = ("#", *(f"q{i + 1} [{unit if a else 'm'}]" for i, a in enumerate(angular)),
+              *((f"to --ref-q [{unit}]",) if ref is not None else ()))
+    rows = []
+    for k, r in enumerate(found):
+        q = np.where(angular, np.rad2deg(r.q), r.q) if deg else r.q
+        gap = () if ref is None else (distance(robot, r.q, ref),)
+        rows.append((str(k + 1), *(f"{v:.4f}" for v in rounded(q, 4)),
+                     *(f"{v:.4f}" for v in rounded([np.rad2deg(d) if deg else d for d in gap], 4))))
+    names = ", ".join(f"q{i + 1} {j.name}" for i, j in enumerate(robot.joints))
+    return Table(header, tuple(rows), None if ref is None else 0, note=f"joints: {names}")

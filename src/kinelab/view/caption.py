@@ -7,21 +7,46 @@ shows the scene only; ``kinelab view`` prints the same lines in the terminal).
 from __future__ import annotations
 
 import html
+from dataclasses import dataclass
 
 STYLE = ("position:fixed;left:10px;top:10px;max-width:46%;padding:8px 12px;border-radius:6px;"
          "background:rgba(255,255,255,0.88);color:#1a1a1a;font:13px/1.45 system-ui,sans-serif;"
          "box-shadow:0 1px 4px rgba(0,0,0,0.3);z-index:10")
 
 
-def caption_html(title: str, lines: list[str]) -> str:
-    """The caption box: a bold title, then one line per legend entry (text is escaped)."""
+@dataclass(frozen=True)
+class Table:
+    """A table under the caption's lines: column names, rows of cells (text), the row to mark (or None)."""
+
+    header: tuple[str, ...]
+    rows: tuple[tuple[str, ...], ...]
+    marked: int | None = None
+    note: str = ""  # a line under the table (what its short column names stand for)
+
+
+def caption_html(title: str, lines: list[str], table: Table | None = None) -> str:
+    """The caption box: a bold title, one line per legend entry, then the table if any (text is escaped)."""
     body = "".join(f"<div>{html.escape(line)}</div>" for line in lines)
-    return f'<div id="kinelab-caption" style="{STYLE}"><b>{html.escape(title)}</b>{body}</div>'
+    return (f'<div id="kinelab-caption" style="{STYLE}"><b>{html.escape(title)}</b>{body}'
+            f"{'' if table is None else table_html(table)}</div>")
 
 
-def with_caption(page: str, title: str, lines: list[str]) -> str:
+def table_html(table: Table) -> str:
+    """The table as HTML (id ``kinelab-table``), numbers right-aligned, the marked row bold on orange."""
+    cell = "padding:1px 6px;text-align:right"
+    head = "".join(f'<th style="{cell}">{html.escape(h)}</th>' for h in table.header)
+    rows = []
+    for k, row in enumerate(table.rows):
+        mark = ' style="background:#fbd3b0;font-weight:bold"' if k == table.marked else ""
+        rows.append(f"<tr{mark}>" + "".join(f'<td style="{cell}">{html.escape(c)}</td>' for c in row) + "</tr>")
+    note = f'<div style="font-size:11px">{html.escape(table.note)}</div>' if table.note else ""
+    return (f'<table id="kinelab-table" style="margin-top:6px;border-collapse:collapse;font-size:12px">'
+            f"<tr>{head}</tr>{''.join(rows)}</table>{note}")
+
+
+def with_caption(page: str, title: str, lines: list[str], table: Table | None = None) -> str:
     """The page with the caption box placed just before ``</body>`` (or at its end)."""
-    return before_body(page, caption_html(title, lines))
+    return before_body(page, caption_html(title, lines, table))
 
 
 def before_body(page: str, box: str) -> str:

@@ -21,8 +21,9 @@ import pinocchio as pin
 
 from kinelab.errors import ConfigurationError, KinelabError
 from kinelab.robot import Robot
-from kinelab.view.caption import with_caption
+from kinelab.view.caption import Table, with_caption
 from kinelab.view.framing import FILL, frame_points
+from kinelab.view.labels import draw_number
 from kinelab.view.server import Server
 
 SPREAD_FILL = 1.1  # side-by-side copies stand on a wide flat patch: its sphere may overfill the frame's height
@@ -56,6 +57,7 @@ class Scene:
         self._reach = self._arm_reach()
         self.title = robot.name
         self.legend: dict[str, str] = {}  # what each mark means, by mark (the caption's lines)
+        self.table: Table | None = None  # a table under the caption's lines (the branches' joints, say)
         if missing or self.stick:
             self.legend["figure"] = _figure_note(robot, missing, self.stick)
         self.viewer["/Axes"].set_property("visible", False)  # an unlabelled world triad; the tool frame is drawn
@@ -232,7 +234,7 @@ class Scene:
     # -- export ---------------------------------------------------------------------------------
     def static_html(self) -> str:
         """The whole scene (and its animation) as one self-contained HTML page (works offline)."""
-        return with_caption(self.viewer.static_html(), self.title, list(self.legend.values()))
+        return with_caption(self.viewer.static_html(), self.title, list(self.legend.values()), self.table)
 
     def notebook_html(self, height: int = 420) -> Any:
         """The static page (caption included) as an IPython HTML object for a notebook cell: it stays visible
@@ -273,23 +275,25 @@ class Scene:
 
 
 def side_by_side(robot: Robot, qs: list, spacing: float | None = None, viewer: Any = None,
-                 labels: list[str] | None = None, highlight: int | None = None) -> Scene:
+                 labels: list[str] | None = None, highlight: int | None = None, target: pin.SE3 | None = None) -> Scene:
     """One scene with the robot drawn once per configuration as a stick figure (joints as spheres, the
-    segments between joint origins and the tool point as cylinders), side by side on a grid (columns
-    along the base y axis, rows along x): the branches of one IK target, say, each with its tool frame.
-    Stick figures keep the page small (a meshed copy repeats the robot's mesh files: 9 MB per copy of a
+    segments between joint origins and the tool point as cylinders), side by side on a grid, each copy numbered
+    in the scene (1, 2, ...: scene nodes ``branches/1``, ...), with its tool frame: the branches of one IK target,
+    say. Stick figures keep the page small (a meshed copy repeats the robot's mesh files: 9 MB per copy of a
     UR5) and the joints visible.
 
     Args:
         robot: the robot.
         qs: the configurations (one number per joint each, rad or m), at least one.
-        spacing: distance between neighbouring copies [m]; default 0.9 × the arm's reach.
+        spacing: distance between neighbouring copies [m]; default: the widest copy's footprint (twice its
+            farthest point from its base, horizontally) and a quarter of the arm's reach between copies.
         viewer: a meshcat viewer to draw in (default: a new one on 127.0.0.1).
-        labels: one label per configuration, named with its place in the grid in the caption (default "copy k").
+        labels: one label per configuration, listed in the caption by number (default "copy k").
         highlight: the index of a copy drawn with orange joints (the nearest branch, say), named in the caption.
+        target: a pose (base frame) marked at every copy by a gold sphere at its point (each copy's tool on it).
 
     Returns:
-        A :class:`Scene` whose viewer holds the row (``save_html`` writes it; ``close`` stops its server).
+        A :class:`Scene` whose viewer holds the copies (``save_html`` writes it; ``close`` stops its server).
 
     Raises:
         ConfigurationError: a q of the wrong length, non-finite, or no q at all.
@@ -303,29 +307,53 @@ def side_by_side(robot: Robot, qs: list, spacing: float | None = None, viewer: A
     scene = Scene(robot, viewer=viewer)
     scene.drop_robot()
     scene.viewer["frames"].delete()
-    spacing = spacing or 0.9 * scene._reach
+    figures = [chain_points(robot, q) for q in checked]
+    spacing = spacing or _spacing(figures, scene._reach)
     columns = int(np.ceil(np.sqrt(len(checked))))
+    rows = -(-len(checked) // columns)
     occupied = []
-    for k, q in enumerate(checked):
-        offset = pin.SE3(np.eye(3), np.array([(k // columns) * spacing, (k % columns) * spacing, 0.0]))
-        points = chain_points(robot, q)
-        _stick_figure(scene.viewer["branches"][str(k)], [offset.act(p) for p in points], scene.frame_length,
+    for k, points in enumerate(figures):
+        # copy 1 nearest the camera, on the left: the first row is the front one, read left to right (+y)
+        row, column = divmod(k, columns)
+        offset = pin.SE3(np.eye(3), np.array([(rows - 1 - row) * spacing, column * spacing, 0.0]))
+        moved = [offset.act(p) for p in points]
+        _stick_figure(scene.viewer["branches"][str(k + 1)], moved, scene.frame_length,
                       HIGHLIGHT if k == highlight else JOINTS)
-        scene.frame(f"tool_{k}", offset * robot.fk(q))
-        occupied += [offset.act(p) for p in points] + [offset.translation]
-    scene.title = f"{robot.name}: {len(checked)} configurations side by side"
-    scene.legend = {"figures": "joints: blue spheres; links: grey cylinders; copies in rows along the base x axis",
-                    "tool": "tool frames: x red, y green, z blue",
-                    "copies": _grid_labels(labels or [f"copy {k + 1}" for k in range(len(checked))], columns)}
-    if highlight is not None:
-        scene.legend["highlight"] = f"orange joints: {(labels or [])[highlight] if labels else f'copy {highlight + 1}'}"
+        scene.frame(f"tool_{k + 1}", offset * robot.fk(checked[k]))
+        top = offset.translation + np.array([0.0, 0.0, max(p[2] for p in points) + 0.8 * scene.frame_length])
+        draw_number(scene.viewer["numbers"][str(k + 1)], str(k + 1), top, 0.6 * scene.frame_length, NUMBERS)
+        if target is not None:
+            _target_mark(scene.viewer["targets"][str(k + 1)], offset.act(target.translation), scene.frame_length)
+        occupied += moved + [offset.translation, top]
+    _side_by_side_legend(scene, robot, labels or [f"copy {k + 1}" for k in range(len(checked))], highlight, target)
     return scene._aim(np.array(occupied), fill=SPREAD_FILL if len(checked) > 1 else FILL)
 
 
-def _grid_labels(labels: list[str], columns: int) -> str:
-    """Where each copy stands, in words: "row 1 (nearest the base), column 1 (at the base's y = 0): label; ..."."""
-    return "; ".join(f"row {k // columns + 1}, column {k % columns + 1}: {label}" for k, label in enumerate(labels)) \
-        + " (rows counted along the base x axis from the first copy, columns along y)"
+def _spacing(figures: list[list[np.ndarray]], reach: float) -> float:
+    """Grid spacing [m] at which no two copies' footprints meet: twice the farthest any point of any copy lies
+    from its base horizontally, and a quarter of the reach between them."""
+    widest = max(float(np.max(np.linalg.norm(np.array(points)[:, :2] - points[0][:2], axis=1))) for points in figures)
+    return 2.0 * widest + 0.25 * reach
+
+
+def _target_mark(node: Any, point: np.ndarray, size: float) -> None:
+    """A gold translucent sphere at the target's point."""
+    import meshcat.geometry as g
+
+    node.set_object(g.Sphere(0.35 * size), g.MeshLambertMaterial(color=TARGET, opacity=0.45, transparent=True))
+    node.set_transform(pin.SE3(np.eye(3), np.asarray(point, dtype=float)).homogeneous)
+
+
+def _side_by_side_legend(scene: Scene, robot: Robot, labels: list[str], highlight: int | None,
+                         target: pin.SE3 | None) -> None:
+    scene.title = f"{robot.name}: {len(labels)} configurations side by side"
+    scene.legend = {"figures": "joints: blue spheres; links: grey cylinders; each copy's number above it",
+                    "tool": "tool frames: x red, y green, z blue",
+                    "copies": "; ".join(f"{k + 1}: {label}" for k, label in enumerate(labels))}
+    if target is not None:
+        scene.legend["target"] = "gold sphere: the target point, at every copy"
+    if highlight is not None:
+        scene.legend["highlight"] = f"orange joints: {labels[highlight]}"
 
 
 def chain_points(robot: Robot, q: Any) -> list[np.ndarray]:
@@ -333,7 +361,7 @@ def chain_points(robot: Robot, q: Any) -> list[np.ndarray]:
     return [m.translation for m in robot.joint_placements(q).values()] + [robot.fk(q).translation]
 
 
-JOINTS, HIGHLIGHT = 0x4363D8, 0xF58231  # blue, orange
+JOINTS, HIGHLIGHT, NUMBERS, TARGET = 0x4363D8, 0xF58231, 0x1A1A1A, 0xFFD700  # blue, orange, black, gold
 LOST_MOVE, LOST_TURN = 0xF032E6, 0x42D4F4  # magenta, cyan: a lost tool direction, a lost turning axis
 
 
