@@ -57,6 +57,7 @@ def test_a_multistart_ik_loads_no_collision_model_closed_form_or_kd_tree():
     assert not _under(modules, "kinelab.collision"), _under(modules, "kinelab.collision")
     assert not _under(modules, "kinelab.ik.analytic")
     assert not _under(modules, "scipy.spatial")
+    assert not {"kinelab.ik.clear", "kinelab.ik.starts", "kinelab.ik.frdm.tracking"} & modules
 
 
 def test_the_closed_form_and_the_collision_model_still_load_when_asked_for():

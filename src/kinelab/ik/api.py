@@ -24,9 +24,7 @@ from kinelab.geometry import stack_homogeneous
 from kinelab.ik.batch import BatchIKResult, prepare, prepare_robot, run_batch
 from kinelab.ik.branches import UNSEEN, Route, find_all, route_of, usual_closed_form
 from kinelab.ik.chain import chain_model
-from kinelab.ik.clear import clear_batch, clear_track, mark_colliding, solve_clear
 from kinelab.ik.driver import solve_one
-from kinelab.ik.frdm.tracking import PathSettings, path_options, run_track
 from kinelab.ik.prepared import collision_check, kept_solver, prepared
 from kinelab.ik.registry import Capabilities, capabilities, one_answer, refuse_options
 from kinelab.ik.request import Request, check_robot, make_request
@@ -38,6 +36,7 @@ if TYPE_CHECKING:  # the collision model and the closed forms load when a call a
     from kinelab.collision.model import CollisionModel
     from kinelab.ik.analytic.branches import BranchBatch
     from kinelab.ik.analytic.sew import SEW
+    from kinelab.ik.frdm.tracking import PathSettings
 
 # The order of the arguments after (robot, target) in kinelab 0.1's positional signatures: a call that still
 # passes them positionally is told which keyword its value was
@@ -159,7 +158,11 @@ def _solve_preferring(robot: Robot, target: Any, q0: Any, seed: int | None, pref
 
 def _one_answer(robot: Robot, target: Any, q0: Any, req: Request, check: CollisionModel | None) -> IKResult:
     """One solve through the driver, clear of collisions when ``check`` is given."""
-    return solve_one(robot, target, q0, req) if check is None else solve_clear(robot, target, q0, req, check)
+    if check is None:
+        return solve_one(robot, target, q0, req)
+    from kinelab.ik.clear import solve_clear  # the collision solves load with the first that checks
+
+    return solve_clear(robot, target, q0, req, check)
 
 
 def _preferred(robot: Robot, target: Any, req: Request, prefer: Any, check: CollisionModel | None,
@@ -169,6 +172,8 @@ def _preferred(robot: Robot, target: Any, req: Request, prefer: Any, check: Coll
     t0 = time.perf_counter()
     found = find_all(robot, target, req, q_ref=prefer, method=method)
     if check is not None:
+        from kinelab.ik.clear import mark_colliding
+
         found = mark_colliding(found, check, drop=True)
     if found:
         return replace(found[0], diagnostics=replace(found[0].diagnostics, branches=len(found)))
@@ -250,6 +255,8 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
     res = run_batch(robot, targets, q0, req)
     if check is None:
         return res
+    from kinelab.ik.clear import clear_batch
+
     return clear_batch(robot, stack_homogeneous(*as_target_arrays(targets)), res, req, check, t0)
 
 
@@ -363,7 +370,11 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
     check = collision_check(robot, collisions)
     found = find_all(robot, target, req, q_ref=q_ref, max_solutions=max_solutions, stop_below=stop_below,
                      method=route_of(kind, given), redundancy=redundancy)
-    return found if check is None else mark_colliding(found, check, drop=bool(drop_colliding))
+    if check is None:
+        return found
+    from kinelab.ik.clear import mark_colliding
+
+    return mark_colliding(found, check, drop=bool(drop_colliding))
 
 
 def _usual_all(q_ref: Any, max_solutions: Any, collisions: Any, redundancy: Any, task: Any, axis: Any) -> bool:
@@ -424,6 +435,8 @@ def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
     t_start = time.perf_counter()  # the budget counts from here, the checks of the call included
     if not capabilities(solver).follows_paths:
         raise OptionError("solver", solver, "'frdm' (track follows a path with FRDM's warm-started sweeps)")
+    from kinelab.ik.frdm.tracking import PathSettings, path_options  # the path follower loads with a path
+
     settings = PathSettings(jump_limit, restrict, hold, rest_weight)
     req = make_request(solver, seed, tol_pos, tol_rot, time_budget, 0, "refuse", options, task, axis,
                        path_options(options, solver_options))
@@ -437,6 +450,9 @@ def _follow_path(robot: Robot, points: np.ndarray, rotations: np.ndarray, q0: An
     target's answer when q0 is None), the path, and the collision check of every answer when ``check`` is given."""
     if q0 is None:
         q0 = _first_answer(robot, pin.SE3(rotations[0], points[0]), req, check)
+    from kinelab.ik.clear import clear_track
+    from kinelab.ik.frdm.tracking import run_track
+
     path = run_track(robot, stack_homogeneous(points, rotations), robot.check_q(q0, limits=True, what="q0"), req,
                      settings, t_start)
     return path if check is None else clear_track(path, check)

@@ -26,7 +26,6 @@ from kinelab.ik.multistart import seed_states
 from kinelab.ik.registry import capabilities
 from kinelab.ik.request import Request
 from kinelab.ik.result import Status, status_counts
-from kinelab.ik.starts import start_table
 from kinelab.ik.targets import as_target_arrays, reach_bound
 from kinelab.robot import Robot
 
@@ -104,7 +103,7 @@ def run_batch(robot: Robot, targets: Any, q0: Any, req: Request) -> BatchIKResul
     t0 = time.perf_counter()
     points, rotations = as_target_arrays(targets)
     tabled = isinstance(q0, str) and _from_table(robot, req, q0)
-    starts = start_table(robot).nearest(stack_homogeneous(points, rotations)) if tabled else \
+    starts = _table_starts(robot, points, rotations) if tabled else \
         _starts(robot, None if isinstance(q0, str) else q0, points.shape[0])
     seed = fresh_seed() if req.seed is None else req.seed
     # the budget covers the whole call: the solvers stop early enough to leave time for Pinocchio's verdict
@@ -163,6 +162,13 @@ def _from_table(robot: Robot, req: Request, q0: str | None) -> bool:
         raise ConfigurationError(f"q0 must be None, 'random', 'table' (task 'pose'), {robot.n} numbers or "
                                  f"(B, {robot.n}), got {q0!r} for task {req.task.name!r}")
     return q0 == "table"
+
+
+def _table_starts(robot: Robot, points: np.ndarray, rotations: np.ndarray) -> np.ndarray:
+    """Each row's first start from the robot's start table (built, with SciPy's k-d tree, on first use)."""
+    from kinelab.ik.starts import start_table
+
+    return start_table(robot).nearest(stack_homogeneous(points, rotations))
 
 
 def _starts(robot: Robot, q0: Any, count: int) -> np.ndarray | None:

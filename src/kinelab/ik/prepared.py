@@ -28,7 +28,6 @@ from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.batch import BatchIKResult, run_batch
 from kinelab.ik.branches import UNSEEN, find_all, route_of
-from kinelab.ik.clear import clear_batch, mark_colliding, solve_clear
 from kinelab.ik.driver import prepare_solver, solve_one
 from kinelab.ik.registry import capabilities, refuse_options
 from kinelab.ik.request import Request, check_robot, check_seed, make_request
@@ -149,6 +148,8 @@ class IK:
         elif self.analytic:
             return self._nearest_branch(target, q0)
         elif self.collisions is not None:
+            from kinelab.ik.clear import solve_clear  # the collision solves load with the first that checks
+
             return solve_clear(self.robot, target, q0, self._request(seed), self.collisions)
         return solve_one(self.robot, target, q0, self._request(seed))
 
@@ -193,6 +194,8 @@ class IK:
         res = run_batch(self.robot, targets, q0, req)
         if self.collisions is None:
             return res
+        from kinelab.ik.clear import clear_batch
+
         return clear_batch(self.robot, stack_homogeneous(*as_target_arrays(targets)), res, req, self.collisions, t0)
 
     def solve_all(self, target: Any, *, seed: int | None = None, q_ref: Any = None,
@@ -215,7 +218,11 @@ class IK:
         found = find_all(self.robot, target, replace(self._request(seed), max_restarts=0), q_ref=q_ref,
                          max_solutions=max_solutions, stop_below=stop_below,
                          method=self.route)
-        return found if self.collisions is None else mark_colliding(found, self.collisions, drop=False)
+        if self.collisions is None:
+            return found
+        from kinelab.ik.clear import mark_colliding
+
+        return mark_colliding(found, self.collisions, drop=False)
 
 
 def collision_check(robot: Robot, collisions: Any) -> CollisionModel | None:
