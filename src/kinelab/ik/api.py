@@ -171,10 +171,7 @@ def _preferred(robot: Robot, target: Any, req: Request, prefer: Any, check: Coll
     prepare(robot, req)  # not the budget's time
     t0 = time.perf_counter()
     found = find_all(robot, target, req, q_ref=prefer, method=method)
-    if check is not None:
-        from kinelab.ik.clear import mark_colliding
-
-        found = mark_colliding(found, check, drop=True)
+    found = _clear_of(found, check, drop=True)
     if found:
         return replace(found[0], diagnostics=replace(found[0].diagnostics, branches=len(found)))
     # no (clear) branch met the tolerances: the best single answer, in what is left of the same budget (at
@@ -370,11 +367,16 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
     check = collision_check(robot, collisions)
     found = find_all(robot, target, req, q_ref=q_ref, max_solutions=max_solutions, stop_below=stop_below,
                      method=route_of(kind, given), redundancy=redundancy)
+    return _clear_of(found, check, drop=bool(drop_colliding))
+
+
+def _clear_of(found: Branches, check: CollisionModel | None, drop: bool) -> Branches:
+    """The branches with the colliding ones dropped (``drop``) or marked, by ``check`` (None: as found)."""
     if check is None:
         return found
-    from kinelab.ik.clear import mark_colliding
+    from kinelab.ik.clear import mark_colliding  # the collision solves load with the first that checks
 
-    return mark_colliding(found, check, drop=bool(drop_colliding))
+    return mark_colliding(found, check, drop=drop)
 
 
 def _usual_all(q_ref: Any, max_solutions: Any, collisions: Any, redundancy: Any, task: Any, axis: Any) -> bool:
