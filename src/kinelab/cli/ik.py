@@ -93,6 +93,7 @@ def add(sub: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Solve, print the result (or its JSON form); exit 0 when reached, 1 when not."""
     from kinelab.ik import solve
+    from kinelab.ik.turns import nearest_turns
 
     robot = load_robot(args)
     target, options = _target(robot, args)
@@ -104,7 +105,7 @@ def run(args: argparse.Namespace) -> int:
     result = solve(robot, target, solver=args.solver, q0=q0, seed=args.seed, tol_pos=args.tol_pos,
                    tol_rot=args.tol_rot, time_budget=args.time_budget, task=args.task, axis=args.axis,
                    collisions=collisions_of(args), **options)
-    result = nearest_turns(robot, result, q0, target, args)
+    result = nearest_turns(robot, result, q0, target, args.task, args.axis, args.tol_pos, args.tol_rot)
     if args.json:
         print_json({"robot": robot.name, "target": pose_dict(target),
                     "start": {"q": None if q0 is None else q0.tolist(), "from": start},
@@ -125,31 +126,6 @@ def _start(robot: Robot, args: argparse.Namespace) -> tuple[np.ndarray | None, s
         return q_from_cli(robot, args.start_q, args.deg, "--start-q"), "--start-q"
     q0, how = robot.reference_q()
     return q0, f"{how} (give --start-q for another)"
-
-
-def nearest_turns(robot: Robot, result: IKResult, q0: np.ndarray | None, target: Any,
-                  args: argparse.Namespace) -> IKResult:
-    """The result with each revolute angle moved by whole turns to the copy nearest ``q0`` within the limits (the
-    same pose), judged again as the solve was (its task, axis and tolerances); unchanged when no angle moves, the
-    answer failed, or the moved one would not pass (rounding of q + 2πk could, in principle, tip it over)."""
-    from dataclasses import replace
-
-    import numpy as np
-
-    from kinelab.ik.limits import nearest_inside
-
-    revolute = np.array([k != "prismatic" for k in robot.joint_kinds])
-    if q0 is None or not result.success or not revolute.any():
-        return result
-    moved, kept = nearest_inside(result.q[None, :], robot.lower, robot.upper, q0, 0.0)
-    q = np.where(revolute, moved[0], result.q) if kept[0] else result.q
-    if np.array_equal(q, result.q):
-        return result
-    axis = "xyz".index(args.axis) if args.task == "axis" else -1
-    dp, dr, within = robot.verdict(target.homogeneous, np.ascontiguousarray(q, dtype=float), axis)
-    met = within and (dp <= args.tol_pos or args.task == "orientation") \
-        and (dr <= args.tol_rot or args.task == "position")
-    return replace(result, q=q, position_error=dp, rotation_error=dr) if met else result
 
 
 def target_of(robot: Robot, args: argparse.Namespace) -> Any:
