@@ -90,6 +90,7 @@ def test_the_page_draws_every_branch_and_names_the_nearest(capsys, tmp_path):
     assert code == 0 and f"wrote {page}" in out
     html = page.read_text()
     assert "orange joints: branch 1 (nearest --ref-q)" in html
+    assert "<title>ur5 · branches — kinelab</title>" in html  # the tab names the robot and the view
     assert {f"/meshcat/branches/{k}/joint0" for k in range(1, 9)} <= scene_paths(html)
 
 

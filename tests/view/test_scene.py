@@ -318,3 +318,28 @@ def test_the_singular_marks_are_seen_over_the_robot(name, tmp_path):
     red = changed & (r > 180) & (g < 90) & (b < 90)
     cyan = changed & (g > 150) & (b > 180) & (r < 130)
     assert red.sum() >= 300 and cyan.sum() >= 300, (int(red.sum()), int(cyan.sum()))
+
+
+def test_every_page_s_tab_names_the_robot_and_the_view():
+    import re
+    import urllib.request
+
+    robot = kinelab.load("stanford")
+    q = robot.display_q()
+
+    def title(page):
+        return re.search(r"<title>(.*?)</title>", page).group(1)
+
+    s = viz.Scene(robot).show(q)
+    try:
+        assert title(s.static_html()) == "stanford · view — kinelab"
+        with urllib.request.urlopen(s.url, timeout=30) as reply:  # the live page meshcat's bridge serves
+            assert title(reply.read().decode("utf-8")) == "stanford · live view — kinelab"
+        assert title(s.singular_directions(q).static_html()) == "stanford · singularity — kinelab"
+    finally:
+        s.close()
+    copies = viz.side_by_side(robot, [q, q])
+    try:
+        assert title(copies.static_html()) == "stanford · side by side — kinelab"
+    finally:
+        copies.close()

@@ -143,6 +143,7 @@ def _write_page(robot: Robot, found: Sequence[IKResult], path: str, target: Any,
     scene = side_by_side(robot, [r.q for r in found], labels=labels, highlight=None if ref is None else 0,
                          target=target)
     scene.title = f"{robot.name}: {len(found)} branch{'es' if len(found) != 1 else ''} of one pose, {_method(found)}"
+    scene.view = "branches"
     scene.table = _joint_table(robot, found, ref, deg)
     scene.legend.pop("copies")  # the table numbers the branches as the scene does
     try:

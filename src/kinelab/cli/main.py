@@ -23,7 +23,7 @@ from kinelab.errors import KinelabError
 # each command → the module with its parser and handler, in the order ``kinelab --help`` lists them
 COMMANDS = {"robots": "robots", "info": "robots", "fk": "fk", "ik": "ik", "branches": "branches",
             "singular": "singular", "view": "view", "animate": "view", "bench": "bench", "map": "maps",
-            "validate": "validate"}
+            "validate": "validate", "teach": "teach"}
 
 
 class _Version(argparse.Action):

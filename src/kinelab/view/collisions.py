@@ -20,6 +20,7 @@ def draw_collisions(scene: Any, model: CollisionModel, q: Any) -> list[Contact]:
     """Draw ``model``'s obstacles in ``scene`` and colour red the robot's visuals on the links in contact at q
     (the robot drawn at q first); returns the contacts, which the caption lists."""
     scene.show(q)
+    scene.view = "collisions"
     if model.spec is not None and model.spec.environment is not None:
         draw_obstacles(scene, model.spec.environment)
     contacts = model.contacts(q)

@@ -32,6 +32,7 @@ def reachability_cloud(robot: Robot, rmap: Any, q: Any = None, viewer: Any = Non
 
     q = robot.display_q() if q is None else q
     scene = Scene(robot, viewer=viewer).show(q)
+    scene.view = "reachability map"
     if not meshes:
         scene.drop_robot()
         _stick_figure(scene.viewer["robot"], chain_points(robot, q), scene.frame_length)

@@ -42,7 +42,7 @@ class Scene:
         self.robot = robot
         self.server: Server | None = None
         if viewer is None:
-            self.server = Server()  # meshcat's bridge on 127.0.0.1 only, ending with this process
+            self.server = Server(f"{robot.name} · live view — kinelab")  # on 127.0.0.1, ending with this process
             viewer_url = self.server.zmq_url
         with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL; we expose it as .url
             self.viewer = viewer if viewer is not None else meshcat.Visualizer(zmq_url=viewer_url)
@@ -56,6 +56,7 @@ class Scene:
         self.frame_length = frame_length or 0.5 * robot.characteristic_length()
         self._reach = self._arm_reach()
         self.title = robot.name
+        self.view = "view"  # what the page shows, for its tab's title: "branches", "animation", "map", ...
         self.legend: dict[str, str] = {}  # what each mark means, by mark (the caption's lines)
         self.table: Table | None = None  # a table under the caption's lines (the branches' joints, say)
         if missing or self.stick:
@@ -131,6 +132,20 @@ class Scene:
         self.legend["tool"] = f"tool frame {self.robot.tool!r}: x red, y green, z blue"
         return self.look_at_robot(q)
 
+    def move(self, q) -> Scene:
+        """Move the drawn robot and its tool frame (drawn by :meth:`show` first) to q, the camera left where the
+        user put it: a live page's next frame.
+
+        Raises:
+            ConfigurationError: q of the wrong length or not finite.
+        """
+        q = self.robot.check_q(q)
+        self.pinviz.display(self.robot.to_pin_q(q))
+        if self.stick:
+            _move_stick(self.viewer["stick"], chain_points(self.robot, q), self._lengths)
+        self.viewer["frames"]["tool"].set_transform(self.robot.fk(q).homogeneous)
+        return self
+
     def drop_robot(self) -> None:
         """Remove the robot as :meth:`show` draws it — its meshes, or its stick figure where the file has none to
         draw — for a page that draws the robot its own way (side by side, over a map)."""
@@ -167,6 +182,7 @@ class Scene:
         """An animation of a joint trajectory (rows of q) with the tool path drawn as a line."""
         from meshcat.animation import Animation
 
+        self.view = "animation"
         qs = np.asarray(qs, dtype=float)
         anim = Animation(default_framerate=max(1, int(round(1.0 / dt))))
         model, data = self.robot.model, self.robot.model.createData()
@@ -204,6 +220,7 @@ class Scene:
         from kinelab.analysis.singular import analyze
 
         a = analyze(self.robot, q)
+        self.view = "singularity"
         oMtool = self.robot.fk(q)
         scale = scale or 2 * self.frame_length
         self.viewer["singular"].delete()
@@ -218,7 +235,7 @@ class Scene:
         ratio = float(a.singular_values[a.full_rank - 1] / a.singular_values[0])
         level = min(1.0, max(0.0, (np.log10(max(ratio, 1e-12)) + 6) / 5))  # 1e-6 → red, 0.1 → green
         color = int(255 * (1 - level)) << 16 | int(255 * level) << 8
-        self.viewer["singular"]["sigma"].set_object(g.Sphere(0.3 * self.frame_length), _on_top(color, 0.75))
+        self.viewer["singular"]["sigma"].set_object(g.Sphere(0.3 * self.frame_length), on_top(color, 0.75))
         self.viewer["singular"]["sigma"].set_transform(pin.SE3(np.eye(3), oMtool.translation).homogeneous)
         self.legend["sigma"] = (f"sphere at the tool: σ_min/σ_max = {ratio:.3g} (red at 1e-6 and below, green at 0.1 "
                                 f"and above); rank {a.rank} of {a.full_rank}")
@@ -234,7 +251,9 @@ class Scene:
     # -- export ---------------------------------------------------------------------------------
     def static_html(self) -> str:
         """The whole scene (and its animation) as one self-contained HTML page (works offline)."""
-        return with_caption(self.viewer.static_html(), self.title, list(self.legend.values()), self.table)
+        page = self.viewer.static_html().replace(
+            "<title>MeshCat</title>", f"<title>{html.escape(f'{self.robot.name} · {self.view} — kinelab')}</title>", 1)
+        return with_caption(page, self.title, list(self.legend.values()), self.table)
 
     def notebook_html(self, height: int = 420) -> Any:
         """The static page (caption included) as an IPython HTML object for a notebook cell: it stays visible
@@ -305,6 +324,7 @@ def side_by_side(robot: Robot, qs: list, spacing: float | None = None, viewer: A
     if labels is not None and len(labels) != len(checked):
         raise ValueError(f"side_by_side: {len(labels)} labels for {len(checked)} configurations")
     scene = Scene(robot, viewer=viewer)
+    scene.view = "side by side"
     scene.drop_robot()
     scene.viewer["frames"].delete()
     figures = [chain_points(robot, q) for q in checked]
@@ -365,7 +385,7 @@ JOINTS, HIGHLIGHT, NUMBERS, TARGET = 0x4363D8, 0xF58231, 0x1A1A1A, 0xFFD700  # b
 LOST_MOVE, LOST_TURN = 0xF032E6, 0x42D4F4  # magenta, cyan: a lost tool direction, a lost turning axis
 
 
-def _on_top(color: int, opacity: float) -> Any:
+def on_top(color: int, opacity: float) -> Any:
     """A material drawn over everything else (no depth test; three.js draws transparent objects last)."""
     import meshcat.geometry as g
 
@@ -382,7 +402,7 @@ def _arrow(node: Any, origin: np.ndarray, axis: np.ndarray, length: float, radiu
     for part, height, shape in (("shaft", length - head, g.Cylinder(length - head, radius)),
                                 ("head", head, g.Cylinder(head, radiusTop=0.0, radiusBottom=2.5 * radius))):
         start = 0.0 if part == "shaft" else length - head
-        node[part].set_object(shape, _on_top(color, 0.9))
+        node[part].set_object(shape, on_top(color, 0.9))
         node[part].set_transform(pin.SE3(turn, origin + (start + height / 2) * axis).homogeneous)
 
 

@@ -31,8 +31,8 @@ class ServerError(RuntimeError):
 class Server:
     """A loopback meshcat server in a child process; ``zmq_url`` and ``web_url`` say where it listens."""
 
-    def __init__(self) -> None:
-        env = {**os.environ, "KINELAB_PARENT_PID": str(os.getpid())}
+    def __init__(self, title: str = "kinelab") -> None:
+        env = {**os.environ, "KINELAB_PARENT_PID": str(os.getpid()), "KINELAB_TAB_TITLE": title}
         self.proc = subprocess.Popen([sys.executable, "-u", "-m", "kinelab.view.server"], stdout=subprocess.PIPE,
                                      stderr=subprocess.DEVNULL, env=env)
         atexit.register(self.stop)
@@ -87,6 +87,7 @@ def _loopback_bridge() -> Any:
 
         def make_app(self) -> Any:
             app = super().make_app()
+            app.add_handlers(r".*$", [(r"/static/(?:index\.html)?", _titled_index())])  # ahead of the files
             listen = app.listen
 
             def loopback_listen(port: int, **kwargs: Any) -> Any:
@@ -96,6 +97,26 @@ def _loopback_bridge() -> Any:
             return app
 
     return LoopbackBridge(host=LOOPBACK)
+
+
+def _titled_index() -> Any:
+    """A handler for the viewer's page with the tab titled by ``KINELAB_TAB_TITLE`` (meshcat's says "MeshCat")."""
+    import html
+    from pathlib import Path
+
+    import tornado.web
+    from meshcat.servers import zmqserver
+
+    page = (Path(zmqserver.VIEWER_ROOT) / zmqserver.VIEWER_HTML).read_text(encoding="utf-8")
+    title = html.escape(os.environ.get("KINELAB_TAB_TITLE", "kinelab"))
+    page = page.replace("<title>MeshCat</title>", f"<title>{title}</title>")
+
+    class TitledIndex(tornado.web.RequestHandler):
+        def get(self) -> None:
+            self.set_header("Cache-Control", "no-store")
+            self.write(page)
+
+    return TitledIndex
 
 
 def main() -> None:

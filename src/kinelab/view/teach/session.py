@@ -1,0 +1,244 @@
+"""What the teach page shows and does, without the page: a robot at q, a target it follows by IK, its branches,
+its collisions, and the numbers read live (tool pose, σ_min, manipulability, the velocity ellipsoid).
+
+Each action changes the state and draws the change in a meshcat scene whose commands a
+:class:`~kinelab.view.teach.recorder.RecordingWindow` keeps for the page; :meth:`TeachSession.readout` is what the
+page prints. Units: SI and radians; poses in the robot's base frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab.errors import ConfigurationError, TargetError
+from kinelab.robot import Robot
+from kinelab.view.teach.recorder import RecordingWindow
+
+HANDLE = 0xFFC000  # the target's grab handle: gold, as the branch pages' target marks
+ELLIPSOID = 0x4363D8
+
+
+@dataclass(frozen=True)
+class TeachOptions:
+    """How the target is followed.
+
+    Attributes:
+        tol_pos: position tolerance [m] of every solve.
+        tol_rot: rotation tolerance [rad].
+        time_budget: wall-clock budget of one follow (FRDM from the current q, then restarts) [s].
+        collisions: what the collision switch checks (a :class:`kinelab.Collisions`; None: the robot with itself).
+    """
+
+    tol_pos: float = 1e-6
+    tol_rot: float = 1e-6
+    time_budget: float = 0.05
+    collisions: Any = None
+
+
+class TeachSession:
+    """A robot to move by hand: joint values set directly, or a target pose the robot follows by IK."""
+
+    def __init__(self, robot: Robot, q: Any = None, options: TeachOptions | None = None):
+        import meshcat
+
+        from kinelab.view.scene import Scene
+
+        self.robot, self.options = robot, options or TeachOptions()
+        if q is None:
+            q, self.start = robot.reference_q()
+        else:
+            self.start = "given"
+        self.q = robot.check_q(q, limits=True)
+        self.window = RecordingWindow()
+        self.scene = Scene(robot, viewer=meshcat.Visualizer(window=self.window)).show(self.q)
+        self.scene.viewer["/Cameras/default/rotated/<object>"].set_property("zoom", 1.0)
+        self.target = robot.fk(self.q)
+        self.status = f"at the start ({self.start}); drag the gold ball to move the target"
+        self.branches: Any = None
+        self.branch = -1
+        self.collisions_on = False
+        self._collision_model: Any = None
+        # the ellipsoid's scale [m drawn per m/rad], fixed at the start: its largest radius there 0.8 frame length
+        self.scale = 0.8 * self.scene.frame_length / max(self._radii().max(), 1e-9)
+        self._draw_target_objects()
+        self._draw()
+
+    # -- actions --------------------------------------------------------------------------------
+    def set_q(self, q: Any) -> None:
+        """Put the robot at q (one value per joint [rad or m], within the limits); the target stays.
+
+        Raises:
+            ConfigurationError: q of the wrong length, not finite or outside the limits (named).
+        """
+        self.q = self.robot.check_q(q, limits=True)
+        self.status = "joints set"
+        self._draw()
+
+    def set_target(self, oMtarget: pin.SE3) -> None:
+        """Move the target to a pose (base frame) and follow it: FRDM from the current q (the answer's revolute
+        angles the turns nearest it), with collisions when switched on; q stays where it was when no answer meets
+        the target within the tolerances, and the status says why.
+
+        Raises:
+            TargetError: a pose that is not finite or whose rotation is not one.
+        """
+        self.target = _checked_pose(oMtarget)
+        self.branches, self.branch = None, -1
+        self._follow()
+        self._draw()
+
+    def snap_target(self) -> None:
+        """Put the target on the tool as it is."""
+        self.target = self.robot.fk(self.q)
+        self.branches, self.branch = None, -1
+        self.status = "target put on the tool"
+        self._draw()
+
+    def step_branch(self, step: int = 1) -> None:
+        """Go to the target's next (``step`` 1) or previous (−1) branch: every branch in closed form or by the
+        1-D search where the arm has one, else those a multistart finds; the first is the one nearest q. With
+        collisions on, only the branches clear of them."""
+        from kinelab.ik import solve_all
+
+        if self.branches is None:
+            self.branches = solve_all(self.robot, self.target, q_ref=self.q, seed=0, tol_pos=self.options.tol_pos,
+                                      tol_rot=self.options.tol_rot, collisions=self._spec(),
+                                      drop_colliding=self.collisions_on)
+            self.branch = -step if len(self.branches) else -1
+        found = self.branches
+        if not len(found):
+            self.status = f"no branch: {found.status} — {found.message}"
+            return
+        self.branch = (self.branch + step) % len(found)
+        self.q = np.array(found.q[self.branch])
+        self.status = f"branch {self.branch + 1} of {len(found)} ({found.method or 'multistart'})"
+        self._draw()
+
+    def set_collisions(self, on: bool) -> None:
+        """Switch the collision check on or off: with it on, no answer that collides is taken, and the contacts at
+        q are listed."""
+        self.collisions_on = bool(on)
+        self.branches, self.branch = None, -1
+        self.status = "collisions on" if on else "collisions off"
+        self._draw()
+
+    # -- what the page shows --------------------------------------------------------------------
+    def readout(self) -> dict[str, Any]:
+        """The numbers of the page: q, the tool and target poses, errors, σ_min, manipulability, the velocity
+        ellipsoid's radii, the status, the branch, the contacts (each with its unit in its name)."""
+        from kinelab.analysis.singular import analyze
+
+        oMtool = self.robot.fk(self.q)
+        a = analyze(self.robot, self.q)
+        error = self.target.actInv(oMtool)
+        contacts = self._model().contacts(self.q) if self.collisions_on else []
+        return {"robot": self.robot.name, "q": self.q.tolist(), "tool": _pose(oMtool), "target": _pose(self.target),
+                "position_error_m": float(np.linalg.norm(oMtool.translation - self.target.translation)),
+                "rotation_error_rad": float(np.linalg.norm(pin.log3(error.rotation))),
+                "sigma_min": float(a.singular_values[a.full_rank - 1]), "manipulability": a.manipulability,
+                "rank": a.rank, "full_rank": a.full_rank, "ellipsoid_radii_m_per_rad": self._radii().tolist(),
+                "status": self.status, "branch": self.branch + 1,
+                "branches": None if self.branches is None else len(self.branches),
+                "collisions": self.collisions_on, "contacts": [str(c) for c in contacts]}
+
+    # -- internals ------------------------------------------------------------------------------
+    def _follow(self) -> None:
+        from kinelab.ik import solve
+        from kinelab.ik.turns import nearest_turns
+
+        o = self.options
+        res = solve(self.robot, self.target, q0=self.q, seed=0, tol_pos=o.tol_pos, tol_rot=o.tol_rot,
+                    time_budget=o.time_budget, collisions=self._spec())
+        res = nearest_turns(self.robot, res, self.q, self.target, tol_pos=o.tol_pos, tol_rot=o.tol_rot)
+        if res.success:
+            self.q = np.array(res.q)
+            self.status = f"following: met by {res.solver} within {o.tol_pos:g} m, {o.tol_rot:g} rad"
+        else:
+            self.status = f"not reached ({res.status}): {res.message or 'no answer within the budget'}; q kept"
+
+    def _spec(self) -> Any:
+        if not self.collisions_on:
+            return None
+        from kinelab.collision import Collisions
+
+        return self.options.collisions or Collisions()
+
+    def _model(self) -> Any:
+        if self._collision_model is None:
+            from kinelab.collision import collision_model
+
+            self._collision_model = collision_model(self.robot, self._spec())
+        return self._collision_model
+
+    def _radii(self) -> np.ndarray:
+        return np.linalg.svd(self.robot.jacobian_local_world_aligned(self.q)[:3], compute_uv=False)
+
+    def _draw_target_objects(self) -> None:
+        import meshcat.geometry as g
+
+        from kinelab.view.scene import on_top
+
+        length = self.scene.frame_length
+        self.scene.target(self.target)
+        handle = self.scene.viewer["frames"]["target"]["handle"]
+        handle.set_object(g.Sphere(0.15 * length), on_top(HANDLE, 0.9))  # grabbable where the robot hides it
+        self.scene.viewer["ellipsoid"].set_object(g.Sphere(1.0), g.MeshLambertMaterial(
+            color=ELLIPSOID, opacity=0.3, transparent=True, depthWrite=False))
+
+    def _draw(self) -> None:
+        self.scene.move(self.q)
+        self.scene.viewer["frames"]["target"].set_transform(self.target.homogeneous)
+        self.scene.viewer["ellipsoid"].set_transform(self._ellipsoid())
+
+    def _ellipsoid(self) -> np.ndarray:
+        """The tool point's velocity ellipsoid (J_v J_vᵀ, base axes) as a scaled sphere's transform: its axes the
+        left singular vectors, its radii the singular values [m/rad] × the page's scale (a floor keeps a
+        singular direction visible as a flat disc)."""
+        U, s, _ = np.linalg.svd(self.robot.jacobian_local_world_aligned(self.q)[:3])
+        if np.linalg.det(U) < 0:
+            U[:, 2] *= -1
+        T = np.eye(4)
+        T[:3, :3] = U * np.maximum(s * self.scale, 0.01 * self.scene.frame_length)
+        T[:3, 3] = self.robot.fk(self.q).translation
+        return T
+
+
+def _checked_pose(oMtarget: Any) -> pin.SE3:
+    """The pose as given, refused when it is not finite or its rotation is not orthonormal within 1e-6."""
+    if not isinstance(oMtarget, pin.SE3):
+        raise TargetError(f"a target is a pinocchio.SE3 (base frame), not {type(oMtarget).__name__}")
+    H = oMtarget.homogeneous
+    if not np.isfinite(H).all():
+        raise TargetError("the target pose is not finite (NaN or inf)")
+    R = H[:3, :3]
+    if np.abs(R.T @ R - np.eye(3)).max() > 1e-6 or np.linalg.det(R) < 0:
+        raise TargetError("the target's rotation is not a rotation matrix (orthonormal within 1e-6, det +1)")
+    return oMtarget.copy()
+
+
+def _pose(oMframe: pin.SE3) -> dict[str, list[float]]:
+    q = pin.Quaternion(oMframe.rotation)
+    return {"position_m": oMframe.translation.tolist(), "rpy_rad": pin.rpy.matrixToRpy(oMframe.rotation).tolist(),
+            "quat_wxyz": [q.w, q.x, q.y, q.z]}
+
+
+def pose_from_matrix(values: Any) -> pin.SE3:
+    """A pose from 16 numbers (a 4 × 4 homogeneous matrix, rows first), as the page sends it.
+
+    Raises:
+        TargetError: not 16 finite numbers, or its rotation is not one.
+    """
+    try:
+        H = np.asarray(values, dtype=float).reshape(4, 4)
+    except (TypeError, ValueError):
+        raise TargetError("a target is 16 numbers: a 4 × 4 homogeneous matrix, rows first") from None
+    if not np.isfinite(H).all():
+        raise TargetError("the target pose is not finite (NaN or inf)")
+    return _checked_pose(pin.SE3(H[:3, :3], H[:3, 3]))
+
+
+__all__ = ["ConfigurationError", "TeachOptions", "TeachSession", "pose_from_matrix"]

@@ -1,0 +1,198 @@
+// The teach page: meshcat's viewer fed by the kinelab server, joint sliders, a draggable target, live readings.
+"use strict";
+const cfg = JSON.parse(document.getElementById("kinelab-config").textContent);
+const THREE = MeshCat.THREE;
+const viewer = new MeshCat.Viewer(document.getElementById("kinelab-viewer"));
+const state = { seq: 0, busy: false, pending: new Map(), dragging: null, readout: null, replies: 0, drags: 0 };
+window.kinelab = state;  // what the browser tests and the console read
+
+const node = (path) => viewer.scene_tree.find(path).object;
+const targetNode = () => node(["meshcat", "frames", "target"]);
+const handleNode = () => node(["meshcat", "frames", "target", "handle", "<object>"]);
+
+function bytes(b64) {
+  const text = atob(b64), out = new Uint8Array(text.length);
+  for (let i = 0; i < text.length; i++) out[i] = text.charCodeAt(i);
+  return out;
+}
+
+function apply(reply) {
+  for (const c of reply.commands || []) viewer.handle_command_bytearray(bytes(c));
+  if (reply.seq >= state.seq) {
+    state.seq = reply.seq;
+    if (reply.readout) show(reply.readout);
+  }
+  document.getElementById("kinelab-error").textContent = reply.error || "";
+  state.replies += 1;
+}
+
+function post(action, body) {
+  state.pending.set(action, body);
+  if (!state.busy) pump();
+}
+
+async function pump() {
+  state.busy = true;
+  while (state.pending.size) {
+    const [action, body] = state.pending.entries().next().value;
+    state.pending.delete(action);
+    try {
+      const r = await fetch(action, { method: "POST", headers: { "Content-Type": "application/json" },
+                                      body: JSON.stringify({ ...body, since: state.seq }) });
+      apply(await r.json());
+    } catch (e) {
+      document.getElementById("kinelab-error").textContent = "the kinelab server does not answer (stopped?)";
+    }
+  }
+  state.busy = false;
+}
+
+async function poll() {
+  if (!state.busy && !state.dragging) {
+    try { apply(await (await fetch("state?since=" + state.seq)).json()); } catch (e) { /* the server stopped */ }
+  }
+  setTimeout(poll, 500);
+}
+
+// -- joints -------------------------------------------------------------------------------------
+const sliders = [];
+function fmt(x, digits) { return Number(x).toFixed(digits); }
+function jointText(j, v) {
+  return j.kind === "prismatic" ? `${fmt(v, 4)} m` : `${fmt(v, 3)} rad (${fmt(v * 180 / Math.PI, 1)}°)`;
+}
+function buildSliders() {
+  const box = document.getElementById("kinelab-joints");
+  cfg.joints.forEach((j, k) => {
+    const row = document.createElement("div");
+    row.className = "joint";
+    row.innerHTML = `<span>${j.name}</span><span class="value"></span>`;
+    const s = document.createElement("input");
+    Object.assign(s, { type: "range", min: j.lower, max: j.upper, step: (j.upper - j.lower) / 2000, value: cfg.q[k] });
+    s.id = `kinelab-joint-${k}`;
+    s.addEventListener("pointerdown", () => { s.dataset.active = "1"; });
+    s.addEventListener("pointerup", () => { delete s.dataset.active; });
+    s.addEventListener("input", () => {
+      row.querySelector(".value").textContent = jointText(j, Number(s.value));
+      // the other joints as the server has them: a slider rounds its value to its step
+      const q = (state.readout ? state.readout.q : cfg.q).slice();
+      q[k] = Number(s.value);
+      post("q", { q });
+    });
+    row.appendChild(s);
+    box.appendChild(row);
+    sliders.push(s);
+  });
+}
+
+// -- readings -----------------------------------------------------------------------------------
+function show(r) {
+  state.readout = r;
+  r.q.forEach((v, k) => {
+    const s = sliders[k];
+    if (!s.dataset.active) s.value = v;
+    s.parentNode.querySelector(".value").textContent = jointText(cfg.joints[k], v);
+  });
+  const deg = (a) => a.map((x) => fmt(x * 180 / Math.PI, 2)).join(", ");
+  const rows = [
+    ["tool position", r.tool.position_m.map((x) => fmt(x, 4)).join(", ") + " m"],
+    ["tool roll, pitch, yaw", deg(r.tool.rpy_rad) + " °"],
+    ["target position", r.target.position_m.map((x) => fmt(x, 4)).join(", ") + " m"],
+    ["target error", `${r.position_error_m.toExponential(2)} m, ${r.rotation_error_rad.toExponential(2)} rad`],
+    ["σ_min (scaled J)", r.sigma_min.toExponential(3) + (r.rank < r.full_rank ? `  — singular: rank ${r.rank} of ${r.full_rank}` : "")],
+    ["manipulability", r.manipulability.toExponential(3)],
+    ["ellipsoid radii", r.ellipsoid_radii_m_per_rad.map((x) => fmt(x, 3)).join(", ") + " m/rad"],
+    ["contacts", r.collisions ? (r.contacts.length ? r.contacts.join("; ") : "none") : "not checked"],
+  ];
+  document.getElementById("kinelab-readout").innerHTML =
+    rows.map(([k, v]) => `<tr><td>${k}</td><td>${v}</td></tr>`).join("");
+  document.getElementById("kinelab-status").textContent = r.status;
+  document.getElementById("kinelab-collisions").checked = r.collisions;
+}
+
+// -- the target: drag to move, Shift+drag to turn -----------------------------------------------
+const raycaster = new THREE.Raycaster();
+function ray(event) {
+  const rect = viewer.renderer.domElement.getBoundingClientRect();
+  const ndc = new THREE.Vector2(((event.clientX - rect.left) / rect.width) * 2 - 1,
+                                -((event.clientY - rect.top) / rect.height) * 2 + 1);
+  raycaster.setFromCamera(ndc, viewer.camera);
+  return raycaster;
+}
+
+function sendTarget() {
+  const e = targetNode().matrix.elements;  // column-major
+  const rows = [];
+  for (let r = 0; r < 4; r++) for (let c = 0; c < 4; c++) rows.push(e[c * 4 + r]);
+  post("target", { matrix: rows });
+}
+
+function onDown(event) {
+  if (event.button !== 0) return;
+  const hit = ray(event).intersectObject(handleNode(), true)[0];
+  if (!hit) return;
+  event.stopPropagation();
+  event.preventDefault();
+  viewer.controls.enabled = false;
+  const normal = viewer.camera.getWorldDirection(new THREE.Vector3());
+  const centre = handleNode().getWorldPosition(new THREE.Vector3());
+  state.dragging = { turn: event.shiftKey, x: event.clientX, y: event.clientY,
+                     plane: new THREE.Plane().setFromNormalAndCoplanarPoint(normal, centre),
+                     offset: centre.clone().sub(hit.point) };
+}
+
+function onMove(event) {
+  const d = state.dragging;
+  if (!d) return;
+  const t = targetNode();
+  if (d.turn) {
+    const dx = event.clientX - d.x, dy = event.clientY - d.y;
+    if (dx === 0 && dy === 0) return;
+    const m = viewer.camera.matrixWorld.elements;
+    const right = new THREE.Vector3(m[0], m[1], m[2]), up = new THREE.Vector3(m[4], m[5], m[6]);
+    const axis = up.multiplyScalar(dx).add(right.multiplyScalar(dy)).normalize();
+    axis.transformDirection(new THREE.Matrix4().copy(t.parent.matrixWorld).invert());
+    t.quaternion.premultiply(new THREE.Quaternion().setFromAxisAngle(axis, 0.01 * Math.hypot(dx, dy)));
+    d.x = event.clientX; d.y = event.clientY;
+  } else {
+    const p = ray(event).ray.intersectPlane(d.plane, new THREE.Vector3());
+    if (!p) return;
+    t.position.copy(t.parent.worldToLocal(p.add(d.offset)));
+  }
+  t.updateMatrix();
+  viewer.set_dirty();
+  sendTarget();
+}
+
+function onUp() {
+  if (!state.dragging) return;
+  state.dragging = null;
+  state.drags += 1;
+  viewer.controls.enabled = true;
+}
+
+// where the handle is on the screen (CSS pixels), for a test that drags it
+state.handleOnScreen = () => {
+  const p = handleNode().getWorldPosition(new THREE.Vector3()).project(viewer.camera);
+  const rect = viewer.renderer.domElement.getBoundingClientRect();
+  return [rect.left + (p.x + 1) / 2 * rect.width, rect.top + (1 - p.y) / 2 * rect.height];
+};
+// a drawn frame's pose in the base frame, rows first
+state.drawnPose = (name) => {
+  const e = node(["meshcat", "frames", name]).matrix.elements, rows = [];
+  for (let r = 0; r < 4; r++) for (let c = 0; c < 4; c++) rows.push(e[c * 4 + r]);
+  return rows;
+};
+state.idle = () => !state.busy && state.pending.size === 0 && !state.dragging;
+
+document.getElementById("kinelab-heading").textContent = cfg.heading;
+document.getElementById("kinelab-legend").textContent = cfg.legend;
+document.getElementById("kinelab-prev").addEventListener("click", () => post("branch", { step: -1 }));
+document.getElementById("kinelab-next").addEventListener("click", () => post("branch", { step: 1 }));
+document.getElementById("kinelab-snap").addEventListener("click", () => post("snap", {}));
+document.getElementById("kinelab-collisions").addEventListener("change",
+  (e) => post("collisions", { on: e.target.checked }));
+viewer.renderer.domElement.addEventListener("pointerdown", onDown);
+window.addEventListener("pointermove", onMove);
+window.addEventListener("pointerup", onUp);
+buildSliders();
+fetch("state?since=0").then((r) => r.json()).then((reply) => { apply(reply); state.ready = true; poll(); });
