@@ -36,7 +36,7 @@ def port_is_free(port):
     return True
 
 
-@pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGTERM])
+@pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
 def test_teach_serves_the_page_and_stops_cleanly_freeing_its_port(stop):
     proc, url, port = start("ur5", "0.3", "-1.2", "1.4", "-0.8", "1.2", "0.2")
     try:
