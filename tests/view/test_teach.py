@@ -47,6 +47,12 @@ def drawn(session, path):
     raise AssertionError(f"no transform of {path}")
 
 
+def objects(session, prefix):
+    """The scene nodes under ``prefix`` that hold an object now (the recorder keeps what a fresh page would get)."""
+    return {c["path"] for c in map(umsgpack.unpackb, session.window.since(0)[1])
+            if c["type"] == "set_object" and c["path"].startswith(prefix)}
+
+
 @pytest.fixture(scope="module")
 def ur5():
     return kinelab.load("ur5")
@@ -155,8 +161,13 @@ def test_with_collisions_on_every_branch_offered_is_clear_and_contacts_are_liste
     session.set_q(inside)
     named = session.readout()["contacts"]
     assert named and named == [str(c) for c in model.contacts(inside)]
+    assert {"/meshcat/obstacles/0", "/meshcat/obstacles/1"} <= objects(session, "/meshcat/obstacles/")
+    red = objects(session, "/meshcat/contacts/")  # the links in contact drawn red: one node per collision object
+    in_contact = {n for c in model.contacts(inside) for n in (c.first, c.second)}
+    robot_names = {o.name for o in model.geom.geometryObjects if o.parentJoint != 0} & in_contact
+    assert len(red) == len(robot_names) > 0
     session.set_collisions(False)
-    assert session.readout()["contacts"] == []
+    assert session.readout()["contacts"] == [] and objects(session, "/meshcat/contacts/") == set()
 
 
 def test_readings_and_the_ellipsoid_agree_with_pinocchio_s_jacobian(ur5):

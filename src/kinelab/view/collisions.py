@@ -24,7 +24,7 @@ def draw_collisions(scene: Any, model: CollisionModel, q: Any) -> list[Contact]:
     if model.spec is not None and model.spec.environment is not None:
         draw_obstacles(scene, model.spec.environment)
     contacts = model.contacts(q)
-    _overlay(scene, model, {n for c in contacts for n in (c.first, c.second)})
+    overlay_contacts(scene, model, {n for c in contacts for n in (c.first, c.second)})
     scene.legend["collisions"] = ("red links: in contact — " + "; ".join(str(c) for c in contacts)) if contacts \
         else "no contact at this q (margin " + f"{model.margin:g} m)"
     return contacts
@@ -52,7 +52,7 @@ def draw_obstacles(scene: Any, environment: Environment) -> Any:
     return scene
 
 
-def _overlay(scene: Any, model: CollisionModel, names: set[str]) -> None:
+def overlay_contacts(scene: Any, model: CollisionModel, names: set[str]) -> None:
     """The robot's collision objects in contact, drawn red over its visuals at the placements of the last check
     (unlit: a mesh without normals would draw black under a lit material; no depth test: drawn at the mesh's own
     depth, the copy and the mesh would fight pixel by pixel, red and black stripes, and a table would hide it)."""

@@ -155,7 +155,8 @@ def _page(session: TeachSession) -> str:
               f"tool point's velocities for unit joint speeds (J_v's singular values), 1 m/rad drawn as "
               f"{session.scale:.3g} m (fixed at the start). "
               f"σ_min and manipulability of the Jacobian with its linear rows divided by L = "
-              f"{robot.characteristic_length():.3g} m (dimensionless). Start: {session.start}.")
+              f"{robot.characteristic_length():.3g} m (dimensionless). Start: {session.start}."
+              + (f" Obstacles: {session.scene.legend['obstacles']}." if "obstacles" in session.scene.legend else ""))
     config = {"q": session.q.tolist(), "joints": joints, "heading": f"kinelab teach — {robot.name}", "legend": legend}
     text = resources.files(__package__).joinpath("teach.html").read_text(encoding="utf-8")
     return (text.replace("__TITLE__", html.escape(f"{robot.name} · teach — kinelab"))

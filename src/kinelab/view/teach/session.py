@@ -62,9 +62,16 @@ class TeachSession:
         self.branch = -1
         self.collisions_on = False
         self._collision_model: Any = None
+        self.contacts: list[Any] = []  # the pairs in contact at q while collisions are on
+        self._drawn_contacts: set[str] = set()
         # the ellipsoid's scale [m drawn per m/rad], fixed at the start: its largest radius there 0.8 frame length
         self.scale = 0.8 * self.scene.frame_length / max(self._radii().max(), 1e-9)
         self._draw_target_objects()
+        environment = getattr(self.options.collisions, "environment", None)
+        if environment is not None:
+            from kinelab.view.collisions import draw_obstacles
+
+            draw_obstacles(self.scene, environment)
         self._draw()
 
     # -- actions --------------------------------------------------------------------------------
@@ -135,7 +142,6 @@ class TeachSession:
         oMtool = self.robot.fk(self.q)
         a = analyze(self.robot, self.q)
         error = self.target.actInv(oMtool)
-        contacts = self._model().contacts(self.q) if self.collisions_on else []
         return {"robot": self.robot.name, "q": self.q.tolist(), "tool": _pose(oMtool), "target": _pose(self.target),
                 "position_error_m": float(np.linalg.norm(oMtool.translation - self.target.translation)),
                 "rotation_error_rad": float(np.linalg.norm(pin.log3(error.rotation))),
@@ -143,7 +149,7 @@ class TeachSession:
                 "rank": a.rank, "full_rank": a.full_rank, "ellipsoid_radii_m_per_rad": self._radii().tolist(),
                 "status": self.status, "branch": self.branch + 1,
                 "branches": None if self.branches is None else len(self.branches),
-                "collisions": self.collisions_on, "contacts": [str(c) for c in contacts]}
+                "collisions": self.collisions_on, "contacts": [str(c) for c in self.contacts]}
 
     # -- internals ------------------------------------------------------------------------------
     def _follow(self) -> None:
@@ -193,6 +199,18 @@ class TeachSession:
         self.scene.move(self.q)
         self.scene.viewer["frames"]["target"].set_transform(self.target.homogeneous)
         self.scene.viewer["ellipsoid"].set_transform(self._ellipsoid())
+        self._draw_contacts()
+
+    def _draw_contacts(self) -> None:
+        """List the pairs in contact at q (collisions on) and draw their links' collision objects red; a page
+        with no contact, now or before, sends nothing."""
+        from kinelab.view.collisions import overlay_contacts
+
+        self.contacts = self._model().contacts(self.q) if self.collisions_on else []
+        names = {n for c in self.contacts for n in (c.first, c.second)}
+        if names or self._drawn_contacts:
+            overlay_contacts(self.scene, self._model(), names)
+        self._drawn_contacts = names
 
     def _ellipsoid(self) -> np.ndarray:
         """The tool point's velocity ellipsoid (J_v J_vᵀ, base axes) as a scaled sphere's transform: its axes the

@@ -92,6 +92,7 @@ function show(r) {
     if (!s.dataset.active) s.value = v;
     s.parentNode.querySelector(".value").textContent = jointText(cfg.joints[k], v);
   });
+  document.getElementById("kinelab-q").textContent = `q = [${r.q.map((v) => fmt(v, 6)).join(", ")}]`;
   const deg = (a) => a.map((x) => fmt(x * 180 / Math.PI, 2)).join(", ");
   const rows = [
     ["tool position", r.tool.position_m.map((x) => fmt(x, 4)).join(", ") + " m"],
