@@ -187,3 +187,40 @@ def test_copies_side_by_side_never_overlap():
     nearest = min(float(np.min(np.linalg.norm(np.array(a)[:, None] - np.array(b)[None], axis=2)))
                   for i, a in copies.items() for j, b in copies.items() if i < j)
     assert nearest > 0.1 * s._reach, (nearest, s._reach)
+
+
+@pytest.mark.browser
+@pytest.mark.skipif(find_chromium() is None and not os.environ.get("CI"),
+                    reason="no chromium on PATH (Debian: apt-get install chromium)")
+def test_the_caption_and_its_table_cover_no_copy(capsys, tmp_path):
+    """The README's CRX-10iA pose, eight branches, at 1280 × 900: every drawn part of every copy lands on the scene's
+    pane and outside the caption (its column held the table over copies 7 and 8)."""
+    from devtools import open_page
+
+    page = tmp_path / "b.html"
+    crx = ["0.3", "0.5", "0.2", "0.4", "0.6", "0.1"]
+    code, _, _ = run(capsys, "branches", "crx10ia", "--target-q", *crx, "--ref-q", *crx, "--html", str(page))
+    assert code == 0
+    where = """(() => {
+      const cap = document.getElementById("kinelab-caption").getBoundingClientRect();
+      const pane = viewer.renderer.domElement.getBoundingClientRect();
+      viewer.render();
+      const out = [];
+      for (let k = 1; k <= 8; k++) {
+        viewer.scene_tree.find(["meshcat", "branches", String(k)]).object.traverse((o) => {
+          if (!o.isMesh) return;
+          const p = o.getWorldPosition(new MeshCat.THREE.Vector3()).project(viewer.camera);
+          const x = pane.left + (p.x + 1) / 2 * pane.width, y = pane.top + (1 - p.y) / 2 * pane.height;
+          out.push([k, x >= pane.left && x <= pane.right && y >= pane.top && y <= pane.bottom,
+                    x >= cap.left && x <= cap.right && y >= cap.top && y <= cap.bottom]);
+        });
+      }
+      return out;
+    })()"""
+    with open_page(page.resolve().as_uri(), size=(1280, 900)) as p:
+        p.wait_for("typeof viewer !== 'undefined' && viewer.scene_tree.find(['meshcat', 'branches', '8', 'joint0'])"
+                   ".object.children.length > 0", 60)
+        parts = p.eval(where)
+    assert {k for k, _, _ in parts} == set(range(1, 9)) and len(parts) > 8 * 7
+    assert [k for k, on_pane, _ in parts if not on_pane] == []
+    assert [k for k, _, under_caption in parts if under_caption] == []

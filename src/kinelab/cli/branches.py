@@ -144,7 +144,7 @@ def _write_page(robot: Robot, found: Sequence[IKResult], path: str, target: Any,
                          target=target)
     scene.title = f"{robot.name}: {len(found)} branch{'es' if len(found) != 1 else ''} of one pose, {_method(found)}"
     scene.view = "branches"
-    scene.table = _joint_table(robot, found, ref, deg)
+    scene.put_table(_joint_table(robot, found, ref, deg))
     scene.legend.pop("copies")  # the table numbers the branches as the scene does
     try:
         scene.save_html(path)

@@ -44,8 +44,20 @@ def table_html(table: Table) -> str:
             f"<tr>{head}</tr>{''.join(rows)}</table>{note}")
 
 
+# a page with a table gives its caption a column of its own: over the scene it hid the copies behind it
+SIDE_COLUMN = ("<style>#kinelab-caption{left:0!important;top:0!important;bottom:0;width:{w};"
+               "max-width:none!important;box-sizing:border-box;overflow-y:auto;border-radius:0!important}"
+               "#meshcat-pane{position:absolute;left:{w};right:0;top:0;bottom:0;"
+               "width:auto!important;height:auto!important}</style>")
+
+
 def with_caption(page: str, title: str, lines: list[str], table: Table | None = None) -> str:
-    """The page with the caption box placed just before ``</body>`` (or at its end)."""
+    """The page with the caption box placed just before ``</body>`` (or at its end); with a table, the caption is
+    a column on the left and the scene takes the rest of the width."""
+    if table is not None:  # in the head: the viewer measures its pane when its script runs, before the body's end
+        at = page.find("</head>")
+        style = SIDE_COLUMN.replace("{w}", "36%")
+        page = page[:at] + style + page[at:] if at >= 0 else style + page
     return before_body(page, caption_html(title, lines, table))
 
 

@@ -27,6 +27,8 @@ from kinelab.view.labels import draw_number
 from kinelab.view.server import Server
 
 SPREAD_FILL = 1.1  # side-by-side copies stand on a wide flat patch: its sphere may overfill the frame's height
+PAGE_ASPECT = 4 / 3  # width / height of the scene on a page (a window of 1280 × 960, say)
+BESIDE_TABLE_ASPECT = 0.9  # the same with 36 % of the width given to the caption's column
 
 AXIS_COLORS = (0xE6194B, 0x3CB44B, 0x4363D8)  # x red, y green, z blue
 
@@ -59,6 +61,8 @@ class Scene:
         self.view = "view"  # what the page shows, for its tab's title: "branches", "animation", "map", ...
         self.legend: dict[str, str] = {}  # what each mark means, by mark (the caption's lines)
         self.table: Table | None = None  # a table under the caption's lines (the branches' joints, say)
+        self.aspect = PAGE_ASPECT  # the scene's share of the page, width / height, the camera is set for
+        self._framed: tuple[np.ndarray, float] | None = None  # what the camera was last set to hold
         if missing or self.stick:
             self.legend["figure"] = _figure_note(robot, missing, self.stick)
         self.viewer["/Axes"].set_property("visible", False)  # an unlabelled world triad; the tool frame is drawn
@@ -111,12 +115,13 @@ class Scene:
         moves to put their centre there, the grid under the base, the camera at the framing distance."""
         import meshcat.geometry as g
 
+        self._framed = (points, fill)
         view = frame_points(points, floor_z=0.0, margin=0.05 * self.robot.characteristic_length(), fill=fill)
         self.viewer.set_transform(view.scene_shift())
         self.viewer["/Grid"].set_property("visible", False)
         self.viewer["floor"].set_object(g.LineSegments(g.PointsGeometry(view.floor_segments()),
                                                        g.LineBasicMaterial(color=0x9A9A9A)))
-        self.viewer["/Cameras/default/rotated/<object>"].set_property("position", view.camera_position())
+        self.viewer["/Cameras/default/rotated/<object>"].set_property("position", view.camera_position(self.aspect))
         self.legend["floor"] = f"floor grid: {view.cell:g} m cells, at the base's height"
         return self
 
@@ -144,6 +149,16 @@ class Scene:
         if self.stick:
             _move_stick(self.viewer["stick"], chain_points(self.robot, q), self._lengths)
         self.viewer["frames"]["tool"].set_transform(self.robot.fk(q).homogeneous)
+        return self
+
+    def put_table(self, table: Table) -> Scene:
+        """A table on the saved page (every branch's joints, say): the caption, table included, becomes a column on
+        the left 36 % of the page, and the camera is set again to hold the same points in the narrower rest."""
+        self.table = table
+        self.aspect = BESIDE_TABLE_ASPECT
+        if self._framed is not None:
+            points, fill = self._framed
+            self._aim(points, min(fill, 1.0))  # held across the width now: a spread may not overfill it
         return self
 
     def drop_robot(self) -> None:
