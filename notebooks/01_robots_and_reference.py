@@ -119,3 +119,14 @@ from kinelab.view import scene as viz
 
 scene = viz.Scene(youbot).show(youbot.random_q(rng))
 scene.notebook_html()
+
+# %% [markdown]
+# To move a robot by hand — a slider per joint, a target to drag that it follows by IK, its branches and the
+# velocity ellipsoid — run `kinelab teach youbot` in a terminal, or in a live notebook:
+#
+# ```python
+# from kinelab.view.teach import teach
+# page = teach(youbot)  # the page in the cell, served by this kernel on 127.0.0.1; page.close() stops it
+# ```
+#
+# It is not run here: a saved or exported notebook has no kernel left to serve the page (docs/teach.md).
