@@ -31,7 +31,7 @@ class TeachServer:
 
     def __init__(self, session: TeachSession, port: int = 0):
         self.session = session
-        self.lock = threading.Lock()
+        self.lock = session.lock  # a request's action and the reply it reads are one step
         self.files = {"/": _page(session).encode("utf-8"), "/meshcat.js": _meshcat_script(),
                       "/teach.js": resources.files(__package__).joinpath("teach.js").read_bytes()}
         try:

@@ -8,8 +8,11 @@ page prints. Units: SI and radians; poses in the robot's base frame.
 
 from __future__ import annotations
 
+import functools
+import threading
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 import pinocchio as pin
@@ -17,6 +20,20 @@ import pinocchio as pin
 from kinelab.errors import ConfigurationError, TargetError
 from kinelab.robot import Robot
 from kinelab.view.teach.recorder import RecordingWindow
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+def _locked(method: F) -> F:
+    """One action at a time: the page's requests come on threads of their own, a notebook's calls on its own."""
+
+    @functools.wraps(method)
+    def run(self: TeachSession, *args: Any, **kwargs: Any) -> Any:
+        with self.lock:
+            return method(self, *args, **kwargs)
+
+    return run  # type: ignore[return-value]
+
 
 HANDLE = 0xFFC000  # the target's grab handle: gold, as the branch pages' target marks
 ELLIPSOID = 0x4363D8
@@ -48,6 +65,7 @@ class TeachSession:
         from kinelab.view.scene import Scene
 
         self.robot, self.options = robot, options or TeachOptions()
+        self.lock = threading.RLock()  # held by each action and reading (the server's threads, a notebook)
         if q is None:
             q, self.start = robot.reference_q()
         else:
@@ -75,6 +93,7 @@ class TeachSession:
         self._draw()
 
     # -- actions --------------------------------------------------------------------------------
+    @_locked
     def set_q(self, q: Any) -> None:
         """Put the robot at q (one value per joint [rad or m], within the limits); the target stays.
 
@@ -85,6 +104,7 @@ class TeachSession:
         self.status = "joints set"
         self._draw()
 
+    @_locked
     def set_target(self, oMtarget: pin.SE3) -> None:
         """Move the target to a pose (base frame) and follow it: FRDM from the current q (the answer's revolute
         angles the turns nearest it), with collisions when switched on; q stays where it was when no answer meets
@@ -98,6 +118,7 @@ class TeachSession:
         self._follow()
         self._draw()
 
+    @_locked
     def snap_target(self) -> None:
         """Put the target on the tool as it is."""
         self.target = self.robot.fk(self.q)
@@ -105,6 +126,7 @@ class TeachSession:
         self.status = "target put on the tool"
         self._draw()
 
+    @_locked
     def step_branch(self, step: int = 1) -> None:
         """Go to the target's next (``step`` 1) or previous (−1) branch: every branch in closed form or by the
         1-D search where the arm has one, else those a multistart finds; the first is the one nearest q. With
@@ -125,6 +147,7 @@ class TeachSession:
         self.status = f"branch {self.branch + 1} of {len(found)} ({found.method or 'multistart'})"
         self._draw()
 
+    @_locked
     def set_collisions(self, on: bool) -> None:
         """Switch the collision check on or off: with it on, no answer that collides is taken, and the contacts at
         q are listed."""
@@ -134,6 +157,7 @@ class TeachSession:
         self._draw()
 
     # -- what the page shows --------------------------------------------------------------------
+    @_locked
     def readout(self) -> dict[str, Any]:
         """The numbers of the page: q, the tool and target poses, errors, σ_min, manipulability, the velocity
         ellipsoid's radii, the status, the branch, the contacts (each with its unit in its name)."""
