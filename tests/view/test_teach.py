@@ -213,9 +213,12 @@ def test_the_server_answers_on_loopback_and_refuses_bad_requests_by_name(ur5):
         code, moved = post(page.url, "q", {"q": [0.4, -1.2, 1.4, -0.8, 1.2, 0.2], "since": first["seq"]})
         assert code == 200 and moved["readout"]["q"][0] == 0.4 and 0 < len(moved["commands"]) < 20
         for action, body, words in (("q", {"q": [0.1] * 5}, "6"), ("q", {"q": [9.0] * 6}, "outside its limits"),
-                                    ("target", {"matrix": [1.0] * 16}, "not a rotation"),
+                                    ("target", {"matrix": [1.0] * 12 + [0, 0, 0, 1]}, "not a rotation"),
                                     ("target", {"matrix": [float("nan")] * 16}, "not finite"),
                                     ("target", {"matrix": "x"}, "16 numbers"), ("fly", {}, "unknown action"),
+                                    ("target", {"matrix": [*np.eye(4)[:3].ravel(), 5, 5, 5, 5]}, "last row"),
+                                    ("branch", {"step": 2}, "1 (next) or -1"),
+                                    ("collisions", {"on": "yes"}, "true or false"),
                                     ("q", b"not json", "not a JSON object")):
             code, reply = post(page.url, action, body)
             assert code == 400 and words in reply["error"], (action, reply)

@@ -85,11 +85,16 @@ class TeachServer:
         elif action == "target":
             s.set_target(pose_from_matrix(body.get("matrix")))
         elif action == "branch":
-            s.step_branch(-1 if body.get("step") == -1 else 1)
+            step = body.get("step", 1)
+            if step not in (1, -1) or isinstance(step, bool):
+                raise KinelabError(f"a branch step is 1 (next) or -1 (previous), not {step!r}")
+            s.step_branch(step)
         elif action == "snap":
             s.snap_target()
         elif action == "collisions":
-            s.set_collisions(bool(body.get("on")))
+            if not isinstance(body.get("on"), bool):
+                raise KinelabError(f"collisions are switched by on: true or false, not {body.get('on')!r}")
+            s.set_collisions(body["on"])
         else:
             raise KinelabError(f"unknown action {action!r}: q, target, branch, snap or collisions")
 

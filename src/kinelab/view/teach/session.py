@@ -280,6 +280,8 @@ def pose_from_matrix(values: Any) -> pin.SE3:
         raise TargetError("a target is 16 numbers: a 4 × 4 homogeneous matrix, rows first") from None
     if not np.isfinite(H).all():
         raise TargetError("the target pose is not finite (NaN or inf)")
+    if not np.array_equal(H[3], [0.0, 0.0, 0.0, 1.0]):
+        raise TargetError(f"a homogeneous matrix's last row is 0, 0, 0, 1; got {H[3].tolist()}")
     return _checked_pose(pin.SE3(H[:3, :3], H[:3, 3]))
 
 
