@@ -3,6 +3,8 @@ Pinocchio), the recorder that feeds the page, and the server's answers to good a
 
 import json
 import socket
+import struct
+import time
 import urllib.error
 import urllib.request
 
@@ -200,7 +202,7 @@ def post(url, action, body):
         return refused.code, json.load(refused)
 
 
-def test_the_server_answers_on_loopback_and_refuses_bad_requests_by_name(ur5):
+def test_the_server_answers_on_loopback_and_refuses_bad_requests_by_name(ur5, capsys):
     with teach(ur5, q=[0.3, -1.2, 1.4, -0.8, 1.2, 0.2]) as page:
         assert page.server.httpd.server_address[0] == "127.0.0.1" and page.url.startswith("http://127.0.0.1:")
         with urllib.request.urlopen(page.url, timeout=30) as reply:
@@ -223,6 +225,14 @@ def test_the_server_answers_on_loopback_and_refuses_bad_requests_by_name(ur5):
             code, reply = post(page.url, action, body)
             assert code == 400 and words in reply["error"], (action, reply)
         assert page.session.q[0] == 0.4  # nothing refused changed it
+        host, port = page.server.httpd.server_address
+        for _ in range(3):  # a browser that goes away while the scene is sent (a reload): nothing printed
+            with socket.create_connection((host, port)) as gone:
+                gone.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))  # close with a reset
+                gone.sendall(b"GET /state?since=0 HTTP/1.1\r\nHost: x\r\n\r\n")
+                gone.recv(1)
+        time.sleep(0.5)
+        assert "Traceback" not in capsys.readouterr().err
         with socket.socket() as other, pytest.raises(KinelabError, match="give another --port"):
             other.bind(("127.0.0.1", 0))
             other.listen()

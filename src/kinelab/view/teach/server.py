@@ -26,6 +26,18 @@ LOOPBACK = "127.0.0.1"
 MAX_BODY = 1 << 16  # [bytes] an action's JSON is a few hundred
 
 
+class _Quiet(ThreadingHTTPServer):
+    """An HTTP server that says nothing when a browser goes away mid-answer (a reload while the scene loads)."""
+
+    daemon_threads = True
+
+    def handle_error(self, request: Any, client_address: Any) -> None:
+        import sys
+
+        if not isinstance(sys.exc_info()[1], ConnectionError):
+            super().handle_error(request, client_address)
+
+
 class TeachServer:
     """The session served on 127.0.0.1 (``port`` 0: a free one); ``url`` is the page."""
 
@@ -35,11 +47,10 @@ class TeachServer:
         self.files = {"/": _page(session).encode("utf-8"), "/meshcat.js": _meshcat_script(),
                       "/teach.js": resources.files(__package__).joinpath("teach.js").read_bytes()}
         try:
-            self.httpd = ThreadingHTTPServer((LOOPBACK, port), _handler(self))
+            self.httpd = _Quiet((LOOPBACK, port), _handler(self))
         except OSError as exc:
             raise KinelabError(f"cannot serve the teach page on {LOOPBACK}:{port}: {exc.strerror or exc}; give "
                                "another --port, or 0 for a free one") from None
-        self.httpd.daemon_threads = True
         self.thread: threading.Thread | None = None
 
     @property
