@@ -17,7 +17,7 @@ from typing import Any, TypeVar
 import numpy as np
 import pinocchio as pin
 
-from kinelab.errors import ConfigurationError, TargetError
+from kinelab.errors import TargetError
 from kinelab.robot import Robot
 from kinelab.view.teach.recorder import RecordingWindow
 
@@ -35,7 +35,6 @@ def _locked(method: F) -> F:
     return run  # type: ignore[return-value]
 
 
-HANDLE = 0xFFC000  # the target's grab handle: gold, as the branch pages' target marks
 ELLIPSOID = 0x4363D8
 
 
@@ -73,7 +72,6 @@ class TeachSession:
         self.q = robot.check_q(q, limits=True)
         self.window = RecordingWindow()
         self.scene = Scene(robot, viewer=meshcat.Visualizer(window=self.window)).show(self.q)
-        self.scene.viewer["/Cameras/default/rotated/<object>"].set_property("zoom", 1.0)
         self.target = robot.fk(self.q)
         self.status = f"at the start ({self.start}); drag the gold ball to move the target"
         self.branches: Any = None
@@ -83,7 +81,7 @@ class TeachSession:
         self.contacts: list[Any] = []  # the pairs in contact at q while collisions are on
         self._drawn_contacts: set[str] = set()
         # the ellipsoid's scale [m drawn per m/rad], fixed at the start: its largest radius there 0.8 frame length
-        self.scale = 0.8 * self.scene.frame_length / max(self._radii().max(), 1e-9)
+        self.scale = 0.8 * self.scene.frame_length / max(self._velocity_svd()[1].max(), 1e-9)
         self._draw_target_objects()
         environment = getattr(self.options.collisions, "environment", None)
         if environment is not None:
@@ -170,7 +168,7 @@ class TeachSession:
                 "position_error_m": float(np.linalg.norm(oMtool.translation - self.target.translation)),
                 "rotation_error_rad": float(np.linalg.norm(pin.log3(error.rotation))),
                 "sigma_min": float(a.singular_values[a.full_rank - 1]), "manipulability": a.manipulability,
-                "rank": a.rank, "full_rank": a.full_rank, "ellipsoid_radii_m_per_rad": self._radii().tolist(),
+                "rank": a.rank, "full_rank": a.full_rank, "ellipsoid_radii_m_per_rad": self._svd[1].tolist(),
                 "status": self.status, "branch": self.branch + 1,
                 "branches": None if self.branches is None else len(self.branches),
                 "collisions": self.collisions_on, "contacts": [str(c) for c in self.contacts]}
@@ -204,23 +202,27 @@ class TeachSession:
             self._collision_model = collision_model(self.robot, self._spec())
         return self._collision_model
 
-    def _radii(self) -> np.ndarray:
-        return np.linalg.svd(self.robot.jacobian_local_world_aligned(self.q)[:3], compute_uv=False)
+    def _velocity_svd(self) -> tuple[np.ndarray, np.ndarray]:
+        """(U, s) of J_v, the tool point's linear velocity Jacobian at q in base axes: the ellipsoid's axes and radii
+        [m/rad]."""
+        U, s, _ = np.linalg.svd(self.robot.jacobian_local_world_aligned(self.q)[:3])
+        return U, s
 
     def _draw_target_objects(self) -> None:
         import meshcat.geometry as g
 
-        from kinelab.view.scene import on_top
+        from kinelab.view.scene import TARGET, on_top
 
         length = self.scene.frame_length
         self.scene.target(self.target)
         handle = self.scene.viewer["frames"]["target"]["handle"]
-        handle.set_object(g.Sphere(0.15 * length), on_top(HANDLE, 0.9))  # grabbable where the robot hides it
+        handle.set_object(g.Sphere(0.15 * length), on_top(TARGET, 0.9))  # over the robot: grabbable behind a link
         self.scene.viewer["ellipsoid"].set_object(g.Sphere(1.0), g.MeshLambertMaterial(
             color=ELLIPSOID, opacity=0.3, transparent=True, depthWrite=False))
 
     def _draw(self) -> None:
         self.scene.move(self.q)
+        self._svd = self._velocity_svd()  # the ellipsoid drawn now and the radii read until q changes again
         self.scene.viewer["frames"]["target"].set_transform(self.target.homogeneous)
         self.scene.viewer["ellipsoid"].set_transform(self._ellipsoid())
         self._draw_contacts()
@@ -240,7 +242,7 @@ class TeachSession:
         """The tool point's velocity ellipsoid (J_v J_vᵀ, base axes) as a scaled sphere's transform: its axes the
         left singular vectors, its radii the singular values [m/rad] × the page's scale (a floor keeps a
         singular direction visible as a flat disc)."""
-        U, s, _ = np.linalg.svd(self.robot.jacobian_local_world_aligned(self.q)[:3])
+        U, s = self._svd[0].copy(), self._svd[1]
         if np.linalg.det(U) < 0:
             U[:, 2] *= -1
         T = np.eye(4)
@@ -250,16 +252,26 @@ class TeachSession:
 
 
 def _checked_pose(oMtarget: Any) -> pin.SE3:
-    """The pose as given, refused when it is not finite or its rotation is not orthonormal within 1e-6."""
+    """A copy of the pose as given, refused when it is no ``pin.SE3`` or not a pose (:func:`_pose_of`)."""
     if not isinstance(oMtarget, pin.SE3):
         raise TargetError(f"a target is a pinocchio.SE3 (base frame), not {type(oMtarget).__name__}")
-    H = oMtarget.homogeneous
-    if not np.isfinite(H).all():
+    return _pose_of(oMtarget.homogeneous)
+
+
+def _pose_of(H: np.ndarray) -> pin.SE3:
+    """The pose of a 4 × 4 homogeneous matrix, checked as batch targets are (the compiled ``first_defect``): finite,
+    its rotation orthonormal within 1e-6 with det +1, its last row 0, 0, 0, 1."""
+    from kinelab.core._verdict import NOT_FINITE, NOT_HOMOGENEOUS, first_defect
+
+    H = np.ascontiguousarray(H, dtype=float)
+    _, defect = first_defect(H[None])
+    if defect == NOT_FINITE:
         raise TargetError("the target pose is not finite (NaN or inf)")
-    R = H[:3, :3]
-    if np.abs(R.T @ R - np.eye(3)).max() > 1e-6 or np.linalg.det(R) < 0:
+    if defect == NOT_HOMOGENEOUS:
+        raise TargetError(f"a homogeneous matrix's last row is 0, 0, 0, 1; got {H[3].tolist()}")
+    if defect:
         raise TargetError("the target's rotation is not a rotation matrix (orthonormal within 1e-6, det +1)")
-    return oMtarget.copy()
+    return pin.SE3(H[:3, :3].copy(), H[:3, 3].copy())
 
 
 def _pose(oMframe: pin.SE3) -> dict[str, list[float]]:
@@ -272,17 +284,13 @@ def pose_from_matrix(values: Any) -> pin.SE3:
     """A pose from 16 numbers (a 4 × 4 homogeneous matrix, rows first), as the page sends it.
 
     Raises:
-        TargetError: not 16 finite numbers, or its rotation is not one.
+        TargetError: not 16 finite numbers, its last row not 0, 0, 0, 1, or its rotation not one.
     """
     try:
         H = np.asarray(values, dtype=float).reshape(4, 4)
     except (TypeError, ValueError):
         raise TargetError("a target is 16 numbers: a 4 × 4 homogeneous matrix, rows first") from None
-    if not np.isfinite(H).all():
-        raise TargetError("the target pose is not finite (NaN or inf)")
-    if not np.array_equal(H[3], [0.0, 0.0, 0.0, 1.0]):
-        raise TargetError(f"a homogeneous matrix's last row is 0, 0, 0, 1; got {H[3].tolist()}")
-    return _checked_pose(pin.SE3(H[:3, :3], H[:3, 3]))
+    return _pose_of(H)
 
 
-__all__ = ["ConfigurationError", "TeachOptions", "TeachSession", "pose_from_matrix"]
+__all__ = ["TeachOptions", "TeachSession", "pose_from_matrix"]
