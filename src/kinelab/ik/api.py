@@ -21,11 +21,10 @@ import pinocchio as pin
 
 from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
-from kinelab.ik.batch import BatchIKResult, prepare, prepare_robot, run_batch
+from kinelab.ik.batch import BatchIKResult, prepare, prepare_robot
 from kinelab.ik.branches import UNSEEN, Route, find_all, route_of, usual_closed_form
 from kinelab.ik.chain import chain_model
-from kinelab.ik.driver import solve_one
-from kinelab.ik.prepared import collision_check, kept_solver, prepared
+from kinelab.ik.prepared import batch_clear_of, clear_of, collision_check, kept_solver, prepared, solve_clear_of
 from kinelab.ik.registry import Capabilities, capabilities, one_answer, refuse_options
 from kinelab.ik.request import Request, check_robot, make_request
 from kinelab.ik.result import Branches, IKResult, TrackResult
@@ -156,28 +155,19 @@ def _solve_preferring(robot: Robot, target: Any, q0: Any, seed: int | None, pref
     return _preferred(robot, target, req, prefer, check, Route.EITHER if closed else Route.MULTISTART)
 
 
-def _one_answer(robot: Robot, target: Any, q0: Any, req: Request, check: CollisionModel | None) -> IKResult:
-    """One solve through the driver, clear of collisions when ``check`` is given."""
-    if check is None:
-        return solve_one(robot, target, q0, req)
-    from kinelab.ik.clear import solve_clear  # the collision solves load with the first that checks
-
-    return solve_clear(robot, target, q0, req, check)
-
-
 def _preferred(robot: Robot, target: Any, req: Request, prefer: Any, check: CollisionModel | None,
                method: Route) -> IKResult:
     """``solve(prefer=)``: the (clear) branch nearest ``prefer`` among every branch found."""
     prepare(robot, req)  # not the budget's time
     t0 = time.perf_counter()
     found = find_all(robot, target, req, q_ref=prefer, method=method)
-    found = _clear_of(found, check, drop=True)
+    found = clear_of(found, check, drop=True)
     if found:
         return replace(found[0], diagnostics=replace(found[0].diagnostics, branches=len(found)))
     # no (clear) branch met the tolerances: the best single answer, in what is left of the same budget (at
     # least one attempt's worth, so that there is an answer to return)
     left = None if req.time_budget is None else max(req.time_budget - (time.perf_counter() - t0), 1e-4)
-    return _one_answer(robot, target, None, replace(req, time_budget=left), check)
+    return solve_clear_of(robot, target, None, replace(req, time_budget=left), check)
 
 
 def _closed_form_one(robot: Robot, target: Any, q0: Any, prefer: Any, collisions: Any, options: Any,
@@ -247,14 +237,7 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
                                                max_restarts, start_outside_limits, None, task, axis, None))
     req = make_request(solver, seed, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options,
                        task, axis, solver_options)
-    check = collision_check(robot, collisions)
-    t0 = time.perf_counter()
-    res = run_batch(robot, targets, q0, req)
-    if check is None:
-        return res
-    from kinelab.ik.clear import clear_batch
-
-    return clear_batch(robot, stack_homogeneous(*as_target_arrays(targets)), res, req, check, t0)
+    return batch_clear_of(robot, targets, q0, req, collision_check(robot, collisions))
 
 
 def _closed_form_batch(robot: Robot, targets: Any, q0: Any, collisions: Any, options: Any,
@@ -367,16 +350,7 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
     check = collision_check(robot, collisions)
     found = find_all(robot, target, req, q_ref=q_ref, max_solutions=max_solutions, stop_below=stop_below,
                      method=route_of(kind, given), redundancy=redundancy)
-    return _clear_of(found, check, drop=bool(drop_colliding))
-
-
-def _clear_of(found: Branches, check: CollisionModel | None, drop: bool) -> Branches:
-    """The branches with the colliding ones dropped (``drop``) or marked, by ``check`` (None: as found)."""
-    if check is None:
-        return found
-    from kinelab.ik.clear import mark_colliding  # the collision solves load with the first that checks
-
-    return mark_colliding(found, check, drop=drop)
+    return clear_of(found, check, drop=bool(drop_colliding))
 
 
 def _usual_all(q_ref: Any, max_solutions: Any, collisions: Any, redundancy: Any, task: Any, axis: Any) -> bool:

@@ -147,11 +147,7 @@ class IK:
                 return res
         elif self.analytic:
             return self._nearest_branch(target, q0)
-        elif self.collisions is not None:
-            from kinelab.ik.clear import solve_clear  # the collision solves load with the first that checks
-
-            return solve_clear(self.robot, target, q0, self._request(seed), self.collisions)
-        return solve_one(self.robot, target, q0, self._request(seed))
+        return solve_clear_of(self.robot, target, q0, self._request(seed), self.collisions)
 
     def _nearest_branch(self, target: Any, q0: Any) -> IKResult:
         """Solver "analytic": the branch nearest q0 in one compiled call where that serves, else root by root."""
@@ -182,7 +178,6 @@ class IK:
             TargetError, ConfigurationError, OptionError: named.
         """
         req = replace(self._request(seed), start_outside_limits="refuse")
-        t0 = time.perf_counter()
         if self.held:
             from kinelab.ik.analytic.held import nearest_held
 
@@ -191,12 +186,7 @@ class IK:
             from kinelab.ik.analytic.branches import nearest_batch
 
             return nearest_batch(self.robot, targets, q0, self.request, self.collisions)
-        res = run_batch(self.robot, targets, q0, req)
-        if self.collisions is None:
-            return res
-        from kinelab.ik.clear import clear_batch
-
-        return clear_batch(self.robot, stack_homogeneous(*as_target_arrays(targets)), res, req, self.collisions, t0)
+        return batch_clear_of(self.robot, targets, q0, req, self.collisions)
 
     def solve_all(self, target: Any, *, seed: int | None = None, q_ref: Any = None,
                   max_solutions: int | None = None, stop_below: float | None = UNSEEN) -> Branches:
@@ -218,11 +208,7 @@ class IK:
         found = find_all(self.robot, target, replace(self._request(seed), max_restarts=0), q_ref=q_ref,
                          max_solutions=max_solutions, stop_below=stop_below,
                          method=self.route)
-        if self.collisions is None:
-            return found
-        from kinelab.ik.clear import mark_colliding
-
-        return mark_colliding(found, self.collisions, drop=False)
+        return clear_of(found, self.collisions, drop=False)
 
 
 def collision_check(robot: Robot, collisions: Any) -> CollisionModel | None:
@@ -234,6 +220,36 @@ def collision_check(robot: Robot, collisions: Any) -> CollisionModel | None:
 
     spec = as_collisions(collisions)
     return None if spec is None else collision_model(robot, spec)
+
+
+def solve_clear_of(robot: Robot, target: Any, q0: Any, req: Request, check: CollisionModel | None) -> IKResult:
+    """One solve through the driver, clear of collisions when ``check`` is given (:mod:`kinelab.ik.clear`, which
+    loads with the first solve that checks)."""
+    if check is None:
+        return solve_one(robot, target, q0, req)
+    from kinelab.ik.clear import solve_clear
+
+    return solve_clear(robot, target, q0, req, check)
+
+
+def batch_clear_of(robot: Robot, targets: Any, q0: Any, req: Request, check: CollisionModel | None) -> BatchIKResult:
+    """A batch through the FRDM batch, its colliding rows solved again clear of ``check`` when given."""
+    t0 = time.perf_counter()
+    res = run_batch(robot, targets, q0, req)
+    if check is None:
+        return res
+    from kinelab.ik.clear import clear_batch
+
+    return clear_batch(robot, stack_homogeneous(*as_target_arrays(targets)), res, req, check, t0)
+
+
+def clear_of(found: Branches, check: CollisionModel | None, drop: bool) -> Branches:
+    """The branches with the colliding ones dropped (``drop``) or marked, by ``check`` (None: as found)."""
+    if check is None:
+        return found
+    from kinelab.ik.clear import mark_colliding
+
+    return mark_colliding(found, check, drop=drop)
 
 
 PREPARED_PER_ROBOT = 16  # a caller sweeping settings: the prepared solvers kept stay bounded
