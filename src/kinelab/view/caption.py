@@ -14,6 +14,16 @@ STYLE = ("position:fixed;left:10px;top:10px;max-width:46%;padding:8px 12px;borde
          "box-shadow:0 1px 4px rgba(0,0,0,0.3);z-index:10")
 
 
+def tab_title(robot: str, view: str) -> str:
+    """What a page's browser tab says: the robot and the view ("ur5 · branches — kinelab")."""
+    return f"{robot} · {view} — kinelab"
+
+
+def titled(page: str, title: str) -> str:
+    """meshcat's page with its tab titled ``title`` (escaped) instead of "MeshCat"."""
+    return page.replace("<title>MeshCat</title>", f"<title>{html.escape(title)}</title>", 1)
+
+
 @dataclass(frozen=True)
 class Table:
     """A table under the caption's lines: column names, rows of cells (text), the row to mark (or None)."""

@@ -21,7 +21,7 @@ import pinocchio as pin
 
 from kinelab.errors import ConfigurationError, KinelabError
 from kinelab.robot import Robot
-from kinelab.view.caption import Table, with_caption
+from kinelab.view.caption import Table, tab_title, titled, with_caption
 from kinelab.view.framing import FILL, frame_points
 from kinelab.view.labels import draw_number
 from kinelab.view.server import Server
@@ -44,7 +44,7 @@ class Scene:
         self.robot = robot
         self.server: Server | None = None
         if viewer is None:
-            self.server = Server(f"{robot.name} · live view — kinelab")  # on 127.0.0.1, ending with this process
+            self.server = Server(tab_title(robot.name, "live view"))  # on 127.0.0.1, ending with this process
             viewer_url = self.server.zmq_url
         with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL; we expose it as .url
             self.viewer = viewer if viewer is not None else meshcat.Visualizer(zmq_url=viewer_url)
@@ -266,8 +266,7 @@ class Scene:
     # -- export ---------------------------------------------------------------------------------
     def static_html(self) -> str:
         """The whole scene (and its animation) as one self-contained HTML page (works offline)."""
-        page = self.viewer.static_html().replace(
-            "<title>MeshCat</title>", f"<title>{html.escape(f'{self.robot.name} · {self.view} — kinelab')}</title>", 1)
+        page = titled(self.viewer.static_html(), tab_title(self.robot.name, self.view))
         return with_caption(page, self.title, list(self.legend.values()), self.table)
 
     def notebook_html(self, height: int = 420) -> Any:

@@ -101,15 +101,15 @@ def _loopback_bridge() -> Any:
 
 def _titled_index() -> Any:
     """A handler for the viewer's page with the tab titled by ``KINELAB_TAB_TITLE`` (meshcat's says "MeshCat")."""
-    import html
     from pathlib import Path
 
     import tornado.web
     from meshcat.servers import zmqserver
 
-    page = (Path(zmqserver.VIEWER_ROOT) / zmqserver.VIEWER_HTML).read_text(encoding="utf-8")
-    title = html.escape(os.environ.get("KINELAB_TAB_TITLE", "kinelab"))
-    page = page.replace("<title>MeshCat</title>", f"<title>{title}</title>")
+    from kinelab.view.caption import titled
+
+    page = titled((Path(zmqserver.VIEWER_ROOT) / zmqserver.VIEWER_HTML).read_text(encoding="utf-8"),
+                  os.environ.get("KINELAB_TAB_TITLE", "kinelab"))
 
     class TitledIndex(tornado.web.RequestHandler):
         def get(self) -> None:

@@ -20,6 +20,7 @@ from typing import Any
 from urllib.parse import parse_qs, urlparse
 
 from kinelab.errors import KinelabError
+from kinelab.view.caption import tab_title
 from kinelab.view.teach.session import TeachSession, pose_from_matrix
 
 LOOPBACK = "127.0.0.1"
@@ -175,7 +176,7 @@ def _page(session: TeachSession) -> str:
               + (f" Obstacles: {session.scene.legend['obstacles']}." if "obstacles" in session.scene.legend else ""))
     config = {"q": session.q.tolist(), "joints": joints, "heading": f"kinelab teach — {robot.name}", "legend": legend}
     text = resources.files(__package__).joinpath("teach.html").read_text(encoding="utf-8")
-    return (text.replace("__TITLE__", html.escape(f"{robot.name} · teach — kinelab"))
+    return (text.replace("__TITLE__", html.escape(tab_title(robot.name, "teach")))
             .replace("__CONFIG__", json.dumps(config).replace("</", "<\\/")))
 
 
