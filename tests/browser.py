@@ -26,6 +26,11 @@ def scene_paths(html: str) -> set[str]:
     return paths
 
 
+# headless, software WebGL, a profile of its own, no network but loopback (the browser tests' every Chromium)
+HEADLESS = ("--headless", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+            "--disable-background-networking", "--disable-component-update", "--disable-sync", "--no-first-run")
+
+
 def find_chromium() -> str | None:
     """Path of a Chromium executable on PATH (Debian's ``chromium``), or None."""
     for name in ("chromium", "chromium-browser", "google-chrome"):
@@ -46,9 +51,7 @@ def screenshot(url_or_path: str | Path, png: str | Path, size: tuple[int, int] =
         target = Path(target).resolve().as_uri()
     png = Path(png).resolve()
     with tempfile.TemporaryDirectory(prefix="kinelab-chromium-") as profile:
-        cmd = [chromium, "--headless", "--no-sandbox", "--disable-gpu", "--use-angle=swiftshader",
-               "--enable-unsafe-swiftshader", "--disable-background-networking", "--disable-component-update",
-               "--disable-sync", "--disable-quic", "--no-first-run", f"--user-data-dir={profile}",
+        cmd = [chromium, *HEADLESS, "--disable-gpu", "--disable-quic", f"--user-data-dir={profile}",
                f"--window-size={size[0]},{size[1]}", f"--virtual-time-budget={wait_ms}", f"--screenshot={png}",
                target]
         subprocess.run(cmd, capture_output=True, timeout=120, check=False)

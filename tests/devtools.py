@@ -22,7 +22,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from browser import find_chromium
+from browser import HEADLESS, find_chromium
 
 START_TIMEOUT = 60.0  # [s]
 
@@ -109,10 +109,8 @@ def open_page(url: str, size: tuple[int, int] = (1280, 900)) -> Iterator[Page]:
         raise FileNotFoundError("no chromium on PATH (Debian: apt-get install chromium)")
     with tempfile.TemporaryDirectory(prefix="kinelab-devtools-", ignore_cleanup_errors=True) as profile:
         proc = subprocess.Popen(
-            [chromium, "--headless", "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
-             "--disable-background-networking", "--disable-component-update", "--disable-sync", "--no-first-run",
-             "--remote-debugging-address=127.0.0.1", "--remote-debugging-port=0", f"--user-data-dir={profile}",
-             f"--window-size={size[0]},{size[1]}", url],
+            [chromium, *HEADLESS, "--remote-debugging-address=127.0.0.1", "--remote-debugging-port=0",
+             f"--user-data-dir={profile}", f"--window-size={size[0]},{size[1]}", url],
             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
         page = None
         try:

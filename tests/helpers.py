@@ -116,6 +116,13 @@ def assert_meets_pose(robot, qs, target, tol):
         assert np.linalg.norm(pin.log3(oMtool.rotation.T @ target.rotation)) <= tol
 
 
+def pinocchio_tool(robot, q):
+    """The tool pose at q (rad or m) by Pinocchio's own FK on fresh data: the oracle, apart from kinelab's FK."""
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, robot.to_pin_q(np.asarray(q, dtype=float)))
+    return data.oMf[robot.tool_frame_id]
+
+
 def pinocchio_axes(robot, q=None):
     """Unit axes, points on them and the tool pose at q (None: q = 0), read from Pinocchio's model and Jacobians."""
     model, data = robot.model, robot.model.createData()

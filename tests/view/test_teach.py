@@ -14,6 +14,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 import umsgpack
+from helpers import pinocchio_tool
 
 import kinelab
 from kinelab.collision import Collisions, Environment, Obstacle, collision_model
@@ -24,13 +25,6 @@ from kinelab.view.teach.recorder import RecordingWindow
 TOL = 1e-6
 FLOOR_AND_TABLE = Environment((Obstacle("plane", name="floor"),
                                Obstacle("box", size=(0.6, 0.8, 0.05), xyz=(0.5, 0.0, 0.2), name="table")))
-
-
-def pinocchio_tool(robot, q):
-    """The tool pose at q by Pinocchio's own FK on fresh data (the oracle)."""
-    data = robot.model.createData()
-    pin.framesForwardKinematics(robot.model, data, robot.to_pin_q(q))
-    return data.oMf[robot.tool_frame_id]
 
 
 def meets(robot, q, target, tol=TOL):

@@ -9,6 +9,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 from devtools import open_page
+from helpers import pinocchio_tool
 
 import kinelab
 from kinelab.view.teach import teach
@@ -19,12 +20,6 @@ SHIFT = 8  # the DevTools protocol's modifier bit for Shift
 pytestmark = [pytest.mark.browser,
               pytest.mark.skipif(browser.find_chromium() is None and not os.environ.get("CI"),
                                  reason="Debian's chromium is not installed here (.ci/run installs it)")]
-
-
-def pinocchio_tool(robot, q):
-    data = robot.model.createData()
-    pin.framesForwardKinematics(robot.model, data, robot.to_pin_q(np.asarray(q, dtype=float)))
-    return data.oMf[robot.tool_frame_id]
 
 
 def drawn(page, name):
