@@ -29,7 +29,6 @@ def run_teach(args: argparse.Namespace) -> int:
     """Serve the teach page until Ctrl-C (or SIGTERM)."""
     import signal
 
-    from kinelab.collision import Collisions
     from kinelab.view.teach import TeachOptions, TeachServer, TeachSession
 
     if not 0 <= args.port <= 65535:
@@ -39,7 +38,7 @@ def run_teach(args: argparse.Namespace) -> int:
     robot = load_robot(args)
     q = q_from_cli(robot, args.q, args.deg) if args.q else None
     spec = collisions_of(args)
-    options = TeachOptions(time_budget=args.time_budget, collisions=spec if spec is not None else Collisions())
+    options = TeachOptions(time_budget=args.time_budget, collisions=spec)  # None: the switch checks self-collisions
     step(f"drawing {robot.name} (its meshes load)")
     session = TeachSession(robot, q, options)
     if spec is not None:
