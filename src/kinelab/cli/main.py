@@ -19,6 +19,7 @@ from typing import Any
 
 from kinelab.cli.common import Parser
 from kinelab.errors import KinelabError
+from kinelab.files import output_target
 
 # each command → the module with its parser and handler, in the order ``kinelab --help`` lists them
 COMMANDS = {"robots": "robots", "info": "robots", "fk": "fk", "ik": "ik", "branches": "branches",
@@ -68,6 +69,8 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser(words).parse_args(words)
     args.command_line = words  # what resumes an interrupted command
     try:
+        if getattr(args, "html", None):  # a page that could not be written is refused before the work it shows
+            output_target(args.html, "page")
         code: int = args.func(args)
         return code
     except KinelabError as exc:

@@ -11,6 +11,7 @@ from typing import Any
 from kinelab.cli import common
 from kinelab.cli.common import Interrupted, Parser, load_robot, plural, print_json, seed_argument, source_arguments
 from kinelab.errors import KinelabError
+from kinelab.files import write_output
 from kinelab.progress import step
 
 
@@ -207,10 +208,7 @@ def run_view(args: argparse.Namespace) -> int:
                            "give that robot with --robot")
     step(f"drawing the map of {robot.name} and its slices")
     page = map_page(robot, rmap)
-    try:
-        Path(args.html).write_text(page)
-    except OSError as err:
-        raise KinelabError(f"cannot write the page {args.html}: {err.strerror or err}") from None
+    write_output(args.html, page, "page")
     print(f"wrote {args.html}: {robot.name}, {int((rmap.array('reachability') > 0).sum())} reached voxels of "
           f"{meta['voxels']}, {meta['spec']['voxel']:g} m")
     return 0

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from kinelab.errors import KinelabError
-from kinelab.files import as_path
+from kinelab.files import as_path, output_folder
 from kinelab.robot import Robot
 
 INSTALL_HINT = "pip install 'kinelab[maps]' (zarr)"
@@ -181,7 +181,7 @@ def open_map(out: str | Path | None, robot: Robot, spec: Any, centres: np.ndarra
         arrays = {"centres": centres, "done": np.zeros(chunks, dtype=bool),
                   **{k: np.full(len(centres), np.nan) for k in VALUES}}
         return ReachabilityMap(meta, arrays)
-    zarr, path = _zarr(), as_path(out, "the map's out", KinelabError)
+    zarr, path = _zarr(), output_folder(out, "map")
     if path.exists():
         found = load(path, check=False)
         _same(found.meta, meta, path)

@@ -16,6 +16,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from kinelab.errors import KinelabError
+from kinelab.files import output_folder, umask
 
 MARKER = ".kinelab-report"
 FIGURES = ("era_elbow.png", "era_wrist.png", "era_shoulder.png", "seed001_convergence.png")  # validate's figures
@@ -26,15 +27,14 @@ def check_output_folder(out: str | Path, kind: str) -> Path:
     """Make sure a ``kind`` report ("validate" or "bench") can be written to the folder ``out`` before any work.
 
     Raises:
-        KinelabError: ``out`` is ``.``, ``..`` or above the working folder, a file, a folder holding anything but
-            a kinelab report of this kind, or not writable.
+        KinelabError: ``out`` is ``.``, ``..`` or above the working folder, a link, a file, a folder holding
+            anything but a kinelab report of this kind, or not writable.
     """
     final = Path(out)
     if final.name in ("", ".", "..") or final.resolve() in (Path.cwd(), *Path.cwd().parents):
         raise KinelabError(f"cannot write the report to {str(out)!r}: give a folder of its own (such as "
                            f"./kinelab-{kind}), not the working folder or one above it")
-    if final.exists() and not final.is_dir():
-        raise KinelabError(f"cannot write the report to {out}: it is a file, not a folder")
+    output_folder(final, "report")  # a link, a file, a device, a FIFO or a socket: refused by name
     if final.is_dir() and not _replaceable(final, kind):
         strangers = sorted(p.name for p in final.iterdir() if p.name not in (MARKER, *KINDS[kind]))
         raise KinelabError(f"cannot write the report to {out}: the folder exists and is not a kinelab {kind} report "
@@ -83,9 +83,7 @@ def atomic_folder(out: str | Path, kind: str) -> Iterator[Path]:
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
-    umask = os.umask(0)
-    os.umask(umask)
-    tmp.chmod(0o777 & ~umask)
+    tmp.chmod(0o777 & ~umask())
     old = final.with_name(f".{final.name}.old-{os.getpid()}") if final.exists() else None
     if old is not None:
         final.rename(old)

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
+from kinelab.files import write_output
 from kinelab.report.bench import loops, scaling, versus
 from kinelab.report.outfolder import atomic_folder
 from kinelab.report.page import CAPTIONS, validate_html
@@ -101,7 +102,7 @@ def provenance_line(p: dict[str, Any]) -> str:
 
 def _write_validate_files(report: Report, folder: Path) -> None:
     figures = validate_figures(report, folder)
-    (folder / "report.json").write_text(json.dumps(report.to_dict(), indent=2))
+    write_output(folder / "report.json", json.dumps(report.to_dict(), indent=2))
     md = ["# kinelab validate", "", f"Robots: {', '.join(report.robots)}; n = {report.n} configurations for the FK "
           f"checks, each other check stating its own sample; seed = {report.seed}. Shares carry their 95 % Wilson "
           "interval.", "",
@@ -115,8 +116,8 @@ def _write_validate_files(report: Report, folder: Path) -> None:
                "|---|---|---|"]
         md += [f"| {c.robot} | {c.measured} | {c.detail} |" for c in complete]
     md += [""] + [f"![{CAPTIONS.get(name, name)}]({name})" for name in figures]
-    (folder / "report.md").write_text("\n".join(md) + "\n")
-    (folder / "report.html").write_text(validate_html(report, {n: (folder / n).read_bytes() for n in figures}))
+    write_output(folder / "report.md", "\n".join(md) + "\n")
+    write_output(folder / "report.html", validate_html(report, {n: (folder / n).read_bytes() for n in figures}))
 
 
 def bench_markdown(result: dict[str, Any]) -> str:
@@ -144,7 +145,7 @@ def write_bench(result: dict[str, Any], out: str | Path) -> Path:
 
 
 def _write_bench_files(result: dict[str, Any], folder: Path) -> None:
-    (folder / "bench.json").write_text(json.dumps(result, indent=2))
+    write_output(folder / "bench.json", json.dumps(result, indent=2))
     sections = [bench_markdown(result)]
     if "scaling" in result:
         sections.append(scaling.markdown(result["scaling"]))
@@ -155,7 +156,7 @@ def _write_bench_files(result: dict[str, Any], folder: Path) -> None:
                                        result["loops"]["budgets"]))
     if "versus" in result:
         sections.append(versus.markdown(result["versus"]))
-    (folder / "bench.md").write_text("\n\n".join(sections) + "\n")
+    write_output(folder / "bench.md", "\n\n".join(sections) + "\n")
     bench_figure(result, folder / "bench.png")
 
 

@@ -11,15 +11,14 @@ from __future__ import annotations
 import contextlib
 import html
 import io
-import os
-import tempfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
-from kinelab.errors import ConfigurationError, KinelabError
+from kinelab.errors import ConfigurationError
+from kinelab.files import write_output
 from kinelab.robot import Robot
 from kinelab.view.caption import Table, tab_title, titled, with_caption
 from kinelab.view.framing import FILL, frame_points
@@ -281,24 +280,13 @@ class Scene:
     def save_html(self, path: str | Path) -> Path:
         """Write the scene as one self-contained HTML page (its caption included); returns the path.
 
-        The page is written beside its final name and renamed into place (never half a page).
+        The page goes through kinelab's one writer (:func:`kinelab.files.write_output`): a new file, or a regular
+        file replaced whole with its mode kept; never a folder, device, FIFO or socket.
 
         Raises:
-            KinelabError: ``path`` is a folder, or its folder is missing or not writable.
+            KinelabError: ``path`` is anything but a new or regular file, or its folder is missing or not writable.
         """
-        path = Path(path)
-        if path.is_dir():
-            raise KinelabError(f"cannot write the page to {path}: it is a folder; give a file name such as "
-                               f"{path / 'view.html'}")
-        text = self.static_html()
-        try:
-            with tempfile.NamedTemporaryFile("w", encoding="utf-8", dir=path.parent, prefix=f".{path.name}.",
-                                             delete=False) as tmp:
-                tmp.write(text)
-            os.replace(tmp.name, path)
-        except OSError as exc:
-            raise KinelabError(f"cannot write the page to {path}: {exc.strerror or exc}") from None
-        return path
+        return write_output(path, self.static_html(), "page")
 
     def close(self) -> None:
         """Stop the server this scene started (a viewer passed in is left alone)."""
