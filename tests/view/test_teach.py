@@ -188,7 +188,7 @@ def test_readings_and_the_ellipsoid_agree_with_pinocchio_s_jacobian(ur5):
 
 def post(url, action, body):
     request = urllib.request.Request(url + action, data=body if isinstance(body, bytes) else json.dumps(body).encode(),
-                                     method="POST")
+                                     method="POST", headers={"Content-Type": "application/json"})
     try:
         with urllib.request.urlopen(request, timeout=30) as reply:
             return reply.status, json.load(reply)

@@ -4,14 +4,18 @@ session's actions as small JSON requests (a thread per request, one action at a 
 Requests: ``GET /`` the page; ``GET /state?since=N`` the scene commands after N and the readings; ``POST /q``
 ``{"q": [...]}``, ``/target`` ``{"matrix": [16 numbers, rows first]}``, ``/branch`` ``{"step": ±1}``, ``/snap``,
 ``/collisions`` ``{"on": bool}``. Each answers ``{"seq", "commands" (base64 msgpack), "readout"}`` and, when the
-request was refused, ``"error"`` naming why (HTTP 400).
+request was refused, ``"error"`` naming why in at most 200 characters (HTTP 400; 403 for a request that is not the
+page's own: another Host or Origin; 415 for a POST that is not JSON). The session is never left broken by a request.
+A connection gets 10 s to send its request.
 """
 
 from __future__ import annotations
 
 import base64
+import contextlib
 import html
 import json
+import sys
 import threading
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from importlib import resources
@@ -25,22 +29,62 @@ from kinelab.view.teach.session import TeachSession, pose_from_matrix
 
 LOOPBACK = "127.0.0.1"
 MAX_BODY = 1 << 16  # [bytes] an action's JSON is a few hundred
+TIMEOUT = 10.0  # [s] a connection that sends nothing (or half a request) for this long is closed
+BACKLOG = 256  # connections the system queues while the server is busy: a browser's bursts fit
+MAX_CONNECTIONS = 64  # connections served at once (a thread each); more wait in the backlog
+MAX_REASON = 200  # [characters] of a refusal's reason
 
 
 class _Quiet(ThreadingHTTPServer):
-    """An HTTP server that says nothing when a browser goes away mid-answer (a reload while the scene loads)."""
+    """An HTTP server on loopback that serves a bounded number of connections at once (the others wait their turn,
+    a 503 after :data:`TIMEOUT`), and says nothing when a browser goes away mid-answer (a reload while the scene
+    loads) or a connection times out."""
 
     daemon_threads = True
+    request_queue_size = BACKLOG
+
+    def __init__(self, address: tuple[str, int], handler: type[BaseHTTPRequestHandler]):
+        super().__init__(address, handler)
+        self.slots = threading.BoundedSemaphore(MAX_CONNECTIONS)
+
+    def process_request(self, request: Any, client_address: Any) -> None:
+        if not self.slots.acquire(timeout=TIMEOUT):  # every slot held by connections that will time out
+            with contextlib.suppress(OSError):
+                request.sendall(b"HTTP/1.1 503 Service Unavailable\r\nContent-Length: 0\r\n\r\n")
+            self.shutdown_request(request)
+            return
+        super().process_request(request, client_address)
+
+    def process_request_thread(self, request: Any, client_address: Any) -> None:
+        try:
+            super().process_request_thread(request, client_address)
+        finally:
+            self.slots.release()
 
     def handle_error(self, request: Any, client_address: Any) -> None:
-        import sys
-
-        if not isinstance(sys.exc_info()[1], ConnectionError):
+        if not isinstance(sys.exc_info()[1], ConnectionError | TimeoutError):
             super().handle_error(request, client_address)
 
 
+class RequestError(KinelabError):
+    """A request the teach server refuses: its HTTP code and a short reason."""
+
+    def __init__(self, code: int, reason: str):
+        self.code = code
+        super().__init__(short(reason))
+
+
+def short(text: str) -> str:
+    """A reason cut to :data:`MAX_REASON` characters."""
+    return text if len(text) <= MAX_REASON else text[: MAX_REASON - 1] + "…"
+
+
 class TeachServer:
-    """The session served on 127.0.0.1 (``port`` 0: a free one); ``url`` is the page."""
+    """The session served on 127.0.0.1 (``port`` 0: a free one); ``url`` is the page.
+
+    It answers its own page only: a request whose ``Host`` is not a loopback name with this port (DNS rebinding),
+    or whose ``Origin`` is another page's, is refused (403); a POST must carry JSON.
+    """
 
     def __init__(self, session: TeachSession, port: int = 0):
         self.session = session
@@ -52,12 +96,15 @@ class TeachServer:
         except OSError as exc:
             raise KinelabError(f"cannot serve the teach page on {LOOPBACK}:{port}: {exc.strerror or exc}; give "
                                "another --port, or 0 for a free one") from None
+        self.port = int(self.httpd.server_address[1])
+        self.hosts = {f"{name}:{self.port}" for name in (LOOPBACK, "localhost")}
+        self.origins = {f"http://{host}" for host in self.hosts}
         self.thread: threading.Thread | None = None
 
     @property
     def url(self) -> str:
         """The page's address."""
-        return f"http://{LOOPBACK}:{self.httpd.server_address[1]}/"
+        return f"http://{LOOPBACK}:{self.port}/"
 
     def start(self) -> TeachServer:
         """Serve in a background thread (a notebook's way); returns self."""
@@ -76,6 +123,18 @@ class TeachServer:
             self.thread = None
         self.httpd.server_close()
 
+    def check_origin(self, headers: Any) -> None:
+        """Refuse a request that is not the page's own.
+
+        Raises:
+            RequestError: 403 for a Host other than 127.0.0.1 or localhost with this port, or another Origin.
+        """
+        host, origin = headers.get("Host"), headers.get("Origin")
+        if host not in self.hosts:
+            raise RequestError(403, f"this server answers its own page only (Host {host!r} is not {self.url})")
+        if origin is not None and origin not in self.origins:
+            raise RequestError(403, f"this server answers its own page only (a request from {origin!r})")
+
     def reply(self, since: int, error: str = "") -> dict[str, Any]:
         """What every request answers: the commands after ``since``, the readings, the error if any."""
         seq, packed = self.session.window.since(since)
@@ -93,35 +152,74 @@ class TeachServer:
         """
         s = self.session
         if action == "q":
-            s.set_q(body.get("q"))
+            s.set_q(_numbers(body.get("q"), f"q is a list of {s.robot.n} numbers (rad or m)"))
         elif action == "target":
-            s.set_target(pose_from_matrix(body.get("matrix")))
+            s.set_target(pose_from_matrix(_numbers(body.get("matrix"), "a target is 16 numbers: a 4 × 4 homogeneous "
+                                                                       "matrix, rows first")))
         elif action == "branch":
-            step = body.get("step", 1)
-            if step not in (1, -1) or isinstance(step, bool):
-                raise KinelabError(f"a branch step is 1 (next) or -1 (previous), not {step!r}")
-            s.step_branch(step)
+            s.step_branch(body.get("step", 1))
         elif action == "snap":
             s.snap_target()
         elif action == "collisions":
-            if not isinstance(body.get("on"), bool):
-                raise KinelabError(f"collisions are switched by on: true or false, not {body.get('on')!r}")
-            s.set_collisions(body["on"])
+            s.set_collisions(body.get("on"))
         else:
-            raise KinelabError(f"unknown action {action!r}: q, target, branch, snap or collisions")
+            raise KinelabError(f"unknown action {short(repr(action))}: q, target, branch, snap or collisions")
+
+
+def _numbers(values: Any, valid: str) -> list[float]:
+    """A JSON list of numbers (not booleans) as floats.
+
+    Raises:
+        KinelabError: anything else (``valid`` says what is).
+    """
+    if not isinstance(values, list) or not all(isinstance(v, int | float) and not isinstance(v, bool)
+                                               for v in values):
+        raise KinelabError(valid)
+    try:
+        return [float(v) for v in values]
+    except OverflowError:
+        raise KinelabError(f"{valid}; a number was too large for a float") from None
+
+
+def read_json(rfile: Any, length_header: str | None) -> dict[str, Any]:
+    """The request's body: a JSON object of at most :data:`MAX_BODY` bytes.
+
+    Raises:
+        RequestError: 400 (411, 413) for a missing or bad length, a body too large, or anything but a JSON object.
+    """
+    try:
+        length = int(length_header or "")
+    except ValueError:
+        raise RequestError(411, "a POST says its Content-Length") from None
+    if not 0 <= length <= MAX_BODY:
+        raise RequestError(413, f"a request's body is at most {MAX_BODY} bytes")
+    try:
+        body = json.loads(rfile.read(length) or b"{}")
+    except (ValueError, RecursionError):  # RecursionError: thousands of nested brackets
+        raise RequestError(400, "the request is not a JSON object") from None
+    if not isinstance(body, dict):
+        raise RequestError(400, "the request is not a JSON object")
+    return body
 
 
 def _handler(server: TeachServer) -> type[BaseHTTPRequestHandler]:
     class Handler(BaseHTTPRequestHandler):
+        timeout = TIMEOUT  # a half-sent request holds its thread this long, not for ever
+
         def log_message(self, format: str, *args: Any) -> None:  # quiet: the terminal shows the address only
             return
 
         def do_GET(self) -> None:  # noqa: N802 (http.server's name)
             url = urlparse(self.path)
+            try:
+                server.check_origin(self.headers)
+            except RequestError as exc:
+                self._send_json(exc.code, {"error": str(exc)})
+                return
             if url.path == "/state":
                 since = _int(parse_qs(url.query).get("since", ["0"])[0])
                 with server.lock:
-                    self._send(200, json.dumps(server.reply(since)).encode("utf-8"), "application/json")
+                    self._send_json(200, server.reply(since))
             elif url.path in server.files:
                 kind = "text/html; charset=utf-8" if url.path == "/" else "text/javascript; charset=utf-8"
                 self._send(200, server.files[url.path], kind)
@@ -129,28 +227,32 @@ def _handler(server: TeachServer) -> type[BaseHTTPRequestHandler]:
                 self._send(404, b"not found", "text/plain")
 
         def do_POST(self) -> None:  # noqa: N802
-            length = _int(self.headers.get("Content-Length", "0"))
             try:
-                body = json.loads(self.rfile.read(min(length, MAX_BODY)) or b"{}")
-                if not isinstance(body, dict):
-                    raise ValueError("not an object")
-            except ValueError:
-                self._send(400, b'{"error": "the request is not a JSON object"}', "application/json")
+                server.check_origin(self.headers)
+                if self.headers.get_content_type() != "application/json":
+                    raise RequestError(415, "the actions take JSON (Content-Type: application/json)")
+                body = read_json(self.rfile, self.headers.get("Content-Length"))
+            except RequestError as exc:
+                self._send_json(exc.code, {"error": str(exc)})
                 return
             with server.lock:
                 code, error = 200, ""
                 try:
                     server.act(urlparse(self.path).path.strip("/"), body)
                 except KinelabError as exc:
-                    code, error = 400, str(exc)
+                    code, error = 400, short(str(exc))
                 reply = server.reply(_int(body.get("since", 0)), error)
-            self._send(code, json.dumps(reply).encode("utf-8"), "application/json")
+            self._send_json(code, reply)
+
+        def _send_json(self, code: int, value: dict[str, Any]) -> None:
+            self._send(code, json.dumps(value).encode("utf-8"), "application/json")
 
         def _send(self, code: int, data: bytes, kind: str) -> None:
             self.send_response(code)
             self.send_header("Content-Type", kind)
             self.send_header("Content-Length", str(len(data)))
             self.send_header("Cache-Control", "no-store")
+            self.send_header("X-Content-Type-Options", "nosniff")
             self.end_headers()
             self.wfile.write(data)
 
@@ -160,7 +262,7 @@ def _handler(server: TeachServer) -> type[BaseHTTPRequestHandler]:
 def _int(text: Any) -> int:
     try:
         return max(0, int(text))
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         return 0
 
 
@@ -177,7 +279,7 @@ def _page(session: TeachSession) -> str:
     config = {"q": session.q.tolist(), "joints": joints, "heading": f"kinelab teach — {robot.name}", "legend": legend}
     text = resources.files(__package__).joinpath("teach.html").read_text(encoding="utf-8")
     return (text.replace("__TITLE__", html.escape(tab_title(robot.name, "teach")))
-            .replace("__CONFIG__", json.dumps(config).replace("</", "<\\/")))
+            .replace("__CONFIG__", json.dumps(config).replace("<", "\\u003c")))  # no tag can end the script
 
 
 def _meshcat_script() -> bytes:

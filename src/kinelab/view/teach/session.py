@@ -17,7 +17,7 @@ from typing import Any, TypeVar
 import numpy as np
 import pinocchio as pin
 
-from kinelab.errors import TargetError
+from kinelab.errors import KinelabError, TargetError
 from kinelab.robot import Robot
 from kinelab.view.teach.recorder import RecordingWindow
 
@@ -53,6 +53,16 @@ class TeachOptions:
     tol_rot: float = 1e-6
     time_budget: float = 0.05
     collisions: Any = None
+
+    def __post_init__(self) -> None:
+        from kinelab.ik import options as opt
+
+        for name in ("tol_pos", "tol_rot", "time_budget"):
+            opt.positive(name, getattr(self, name))
+        if self.collisions is not None:  # "self", an Environment or a Collisions (anything else named)
+            from kinelab.collision.model import as_collisions
+
+            as_collisions(self.collisions)
 
 
 class TeachSession:
@@ -128,9 +138,16 @@ class TeachSession:
     def step_branch(self, step: int = 1) -> None:
         """Go to the target's next (``step`` 1) or previous (−1) branch: every branch in closed form or by the
         1-D search where the arm has one, else those a multistart finds; the first is the one nearest q. With
-        collisions on, only the branches clear of them."""
+        collisions on, only the branches clear of them.
+
+        Raises:
+            KinelabError: a step other than the integers 1 and −1 (a float, a bool, anything else).
+        """
         from kinelab.ik import solve_all
 
+        if isinstance(step, bool) or not isinstance(step, int | np.integer) or step not in (1, -1):
+            raise KinelabError(f"a branch step is the integer 1 (next) or -1 (previous), not {_short(repr(step))}")
+        step = int(step)
         if self.branches is None:
             self.branches = solve_all(self.robot, self.target, q_ref=self.q, seed=0, tol_pos=self.options.tol_pos,
                                       tol_rot=self.options.tol_rot, collisions=self._spec(),
@@ -146,9 +163,15 @@ class TeachSession:
         self._draw()
 
     @_locked
-    def set_collisions(self, on: bool) -> None:
+    def set_collisions(self, on: Any) -> None:
         """Switch the collision check on or off: with it on, no answer that collides is taken, and the contacts at
-        q are listed."""
+        q are listed.
+
+        Raises:
+            KinelabError: ``on`` is not True or False.
+        """
+        if not isinstance(on, bool | np.bool_):
+            raise KinelabError(f"collisions are switched by on: true or false, not {_short(repr(on))}")
         self.collisions_on = bool(on)
         self.branches, self.branch = None, -1
         self.status = "collisions on" if on else "collisions off"
@@ -204,9 +227,9 @@ class TeachSession:
 
     def _velocity_svd(self) -> tuple[np.ndarray, np.ndarray]:
         """(U, s) of J_v, the tool point's linear velocity Jacobian at q in base axes: the ellipsoid's axes and radii
-        [m/rad]."""
+        [m/rad]; three radii whatever the joint count (an arm of fewer than three joints has zeros)."""
         U, s, _ = np.linalg.svd(self.robot.jacobian_local_world_aligned(self.q)[:3])
-        return U, s
+        return U, np.pad(s, (0, 3 - s.size))
 
     def _draw_target_objects(self) -> None:
         import meshcat.geometry as g
@@ -278,6 +301,11 @@ def _pose(oMframe: pin.SE3) -> dict[str, list[float]]:
     q = pin.Quaternion(oMframe.rotation)
     return {"position_m": oMframe.translation.tolist(), "rpy_rad": pin.rpy.matrixToRpy(oMframe.rotation).tolist(),
             "quat_wxyz": [q.w, q.x, q.y, q.z]}
+
+
+def _short(text: str, most: int = 60) -> str:
+    """``text`` cut to ``most`` characters (a value echoed in a message: a 4,000-digit number is not read)."""
+    return text if len(text) <= most else text[: most - 1] + "…"
 
 
 def pose_from_matrix(values: Any) -> pin.SE3:

@@ -54,6 +54,14 @@ async function poll() {
   setTimeout(poll, 500);
 }
 
+// an element holding text only (no markup is ever parsed from a string)
+function element(tag, text = "", className = "") {
+  const e = document.createElement(tag);
+  e.textContent = text;
+  if (className) e.className = className;
+  return e;
+}
+
 // -- joints -------------------------------------------------------------------------------------
 const sliders = [];
 function fmt(x, digits) { return Number(x).toFixed(digits); }
@@ -65,7 +73,8 @@ function buildSliders() {
   cfg.joints.forEach((j, k) => {
     const row = document.createElement("div");
     row.className = "joint";
-    row.innerHTML = `<span>${j.name}</span><span class="value"></span>`;
+    // a robot file's names are text, never markup: every string reaches the page through textContent
+    row.append(element("span", j.name), element("span", "", "value"));
     const s = document.createElement("input");
     Object.assign(s, { type: "range", min: j.lower, max: j.upper, step: (j.upper - j.lower) / 2000, value: cfg.q[k] });
     s.id = `kinelab-joint-${k}`;
@@ -104,8 +113,8 @@ function show(r) {
     ["ellipsoid radii", r.ellipsoid_radii_m_per_rad.map((x) => fmt(x, 3)).join(", ") + " m/rad"],
     ["contacts", r.collisions ? (r.contacts.length ? r.contacts.join("; ") : "none") : "not checked"],
   ];
-  document.getElementById("kinelab-readout").innerHTML =
-    rows.map(([k, v]) => `<tr><td>${k}</td><td>${v}</td></tr>`).join("");
+  document.getElementById("kinelab-readout").replaceChildren(
+    ...rows.map(([k, v]) => { const tr = element("tr"); tr.append(element("td", k), element("td", v)); return tr; }));
   document.getElementById("kinelab-status").textContent = r.status;
   document.getElementById("kinelab-collisions").checked = r.collisions;
 }
