@@ -33,7 +33,9 @@ def test_the_era_passages_reach_every_reachable_sample_and_the_paper_s_frdm_stil
     era = kinelab.load("era")
     for passage in (ep.elbow_passage(era), ep.wrist_passage(era), ep.shoulder_passage(era)):
         reachable = np.array([out_of_reach(era, t.translation) <= 0 for t in passage.targets])
-        res = kinelab.track(era, passage.targets, q0=passage.q0, seed=0)
+        # the elbow passage turns a joint 0.21 rad in a sample at the straight arm (2.3 times its step), which the
+        # default jump_limit (0.2 rad) marks as a jump since #57; here: every reachable sample met, within 0.3 rad
+        res = kinelab.track(era, passage.targets, q0=passage.q0, seed=0, jump_limit=0.3)
         assert (res.reached == reachable).all(), passage.name
     elbow = ep.elbow_passage(era)
     pure = kinelab.track(era, elbow.targets, q0=elbow.q0, finish="none")

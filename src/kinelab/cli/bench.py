@@ -56,6 +56,8 @@ def add(sub: Any) -> None:
     s.add_argument("--startup", action="store_true",
                    help="also how long --help, robots, fk, info and ik take from the shell against python -c "
                         "\"import pinocchio\" (best of --repeats + 4 rounds, interleaved)")
+    s.add_argument("--budgets", action="store_true",
+                   help="also measure how every entry point with a budget keeps 5 ms (p50, p99, max per robot)")
     s.add_argument("--out", help="write bench.json, bench.md and bench.png here")
     s.add_argument("--json", action="store_true", help="print the results as JSON instead of tables")
     s.set_defaults(func=run)
@@ -81,6 +83,10 @@ def run(args: argparse.Namespace) -> int:
         from kinelab.report.bench import loops
 
         result["loops"] = loops.run(args.robots, seed=args.seed, repeats=args.repeats, progress=not args.json)
+    if args.budgets:
+        from kinelab.report.bench import loops
+
+        result["budgets"] = loops.budgets_run(args.robots, seed=args.seed, n=args.n, progress=not args.json)
     if args.versus:
         from kinelab.report.bench import versus
 
@@ -150,6 +156,11 @@ def _print_tables(result: dict[str, Any]) -> None:
         from kinelab.report.bench import loops
 
         print(loops.markdown(result["loops"]["throughput"], result["loops"]["tracking"], result["loops"]["budgets"]))
+    if "budgets" in result:
+        from kinelab.report.bench import loops
+
+        print()
+        print(loops.budget_markdown(result["budgets"]))
     if "versus" in result:
         from kinelab.report.bench import versus
 

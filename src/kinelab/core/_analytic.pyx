@@ -59,7 +59,9 @@ cdef enum:
     SPHERICAL_6R = 2
     MEETING_6R = 3
     TWO_THREE_6R = 4
+    NOT_STARTED = 2  # a batch's near[b]: the pose was not started before the deadline
 
+ROW_NOT_STARTED = NOT_STARTED  # for Python: a batch row left when the deadline passed (its near[b])
 cdef double TANGENT_SLACK = 1e-9  # |cos| above 1 by this much is a double root met to rounding, beyond it no root
 cdef double FLAT = 1e-12  # a length below this is treated as zero
 cdef double SINGULAR_WRIST = 1e-6  # [rad] q5's two roots closer than twice this are the singular wrist's double root
@@ -806,12 +808,14 @@ cdef class ClosedForm:
 
     def solve_batch(self, const double[:, :, ::1] H, double[:, :, ::1] q, double[:, :, ::1] errors,
                     long long[:, ::1] merged, unsigned char[:, ::1] continuum, long long[::1] count,
-                    unsigned char[::1] near, int threads):
+                    unsigned char[::1] near, int threads, double deadline=INFINITY):
         """:meth:`solve` for every pose of the (B, 4, 4) stack H (proper poses, checked by the caller; copies
         nearest 0) on ``threads`` OpenMP threads: per pose b the branches the judge confirms in
         q[b, :count[b]] [rad], errors[b, :count[b]] ([m, rad] each), merged and continuum (a bool array's
         ``view(np.uint8)``); rows after count[b] are left as given. near[b] = 1 (and count[b] = 0) where a root
-        fell short of the tolerances but near them: the caller solves that pose by the general route."""
+        fell short of the tolerances but near them: the caller solves that pose by the general route; near[b] =
+        NOT_STARTED (count 0) for a pose not started before ``deadline`` (the monotonic clock of
+        ``time.perf_counter``, [s])."""
         cdef Py_ssize_t B = H.shape[0], b
         cdef int n = self.n
         if H.shape[1] != 4 or H.shape[2] != 4 or q.shape[0] != B or q.shape[1] < MAX_ROWS or q.shape[2] != n \
@@ -821,18 +825,23 @@ cdef class ClosedForm:
             raise ValueError("ClosedForm.solve_batch: H (B, 4, 4), q (B, MAX_ROWS, n), errors (B, MAX_ROWS, 2), "
                              "merged and continuum (B, MAX_ROWS), count and near (B,)")
         with nogil:
-            for b in prange(B, num_threads=max(1, threads), schedule="dynamic", chunksize=32):
-                count[b] = self._pose_row(&H[b, 0, 0], NO_AIM, &q[b, 0, 0], &errors[b, 0, 0], &merged[b, 0],
-                                          &continuum[b, 0], &near[b])
+            for b in prange(B, num_threads=max(1, threads), schedule="dynamic", chunksize=8):
+                if now() > deadline:
+                    count[b], near[b] = 0, NOT_STARTED
+                else:
+                    count[b] = self._pose_row(&H[b, 0, 0], NO_AIM, &q[b, 0, 0], &errors[b, 0, 0], &merged[b, 0],
+                                              &continuum[b, 0], &near[b])
 
     def nearest_batch(self, const double[:, :, ::1] H, const double[:, ::1] refs, double[:, ::1] q,
-                      double[:, ::1] errors, long long[::1] count, unsigned char[::1] near, int threads):
+                      double[:, ::1] errors, long long[::1] count, unsigned char[::1] near, int threads,
+                      double deadline=INFINITY):
         """:meth:`solve` and the pick of ``NearestBranch`` for every pose of the (B, 4, 4) stack H (proper poses,
         checked by the caller) on ``threads`` OpenMP threads: per pose b, with ``refs`` (B, n) [rad], the branch
         nearest refs[b] (each angle's copy nearest it; the first of the nearest by the largest joint difference
         modulo 2π), with ``refs`` of no rows the first branch (copies nearest 0), in q[b] [rad] and its errors in
         errors[b] ([m, rad]); count[b] the branches the judge confirms (0: none, q[b] left as given); near[b] = 1
-        (count 0) where a root fell short of the tolerances but near them: the caller's general route."""
+        (count 0) where a root fell short of the tolerances but near them: the caller's general route; near[b] =
+        NOT_STARTED (count 0) for a pose not started before ``deadline`` (``time.perf_counter``'s clock, [s])."""
         cdef Py_ssize_t B = H.shape[0], b
         cdef bint use_ref = refs.shape[0] > 0
         if H.shape[1] != 4 or H.shape[2] != 4 or q.shape[0] != B or q.shape[1] != self.n or errors.shape[0] != B \
@@ -841,9 +850,12 @@ cdef class ClosedForm:
             raise ValueError("ClosedForm.nearest_batch: H (B, 4, 4), refs (B, n) or (0, n), q (B, n), errors (B, 2), "
                              "count and near (B,)")
         with nogil:
-            for b in prange(B, num_threads=max(1, threads), schedule="dynamic", chunksize=32):
-                count[b] = self._nearest_row(&H[b, 0, 0], &refs[b, 0] if use_ref else NO_AIM, use_ref, &q[b, 0],
-                                             &errors[b, 0], &near[b])
+            for b in prange(B, num_threads=max(1, threads), schedule="dynamic", chunksize=8):
+                if now() > deadline:
+                    count[b], near[b] = 0, NOT_STARTED
+                else:
+                    count[b] = self._nearest_row(&H[b, 0, 0], &refs[b, 0] if use_ref else NO_AIM, use_ref, &q[b, 0],
+                                                 &errors[b, 0], &near[b])
 
     cdef int _nearest_row(self, const double* T, const double* aim, bint use_ref, double* q, double* errors,
                           unsigned char* near) noexcept nogil:

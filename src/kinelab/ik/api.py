@@ -14,7 +14,7 @@ from __future__ import annotations
 import time
 from collections.abc import Sequence
 from dataclasses import replace
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 import pinocchio as pin
@@ -258,7 +258,7 @@ def _closed_form_batch(robot: Robot, targets: Any, q0: Any, collisions: Any, opt
 
 
 def solve_all_batch(robot: Robot, targets: Any, *positional: Any, tol_pos: float = 1e-6,
-                    tol_rot: float = 1e-6) -> BranchBatch:
+                    tol_rot: float = 1e-6, time_budget: float | None = None) -> BranchBatch:
     """Every branch of each target, arrays in, arrays out: in closed form, by the 1-D search or by the general 6R
     elimination, compiled, on all cores.
 
@@ -273,6 +273,8 @@ def solve_all_batch(robot: Robot, targets: Any, *positional: Any, tol_pos: float
         positional: nothing: the tolerances are keyword-only.
         tol_pos: position tolerance [m].
         tol_rot: rotation tolerance [rad].
+        time_budget: wall-clock budget [s] of the whole batch (None, the default: none); the targets not started
+            when it runs out get no branch and are marked in the result's ``late``.
 
     Returns:
         The :class:`~kinelab.ik.analytic.branches.BranchBatch`: ``q`` (B, 16, n) [rad] with the first ``count[b]``
@@ -288,11 +290,12 @@ def solve_all_batch(robot: Robot, targets: Any, *positional: Any, tol_pos: float
     check_entry(robot, "solve_all_batch", positional)
     from kinelab.ik.analytic.branches import all_branches_batch
 
-    return all_branches_batch(robot, targets, tol_pos, tol_rot)
+    return all_branches_batch(robot, targets, tol_pos, tol_rot, time_budget)
 
 
 def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto", seed: int | None = None,
-              tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float = 0.05, options: Any = None,
+              tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float | str | None = "auto",
+              options: Any = None,
               task: str = "pose", axis: str = "z", q_ref: Any = None, max_solutions: int | None = None,
               stop_below: float | None = UNSEEN, collisions: Any = None, drop_colliding: bool = False,
               redundancy: int | dict[str, float] | SEW | None = None, **solver_options: Any) -> Branches:
@@ -314,8 +317,10 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
         task: the components to meet, as :func:`solve`.
         axis: the tool axis of task "axis".
         solver_options: the solver's option fields as keyword arguments.
-        time_budget: wall-clock budget [s] of the multistart search (default 0.05 s: every branch of a
-            Stanford target in 197 of 200 cases); the closed form takes microseconds and no budget.
+        time_budget: wall-clock budget [s] of the search, or None (none). "auto" (the default): 0.05 s for the
+            multistart (every branch of a Stanford target in 197 of 200 cases), 5 s for a 7R arm's ``redundancy=``
+            searches (the values of the held joint, the SEW angle's 1-D search), none for the closed form (it takes
+            microseconds). A search stopped by its budget says so (``time_budget``, or ``complete_reason``).
         q_ref: sort the solutions by distance to this configuration (rad or m; revolute joints modulo 2π).
         max_solutions: stop once this many distinct solutions are found (None: no such limit).
         stop_below: the stopping rule (:func:`kinelab.ik.branches.unseen`, a Good–Turing estimate from how many
@@ -337,20 +342,30 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
         TargetError, ConfigurationError, OptionError: bad input, named.
     """
     check_entry(robot, "solve_all", positional)
+    if isinstance(time_budget, str):
+        if time_budget != AUTO:
+            raise OptionError("time_budget", time_budget, "a finite number > 0 [s], None (none) or 'auto'")
+        time_budget = AUTO_BUDGET if redundancy is None else AUTO_REDUNDANT_BUDGET
+    budget = cast(float | None, time_budget)
     if options is None and not solver_options and _usual_all(q_ref, max_solutions, collisions, redundancy, task,
                                                              axis):
-        found = usual_closed_form(robot, target, seed, (solver, tol_pos, tol_rot, time_budget, stop_below))
+        found = usual_closed_form(robot, target, seed, (solver, tol_pos, tol_rot, budget, stop_below))
         if found is not None:
             return found
     kind, given = capabilities(solver), options is not None or bool(solver_options)
     if kind.closed_form and given:  # refusing says so rather than ignoring them
         refuse_options(options or solver_options)
-    req = make_request(kind.request_solver(solver), seed, tol_pos, tol_rot, time_budget, 0, "refuse", options, task,
+    req = make_request(kind.request_solver(solver), seed, tol_pos, tol_rot, budget, 0, "refuse", options, task,
                        axis, solver_options)
     check = collision_check(robot, collisions)
     found = find_all(robot, target, req, q_ref=q_ref, max_solutions=max_solutions, stop_below=stop_below,
                      method=route_of(kind, given), redundancy=redundancy)
     return clear_of(found, check, drop=bool(drop_colliding))
+
+
+AUTO = "auto"  # solve_all's default time_budget: the route's own (below)
+AUTO_BUDGET = 0.05  # [s] solve_all's multistart when no budget is named
+AUTO_REDUNDANT_BUDGET = 5.0  # [s] a 7R arm's redundancy= searches when no budget is named (≈ 0.2-0.9 s a pose)
 
 
 def _usual_all(q_ref: Any, max_solutions: Any, collisions: Any, redundancy: Any, task: Any, axis: Any) -> bool:

@@ -21,6 +21,8 @@ class Status(str, Enum):
     TIME_BUDGET = "time_budget"
     OUTSIDE_LIMITS = "outside_limits"  # the pose is met, but only with a joint outside its limits
     COLLISION = "collision"  # the pose is met, but every answer found collides (``collisions=``)
+    NOT_FOUND = "not_found"  # a search found no answer, and none is proved not to exist
+    JUMP = "jump"  # a tracked sample met its pose, but by a joint step larger than the path's jump limit
 
     def __str__(self) -> str:
         return str(self.value)
@@ -529,6 +531,11 @@ class TrackResult:
     def success(self) -> np.ndarray:
         """The same as :attr:`reached` (the name :class:`~kinelab.ik.result.IKResult` uses)."""
         return self.reached
+
+    @property
+    def path_success(self) -> bool:
+        """True when every sample is reached: met within the limits and not by a jump."""
+        return bool(self.reached.all())
 
     def summary(self) -> dict[str, Any]:
         """Samples, reached, the worst errors and step, monitor counts, the median time per sample."""

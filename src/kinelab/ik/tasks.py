@@ -58,6 +58,16 @@ class Task:
         return self.name != "position"
 
     @property
+    def dimension(self) -> int:
+        """How many components of the tool's pose the task constrains (6, 3 or 5)."""
+        return COMPONENTS[self.name]
+
+    @property
+    def rows(self) -> list[int]:
+        """The rows of a [linear; angular] Jacobian the task constrains (task "axis": all six, a superset)."""
+        return [0, 1, 2] if self.name == "position" else [3, 4, 5] if self.name == "orientation" else list(range(6))
+
+    @property
     def constrained(self) -> str:
         """What the task constrains, in words (for results and messages)."""
         return {"pose": "position and rotation", "position": "position", "orientation": "rotation",

@@ -154,6 +154,8 @@ def _write_bench_files(result: dict[str, Any], folder: Path) -> None:
     if "loops" in result:
         sections.append(loops.markdown(result["loops"]["throughput"], result["loops"]["tracking"],
                                        result["loops"]["budgets"]))
+    if "budgets" in result:
+        sections.append(loops.budget_markdown(result["budgets"]))
     if "versus" in result:
         sections.append(versus.markdown(result["versus"]))
     write_output(folder / "bench.md", "\n\n".join(sections) + "\n")

@@ -20,7 +20,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.core import threads
-from kinelab.core._analytic import ClosedForm
+from kinelab.core._analytic import ROW_NOT_STARTED, ClosedForm
 from kinelab.core._joints import turn_distances
 from kinelab.errors import ConfigurationError, OptionError
 from kinelab.geometry import pose_errors, stack_homogeneous, wrap_to_pi
@@ -140,8 +140,8 @@ def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | No
     if q_ref is not None:
         rows = rows.taken(sorted(range(len(rows.q)), key=lambda k: distance(robot, rows.q[k], q_ref)))
     return branch_results(robot, rows, req, arm.mode, time.perf_counter() - t0, max_solutions, _method(arm),
-                          beyond_reach(robot, target.translation)
-                          or f"no branch within the joint limits ({arm.method})", uncertified, target.homogeneous)
+                          f"no branch within the joint limits ({arm.method})", uncertified, target.homogeneous,
+                          beyond="" if len(rows.q) else beyond_reach(robot, target.translation))
 
 
 def _inside(robot: Robot, q: np.ndarray, found: np.ndarray, free: np.ndarray,
@@ -240,21 +240,23 @@ def _judged_each(robot: Robot, q: np.ndarray, found: np.ndarray, free: np.ndarra
 
 
 def branch_results(robot: Robot, rows: Rows, req: Request, mode: str, elapsed: float, max_solutions: int | None,
-                   method: str, empty: str, uncertified: str | None = None, H: np.ndarray | None = None) -> Branches:
+                   method: str, empty: str, uncertified: str | None = None, H: np.ndarray | None = None, *,
+                   beyond: str = "", late: str = "") -> Branches:
     """The closed form's judged rows as :class:`Branches`, the first ``max_solutions``: arrays, and an IKResult per
-    row built when the set is first read; ``diagnostics.branches`` counts them all. With no row the set's status is
-    ``unreachable`` for the reason ``empty``: the closed form and the search compute every branch, so finding none
-    proves it (the general 6R elimination: when its set is certified). ``method``: "closed form", "search",
-    "elimination" or "sweep"; ``uncertified``: the elimination's reason its set is not certified ("" when it is);
-    ``H``: the pose, for the set's certificate when ``uncertified`` is None (computed when the set's completeness
-    is first read)."""
+    row built when the set is first read; ``diagnostics.branches`` counts them all. With no row the set says why by
+    what was proved: ``unreachable`` for ``beyond`` (the reach bound's words) or, when the set is proved complete
+    (the closed form, the search; the general 6R elimination when certified), for the reason ``empty``;
+    ``time_budget`` when ``late`` says the budget ran out first; else ``not_found``. ``method``: "closed form",
+    "search", "elimination" or "sweep"; ``uncertified``: why the set is not certified ("" when it is); ``H``: the
+    pose, for the set's certificate when ``uncertified`` is None (computed when the set's completeness is first
+    read)."""
     total = len(rows.q)
+    if late:
+        uncertified = f"the time budget ran out ({late})"
     kept = rows if max_solutions is None or max_solutions >= total else rows.taken(slice(max_solutions))
     unseen = 0.0 if method == "closed form" else None
     make = partial(_filled, _constant_fields(robot, req, mode), kept, wall_time=elapsed, branches=total, unseen=unseen)
-    proved = uncertified in (None, "")
-    status = None if total else Status.UNREACHABLE if proved else Status.TIME_BUDGET
-    message = "" if total else empty if proved else f"no branch found, and the set is not certified: {uncertified}"
+    status, message = _empty_set(total, beyond, late, uncertified, empty)
     made = Branches.from_arrays(kept.q, kept.position_error, kept.rotation_error, make, status, message, method,
                                 unseen)
     if uncertified is not None:
@@ -262,6 +264,19 @@ def branch_results(robot: Robot, rows: Rows, req: Request, mode: str, elapsed: f
     if H is not None:
         return made.certified_by(partial(certificate_of, robot, method, H, rows.q, rows.merged, rows.continuum))
     return made
+
+
+def _empty_set(total: int, beyond: str, late: str, uncertified: str | None, empty: str) -> tuple[Status | None, str]:
+    """(status, message) of a set of ``total`` branches (None, "" when it has one): see :func:`branch_results`."""
+    if total:
+        return None, ""
+    if beyond:
+        return Status.UNREACHABLE, beyond
+    if late:
+        return Status.TIME_BUDGET, f"no branch found before the time budget ran out ({late})"
+    if uncertified in (None, ""):
+        return Status.UNREACHABLE, empty
+    return Status.NOT_FOUND, f"no branch found, and the set is not certified: {uncertified}"
 
 
 def certificate_of(robot: Robot, method: str, H: np.ndarray, q: np.ndarray, merged: np.ndarray,
@@ -406,6 +421,7 @@ class BranchBatch:
         judge: whose FK judged the branches.
         uncertified: the elimination's reason per pose that its set is not certified ("" where it is); None for
             the other methods.
+        late: (B,) poses left unsolved when the time budget ran out (count 0, NaN); None: no budget was given.
     """
 
     q: np.ndarray
@@ -417,9 +433,11 @@ class BranchBatch:
     method: str = "closed form"
     judge: str = "Pinocchio FK"
     uncertified: list[str] | None = None
+    late: np.ndarray | None = None
 
 
-def all_branches_batch(robot: Robot, targets: Any, tol_pos: float = 1e-6, tol_rot: float = 1e-6) -> BranchBatch:
+def all_branches_batch(robot: Robot, targets: Any, tol_pos: float = 1e-6, tol_rot: float = 1e-6,
+                       time_budget: float | None = None) -> BranchBatch:
     """Every branch of each pose in ``targets`` (what :func:`analytic_all` gives each, copies nearest 0), on all
     cores: where the robot's compiled FK is certified the closed form and the judge run in one compiled pass; a pose
     with a root short of the tolerances but near them is solved by :func:`analytic_all` (which finishes it).
@@ -429,40 +447,51 @@ def all_branches_batch(robot: Robot, targets: Any, tol_pos: float = 1e-6, tol_ro
         targets: a sequence of ``pin.SE3`` or a (B, 4, 4) array of oMtarget, base frame.
         tol_pos: position tolerance [m].
         tol_rot: rotation tolerance [rad].
+        time_budget: wall-clock budget [s] of the whole batch (None: none); the poses not started when it runs out
+            are left with no branch and marked in ``late``.
 
     Returns:
         The :class:`BranchBatch`.
 
     Raises:
         TargetError: a bad target, its index named.
-        OptionError: the chain is in no analytic class, or a bad tolerance.
+        OptionError: the chain is in no analytic class, or a bad tolerance or budget.
     """
-    req = make_request("frdm", tol_pos=tol_pos, tol_rot=tol_rot)
+    t0 = time.perf_counter()
+    req = make_request("frdm", tol_pos=tol_pos, tol_rot=tol_rot, time_budget=time_budget)
     arm = arm_of(robot, req)
     H = np.ascontiguousarray(stack_homogeneous(*as_target_arrays(targets)))
+    deadline = np.inf if time_budget is None else t0 + time_budget - verdict_reserve(time_budget)
     form = prepared_form(robot, req)
     if form is None:
-        return _pinocchio_batch(robot, arm, H, req)
+        return _pinocchio_batch(robot, arm, H, req, deadline)
     B, n = H.shape[0], arm.n
     q, errors = np.full((B, MAX_ROWS, n), np.nan), np.full((B, MAX_ROWS, 2), np.nan)
     found, free = np.zeros((B, MAX_ROWS), dtype=np.int64), np.zeros((B, MAX_ROWS), dtype=np.bool_)
     count, near = np.zeros(B, dtype=np.int64), np.zeros(B, dtype=np.uint8)
-    form.solve_batch(H, q, errors, found, free.view(np.uint8), count, near, threads.count())
+    form.solve_batch(H, q, errors, found, free.view(np.uint8), count, near, threads.count(), deadline)
+    late = near == ROW_NOT_STARTED
     if arm.kind == GENERAL_6R:  # no root, or roots merged: the root-by-root route says why, or splits them
         near |= (count == 0) | ((found > 1) & ~free).any(axis=1)
-    for b in np.flatnonzero(near):
+    for b in np.flatnonzero(near & ~late):
+        if time.perf_counter() > deadline:
+            late[b] = True
+            continue
         one = analytic_all(robot, pin.SE3(H[b]), req)
         k = count[b] = len(one)
         q[b, :k], errors[b, :k, 0], errors[b, :k, 1] = one.q, one.position_error, one.rotation_error
         found[b, :k] = [int(r.diagnostics.found or 0) for r in one]
         free[b, :k] = [r.message == CONTINUUM for r in one]
-    return BranchBatch(q, count, found, free, errors[..., 0], errors[..., 1], _method(arm), robot.fk_certificate.judge)
+    return BranchBatch(q, count, found, free, errors[..., 0], errors[..., 1], _method(arm), robot.fk_certificate.judge,
+                       late=None if time_budget is None else late)
 
 
-def _pinocchio_batch(robot: Robot, arm: ArmClass, H: np.ndarray, req: Request) -> BranchBatch:
+def _pinocchio_batch(robot: Robot, arm: ArmClass, H: np.ndarray, req: Request, deadline: float) -> BranchBatch:
     """:func:`all_branches_batch` where Pinocchio's FK judges: the closed form in threads, then every branch judged
-    in one FK batch; a root that falls short is dropped."""
+    in one FK batch; a root that falls short is dropped. Pose by pose (the elimination, Pieper's decoupling) the
+    poses not started before ``deadline`` are left."""
     B, n = H.shape[0], arm.n
+    late = np.zeros(B, dtype=np.bool_)
     out = np.full((B, MAX_ROWS, n), np.nan)
     found, free = np.zeros((B, MAX_ROWS), dtype=np.int64), np.zeros((B, MAX_ROWS), dtype=np.bool_)
     count = np.zeros(B, dtype=np.int64)
@@ -470,12 +499,19 @@ def _pinocchio_batch(robot: Robot, arm: ArmClass, H: np.ndarray, req: Request) -
     if arm.kind == GENERAL_6R:  # no certified compiled FK: the elimination pose by pose, Pinocchio judging
         reasons = []
         for b in range(B):
+            if time.perf_counter() > deadline:
+                late[b:] = True
+                reasons += [""] * (B - b)
+                break
             q, merged, loose, why = roots_within(arm, H[b], robot.lower, robot.upper, None, limit_slack(req.tol_rot))
             k = count[b] = len(q)
             out[b, :k], found[b, :k], free[b, :k] = q, merged, loose
             reasons.append(why)
     elif arm.kind == PIEPER_6R:  # not compiled: pose by pose
         for b in range(B):
+            if time.perf_counter() > deadline:
+                late[b:] = True
+                break
             q, merged, loose = arm_roots(arm, H[b], robot.lower, robot.upper, None, limit_slack(req.tol_rot))
             k = count[b] = len(q)
             out[b, :k], found[b, :k], free[b, :k] = q, merged, loose
@@ -496,7 +532,7 @@ def _pinocchio_batch(robot: Robot, arm: ArmClass, H: np.ndarray, req: Request) -
         reasons = [why or ("" if kept[b] == count[b] else "a root the judge does not confirm")
                    for b, why in enumerate(reasons)]
     return BranchBatch(q, kept, f, loose, errors[..., 0], errors[..., 1], _method(arm), robot.fk_certificate.judge,
-                       reasons)
+                       reasons, None if req.time_budget is None else late)
 
 
 def _constant_fields(robot: Robot, req: Request, mode: str) -> dict[str, Any]:
@@ -686,7 +722,7 @@ def nearest_batch(robot: Robot, targets: Any, q0: Any, req: Request, model: Coll
     t0 = time.perf_counter()
     H = stack_homogeneous(*as_target_arrays(targets))
     starts = batch_starts(robot, q0, len(H))
-    form = prepared_form(robot, req) if model is None and req.time_budget is None else None
+    form = prepared_form(robot, req) if model is None else None
     if form is not None:
         return _compiled_nearest(robot, form, np.ascontiguousarray(H), starts, req, t0)
     return _nearest_rows(robot, H, starts, req, model, t0)
@@ -707,18 +743,25 @@ def batch_starts(robot: Robot, q0: Any, count: int) -> np.ndarray | None:
 
 def _compiled_nearest(robot: Robot, form: ClosedForm, H: np.ndarray, starts: np.ndarray | None, req: Request,
                       t0: float) -> BatchIKResult:
-    """:func:`nearest_batch` in one compiled call on all cores (no collision model, no budget): each row the branch
+    """:func:`nearest_batch` in one compiled call on all cores (no collision model): each row the branch
     ``NearestBranch`` gives its pose alone; a row the compiled form leaves (no branch, or a root to finish) by
-    :func:`analytic_one`."""
+    :func:`analytic_one` while the budget lasts; rows not started when it runs out: NaN, status ``time_budget``."""
     B, n = len(H), robot.n
+    deadline = np.inf if req.time_budget is None else t0 + req.time_budget - verdict_reserve(req.time_budget)
     q, errors = np.full((B, n), np.nan), np.full((B, 2), np.nan)
     count, near = np.zeros(B, dtype=np.int64), np.zeros(B, dtype=np.uint8)
     refs = np.empty((0, n)) if starts is None else np.ascontiguousarray(starts, dtype=float)
-    form.nearest_batch(H, refs, q, errors, count, near, threads.count())
+    form.nearest_batch(H, refs, q, errors, count, near, threads.count(), deadline)
     success = count > 0
     code = np.where(success, Status.CONVERGED.code, Status.UNREACHABLE.code).astype(np.int8)
+    code[near == ROW_NOT_STARTED] = Status.TIME_BUDGET.code
     for b in np.flatnonzero(~success):
-        row = analytic_one(robot, pin.SE3(H[b]), req, None if starts is None else starts[b], None)
+        left = deadline - time.perf_counter()
+        if left <= 0:
+            code[b] = Status.TIME_BUDGET.code
+            continue
+        row = analytic_one(robot, pin.SE3(H[b]), req if req.time_budget is None else replace(req, time_budget=left),
+                           None if starts is None else starts[b], None)
         q[b], success[b], code[b] = row.q, row.success, row.status.code
         errors[b] = row.position_error, row.rotation_error
     none = np.zeros(B, dtype=int)

@@ -23,14 +23,15 @@ from typing import Any
 import numpy as np
 
 from kinelab.core import threads
+from kinelab.core._analytic import ROW_NOT_STARTED
 from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.analytic.branches import arm_of, batch_starts, prepared_form
 from kinelab.ik.analytic.classify import classify, general_class
 from kinelab.ik.analytic.redundancy import SweptArm, has_swept_form, samples, swept_arm
-from kinelab.ik.batch import BatchIKResult, judged_rows, run_batch
+from kinelab.ik.batch import BatchIKResult, judged_rows, prepare, run_batch
 from kinelab.ik.frdm.batch import Rows
-from kinelab.ik.request import Request, make_request
+from kinelab.ik.request import Request, make_request, verdict_reserve
 from kinelab.ik.result import Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target_arrays
 from kinelab.robot import Robot
@@ -117,9 +118,11 @@ def sub_targets(sw: SweptArm, H: np.ndarray, theta: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(back @ H if sw.joint == 0 else H @ back)
 
 
-def held_rows(robot: Robot, H: np.ndarray, starts: np.ndarray | None, req: Request) -> tuple[np.ndarray, np.ndarray]:
+def held_rows(robot: Robot, H: np.ndarray, starts: np.ndarray | None, req: Request,
+              deadline: float = np.inf) -> tuple[np.ndarray, np.ndarray, bool]:
     """Each row's answer (B, 7) [rad] from the six's closed form at the first value of :func:`held_values` with a
-    branch within the limits (NaN where none has one), and how many values each row tried.
+    branch within the limits (NaN where none has one), how many values each row tried, and whether ``deadline``
+    (``time.perf_counter``'s clock [s]) passed with rows left untried.
 
     Raises:
         OptionError: the six's compiled FK is not certified (no compiled closed form to call).
@@ -138,49 +141,57 @@ def held_rows(robot: Robot, H: np.ndarray, starts: np.ndarray | None, req: Reque
         q6, errors = np.full((len(left), 6), np.nan), np.full((len(left), 2), np.nan)
         count, near = np.zeros(len(left), dtype=np.int64), np.zeros(len(left), dtype=np.uint8)
         refs = np.empty((0, 6)) if starts is None else np.ascontiguousarray(starts[left][:, keep])
-        form.nearest_batch(sub_targets(sw, H[left], theta), refs, q6, errors, count, near, threads.count())
-        tried[left] += 1
+        form.nearest_batch(sub_targets(sw, H[left], theta), refs, q6, errors, count, near, threads.count(), deadline)
+        tried[left[near != ROW_NOT_STARTED]] += 1
         found = count > 0
         q[left[found]] = np.insert(q6[found], sw.joint, theta[found], axis=1)
         left = left[~found]
         if not left.size:
             break
-    return q, tried
+        if time.perf_counter() > deadline:
+            return q, tried, True
+    return q, tried, False
 
 
 def nearest_held(robot: Robot, targets: Any, q0: Any, req: Request) -> BatchIKResult:
     """Solver "analytic" for every target of a 7R arm (see the module's docstring): q0 None, one start for every
-    row, or (B, 7) starts [rad]; the request's budget, when it has one, bounds the FRDM rows.
+    row, or (B, 7) starts [rad]; the request's budget, when it has one, bounds the whole batch (rows left when it
+    runs out: NaN, status ``time_budget``).
 
     Raises:
         TargetError, ConfigurationError: a bad target or start, its index named.
         OptionError: the task is not "pose", or the six held have no certified compiled FK.
     """
+    prepare(robot, req)  # FRDM's model for the rows no held value solves: built once, before the clock starts
     t0 = time.perf_counter()
     points, rotations = as_target_arrays(targets)
     H = stack_homogeneous(points, rotations)
     arm_of(held_robot(robot), req)  # the task is "pose" (named otherwise)
     starts = batch_starts(robot, q0, len(H))
-    q, tried = held_rows(robot, H, starts, req)
+    deadline = np.inf if req.time_budget is None else t0 + req.time_budget - verdict_reserve(req.time_budget)
+    q, tried, late = held_rows(robot, H, starts, req, deadline)
     held = ~np.isnan(q[:, 0])
     # the rows no held value solves are left to FRDM below: judged here as not yet run
-    rows = Rows(q, np.where(held, Status.CONVERGED.code, Status.TIME_BUDGET.code).astype(np.int8), tried - 1,
-                np.zeros(len(H), dtype=np.int64))
+    rows = Rows(q, np.where(held, Status.CONVERGED.code, Status.TIME_BUDGET.code).astype(np.int8),
+                np.maximum(tried - 1, 0), np.zeros(len(H), dtype=np.int64))
     mode = f"analytic ({robot.joints[swept_arm(robot).joint].name} held at the start's value, else at one of " \
            f"{SAMPLES} samples; the other six in closed form)"
     res = judged_rows(robot, rows, points, rotations, req, 0, t0, mode)
     res.solver = "analytic"
     rest = np.flatnonzero(~held)
-    if rest.size:
-        _by_frdm(robot, res, H, starts, rest, req, t0)
+    if rest.size and not late and time.perf_counter() < deadline:
+        _by_frdm(robot, res, H, starts, rest, req, deadline)
+    elif rest.size:
+        res.mode += f"; {rest.size} of {len(H)} rows left when the budget ran out"
     res.wall_time = time.perf_counter() - t0
     return res
 
 
 def _by_frdm(robot: Robot, res: BatchIKResult, H: np.ndarray, starts: np.ndarray | None, rest: np.ndarray,
-             req: Request, t0: float) -> None:
-    """The rows no held value solves, by FRDM's batch from their starts, written into ``res``."""
-    left = None if req.time_budget is None else max(req.time_budget - (time.perf_counter() - t0), 1e-4)
+             req: Request, deadline: float) -> None:
+    """The rows no held value solves, by FRDM's batch from their starts within what is left before ``deadline``,
+    written into ``res``."""
+    left = None if req.time_budget is None else max(deadline - time.perf_counter(), 1e-5)
     frdm = run_batch(robot, H[rest], None if starts is None else starts[rest], replace(req, time_budget=left))
     for name in ("q", "success", "status_code", "position_error", "rotation_error", "iterations", "restarts"):
         getattr(res, name)[rest] = getattr(frdm, name)

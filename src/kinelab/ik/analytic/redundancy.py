@@ -298,16 +298,21 @@ def redundant_all(robot: Robot, target: pin.SE3, req: Request, redundancy: objec
     if req.task.name != "pose":
         raise OptionError("task", req.task_label, "'pose' with redundancy= (other tasks: solver='frdm')")
     values, how, joint = held_values(robot, redundancy)
-    answers = []
-    for theta in values:
+    deadline = np.inf if req.time_budget is None else t0 + req.time_budget
+    answers: list[Answer] = []
+    late = ""
+    beyond = beyond_reach(robot, target.translation)
+    for k, theta in enumerate(values if not beyond else ()):
+        if time.perf_counter() > deadline:
+            late = f"after {k} of {len(values)} values of joint {joint + 1}"
+            break
         answers += at_value(robot, target, req, float(theta), q_ref, joint)
     if q_ref is not None:
         answers.sort(key=lambda a: distance(robot, a[0], q_ref))
     arm = swept_arm(robot).arm if _is_swept(robot, joint) else arm_holding(robot, joint, float(values[0]))
     mode = f"analytic ({_arm_words(arm)}; joint {joint + 1} {how})"
     return branch_results(robot, Rows.of(answers, robot.n), req, mode, time.perf_counter() - t0, max_solutions, "sweep",
-                          beyond_reach(robot, target.translation)
-                          or f"no branch within the joint limits with joint {joint + 1} {how}")
+                          f"no branch within the joint limits with joint {joint + 1} {how}", beyond=beyond, late=late)
 
 
 def _arm_words(arm: ArmClass | str) -> str:

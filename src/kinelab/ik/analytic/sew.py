@@ -66,7 +66,7 @@ class SEW:
     """The stereographic SEW angle as ``redundancy=`` of :func:`kinelab.solve_all` for a 7R arm.
 
     Attributes:
-        angle: ψ₀ [rad], the elbow's turn about the shoulder–wrist line.
+        angle: ψ₀ [rad], the elbow's turn about the shoulder–wrist line (kept wrapped into (−π, π]).
         singular: e_t, the wrist direction (from the shoulder, base frame) where the angle is undefined; default
             straight down.
         reference: e_r, the reference direction (base frame); its part perpendicular to ``singular`` is used.
@@ -89,6 +89,7 @@ class SEW:
         a = self.angle
         if isinstance(a, bool) or not isinstance(a, int | float | np.number) or not math.isfinite(float(a)):
             raise OptionError("SEW.angle", a, "a finite angle [rad]")
+        object.__setattr__(self, "angle", wrap_angle(float(a)))  # the same elbow plane: ψ kept in (−π, π]
         s = self.samples
         if isinstance(s, bool) or not isinstance(s, int | np.integer) or not 8 <= s <= 4096:
             raise OptionError("SEW.samples", s, "an integer in [8, 4096]")
@@ -297,13 +298,14 @@ def _refined(A: np.ndarray, gA: np.ndarray, B: np.ndarray, gB: np.ndarray, width
     return any(d[a, b] < MATCH and _crossing(float(gA[a]), float(gB[b])) for a, b in matched)
 
 
-def sampled(robot: Robot, arm: Arm7, sew: SEW, H: np.ndarray,
-            sw: SweptArm) -> tuple[list[np.ndarray], list[np.ndarray], bool]:
+def sampled(robot: Robot, arm: Arm7, sew: SEW, H: np.ndarray, sw: SweptArm,
+            deadline: float = math.inf) -> tuple[list[np.ndarray], list[np.ndarray], bool, str]:
     """The branches (m, 7) at the samples of the swept joint, in order, each a root of the loop equations to ROOT
     with every joint but the swept one unbounded (a branch is followed past the limits it crosses; the limits judge
-    the answers), their ψ − ψ₀ [rad], and whether the swept joint's range is a whole turn: ``sew.samples`` values
-    spread over its range (its ends included unless it is a whole turn), and midpoints added, REFINE times over,
-    in every cell :func:`_refined` names."""
+    the answers), their ψ − ψ₀ [rad], whether the swept joint's range is a whole turn, and how far it got when
+    ``deadline`` (``time.perf_counter``'s clock [s]) passed ("" when it did not): ``sew.samples`` values spread
+    over its range (its ends included unless it is a whole turn), and midpoints added, REFINE times over, in every
+    cell :func:`_refined` names."""
     lo, hi = float(robot.lower[sw.joint]), float(robot.upper[sw.joint])
     around = hi - lo >= 2 * math.pi
     values = list(samples(lo, hi, sew.samples) if around else np.linspace(lo, hi, sew.samples))
@@ -316,15 +318,21 @@ def sampled(robot: Robot, arm: Arm7, sew: SEW, H: np.ndarray,
             q = q[np.linalg.norm(F, axis=1) <= ROOT]
         return q, np.array([wrap_angle(sew.of(*arm.points(x)) - sew.angle) for x in q])
 
-    found = [at(float(v)) for v in values]
+    found = []
+    for k, v in enumerate(values):
+        if time.perf_counter() > deadline:
+            return [], [], around, f"after {k} of {len(values)} samples of joint {sw.joint + 1}"
+        found.append(at(float(v)))
     for _ in range(REFINE):
         cells = [i for i in range(len(values) - 1)
                  if _refined(*found[i], *found[i + 1], values[i + 1] - values[i])]
         for i in reversed(cells):
+            if time.perf_counter() > deadline:
+                return [], [], around, f"while refining the {len(values)} samples of joint {sw.joint + 1}"
             mid = 0.5 * (values[i] + values[i + 1])
             values.insert(i + 1, mid)
             found.insert(i + 1, at(mid))
-    return [f[0] for f in found], [f[1] for f in found], around
+    return [f[0] for f in found], [f[1] for f in found], around, ""
 
 
 def distinct(q: list[np.ndarray], apart: float = 1e-6) -> np.ndarray:
@@ -345,19 +353,27 @@ def sew_all(robot: Robot, target: pin.SE3, req: Request, sew: SEW, q_ref: np.nda
         OptionError: the robot is not a 7R arm with a swept form (:func:`~kinelab.ik.analytic.redundancy.swept_arm`),
             or the task is not "pose".
     """
-    t0 = time.perf_counter()
     if req.task.name != "pose":
         raise OptionError("task", req.task_label, "'pose' with redundancy= (other tasks: solver='frdm')")
-    sw = swept_arm(robot, sew)
+    sw = swept_arm(robot, sew)  # built once per robot, before the clock starts
     arm, H = arm7(robot), target.homogeneous
-    sets, gaps, around = sampled(robot, arm, sew, H, sw)
-    roots = [r for x in starts(sets, gaps, around) if (r := finish(arm, sew, x, H)) is not None]
+    t0 = time.perf_counter()
+    deadline = math.inf if req.time_budget is None else t0 + req.time_budget
+    beyond = beyond_reach(robot, target.translation)
+    sets, gaps, around, late = ([], [], False, "") if beyond else sampled(robot, arm, sew, H, sw, deadline)
+    roots = []
+    for x in starts(sets, gaps, around):
+        if time.perf_counter() > deadline:
+            late = late or "while finishing the roots found"
+            break
+        if (r := finish(arm, sew, x, H)) is not None:
+            roots.append(r)
     answers = _judged(robot, distinct(roots), target, req, sew, q_ref)
     mode = f"analytic (SEW angle {float(sew.angle):.6g} rad; joint {sw.joint + 1} searched over {sew.samples} samples)"
     return branch_results(robot, Rows.of(answers, 7), req, mode, time.perf_counter() - t0, max_solutions, "search",
-                          beyond_reach(robot, target.translation) or "no branch found at this SEW angle",
+                          "no branch found at this SEW angle",
                           uncertified=f"the SEW angle's branches come from a search over joint {sw.joint + 1}'s "
-                                      f"{sew.samples} samples: not proved complete")
+                                      f"{sew.samples} samples: not proved complete", beyond=beyond, late=late)
 
 
 def _judged(robot: Robot, q: np.ndarray, target: pin.SE3, req: Request, sew: SEW,

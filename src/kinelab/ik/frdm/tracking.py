@@ -32,6 +32,7 @@ from kinelab.ik.limits import wrap_q
 from kinelab.ik.request import Request
 from kinelab.ik.result import Attempt, BypassRecord, SingularEvent, Status, TrackResult
 from kinelab.ik.targets import as_target_arrays
+from kinelab.ik.tasks import Task
 from kinelab.robot import Robot
 
 RESTRICTIONS = ("intervals", "freeze")
@@ -93,19 +94,76 @@ def run_track(robot: Robot, targets: Any, q0: np.ndarray, req: Request, settings
     """
     opts: FRDMOptions = req.options
     _check_restrict(settings.restrict, opts.intervals, opts.freeze)
+    points, rotations = as_target_arrays(targets)
     if _followable(opts) and not settings.restrict:
         followed = follow(robot, targets, q0, req.tol_pos, req.tol_rot, opts.sweep_cap, settings.rest_weight, opts,
                           req.task, req.seed, req.time_budget, t_start)
         followed.events += jump_events(followed.q, q0, settings.jump_limit)
-        return followed
-    policy = opts.policy or ()
-    attempt_opts = replace(opts, policy=tuple(s for s in policy if s not in RESTRICTIONS))
-    path = _Path(robot, req, attempt_opts, settings, [s for s in policy if s in RESTRICTIONS])
-    points, rotations = as_target_arrays(targets)
-    q_prev = q0
-    for k in range(points.shape[0]):
-        q_prev = path.sample(k, pin.SE3(rotations[k], points[k]), q_prev)
-    return path.result()
+    else:
+        policy = opts.policy or ()
+        attempt_opts = replace(opts, policy=tuple(s for s in policy if s not in RESTRICTIONS))
+        path = _Path(robot, req, attempt_opts, settings, [s for s in policy if s in RESTRICTIONS])
+        q_prev = q0
+        for k in range(points.shape[0]):
+            q_prev = path.sample(k, pin.SE3(rotations[k], points[k]), q_prev)
+        followed = path.result()
+    mark_jumps(followed, q0, settings.jump_limit)
+    followed.events += self_motion_events(robot, followed.q, q0, points, rotations, req.task)
+    return followed
+
+
+def mark_jumps(path: TrackResult, q0: np.ndarray, jump_limit: float | None) -> None:
+    """Mark ``jump`` every sample the path reached by a joint step [rad or m] larger than ``jump_limit`` from the last
+    sample before it that met its pose (q0 before the first): its pose is met, but not by following the path (None:
+    no limit). A missed sample is skipped (a controller holds where it was); after a jump the path goes on from
+    where it jumped to."""
+    if jump_limit is None or path.q.shape[0] == 0:
+        return
+    last = np.asarray(q0, dtype=float)
+    for k in range(path.q.shape[0]):
+        if path.status_code[k] != Status.CONVERGED.code:
+            continue
+        if np.abs(path.q[k] - last).max() > jump_limit:
+            path.status_code[k] = Status.JUMP.code
+        last = path.q[k]
+
+
+SELF_MOTION = 5.0  # a self-motion event: the joints' drift along the task's null space beyond 5 × the path's step
+
+
+def self_motion_events(robot: Robot, Q: np.ndarray, q0: np.ndarray, points: np.ndarray, rotations: np.ndarray,
+                       task: Task) -> list[SingularEvent]:
+    """A ``self_motion`` event wherever the answers have drifted along the task's null space (the motion the task
+    does not ask for: Δq less its least-norm part J⁺JΔq, summed since the last event) by more than SELF_MOTION times
+    the path's own largest step (the least-norm joint step J⁺Δx that each target's motion asks for) [rad or m]. Only
+    on a chain with more joints than its task constrains; samples left unsolved (NaN) are skipped."""
+    if robot.n <= task.dimension or Q.shape[0] < 2:
+        return []
+    prev = np.vstack([q0, Q[:-1]])
+    finite = np.isfinite(prev).all(axis=1)
+    J = np.zeros((Q.shape[0], 6, robot.n))
+    for row in np.flatnonzero(finite):
+        J[row] = robot.jacobian_local_world_aligned(prev[row])
+    J = J[:, task.rows]
+    dx = np.zeros((Q.shape[0], 6))
+    dx[:, :3] = np.diff(np.vstack([points[:1], points]), axis=0)
+    dx[1:, 3:] = [a @ pin.log3(a.T @ b) for a, b in zip(rotations[:-1], rotations[1:], strict=True)]
+    dq = np.nan_to_num(Q - prev)
+    # least-norm steps by the damped normal equations: J⁺v = Jᵀ(JJᵀ + λ²I)⁻¹v, batched
+    JJt = J @ J.transpose(0, 2, 1) + 1e-12 * np.eye(len(task.rows))
+    least = np.linalg.solve(JJt, np.stack([dx[:, task.rows], np.einsum("kij,kj->ki", J, dq)], axis=2))
+    own = np.abs(np.einsum("kji,kj->ki", J, least[..., 0])).max(axis=1)
+    drift = dq - np.einsum("kji,kj->ki", J, least[..., 1])
+    largest = max(float(np.nan_to_num(own).max()), 1e-12)
+    events, total = [], np.zeros(robot.n)
+    for k in range(Q.shape[0]):
+        total += drift[k]
+        if np.abs(total).max() > SELF_MOTION * largest:
+            events.append(SingularEvent("self_motion", f"the joints moved {np.abs(total).max():.3g} along the "
+                                        f"task's null space (the path's largest step: {largest:.3g})", sample=k,
+                                        max_joint_step=float(np.abs(total).max())))
+            total[:] = 0.0
+    return events
 
 
 def jump_events(Q: np.ndarray, q0: np.ndarray, jump_limit: float | None) -> list[SingularEvent]:

@@ -17,6 +17,7 @@ import pinocchio as pin
 from tqdm import tqdm
 
 from kinelab.collision.model import CollisionError, Collisions, collision_model
+from kinelab.errors import KinelabError
 from kinelab.ik.api import solve, solve_all, solve_batch, track
 from kinelab.ik.prepared import IK
 from kinelab.ik.request import unmeetable_tolerances
@@ -154,10 +155,11 @@ def budgets(robot: Robot, budget: float = 0.005, n: int = 200, seed: int = 0,
                 t0 = time.perf_counter()
                 paths[name](case, seed + k, 1e-300)
                 times[name].append(time.perf_counter() - t0)
-    allowed = budget * 1.05 + 1e-4
+    allowed, loose = budget * 1.05 + 1e-4, budget * 1.10 + 2e-3
     return [{"robot": robot.name, "solver": name, "budget_ms": budget * 1e3,
              "p50_ms": float(np.percentile(t, 50) * 1e3), "p99_ms": float(np.percentile(t, 99) * 1e3),
-             "max_ms": float(np.max(t) * 1e3), "kept": bool(np.percentile(t, 99) <= allowed)}
+             "max_ms": float(np.max(t) * 1e3), "kept": bool(np.percentile(t, 99) <= allowed),
+             "kept_loose": bool(np.percentile(t, 99) <= loose)}
             for name, t in times.items()]
 
 
@@ -188,7 +190,49 @@ def _budget_paths(robot: Robot, budget: float, solvers: tuple[str, ...]) -> dict
             collisions="self")
     paths["frdm track of 50"] = lambda case, seed, tol: track(
         robot, [case.oMtarget] * 50, q0=case.q_start, tol_pos=tol, tol_rot=tol, time_budget=budget)
+    paths.update(_analytic_paths(robot, budget))
     return paths
+
+
+def _analytic_paths(robot: Robot, budget: float) -> dict[str, Callable[..., Any]]:
+    """The closed form's paths where the robot has one: ``solve`` and a batch of 100 with solver "analytic",
+    ``solve_all_batch`` of 1,000 (a 6R chain in a class), and ``solve_all`` with ``redundancy=`` 64 samples and a
+    SEW angle (a 7R arm with a swept form)."""
+    from kinelab.ik.analytic.redundancy import has_swept_form
+    from kinelab.ik.analytic.sew import SEW
+    from kinelab.ik.api import solve_all_batch
+
+    try:
+        IK(robot, solver="analytic")
+    except KinelabError:
+        return {}
+    paths: dict[str, Callable[..., Any]] = {
+        "analytic solve": lambda case, seed, tol: solve(robot, case.oMtarget, solver="analytic", q0=case.q_start,
+                                                        tol_pos=tol, tol_rot=tol, time_budget=budget),
+        "analytic batch of 100": lambda case, seed, tol: solve_batch(
+            robot, [case.oMtarget] * 100, solver="analytic", q0=case.q_start, tol_pos=tol, tol_rot=tol,
+            time_budget=budget)}
+    if robot.n == 7 and has_swept_form(robot):
+        paths["solve_all K=64"] = lambda case, seed, tol: solve_all(robot, case.oMtarget, redundancy=64,
+                                                                    tol_pos=tol, tol_rot=tol, time_budget=budget)
+        paths["solve_all SEW"] = lambda case, seed, tol: solve_all(
+            robot, case.oMtarget, redundancy=SEW(0.3), tol_pos=tol, tol_rot=tol, time_budget=budget)
+    else:
+        paths["solve_all_batch of 1000"] = lambda case, seed, tol: solve_all_batch(
+            robot, [case.oMtarget] * 1000, tol_pos=tol, tol_rot=tol, time_budget=budget)
+    return paths
+
+
+BUDGET_ROBOTS = ("ur5", "crx10ia", "panda", "baxter_left", "tiago")  # a closed form, a search, three held 7R arms
+
+
+def budgets_run(robots: list[str] | None, seed: int = 0, n: int = 200,
+                progress: bool = False) -> list[dict[str, Any]]:
+    """``kinelab bench --budgets``: :func:`budgets` at 5 ms on each robot (default :data:`BUDGET_ROBOTS`)."""
+    rows: list[dict[str, Any]] = []
+    for name in tqdm(list(robots or BUDGET_ROBOTS), desc="budgets", disable=not progress, unit="robot"):
+        rows += budgets(load(name), n=n, seed=seed)
+    return rows
 
 
 def _has_collision_geometry(robot: Robot) -> bool:
@@ -214,6 +258,18 @@ def run(robots: list[str] | None, seed: int = 0, repeats: int = 3, n: int = 2000
     return out
 
 
+def budget_markdown(rows: list[dict[str, Any]]) -> str:
+    """The budget table: per robot and entry point, p50, p99 and the largest wall time of a call that cannot
+    succeed, against two bars."""
+    lines = ["| robot | entry point | budget | p50 | p99 | max | p99 ≤ budget + 5 % + 0.1 ms | ≤ + 10 % + 2 ms |",
+             "|---|---|---:|---:|---:|---:|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['robot']} | {r['solver']} | {r['budget_ms']:.1f} ms | {r['p50_ms']:.2f} ms | "
+                     f"{r['p99_ms']:.2f} ms | {r['max_ms']:.2f} ms | {'yes' if r['kept'] else 'NO'} | "
+                     f"{'yes' if r.get('kept_loose', r['kept']) else 'NO'} |")
+    return "\n".join(lines)
+
+
 def markdown(throughput_rows: list[dict[str, Any]], tracking_rows: list[dict[str, Any]],
              budget_rows: list[dict[str, Any]] | None = None) -> str:
     """The tables: throughput, tracking and (if given) budgets."""
@@ -228,9 +284,5 @@ def markdown(throughput_rows: list[dict[str, Any]], tracking_rows: list[dict[str
         lines.append(f"| {r['robot']} | {r['tracker']} | {r['reached']}/{r['samples']} | "
                      f"{r['paths_with_jump']}/{r['paths']} | {r['us_per_sample']:.1f} | {r['spread']:.2f} |")
     if budget_rows:
-        lines += ["", "| robot | solver | budget | p50 | p99 | max | p99 ≤ budget + 5 % + 0.1 ms |",
-                  "|---|---|---:|---:|---:|---:|---|"]
-        for r in budget_rows:
-            lines.append(f"| {r['robot']} | {r['solver']} | {r['budget_ms']:.1f} ms | {r['p50_ms']:.2f} ms | "
-                         f"{r['p99_ms']:.2f} ms | {r['max_ms']:.2f} ms | {'yes' if r['kept'] else 'NO'} |")
+        lines += ["", budget_markdown(budget_rows)]
     return "\n".join(lines)

@@ -1,0 +1,79 @@
+"""#57 item 6: a tracked sample reached by a joint step larger than ``jump_limit`` is not a success (status
+``jump``, the path's success False), and slow self-motion (drift along the task's null space beyond five times the
+path's own largest step) is an event in the result."""
+
+import numpy as np
+import pytest
+
+import kinelab
+from kinelab.ik.result import Status
+
+
+def cosine_path(robot, rng, samples=2000, share=0.6):
+    """The issue's path: two random configurations pulled to ``share`` of every joint's range about its middle,
+    joined by a cosine blend."""
+    mid = (robot.lower + robot.upper) / 2
+    qa, qb = (mid + share * (rng.uniform(robot.lower, robot.upper) - mid) for _ in range(2))
+    s = (1 - np.cos(np.pi * np.linspace(0, 1, samples))) / 2
+    return qa + s[:, None] * (qb - qa)
+
+
+def joint_line(robot, rng, samples=400, step=0.025):
+    """A straight joint-space line of ``samples`` samples, no joint moving more than ``step`` between two."""
+    mid = (robot.lower + robot.upper) / 2
+    qa, qb = (mid + 0.6 * (rng.uniform(robot.lower, robot.upper) - mid) for _ in range(2))
+    d = qb - qa
+    d *= min(1.0, step * (samples - 1) / np.abs(d).max())
+    return qa + np.linspace(0, 1, samples)[:, None] * d
+
+
+def assert_jumps_are_not_successes(res, q0, jump_limit=0.2):
+    steps = np.abs(np.diff(np.vstack([q0, res.q]), axis=0)).max(axis=1)
+    jumped = np.nan_to_num(steps) > jump_limit
+    assert not res.success[jumped].any()
+    assert (res.status[jumped & (res.position_error <= 1e-6)] != Status.CONVERGED).all()
+    if jumped.any():
+        assert not res.path_success
+
+
+def test_the_issues_panda_path_with_seed_3_is_not_a_success():
+    """On aadeea0 all 2,000 samples met their pose and success was True, the 2.18 rad jump at sample 1449 only an
+    event; joint 1 had slid along the self-motion to -2.896 against the path's -0.66."""
+    panda = kinelab.load("panda")
+    path = cosine_path(panda, np.random.default_rng(4))
+    res = kinelab.track(panda, panda.fk_batch(path), q0=path[0], seed=3)
+    assert_jumps_are_not_successes(res, path[0])
+    jumps = np.flatnonzero(res.status == Status.JUMP)
+    assert jumps.size >= 1 and not res.path_success and not res.success.all()
+    drift = [e for e in res.events if e.trigger == "self_motion"]
+    assert drift and drift[0].sample < 1449  # the slide is reported before the jump it leads to
+    step = np.abs(np.diff(path, axis=0)).max()
+    assert drift[0].max_joint_step > 5 * 0.5 * step  # at least the rule's bar (the path's own step, halved)
+
+
+@pytest.mark.parametrize("name", ["era", "baxter_left", "xarm7", "panda"])
+def test_on_joint_space_lines_every_jump_is_marked(name):
+    """On aadeea0: era turned a joint 6.27 rad in one sample, baxter_left 6.12, xarm7 3.59, panda 1.50, each a
+    success."""
+    robot = kinelab.load(name)
+    for seed in range(4):
+        path = joint_line(robot, np.random.default_rng(seed))
+        res = kinelab.track(robot, robot.fk_batch(path), q0=path[0], seed=seed)
+        assert_jumps_are_not_successes(res, path[0])
+
+
+def test_a_six_joint_arm_has_no_self_motion_events():
+    ur5 = kinelab.load("ur5")
+    path = joint_line(ur5, np.random.default_rng(1))
+    res = kinelab.track(ur5, ur5.fk_batch(path), q0=path[0], seed=0)
+    assert res.path_success and not [e for e in res.events if e.trigger == "self_motion"]
+
+
+def test_the_monitored_loop_marks_jumps_too():
+    panda = kinelab.load("panda")
+    path = cosine_path(panda, np.random.default_rng(4), samples=300)
+    res = kinelab.track(panda, panda.fk_batch(path), q0=path[0], seed=3, jump_limit=1e-4, restrict=(),
+                        policy=("auto_kick",))
+    assert "monitored" in res.mode
+    assert_jumps_are_not_successes(res, path[0], jump_limit=1e-4)
+    assert (res.status == Status.JUMP).any()
