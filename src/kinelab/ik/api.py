@@ -14,7 +14,7 @@ from __future__ import annotations
 import time
 from collections.abc import Sequence
 from dataclasses import replace
-from typing import TYPE_CHECKING, Any, cast
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
@@ -346,7 +346,7 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
         if time_budget != AUTO:
             raise OptionError("time_budget", time_budget, "a finite number > 0 [s], None (none) or 'auto'")
         time_budget = AUTO_BUDGET if redundancy is None else AUTO_REDUNDANT_BUDGET
-    budget = cast(float | None, time_budget)
+    budget: float | None = time_budget
     if options is None and not solver_options and _usual_all(q_ref, max_solutions, collisions, redundancy, task,
                                                              axis):
         found = usual_closed_form(robot, target, seed, (solver, tol_pos, tol_rot, budget, stop_below))
