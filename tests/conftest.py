@@ -1,3 +1,6 @@
+import os
+import shutil
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -5,6 +8,23 @@ import pytest
 from helpers import BUNDLED, ERD_ARMS
 
 import kinelab
+
+
+@pytest.fixture(scope="session", autouse=True)
+def session_temp():
+    """One temporary folder for everything the session writes outside pytest's tmp_path: kinelab's xacro expansions,
+    the CLI's subprocesses, Chromium's profiles, Dask's scratch space (TMPDIR, inherited by every child). Removed
+    when the session ends, so a run leaves nothing in the machine's temporary folder (.ci/run checks it)."""
+    folder = tempfile.mkdtemp(prefix="kinelab-tests-")
+    saved = os.environ.get("TMPDIR"), tempfile.tempdir
+    os.environ["TMPDIR"], tempfile.tempdir = folder, folder
+    yield Path(folder)
+    if saved[0] is None:
+        os.environ.pop("TMPDIR", None)
+    else:
+        os.environ["TMPDIR"] = saved[0]
+    tempfile.tempdir = saved[1]
+    shutil.rmtree(folder, ignore_errors=True)
 
 
 @pytest.fixture(scope="session")

@@ -19,6 +19,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+from kinelab.errors import OptionError
 from kinelab.robot import Robot
 
 RANK_RTOL = 1e-6  # singular values below RANK_RTOL × σ_max count as zero
@@ -117,10 +118,37 @@ def describe_direction(u: np.ndarray, sigma: float | None = None) -> LostDirecti
     return LostDirection(tuple(u.tolist()), float(lin @ lin), float(ang @ ang), axes[0], axes[1], sigma)
 
 
+LENGTHS = (1e-6, 1e6)  # [m] the scale lengths analyze accepts
+
+
+def checked_length(length: object) -> float:
+    """``length`` [m] as a float within :data:`LENGTHS`.
+
+    Raises:
+        OptionError: anything else (named, with the bounds).
+    """
+    ok = isinstance(length, int | float | np.number) and not isinstance(length, bool) \
+        and LENGTHS[0] <= float(length) <= LENGTHS[1]  # NaN fails both comparisons
+    if not ok:
+        raise OptionError("length", length, f"a length in [{LENGTHS[0]:g}, {LENGTHS[1]:g}] m, or None (the robot's "
+                          "characteristic length)")
+    return float(length)  # type: ignore[arg-type]
+
+
 def analyze(robot: Robot, q, length: float | None = None) -> Analysis:
-    """SVD of the scaled tool Jacobian at q: rank, σ, manipulability, condition, lost and null directions."""
+    """SVD of the scaled tool Jacobian at q: rank, σ, manipulability, condition, lost and null directions.
+
+    Args:
+        robot: the robot.
+        q: the configuration [rad or m].
+        length: the length [m] the Jacobian's linear rows are divided by (None: the robot's characteristic length),
+            within [1e-6, 1e6] m: beyond those the rows of one kind swamp the other's in double precision.
+
+    Raises:
+        ConfigurationError: a bad q. OptionError: a length that is not a number within those bounds.
+    """
     q = robot.check_q(q)
-    L = length or robot.characteristic_length()
+    L = robot.characteristic_length() if length is None else checked_length(length)
     J = scaled_jacobian(robot, q, L)
     U, s, Vt = np.linalg.svd(J)
     full = min(6, robot.n)

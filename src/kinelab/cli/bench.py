@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from kinelab.cli.common import print_json, seed_argument
+from kinelab.cli.common import count, positive_number, print_json, seed_argument
 from kinelab.ik.words import TASKS
 from kinelab.report.outfolder import check_output_folder
 
@@ -15,15 +15,16 @@ def add(sub: Any) -> None:
     s = sub.add_parser("bench", help="the IK benchmark: kinelab's solvers and the installed peers")
     s.add_argument("--robots", nargs="+", default=None,
                    help="robots (default: panda ur5 stanford era xarm7 z1 kinova ur10 so101 youbot)")
-    s.add_argument("--n", type=int, default=200, help="targets per robot (default 200)")
+    s.add_argument("--n", type=count, default=200, help="targets per robot (default 200)")
     seed_argument(s)
     s.add_argument("--solvers", nargs="+", default=None, help="solvers to run (default: all available)")
-    s.add_argument("--budget-ms", type=float, default=5.0, help="time budget per solve [ms] (default 5)")
-    s.add_argument("--repeats", type=int, default=3,
+    s.add_argument("--budget-ms", type=positive_number, default=5.0, help="time budget per solve [ms] (default 5)")
+    s.add_argument("--repeats", type=count, default=3,
                    help="rounds over the set; per problem the fastest counts (default 3)")
     s.add_argument("--start", choices=("random", "warm"), default="random",
                    help="starts: random in the limits (default), or warm: the target's q plus N(0, sigma) per joint")
-    s.add_argument("--sigma", type=float, default=0.2, help="warm starts' noise per joint [rad or m] (default 0.2)")
+    s.add_argument("--sigma", type=positive_number, default=0.2,
+                   help="warm starts' noise per joint [rad or m] (default 0.2)")
     s.add_argument("--task", choices=TASKS, default="pose",
                    help="the components judged (default pose; position: random target rotations; axis: tool z, "
                         "random roll)")

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 from typing import TYPE_CHECKING, Any, NoReturn
 
 from kinelab.errors import ConfigurationError, KinelabError
@@ -44,6 +45,36 @@ class Parser(argparse.ArgumentParser):
                 leave = " or leave the option out" if action.option_strings else ""
                 self.error(f"argument {name}: an empty value; give {action.metavar or action.dest.upper()}{leave}")
         return found, extra
+
+
+def positive_number(text: str) -> float:
+    """An argparse type: a finite number > 0 (a time, a length, a noise level).
+
+    Raises:
+        argparse.ArgumentTypeError: anything else (argparse names the option).
+    """
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"{text} is not a finite number > 0")
+    return value
+
+
+def count(text: str) -> int:
+    """An argparse type: a whole number ≥ 1 that a C int holds (a count of targets, rounds, samples).
+
+    Raises:
+        argparse.ArgumentTypeError: anything else (argparse names the option).
+    """
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if not 1 <= value <= 2**31 - 1:
+        raise argparse.ArgumentTypeError(f"{text} is not a whole number in [1, {2**31 - 1}]")
+    return value
 
 
 def q_from_cli(robot: Robot, values: list[str], deg: bool, what: str = "q") -> np.ndarray:

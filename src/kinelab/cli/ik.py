@@ -35,6 +35,11 @@ SOLVER_FLAGS = (("--polish", "polish", "polish"), ("--law", "law", "law"), ("--i
                 ("--step", "step", "step"), ("--gain", "gain", "k"))  # (flag, its argparse name, the option field)
 
 
+def _given(value: Any) -> bool:
+    """A solver flag given on the command line: anything but None and an unset switch (0 is a value given)."""
+    return value is not None and value is not False
+
+
 def option_fields(solver: str) -> frozenset[str]:
     """The option fields of the solver a ``--solver`` name runs (none for the closed form, which takes none).
 
@@ -100,8 +105,7 @@ def run(args: argparse.Namespace) -> int:
     q0, start = _start(robot, args)
     _refuse_other_solvers_flags(args)
     options.update(_bypass_options(robot, args))
-    options.update({field: getattr(args, dest) for _, dest, field in SOLVER_FLAGS
-                    if getattr(args, dest) not in (None, False)})
+    options.update({field: getattr(args, dest) for _, dest, field in SOLVER_FLAGS if _given(getattr(args, dest))})
     result = solve(robot, target, solver=args.solver, q0=q0, seed=args.seed, tol_pos=args.tol_pos,
                    tol_rot=args.tol_rot, time_budget=args.time_budget, task=args.task, axis=args.axis,
                    collisions=collisions_of(args), **options)
@@ -175,8 +179,7 @@ def _refuse_other_solvers_flags(args: argparse.Namespace) -> None:
     from kinelab.ik.registry import names
 
     mine = option_fields(args.solver)
-    given = [(flag, field) for flag, dest, field in SOLVER_FLAGS
-             if getattr(args, dest) not in (None, False) and field not in mine]
+    given = [(flag, field) for flag, dest, field in SOLVER_FLAGS if _given(getattr(args, dest)) and field not in mine]
     if given:
         flag, field = given[0]
         owners = [name for name in names() if field in option_fields(name)]

@@ -62,6 +62,15 @@ def _one_line(message: Warning | str, category: type[Warning], filename: str, li
     return f"kinelab: warning: {' '.join(str(message).split())}\n"
 
 
+MAX_MESSAGE = 2000  # [characters] of an error line; the rest is counted, not printed
+
+
+def one_line(message: str) -> str:
+    """An error message on one line of at most MAX_MESSAGE characters."""
+    text = " ".join(message.split())
+    return text if len(text) <= MAX_MESSAGE else f"{text[:MAX_MESSAGE]}… ({len(text)} characters)"
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run one command; a user error prints one line and returns 2, Ctrl-C returns 130."""
     warnings.formatwarning = _one_line
@@ -74,7 +83,7 @@ def main(argv: list[str] | None = None) -> int:
         code: int = args.func(args)
         return code
     except KinelabError as exc:
-        print(f"kinelab: error: {exc}", file=sys.stderr)
+        print(f"kinelab: error: {one_line(str(exc))}", file=sys.stderr)
         return 2
     except KeyboardInterrupt as stop:
         note = getattr(stop, "note", "")

@@ -35,6 +35,9 @@ MAX_FILE_BYTES = 16 * 2**20  # [bytes] 1000 obstacles take about 150 kB
 SIZES = {"plane": 0, "box": 3, "sphere": 1, "cylinder": 2, "capsule": 2, "mesh": 1}
 
 
+MAX_EXTENT = 1e4  # [m] the largest size or distance of an obstacle (as of a robot's offsets)
+
+
 class ObstacleError(KinelabError):
     """An obstacle or an obstacle file that cannot be used; names the obstacle and what is valid."""
 
@@ -68,6 +71,9 @@ class Obstacle:
                                 f"[m], got {len(size)}")
         if any(s <= 0 for s in size):
             raise ObstacleError(f"obstacle {label!r}: sizes must be > 0 m, got {list(size)}")
+        if max((*map(abs, size), *map(abs, xyz))) > MAX_EXTENT:
+            raise ObstacleError(f"obstacle {label!r}: its size and position must lie within ±{MAX_EXTENT:g} m, got "
+                                f"size {list(size)}, xyz {list(xyz)}")
         if len(xyz) != 3 or len(rpy) != 3:
             raise ObstacleError(f"obstacle {label!r}: xyz and rpy take 3 numbers each")
         object.__setattr__(self, "size", size)
@@ -113,7 +119,8 @@ class Obstacle:
 
 def _numbers(label: str, what: str, values: Any) -> tuple[float, ...]:
     try:
-        if isinstance(values, str | bytes) or np.ndim(values) != 1 or np.iscomplexobj(values):
+        if isinstance(values, str | bytes) or np.ndim(values) != 1 or np.iscomplexobj(values) \
+                or any(isinstance(v, bool | np.bool_) for v in values):  # true is no length
             raise TypeError
         out = tuple(float(v) for v in values)
     except (TypeError, ValueError):

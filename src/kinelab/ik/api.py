@@ -24,6 +24,7 @@ from kinelab.geometry import stack_homogeneous
 from kinelab.ik.batch import BatchIKResult, prepare, prepare_robot
 from kinelab.ik.branches import UNSEEN, Route, find_all, route_of, usual_closed_form
 from kinelab.ik.chain import chain_model
+from kinelab.ik.options import flag
 from kinelab.ik.prepared import batch_clear_of, clear_of, collision_check, kept_solver, prepared, solve_clear_of
 from kinelab.ik.registry import Capabilities, capabilities, one_answer, refuse_options
 from kinelab.ik.request import Request, check_robot, make_request
@@ -342,6 +343,7 @@ def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto",
         TargetError, ConfigurationError, OptionError: bad input, named.
     """
     check_entry(robot, "solve_all", positional)
+    flag("drop_colliding", drop_colliding)
     if isinstance(time_budget, str):
         if time_budget != AUTO:
             raise OptionError("time_budget", time_budget, "a finite number > 0 [s], None (none) or 'auto'")

@@ -80,20 +80,25 @@ def choice(name: str, value: object, valid: tuple[str, ...], what: str | None = 
                           f"unknown {label} {value!r} (option {name}); valid: {', '.join(valid)}")
 
 
+MAX_COUNT = 2**31 - 1  # the largest count (sweeps, restarts, samples): what the kernels' C int holds
+
+
 def positive(name: str, value: object, *, allow_none: bool = False, integer: bool = False,
              zero: bool = False) -> None:
-    """Refuse anything but a finite number > 0 (≥ 0 with ``zero``; an int with ``integer``)."""
+    """Refuse anything but a finite number > 0 (≥ 0 with ``zero``; an int of at most MAX_COUNT with ``integer``)."""
     if value is None and allow_none:
         return
     if not _in_range(value, integer, zero):
         kind = "an integer" if integer else "a finite number"
-        bound = "≥ 0" if zero else "> 0 (positive)"
+        bound = ("≥ 0" if zero else "> 0 (positive)") + (f" and at most {MAX_COUNT}" if integer else "")
         raise OptionError(name, value, f"{kind} {bound}" + (" or None" if allow_none else ""))
 
 
 def _in_range(value: object, integer: bool, zero: bool) -> bool:
     """A number (not a bool; an integer with ``integer``), finite and > 0 (≥ 0 with ``zero``)."""
     if isinstance(value, bool) or not isinstance(value, numbers.Integral if integer else numbers.Real):
+        return False
+    if integer and int(value) > MAX_COUNT:  # type: ignore[call-overload]
         return False
     number = float(value)
     return math.isfinite(number) and (number > 0 or (zero and number == 0))

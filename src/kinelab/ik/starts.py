@@ -40,8 +40,9 @@ class StartTable:
         return np.hstack([H[:, :3, 3] / self.length, WEIGHT * H[:, :3, :3].reshape(len(H), 9)])
 
     def nearest(self, H: np.ndarray) -> np.ndarray:
-        """The stored configuration (B, n) whose tool pose is nearest each target of H (B, 4, 4)."""
-        _, index = self.tree.query(self.features(H), k=1)
+        """The stored configuration (B, n) whose tool pose is nearest each target of H (B, 4, 4); a target far beyond
+        the table (1e154 m: its squared distance overflows) gets the nearest to its direction."""
+        _, index = self.tree.query(np.clip(self.features(H), -1e6, 1e6), k=1)
         return np.array(self.q[index], dtype=float)
 
     @property

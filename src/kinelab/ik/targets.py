@@ -25,11 +25,14 @@ def from_xyz_rpy(xyz: ArrayLike, rpy: ArrayLike = (0.0, 0.0, 0.0), *, degrees: b
         degrees: the angles are in degrees.
 
     Raises:
-        TargetError: not three finite numbers each, or radians beyond ±2π (degrees given as radians, most
-            likely: said, with ``degrees=True`` named).
+        TargetError: not three finite numbers each, radians beyond ±2π (degrees given as radians, most
+            likely: said, with ``degrees=True`` named), or degrees beyond ±3600.
     """
     xyz, rpy = _finite(xyz, 3, "xyz"), _finite(rpy, 3, "rpy")
     if degrees:
+        if np.abs(rpy).max() > MAX_DEGREES:
+            raise TargetError(f"rpy {rpy.tolist()} [deg]: an angle beyond ±{MAX_DEGREES:g}° (ten turns) is no "
+                              "orientation anyone means; give angles within a turn")
         rpy = np.asarray(np.deg2rad(rpy), dtype=float)
     elif np.abs(rpy).max() > DEGREES_LIKELY:
         raise TargetError(f"rpy {rpy.tolist()} looks like degrees (an angle beyond ±2π rad): pass degrees=True, or "
@@ -37,6 +40,7 @@ def from_xyz_rpy(xyz: ArrayLike, rpy: ArrayLike = (0.0, 0.0, 0.0), *, degrees: b
     return pin.SE3(pin.rpy.rpyToMatrix(*rpy), xyz)
 
 
+MAX_DEGREES = 3600.0  # [deg] the largest roll, pitch or yaw taken in degrees
 DEGREES_LIKELY = 2 * np.pi + 1e-9  # [rad] an angle beyond this, where radians are expected, was meant in degrees
 
 

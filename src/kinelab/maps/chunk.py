@@ -32,6 +32,9 @@ METHODS = ("auto", "numeric")
 MAX_TARGETS = 2_000_000  # a map asking for more needs force=True (about an hour per million on one core)
 
 
+MAX_ORIENTATIONS = 4096  # target orientations per voxel (a map's targets are voxels × this)
+
+
 @dataclass(frozen=True)
 class MapSpec:
     """What a reachability map computes (stored with it; a resumed run must ask for the same).
@@ -64,8 +67,10 @@ class MapSpec:
 
     def check(self) -> None:
         """Raises KinelabError naming a bad field and what is valid."""
-        if isinstance(self.orientations, bool) or not (isinstance(self.orientations, int) and self.orientations >= 1):
-            raise KinelabError(f"orientations must be an integer ≥ 1, got {self.orientations!r}")
+        if isinstance(self.orientations, bool) or not (isinstance(self.orientations, int)
+                                                       and 1 <= self.orientations <= MAX_ORIENTATIONS):
+            raise KinelabError(f"orientations must be an integer ≥ 1 and at most {MAX_ORIENTATIONS}, got "
+                               f"{self.orientations!r}")
         if self.task not in ("pose", "axis"):
             raise KinelabError(f"a reachability map takes task 'pose' or 'axis', got {self.task!r}")
         if isinstance(self.chunk_voxels, bool) or not (isinstance(self.chunk_voxels, int) and self.chunk_voxels >= 1):

@@ -5,6 +5,7 @@ The chunks and the spec are :mod:`kinelab.maps.chunk`'s; the storage :mod:`kinel
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 from typing import Any
 
@@ -15,6 +16,26 @@ from kinelab.progress import bar
 from kinelab.robot import Robot
 
 __all__ = ["MAX_TARGETS", "MapSpec", "compute_chunk", "reachability"]
+
+
+def spec_of(spec: Any, fields: dict[str, Any]) -> MapSpec:
+    """The map's :class:`MapSpec`: ``spec`` as given, or one built from its fields, checked.
+
+    Raises:
+        OptionError: ``spec`` is not a MapSpec, both are given, or a field it does not have (the fields listed).
+    """
+    if spec is not None and not isinstance(spec, MapSpec):
+        raise OptionError("spec", spec, "a kinelab.maps.MapSpec, or its fields as keyword arguments")
+    if spec is not None and fields:
+        raise OptionError(next(iter(fields)), "given with spec=", "either spec=MapSpec(...) or its fields")
+    names = [f.name for f in dataclasses.fields(MapSpec)]
+    unknown = [k for k in fields if k not in names]
+    if unknown:
+        raise OptionError(unknown[0], fields[unknown[0]], ", ".join(names),
+                          f"unknown map field {unknown[0]!r}; a map's fields are: {', '.join(names)}")
+    made = spec or MapSpec(**fields)
+    made.check()
+    return made
 
 
 def reachability(robot: Robot, spec: MapSpec | None = None, out: str | None = None, force: bool = False,
@@ -39,8 +60,7 @@ def reachability(robot: Robot, spec: MapSpec | None = None, out: str | None = No
     Raises:
         KinelabError: a bad spec, a map too large without ``force``, or ``out`` holding another map.
     """
-    spec = spec or MapSpec(**fields)
-    spec.check()
+    spec = spec_of(spec, fields)
     if out is not None and not (isinstance(out, Path) or (isinstance(out, str) and out.strip())):
         raise OptionError("out", out, "a folder path (a str or pathlib.Path), or None (in memory)")
     if client is not None and not (callable(getattr(client, "submit", None)) and hasattr(client, "scatter")):

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from kinelab.errors import KinelabError
+from kinelab.errors import KinelabError, OptionError
 from kinelab.files import as_path, output_folder
 from kinelab.robot import Robot
 
@@ -219,6 +219,8 @@ def load(path: str | Path, check: bool = True) -> ReachabilityMap:
     """
     from kinelab import __version__
 
+    if not isinstance(check, bool):
+        raise OptionError("check", check, "True or False (verify every finished chunk's checksum)")
     zarr, path = _zarr(), as_path(path, "a reachability map", KinelabError)
     try:
         group = zarr.open_group(str(path), mode="r+")

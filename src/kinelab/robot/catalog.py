@@ -165,6 +165,9 @@ def names() -> list[str]:
     return list(ENTRIES)
 
 
+MAX_PATH = 4096  # [characters] a path longer than Linux's PATH_MAX names no file
+
+
 def resolve(name_or_path: str | Path) -> tuple[Path, Entry | None]:
     """Turn a registered name or a URDF path into (urdf path, catalogue entry or None); an entry's SRDF
     lies below the same directory as its URDF (:func:`srdf_path`)."""
@@ -176,6 +179,10 @@ def resolve(name_or_path: str | Path) -> tuple[Path, Entry | None]:
             raise RobotNotFoundError(key + " (example-robot-data is not installed)", names())
         return root / entry.relpath, entry
     path = Path(key)
-    if path.suffix.lower() in {".urdf", ".xml"} or path.exists() or "/" in key:
+    try:
+        exists = path.exists()
+    except OSError:  # a name longer than the system takes for a file (ENAMETOOLONG)
+        exists = False
+    if (path.suffix.lower() in {".urdf", ".xml"} or exists or "/" in key) and len(key) <= MAX_PATH:
         return path, None
     raise RobotNotFoundError(key, names(), _maker_words())

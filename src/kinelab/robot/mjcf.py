@@ -16,9 +16,7 @@ import pinocchio as pin
 
 from kinelab.errors import URDFError
 from kinelab.files import read_text
-from kinelab.robot.urdf import MAX_OFFSET, UrdfTree, check_size
-
-MAX_COMPONENT = 1e6  # the largest component of a direction (an axis, xyaxes, zaxis): its length must fit a float
+from kinelab.robot.urdf import MAX_COMPONENT, MAX_OFFSET, UrdfTree, check_size
 
 UNREAD = ("frame", "replicate", "attach")  # MuJoCo 3 elements Pinocchio's parser skips, with their bodies
 
@@ -46,6 +44,28 @@ def read_mjcf(path: Path) -> tuple[pin.Model, UrdfTree]:
         raise URDFError(f"Pinocchio cannot read the MJCF {path}: {type(exc).__name__}: {exc}") from None
     _restore_slide_ranges(model, ET.fromstring(read_text(path, "MJCF file", URDFError)))
     return model, body_tree(model)
+
+
+def meshes_outside(path: Path) -> list[str]:
+    """The mesh files an MJCF file names (``<mesh file=...>`` under its compiler's ``meshdir`` or ``assetdir``) that
+    lie outside the file's own folder: kinelab hands no such path to a mesh loader (a robot file is data).
+
+    Raises:
+        URDFError: a file that cannot be read as XML (named).
+    """
+    try:
+        root = ET.fromstring(read_text(path, "MJCF file", URDFError))
+    except ET.ParseError as exc:
+        raise URDFError(f"{path}: not well-formed XML ({exc})") from None
+    compiler = root.find("compiler")
+    folder = path.parent.resolve()
+    meshdir = "" if compiler is None else compiler.get("meshdir", compiler.get("assetdir", ""))
+    outside = []
+    for mesh in root.iter("mesh"):
+        name = mesh.get("file")
+        if name and not (folder / meshdir / name).resolve().is_relative_to(folder):
+            outside.append(name)
+    return outside
 
 
 def check_mjcf(path: Path) -> None:
@@ -146,9 +166,14 @@ def _check_joint(path: Path, joint: ET.Element) -> None:
     ref = _numbers(path, joint, "ref", 1)
     if ref is not None and abs(ref[0]) > MAX_OFFSET:
         raise URDFError(f"{path}: joint {name!r} ref {ref[0]:g} lies beyond ±{MAX_OFFSET:g} (rad, degrees or m)")
+    pos = _numbers(path, joint, "pos", 3)
+    if pos is not None and max(map(abs, pos)) > MAX_OFFSET:
+        raise URDFError(f"{path}: joint {name!r} pos {pos} lies beyond ±{MAX_OFFSET:g} m of its body")
     span = _numbers(path, joint, "range", 2)
     if span is not None and span[0] > span[1]:
         raise URDFError(f"{path}: joint {name!r} range lower {span[0]:g} > upper {span[1]:g}")
+    if span is not None and max(map(abs, span)) > MAX_OFFSET:
+        raise URDFError(f"{path}: joint {name!r} range {span} reaches beyond ±{MAX_OFFSET:g} (rad, degrees or m)")
 
 
 def _restore_slide_ranges(model: pin.Model, root: ET.Element) -> None:

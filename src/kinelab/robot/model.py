@@ -15,6 +15,7 @@ from __future__ import annotations
 import functools
 import itertools
 import operator
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar, cast
@@ -31,10 +32,11 @@ from kinelab.robot.build import LIMIT_SLACK, Built, build_file, build_model, fra
 from kinelab.robot.certificate import ChainArrays, FKCertificate, certify, chain_arrays
 from kinelab.robot.joints import Joint, Mimic
 from kinelab.robot.meshes import build_visual_model
-from kinelab.robot.mjcf import is_mjcf
+from kinelab.robot.mjcf import is_mjcf, meshes_outside
 from kinelab.scratch import own
 
 T = TypeVar("T")
+MAX_SAMPLE_BYTES = 8 * 2**30  # the most memory one random_qs call fills
 SAMPLE_TURNS = 4  # random configurations keep revolute joints within ±4 turns (see Robot.random_q)
 __all__ = ["LIMIT_SLACK", "Joint", "Mimic", "Robot", "load"]
 
@@ -176,7 +178,8 @@ class Robot:
     def check_q(self, q: ArrayLike, *, limits: bool = False, what: str = "q") -> np.ndarray:
         """``q`` as a float array of length n, refusing wrong shapes, NaN/inf and (if asked) limits."""
         if not limits and plain_q(q, self.n):  # the usual call, checked in one compiled pass
-            return cast(np.ndarray, q)
+            arr = cast(np.ndarray, q)
+            return arr if arr.flags.c_contiguous else np.ascontiguousarray(arr)  # a strided view: the kernels' form
         try:
             raw = q if type(q) is np.ndarray else np.asarray(q)
             if raw.dtype.kind not in "fiu":  # complex, bool, text and objects are not joint values
@@ -199,7 +202,7 @@ class Robot:
                 i = int(np.flatnonzero(outside)[0])
                 j = self.joints[i]
                 raise JointLimitError(j.name, arr[i], j.lower, j.upper, j.unit)
-        return arr
+        return np.ascontiguousarray(arr)
 
     def within_limits(self, q: ArrayLike, slack: float = LIMIT_SLACK) -> bool:
         """True when every bounded joint lies within its limits (plus ``slack``); continuous joints have none; a
@@ -224,8 +227,17 @@ class Robot:
                 for j, v, lo, hi in zip(self.joints, values.tolist(), lower, upper, strict=True) if not lo <= v <= hi]
 
     def within_limits_batch(self, Q: np.ndarray) -> np.ndarray:
-        """:meth:`within_limits` per row of a (B, n) array (default slack): a (B,) bool array."""
-        Q = np.asarray(Q, dtype=float)
+        """:meth:`within_limits` per row of a (B, n) array (default slack): a (B,) bool array; a NaN row is within
+        none.
+
+        Raises:
+            ConfigurationError: Q is not a (B, n) array of numbers.
+        """
+        arr = np.asarray(Q) if not isinstance(Q, np.ndarray) else Q
+        if arr.dtype.kind not in "fiu" or arr.ndim != 2 or arr.shape[1] != self.n:
+            raise ConfigurationError(f"Q must be a (B, {self.n}) array of numbers for {self.name}, got "
+                                     f"{getattr(arr, 'shape', '?')} of {arr.dtype}")
+        Q = arr.astype(float, copy=False)
         lower, upper = self.check_bounds
         inside: np.ndarray = (lower <= Q) & (upper >= Q)
         return np.asarray(inside.all(axis=1))
@@ -296,9 +308,16 @@ class Robot:
         return _uniform(_generator(rng), *self.sample_bounds, None)
 
     def random_qs(self, count: int, rng: np.random.Generator | int | None = None) -> np.ndarray:
-        """``count`` configurations (rows) drawn as :meth:`random_q` draws one."""
+        """``count`` configurations (rows) drawn as :meth:`random_q` draws one.
+
+        Raises:
+            OptionError: a count that is not a whole number ≥ 0, or whose rows would take more than 8 GiB.
+        """
         if not isinstance(count, int | np.integer) or isinstance(count, bool) or count < 0:
             raise OptionError("count", count, "a whole number ≥ 0 of configurations")
+        if int(count) * self.n * 8 > MAX_SAMPLE_BYTES:
+            raise OptionError("count", count, f"at most {MAX_SAMPLE_BYTES // (8 * self.n)} configurations of "
+                              f"{self.name} (their rows would take more than {MAX_SAMPLE_BYTES >> 30} GiB)")
         return _uniform(_generator(rng), *self.sample_bounds, (int(count), self.n))
 
     @functools.cached_property
@@ -457,6 +476,12 @@ class Robot:
             return pin.GeometryModel()  # an in-memory model brings no geometry: the viewer draws a stick figure
         geometry_type = pin.GeometryType.COLLISION if kind == "collision" else pin.GeometryType.VISUAL
         if is_mjcf(b.urdf_path):
+            outside = meshes_outside(b.urdf_path)
+            if outside:  # Pinocchio builds all of a file's geometry or none: none, said
+                warnings.warn(f"{b.urdf_path.name}: mesh {outside[0]!r} lies outside the file's folder; kinelab "
+                              f"reads no file outside it, so {self.name} is drawn without its {kind} geometry",
+                              stacklevel=2)
+                return pin.GeometryModel()
             geom = pin.buildGeomFromMJCF(b.full, str(b.urdf_path), geometry_type)
         else:
             geom = build_visual_model(b.full, b.urdf_path, package_dirs or self.package_dirs, kind)

@@ -2,8 +2,9 @@
 file must meet to be a model (so that errors name the file, the element and the rule).
 
 Rules: one root link; no link that is its own parent; every joint has a parent and a child; origins are
-finite and within ``MAX_OFFSET`` of their parent; axes are finite and not zero; limits are finite with
-lower ≤ upper; the text decodes in the encoding the XML declares (UTF-8 when it declares none).
+finite and within ``MAX_OFFSET`` of their parent; axes are finite, not zero, and no component beyond
+``MAX_COMPONENT``; limits are finite with lower ≤ upper; the text decodes in the encoding the XML declares
+(UTF-8 when it declares none).
 
 What Pinocchio's own parser (urdfdom on tinyxml2) reads, this reader reads too: a comment nested inside a
 comment (xacro output has them) and a namespace prefix used without its declaration (``<xacro:...>`` left in
@@ -25,6 +26,7 @@ from typing import Any, cast
 
 from kinelab.errors import ChainError, URDFError
 
+MAX_COMPONENT = 1e6  # the largest component of a direction (an axis): its length must fit a float
 MAX_OFFSET = 1e4  # [m] the largest joint or link offset a model may have (no robot is 10 km long)
 # links (or MJCF bodies) a file may have: checked before Pinocchio's parser, which crashes the process on a
 # URDF of 4000 links and runs out of memory on an MJCF of 2000 bodies; the longest chain kinelab can use is
@@ -198,6 +200,9 @@ def _check_joint(path: Path, joint: ET.Element) -> tuple[str, str]:
         a = _numbers(where, "axis xyz", axis.get("xyz", "1 0 0"), 3)
         if math.hypot(*a) < 1e-12:
             raise URDFError(f"{where}: the axis is zero; an axis must be a non-zero direction")
+        if max(map(abs, a)) > MAX_COMPONENT:  # its length overflows: Pinocchio would turn about no unit axis
+            raise URDFError(f"{where}: the axis {a} has a component beyond ±{MAX_COMPONENT:g}; give a direction "
+                            "(its length is normalised)")
     limit = joint.find("limit")
     if limit is not None and joint.get("type") in ("revolute", "prismatic"):
         lo = _numbers(where, "limit lower", limit.get("lower", "0"), 1)[0]

@@ -27,6 +27,7 @@ from __future__ import annotations
 import contextlib
 import importlib.util
 import re
+import shutil
 import threading
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -74,8 +75,12 @@ def expand(path: Path, args: dict[str, str] | None = None, trusted: bool = False
     if importlib.util.find_spec("xacro") is None:  # optional extra: imported only by the expansion
         raise URDFError(f"{path.name} is a xacro file; reading it needs xacro: {INSTALL_HINT}")
     out = scratch_dir("kinelab-xacro-") / (path.name.removesuffix(".xacro") or "robot.urdf")
-    bounded.run(path, {"path": str(path), "args": {k: str(v) for k, v in (args or {}).items()}, "trusted": trusted,
-                       "roots": [str(r) for r in roots], "out": str(out)})
+    try:
+        bounded.run(path, {"path": str(path), "args": {k: str(v) for k, v in (args or {}).items()},
+                           "trusted": trusted, "roots": [str(r) for r in roots], "out": str(out)})
+    except BaseException:
+        shutil.rmtree(out.parent, ignore_errors=True)  # a refused expansion leaves nothing (a 64 MB URDF, say)
+        raise
     return out
 
 
@@ -115,8 +120,16 @@ def _failure(path: Path, exc: BaseException) -> str:
             return f"{path}: {seen}; kinelab expands files within {SECONDS:g} s and {ELEMENTS} elements"
         if isinstance(seen, RecursionError):
             return f"xacro cannot expand {path}: its macros or includes nest without end"
+        if isinstance(seen, MemoryError):
+            return (f"{path}: the expansion needs more than {bounded.MEMORY >> 20} MB (kinelab's limit for a whole "
+                    "xacro expansion)")
         seen = getattr(seen, "exc", None) or seen.__cause__ or seen.__context__
-    return f"xacro cannot expand {path}: {' '.join(str(exc).split())}"
+    return f"xacro cannot expand {path}: {_cut(' '.join(str(exc).split()))}"
+
+
+def _cut(text: str, most: int = 400) -> str:
+    """xacro's reason cut to ``most`` characters (it quotes whole expressions: a 6 MB list literal, say)."""
+    return text if len(text) <= most else f"{text[:most]}… ({len(text)} characters)"
 
 
 def _roots(path: Path, package_dirs: list[str]) -> list[Path]:
@@ -265,6 +278,9 @@ def _safe_eval(xacro: Any, budget: xacro_eval.Budget) -> Callable[..., Any]:
         try:
             return xacro_eval.evaluate(expr, lookup_in(symbols))
         except xacro_eval.RefusedError as refused:
+            if refused.too_large:
+                raise _RefusalError(f"{_current(xacro)}: {refused.construct} {_where(_current(xacro), expr)} is "
+                                    "more than kinelab builds while reading a robot file") from None
             _refuse(xacro, refused.construct, expr)
 
     return safe_eval

@@ -52,9 +52,10 @@ _COMPARE: dict[type[ast.cmpop], Callable[[Any, Any], Any]] = {
 class RefusedError(Exception):
     """An expression uses what an untrusted file may not (``construct`` names it)."""
 
-    def __init__(self, construct: str):
+    def __init__(self, construct: str, too_large: bool = False):
         super().__init__(construct)
         self.construct = construct
+        self.too_large = too_large  # a size limit passed, not a forbidden construct
 
 
 class LimitError(Exception):
@@ -139,7 +140,7 @@ def checked(value: Any) -> Any:
         pass
     elif isinstance(value, int):
         if value.bit_length() > MAX_INT_BITS:
-            raise RefusedError(f"an integer of more than {MAX_INT_BITS} bits")
+            raise RefusedError(f"an integer of more than {MAX_INT_BITS} bits", too_large=True)
     elif isinstance(value, list | tuple | dict):
         items = value.items() if isinstance(value, dict) else enumerate(value)
         for key, item in items:
@@ -148,7 +149,7 @@ def checked(value: Any) -> Any:
     else:
         raise RefusedError(f"a value of type {type(value).__name__} (only numbers, strings and lists of them)")
     if size(value) > MAX_ITEMS:
-        raise RefusedError(f"a string or list of more than {MAX_ITEMS} items")
+        raise RefusedError(f"a string or list of more than {MAX_ITEMS} items", too_large=True)
     return value
 
 
@@ -274,23 +275,23 @@ def _check_operands(op: ast.operator, left: Any, right: Any) -> None:
 
 def _check_power(left: Any, right: Any) -> None:
     if _is_int(left) and _is_int(right) and right > 0 and abs(left) > 1 and left.bit_length() * right > MAX_INT_BITS:
-        raise RefusedError(f"a power of more than {MAX_INT_BITS} bits")
+        raise RefusedError(f"a power of more than {MAX_INT_BITS} bits", too_large=True)
 
 
 def _check_repetition(left: Any, right: Any) -> None:
     for seq, count in ((left, right), (right, left)):
         if isinstance(seq, str | list | tuple) and _is_int(count) and size(seq) * max(count, 0) > MAX_ITEMS:
-            raise RefusedError(f"a repetition of more than {MAX_ITEMS} items")
+            raise RefusedError(f"a repetition of more than {MAX_ITEMS} items", too_large=True)
 
 
 def _check_format(left: Any, _right: Any) -> None:
     if isinstance(left, str) and _WIDE_FORMAT.search(left):
-        raise RefusedError("a '%' format wider than 999 characters")
+        raise RefusedError("a '%' format wider than 999 characters", too_large=True)
 
 
 def _check_concatenation(left: Any, right: Any) -> None:
     if isinstance(left, str | list | tuple) and size(left) + size(right) > MAX_ITEMS:
-        raise RefusedError(f"a string or list of more than {MAX_ITEMS} items")
+        raise RefusedError(f"a string or list of more than {MAX_ITEMS} items", too_large=True)
 
 
 _OPERAND_CHECKS: dict[type[ast.operator], Callable[[Any, Any], None]] = {

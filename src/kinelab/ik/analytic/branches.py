@@ -42,7 +42,7 @@ from kinelab.ik.driver import solve_one
 from kinelab.ik.limits import distance, inside_limits
 from kinelab.ik.request import Request, make_request, verdict_reserve
 from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
-from kinelab.ik.targets import as_target_arrays, beyond_reach
+from kinelab.ik.targets import as_target_arrays, beyond_reach, reach_bound
 from kinelab.robot import Robot
 from kinelab.robot.model import _compiled_judge
 
@@ -116,6 +116,10 @@ def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | No
     """
     t0 = time.perf_counter()
     arm = arm_of(robot, req)
+    beyond = beyond_reach(robot, target.translation)
+    if beyond:  # proved unreachable: no root to look for (the elimination overflows at 1e155 m)
+        return branch_results(robot, Rows.of([], robot.n), req, arm.mode, time.perf_counter() - t0, max_solutions,
+                              _method(arm), "", "", beyond=beyond)
     form = prepared_form(robot, req)
     compiled = None if form is None else form.solve(target.homogeneous, q_ref)
     if compiled is not None and ((compiled[3] > 1) & ~compiled[4]).any():
@@ -473,6 +477,7 @@ def all_branches_batch(robot: Robot, targets: Any, tol_pos: float = 1e-6, tol_ro
     late = near == ROW_NOT_STARTED
     if arm.kind == GENERAL_6R:  # no root, or roots merged: the root-by-root route says why, or splits them
         near |= (count == 0) | ((found > 1) & ~free).any(axis=1)
+    near &= ~beyond_reach_rows(robot, H)  # proved unreachable: no root to look for
     for b in np.flatnonzero(near & ~late):
         if time.perf_counter() > deadline:
             late[b] = True
@@ -486,12 +491,18 @@ def all_branches_batch(robot: Robot, targets: Any, tol_pos: float = 1e-6, tol_ro
                        late=None if time_budget is None else late)
 
 
+def beyond_reach_rows(robot: Robot, H: np.ndarray) -> np.ndarray:
+    """(B,) True where pose b's point lies beyond the robot's reach bound (no configuration reaches it)."""
+    anchor, radius = reach_bound(robot)
+    return np.asarray(np.linalg.norm(H[:, :3, 3] - np.asarray(anchor), axis=1) > radius)
+
+
 def _pinocchio_batch(robot: Robot, arm: ArmClass, H: np.ndarray, req: Request, deadline: float) -> BranchBatch:
     """:func:`all_branches_batch` where Pinocchio's FK judges: the closed form in threads, then every branch judged
     in one FK batch; a root that falls short is dropped. Pose by pose (the elimination, Pieper's decoupling) the
     poses not started before ``deadline`` are left."""
     B, n = H.shape[0], arm.n
-    late = np.zeros(B, dtype=np.bool_)
+    late, far = np.zeros(B, dtype=np.bool_), beyond_reach_rows(robot, H)
     out = np.full((B, MAX_ROWS, n), np.nan)
     found, free = np.zeros((B, MAX_ROWS), dtype=np.int64), np.zeros((B, MAX_ROWS), dtype=np.bool_)
     count = np.zeros(B, dtype=np.int64)
@@ -503,6 +514,9 @@ def _pinocchio_batch(robot: Robot, arm: ArmClass, H: np.ndarray, req: Request, d
                 late[b:] = True
                 reasons += [""] * (B - b)
                 break
+            if far[b]:
+                reasons.append("")
+                continue
             q, merged, loose, why = roots_within(arm, H[b], robot.lower, robot.upper, None, limit_slack(req.tol_rot))
             k = count[b] = len(q)
             out[b, :k], found[b, :k], free[b, :k] = q, merged, loose
@@ -512,6 +526,8 @@ def _pinocchio_batch(robot: Robot, arm: ArmClass, H: np.ndarray, req: Request, d
             if time.perf_counter() > deadline:
                 late[b:] = True
                 break
+            if far[b]:
+                continue
             q, merged, loose = arm_roots(arm, H[b], robot.lower, robot.upper, None, limit_slack(req.tol_rot))
             k = count[b] = len(q)
             out[b, :k], found[b, :k], free[b, :k] = q, merged, loose
@@ -649,6 +665,8 @@ def analytic_one(robot: Robot, target: Any, req: Request, q0: np.ndarray | None,
     """
     t0 = time.perf_counter()
     arm = arm_of(robot, req)
+    if beyond_reach(robot, target.translation):  # proved unreachable: no root to look for
+        return _no_branch(robot, target, req, q0, 0, (None, None), arm.mode, t0)
     q, found, free, order = nearest_roots(robot, arm, target, req, q0)
     k, verdict, collided = _first_clear(robot, q, order, target, req, model)
     if verdict is not None:

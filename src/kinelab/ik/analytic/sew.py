@@ -200,9 +200,11 @@ def sew_angle(robot: Robot, q: Any, sew: SEW | None = None) -> float:
     """The SEW angle ψ [rad] of the 7R robot at q (rad), by ``sew``'s reference (None: the default one).
 
     Raises:
-        OptionError: the robot is not a 7R chain.
+        OptionError: the robot is not a 7R chain, or ``sew`` is not a SEW.
         ConfigurationError: q is not a valid configuration.
     """
+    if sew is not None and not isinstance(sew, SEW):
+        raise OptionError("sew", sew, "a kinelab.SEW(angle, singular=, reference=), or None (the default reference)")
     chain7_vectors(robot)
     arm = arm7(robot)
     return (sew or SEW(0.0)).of(*arm.points(robot.check_q(q)))
