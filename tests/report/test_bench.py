@@ -211,7 +211,10 @@ def test_every_budgeted_path_runs_until_its_budget_and_is_reported():
 
     rows = loops.budgets(kinelab.load("ur5"), budget=0.004, n=3)
     assert [r["solver"] for r in rows] == ["frdm", "biquat", "dls", "frdm IK.solve", "frdm batch of 64",
-                                           "frdm solve_all", "frdm prefer=", "frdm collisions", "frdm track of 50"]
+                                           "frdm solve_all", "frdm prefer=", "frdm collisions", "frdm track of 50",
+                                           "analytic solve", "analytic batch of 100", "solve_all_batch of 1000"]
+    # the closed form's paths (#57) prove in microseconds that no branch meets 1e-300: they need no budget
+    rows = [r for r in rows if not r["solver"].startswith(("analytic", "solve_all_batch"))]
     # each path spends most of its budget on a target it cannot meet: none returns at once (a path that ignored the
     # budget, or gave up early, would). Not "at least 4 ms": the batch and solve_all keep back time for their
     # verdicts, by an estimate a fast judge beats, and a wall-clock bound is the bench's to measure, not a test's.

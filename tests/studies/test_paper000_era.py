@@ -124,7 +124,9 @@ def test_shoulder_with_q7_frozen_closes_every_lap_too():
 def test_shoulder_without_bypass_q1_and_q7_climb_together_until_the_stop(shoulder):
     passage, run = shoulder
     res = run.without
-    _every_sample_reached(res)
+    # every sample's pose met; since #57 the one reached by the whole turn at the stop is a jump, not reached
+    assert (res.position_error <= 1e-6).all() and (res.rotation_error <= 1e-6).all()
+    assert list(np.flatnonzero(~res.reached)) == list(np.flatnonzero(res.status == "jump")) and (~res.reached).sum() == 1
     laps = np.rad2deg(ep.lap_changes(res, passage))
     assert (laps[:2, 0] > 60).all()  # the arm turns with the tool, lap after lap
     np.testing.assert_allclose(laps[:, 0], laps[:, 6], atol=1e-6)  # q1 and q7 in phase

@@ -43,8 +43,9 @@ def add(sub: Any) -> None:
                    help="a 7R arm: every branch with the elbow at this SEW angle (rad, degrees with --deg; "
                         "docs/analytic.md, The SEW angle)")
     seed_argument(s)
-    s.add_argument("--time-budget", type=float, default=0.05,
-                   help="the multistart's wall-clock budget [s] (default 0.05); the closed form needs none")
+    s.add_argument("--time-budget", type=float, default=None,
+                   help="the search's wall-clock budget [s] (default: 0.05 for the multistart, 5 for --redundancy and "
+                        "--sew); the closed form needs none")
     s.add_argument("--html", help="also write the branches side by side, labelled, as a self-contained page")
     source_arguments(s)
     json_flag(s, "the branches")
@@ -59,7 +60,7 @@ def run(args: argparse.Namespace) -> int:
     robot = load_robot(args)
     target = target_of(robot, args)
     ref = None if args.ref_q is None else q_from_cli(robot, args.ref_q, args.deg, "--ref-q")
-    found = solve_all(robot, target, solver=args.solver, seed=args.seed, time_budget=args.time_budget, q_ref=ref,
+    found = solve_all(robot, target, solver=args.solver, seed=args.seed, time_budget="auto" if args.time_budget is None else args.time_budget, q_ref=ref,
                       redundancy=_redundancy(args))
     if args.json:
         print_json({"robot": robot.name, "target": pose_dict(target), "method": _method(found),

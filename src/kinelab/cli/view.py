@@ -76,8 +76,10 @@ def run_animate(args: argparse.Namespace) -> int:
     for k, target in enumerate(one_lap[:: max(1, len(one_lap) // 8)]):
         scene.frame(f"target{k}", target, 0.5 * scene.frame_length)
     summary = result.summary()
+    jumps = summary["status"].get("jump", 0)
     print(f"{args.passage} {'without' if args.without_bypass else 'with'} bypass: {summary['reached']} of "
-          f"{summary['samples']} samples reached, largest joint step {summary['max_joint_step']:.3f} rad, "
+          f"{summary['samples']} samples reached{f' ({jumps} met by a jump)' if jumps else ''}, largest joint step "
+          f"{summary['max_joint_step']:.3f} rad, "
           f"{plural(summary['monitor_events'], 'monitor event')}")
     return _publish(scene, args.html)
 
