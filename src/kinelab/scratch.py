@@ -1,4 +1,4 @@
-"""Private temporary folders that go away with what needs them: a xacro expansion lives as long as its Robot,
+"""Private temporary folders that go away with what needs them: a xacro expansion lives as long as its Chain,
 a bench's stripped URDFs as long as the process; none is left in the temporary directory afterwards."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Analyses of a Robot at one or many configurations.
+"""Analyses of a Chain at one or many configurations.
 
 - :mod:`~kinelab.analysis.singular`: the singularity picture at one configuration.
 - :mod:`~kinelab.analysis.families`: sweeps, refinement onto the singular set, families.

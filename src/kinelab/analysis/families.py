@@ -15,14 +15,14 @@ from kinelab.analysis.singular import NEAR_SINGULAR, analyze, scaled_jacobian
 from kinelab.errors import KinelabError
 from kinelab.ik.request import check_seed
 from kinelab.progress import bar
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 RELATION_TOL = 1e-3  # [rad or m] a joint relation holds within this
 SPECIAL_VALUES = (0.0, np.pi / 2, -np.pi / 2, np.pi, -np.pi, 2 * np.pi, -2 * np.pi)
 FAMILY_MARGIN = 0.1  # [rad] a sample this close to every relation of a known family is explained by it
 
 
-def sigma_ratio_batch(robot: Robot, qs: np.ndarray, length: float | None = None,
+def sigma_ratio_batch(robot: Chain, qs: np.ndarray, length: float | None = None,
                       progress: bool | None = False) -> np.ndarray:
     """σ_min/σ_max of the scaled Jacobian for each row of ``qs`` (one batched SVD)."""
     L = length or robot.characteristic_length()
@@ -36,7 +36,7 @@ def sigma_ratio_batch(robot: Robot, qs: np.ndarray, length: float | None = None,
     return s[:, full - 1] / s[:, 0]
 
 
-def refine(robot: Robot, q0, lower=None, upper=None, length: float | None = None) -> np.ndarray:
+def refine(robot: Chain, q0, lower=None, upper=None, length: float | None = None) -> np.ndarray:
     """Move q0 onto the singular set: minimise σ_min/σ_max within the joint box (L-BFGS-B)."""
     from scipy.optimize import minimize
 
@@ -74,7 +74,7 @@ def _label(c: float) -> str:
     return f"{c:.6g}"
 
 
-def _values(robot: Robot, index: tuple[int, ...]) -> list[float]:
+def _values(robot: Chain, index: tuple[int, ...]) -> list[float]:
     """Values a relation on these joints is tried at: 0, ±π/2, ±π, ±2π (angles), and a single joint's limits."""
     out = [0.0] if robot.joint_kinds[index[0]] == "prismatic" and len(index) == 1 else list(SPECIAL_VALUES)
     if len(index) == 1:
@@ -83,7 +83,7 @@ def _values(robot: Robot, index: tuple[int, ...]) -> list[float]:
     return out
 
 
-def _combos(robot: Robot) -> list[tuple[tuple[int, ...], tuple[int, ...]]]:
+def _combos(robot: Chain) -> list[tuple[tuple[int, ...], tuple[int, ...]]]:
     """Single joints (any kind), sums and differences of two and of three angular joints."""
     angular = [i for i, k in enumerate(robot.joint_kinds) if k != "prismatic"]
     combos: list[tuple[tuple[int, ...], tuple[int, ...]]] = [((i,), (1,)) for i in range(robot.n)]
@@ -93,7 +93,7 @@ def _combos(robot: Robot) -> list[tuple[tuple[int, ...], tuple[int, ...]]]:
     return combos
 
 
-def joint_relations(robot: Robot, q, tol: float = RELATION_TOL) -> list[Relation]:
+def joint_relations(robot: Chain, q, tol: float = RELATION_TOL) -> list[Relation]:
     """Simple relations the configuration satisfies: single joints at 0, ±π/2, ±π, ±2π or at a limit; sums
     and differences of two or three angular joints at 0, ±π/2, ±π, ±2π (joint names in the text); relations
     implied by single-joint ones (θ2 = 0 and θ3 = 0 imply θ2 ± θ3 = 0) are left out."""
@@ -119,7 +119,7 @@ MOVES = 8  # configurations a relation set is tested at, away from the one it wa
 MOVE = 0.5  # [rad] (a tenth of the range for a slide) how far the other joints move
 
 
-def moved_along(robot: Robot, relations: list[Relation], q, rng: np.random.Generator) -> np.ndarray | None:
+def moved_along(robot: Chain, relations: list[Relation], q, rng: np.random.Generator) -> np.ndarray | None:
     """q with every joint moved at random, then put back on the relations (the nearest point satisfying all of
     them); None when that leaves the limits."""
     span = np.where(np.isfinite(robot.upper - robot.lower), robot.upper - robot.lower, 2 * np.pi)
@@ -136,7 +136,7 @@ def moved_along(robot: Robot, relations: list[Relation], q, rng: np.random.Gener
     return moved
 
 
-def holds_along(robot: Robot, relations: list[Relation], q, seed: int = 0, length: float | None = None) -> float:
+def holds_along(robot: Chain, relations: list[Relation], q, seed: int = 0, length: float | None = None) -> float:
     """The share of MOVES configurations satisfying ``relations`` (moved from q, see :func:`moved_along`) at
     which the Jacobian loses rank: 1.0 when the relations are enough for the singularity."""
     rng = np.random.default_rng(seed)
@@ -152,7 +152,7 @@ def holds_along(robot: Robot, relations: list[Relation], q, seed: int = 0, lengt
     return hits / tries if tries else 0.0
 
 
-def characterise(robot: Robot, q, length: float | None = None) -> tuple[list[Relation], bool]:
+def characterise(robot: Chain, q, length: float | None = None) -> tuple[list[Relation], bool]:
     """The relations that explain the singularity at q, and whether they do: the simple relations q satisfies,
     pruned to those without which the rank drop no longer holds along the family (coincidences such as a
     last joint at π/2 go); (relations found, False) when even all of them do not keep the rank down."""
@@ -205,7 +205,7 @@ class Family:
                 "sigma_min_over_max": self.sigma_ratio}
 
 
-def sweep_limits(robot: Robot) -> tuple[np.ndarray, np.ndarray, list[str]]:
+def sweep_limits(robot: Chain) -> tuple[np.ndarray, np.ndarray, list[str]]:
     """The box a sweep samples, and notes for joints whose range is not a finite limit."""
     notes = []
     for j in robot.joints:
@@ -214,7 +214,7 @@ def sweep_limits(robot: Robot) -> tuple[np.ndarray, np.ndarray, list[str]]:
     return robot.lower.copy(), robot.upper.copy(), notes
 
 
-def grid(robot: Robot, samples: int, rng: np.random.Generator) -> np.ndarray:
+def grid(robot: Chain, samples: int, rng: np.random.Generator) -> np.ndarray:
     """A stratified grid over the joint box: k cells per joint (k^n ≤ samples, k ≥ 2), one sample per cell,
     jittered within it. (A plain grid puts joints on 0 and ±π/2 together, where every relation holds.)"""
     k = max(2, int(np.floor(samples ** (1.0 / robot.n) + 1e-9)))
@@ -226,12 +226,12 @@ def grid(robot: Robot, samples: int, rng: np.random.Generator) -> np.ndarray:
 MAX_SWEEP_BYTES = 2**30  # [bytes] the largest sweep that runs without force=True
 
 
-def sweep_bytes(robot: Robot, samples: int) -> int:
+def sweep_bytes(robot: Chain, samples: int) -> int:
     """Memory a sweep of ``samples`` configurations needs: the samples, their 6 × n Jacobians and σ."""
     return 8 * samples * (robot.n + 6 * robot.n + min(6, robot.n) + 1)
 
 
-def check_sweep_size(robot: Robot, samples: int, force: bool = False) -> None:
+def check_sweep_size(robot: Chain, samples: int, force: bool = False) -> None:
     """Refuse a sweep whose memory estimate passes MAX_SWEEP_BYTES (unless ``force``), or a count < 1.
 
     Raises:
@@ -271,7 +271,7 @@ class SweepResult:
                 "singular": self.singular, "notes": self.notes, "families": [f.to_dict() for f in self.families]}
 
 
-def sweep(robot: Robot, samples: int = 5000, seed: int = 0, refine_top: int = 40, progress: bool = False,
+def sweep(robot: Chain, samples: int = 5000, seed: int = 0, refine_top: int = 40, progress: bool = False,
           method: str = "random") -> SweepResult:
     """Sample the joint box (seeded uniform samples, or a full grid), keep near-singular configurations,
     refine them onto the singular set, and group those that are singular into families by the joint
@@ -302,7 +302,7 @@ def sweep(robot: Robot, samples: int = 5000, seed: int = 0, refine_top: int = 40
                        ratios)
 
 
-def _refine_samples(robot: Robot, qs: np.ndarray, order: list[int], lower: np.ndarray, upper: np.ndarray,
+def _refine_samples(robot: Chain, qs: np.ndarray, order: list[int], lower: np.ndarray, upper: np.ndarray,
                     L: float, refine_top: int, progress: bool) -> tuple[dict, int, int]:
     """Refine the most singular samples that no family found so far explains; group the singular ones.
 

@@ -1,4 +1,4 @@
-"""Independent references for a Robot's model: yourdfpy's FK against Pinocchio's, Pinocchio's Jacobians
+"""Independent references for a Chain's model: yourdfpy's FK against Pinocchio's, Pinocchio's Jacobians
 against finite differences. Used by the tests and by ``kinelab validate``; each returns measured figures.
 
 yourdfpy is a second URDF reader, independent of Pinocchio; meshes are never loaded, so kinematics
@@ -14,7 +14,7 @@ import yourdfpy
 
 from kinelab.errors import ChainError
 from kinelab.geometry import pose_error
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 
 @dataclass(frozen=True)
@@ -28,7 +28,7 @@ class Agreement:
     max_rotation: float  # [rad] for FK checks; max abs entry difference for Jacobian checks
 
 
-def fk_vs_yourdfpy(robot: Robot, count: int = 1000, seed: int = 0) -> Agreement:
+def fk_vs_yourdfpy(robot: Chain, count: int = 1000, seed: int = 0) -> Agreement:
     """Tool pose from Pinocchio and from yourdfpy at ``count`` random configurations within limits."""
     other = YourdfpyFK(robot)
     worst_p = worst_r = 0.0
@@ -38,7 +38,7 @@ def fk_vs_yourdfpy(robot: Robot, count: int = 1000, seed: int = 0) -> Agreement:
     return Agreement(robot.name, "fk_vs_yourdfpy", count, worst_p, worst_r)
 
 
-def jacobian_local_fd(robot: Robot, q, eps: float = 1e-6) -> np.ndarray:
+def jacobian_local_fd(robot: Chain, q, eps: float = 1e-6) -> np.ndarray:
     """Central finite-difference LOCAL tool Jacobian: log6 of the tool displacement, steps by pin.integrate."""
     q = robot.check_q(q)
     oMtool = robot.fk(q)
@@ -52,7 +52,7 @@ def jacobian_local_fd(robot: Robot, q, eps: float = 1e-6) -> np.ndarray:
     return J
 
 
-def jacobians_vs_fd(robot: Robot, count: int = 100, seed: int = 0, eps: float = 1e-6) -> Agreement:
+def jacobians_vs_fd(robot: Chain, count: int = 100, seed: int = 0, eps: float = 1e-6) -> Agreement:
     """Pinocchio's LOCAL, WORLD and LOCAL_WORLD_ALIGNED tool Jacobians against finite differences.
 
     The LOCAL Jacobian is compared with differences directly; the other two with the difference
@@ -74,7 +74,7 @@ def jacobians_vs_fd(robot: Robot, count: int = 100, seed: int = 0, eps: float = 
     return Agreement(robot.name, "jacobians_vs_fd", count, 0.0, worst)
 
 
-def tool_link(robot: Robot) -> str:
+def tool_link(robot: Chain) -> str:
     """The URDF link whose placement is the tool frame's (yourdfpy knows links, not joint frames)."""
     frames = robot.model.frames
     fid = robot.tool_frame_id
@@ -90,7 +90,7 @@ class YourdfpyFK:
     """FK of the robot's tool link relative to its base link (the URDF root unless ``load(base=...)``),
     computed by yourdfpy."""
 
-    def __init__(self, robot: Robot):
+    def __init__(self, robot: Chain):
         self.robot = robot
         self.urdf = yourdfpy.URDF.load(
             str(robot.urdf_path), build_scene_graph=True, load_meshes=False,

@@ -2,7 +2,7 @@
 
 Units. A tool twist mixes m/s and rad/s, so the singular values of a raw Jacobian depend on the unit of
 length. kinelab divides the linear rows by the chain's characteristic length L (the mean spacing of its
-joint origins, :meth:`Robot.characteristic_length`): the scaled Jacobian maps joint rates to
+joint origins, :meth:`Chain.characteristic_length`): the scaled Jacobian maps joint rates to
 (v/L, ω), both in 1/s, and its singular values, condition number and manipulability are
 dimensionless (for revolute chains; a prismatic column carries 1/L). The rank is the number of singular
 values above ``RANK_RTOL``·σ_max. The rank itself does not depend on L or on the frame: only the
@@ -20,7 +20,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from kinelab.errors import OptionError
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 RANK_RTOL = 1e-6  # singular values below RANK_RTOL × σ_max count as zero
 NEAR_SINGULAR = 1e-2  # σ_min/σ_max below this: worth refining onto the singular set
@@ -61,7 +61,7 @@ class Analysis:
         }
 
 
-def scaled_jacobian(robot: Robot, q, length: float | None = None) -> np.ndarray:
+def scaled_jacobian(robot: Chain, q, length: float | None = None) -> np.ndarray:
     """6 × n LOCAL_WORLD_ALIGNED tool Jacobian with the linear rows divided by L."""
     L = length or robot.characteristic_length()
     J = robot.jacobian_local_world_aligned(q)
@@ -135,7 +135,7 @@ def checked_length(length: object) -> float:
     return float(length)  # type: ignore[arg-type]
 
 
-def analyze(robot: Robot, q, length: float | None = None) -> Analysis:
+def analyze(robot: Chain, q, length: float | None = None) -> Analysis:
     """SVD of the scaled tool Jacobian at q: rank, σ, manipulability, condition, lost and null directions.
 
     Args:

@@ -24,7 +24,7 @@ from kinelab.progress import step
 if TYPE_CHECKING:
     from kinelab.ik.analytic.sew import SEW
     from kinelab.ik.result import Branches, IKResult
-    from kinelab.robot import Robot
+    from kinelab.robot import Chain
 
 
 def add(sub: Any) -> None:
@@ -60,7 +60,8 @@ def run(args: argparse.Namespace) -> int:
     robot = load_robot(args)
     target = target_of(robot, args)
     ref = None if args.ref_q is None else q_from_cli(robot, args.ref_q, args.deg, "--ref-q")
-    found = solve_all(robot, target, solver=args.solver, seed=args.seed, time_budget="auto" if args.time_budget is None else args.time_budget, q_ref=ref,
+    budget = "auto" if args.time_budget is None else args.time_budget
+    found = solve_all(robot, target, solver=args.solver, seed=args.seed, time_budget=budget, q_ref=ref,
                       redundancy=_redundancy(args))
     if args.json:
         print_json({"robot": robot.name, "target": pose_dict(target), "method": _method(found),
@@ -112,7 +113,7 @@ def _completeness(found: Branches) -> str:
     return f"{COMPLETENESS.get(found.method, found.method)} (complete: {how})"
 
 
-def _print_branches(robot: Robot, args: argparse.Namespace, found: Branches, ref: Any) -> None:
+def _print_branches(robot: Chain, args: argparse.Namespace, found: Branches, ref: Any) -> None:
     """One line per branch: its configuration and Pinocchio's errors (nearest ``ref`` first when given)."""
     import numpy as np
 
@@ -131,7 +132,7 @@ def _print_branches(robot: Robot, args: argparse.Namespace, found: Branches, ref
               "loads the solver)")
 
 
-def _write_page(robot: Robot, found: Sequence[IKResult], path: str, target: Any, ref: Any, deg: bool) -> None:
+def _write_page(robot: Chain, found: Sequence[IKResult], path: str, target: Any, ref: Any, deg: bool) -> None:
     """The branches side by side, numbered in the scene as in the table of their joints under the caption (the
     target's point marked at each; with ``ref``, the nearest first, orange, its distance in the table)."""
     from kinelab.view.scene import side_by_side
@@ -154,7 +155,7 @@ def _write_page(robot: Robot, found: Sequence[IKResult], path: str, target: Any,
     print(f"wrote {path}")
 
 
-def _joint_table(robot: Robot, found: Sequence[IKResult], ref: Any, deg: bool) -> Any:
+def _joint_table(robot: Chain, found: Sequence[IKResult], ref: Any, deg: bool) -> Any:
     """Every branch's joints (rad and m; degrees and m with ``deg``), and with ``ref`` each one's distance to it
     (the largest joint difference, revolute joints modulo 2π), the nearest marked."""
     import numpy as np

@@ -20,7 +20,7 @@ if TYPE_CHECKING:
     import numpy as np
     import pinocchio as pin
 
-    from kinelab.robot import Robot
+    from kinelab.robot import Chain
 
 
 class Parser(argparse.ArgumentParser):
@@ -77,7 +77,7 @@ def count(text: str) -> int:
     return value
 
 
-def q_from_cli(robot: Robot, values: list[str], deg: bool, what: str = "q") -> np.ndarray:
+def q_from_cli(robot: Chain, values: list[str], deg: bool, what: str = "q") -> np.ndarray:
     """One number per joint (rad or m; degrees with --deg), or the name of an SRDF configuration.
 
     Raises:
@@ -113,7 +113,7 @@ def _is_number(text: str) -> bool:
     return True
 
 
-def load_robot(args: argparse.Namespace) -> Robot:
+def load_robot(args: argparse.Namespace) -> Chain:
     """The robot a per-robot command names, with its --tool, --base, --srdf, --group, --package-dir and
     --xacro-arg."""
     from kinelab.robot import load

@@ -29,7 +29,7 @@ if TYPE_CHECKING:
     import numpy as np
 
     from kinelab.ik.result import IKResult
-    from kinelab.robot import Robot
+    from kinelab.robot import Chain
 
 SOLVER_FLAGS = (("--polish", "polish", "polish"), ("--law", "law", "law"), ("--integrator", "integrator", "integrator"),
                 ("--step", "step", "step"), ("--gain", "gain", "k"))  # (flag, its argparse name, the option field)
@@ -121,9 +121,9 @@ def run(args: argparse.Namespace) -> int:
     return 0 if result.success else 1
 
 
-def _start(robot: Robot, args: argparse.Namespace) -> tuple[np.ndarray | None, str]:
+def _start(robot: Chain, args: argparse.Namespace) -> tuple[np.ndarray | None, str]:
     """The first start [rad, m] and where it comes from: --start-q (``random``: drawn from the seed, None), else
-    the robot's reference configuration (:meth:`~kinelab.robot.Robot.reference_q`)."""
+    the robot's reference configuration (:meth:`~kinelab.robot.Chain.reference_q`)."""
     if args.start_q == ["random"]:
         return None, "drawn at random from the seed (--start-q random)"
     if args.start_q is not None:
@@ -132,12 +132,12 @@ def _start(robot: Robot, args: argparse.Namespace) -> tuple[np.ndarray | None, s
     return q0, f"{how} (give --start-q for another)"
 
 
-def target_of(robot: Robot, args: argparse.Namespace) -> Any:
+def target_of(robot: Chain, args: argparse.Namespace) -> Any:
     """The target pose of ``--target-q`` or ``--target-xyz``/``--target-rpy`` (shared with ``kinelab branches``)."""
     return _target(robot, args)[0]
 
 
-def _target(robot: Robot, args: argparse.Namespace) -> tuple[Any, dict[str, Any]]:
+def _target(robot: Chain, args: argparse.Namespace) -> tuple[Any, dict[str, Any]]:
     """The target pose, and the biquaternion solver's signed target when it is given as a configuration."""
     import numpy as np
 
@@ -162,7 +162,7 @@ def _target(robot: Robot, args: argparse.Namespace) -> tuple[Any, dict[str, Any]
     return robot.fk(q_target), options
 
 
-def _bypass_value(robot: Robot, joint: str, text: str, deg: bool, flag: str) -> float:
+def _bypass_value(robot: Chain, joint: str, text: str, deg: bool, flag: str) -> float:
     import numpy as np
 
     try:
@@ -188,7 +188,7 @@ def _refuse_other_solvers_flags(args: argparse.Namespace) -> None:
         raise KinelabError(f"--axis {args.axis} names the tool axis of --task axis; the task is {args.task}")
 
 
-def _bypass_options(robot: Robot, args: argparse.Namespace) -> dict[str, Any]:
+def _bypass_options(robot: Chain, args: argparse.Namespace) -> dict[str, Any]:
     """FRDM's bypass tables from --kick J=D, --interval J=LO:HI and --freeze J[=V] (rad, m; deg with --deg), with
     the policy :func:`kinelab.ik.frdm.options.bypass_plan` gives for --on-singular."""
     specs = {"kicks": args.kick or [], "intervals": args.interval or [], "freeze": args.freeze or []}
@@ -227,7 +227,7 @@ def _split_spec(spec: str, flag: str, form: str) -> tuple[str, str]:
     return joint, value
 
 
-def _print_ik(robot: Robot, args: argparse.Namespace, result: IKResult) -> None:
+def _print_ik(robot: Chain, args: argparse.Namespace, result: IKResult) -> None:
     """The text form of an IK result: status, q, Pinocchio's errors on the task's components, effort."""
     import numpy as np
 

@@ -27,7 +27,7 @@ from kinelab.collision.obstacles import Environment
 from kinelab.collision.spheres import PLANE, Frames
 from kinelab.collision.spheres import candidates as sphere_candidates
 from kinelab.errors import KinelabError
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 from kinelab.robot.meshes import mesh_package_dirs, missing_meshes
 from kinelab.robot.mjcf import is_mjcf
 
@@ -102,7 +102,7 @@ class CollisionModel:
     point ``centres`` and unit ``normals`` (base frame).
     """
 
-    robot: Robot
+    robot: Chain
     geom: pin.GeometryModel
     pairs: np.ndarray  # (P, 2) object indices, the moving object first
     centres: np.ndarray  # (G, 3) sphere centres in each object's joint frame [m]
@@ -206,8 +206,8 @@ class CollisionModel:
                        float(distance))
 
 
-def collision_model(robot: Robot, collisions: Collisions) -> CollisionModel:
-    """The robot's collision model for ``collisions``, built once per Robot and setting.
+def collision_model(robot: Chain, collisions: Collisions) -> CollisionModel:
+    """The robot's collision model for ``collisions``, built once per Chain and setting.
 
     Raises:
         CollisionError: the robot has no collision geometry (an in-memory model, or a file without
@@ -219,7 +219,7 @@ def collision_model(robot: Robot, collisions: Collisions) -> CollisionModel:
     return models[collisions]
 
 
-def _build(robot: Robot, collisions: Collisions) -> CollisionModel:
+def _build(robot: Chain, collisions: Collisions) -> CollisionModel:
     _check_meshes(robot)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # missing meshes were refused above, by name
@@ -246,7 +246,7 @@ def _build(robot: Robot, collisions: Collisions) -> CollisionModel:
                           joints.astype(np.int64), float(collisions.margin), summary, collisions, _frames(robot))
 
 
-def _frames(robot: Robot) -> Frames | None:
+def _frames(robot: Chain) -> Frames | None:
     """The model's joints as the compiled sphere test reads them; None when a joint is not one of the chain's
     (a mimic follower): the sphere test is then skipped."""
     model = robot.model
@@ -281,7 +281,7 @@ def _hulls(geom: pin.GeometryModel) -> pin.GeometryModel:
     return hulls
 
 
-def _check_meshes(robot: Robot) -> None:
+def _check_meshes(robot: Chain) -> None:
     """Refuse a robot whose collision meshes cannot all be found (a missing mesh would be a hole in the check);
     report SRDF pairs that name links the model does not have."""
     path = robot.urdf_path
@@ -300,7 +300,7 @@ def _check_meshes(robot: Robot) -> None:
                           f"{robot.name}'s model does not have; those pairs are ignored", stacklevel=3)
 
 
-def _self_pairs(robot: Robot, objects: list[Any], own: int) -> tuple[list[tuple[int, int]], tuple[int, int]]:
+def _self_pairs(robot: Chain, objects: list[Any], own: int) -> tuple[list[tuple[int, int]], tuple[int, int]]:
     """The robot's own pairs worth checking, and how many were left out as adjacent and as SRDF-disabled."""
     parents = robot.model.parents
     link = [robot.model.frames[o.parentFrame].name for o in objects[:own]]

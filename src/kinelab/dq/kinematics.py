@@ -1,7 +1,7 @@
 """Kinematics of a chain written with biquaternions (Chelnokov): Λ(q) and A(q).
 
 Λ(q) = Λ_1(q_1)∘…∘Λ_n(q_n)∘Λ_tool, with Λ_i(q_i) = Λ(placement_i)∘Λ(joint motion q_i): only the
-constant joint placements and axes are read from the Robot's model, the products are our own.
+constant joint placements and axes are read from the Chain's model, the products are our own.
 
 A(q) maps q̇ to U = ω + s v, the end link's angular velocity and the velocity of its origin, both in
 its own axes (2Λ̇ = Λ∘U). Column i is the joint's unit screw carried to the tool frame,
@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from kinelab.dq.algebra import DualQuat, qconj, qmul
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 
 def _joint_motion(kind: str, axis: np.ndarray, value: float) -> DualQuat:
@@ -25,23 +25,23 @@ def _joint_motion(kind: str, axis: np.ndarray, value: float) -> DualQuat:
     return DualQuat(np.r_[np.cos(half), np.sin(half) * axis], np.zeros(4))
 
 
-def _build_constants(robot: Robot) -> tuple[list[DualQuat], DualQuat]:
+def _build_constants(robot: Chain) -> tuple[list[DualQuat], DualQuat]:
     model = robot.model
     placements = [DualQuat.from_se3(model.jointPlacements[j]) for j in range(1, model.njoints)]
     return placements, DualQuat.from_se3(model.frames[robot.tool_frame_id].placement)
 
 
-def _constants(robot: Robot) -> tuple[list[DualQuat], DualQuat]:
-    """The joint placements and the tool placement as biquaternions, computed once per Robot."""
+def _constants(robot: Chain) -> tuple[list[DualQuat], DualQuat]:
+    """The joint placements and the tool placement as biquaternions, computed once per Chain."""
     return robot.derived("biquaternion_constants", _build_constants)
 
 
-def tool_in_last_joint(robot: Robot) -> DualQuat:
+def tool_in_last_joint(robot: Chain) -> DualQuat:
     """The constant tool placement in the last joint's frame, as a unit biquaternion."""
     return _constants(robot)[1]
 
 
-def chain(robot: Robot, q) -> list[DualQuat]:
+def chain(robot: Chain, q) -> list[DualQuat]:
     """Λ_0i for i = 1..n (joint frames after their motion, base frame) and, last, Λ of the tool."""
     q = robot.check_q(q)
     out, acc = [], DualQuat.identity()
@@ -53,7 +53,7 @@ def chain(robot: Robot, q) -> list[DualQuat]:
     return out
 
 
-def pose(robot: Robot, q) -> DualQuat:
+def pose(robot: Chain, q) -> DualQuat:
     """Λ(q): the tool's biquaternion in the base frame."""
     return chain(robot, q)[-1]
 
@@ -68,7 +68,7 @@ def screw_transform(screw: tuple[np.ndarray, np.ndarray], lam: DualQuat) -> tupl
     return real[1:], dual[1:]
 
 
-def a_matrix(robot: Robot, q) -> np.ndarray:
+def a_matrix(robot: Chain, q) -> np.ndarray:
     """A(q), 6 × n: (ω; v) of the end link in its own axes per unit joint rate (the paper's eq. 8)."""
     frames = chain(robot, q)
     tool = frames[-1]

@@ -30,7 +30,7 @@ from kinelab.ik.registry import Capabilities, capabilities, one_answer, refuse_o
 from kinelab.ik.request import Request, check_robot, make_request
 from kinelab.ik.result import Branches, IKResult, TrackResult
 from kinelab.ik.targets import as_target, as_target_arrays
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 if TYPE_CHECKING:  # the collision model and the closed forms load when a call asks for them
     from kinelab.collision.model import CollisionModel
@@ -49,10 +49,10 @@ _OLD_ORDER = {
 
 
 def check_entry(robot: Any, function: str, positional: tuple[Any, ...]) -> None:
-    """What every entry point checks first: a Robot, and nothing positional after the target.
+    """What every entry point checks first: a Chain, and nothing positional after the target.
 
     Raises:
-        ChainError: not a Robot. TypeError: a setting given positionally.
+        ChainError: not a Chain. TypeError: a setting given positionally.
     """
     check_robot(robot)
     if positional:
@@ -72,7 +72,7 @@ def refuse_positional(function: str, extra: tuple[Any, ...]) -> None:
                     f"{'s' if len(extra) > 1 else ''})")
 
 
-def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0: Any = None,
+def solve(robot: Chain, target: Any, *positional: Any, solver: str = "frdm", q0: Any = None,
           seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float = 1.0,
           max_restarts: int = 1000, start_outside_limits: str = "project", options: Any = None,
           task: str = "pose", axis: str = "z", prefer: Any = None, collisions: Any = None,
@@ -134,7 +134,7 @@ def solve(robot: Robot, target: Any, *positional: Any, solver: str = "frdm", q0:
     return _solve_preferring(robot, target, q0, seed, prefer, settings, kind)
 
 
-def _solve_preferring(robot: Robot, target: Any, q0: Any, seed: int | None, prefer: Any,
+def _solve_preferring(robot: Chain, target: Any, q0: Any, seed: int | None, prefer: Any,
                       settings: dict[str, Any], kind: Capabilities) -> IKResult:
     """``solve(prefer=...)`` with the rest of ``solve``'s settings (``settings``: its keywords but q0, seed and
     prefer; ``kind``: what the solver can do): the nearest branch in closed form for solver "analytic", else among
@@ -156,7 +156,7 @@ def _solve_preferring(robot: Robot, target: Any, q0: Any, seed: int | None, pref
     return _preferred(robot, target, req, prefer, check, Route.EITHER if closed else Route.MULTISTART)
 
 
-def _preferred(robot: Robot, target: Any, req: Request, prefer: Any, check: CollisionModel | None,
+def _preferred(robot: Chain, target: Any, req: Request, prefer: Any, check: CollisionModel | None,
                method: Route) -> IKResult:
     """``solve(prefer=)``: the (clear) branch nearest ``prefer`` among every branch found."""
     prepare(robot, req)  # not the budget's time
@@ -171,7 +171,7 @@ def _preferred(robot: Robot, target: Any, req: Request, prefer: Any, check: Coll
     return solve_clear_of(robot, target, None, replace(req, time_budget=left), check)
 
 
-def _closed_form_one(robot: Robot, target: Any, q0: Any, prefer: Any, collisions: Any, options: Any,
+def _closed_form_one(robot: Chain, target: Any, q0: Any, prefer: Any, collisions: Any, options: Any,
                      req: Request) -> IKResult:
     """``solve(solver="analytic")``: the branch nearest q0 (or ``prefer``), from the closed form."""
     from kinelab.ik.analytic import held
@@ -189,7 +189,7 @@ def _closed_form_one(robot: Robot, target: Any, q0: Any, prefer: Any, collisions
                         None if ref is None else robot.check_q(ref, what="q0"), collision_check(robot, collisions))
 
 
-def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frdm", q0: Any = None,
+def solve_batch(robot: Chain, targets: Any, *positional: Any, solver: str = "frdm", q0: Any = None,
                 seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6,
                 time_budget: float | None = None, max_restarts: int = 1000, start_outside_limits: str = "refuse",
                 options: Any = None, task: str = "pose", axis: str = "z", collisions: Any = None,
@@ -241,7 +241,7 @@ def solve_batch(robot: Robot, targets: Any, *positional: Any, solver: str = "frd
     return batch_clear_of(robot, targets, q0, req, collision_check(robot, collisions))
 
 
-def _closed_form_batch(robot: Robot, targets: Any, q0: Any, collisions: Any, options: Any,
+def _closed_form_batch(robot: Chain, targets: Any, q0: Any, collisions: Any, options: Any,
                        req: Request) -> BatchIKResult:
     """``solve_batch(solver="analytic")``: each row the branch nearest its start, from the closed form (a 7R arm's
     with its swept joint held at the start's value, :mod:`kinelab.ik.analytic.held`)."""
@@ -258,7 +258,7 @@ def _closed_form_batch(robot: Robot, targets: Any, q0: Any, collisions: Any, opt
     return nearest_batch(robot, targets, q0, req, collision_check(robot, collisions))
 
 
-def solve_all_batch(robot: Robot, targets: Any, *positional: Any, tol_pos: float = 1e-6,
+def solve_all_batch(robot: Chain, targets: Any, *positional: Any, tol_pos: float = 1e-6,
                     tol_rot: float = 1e-6, time_budget: float | None = None) -> BranchBatch:
     """Every branch of each target, arrays in, arrays out: in closed form, by the 1-D search or by the general 6R
     elimination, compiled, on all cores.
@@ -294,7 +294,7 @@ def solve_all_batch(robot: Robot, targets: Any, *positional: Any, tol_pos: float
     return all_branches_batch(robot, targets, tol_pos, tol_rot, time_budget)
 
 
-def solve_all(robot: Robot, target: Any, *positional: Any, solver: str = "auto", seed: int | None = None,
+def solve_all(robot: Chain, target: Any, *positional: Any, solver: str = "auto", seed: int | None = None,
               tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float | str | None = "auto",
               options: Any = None,
               task: str = "pose", axis: str = "z", q_ref: Any = None, max_solutions: int | None = None,
@@ -376,7 +376,7 @@ def _usual_all(q_ref: Any, max_solutions: Any, collisions: Any, redundancy: Any,
         and task == "pose" and axis == "z"
 
 
-def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any = None, solver: str = "frdm",
+def track(robot: Chain, targets: Sequence[Any] | Any, *positional: Any, q0: Any = None, solver: str = "frdm",
           seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float | None = None,
           options: Any = None, task: str = "pose", axis: str = "z", jump_limit: float | None = 0.2,
           restrict: tuple[str, ...] = (), hold: int = 10, rest_weight: float | None = None,
@@ -437,7 +437,7 @@ def track(robot: Robot, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
     return _follow_path(robot, points, rotations, q0, req, settings, collision_check(robot, collisions), t_start)
 
 
-def _follow_path(robot: Robot, points: np.ndarray, rotations: np.ndarray, q0: Any, req: Request,
+def _follow_path(robot: Chain, points: np.ndarray, rotations: np.ndarray, q0: Any, req: Request,
                  settings: PathSettings, check: CollisionModel | None, t_start: float) -> TrackResult:
     """:func:`track` once its settings and targets (points [m], rotations) are checked: the start (the first
     target's answer when q0 is None), the path, and the collision check of every answer when ``check`` is given."""
@@ -451,7 +451,7 @@ def _follow_path(robot: Robot, points: np.ndarray, rotations: np.ndarray, q0: An
     return path if check is None else clear_track(path, check)
 
 
-def _first_answer(robot: Robot, target: pin.SE3, req: Request, check: CollisionModel | None) -> np.ndarray:
+def _first_answer(robot: Chain, target: pin.SE3, req: Request, check: CollisionModel | None) -> np.ndarray:
     """Where a path without q0 starts: the answer to its first target, with the path's seed, tolerances and task
     (clear of collisions when the path checks them)."""
     first = solve(robot, target, seed=req.seed, tol_pos=req.tol_pos, tol_rot=req.tol_rot, task=req.task.name,

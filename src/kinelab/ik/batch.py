@@ -27,7 +27,7 @@ from kinelab.ik.registry import capabilities
 from kinelab.ik.request import Request
 from kinelab.ik.result import Status, status_counts
 from kinelab.ik.targets import as_target_arrays, reach_bound
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 # [s] kept out of the solvers' share of a budget: Pinocchio's FK and error per row (about 7 µs on a busy 2-core
 # machine), and the fixed cost of a call's arrays and thread start
@@ -79,7 +79,7 @@ class BatchIKResult:
                 "mode": self.mode}
 
 
-def run_batch(robot: Robot, targets: Any, q0: Any, req: Request) -> BatchIKResult:
+def run_batch(robot: Chain, targets: Any, q0: Any, req: Request) -> BatchIKResult:
     """Solve IK for every target of a batch (each a tool pose in the robot's base frame).
 
     Args:
@@ -121,7 +121,7 @@ def run_batch(robot: Robot, targets: Any, q0: Any, req: Request) -> BatchIKResul
     return judged_rows(robot, rows, points, rotations, req, seed, t0, mode)
 
 
-def prepare(robot: Robot, req: Request) -> bool:
+def prepare(robot: Chain, req: Request) -> bool:
     """Build what a batch of this request needs once per robot, before any clock starts: the solver's model and
     what :func:`prepare_robot` builds. No budget pays for this: a first call with a 50 ms budget once spent it all
     on the certificate and returned nothing.
@@ -135,7 +135,7 @@ def prepare(robot: Robot, req: Request) -> bool:
     return compiled
 
 
-def prepare_robot(robot: Robot) -> None:
+def prepare_robot(robot: Chain) -> None:
     """What the compiled kernels and the judge need once per robot, before any clock starts: the certified judge, the
     reach bound and the BLAS routines (the kernels themselves are compiled at install; a solver's own model is its
     ``prepare``'s)."""
@@ -149,7 +149,7 @@ def fresh_seed() -> int:
     return int(np.random.SeedSequence().generate_state(1, np.uint64)[0] >> np.uint64(2))
 
 
-def _from_table(robot: Robot, req: Request, q0: str | None) -> bool:
+def _from_table(robot: Chain, req: Request, q0: str | None) -> bool:
     """True when the batch's first starts come from the robot's start table (:mod:`kinelab.ik.starts`): ``q0``
     "table" for a pose task. Not the default: measured on 2,000 random targets it saves FRDM a fifth of its sweeps
     on the Panda and a tenth on the UR5, less than the look-up costs on the UR5 (docs/bench/throughput-2026-12-04.md).
@@ -164,14 +164,14 @@ def _from_table(robot: Robot, req: Request, q0: str | None) -> bool:
     return q0 == "table"
 
 
-def _table_starts(robot: Robot, points: np.ndarray, rotations: np.ndarray) -> np.ndarray:
+def _table_starts(robot: Chain, points: np.ndarray, rotations: np.ndarray) -> np.ndarray:
     """Each row's first start from the robot's start table (built, with SciPy's k-d tree, on first use)."""
     from kinelab.ik.starts import start_table
 
     return start_table(robot).nearest(stack_homogeneous(points, rotations))
 
 
-def _starts(robot: Robot, q0: Any, count: int) -> np.ndarray | None:
+def _starts(robot: Chain, q0: Any, count: int) -> np.ndarray | None:
     """The (count, n) starts, checked (None: every row draws its own)."""
     if q0 is None:
         return None
@@ -188,7 +188,7 @@ def _starts(robot: Robot, q0: Any, count: int) -> np.ndarray | None:
     return np.array(arr, dtype=float)
 
 
-def _beyond(robot: Robot, points: np.ndarray, req: Request) -> np.ndarray:
+def _beyond(robot: Chain, points: np.ndarray, req: Request) -> np.ndarray:
     """Per target: how far [m] its position lies beyond the reach bound (≤ 0: maybe reachable; always 0 for a
     task that ignores the point)."""
     if not req.task.position:
@@ -198,7 +198,7 @@ def _beyond(robot: Robot, points: np.ndarray, req: Request) -> np.ndarray:
     return beyond
 
 
-def _per_target(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts: np.ndarray | None,
+def _per_target(robot: Chain, points: np.ndarray, rotations: np.ndarray, starts: np.ndarray | None,
                 req: Request, deadline: float) -> Rows:
     """The driver row by row (solvers without a compiled batch); rows after the deadline are left unsolved."""
     count, n = points.shape[0], robot.n
@@ -215,7 +215,7 @@ def _per_target(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts:
     return rows
 
 
-def judged_rows(robot: Robot, rows: Rows, points: np.ndarray, rotations: np.ndarray, req: Request, seed: int,
+def judged_rows(robot: Chain, rows: Rows, points: np.ndarray, rotations: np.ndarray, req: Request, seed: int,
             t0: float, mode: str) -> BatchIKResult:
     """Pinocchio's verdict on every solved row; statuses as :func:`kinelab.solve` gives them."""
     count, task = points.shape[0], req.task

@@ -23,7 +23,7 @@ from kinelab.ik.registry import Capabilities, capabilities
 from kinelab.ik.request import Request, check_seed, count_ok, make_request
 from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target, beyond_reach
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 if TYPE_CHECKING:  # the closed forms load when a route asks for them: a multistart solve does without
     from kinelab.ik.analytic.branches import EveryBranch
@@ -62,7 +62,7 @@ def route_of(kind: Capabilities, options_given: bool) -> Route:
     return Route.EITHER if kind.picks and not options_given else Route.MULTISTART
 
 
-def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_solutions: int | None = None,
+def find_all(robot: Chain, target: Any, req: Request, q_ref: Any = None, max_solutions: int | None = None,
              stop_below: float | None = UNSEEN, method: Route = Route.MULTISTART,
              redundancy: int | dict[str, float] | SEW | None = None) -> Branches:
     """The distinct solutions of ``target``, each checked by Pinocchio: every branch in closed form where the
@@ -115,7 +115,7 @@ def find_all(robot: Robot, target: Any, req: Request, q_ref: Any = None, max_sol
     return _multistart_all(robot, target, req, ref, max_solutions, stop_below)
 
 
-def _closed_form_all(robot: Robot, target: Any, req: Request, ref: Any, max_solutions: int | None,
+def _closed_form_all(robot: Chain, target: Any, req: Request, ref: Any, max_solutions: int | None,
                      method: Route) -> Branches | None:
     """Every branch in closed form (or by the 1-D search or the general elimination) where the route and the chain
     allow it; None where the multistart is to answer instead."""
@@ -135,7 +135,7 @@ def _closed_form_all(robot: Robot, target: Any, req: Request, ref: Any, max_solu
 USUAL_PER_ROBOT = 16  # a caller sweeping settings: the prepared closed forms kept stay bounded
 
 
-def usual_closed_form(robot: Robot, target: Any, seed: Any, settings: tuple[Any, ...]) -> Branches | None:
+def usual_closed_form(robot: Chain, target: Any, seed: Any, settings: tuple[Any, ...]) -> Branches | None:
     """Every branch of ``target`` in one compiled call for the usual call of :func:`kinelab.solve_all` — a solver
     that picks its route ("auto") on a chain with a closed form or the general elimination and a certified compiled
     FK, a ``pin.SE3`` target, no options, references, collisions or sweeps — with ``settings`` = (solver, tol_pos,
@@ -157,7 +157,7 @@ def usual_closed_form(robot: Robot, target: Any, seed: Any, settings: tuple[Any,
     return entry.solve(target)  # None: a root to finish, a bad pose or none, which the general route says
 
 
-def _usual_entry(robot: Robot, settings: tuple[Any, ...]) -> EveryBranch | Literal[False]:
+def _usual_entry(robot: Chain, settings: tuple[Any, ...]) -> EveryBranch | Literal[False]:
     """The one-call solver of every branch for these settings, or False when the usual call does not apply.
 
     Raises:
@@ -176,7 +176,7 @@ def _usual_entry(robot: Robot, settings: tuple[Any, ...]) -> EveryBranch | Liter
     return False if form is None else EveryBranch(robot, req, form)
 
 
-def _new_kept(_: Robot) -> dict[tuple[Any, ...], Any]:
+def _new_kept(_: Chain) -> dict[tuple[Any, ...], Any]:
     return {}
 
 
@@ -191,7 +191,7 @@ def _check_search(method: Route, max_solutions: int | None, stop_below: float | 
         raise OptionError("stop_below", stop_below, "a chance in (0, 1), or None to spend the whole budget")
 
 
-def _multistart_all(robot: Robot, target: Any, req: Request, ref: np.ndarray | None, max_solutions: int | None,
+def _multistart_all(robot: Chain, target: Any, req: Request, ref: np.ndarray | None, max_solutions: int | None,
                     stop_below: float | None) -> Branches:
     """Every solution rounds of seeded starts find (see :func:`find_all`), nearest ``ref`` first when given."""
     prepare(robot, req)  # before the budget's clock
@@ -215,7 +215,7 @@ def _multistart_all(robot: Robot, target: Any, req: Request, ref: np.ndarray | N
                      for q, dp, dr, count in found[:max_solutions]], status, why, "multistart", missing)
 
 
-def _search(robot: Robot, target: Any, req: Request, max_solutions: int | None, stop_below: float | None,
+def _search(robot: Chain, target: Any, req: Request, max_solutions: int | None, stop_below: float | None,
             t0: float) -> tuple[list[tuple[np.ndarray, float, float, int]], int]:
     """Rounds of ROUND seeded starts until the budget (counted from t0), ``max_solutions`` or the stopping rule
     ends them: the distinct solutions (q, position error, rotation error, starts that reached it) and the rounds
@@ -245,7 +245,7 @@ def _wanting(found: list[tuple[np.ndarray, float, float, int]], rounds: int, max
     return stop_below is None or rounds < MIN_ROUNDS or unseen([f[3] for f in found]) >= stop_below
 
 
-def _merge(robot: Robot, found: list[tuple[np.ndarray, float, float, int]], q: np.ndarray, dp: float,
+def _merge(robot: Chain, found: list[tuple[np.ndarray, float, float, int]], q: np.ndarray, dp: float,
            dr: float) -> None:
     """Count q towards the solution it equals (joint by joint, revolute joints modulo 2π), or add it."""
     for k, (other, odp, odr, count) in enumerate(found):

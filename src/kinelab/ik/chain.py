@@ -1,6 +1,6 @@
 """The serial chain as plain arrays, as every kinelab kernel reads it.
 
-A :class:`ChainModel` is built once per Robot (and dies with it): the joint placements at q = 0, the
+A :class:`ChainModel` is built once per Chain (and dies with it): the joint placements at q = 0, the
 local joint axes, the joint kinds and the tool placement, in Pinocchio's terms. The compiled FK
 (:func:`chain_fk`, :mod:`kinelab.core._frdm`) turns it into the chain's vectors at any q: unit joint axes e_i
 and points o_i on them, the tool point p and tool rotation R, all in the base frame. These are the vector model of the
@@ -21,14 +21,14 @@ from kinelab.core import _frdm
 from kinelab.core._biquat import jacobian_local_of
 from kinelab.core._frdm import JointKind
 from kinelab.errors import ChainError
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 from kinelab.robot.certificate import chain_arrays
 
 REVOLUTE, PRISMATIC, CONTINUOUS = (int(k) for k in (JointKind.REVOLUTE, JointKind.PRISMATIC, JointKind.CONTINUOUS))
 KIND_CODES = {"revolute": REVOLUTE, "prismatic": PRISMATIC, "continuous": CONTINUOUS}
 
 
-class Chain(NamedTuple):
+class PackedChain(NamedTuple):
     """The arrays the compiled FK reads. Units: m, rad; frames as named."""
 
     placement_R: np.ndarray  # (n, 3, 3) joint frame in its parent's, at q = 0
@@ -41,13 +41,13 @@ class Chain(NamedTuple):
 
 @dataclass(frozen=True)
 class ChainModel:
-    """A Robot's base → tool chain as arrays, with its limits and its characteristic length."""
+    """A Chain's base → tool chain as arrays, with its limits and its characteristic length."""
 
     joint_names: tuple[str, ...]
-    chain: Chain
+    chain: PackedChain
     lower: np.ndarray  # (n,) limits [rad or m]; continuous joints −inf
     upper: np.ndarray  # (n,) continuous joints +inf
-    length: float  # characteristic length L [m] (Robot.characteristic_length)
+    length: float  # characteristic length L [m] (Chain.characteristic_length)
 
     @property
     def n(self) -> int:
@@ -83,7 +83,7 @@ class ChainModel:
                 "u_x": R[:, 0], "u_y": R[:, 1], "u_z": R[:, 2], "R": R}
 
 
-def build(robot: Robot) -> ChainModel:
+def build(robot: Chain) -> ChainModel:
     """The chain model of ``robot`` (every joint 1-DoF and in series: checked here).
 
     Raises:
@@ -99,19 +99,19 @@ def build(robot: Robot) -> ChainModel:
     if isinstance(arrays, str):
         raise ChainError(f"{robot.name}: {arrays}")
     kind = np.array([KIND_CODES[k] for k in robot.joint_kinds], dtype=np.int64)
-    chain = Chain(placement_R=arrays.placement_R, placement_t=arrays.placement_t, axis_local=arrays.axis, kind=kind,
-                  tool_R=arrays.tool_R, tool_t=arrays.tool_t)
+    chain = PackedChain(placement_R=arrays.placement_R, placement_t=arrays.placement_t, axis_local=arrays.axis,
+                        kind=kind, tool_R=arrays.tool_R, tool_t=arrays.tool_t)
     lower = np.where(kind == CONTINUOUS, -np.inf, robot.lower).astype(float)
     upper = np.where(kind == CONTINUOUS, np.inf, robot.upper).astype(float)
     return ChainModel(tuple(robot.joint_names), chain, lower, upper, robot.characteristic_length())
 
 
-def chain_model(robot: Robot) -> ChainModel:
-    """The robot's chain model, built on first use and kept on the Robot."""
+def chain_model(robot: Chain) -> ChainModel:
+    """The robot's chain model, built on first use and kept on the Chain."""
     return robot.derived("chain_model", build)
 
 
-def chain_fk(ch: Chain, q: np.ndarray, e_out: np.ndarray, o_out: np.ndarray, p_out: np.ndarray,
+def chain_fk(ch: PackedChain, q: np.ndarray, e_out: np.ndarray, o_out: np.ndarray, p_out: np.ndarray,
              R_out: np.ndarray) -> None:
     """FK of the chain ``ch`` at q: joint axes ``e_out`` and origins ``o_out`` (n × 3) and the tool pose (``p_out``
     [m], ``R_out``), all in the base frame, written in place (the compiled kernels' own FK)."""

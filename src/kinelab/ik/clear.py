@@ -23,7 +23,7 @@ from kinelab.ik.batch import BatchIKResult, fresh_seed
 from kinelab.ik.driver import solve_one
 from kinelab.ik.request import Request
 from kinelab.ik.result import Branches, IKResult, Status, TrackResult
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 if TYPE_CHECKING:
     from kinelab.collision.model import CollisionModel
@@ -33,7 +33,7 @@ ROW_RUNS = 20  # runs a colliding batch row gets (each a full solve): a row with
 STRIDE = 1_000_003  # seeds between two runs: a run's restarts use seed, seed + 1, ... within one run
 
 
-def solve_clear(robot: Robot, target: Any, q0: Any, req: Request, model: CollisionModel) -> IKResult:
+def solve_clear(robot: Chain, target: Any, q0: Any, req: Request, model: CollisionModel) -> IKResult:
     """The first answer that meets the target and collides with nothing ``model`` checks.
 
     Args:
@@ -80,7 +80,7 @@ def _run_request(req: Request, seed: int, runs: int, t0: float) -> Request | Non
     return replace(req, seed=seed + runs * STRIDE, time_budget=left)
 
 
-def _from_branches(robot: Robot, target: Any, collided: IKResult, q0: Any, req: Request, model: CollisionModel,
+def _from_branches(robot: Chain, target: Any, collided: IKResult, q0: Any, req: Request, model: CollisionModel,
                    t0: float) -> IKResult:
     """The solver run again from the pose's clear branches (closed form), nearest ``q0`` or the colliding answer
     first; a failure with status ``collision`` when every branch within the limits collides."""
@@ -132,7 +132,7 @@ def mark_colliding(found: Branches, model: CollisionModel, drop: bool) -> Branch
     return out
 
 
-def clear_batch(robot: Robot, H: np.ndarray, res: BatchIKResult, req: Request, model: CollisionModel,
+def clear_batch(robot: Chain, H: np.ndarray, res: BatchIKResult, req: Request, model: CollisionModel,
                 t0: float) -> BatchIKResult:
     """The batch with every colliding row solved again by :func:`solve_clear` (fresh seeds, what is left of the
     budget); a row with no clear answer fails with status ``collision``."""

@@ -21,7 +21,7 @@ from kinelab.ik import options as opt
 from kinelab.ik.limits import PinLimits
 from kinelab.ik.result import Attempt, Status
 from kinelab.ik.tasks import Task
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 
 @dataclass(frozen=True)
@@ -79,7 +79,7 @@ STALL_ITERATIONS, STALL_FALL = 5, 0.05
 
 
 def attempt(
-    robot: Robot,
+    robot: Chain,
     oMtarget: pin.SE3,
     q0: np.ndarray,
     tol_pos: float,

@@ -23,8 +23,8 @@ from kinelab.ik.request import Request, verdict_reserve
 from kinelab.ik.result import Attempt, BypassRecord, IKResult, SingularEvent, Status
 from kinelab.ik.targets import as_target, out_of_reach, reach_bound
 from kinelab.ik.tasks import COMPONENTS, POSE, Task
-from kinelab.robot import Robot
-from kinelab.robot.model import _compiled_judge
+from kinelab.robot import Chain
+from kinelab.robot.chain import _compiled_judge
 
 
 class _LazyRng:
@@ -41,7 +41,7 @@ class _LazyRng:
         return drawn
 
 
-def _start(robot: Robot, q0: Any, rng: _LazyRng, on_limits: str) -> np.ndarray:
+def _start(robot: Chain, q0: Any, rng: _LazyRng, on_limits: str) -> np.ndarray:
     if q0 is None:
         return rng.uniform(robot.lower, robot.upper)
     q = robot.check_q(q0, what="q0")
@@ -54,7 +54,7 @@ def _start(robot: Robot, q0: Any, rng: _LazyRng, on_limits: str) -> np.ndarray:
     return projected
 
 
-def solve_one(robot: Robot, target: Any, q0: Any, req: Request) -> IKResult:
+def solve_one(robot: Chain, target: Any, q0: Any, req: Request) -> IKResult:
     """Solve IK for one target.
 
     Args:
@@ -88,7 +88,7 @@ def solve_one(robot: Robot, target: Any, q0: Any, req: Request) -> IKResult:
     return _loop(module, problem, _start(robot, q0, rng, req.start_outside_limits), max_restarts, opts, rng, beyond)
 
 
-def prepare_solver(module: Any, robot: Robot, options: Any) -> None:
+def prepare_solver(module: Any, robot: Chain, options: Any) -> None:
     """The solver module's model building for this robot (its ``prepare``, where it has one): not a solve's time."""
     prepare = getattr(module, "prepare", None)
     if prepare is not None:
@@ -99,7 +99,7 @@ def prepare_solver(module: Any, robot: Robot, options: Any) -> None:
 class Call:
     """What one solve is asked, handed between the driver's helpers (and to an engine's general result)."""
 
-    robot: Robot
+    robot: Chain
     target: pin.SE3
     solver: str
     tol_pos: float
@@ -215,7 +215,7 @@ def compiled_result(pb: Call, att: Attempt, restarts: int, success: bool, dp: fl
     )
 
 
-def engine_spec(robot: Robot, req: Request, cm: Any,
+def engine_spec(robot: Chain, req: Request, cm: Any,
                 attempt_of: Callable[[int, np.ndarray, np.ndarray, float], Attempt], mode: str,
                 diagnostics: Callable[[np.ndarray], Any], **kernel: Any) -> SimpleNamespace:
     """What a solver's one-call engine (:class:`kinelab.core._engine.Engine`) reads from its prepared solver: the
@@ -255,7 +255,7 @@ def engine_spec(robot: Robot, req: Request, cm: Any,
 ATTEMPTS = 0  # the statistics slot in which every compiled multistart counts its attempts
 
 
-def engine_judge(robot: Robot, options: Any) -> Any:
+def engine_judge(robot: Chain, options: Any) -> Any:
     """The judge an engine can use for these options: the robot's certified compiled FK (``kinelab.core._chain.
     Judge``) when the options run compiled, else None (no engine: the general route serves)."""
     return robot.derived("compiled judge", _compiled_judge) if getattr(options, "compiled", False) else None
@@ -273,7 +273,7 @@ def _outside_limits(pb: Call, q: np.ndarray, dp: float, dr: float, status: Statu
     return status, f"{message}; the best answer has {where}" if message else f"the best answer has {where}"
 
 
-def _outside_where(robot: Robot, q: np.ndarray) -> str | None:
+def _outside_where(robot: Chain, q: np.ndarray) -> str | None:
     """The first joint of q outside its limits, named with its value and limits (and how many more), or None."""
     lower, upper = robot.check_bounds
     outside = [i for i in range(robot.n) if not lower[i] <= q[i] <= upper[i]]

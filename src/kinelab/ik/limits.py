@@ -5,13 +5,13 @@ from __future__ import annotations
 import numpy as np
 
 from kinelab.geometry import TWO_PI, turns_into, wrap_to_pi
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 
 class PinLimits:
     """Bounded scalar joints of a robot, indexed in Pinocchio's q, for fast projection inside loops."""
 
-    def __init__(self, robot: Robot):
+    def __init__(self, robot: Chain):
         bounded = [j for j in robot.joints if j.kind != "continuous"]
         self.idx = np.array([j.idx_q for j in bounded], dtype=int)
         self.lower = np.array([j.lower for j in bounded])
@@ -47,7 +47,7 @@ def nearest_inside(q: np.ndarray, lower: np.ndarray, upper: np.ndarray, ref: np.
     return inside_limits(q + TWO_PI * np.round((base - q) / TWO_PI), lower, upper, slack)
 
 
-def wrap_q(robot: Robot, q: np.ndarray) -> np.ndarray:
+def wrap_q(robot: Chain, q: np.ndarray) -> np.ndarray:
     """q with each out-of-limit revolute joint shifted by a multiple of 2π into its limits, where one
     exists (the pose is unchanged); other values are returned as they are."""
     q = np.asarray(q, dtype=float)
@@ -57,7 +57,7 @@ def wrap_q(robot: Robot, q: np.ndarray) -> np.ndarray:
     return np.where(outside & (lowest <= robot.upper), lowest, q)
 
 
-def turned_verdict(robot: Robot, H_target: np.ndarray, q: np.ndarray,
+def turned_verdict(robot: Chain, H_target: np.ndarray, q: np.ndarray,
                    axis: int = -1) -> tuple[np.ndarray, float, float, bool]:
     """The judge's word on an answer q (n floats, C-contiguous) against H_target (4 × 4, base frame), on the answer
     turned into the limits: (q or :func:`wrap_q`'s turn of it, position error [m], rotation error [rad], within the
@@ -73,7 +73,7 @@ def turned_verdict(robot: Robot, H_target: np.ndarray, q: np.ndarray,
     return turned, dp, dr, within
 
 
-def distance(robot: Robot, q: np.ndarray, ref: np.ndarray) -> float:
+def distance(robot: Chain, q: np.ndarray, ref: np.ndarray) -> float:
     """max |q_i − ref_i| over the joints [rad or m], revolute and continuous joints modulo 2π."""
     d = np.asarray(q, dtype=float) - np.asarray(ref, dtype=float)
     revolute = np.array([k != "prismatic" for k in robot.joint_kinds])

@@ -33,7 +33,7 @@ from kinelab.ik.registry import capabilities, refuse_options
 from kinelab.ik.request import Request, check_robot, check_seed, make_request
 from kinelab.ik.result import Branches, IKResult
 from kinelab.ik.targets import as_target, as_target_arrays
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 if TYPE_CHECKING:
     from kinelab.collision.model import CollisionModel
@@ -69,7 +69,7 @@ class IK:
         SolverNotFoundError, OptionError: a bad setting, named (once, here).
     """
 
-    def __init__(self, robot: Robot, *positional: Any, solver: str = "frdm", tol_pos: float = 1e-6,
+    def __init__(self, robot: Chain, *positional: Any, solver: str = "frdm", tol_pos: float = 1e-6,
                  tol_rot: float = 1e-6, time_budget: float | None = 1.0, max_restarts: int = 1000,
                  start_outside_limits: str = "project", options: Any = None, task: str = "pose", axis: str = "z",
                  collisions: Any = None, **solver_options: Any):
@@ -211,7 +211,7 @@ class IK:
         return clear_of(found, self.collisions, drop=False)
 
 
-def collision_check(robot: Robot, collisions: Any) -> CollisionModel | None:
+def collision_check(robot: Chain, collisions: Any) -> CollisionModel | None:
     """The collision model a ``collisions=`` argument asks for (None, "self", an Environment or a Collisions), or
     None: the collision package (coal's geometry, the robot's meshes) loads only for a solve that checks."""
     if collisions is None:
@@ -222,7 +222,7 @@ def collision_check(robot: Robot, collisions: Any) -> CollisionModel | None:
     return None if spec is None else collision_model(robot, spec)
 
 
-def solve_clear_of(robot: Robot, target: Any, q0: Any, req: Request, check: CollisionModel | None) -> IKResult:
+def solve_clear_of(robot: Chain, target: Any, q0: Any, req: Request, check: CollisionModel | None) -> IKResult:
     """One solve through the driver, clear of collisions when ``check`` is given (:mod:`kinelab.ik.clear`, which
     loads with the first solve that checks)."""
     if check is None:
@@ -232,7 +232,7 @@ def solve_clear_of(robot: Robot, target: Any, q0: Any, req: Request, check: Coll
     return solve_clear(robot, target, q0, req, check)
 
 
-def batch_clear_of(robot: Robot, targets: Any, q0: Any, req: Request, check: CollisionModel | None) -> BatchIKResult:
+def batch_clear_of(robot: Chain, targets: Any, q0: Any, req: Request, check: CollisionModel | None) -> BatchIKResult:
     """A batch through the FRDM batch, its colliding rows solved again clear of ``check`` when given."""
     t0 = time.perf_counter()
     res = run_batch(robot, targets, q0, req)
@@ -255,7 +255,7 @@ def clear_of(found: Branches, check: CollisionModel | None, drop: bool) -> Branc
 PREPARED_PER_ROBOT = 16  # a caller sweeping settings: the prepared solvers kept stay bounded
 
 
-def prepared(robot: Robot, settings: dict[str, Any], key: tuple[Any, ...] | None = None) -> IK:
+def prepared(robot: Chain, settings: dict[str, Any], key: tuple[Any, ...] | None = None) -> IK:
     """The robot's prepared solver for these settings (``IK``'s keywords), built once and kept on the robot under
     ``key`` (default: the settings sorted) while the same settings come back (a loop of :func:`kinelab.solve`
     calls); settings that cannot be a key (a dict of kicks, say) get a new one each call. Either way the call takes
@@ -280,7 +280,7 @@ def prepared(robot: Robot, settings: dict[str, Any], key: tuple[Any, ...] | None
     return ik
 
 
-def kept_solver(robot: Robot, key: tuple[Any, ...]) -> IK | None:
+def kept_solver(robot: Chain, key: tuple[Any, ...]) -> IK | None:
     """The prepared solver :func:`prepared` keeps on the robot under ``key``, or None (none yet, or a key that
     cannot be one)."""
     try:
@@ -289,5 +289,5 @@ def kept_solver(robot: Robot, key: tuple[Any, ...]) -> IK | None:
         return None
 
 
-def _new_table(_: Robot) -> dict[tuple[Any, ...], IK]:
+def _new_table(_: Chain) -> dict[tuple[Any, ...], IK]:
     return {}

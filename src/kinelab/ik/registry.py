@@ -12,7 +12,7 @@ import pinocchio as pin
 
 from kinelab.errors import OptionError, SolverNotFoundError
 from kinelab.ik.result import Attempt
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 BUILTIN = {"frdm": "kinelab.ik.frdm.solver", "biquat": "kinelab.ik.biquat.solver", "dls": "kinelab.ik.dls"}
 SOLVERS: dict[str, Any] = {}
@@ -67,7 +67,7 @@ class SolverModule(Protocol):
 
     Options: Any
 
-    def attempt(self, robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol_rot: float,
+    def attempt(self, robot: Chain, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol_rot: float,
                 deadline: float, options: Any = None) -> Attempt:
         """One run from ``q0`` towards ``oMtarget``, before kinelab's Pinocchio check."""
 

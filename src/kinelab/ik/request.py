@@ -19,7 +19,7 @@ from typing import Any
 from kinelab.errors import ChainError, OptionError
 from kinelab.ik.registry import solver_module
 from kinelab.ik.tasks import POSE, Task
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 START_POLICIES = ("project", "refuse")
 TOL_FLOOR = 1e-12
@@ -75,13 +75,13 @@ class Request:
 
 
 def check_robot(robot: object) -> None:
-    """Refuse anything but a :class:`kinelab.Robot` where an entry point takes the robot.
+    """Refuse anything but a :class:`kinelab.Chain` where an entry point takes the robot.
 
     Raises:
         ChainError: naming what was given.
     """
-    if not isinstance(robot, Robot):
-        raise ChainError(f"the robot must be a kinelab.Robot (kinelab.load(...) or Robot.from_model(...)), got "
+    if not isinstance(robot, Chain):
+        raise ChainError(f"the robot must be a kinelab.Chain (kinelab.load(...) or Chain.from_model(...)), got "
                          f"{type(robot).__name__}")
 
 

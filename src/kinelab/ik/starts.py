@@ -6,7 +6,7 @@ already near the target leaves it only the last steps. The table holds SIZE conf
 within the limits from a fixed seed (the same table on every machine), their tool poses by the judge's FK, and
 a k-d tree over (position / L, WEIGHT · R), L the robot's characteristic length and R the tool rotation's nine
 entries (the Frobenius distance between rotations is 2√2·sin(θ/2) for a turn θ between them). It is built once
-per Robot, on first use, in milliseconds; its cost and its effect per arm are in docs/bench/throughput-2026-12-04.md.
+per Chain, on first use, in milliseconds; its cost and its effect per arm are in docs/bench/throughput-2026-12-04.md.
 Nothing about an answer's judgement changes: a start is only where the solver begins.
 """
 
@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 if TYPE_CHECKING:  # SciPy's spatial module costs 0.3 s to import: it loads when a table is first built
     from scipy.spatial import cKDTree
@@ -51,12 +51,12 @@ class StartTable:
         return int(self.q.nbytes + self.tree.data.nbytes + self.tree.indices.nbytes)
 
 
-def start_table(robot: Robot) -> StartTable:
-    """The robot's start table, built on first use and kept on the Robot."""
+def start_table(robot: Chain) -> StartTable:
+    """The robot's start table, built on first use and kept on the Chain."""
     return robot.derived("start table", _build)
 
 
-def _build(robot: Robot) -> StartTable:
+def _build(robot: Chain) -> StartTable:
     from scipy.spatial import cKDTree
 
     q = robot.random_qs(SIZE, np.random.default_rng(SEED))

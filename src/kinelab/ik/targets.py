@@ -13,7 +13,7 @@ from numpy.typing import ArrayLike
 from kinelab.core._verdict import NOT_A_ROTATION, NOT_FINITE, NOT_HOMOGENEOUS, first_defect, pose_defect
 from kinelab.dq.algebra import DualQuat
 from kinelab.errors import TargetError
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 
 def from_xyz_rpy(xyz: ArrayLike, rpy: ArrayLike = (0.0, 0.0, 0.0), *, degrees: bool = False) -> pin.SE3:
@@ -164,7 +164,7 @@ def _item(k: int, target: Any) -> pin.SE3:
 
 
 # -- the reach bound: a cheap, certain test that a target position is out of reach ---------------------------
-def _reach(robot: Robot) -> tuple[tuple[float, float, float], float]:
+def _reach(robot: Chain) -> tuple[tuple[float, float, float], float]:
     q = robot.neutral()
     oMi = list(robot.joint_placements(q).values())
     anchor = robot.model.jointPlacements[1].translation  # where joint 1 sits, fixed in the base
@@ -177,18 +177,18 @@ def _reach(robot: Robot) -> tuple[tuple[float, float, float], float]:
     return tuple(np.asarray(anchor, dtype=float).tolist()), rigid + slides
 
 
-def reach_bound(robot: Robot) -> tuple[tuple[float, float, float], float]:
+def reach_bound(robot: Chain) -> tuple[tuple[float, float, float], float]:
     """(anchor [m], radius [m]): every reachable tool position lies within the radius of the anchor."""
     return robot.derived("reach_bound", _reach)
 
 
-def out_of_reach(robot: Robot, position: np.ndarray) -> float:
+def out_of_reach(robot: Chain, position: np.ndarray) -> float:
     """How far [m] a position lies beyond the reach bound (≤ 0 when it may be reachable)."""
     anchor, radius = robot.derived("reach_bound", _reach)
     return math.dist(np.asarray(position, dtype=float).tolist(), anchor) - radius
 
 
-def beyond_reach(robot: Robot, position: np.ndarray) -> str:
+def beyond_reach(robot: Chain, position: np.ndarray) -> str:
     """Why no configuration can reach ``position`` [m] (base frame) when it lies beyond the reach bound, in words;
     "" when it may be reachable."""
     beyond = out_of_reach(robot, position)

@@ -26,7 +26,7 @@ from kinelab.ik.analytic.classify import classify
 from kinelab.ik.api import solve_batch
 from kinelab.ik.request import check_seed
 from kinelab.ik.targets import as_target, reach_bound
-from kinelab.robot import Robot, load
+from kinelab.robot import Chain, load
 
 PLATFORM = ("platform_x", "platform_y", "platform_yaw")
 
@@ -71,7 +71,7 @@ def check_count(count: Any) -> None:
         raise OptionError("count", count, "an integer ≥ 0: how many of the best poses (kinelab map base --top)")
 
 
-def base_map(robot: Robot, grasp: pin.SE3, step: float = 0.05, restarts: int = 10, seed: int = 0) -> BaseMap:
+def base_map(robot: Chain, grasp: pin.SE3, step: float = 0.05, restarts: int = 10, seed: int = 0) -> BaseMap:
     """The platform poses from which ``robot`` (a mobile manipulator whose first joints are the platform's x,
     y and yaw) reaches ``grasp`` (oMgrasp, world frame).
 
@@ -119,13 +119,13 @@ def base_map(robot: Robot, grasp: pin.SE3, step: float = 0.05, restarts: int = 1
     return BaseMap(np.column_stack([xy, yaw]), success, manip, q)
 
 
-def _manipulability(turning: Robot, q: np.ndarray) -> np.ndarray:
+def _manipulability(turning: Chain, q: np.ndarray) -> np.ndarray:
     """Yoshikawa's measure of the arm's columns of the Jacobian (linear rows / L) at each row of q."""
     J = turning.jacobian_batch(q, frame="local_world_aligned")[:, :, 1:]  # the arm's columns
     return np.asarray(conditioning_batch(J, turning.characteristic_length())[0])
 
 
-def _best_branches(turning: Robot, targets: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _best_branches(turning: Chain, targets: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(reached, the best-conditioned branch (P, 6), its manipulability) per target from the closed form's batch
     (every branch confirmed by Pinocchio)."""
     batch = all_branches_batch(turning, targets)

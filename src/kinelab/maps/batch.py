@@ -25,7 +25,7 @@ from kinelab.files import as_path
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.batch import BatchIKResult
 from kinelab.ik.targets import as_target_arrays
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 CHUNK = 10_000  # targets per task: ~0.3 s of a panda worker, 1.3 MB of targets sent
 FIELDS = {"q": "f8", "success": "?", "status_code": "i1", "position_error": "f8", "rotation_error": "f8",
@@ -86,7 +86,7 @@ def targets_sha256(H: np.ndarray) -> str:
     return hashlib.sha256(np.ascontiguousarray(H, dtype="<f8").tobytes()).hexdigest()
 
 
-def _open(out: str | Path, robot: Robot, H: np.ndarray, spec: BatchSpec) -> Any:
+def _open(out: str | Path, robot: Chain, H: np.ndarray, spec: BatchSpec) -> Any:
     """The store at ``out``: new, or the unfinished one of this very run.
 
     Raises:
@@ -121,7 +121,7 @@ def _open(out: str | Path, robot: Robot, H: np.ndarray, spec: BatchSpec) -> Any:
     return group
 
 
-def solve_batch_on_cluster(robot: Robot, targets: Any, out: str | Path, spec: BatchSpec | None = None,
+def solve_batch_on_cluster(robot: Chain, targets: Any, out: str | Path, spec: BatchSpec | None = None,
                            client: Any = None, scheduler: str | None = None, workers: int | None = None,
                            progress: bool | None = None) -> ClusterRun:
     """Solve every target on a Dask cluster (FRDM's compiled batch on each worker), writing to ``out``.
@@ -168,7 +168,7 @@ def solve_batch_on_cluster(robot: Robot, targets: Any, out: str | Path, spec: Ba
     return ClusterRun(result, tuple(todo), len(done) - len(todo))
 
 
-def _run(client: Any, robot: Robot, H: np.ndarray, spec: BatchSpec, group: Any, todo: list[int], resumed: int,
+def _run(client: Any, robot: Chain, H: np.ndarray, spec: BatchSpec, group: Any, todo: list[int], resumed: int,
          progress: bool | None) -> None:
     """Submit the chunks ``todo``; write each one's rows, then its flag, as it arrives."""
     from dask.distributed import as_completed

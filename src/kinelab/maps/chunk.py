@@ -26,7 +26,7 @@ from kinelab.ik.analytic.classify import classify
 from kinelab.ik.api import solve_batch
 from kinelab.ik.request import check_seed
 from kinelab.maps import grid
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 METHODS = ("auto", "numeric")
 MAX_TARGETS = 2_000_000  # a map asking for more needs force=True (about an hour per million on one core)
@@ -85,7 +85,7 @@ class MapSpec:
         check_seed(self.seed)
         check_seed(self.restarts, "restarts")
 
-    def closed_form(self, robot: Robot) -> bool:
+    def closed_form(self, robot: Chain) -> bool:
         """True when this map of ``robot`` is computed with every branch in closed form."""
         return self.method == "auto" and self.task == "pose" and classify(robot).arm is not None
 
@@ -111,7 +111,7 @@ def targets_of(centres: np.ndarray, rotations: np.ndarray) -> np.ndarray:
     return H
 
 
-def compute_chunk(robot: Robot, spec: MapSpec, centres: np.ndarray, index: int) -> dict[str, np.ndarray]:
+def compute_chunk(robot: Chain, spec: MapSpec, centres: np.ndarray, index: int) -> dict[str, np.ndarray]:
     """The map's values for chunk ``index`` (voxels index·chunk_voxels onwards): reachability (share of the
     orientations reached), best manipulability (Yoshikawa, of the Jacobian with linear rows / L; 0 where
     nothing is reached), smallest σ_min/σ_max (1 where nothing is reached) and the mean number of branches per
@@ -137,7 +137,7 @@ def compute_chunk(robot: Robot, spec: MapSpec, centres: np.ndarray, index: int) 
             "sigma_ratio": ratio.reshape(ok.shape).min(axis=1), "branches": np.full(len(chunk), np.nan)}
 
 
-def _every_branch(robot: Robot, spec: MapSpec, targets: np.ndarray, voxels: int) -> dict[str, np.ndarray]:
+def _every_branch(robot: Chain, spec: MapSpec, targets: np.ndarray, voxels: int) -> dict[str, np.ndarray]:
     """The chunk's values from every branch of every pose: a pose is reached when it has a branch, its
     manipulability and σ ratio are its best branch's."""
     batch = all_branches_batch(robot, targets, tol_pos=spec.tol_pos, tol_rot=spec.tol_rot)

@@ -22,15 +22,15 @@ import numpy as np
 
 from kinelab.errors import KinelabError
 from kinelab.maps.store import model_sha256
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 INSTALL_HINT = "pip install 'kinelab[cluster]' (dask.distributed, cryptography)"
 CONNECT_TIMEOUT = 5.0  # [s] to reach a scheduler before giving up
 MAX_HANDSHAKE = 1 << 20  # [bytes] a Dask handshake is a few dozen bytes; a stranger's claim beyond this is refused
-_ROBOTS: dict[tuple, Robot] = {}  # per worker process: robots already loaded, by recipe
+_ROBOTS: dict[tuple, Chain] = {}  # per worker process: robots already loaded, by recipe
 
 
-def recipe(robot: Robot) -> dict:
+def recipe(robot: Chain) -> dict:
     """How a worker loads the same robot: its registered name or model file, tool and base, and the hash the
     worker's copy must have."""
     from kinelab.robot import catalog
@@ -43,7 +43,7 @@ def recipe(robot: Robot) -> dict:
             "trust_xacro": robot.trust_xacro, "sha256": model_sha256(robot)}
 
 
-def worker_robot(how: dict) -> Robot:
+def worker_robot(how: dict) -> Chain:
     """The robot ``how`` (:func:`recipe`) names, loaded once per worker process and checked to be the client's."""
     from kinelab.robot import load
 
@@ -182,7 +182,7 @@ def _local_client(workers: int | None) -> Any:
     return Client(cluster, security=cluster.security)
 
 
-def run_chunks(client: Any, robot: Robot, spec: Any, centres: np.ndarray, todo: list[int], target: Any,
+def run_chunks(client: Any, robot: Chain, spec: Any, centres: np.ndarray, todo: list[int], target: Any,
                progress: bool | None = None) -> None:
     """Submit the chunks ``todo`` and write each into ``target`` as it arrives."""
     from dask.distributed import as_completed

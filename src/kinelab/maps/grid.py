@@ -12,7 +12,7 @@ import numpy as np
 
 from kinelab.errors import KinelabError
 from kinelab.ik.targets import reach_bound
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 PHI = np.sqrt(2.0)
 PSI = 1.533751168755204288118041  # the root of ψ⁴ = ψ + 4 the spiral uses
@@ -20,7 +20,7 @@ GOLDEN = (1.0 + np.sqrt(5.0)) / 2.0
 MAX_LATTICE = 20_000_000  # lattice points of a voxel grid (about 1.5 GB while the sphere is cut out of it)
 
 
-def estimated_voxels(robot: Robot, voxel: float) -> int:
+def estimated_voxels(robot: Chain, voxel: float) -> int:
     """About how many voxels :func:`voxel_centres` returns (the reach sphere's volume over a voxel's), computed
     without building the grid: the size guards run before anything is allocated."""
     _, radius = reach_bound(robot)
@@ -29,7 +29,7 @@ def estimated_voxels(robot: Robot, voxel: float) -> int:
     return int(min(count, 1e30)) + 1
 
 
-def voxel_centres(robot: Robot, voxel: float) -> np.ndarray:
+def voxel_centres(robot: Chain, voxel: float) -> np.ndarray:
     """(V, 3) centres [m] of the voxels of side ``voxel`` [m] whose centre lies within the reach bound
     (the sphere every reachable tool point lies in), on a lattice aligned with the base frame.
 

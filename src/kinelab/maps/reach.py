@@ -13,7 +13,7 @@ from kinelab.errors import KinelabError, OptionError
 from kinelab.maps import cluster, grid, store
 from kinelab.maps.chunk import MAX_TARGETS, MapSpec, compute_chunk
 from kinelab.progress import bar
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 __all__ = ["MAX_TARGETS", "MapSpec", "compute_chunk", "reachability"]
 
@@ -38,7 +38,7 @@ def spec_of(spec: Any, fields: dict[str, Any]) -> MapSpec:
     return made
 
 
-def reachability(robot: Robot, spec: MapSpec | None = None, out: str | None = None, force: bool = False,
+def reachability(robot: Chain, spec: MapSpec | None = None, out: str | None = None, force: bool = False,
                  progress: bool | None = None, client: Any = None, **fields) -> Any:
     """The reachability map of ``robot``, computed in this process chunk by chunk (written to ``out`` as they
     finish when given: an interrupted run resumes from the chunks already there).

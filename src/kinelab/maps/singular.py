@@ -11,7 +11,7 @@ from kinelab.analysis import families
 from kinelab.analysis.singular import RANK_RTOL
 from kinelab.errors import KinelabError
 from kinelab.ik.request import check_seed
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 
 @dataclass(frozen=True)
@@ -28,7 +28,7 @@ class SingularityMap:
         return self.sigma_ratio <= RANK_RTOL
 
 
-def singularity(robot: Robot, samples: int = 5000, seed: int = 0, method: str = "random",
+def singularity(robot: Chain, samples: int = 5000, seed: int = 0, method: str = "random",
                 progress: bool | None = None) -> SingularityMap:
     """σ_min/σ_max over ``samples`` configurations within the limits.
 

@@ -17,7 +17,7 @@ import numpy as np
 
 from kinelab.errors import KinelabError, OptionError
 from kinelab.files import as_path, output_folder
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 INSTALL_HINT = "pip install 'kinelab[maps]' (zarr)"
 VALUES = ("reachability", "manipulability", "sigma_ratio", "branches")
@@ -31,14 +31,14 @@ def _zarr() -> Any:
     return zarr
 
 
-def model_sha256(robot: Robot) -> str:
+def model_sha256(robot: Chain) -> str:
     """SHA-256 of the robot's model file (the map's, and every worker's, proof of the same robot)."""
     if robot.urdf_path is None:  # an in-memory model: its own serialisation
         return hashlib.sha256(robot.model.saveToString().encode()).hexdigest()
     return hashlib.sha256(Path(robot.urdf_path).read_bytes()).hexdigest()
 
 
-def metadata(robot: Robot, spec: Any, voxels: int) -> dict:
+def metadata(robot: Chain, spec: Any, voxels: int) -> dict:
     """What identifies a map: the robot, its model file's hash, the spec and the kinelab version."""
     from kinelab import __version__
 
@@ -169,7 +169,7 @@ class ReachabilityMap:
         return np.asarray(self.centres[:] if name == "centres" else self.values[name][:])
 
 
-def open_map(out: str | Path | None, robot: Robot, spec: Any, centres: np.ndarray) -> ReachabilityMap:
+def open_map(out: str | Path | None, robot: Chain, spec: Any, centres: np.ndarray) -> ReachabilityMap:
     """A new map (in memory, or a new Zarr directory), or the unfinished one at ``out`` if it is the same map.
 
     Raises:

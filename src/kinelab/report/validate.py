@@ -19,7 +19,7 @@ from kinelab.errors import KinelabError
 from kinelab.geometry import quat_wxyz_from_matrix
 from kinelab.ik.request import check_seed
 from kinelab.report.provenance import provenance
-from kinelab.robot import Robot, load
+from kinelab.robot import Chain, load
 from kinelab.studies import paper001_stanford as seed001
 
 DEFAULT_ROBOTS = ("stanford", "era", "youbot", "panda", "ur5")
@@ -121,7 +121,7 @@ class Report:
         }
 
 
-def model_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+def model_checks(robot: Chain, n: int, seed: int) -> list[Check]:
     """yourdfpy vs Pinocchio FK at n configurations; Pinocchio's Jacobians vs finite differences."""
     fk = checks.fk_vs_yourdfpy(robot, n, seed)
     jac = checks.jacobians_vs_fd(robot, max(10, n // 10), seed)
@@ -137,7 +137,7 @@ def model_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     ]
 
 
-def stanford_paper_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+def stanford_paper_checks(robot: Chain, n: int, seed: int) -> list[Check]:
     """Seed 001: the tool rotation at the paper's target against the printed N (6 digits)."""
     oMtool = robot.fk(seed001.TARGET_Q)
     d = seed001.quat_distance_wxyz(quat_wxyz_from_matrix(oMtool.rotation), seed001.N_REAL_WXYZ)
@@ -145,7 +145,7 @@ def stanford_paper_checks(robot: Robot, n: int, seed: int) -> list[Check]:
                   seed001.PRINTED_DIGITS_TOL, "", "quaternion components, up to sign")]
 
 
-def biquaternion_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+def biquaternion_checks(robot: Chain, n: int, seed: int) -> list[Check]:
     """Λ(q) by the chain product and A(q) by screw transforms against Pinocchio."""
     from kinelab.dq import kinematics as bk
     from kinelab.dq.algebra import DualQuat
@@ -161,7 +161,7 @@ def biquaternion_checks(robot: Robot, n: int, seed: int) -> list[Check]:
             Check(robot.name, "biquaternion A(q) vs Pinocchio LOCAL Jacobian", worst_A, 1e-10, "", f"{count} q")]
 
 
-def solver_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+def solver_checks(robot: Chain, n: int, seed: int) -> list[Check]:
     """FRDM and the biquaternion solver on seeded reachable targets, every answer checked by Pinocchio."""
     from kinelab.ik import solve
 
@@ -188,7 +188,7 @@ def solver_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     return rows
 
 
-def analytic_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+def analytic_checks(robot: Chain, n: int, seed: int) -> list[Check]:
     """Where the arm has a closed form: its branches confirmed by Pinocchio, and every FRDM, biquaternion and DLS
     answer from a random start is one of them (with the share of FRDM answers on the branch nearest the start)."""
     from kinelab.ik import solve_all
@@ -224,7 +224,7 @@ def analytic_checks(robot: Robot, n: int, seed: int) -> list[Check]:
 COMPLETENESS_POSES = 2000
 
 
-def completeness_checks(robot: Robot, seed: int) -> list[Check]:
+def completeness_checks(robot: Chain, seed: int) -> list[Check]:
     """Where the arm has every branch (a closed form or a 1-D search, at a held joint for a 7R arm): the share of
     COMPLETENESS_POSES seeded poses whose own configuration is among the branches Pinocchio confirms, 99.9 % at
     least (a double root is met to the square root of rounding only: its misses are counted apart)."""
@@ -241,7 +241,7 @@ def completeness_checks(robot: Robot, seed: int) -> list[Check]:
                   f"(at most {r['branches_max']})", at_least=True, samples=r["poses"])]
 
 
-def _swept_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+def _swept_checks(robot: Chain, n: int, seed: int) -> list[Check]:
     """A 7R arm with a swept closed form (docs/analytic.md): its branches at 16 values of the held joint
     confirmed by Pinocchio, and every FRDM and DLS answer from a random start one of the branches at its own
     value of that joint, to SAME (95 % at least: an answer within the tolerances can sit at a limit whose exact
@@ -275,18 +275,18 @@ def _swept_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     return rows
 
 
-def _closed_form_targets(robot: Robot, n: int, seed: int) -> list[Any]:
+def _closed_form_targets(robot: Chain, n: int, seed: int) -> list[Any]:
     """max(10, n / 4) seeded targets, the FK of random configurations (oMtool)."""
     rng = np.random.default_rng(seed + 5)
     return [robot.fk(robot.random_q(rng)) for _ in range(max(10, n // 4))]
 
 
-def _worst(robot: Robot, targets: list[Any], answers: Sequence[Sequence[Any]]) -> float:
+def _worst(robot: Chain, targets: list[Any], answers: Sequence[Sequence[Any]]) -> float:
     """The largest position or rotation error [m or rad] (Pinocchio) of any answer against its target."""
     return max(max(robot.tool_error(a.q, t)) for t, found in zip(targets, answers, strict=True) for a in found)
 
 
-def _solved_from_random_starts(robot: Robot, targets: list[Any], solver: str,
+def _solved_from_random_starts(robot: Chain, targets: list[Any], solver: str,
                                seed: int) -> list[tuple[int, np.ndarray, Any]]:
     """(target index, start, answer) of each target that ``solver`` solves from its seeded random start."""
     from kinelab.ik import solve
@@ -300,7 +300,7 @@ def _solved_from_random_starts(robot: Robot, targets: list[Any], solver: str,
     return out
 
 
-def collision_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+def collision_checks(robot: Chain, n: int, seed: int) -> list[Check]:
     """Where the robot has collision geometry: the check (sphere, hull and exact tests) agrees with Pinocchio's
     distance computation on every pair, and no success of a solve with collisions= collides (a floor and a
     table around it)."""
@@ -341,7 +341,7 @@ def collision_checks(robot: Robot, n: int, seed: int) -> list[Check]:
                   f"{solved} targets solved clear of the floor and table", at_least=True, samples=solved)]
 
 
-def seed001_run_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+def seed001_run_checks(robot: Chain, n: int, seed: int) -> list[Check]:
     """Seed 001's run: from the paper's start to its target with K = 1, h = 0.01 s."""
     run = seed001.reproduce(robot, record=True)
     dp, dr = robot.tool_error(run.q, robot.fk(seed001.TARGET_Q))
@@ -357,7 +357,7 @@ def seed001_run_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     ]
 
 
-def youbot_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+def youbot_checks(robot: Chain, n: int, seed: int) -> list[Check]:
     """Seed 003: the paper's J and Pinocchio's rank at θ2 = θ3 = 0, the box, and the families of a sweep."""
     from kinelab.analysis import families, singular
     from kinelab.studies import paper003_youbot as yb
@@ -389,14 +389,14 @@ def youbot_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     ]
 
 
-def era_checks(robot: Robot, n: int, seed: int) -> list[Check]:
+def era_checks(robot: Chain, n: int, seed: int) -> list[Check]:
     """Seed 000: the three ERA passages with and without the paper's bypass."""
     from kinelab.studies import paper000_era as ep
 
     return _elbow_checks(robot, ep) + _lock_checks(robot, ep)
 
 
-def _elbow_checks(robot: Robot, ep) -> list[Check]:
+def _elbow_checks(robot: Chain, ep) -> list[Check]:
     passage = ep.elbow_passage(robot)
     run = ep.run(passage, robot)
     reach = ~passage.unreachable
@@ -414,7 +414,7 @@ def _elbow_checks(robot: Robot, ep) -> list[Check]:
     ]
 
 
-def _lock_checks(robot: Robot, ep) -> list[Check]:
+def _lock_checks(robot: Chain, ep) -> list[Check]:
     """Passages 2 and 3: with the bypass the joint path closes every lap; without, the paper's drift."""
     checks = []
     for name, joints, bypass in (("wrist", (4, 6), "q5, q6 < 80°"), ("shoulder", (0, 6), "q1 frozen")):
@@ -442,7 +442,7 @@ def _lock_checks(robot: Robot, ep) -> list[Check]:
     return checks
 
 
-PAPER_CHECKS: dict[str, list[Callable[[Robot, int, int], list[Check]]]] = {
+PAPER_CHECKS: dict[str, list[Callable[[Chain, int, int], list[Check]]]] = {
     "stanford": [stanford_paper_checks, seed001_run_checks],
     "youbot": [youbot_checks],
     "era": [era_checks],

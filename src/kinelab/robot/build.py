@@ -1,9 +1,9 @@
-"""Building a Robot: a model file (URDF, xacro, MJCF) or an in-memory ``pin.Model`` → the chain's reduced model.
+"""Building a Chain: a model file (URDF, xacro, MJCF) or an in-memory ``pin.Model`` → the chain's reduced model.
 
 Everything a load decides happens here, once: reading the file (and expanding xacro), the SRDF and its group,
 the base → tool chain, mimic joints, the joints held fixed (off the chain, or named in ``locked``), the
 reduced model and its re-rooting at the base frame. The result is a frozen :class:`Built`;
-:class:`~kinelab.robot.model.Robot` uses it and decides nothing.
+:class:`~kinelab.robot.chain.Chain` uses it and decides nothing.
 """
 
 from __future__ import annotations
@@ -32,6 +32,7 @@ from kinelab.robot import xacro
 from kinelab.robot.joints import Joint, Mimic
 from kinelab.robot.meshes import c_stderr_captured, mesh_package_dirs
 from kinelab.robot.mjcf import body_tree, is_mjcf, read_mjcf
+from kinelab.robot.space import LIMIT_SLACK
 from kinelab.robot.srdf import Srdf, read_srdf
 from kinelab.robot.urdf import UrdfTree, read_tree
 
@@ -39,12 +40,11 @@ _REVOLUTE = {"JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevolute
 _PRISMATIC = {"JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned"}
 _CONTINUOUS = {"JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "JointModelRevoluteUnboundedUnaligned"}
 MAX_DATA_BYTES = 2**31  # 2 GiB for one Pinocchio Data (see data_bytes)
-LIMIT_SLACK = 1e-9  # joint values this far past a limit still count as within it (rad or m)
 
 
 @dataclass(frozen=True)
 class Built:
-    """Everything a :class:`~kinelab.robot.model.Robot` is made of, decided once.
+    """Everything a :class:`~kinelab.robot.chain.Chain` is made of, decided once.
 
     Attributes:
         name: the robot's name.
@@ -90,6 +90,67 @@ def build_file(path: str | Path, tool: str | None = None, locked: dict[str, floa
     """
     return _Builder.from_file(Path(path), tool, locked, name, base, package_dirs, srdf, group, xacro_args,
                               trust_xacro).built()
+
+
+@dataclass(frozen=True)
+class Whole:
+    """A whole robot's model read from a file (:func:`whole_model`).
+
+    Attributes:
+        model: the whole Pinocchio model (a free-flyer at its root when asked for; mimic joints as Pinocchio's).
+        name: the robot's name; source: the file the user named; urdf_path: the file Pinocchio read.
+        srdf: the SRDF read, or None.
+    """
+
+    model: pin.Model
+    name: str
+    source: Path
+    urdf_path: Path
+    srdf: Srdf | None
+
+
+def whole_model(path: str | Path, *, floating: bool = False, name: str | None = None,
+                package_dirs: list[str] | None = None, srdf: str | Path | None = None,
+                xacro_args: dict[str, str] | None = None, trust_xacro: bool = False) -> Whole:
+    """The whole model of a file (URDF, xacro or MJCF): every joint, none locked.
+
+    Args:
+        path: the file.
+        floating: a free-flyer between the world and the file's root link.
+        name: the robot's name (default: the file's).
+        package_dirs: where a xacro's includes may be read from.
+        srdf: an SRDF file (checked against the file's joints and links).
+        xacro_args: a xacro source's arguments.
+        trust_xacro: let a xacro source run what xacro runs.
+
+    Raises:
+        URDFError, SRDFError, ChainError: the file, the SRDF or the model refused, named.
+    """
+    source = Path(path)
+    checked_file(source, "robot file", URDFError)
+    urdf_path = xacro.expand(source, xacro_args, trusted=trust_xacro, package_dirs=package_dirs) \
+        if xacro.is_xacro(source) else source
+    root = pin.JointModelFreeFlyer() if floating else None
+    if is_mjcf(urdf_path):
+        model, tree = read_mjcf(urdf_path, root)
+    else:
+        tree = read_tree(urdf_path)
+        model = _whole_urdf(urdf_path, bool(tree.mimic), root)
+    _check_names(model, urdf_path)
+    _check_data_size(model, name or model.name or urdf_path.stem)
+    found = _Builder._read_srdf(srdf, tree)
+    return Whole(model, name or model.name or urdf_path.stem, source, urdf_path, found)
+
+
+def _whole_urdf(path: Path, mimic: bool, root: pin.JointModel | None) -> pin.Model:
+    """The URDF's whole model, its mimic joints Pinocchio's own where it can build them, else plain joints (said)."""
+    if mimic:
+        try:
+            return _build_full_model(path, mimic=True, root=root)
+        except URDFError as refused:
+            warnings.warn(f"{path.name}: Pinocchio cannot build its mimic joints ({refused}); they are plain joints "
+                          "(hold them with a CouplingTask)", stacklevel=3)
+    return _build_full_model(path, root=root)
 
 
 def build_model(model: pin.Model, tool: str | None = None, locked: dict[str, float] | None = None,
@@ -223,7 +284,7 @@ class _Builder:
         for jid in chain:
             jname = full.names[jid]
             if full.joints[jid].shortname() == "JointModelMimic":
-                continue  # follows its leader (Robot._with_mimics checked it is on the chain)
+                continue  # follows its leader (Chain._with_mimics checked it is on the chain)
             if _kind(full.joints[jid]) is None:
                 raise ChainError(
                     f"joint {jname!r} is a {full.joints[jid].shortname()}: kinelab chains take revolute, "
@@ -360,11 +421,12 @@ def _check_names(model: pin.Model, path: Path) -> None:
                         "another encoding); kinelab reads names as UTF-8: save the file as UTF-8") from None
 
 
-def _build_full_model(path: Path, mimic: bool = False) -> pin.Model:
+def _build_full_model(path: Path, mimic: bool = False, root: pin.JointModel | None = None) -> pin.Model:
     said: list[str] = []
     try:
         with c_stderr_captured(said):  # urdfdom prints its complaints on the process's stderr
-            model = pin.buildModelFromUrdf(str(path), mimic=mimic)
+            model = pin.buildModelFromUrdf(str(path), mimic=mimic) if root is None else \
+                pin.buildModelFromUrdf(str(path), root, mimic=mimic)
     except (RuntimeError, ValueError, UnicodeDecodeError) as exc:
         detail = " ".join([str(exc), *said]).strip()
         raise URDFError(f"Pinocchio cannot read {path}: {detail}") from None

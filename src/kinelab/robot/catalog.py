@@ -28,10 +28,14 @@ class Entry:
     srdf: str | None = None  # below the same directory as relpath
     group: str | None = None  # the SRDF group that gives base and tool
     display: tuple[float, ...] | None = None  # a well-conditioned pose to show [rad, m] (None: computed)
+    whole: bool = False  # the name loads the whole robot (a humanoid, a two-armed robot, a quadruped), not a chain
+    floating: bool = False  # the whole robot's base floats (a free-flyer at its root)
 
     @property
     def chain(self) -> str:
-        """Where the chain comes from, in words (``kinelab robots``)."""
+        """Where the chain comes from, in words (``kinelab robots``); a whole robot's base."""
+        if self.whole:
+            return "the whole robot, " + ("free-flyer base" if self.floating else "fixed base")
         if self.group:
             return f"SRDF group {self.group!r} of {Path(self.srdf or '').name}"
         return f"{self.base or 'root'} → {self.tool}"
@@ -94,7 +98,31 @@ ERD_ARMS = (
           "PAL TIAGo Pro, right arm from the torso lift link, 7R", base="torso_lift_link"),
 )
 
-ENTRIES = {e.name: e for e in BUNDLED + ERD_ARMS}
+
+def _whole(name: str, relpath: str, description: str, srdf: str | None = None, floating: bool = True) -> Entry:
+    return Entry(name, "example-robot-data", relpath, None, description, srdf=srdf, whole=True, floating=floating)
+
+
+# the whole robots of example-robot-data: humanoids and quadrupeds on a free-flyer, two-armed robots on a fixed base
+ERD_WHOLE = (
+    _whole("talos", "talos_data/robots/talos_reduced.urdf", "PAL TALOS humanoid, 32 joints (reduced: no fingers)",
+           "talos_data/srdf/talos.srdf"),
+    _whole("g1", "g1_description/urdf/g1_29dof_rev_1_0.urdf", "Unitree G1 humanoid, 29 joints"),
+    _whole("romeo", "romeo_description/urdf/romeo.urdf", "Aldebaran Romeo humanoid"),  # its SRDF: other joints
+    _whole("icub", "icub_description/robots/icub_reduced.urdf", "iCub humanoid (reduced)",
+           "icub_description/srdf/icub.srdf"),
+    _whole("baxter", "baxter_description/urdf/baxter.urdf", "Rethink Baxter, both arms and the head, fixed base",
+           floating=False),
+    _whole("pr2", "pr2_description/urdf/pr2.urdf", "PR2, both arms, torso and head, fixed base",
+           "pr2_description/srdf/pr2.srdf", floating=False),
+    _whole("solo12", "solo_description/robots/solo12.urdf", "Solo-12 quadruped"),  # its SRDF names missing groups
+    _whole("anymal", "anymal_b_simple_description/robots/anymal.urdf", "ANYmal B quadruped",
+           "anymal_b_simple_description/srdf/anymal.srdf"),
+    _whole("go2", "go2_description/urdf/go2.urdf", "Unitree Go2 quadruped", "go2_description/srdf/go2.srdf"),
+    _whole("hyq", "hyq_description/robots/hyq_no_sensors.urdf", "IIT HyQ quadruped"),
+)
+
+ENTRIES = {e.name: e for e in BUNDLED + ERD_ARMS + ERD_WHOLE}
 
 
 def bundled_urdf_dir() -> Path:

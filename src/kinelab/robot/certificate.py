@@ -1,10 +1,10 @@
 """The judge of kinelab's answers: the compiled chain FK, certified equal to Pinocchio's on each robot.
 
-A Robot's chain (base → tool, joints in series) is packed into plain arrays and run through the compiled FK of
+A Chain's chain (base → tool, joints in series) is packed into plain arrays and run through the compiled FK of
 :mod:`kinelab.core` (built when kinelab is installed). Before it judges anything, it is compared with Pinocchio's
 FK on that robot at seeded configurations: random ones over the joints' ranges and, for every joint, its lower
 and its upper limit. It is *certified* when every tool pose agrees within :data:`TOLERANCE` (m, and rad of the
-rotation between them); the certificate is kept on the Robot (``robot.fk_certificate``). A chain that is not a
+rotation between them); the certificate is kept on the Chain (``robot.fk_certificate``). A chain that is not a
 plain series of 1-DoF joints (a mimic joint) or that fails the comparison is judged by Pinocchio's FK, and its
 certificate says why.
 """
@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-Robot = Any  # a kinelab.Robot (the model module imports this one, so the type is not imported back)
+Chain = Any  # a kinelab.Chain (the model module imports this one, so the type is not imported back)
 
 TOLERANCE = 1e-12  # [m] and [rad]: the compiled FK and Pinocchio's agree to rounding (measured: ≤ 6e-15 on ERA)
 RANDOM_CONFIGURATIONS = 64  # and two per joint at its limits
@@ -80,7 +80,7 @@ class FKCertificate:
         return f"Pinocchio FK (the compiled FK is not certified: {self.reason})"
 
 
-def chain_arrays(robot: Robot) -> ChainArrays | str:
+def chain_arrays(robot: Chain) -> ChainArrays | str:
     """The robot's chain as arrays, or the reason it is not a plain series of 1-DoF joints."""
     model = robot.model
     if robot.mimics:
@@ -101,7 +101,7 @@ def chain_arrays(robot: Robot) -> ChainArrays | str:
     return ChainArrays(*(np.ascontiguousarray(a) for a in packed))  # the compiled FK reads rows in C order
 
 
-def certify(robot: Robot) -> FKCertificate:
+def certify(robot: Chain) -> FKCertificate:
     """Compare the compiled FK with Pinocchio's on ``robot`` (see the module docstring).
 
     Returns:
@@ -122,7 +122,7 @@ def certify(robot: Robot) -> FKCertificate:
     return FKCertificate(True, len(Q), dp, dr)
 
 
-def _configurations(robot: Robot) -> np.ndarray:
+def _configurations(robot: Chain) -> np.ndarray:
     """Seeded random configurations, then each joint at its lower and its upper limit (the others random)."""
     rng = np.random.default_rng(0)
     Q = robot.random_qs(RANDOM_CONFIGURATIONS + 2 * robot.n, rng)

@@ -31,15 +31,16 @@ def is_mjcf(path: Path) -> bool:
     return False
 
 
-def read_mjcf(path: Path) -> tuple[pin.Model, UrdfTree]:
-    """Pinocchio's model of an MJCF file and its body tree.
+def read_mjcf(path: Path, root: pin.JointModel | None = None) -> tuple[pin.Model, UrdfTree]:
+    """Pinocchio's model of an MJCF file (``root``: a joint between the world and its root body, a free-flyer
+    say) and its body tree.
 
     Raises:
         URDFError: a file Pinocchio cannot read (the file and Pinocchio's reason named).
     """
     check_mjcf(path)
     try:
-        model = pin.buildModelFromMJCF(str(path))
+        model = pin.buildModelFromMJCF(str(path)) if root is None else pin.buildModelFromMJCF(str(path), root)
     except Exception as exc:  # noqa: BLE001 - the parser raises RuntimeError, ValueError, IndexError, ...
         raise URDFError(f"Pinocchio cannot read the MJCF {path}: {type(exc).__name__}: {exc}") from None
     _restore_slide_ranges(model, ET.fromstring(read_text(path, "MJCF file", URDFError)))

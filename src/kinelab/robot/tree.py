@@ -11,16 +11,15 @@ universe) frame, ``oM<frame>``; Jacobians are 6 × nv with rows [linear; angular
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TypeVar, cast
+from typing import TYPE_CHECKING, Any, TypeVar, cast, overload
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from kinelab.errors import FrameNotFoundError, OptionError, SRDFError
+from kinelab.errors import ChainError, FrameNotFoundError, OptionError, SRDFError
 from kinelab.robot import space as sp
 
 if TYPE_CHECKING:
@@ -66,20 +65,44 @@ class Robot:
         self._bodies = {f.name: i for i, f in reversed(list(enumerate(model.frames))) if f.type == pin.FrameType.BODY}
         self._derived: dict[str, Any] = {}
 
+    @overload
     @classmethod
-    def from_model(cls, model: pin.Model, *, name: str | None = None, floating: bool = False) -> Robot:
-        """The whole robot of an in-memory Pinocchio model (what pink and mink take); a copy, yours left as it is.
+    def from_model(cls, model: pin.Model, *, name: str | None = ..., floating: bool = ...) -> Robot: ...
+
+    @overload
+    @classmethod
+    def from_model(cls, model: pin.Model, *, tool: str, base: str | None = ..., locked: dict[str, float] | None = ...,
+                   name: str | None = ...) -> Chain: ...
+
+    @classmethod
+    def from_model(cls, model: pin.Model, *, tool: str | None = None, base: str | None = None,
+                   locked: dict[str, float] | None = None, name: str | None = None,
+                   floating: bool = False) -> Robot | Chain:
+        """The whole robot of an in-memory Pinocchio model (what pink and mink take), or with ``tool`` the chain
+        base → tool of it (:meth:`Chain.from_model <kinelab.robot.chain.Chain.from_model>`); a copy, yours left as
+        it is.
 
         Args:
             model: the model.
+            tool: the chain's tool frame (None: the whole robot).
+            base: the chain's base frame (default: the model's root).
+            locked: the chain's held joints, name → value [rad or m].
             name: its name (default: the model's).
-            floating: put a free-flyer at its root (a model built without one).
+            floating: put a free-flyer at the whole robot's root (a model built without one).
 
         Raises:
-            OptionError: not a ``pin.Model``, or ``floating`` with a model whose root joint is one already.
+            ChainError: not a ``pin.Model``. OptionError: ``floating`` with a model whose root joint is one
+                already, or chain settings with ``floating``.
+            FrameNotFoundError, JointNotFoundError: the chain's, named.
         """
+        if tool is not None or base is not None or locked is not None:
+            from kinelab.robot.chain import Chain
+
+            if floating:
+                raise OptionError("floating", floating, "False with tool=, base= or locked= (a chain is fixed)")
+            return Chain.from_model(model, tool=tool, base=base, locked=locked, name=name)
         if not isinstance(model, pin.Model):
-            raise OptionError("model", type(model).__name__, "a pinocchio.Model")
+            raise ChainError(f"from_model takes a pinocchio.Model, got {type(model).__name__}")
         whole = pin.Model(model)
         if floating:
             whole = with_free_flyer(whole)
@@ -309,8 +332,3 @@ def without_free_flyer(model: pin.Model) -> pin.Model:
     """The model with its root free-flyer locked at the neutral pose (the frames' placements relative to the root
     body kept)."""
     return pin.buildReducedModel(model, [1], pin.neutral(model))
-
-
-def pairs(items: Sequence[T]) -> list[tuple[T, T]]:
-    """Consecutive pairs of ``items``."""
-    return list(itertools.pairwise(items))

@@ -44,7 +44,7 @@ from kinelab.geometry import wrap_to_pi
 from kinelab.ik.api import track
 from kinelab.ik.frdm import solver
 from kinelab.ik.result import TrackResult
-from kinelab.robot import Robot, load
+from kinelab.robot import Chain, load
 
 FULL_REACH = 1.228 + 0.340 + 4.072 + 4.072 + 0.340 + 1.228  # [m] joint 1 to the tool, straight
 ELBOW_FOLD = np.deg2rad(40.0)  # start: q3 = a, q4 = −2a, q5 = a keeps the tool on the vertical axis
@@ -90,7 +90,7 @@ class PassageRun:
     with_bypass: TrackResult
 
 
-def elbow_passage(robot: Robot | None = None, samples: int = 40) -> Passage:
+def elbow_passage(robot: Chain | None = None, samples: int = 40) -> Passage:
     """Passage 1: up the vertical axis past full reach and back down, tool orientation fixed."""
     robot = robot or load("era")
     a = ELBOW_FOLD
@@ -118,7 +118,7 @@ def _circle(oMstart: pin.SE3, radius: float, plane: tuple, samples: int, laps: i
     return [pin.SE3(oMstart.rotation, centre + radius * (np.cos(p) * u + np.sin(p) * v)) for p in phi]
 
 
-def wrist_passage(robot: Robot | None = None, radius: float = 0.35, samples: int = 60, laps: int = 4) -> Passage:
+def wrist_passage(robot: Chain | None = None, radius: float = 0.35, samples: int = 60, laps: int = 4) -> Passage:
     """Passage 2: at q6 = 90° the wrist circles in the arm's vertical plane (y, z), tool orientation fixed."""
     robot = robot or load("era")
     targets = _circle(robot.fk(WRIST_LOCK), radius, ((0, 1, 0), (0, 0, 1)), samples, laps)
@@ -137,7 +137,7 @@ def wrist_passage(robot: Robot | None = None, radius: float = 0.35, samples: int
     )
 
 
-def shoulder_passage(robot: Robot | None = None, radius: float = 0.5, samples: int = 72, laps: int = 3,
+def shoulder_passage(robot: Chain | None = None, radius: float = 0.5, samples: int = 72, laps: int = 3,
                      frozen: str = "joint1") -> Passage:
     """Passage 3: the tool, pointing down, circles the vertical roll axis J1 (J7 ∥ J1), orientation fixed."""
     robot = robot or load("era")
@@ -160,7 +160,7 @@ PASSAGES: dict[str, Callable[..., Passage]] = {"elbow": elbow_passage, "wrist": 
                                                "shoulder": shoulder_passage}
 
 
-def run(passage: Passage, robot: Robot | None = None, **options) -> PassageRun:
+def run(passage: Passage, robot: Chain | None = None, **options) -> PassageRun:
     """Track the passage without bypass and with the paper's bypass (FRDM, warm-started, no restarts).
 
     ``options`` go to :func:`~kinelab.ik.frdm.tracking.track`; the study's default weighting is
@@ -193,7 +193,7 @@ SINGULAR_KINDS = {"elbow reach": ("joint4", 0.0), "wrist gimbal lock": ("joint6"
                   "shoulder": ("joint2", np.pi / 2)}
 
 
-def singular_examples(robot: Robot | None = None, seed: int = 0) -> dict[str, np.ndarray]:
+def singular_examples(robot: Chain | None = None, seed: int = 0) -> dict[str, np.ndarray]:
     """One configuration per kind: the defining joint held at its value, the others moved onto the singular
     set (σ_min minimised). A 7R arm needs more than one condition to lose rank; the refinement finds it."""
     from kinelab.analysis.families import refine
@@ -211,7 +211,7 @@ def singular_examples(robot: Robot | None = None, seed: int = 0) -> dict[str, np
     return out
 
 
-def dls_tracking(passage: Passage, robot: Robot | None = None) -> TrackResult:
+def dls_tracking(passage: Passage, robot: Chain | None = None) -> TrackResult:
     """The Pinocchio DLS reference along the same path, warm-started from the previous sample, no restarts."""
     import time
 
@@ -234,7 +234,7 @@ def dls_tracking(passage: Passage, robot: Robot | None = None) -> TrackResult:
                        np.array(iters), np.array(times))
 
 
-def tracking_bench(repeats: int = 3, robot: Robot | None = None) -> dict:
+def tracking_bench(repeats: int = 3, robot: Chain | None = None) -> dict:
     """Per-sample cost along the three passages: FRDM with the paper's bypass against the Pinocchio DLS
     reference, both warm-started from the previous sample with no restarts. Each run is repeated and
     every sample keeps its fastest time (the runs are deterministic, so the work is the same).

@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 from kinelab.view.caption import before_body
 from kinelab.view.scene import Scene, _stick_figure, chain_points
 
@@ -17,7 +17,7 @@ def colours(values: np.ndarray) -> np.ndarray:
     return np.vstack([np.clip(2 * (1 - v), 0, 1), np.clip(2 * v, 0, 1), np.zeros_like(v)])
 
 
-def reachability_cloud(robot: Robot, rmap: Any, q: Any = None, viewer: Any = None, meshes: bool = True) -> Scene:
+def reachability_cloud(robot: Chain, rmap: Any, q: Any = None, viewer: Any = None, meshes: bool = True) -> Scene:
     """The robot at q (default: its display pose) with the map's reached voxels as points coloured by their
     reachability index; the caption says what the colours mean.
 
@@ -72,7 +72,7 @@ SLICES_STYLE = ("position:fixed;right:10px;top:40px;width:300px;padding:6px;bord
                 "background:rgba(255,255,255,0.92);box-shadow:0 1px 4px rgba(0,0,0,0.3);z-index:10")
 
 
-def map_page(robot: Robot, rmap: Any) -> str:
+def map_page(robot: Chain, rmap: Any) -> str:
     """A reachability map as one self-contained page: the reached voxels in 3-D over the robot's stick figure
     (the caption says what the colours mean) and the three slices through the map's centre (x, y and z layers)
     as images in a box on the right."""

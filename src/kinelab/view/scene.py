@@ -19,7 +19,7 @@ import pinocchio as pin
 
 from kinelab.errors import ConfigurationError
 from kinelab.files import write_output
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 from kinelab.view.caption import Table, tab_title, titled, with_caption
 from kinelab.view.framing import FILL, frame_points
 from kinelab.view.labels import draw_number
@@ -35,7 +35,7 @@ AXIS_COLORS = (0xE6194B, 0x3CB44B, 0x4363D8)  # x red, y green, z blue
 class Scene:
     """A meshcat scene for one robot. ``scene.url`` is the live viewer; ``save_html`` writes a static copy."""
 
-    def __init__(self, robot: Robot, viewer=None, open: bool = False, name: str | None = None,
+    def __init__(self, robot: Chain, viewer=None, open: bool = False, name: str | None = None,
                  frame_length: float | None = None):
         import meshcat
         from pinocchio.visualize import MeshcatVisualizer
@@ -295,7 +295,7 @@ class Scene:
 
 
 
-def side_by_side(robot: Robot, qs: list, spacing: float | None = None, viewer: Any = None,
+def side_by_side(robot: Chain, qs: list, spacing: float | None = None, viewer: Any = None,
                  labels: list[str] | None = None, highlight: int | None = None, target: pin.SE3 | None = None) -> Scene:
     """One scene with the robot drawn once per configuration as a stick figure (joints as spheres, the
     segments between joint origins and the tool point as cylinders), side by side on a grid, each copy numbered
@@ -366,7 +366,7 @@ def _target_mark(node: Any, point: np.ndarray, size: float) -> None:
     node.set_transform(pin.SE3(np.eye(3), np.asarray(point, dtype=float)).homogeneous)
 
 
-def _side_by_side_legend(scene: Scene, robot: Robot, labels: list[str], highlight: int | None,
+def _side_by_side_legend(scene: Scene, robot: Chain, labels: list[str], highlight: int | None,
                          target: pin.SE3 | None) -> None:
     scene.title = f"{robot.name}: {len(labels)} configurations side by side"
     scene.legend = {"figures": "joints: blue spheres; links: grey cylinders; each copy's number above it",
@@ -378,7 +378,7 @@ def _side_by_side_legend(scene: Scene, robot: Robot, labels: list[str], highligh
         scene.legend["highlight"] = f"orange joints: {labels[highlight]}"
 
 
-def chain_points(robot: Robot, q: Any) -> list[np.ndarray]:
+def chain_points(robot: Chain, q: Any) -> list[np.ndarray]:
     """The joint origins and the tool point at q [m, base frame], base first."""
     return [m.translation for m in robot.joint_placements(q).values()] + [robot.fk(q).translation]
 
@@ -442,7 +442,7 @@ def _move_stick(node, points: list[np.ndarray], lengths: list[float]) -> None:
         node[f"link{k}"].set_transform(T)
 
 
-def _figure_note(robot: Robot, missing: list[str], stick: bool) -> str:
+def _figure_note(robot: Chain, missing: list[str], stick: bool) -> str:
     """The caption line that says what the file could not give the view, and how the robot is drawn instead."""
     lost = (f"{len(missing)} visual mesh(es) of the file not found (first: {missing[0]}; --package-dir or "
             "package_dirs= finds them)") if missing else ""

@@ -43,8 +43,8 @@ from kinelab.ik.limits import distance, inside_limits
 from kinelab.ik.request import Request, make_request, verdict_reserve
 from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target_arrays, beyond_reach, reach_bound
-from kinelab.robot import Robot
-from kinelab.robot.model import _compiled_judge
+from kinelab.robot import Chain
+from kinelab.robot.chain import _compiled_judge
 
 if TYPE_CHECKING:
     from kinelab.collision.model import CollisionModel
@@ -64,7 +64,7 @@ CONTINUUM = "one of a continuum: a singular pose, another angle of the free join
 _NO_REF = {n: np.zeros(n) for n in (5, 6)}
 
 
-def arm_of(robot: Robot, req: Request) -> ArmClass:
+def arm_of(robot: Chain, req: Request) -> ArmClass:
     """The robot's analytic class for a pose request: a closed form or a search class, else the general 6R
     elimination.
 
@@ -83,18 +83,18 @@ def arm_of(robot: Robot, req: Request) -> ArmClass:
     return arm
 
 
-def has_closed_form(robot: Robot, req: Request) -> bool:
+def has_closed_form(robot: Chain, req: Request) -> bool:
     """True when the chain is in an analytic class and the request asks for the whole pose."""
     return req.task.name == "pose" and classify(robot).arm is not None
 
 
-def has_general_form(robot: Robot, req: Request) -> bool:
+def has_general_form(robot: Chain, req: Request) -> bool:
     """True when the chain is a 6R chain the general elimination takes (and no class of its own) and the request
     asks for the whole pose."""
     return req.task.name == "pose" and general_class(robot).arm is not None
 
 
-def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | None = None,
+def analytic_all(robot: Chain, target: Any, req: Request, q_ref: np.ndarray | None = None,
                  max_solutions: int | None = None) -> Branches:
     """Every branch of the pose ``target`` (oMtarget, base frame) that Pinocchio confirms within the limits.
 
@@ -148,7 +148,7 @@ def analytic_all(robot: Robot, target: Any, req: Request, q_ref: np.ndarray | No
                           beyond="" if len(rows.q) else beyond_reach(robot, target.translation))
 
 
-def _inside(robot: Robot, q: np.ndarray, found: np.ndarray, free: np.ndarray,
+def _inside(robot: Chain, q: np.ndarray, found: np.ndarray, free: np.ndarray,
             slack: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The rows of q within the limits, each angle turned into them where it can be and clipped when ``slack`` [rad]
     past a limit (a root split beside a fold can land a hair past one); the others dropped."""
@@ -163,7 +163,7 @@ def _method(arm: ArmClass) -> str:
     return "elimination" if arm.kind == GENERAL_6R else "search" if arm.searched else "closed form"
 
 
-def prepared_form(robot: Robot, req: Request) -> ClosedForm | None:
+def prepared_form(robot: Chain, req: Request) -> ClosedForm | None:
     """The robot's compiled closed form for the request's tolerances (kept on the robot), or None where its compiled
     FK is not certified (Pinocchio then judges root by root)."""
     forms: dict[tuple[float, float], ClosedForm | None] = robot.derived("closed forms", _new_forms)
@@ -182,7 +182,7 @@ def prepared_form(robot: Robot, req: Request) -> ClosedForm | None:
     return forms[key]
 
 
-def _new_forms(_: Robot) -> dict[tuple[float, float], ClosedForm | None]:
+def _new_forms(_: Chain) -> dict[tuple[float, float], ClosedForm | None]:
     return {}
 
 
@@ -214,7 +214,7 @@ class Rows(NamedTuple):
         return Rows(*(column[order] for column in self))
 
 
-def judged_roots(robot: Robot, q: np.ndarray, found: np.ndarray, free: np.ndarray, target: Any,
+def judged_roots(robot: Chain, q: np.ndarray, found: np.ndarray, free: np.ndarray, target: Any,
                  req: Request, held: dict[str, float] | None = None) -> list[Answer]:
     """The roots q (m × n) the judge confirms, in their order: each as (q, position error [m], rotation error [rad],
     finished, roots merged, one of a continuum). Where the robot's compiled FK is certified, every root is judged in
@@ -236,14 +236,14 @@ def judged_roots(robot: Robot, q: np.ndarray, found: np.ndarray, free: np.ndarra
     return answers
 
 
-def _judged_each(robot: Robot, q: np.ndarray, found: np.ndarray, free: np.ndarray, target: Any, req: Request,
+def _judged_each(robot: Chain, q: np.ndarray, found: np.ndarray, free: np.ndarray, target: Any, req: Request,
                  held: dict[str, float] | None) -> list[Answer]:
     """:func:`judged_roots` root by root with Pinocchio's FK (a robot whose compiled FK is not its judge)."""
     return [(*v, int(found[k]), bool(free[k])) for k in range(q.shape[0])
             if (v := judged(robot, q[k], target, req, held)) is not None]
 
 
-def branch_results(robot: Robot, rows: Rows, req: Request, mode: str, elapsed: float, max_solutions: int | None,
+def branch_results(robot: Chain, rows: Rows, req: Request, mode: str, elapsed: float, max_solutions: int | None,
                    method: str, empty: str, uncertified: str | None = None, H: np.ndarray | None = None, *,
                    beyond: str = "", late: str = "") -> Branches:
     """The closed form's judged rows as :class:`Branches`, the first ``max_solutions``: arrays, and an IKResult per
@@ -283,7 +283,7 @@ def _empty_set(total: int, beyond: str, late: str, uncertified: str | None, empt
     return Status.NOT_FOUND, f"no branch found, and the set is not certified: {uncertified}"
 
 
-def certificate_of(robot: Robot, method: str, H: np.ndarray, q: np.ndarray, merged: np.ndarray,
+def certificate_of(robot: Chain, method: str, H: np.ndarray, q: np.ndarray, merged: np.ndarray,
                    continuum: np.ndarray) -> tuple[str, str]:
     """(complete, reason) of a closed form's, a search's or the compiled elimination's set q (k, 6) [rad] of the
     pose H (docs/analytic.md, Certificates). A search's set short of 16 proved branches is certified when the
@@ -311,7 +311,7 @@ def certificate_of(robot: Robot, method: str, H: np.ndarray, q: np.ndarray, merg
     return proved_each(loop, H, q)
 
 
-def _decoupled(robot: Robot) -> bool:
+def _decoupled(robot: Chain) -> bool:
     """True when the robot's chain is solved by Pieper's decoupling."""
     arm = classify(robot).arm or general_class(robot).arm
     return arm is not None and arm.kind == PIEPER_6R
@@ -324,7 +324,7 @@ def proved_each(loop: Loop | None, H: np.ndarray, q: np.ndarray) -> tuple[str, s
     return "certified", ""
 
 
-def _elimination(robot: Robot) -> ArmClass | None:
+def _elimination(robot: Chain) -> ArmClass | None:
     """The general elimination of a 6R robot's chain where it takes it, to cross-check a 1-D search's sets (None
     where the chain is taken otherwise, e.g. by Pieper's decoupling)."""
     six = _six_vectors(robot)
@@ -332,17 +332,17 @@ def _elimination(robot: Robot) -> ArmClass | None:
     return arm if arm is not None and arm.kind == GENERAL_6R else None
 
 
-def robot_loop(robot: Robot) -> Loop | None:
+def robot_loop(robot: Chain) -> Loop | None:
     """The loop equations of a 6R robot's chain (:mod:`kinelab.ik.analytic.certify`), built once; None otherwise."""
     return robot.derived("loop equations", _loop)
 
 
-def _loop(robot: Robot) -> Loop | None:
+def _loop(robot: Chain) -> Loop | None:
     six = _six_vectors(robot)
     return None if six is None else loop_of(*six)
 
 
-def _six_vectors(robot: Robot) -> tuple[np.ndarray, ...] | None:
+def _six_vectors(robot: Chain) -> tuple[np.ndarray, ...] | None:
     """A 6-joint robot's chain at q = 0 (axes, points, tool rotation and point; base frame), None otherwise."""
     if robot.n != 6:
         return None
@@ -350,7 +350,7 @@ def _six_vectors(robot: Robot) -> tuple[np.ndarray, ...] | None:
     return v["e"].copy(), v["o"].copy(), v["R"].copy(), v["N"].copy()
 
 
-def nearest_roots(robot: Robot, arm: ArmClass, target: Any, req: Request,
+def nearest_roots(robot: Chain, arm: ArmClass, target: Any, req: Request,
                   ref: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any]:
     """:func:`roots` of the pose ``target`` (copies nearest ``ref``, roots up to ``tol_rot`` past a limit tried at
     it) and the order to try them in: nearest ``ref`` first (joint by joint, modulo 2π), as found without it."""
@@ -359,7 +359,7 @@ def nearest_roots(robot: Robot, arm: ArmClass, target: Any, req: Request,
     return q, found, free, order
 
 
-def roots(robot: Robot, arm: ArmClass, H: np.ndarray, q_ref: np.ndarray | None,
+def roots(robot: Chain, arm: ArmClass, H: np.ndarray, q_ref: np.ndarray | None,
           slack: float = LIMIT_SLACK) -> tuple[np.ndarray, ...]:
     """The compiled branches of the pose H (4 × 4, base frame): (q (m, n) within the limits, a root up to
     ``slack`` [rad] outside one clipped to it; roots merged into each; one-of-a-continuum flags), before
@@ -392,7 +392,7 @@ def near_enough(dp: float, dr: float, req: Request) -> bool:
     return dp <= 1e3 * req.tol_pos + 1e-6 and dr <= 1e3 * req.tol_rot + 1e-6
 
 
-def judged(robot: Robot, q: np.ndarray, target: Any, req: Request,
+def judged(robot: Chain, q: np.ndarray, target: Any, req: Request,
            held: dict[str, float] | None = None) -> tuple[np.ndarray, float, float, bool] | None:
     """(q, position error, rotation error, finished) when Pinocchio's FK of q meets the tolerances, after a
     warm-started finish (``finished``; the joints of ``held`` frozen at their values [rad]) if the closed form
@@ -440,7 +440,7 @@ class BranchBatch:
     late: np.ndarray | None = None
 
 
-def all_branches_batch(robot: Robot, targets: Any, tol_pos: float = 1e-6, tol_rot: float = 1e-6,
+def all_branches_batch(robot: Chain, targets: Any, tol_pos: float = 1e-6, tol_rot: float = 1e-6,
                        time_budget: float | None = None) -> BranchBatch:
     """Every branch of each pose in ``targets`` (what :func:`analytic_all` gives each, copies nearest 0), on all
     cores: where the robot's compiled FK is certified the closed form and the judge run in one compiled pass; a pose
@@ -491,13 +491,13 @@ def all_branches_batch(robot: Robot, targets: Any, tol_pos: float = 1e-6, tol_ro
                        late=None if time_budget is None else late)
 
 
-def beyond_reach_rows(robot: Robot, H: np.ndarray) -> np.ndarray:
+def beyond_reach_rows(robot: Chain, H: np.ndarray) -> np.ndarray:
     """(B,) True where pose b's point lies beyond the robot's reach bound (no configuration reaches it)."""
     anchor, radius = reach_bound(robot)
     return np.asarray(np.linalg.norm(H[:, :3, 3] - np.asarray(anchor), axis=1) > radius)
 
 
-def _pinocchio_batch(robot: Robot, arm: ArmClass, H: np.ndarray, req: Request, deadline: float) -> BranchBatch:
+def _pinocchio_batch(robot: Chain, arm: ArmClass, H: np.ndarray, req: Request, deadline: float) -> BranchBatch:
     """:func:`all_branches_batch` where Pinocchio's FK judges: the closed form in threads, then every branch judged
     in one FK batch; a root that falls short is dropped. Pose by pose (the elimination, Pieper's decoupling) the
     poses not started before ``deadline`` are left."""
@@ -551,7 +551,7 @@ def _pinocchio_batch(robot: Robot, arm: ArmClass, H: np.ndarray, req: Request, d
                        reasons, None if req.time_budget is None else late)
 
 
-def _constant_fields(robot: Robot, req: Request, mode: str) -> dict[str, Any]:
+def _constant_fields(robot: Chain, req: Request, mode: str) -> dict[str, Any]:
     """The fields every closed-form answer of this robot, request and mode shares."""
     return {"success": True, "status": Status.CONVERGED, "iterations": 0, "restarts": 0, "solver": "analytic",
             "mode": mode, "task": req.task_label, "judge": robot.fk_certificate.judge}
@@ -582,7 +582,7 @@ class OneCall:
         form: the robot's compiled closed form for the request's tolerances (:func:`prepared_form`).
     """
 
-    def __init__(self, robot: Robot, req: Request, form: ClosedForm):
+    def __init__(self, robot: Chain, req: Request, form: ClosedForm):
         arm = arm_of(robot, req)
         self.form, self.fields = form, _constant_fields(robot, req, arm.mode)
         self.method = _method(arm)
@@ -643,7 +643,7 @@ class EveryBranch(OneCall):
         return _filled(self.fields, rows, i, wall_time, len(q), self.unseen)
 
 
-def analytic_one(robot: Robot, target: Any, req: Request, q0: np.ndarray | None,
+def analytic_one(robot: Chain, target: Any, req: Request, q0: np.ndarray | None,
                  model: CollisionModel | None = None) -> IKResult:
     """The branch nearest ``q0`` (each angle's copy in the limits nearest it; without q0 the first branch) that
     Pinocchio confirms — and, with a collision ``model``, the nearest that is clear.
@@ -683,7 +683,7 @@ def analytic_one(robot: Robot, target: Any, req: Request, q0: np.ndarray | None,
     return _no_branch(robot, target, req, q0, q.shape[0], (collided, contact), arm.mode, t0)
 
 
-def _first_clear(robot: Robot, q: np.ndarray, order: Any, target: Any, req: Request,
+def _first_clear(robot: Chain, q: np.ndarray, order: Any, target: Any, req: Request,
                  model: CollisionModel | None) -> tuple[int, Any, Any]:
     """(index, verdict) of the first root in ``order`` the judge confirms and ``model`` finds clear ((−1, None)
     when none is), and the verdict of the first confirmed one that collides (None when none did)."""
@@ -699,7 +699,7 @@ def _first_clear(robot: Robot, q: np.ndarray, order: Any, target: Any, req: Requ
     return -1, None, collided
 
 
-def _numeric_check(robot: Robot, target: Any, req: Request, q0: np.ndarray | None, t0: float) -> IKResult:
+def _numeric_check(robot: Chain, target: Any, req: Request, q0: np.ndarray | None, t0: float) -> IKResult:
     """When the 1-D search finds no branch of a pose within reach: FRDM from q0 (or seeded starts) within what is
     left of the budget. The search is measured complete (99.99 %), not proved so, and a reachable pose must never be
     answered "unreachable" by it alone (2 of 6,120 poses of random arms whose axes nearly meet were)."""
@@ -710,7 +710,7 @@ def _numeric_check(robot: Robot, target: Any, req: Request, q0: np.ndarray | Non
                    wall_time=time.perf_counter() - t0)
 
 
-def _no_branch(robot: Robot, target: Any, req: Request, q0: np.ndarray | None, count: int, collided: Any, mode: str,
+def _no_branch(robot: Chain, target: Any, req: Request, q0: np.ndarray | None, count: int, collided: Any, mode: str,
                t0: float) -> IKResult:
     """The failure of :func:`analytic_one`: the nearest colliding branch, or the reference (or zero) when the
     closed form has no branch within the limits."""
@@ -730,7 +730,7 @@ def _no_branch(robot: Robot, target: Any, req: Request, q0: np.ndarray | None, c
                     task=req.task_label, diagnostics=Diagnostics(path="compiled", branches=0))
 
 
-def nearest_batch(robot: Robot, targets: Any, q0: Any, req: Request, model: CollisionModel | None) -> BatchIKResult:
+def nearest_batch(robot: Chain, targets: Any, q0: Any, req: Request, model: CollisionModel | None) -> BatchIKResult:
     """:func:`analytic_one` for every target of a batch (q0: None, one start for every row, or (B, n) starts).
 
     Raises:
@@ -746,7 +746,7 @@ def nearest_batch(robot: Robot, targets: Any, q0: Any, req: Request, model: Coll
     return _nearest_rows(robot, H, starts, req, model, t0)
 
 
-def batch_starts(robot: Robot, q0: Any, count: int) -> np.ndarray | None:
+def batch_starts(robot: Chain, q0: Any, count: int) -> np.ndarray | None:
     """A batch's starts as (count, n) [rad or m] (None: none given; one start serves every row).
 
     Raises:
@@ -759,7 +759,7 @@ def batch_starts(robot: Robot, q0: Any, count: int) -> np.ndarray | None:
     return None if starts is None else np.broadcast_to(starts, (count, robot.n))
 
 
-def _compiled_nearest(robot: Robot, form: ClosedForm, H: np.ndarray, starts: np.ndarray | None, req: Request,
+def _compiled_nearest(robot: Chain, form: ClosedForm, H: np.ndarray, starts: np.ndarray | None, req: Request,
                       t0: float) -> BatchIKResult:
     """:func:`nearest_batch` in one compiled call on all cores (no collision model): each row the branch
     ``NearestBranch`` gives its pose alone; a row the compiled form leaves (no branch, or a root to finish) by
@@ -788,7 +788,7 @@ def _compiled_nearest(robot: Robot, form: ClosedForm, H: np.ndarray, starts: np.
                          wall_time=time.perf_counter() - t0, solver="analytic", mode=arm_of(robot, req).mode)
 
 
-def _nearest_rows(robot: Robot, H: np.ndarray, starts: np.ndarray | None, req: Request, model: CollisionModel | None,
+def _nearest_rows(robot: Chain, H: np.ndarray, starts: np.ndarray | None, req: Request, model: CollisionModel | None,
                   t0: float) -> BatchIKResult:
     """:func:`analytic_one` row by row within what is left of the request's budget (counted from t0): each row gets
     the rest of it, a row starts only while the rows so far say it fits (a search cannot stop inside a pose), and

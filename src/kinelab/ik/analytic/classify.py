@@ -38,7 +38,7 @@ from kinelab.ik.analytic.kernel import (
     TWO_THREE_6R,
 )
 from kinelab.ik.chain import PRISMATIC, chain_model
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 AXIS_TOL = 1e-5  # [rad] axes closer to parallel are parallel (URDF numbers are rounded: 1.5708 is π/2 + 3.7e-6)
 POINT_TOL = 1e-5  # [m] axes closer than this meet
@@ -108,19 +108,19 @@ class Classification:
     reason: str
 
 
-def classify(robot: Robot) -> Classification:
-    """The analytic class of ``robot``'s chain, built once per Robot (see the module's docstring)."""
+def classify(robot: Chain) -> Classification:
+    """The analytic class of ``robot``'s chain, built once per Chain (see the module's docstring)."""
     return robot.derived("analytic_class", _classify)
 
 
-def general_class(robot: Robot) -> Classification:
+def general_class(robot: Chain) -> Classification:
     """The general 6R class of ``robot``'s chain (the algebraic elimination, :mod:`kinelab.ik.analytic.general`), or
     None with the reason: not 6R, a prismatic joint, or a structure the elimination cannot take. Built once per
-    Robot; an arm in a closed-form or search class has its own (:func:`classify`) and is not offered this one."""
+    Chain; an arm in a closed-form or search class has its own (:func:`classify`) and is not offered this one."""
     return robot.derived("general_class", _general)
 
 
-def _general(robot: Robot) -> Classification:
+def _general(robot: Chain) -> Classification:
     if classify(robot).arm is not None:
         return Classification(None, "the chain has a class of its own: " + classify(robot).arm.name)  # type: ignore[union-attr]
     try:
@@ -207,7 +207,7 @@ def special(h: np.ndarray, o: np.ndarray) -> str:
     return ", ".join(found) or "no two axes parallel or meeting"
 
 
-def _classify(robot: Robot) -> Classification:
+def _classify(robot: Chain) -> Classification:
     try:
         cm = chain_model(robot)
     except ChainError as err:

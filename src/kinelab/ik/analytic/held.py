@@ -34,21 +34,21 @@ from kinelab.ik.frdm.batch import Rows
 from kinelab.ik.request import Request, make_request, verdict_reserve
 from kinelab.ik.result import Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target_arrays
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 SAMPLES = 32  # values of the held joint tried over its range when the start's own value has no branch
 CHECKS = 32  # seeded poses at which the six's compiled roots must meet the pose as they come
 CHECK_SEED = 20261204
 
 
-def applies(robot: Robot) -> bool:
+def applies(robot: Chain) -> bool:
     """True for a 7R arm with no closed form of its own but one with an end joint held (its swept form) whose
     compiled roots meet the pose without a finish (see the module's docstring)."""
     return robot.n == 7 and classify(robot).arm is None and general_class(robot).arm is None \
         and has_swept_form(robot) and not robot.derived("held form refused", _refusal)
 
 
-def refuse_7r(robot: Robot) -> None:
+def refuse_7r(robot: Chain) -> None:
     """Refuse solver "analytic" on a 7R arm with no closed form of its own that this module cannot take either.
 
     Raises:
@@ -59,14 +59,14 @@ def refuse_7r(robot: Robot) -> None:
                           f"with an end joint held (docs/analytic.md); {robot.name}: {refusal(robot)}")
 
 
-def refusal(robot: Robot) -> str:
+def refusal(robot: Chain) -> str:
     """Why solver "analytic" does not take this 7R arm ("" when it does: :func:`applies`)."""
     if not has_swept_form(robot):
         return "no end joint whose holding leaves six joints in a closed form"
     return robot.derived("held form refused", _refusal)
 
 
-def _refusal(robot: Robot) -> str:
+def _refusal(robot: Chain) -> str:
     six = held_robot(robot)
     req = make_request("frdm", None, 1e-6, 1e-6, None, 0, "refuse", None, "pose", "z", None)
     form = prepared_form(six, req)
@@ -85,18 +85,18 @@ def _refusal(robot: Robot) -> str:
     return ""
 
 
-def held_robot(robot: Robot) -> Robot:
-    """The arm with its swept joint locked at 0: six joints in a closed form, built once per Robot."""
+def held_robot(robot: Chain) -> Chain:
+    """The arm with its swept joint locked at 0: six joints in a closed form, built once per Chain."""
     return robot.derived("held at the swept joint", _locked)
 
 
-def _locked(robot: Robot) -> Robot:
+def _locked(robot: Chain) -> Chain:
     joint = robot.joints[swept_arm(robot).joint].name
-    return Robot.from_model(robot.model, tool=robot.tool, base=robot.base, locked={joint: 0.0},
+    return Chain.from_model(robot.model, tool=robot.tool, base=robot.base, locked={joint: 0.0},
                             name=f"{robot.name} ({joint} held)")
 
 
-def held_values(robot: Robot, starts: np.ndarray | None, count: int) -> np.ndarray:
+def held_values(robot: Chain, starts: np.ndarray | None, count: int) -> np.ndarray:
     """(count, 1 + SAMPLES) values [rad] of the swept joint per row, in the order they are tried: the start's own
     (no start: the middle of its range), then the SAMPLES cell midpoints of its range nearest it first."""
     sw = swept_arm(robot)
@@ -118,7 +118,7 @@ def sub_targets(sw: SweptArm, H: np.ndarray, theta: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(back @ H if sw.joint == 0 else H @ back)
 
 
-def held_rows(robot: Robot, H: np.ndarray, starts: np.ndarray | None, req: Request,
+def held_rows(robot: Chain, H: np.ndarray, starts: np.ndarray | None, req: Request,
               deadline: float = np.inf) -> tuple[np.ndarray, np.ndarray, bool]:
     """Each row's answer (B, 7) [rad] from the six's closed form at the first value of :func:`held_values` with a
     branch within the limits (NaN where none has one), how many values each row tried, and whether ``deadline``
@@ -153,7 +153,7 @@ def held_rows(robot: Robot, H: np.ndarray, starts: np.ndarray | None, req: Reque
     return q, tried, False
 
 
-def nearest_held(robot: Robot, targets: Any, q0: Any, req: Request) -> BatchIKResult:
+def nearest_held(robot: Chain, targets: Any, q0: Any, req: Request) -> BatchIKResult:
     """Solver "analytic" for every target of a 7R arm (see the module's docstring): q0 None, one start for every
     row, or (B, 7) starts [rad]; the request's budget, when it has one, bounds the whole batch (rows left when it
     runs out: NaN, status ``time_budget``).
@@ -187,7 +187,7 @@ def nearest_held(robot: Robot, targets: Any, q0: Any, req: Request) -> BatchIKRe
     return res
 
 
-def _by_frdm(robot: Robot, res: BatchIKResult, H: np.ndarray, starts: np.ndarray | None, rest: np.ndarray,
+def _by_frdm(robot: Chain, res: BatchIKResult, H: np.ndarray, starts: np.ndarray | None, rest: np.ndarray,
              req: Request, deadline: float) -> None:
     """The rows no held value solves, by FRDM's batch from their starts within what is left before ``deadline``,
     written into ``res``."""
@@ -199,7 +199,7 @@ def _by_frdm(robot: Robot, res: BatchIKResult, H: np.ndarray, starts: np.ndarray
     res.mode += f"; {rest.size} of {len(H)} rows by FRDM (no branch at any value tried)"
 
 
-def nearest_held_one(robot: Robot, target: Any, q0: np.ndarray | None, req: Request) -> IKResult:
+def nearest_held_one(robot: Chain, target: Any, q0: np.ndarray | None, req: Request) -> IKResult:
     """Solver "analytic" for one target of a 7R arm: the batch of one (:func:`nearest_held`), as a result."""
     t0 = time.perf_counter()
     res = nearest_held(robot, [target], None if q0 is None else q0[None, :], req)

@@ -40,7 +40,7 @@ from kinelab.ik.limits import distance
 from kinelab.ik.request import Request
 from kinelab.ik.result import Branches
 from kinelab.ik.targets import beyond_reach
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 
 @dataclass(frozen=True, eq=False)
@@ -68,8 +68,8 @@ class SweptArm:
         return back @ H if self.joint == 0 else H @ back
 
 
-def swept_arm(robot: Robot, k: object = None) -> SweptArm:
-    """The robot's swept form, built once per Robot.
+def swept_arm(robot: Chain, k: object = None) -> SweptArm:
+    """The robot's swept form, built once per Chain.
 
     Raises:
         OptionError: the chain is not 7R, or holding neither end joint leaves an analytic class (the tests
@@ -82,12 +82,12 @@ def swept_arm(robot: Robot, k: object = None) -> SweptArm:
     return found
 
 
-def has_swept_form(robot: Robot) -> bool:
+def has_swept_form(robot: Chain) -> bool:
     """True when :func:`swept_arm` accepts the robot."""
     return isinstance(robot.derived("analytic_swept", _swept), SweptArm)
 
 
-def _swept(robot: Robot) -> SweptArm | str:
+def _swept(robot: Chain) -> SweptArm | str:
     v = _chain7(robot)
     if isinstance(v, str):
         return v
@@ -104,7 +104,7 @@ def _swept(robot: Robot) -> SweptArm | str:
     return "; ".join(reasons)
 
 
-def _chain7(robot: Robot) -> dict[str, np.ndarray] | str:
+def _chain7(robot: Chain) -> dict[str, np.ndarray] | str:
     """The 7R chain's vectors at q = 0 (``e`` axes, ``o`` points, ``R``, ``N`` the tool), or why it is not one."""
     try:
         cm = chain_model(robot)
@@ -115,7 +115,7 @@ def _chain7(robot: Robot) -> dict[str, np.ndarray] | str:
     return {k: np.array(a, dtype=float) for k, a in cm.vectors(np.zeros(7)).items()}
 
 
-def chain7_vectors(robot: Robot) -> dict[str, np.ndarray]:
+def chain7_vectors(robot: Chain) -> dict[str, np.ndarray]:
     """The 7R chain's vectors at q = 0 (:func:`_chain7`).
 
     Raises:
@@ -157,7 +157,7 @@ def fold(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray, joint: in
 HELD_KEPT = 64  # held (joint, value) arms kept per robot: a sweep over a middle joint builds one arm per value
 
 
-def arm_holding(robot: Robot, joint: int, theta: float) -> ArmClass | str:
+def arm_holding(robot: Chain, joint: int, theta: float) -> ArmClass | str:
     """The arm of the six joints left when the 7R robot's joint ``joint`` is held at ``theta`` [rad] — a class,
     else the general elimination or Pieper's decoupling (:func:`~kinelab.ik.analytic.classify.general_vectors`) —
     or why there is none."""
@@ -189,7 +189,7 @@ def recovers(arm: ArmClass, h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np
     return True
 
 
-def _new_held(_: Robot) -> dict[tuple[int, float], ArmClass | str]:
+def _new_held(_: Chain) -> dict[tuple[int, float], ArmClass | str]:
     return {}
 
 
@@ -214,7 +214,7 @@ def check_redundancy(k: object) -> int:
     return int(k)
 
 
-def held_values(robot: Robot, redundancy: object) -> tuple[np.ndarray, str, int]:
+def held_values(robot: Chain, redundancy: object) -> tuple[np.ndarray, str, int]:
     """The values [rad] of the held joint that ``redundancy`` asks for, how they read in ``mode``, and the joint's
     index: K samples of the swept end joint (:func:`samples`), or the one value of ``{joint name: value}`` for any
     joint of the 7R chain.
@@ -243,7 +243,7 @@ def held_values(robot: Robot, redundancy: object) -> tuple[np.ndarray, str, int]
     return np.array([float(value)]), f"held at {float(value):.6g} rad", index
 
 
-def at_value(robot: Robot, target: pin.SE3, req: Request, theta: float,
+def at_value(robot: Chain, target: pin.SE3, req: Request, theta: float,
              q_ref: np.ndarray | None = None, joint: int | None = None) -> list[Answer]:
     """Every branch of ``target`` with joint ``joint`` (None: the swept one) held at ``theta`` [rad] that Pinocchio
     confirms within the limits: (q, position error [m], rotation error [rad], finished by FRDM, roots merged, one
@@ -268,12 +268,12 @@ def at_value(robot: Robot, target: pin.SE3, req: Request, theta: float,
     return judged_roots(robot, q, found_, free, target, req, {robot.joints[joint].name: theta})
 
 
-def _is_swept(robot: Robot, joint: int) -> bool:
+def _is_swept(robot: Chain, joint: int) -> bool:
     """True when ``joint`` is the end joint the robot's swept form holds."""
     return has_swept_form(robot) and joint == swept_arm(robot).joint
 
 
-def redundant_all(robot: Robot, target: pin.SE3, req: Request, redundancy: object,
+def redundant_all(robot: Chain, target: pin.SE3, req: Request, redundancy: object,
                   q_ref: np.ndarray | None = None, max_solutions: int | None = None) -> Branches:
     """Every branch of ``target`` (oMtarget, base frame) at the values of the held joint ``redundancy`` asks for
     (:func:`held_values`), each judged by Pinocchio within the limits.
@@ -322,7 +322,7 @@ def _arm_words(arm: ArmClass | str) -> str:
     return arm.mode.removeprefix("analytic (").removesuffix(")") + (" of the other six" if arm.searched else "")
 
 
-def closed_form_summary(robot: Robot) -> str:
+def closed_form_summary(robot: Chain) -> str:
     """One line on the robot's every-branch method and how complete its sets are (``kinelab info``): its class,
     the joint a 7R arm holds, the general 6R elimination, or none."""
     arm = classify(robot).arm

@@ -38,7 +38,7 @@ from kinelab.ik.limits import distance, nearest_inside
 from kinelab.ik.request import Request
 from kinelab.ik.result import Branches
 from kinelab.ik.targets import beyond_reach
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 MATCH = 1.0  # rad: a branch at one sample and its nearest at the next are one branch followed when this close
 NEWTON_STEPS = 30
@@ -184,19 +184,19 @@ class Arm7:
         return E, R @ self.wrist + t, axes, through
 
 
-def arm7(robot: Robot) -> Arm7:
-    """The robot's 7R chain with its S, E, W (built once per Robot; the caller checked it is 7R)."""
+def arm7(robot: Chain) -> Arm7:
+    """The robot's 7R chain with its S, E, W (built once per Chain; the caller checked it is 7R)."""
     return robot.derived("sew arm", _arm7)
 
 
-def _arm7(robot: Robot) -> Arm7:
+def _arm7(robot: Chain) -> Arm7:
     v = chain7_vectors(robot)
     h, o = v["e"], v["o"]
     return Arm7(loop_of(h, o, v["R"], v["N"]), nearest_on(h[0], o[0], h[1], o[1]), nearest_on(h[3], o[3], h[2], o[2]),
                 nearest_on(h[6], o[6], h[5], o[5]))
 
 
-def sew_angle(robot: Robot, q: Any, sew: SEW | None = None) -> float:
+def sew_angle(robot: Chain, q: Any, sew: SEW | None = None) -> float:
     """The SEW angle ψ [rad] of the 7R robot at q (rad), by ``sew``'s reference (None: the default one).
 
     Raises:
@@ -300,7 +300,7 @@ def _refined(A: np.ndarray, gA: np.ndarray, B: np.ndarray, gB: np.ndarray, width
     return any(d[a, b] < MATCH and _crossing(float(gA[a]), float(gB[b])) for a, b in matched)
 
 
-def sampled(robot: Robot, arm: Arm7, sew: SEW, H: np.ndarray, sw: SweptArm,
+def sampled(robot: Chain, arm: Arm7, sew: SEW, H: np.ndarray, sw: SweptArm,
             deadline: float = math.inf) -> tuple[list[np.ndarray], list[np.ndarray], bool, str]:
     """The branches (m, 7) at the samples of the swept joint, in order, each a root of the loop equations to ROOT
     with every joint but the swept one unbounded (a branch is followed past the limits it crosses; the limits judge
@@ -346,7 +346,7 @@ def distinct(q: list[np.ndarray], apart: float = 1e-6) -> np.ndarray:
     return np.array(kept, dtype=float).reshape(len(kept), 7)
 
 
-def sew_all(robot: Robot, target: pin.SE3, req: Request, sew: SEW, q_ref: np.ndarray | None = None,
+def sew_all(robot: Chain, target: pin.SE3, req: Request, sew: SEW, q_ref: np.ndarray | None = None,
             max_solutions: int | None = None) -> Branches:
     """Every branch of ``target`` (oMtarget, base frame) with the SEW angle ``sew.angle`` that the search finds,
     each judged by Pinocchio within the limits and its angle within ``req.tol_rot``.
@@ -378,7 +378,7 @@ def sew_all(robot: Robot, target: pin.SE3, req: Request, sew: SEW, q_ref: np.nda
                                       f"{sew.samples} samples: not proved complete", beyond=beyond, late=late)
 
 
-def _judged(robot: Robot, q: np.ndarray, target: pin.SE3, req: Request, sew: SEW,
+def _judged(robot: Chain, q: np.ndarray, target: pin.SE3, req: Request, sew: SEW,
             q_ref: np.ndarray | None) -> list[Answer]:
     """The roots q (m, 7) turned into the limits (each angle's copy nearest ``q_ref``), judged by Pinocchio, and
     kept where the SEW angle of the judged q is within ``req.tol_rot`` of ψ₀; nearest ``q_ref`` first."""

@@ -18,7 +18,7 @@ from kinelab.ik.biquat.options import BiquatOptions
 from kinelab.ik.chain import chain_fk, chain_model, jacobian_local
 from kinelab.ik.limits import PinLimits
 from kinelab.ik.result import BiquatTrajectory, Status
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 _ZERO2 = np.zeros(2)
 
@@ -53,7 +53,7 @@ class System:
     functions the compiled preset calls.
     """
 
-    def __init__(self, robot: Robot, oMtarget: pin.SE3, options: BiquatOptions):
+    def __init__(self, robot: Chain, oMtarget: pin.SE3, options: BiquatOptions):
         self.robot, self.model = robot, robot.model
         self.cm = chain_model(robot)
         self.pstar, self.Rstar = np.array(oMtarget.translation), np.array(oMtarget.rotation)

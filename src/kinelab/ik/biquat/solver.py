@@ -31,7 +31,7 @@ from kinelab.ik.limits import wrap_q
 from kinelab.ik.multistart import clock_chunk
 from kinelab.ik.request import Request
 from kinelab.ik.result import Attempt, BiquatDiagnostics, Status
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 Options = BiquatOptions
 # integration steps × joints before the first look at the clock (most solves end within them), then between
@@ -74,7 +74,7 @@ def regular_law(M: DualQuat, T: tuple[float, float], k: float, k0: float = 0.0) 
     return twist[3:], twist[:3], T_dot
 
 
-def attempt(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol_rot: float, deadline: float,
+def attempt(robot: Chain, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol_rot: float, deadline: float,
             options: BiquatOptions | None = None, **kwargs: Any) -> Attempt:
     """Integrate q̇ = A⁻¹U from ``q0`` until M* is within tolerance of ±1 or a limit is reached.
 
@@ -137,7 +137,7 @@ def paper_unit_biquaternion(real_wxyz: Any, dual_wxyz: Any) -> DualQuat:
     return lam.require_unit("the target biquaternion", tol=1e-5).normalized()
 
 
-def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: float, tol_rot: float, deadline: float,
+def multistart(robot: Chain, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: float, tol_rot: float, deadline: float,
                seed: int | None, max_restarts: int, options: BiquatOptions | None = None) -> tuple[Attempt, int]:
     """The default preset (law (9), Euler, h = 1/k, steps capped at 0.5 rad, 30 steps per attempt) with
     its seeded restarts inside the compiled kernel; answers outside the joint limits are restarted."""
@@ -183,7 +183,7 @@ def compiled_mode(k: float) -> str:
     return f"biquat (simple, newton euler, h={1.0 / k:g}, k={k:g}, compiled)"
 
 
-def engine(robot: Robot, req: Request) -> BiquatEngine | None:
+def engine(robot: Chain, req: Request) -> BiquatEngine | None:
     """The prepared solver's one-call engine (:class:`kinelab.core._engine.BiquatEngine`): the compiled preset with
     its restarts, judged by the robot's certified compiled FK, the result filled in C. None where the general route
     must serve: options the preset does not run, a robot judged by Pinocchio's FK.
@@ -213,6 +213,6 @@ def _max_steps(opts: BiquatOptions) -> int:
     return 30 if opts.max_time is None else max(1, int(np.ceil(float(opts.max_time) * opts.gain)))
 
 
-def prepare(robot: Robot, options: BiquatOptions | None = None) -> None:
+def prepare(robot: Chain, options: BiquatOptions | None = None) -> None:
     """Build the chain model before a solve's clock starts (the kernels are compiled at install)."""
     chain_model(robot)

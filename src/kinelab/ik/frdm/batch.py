@@ -20,7 +20,7 @@ from kinelab.ik.frdm.kernel import CONVERGED, STATS_SIZE, T_ATTEMPTS, T_STALLS, 
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.multistart import clock_chunk, first_start
 from kinelab.ik.result import Status
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 NOT_STARTED, STOPPED = -2, -3  # a row's code when the budget ran out before it started, or while it ran
 
@@ -41,7 +41,7 @@ class Rows:
                    np.zeros(count, dtype=np.int64), np.zeros(count, dtype=np.int64))
 
 
-def run(robot: Robot, points: np.ndarray, rotations: np.ndarray, starts: np.ndarray | None, rng_states: np.ndarray,
+def run(robot: Chain, points: np.ndarray, rotations: np.ndarray, starts: np.ndarray | None, rng_states: np.ndarray,
         attempts: np.ndarray, tol_pos: float, tol_rot: float, deadline: float, opts: FRDMOptions) -> Rows:
     """Solve every row in one parallel compiled call; each row looks at the clock between its chunks of sweeps (the
     points at which the single solve looks at it) and stops once the deadline has passed.

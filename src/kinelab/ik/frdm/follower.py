@@ -18,7 +18,7 @@ from kinelab.ik.request import verdict_reserve
 from kinelab.ik.result import SingularEvent, Status, TrackResult
 from kinelab.ik.targets import as_target_arrays
 from kinelab.ik.tasks import POSE, Task
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 NOT_STARTED = -2  # the follower's code for a sample the time budget left unstarted
 REST_WEIGHT = 0.01  # objective units (the weighted pose error is ~1 at a chain length's distance)
@@ -30,7 +30,7 @@ _STATUS = {kernel.STALL_STEP: Status.STALLED, kernel.STALL_WINDOW: Status.STALLE
            NOT_STARTED: Status.TIME_BUDGET}
 
 
-def follow(robot: Robot, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: float, max_sweeps: int,
+def follow(robot: Chain, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: float, max_sweeps: int,
            rest_weight: float | None, opts: FRDMOptions, task: Task = POSE, seed: int | None = None,
            time_budget: float | None = None, t_start: float | None = None) -> TrackResult:
     """Solve every sample of a path in the compiled follower; each answer judged by Pinocchio.
@@ -108,7 +108,7 @@ def _objective(cm: Any, opts: FRDMOptions, tol_pos: float, tol_rot: float) -> An
                             opts.mode != "orientation", opts.mode != "position", kernel.no_rest(cm.n), 0.0, -1)
 
 
-def _judged(robot: Robot, Q: np.ndarray, points: np.ndarray, rotations: np.ndarray, task: Task, tol_pos: float,
+def _judged(robot: Chain, Q: np.ndarray, points: np.ndarray, rotations: np.ndarray, task: Task, tol_pos: float,
             tol_rot: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The judge's word on every sample the follower started (the others are NaN rows): position errors [m],
     rotation errors [rad], and whether the task's components are met within the limits. A joint past a limit by

@@ -8,7 +8,7 @@ point, R = tool rotation (columns u_x, u_y, u_z), starred = target. Objective
 
     E = w_p ‖p − p*‖² + Σ_j w_j ‖u_j − u*_j‖².
 
-Inputs travel as typed tuples: :class:`~kinelab.ik.chain.Chain` (the robot), :class:`Objective` (the
+Inputs travel as typed tuples: :class:`~kinelab.ik.chain.PackedChain` (the robot), :class:`Objective` (the
 target, weights, tolerances and windows of one solve), :class:`Settings` (the sweep and monitor
 settings) and :class:`Memory` (work arrays the caller keeps between calls). State and statistics are
 float arrays whose slots have names (``S_*``, ``T_*``).
@@ -23,7 +23,7 @@ import numpy as np
 
 from kinelab.core import _frdm
 from kinelab.core._frdm import Code, Order
-from kinelab.ik.chain import Chain
+from kinelab.ik.chain import PackedChain
 
 # sweep order codes (MIXED: per restart, in turn) and run()'s return codes: the compiled core's enums, as ints
 TIP_TO_BASE, BASE_TO_TIP, ALTERNATE, MIXED = (int(o) for o in (Order.TIP_TO_BASE, Order.BASE_TO_TIP, Order.ALTERNATE,
@@ -110,14 +110,14 @@ def sweep(q: np.ndarray, e: np.ndarray, o: np.ndarray, kind: np.ndarray, lower: 
                             np.ascontiguousarray(q_rest, dtype=float), float(w_rest))
 
 
-def run(q: np.ndarray, ch: Chain, pb: Objective, st: Settings, order: int, max_sweeps: int,
+def run(q: np.ndarray, ch: PackedChain, pb: Objective, st: Settings, order: int, max_sweeps: int,
         mem: Memory) -> tuple[int, int]:
     """Sweep until converged, stalled or ``max_sweeps`` sweeps; q is updated in place. Returns (code, sweeps in
     this call); the state slots S_* carry the rest."""
     return _frdm.run_kernel(q, ch, pb, st, order, max_sweeps, mem)
 
 
-def multistart(q: np.ndarray, ch: Chain, pb: Objective, st: Settings, order: int, max_sweeps: int,
+def multistart(q: np.ndarray, ch: PackedChain, pb: Objective, st: Settings, order: int, max_sweeps: int,
                rng_state: np.ndarray, max_attempts: int, sweep_budget: float, best_q: np.ndarray, stats: np.ndarray,
                mem: Memory) -> int:
     """Attempts from q, then from seeded uniform starts, until one converges, ``max_attempts`` have run or

@@ -32,7 +32,7 @@ from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm.kernel import no_rest
 from kinelab.ik.frdm.options import BYPASSES, ORDERS, FRDMOptions
 from kinelab.ik.result import BypassRecord, SingularEvent, Status
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 SINGULAR_SIGMA = 1e-4  # σ_min of the scaled Jacobian below this: a kinematic singularity
 CHUNK = 64  # sweeps between two looks at the clock
@@ -56,7 +56,7 @@ class Bypass:
         configured = tuple(k for k in ("kicks", "intervals", "freeze") if getattr(self, k))
         return configured or ("auto_kick",)
 
-    def validate(self, robot: Robot) -> None:
+    def validate(self, robot: Chain) -> None:
         """Refuse a bypass that names a joint the robot does not have (JointNotFoundError)."""
         for table in (self.kicks, self.intervals, self.freeze):
             for name in table:
@@ -95,7 +95,7 @@ class Goal:
                               self.rot_axis)
 
 
-def _scaled_sigma_min(robot: Robot, q: np.ndarray, length: float) -> float:
+def _scaled_sigma_min(robot: Chain, q: np.ndarray, length: float) -> float:
     J = robot.jacobian_local(q)
     J[:3] /= length
     return float(np.linalg.svd(J, compute_uv=False)[-1])
@@ -104,7 +104,7 @@ def _scaled_sigma_min(robot: Robot, q: np.ndarray, length: float) -> float:
 class Runner:
     """Runs the kernel in chunks, fires the monitor, applies bypasses and logs everything."""
 
-    def __init__(self, robot: Robot, cm: ChainModel, prob: Goal, options: FRDMOptions):
+    def __init__(self, robot: Chain, cm: ChainModel, prob: Goal, options: FRDMOptions):
         self.robot, self.vm, self.prob = robot, cm, prob
         self.order = ORDERS[options.order] if options.order != "mixed" else kernel.BASE_TO_TIP
         self.settings = options.settings()

@@ -10,10 +10,10 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 
-def vector_model(robot: Robot, q) -> dict[str, np.ndarray]:
+def vector_model(robot: Chain, q) -> dict[str, np.ndarray]:
     """Axes e_i, points o_i (base frame) from Pinocchio's WORLD joint Jacobians, tool point p and axes R.
 
     A revolute column is (v, ω) with v = o × ω, so e = ω and o = ω × v (the foot of the perpendicular
@@ -71,7 +71,7 @@ def prismatic_step(e, p, pstar, w_p, window=(-np.inf, np.inf)) -> float:
     return float(np.clip(s, *window))
 
 
-def sweep(robot: Robot, q, oMtarget: pin.SE3, w_p: float, w_ax=(1.0, 1.0, 1.0), base_to_tip: bool = True):
+def sweep(robot: Chain, q, oMtarget: pin.SE3, w_p: float, w_ax=(1.0, 1.0, 1.0), base_to_tip: bool = True):
     """One FRDM sweep, re-reading the vector model from Pinocchio after every joint step. Returns q."""
     q = np.array(q, dtype=float)
     order = range(robot.n) if base_to_tip else reversed(range(robot.n))

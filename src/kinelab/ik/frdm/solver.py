@@ -29,7 +29,7 @@ from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.multistart import clock_chunk
 from kinelab.ik.request import Request
 from kinelab.ik.result import Attempt, FRDMDiagnostics, SingularEvent, Status
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 Options = FRDMOptions
 # joint steps before the first look at the clock (most solves end within them: one kernel call), and then
@@ -38,7 +38,7 @@ JOINT_SWEEPS_PER_LOOK = 256
 JOINT_SWEEPS_PER_LATER_LOOK = 64
 
 
-def prepare(robot: Robot, options: FRDMOptions | None = None) -> None:
+def prepare(robot: Chain, options: FRDMOptions | None = None) -> None:
     """Build the chain model before a solve's clock starts (the kernels are compiled at install).
 
     Args:
@@ -48,7 +48,7 @@ def prepare(robot: Robot, options: FRDMOptions | None = None) -> None:
     chain_model(robot)
 
 
-def attempt(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol_rot: float, deadline: float,
+def attempt(robot: Chain, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol_rot: float, deadline: float,
             options: FRDMOptions | None = None, **kwargs: Any) -> Attempt:
     """One FRDM run from ``q0`` with the singularity monitor and the bypass policy.
 
@@ -91,7 +91,7 @@ def attempt(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol
     return att
 
 
-def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: float, tol_rot: float, deadline: float,
+def multistart(robot: Chain, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: float, tol_rot: float, deadline: float,
                seed: int | None, max_restarts: int, options: FRDMOptions | None = None) -> tuple[Attempt, int]:
     """FRDM from q0 and then from seeded random starts, all inside the compiled kernel.
 
@@ -106,7 +106,7 @@ def multistart(robot: Robot, oMtarget: pin.SE3, q0: np.ndarray | None, tol_pos: 
     return ctx.attempt(code, q, stats, deadline), max(0, int(stats[kernel.T_ATTEMPTS]) - 1)
 
 
-def engine(robot: Robot, req: Request) -> FRDMEngine | None:
+def engine(robot: Chain, req: Request) -> FRDMEngine | None:
     """The prepared solver's one-call engine (:class:`kinelab.core._engine.FRDMEngine`): the compiled multistart,
     judged by the robot's certified compiled FK, the result filled in C. It owns its context (the kernel's problem,
     settings and memory). None where the general route must serve: options the compiled multistart does not run
@@ -129,9 +129,9 @@ def engine(robot: Robot, req: Request) -> FRDMEngine | None:
 class _Context:
     """Everything a compiled FRDM solve on one robot with one set of options and tolerances passes to the
     kernel, built once: per call only the target (copied into the problem's own arrays), the start, the
-    seed and the budget change. Not for concurrent solves on one Robot (its Pinocchio data is shared too)."""
+    seed and the budget change. Not for concurrent solves on one Chain (its Pinocchio data is shared too)."""
 
-    def __init__(self, robot: Robot, opts: FRDMOptions, tol_pos: float, tol_rot: float):
+    def __init__(self, robot: Chain, opts: FRDMOptions, tol_pos: float, tol_rot: float):
         cm = chain_model(robot)
         self.robot, self.order_name = robot, opts.order
         self.cm, self.n, self.continuous = cm, cm.n, bool((cm.kind == CONTINUOUS).any())
@@ -201,8 +201,8 @@ class _Context:
         return [SingularEvent("stall", "not diagnosed (compiled multistart: restarted)", count=stalls)]
 
 
-def _context(robot: Robot, opts: FRDMOptions, tol_pos: float, tol_rot: float) -> _Context:
-    """The robot's context for these options and tolerances (kept on the Robot, a few per robot)."""
+def _context(robot: Chain, opts: FRDMOptions, tol_pos: float, tol_rot: float) -> _Context:
+    """The robot's context for these options and tolerances (kept on the Chain, a few per robot)."""
     last = _LAST
     if last and last[0] is robot and last[1] is opts and last[2] == tol_pos and last[3] == tol_rot:
         return last[4]
@@ -220,7 +220,7 @@ def _context(robot: Robot, opts: FRDMOptions, tol_pos: float, tol_rot: float) ->
 _LAST: list = []  # the context of the last call (a loop asks for the same one every time)
 
 
-def _new_dict(_: Robot) -> dict:
+def _new_dict(_: Chain) -> dict:
     return {}
 
 

@@ -33,7 +33,7 @@ from kinelab.ik.request import Request
 from kinelab.ik.result import Attempt, BypassRecord, SingularEvent, Status, TrackResult
 from kinelab.ik.targets import as_target_arrays
 from kinelab.ik.tasks import Task
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 RESTRICTIONS = ("intervals", "freeze")
 # FRDM's defaults on a path: a longer sweep cap and stall window than a single solve's, since a warm start
@@ -74,7 +74,7 @@ def path_options(options: Any, solver_options: dict[str, Any]) -> dict[str, Any]
     return solver_options if options is not None else {**PATH_DEFAULTS, **solver_options}
 
 
-def run_track(robot: Robot, targets: Any, q0: np.ndarray, req: Request, settings: PathSettings,
+def run_track(robot: Chain, targets: Any, q0: np.ndarray, req: Request, settings: PathSettings,
               t_start: float | None = None) -> TrackResult:
     """Solve each target in turn, warm-started from the previous answer, each sample judged by Pinocchio.
 
@@ -131,7 +131,7 @@ def mark_jumps(path: TrackResult, q0: np.ndarray, jump_limit: float | None) -> N
 SELF_MOTION = 5.0  # a self-motion event: the joints' drift along the task's null space beyond 5 × the path's step
 
 
-def self_motion_events(robot: Robot, Q: np.ndarray, q0: np.ndarray, points: np.ndarray, rotations: np.ndarray,
+def self_motion_events(robot: Chain, Q: np.ndarray, q0: np.ndarray, points: np.ndarray, rotations: np.ndarray,
                        task: Task) -> list[SingularEvent]:
     """A ``self_motion`` event wherever the answers have drifted along the task's null space (the motion the task
     does not ask for: Δq less its least-norm part J⁺JΔq, summed since the last event) by more than SELF_MOTION times
@@ -192,7 +192,7 @@ def _check_restrict(restrict: tuple[str, ...], intervals: Any, freeze: Any) -> N
 class _Path:
     """The samples solved so far, the restrictions held and the monitor log of one tracked path."""
 
-    def __init__(self, robot: Robot, req: Request, opts: FRDMOptions, settings: PathSettings,
+    def __init__(self, robot: Chain, req: Request, opts: FRDMOptions, settings: PathSettings,
                  restrictions: list[str]):
         self.robot, self.req, self.opts, self.settings = robot, req, opts, settings
         self.restrictions = restrictions

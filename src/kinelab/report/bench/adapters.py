@@ -6,13 +6,13 @@ from typing import Any
 
 from kinelab.ik import solve
 from kinelab.report.bench.protocol import TOL_POS, TOL_ROT, Case, Prepare, SolveFn
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 
 def kinelab_solver(solver: str, **options: Any) -> Prepare:
     """A bench adapter for ``kinelab.solve(..., solver=solver, **options)``."""
 
-    def prepare(robot: Robot, budget: float) -> SolveFn:
+    def prepare(robot: Chain, budget: float) -> SolveFn:
         def run(case: Case, seed: int) -> tuple:
             res = solve(robot, case.oMtarget, solver=solver, q0=case.q_start, seed=seed, time_budget=budget,
                         tol_pos=TOL_POS, tol_rot=TOL_ROT, task=case.task, **options)

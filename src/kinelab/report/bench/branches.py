@@ -33,7 +33,7 @@ from kinelab.ik.branches import SAME
 from kinelab.ik.limits import distance
 from kinelab.ik.request import make_request
 from kinelab.report.bench.protocol import Call, figures, warmed_rounds
-from kinelab.robot import Robot, load
+from kinelab.robot import Chain, load
 
 ANALYTIC_ROBOTS = ("ur3", "ur5", "ur10", "z1", "kinova", "so101", "xarm6", "crx10ia")
 NUMERIC_ROBOTS = ("stanford",)
@@ -41,7 +41,7 @@ REDUNDANT_ROBOTS = ("era", "panda", "baxter_left")
 K = 16  # samples of a 7R arm's swept joint
 
 
-def _eaik(robot: Robot) -> Call | None:
+def _eaik(robot: Chain) -> Call | None:
     """EAIK's solver for the robot (built from kinelab's axes at q = 0), or None when it is not installed."""
     try:
         from eaik.IK_HP import HPRobot
@@ -64,12 +64,12 @@ def _eaik(robot: Robot) -> Call | None:
     return call
 
 
-def _complete(robot: Robot, found: Sequence[Any], reference: Sequence[Any], same: float) -> bool:
+def _complete(robot: Chain, found: Sequence[Any], reference: Sequence[Any], same: float) -> bool:
     """Every reference answer has a found answer within ``same`` (joint by joint, modulo 2π)."""
     return all(any(distance(robot, f.q, r.q) <= same for f in found) for r in reference)
 
 
-def analytic_arm(robot: Robot, n: int, seed: int, repeats: int) -> dict[str, Any]:
+def analytic_arm(robot: Chain, n: int, seed: int, repeats: int) -> dict[str, Any]:
     """One arm with a closed form: times per call, the multistart's completeness, the batch's throughput."""
     rng = np.random.default_rng(seed)
     poses = [robot.fk(robot.random_q(rng)) for _ in range(n)]
@@ -89,7 +89,7 @@ def analytic_arm(robot: Robot, n: int, seed: int, repeats: int) -> dict[str, Any
             "multistart_complete": complete / n, "multistart_beyond_closed_form": extra, **batch}
 
 
-def _throughput(robot: Robot, rng: np.random.Generator, count: int = 20_000) -> dict[str, float]:
+def _throughput(robot: Chain, rng: np.random.Generator, count: int = 20_000) -> dict[str, float]:
     """Poses per second of the closed form's batch on all cores: checked by Pinocchio, and the kernel alone."""
     from kinelab.ik.analytic.branches import LIMIT_SLACK
     from kinelab.ik.analytic.kernel import MAX_ROWS, branches_batch
@@ -113,7 +113,7 @@ def _throughput(robot: Robot, rng: np.random.Generator, count: int = 20_000) -> 
     return {"batch_checked_per_s": checked, "batch_kernel_per_s": count / best}
 
 
-def numeric_arm(robot: Robot, n: int, seed: int, repeats: int) -> dict[str, Any]:
+def numeric_arm(robot: Chain, n: int, seed: int, repeats: int) -> dict[str, Any]:
     """An arm without a closed form: the multistart's time and its completeness against a dense search."""
     rng = np.random.default_rng(seed)
     poses = [robot.fk(robot.random_q(rng)) for _ in range(n)]
@@ -126,7 +126,7 @@ def numeric_arm(robot: Robot, n: int, seed: int, repeats: int) -> dict[str, Any]
             "multistart_complete": complete / n}
 
 
-def redundant_arm(robot: Robot, n: int, seed: int, repeats: int) -> dict[str, Any]:
+def redundant_arm(robot: Chain, n: int, seed: int, repeats: int) -> dict[str, Any]:
     """A 7R arm with a swept closed form: its time and answer count at K samples against the multistart's."""
     rng = np.random.default_rng(seed)
     poses = [robot.fk(robot.random_q(rng)) for _ in range(n)]

@@ -20,14 +20,14 @@ from tqdm import tqdm
 from kinelab.collision import Collisions, Environment, Obstacle, collision_model
 from kinelab.ik.api import solve
 from kinelab.report.bench.protocol import figures, warmed_rounds
-from kinelab.robot import Robot, load
+from kinelab.robot import Chain, load
 
 ROBOTS = ("panda", "ur5", "kinova")
 FLOOR_AND_TABLE = Environment((Obstacle("plane", name="floor"),
                                Obstacle("box", size=(0.6, 0.8, 0.05), xyz=(0.5, 0.0, 0.2), name="table")))
 
 
-def arm(robot: Robot, n: int, seed: int, repeats: int) -> dict[str, Any]:
+def arm(robot: Chain, n: int, seed: int, repeats: int) -> dict[str, Any]:
     """One arm's row (see the module's docstring)."""
     model = collision_model(robot, Collisions(environment=FLOOR_AND_TABLE))
     rng = np.random.default_rng(seed)

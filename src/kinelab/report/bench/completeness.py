@@ -30,7 +30,7 @@ from kinelab.ik.analytic.certify import chain_pose
 from kinelab.ik.analytic.classify import classify, classify_vectors, general_class
 from kinelab.ik.analytic.redundancy import at_value, has_swept_form, swept_arm
 from kinelab.ik.request import make_request
-from kinelab.robot import Robot, load
+from kinelab.robot import Chain, load
 
 FOUND = 1e-6  # [rad] the pose's own configuration is a branch to this
 NEAR = 1e-4  # [rad] a miss nearer than this is a double root met to rounding's square root
@@ -40,7 +40,7 @@ HARD = ("xarm6", "crx10ia", "ur10e_calibrated", "general6r")  # the arms the har
 HELD = (("tiago_pro", (0, 1, 2, 3, 4, 5, 6)), ("panda", (3,)), ("xarm7", (3,)))  # 7R arms and the joints held
 
 
-def own_configuration(robot: Robot, n: int, seed: int) -> dict[str, Any]:
+def own_configuration(robot: Chain, n: int, seed: int) -> dict[str, Any]:
     """The share of n seeded poses whose own configuration is among the branches (6R arms: the batch; 7R arms:
     the branches at the held joint's own value), the share whose set is certified complete, the misses' nearest
     distances, and every missed pose's q."""
@@ -68,12 +68,12 @@ def own_configuration(robot: Robot, n: int, seed: int) -> dict[str, Any]:
             "branches_mean": float(np.mean(counts)), "branches_max": int(np.max(counts)), "seconds": elapsed}
 
 
-def _six(robot: Robot) -> Any:
+def _six(robot: Chain) -> Any:
     """The 6R arm's class or general elimination, None for a 7R arm swept."""
     return classify(robot).arm or (general_class(robot).arm if not has_swept_form(robot) else None)
 
 
-def _certified(robot: Robot, Q: np.ndarray, batch: Any) -> float:
+def _certified(robot: Chain, Q: np.ndarray, batch: Any) -> float:
     """The share of the poses of Q whose set of branches (``batch``) is certified complete, by the certificate
     ``Branches.complete`` gives the same set (docs/analytic.md, Certificates)."""
     from kinelab.ik.analytic.branches import certificate_of
@@ -88,7 +88,7 @@ def _certified(robot: Robot, Q: np.ndarray, batch: Any) -> float:
     return certified / Q.shape[0]
 
 
-def _method(robot: Robot) -> str:
+def _method(robot: Chain) -> str:
     arm = _six(robot)
     if arm is not None:
         return str(arm.mode)
@@ -99,7 +99,7 @@ def _method(robot: Robot) -> str:
 SSIK_GENERAL = 100  # poses against ssik for an arm of the general elimination: ssik's route there took 40-460 ms
 
 
-def against_ssik(robot: Robot, n: int, seed: int) -> dict[str, Any] | None:
+def against_ssik(robot: Chain, n: int, seed: int) -> dict[str, Any] | None:
     """kinelab's branch sets against ssik's for n seeded poses of the same URDF, or None without ssik or a
     6-joint class."""
     try:
@@ -199,7 +199,7 @@ def random_general_arm(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray
             return h, o, pin.SE3(pin.exp3(rng.normal(size=3)), rng.uniform(-0.4, 0.4, 3))
 
 
-def held_joint(robot: Robot, joint: int, n: int, seed: int) -> dict[str, Any]:
+def held_joint(robot: Chain, joint: int, n: int, seed: int) -> dict[str, Any]:
     """n seeded poses of a 7R arm with joint ``joint`` held at the pose's own value: the share whose own
     configuration is among the branches, the poses refused (the six left solved by nothing here at that value),
     and every miss's q."""

@@ -28,12 +28,12 @@ import numpy as np
 from kinelab.core._fabrik import attempt
 from kinelab.ik.chain import chain_model
 from kinelab.report.bench.protocol import TOL_POS, Case, SolveFn
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 MAX_ITERATIONS = 500  # per attempt; a converging run needs tens to a few hundred, a stall ends it sooner
 
 
-def prepare(robot: Robot, budget: float, max_attempts: int | None = None) -> SolveFn:
+def prepare(robot: Chain, budget: float, max_attempts: int | None = None) -> SolveFn:
     """The bench adapter: FABRIK attempts from the case's start, then from seeded random starts, until one
     reaches the target point within TOL_POS, the budget [s] is spent or ``max_attempts`` have run (None: no
     count; a test bounds the attempts, not the time, so that its verdict does not depend on the machine's load)."""

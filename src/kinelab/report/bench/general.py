@@ -29,14 +29,14 @@ from kinelab.ik.analytic.general import roots_within
 from kinelab.ik.api import solve_all
 from kinelab.ik.request import make_request
 from kinelab.report.bench.protocol import Call, figures, warmed_rounds
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 GENERAL_ROBOTS = ("ur10e_calibrated", "general6r")
 SSIK_CAP = 0.05  # [s] ssik joins the rounds when its first pose took less than this (460 ms on the calibrated UR10e)
 BATCH = 2_000  # poses in each timed batch
 
 
-def general_arm(robot: Robot, n: int, seed: int, repeats: int) -> dict[str, Any]:
+def general_arm(robot: Chain, n: int, seed: int, repeats: int) -> dict[str, Any]:
     """One arm of the general elimination: times per call (see the module), the batch's poses per second."""
     rng = np.random.default_rng(seed)
     poses = [robot.fk(robot.random_q(rng)) for _ in range(n)]
@@ -54,7 +54,7 @@ def general_arm(robot: Robot, n: int, seed: int, repeats: int) -> dict[str, Any]
             **_batch(robot, rng)}
 
 
-def _python_route(robot: Robot) -> Call:
+def _python_route(robot: Chain) -> Call:
     """The elimination as it ran before it was compiled: NumPy and SciPy's QZ, the set certified on the way,
     each root judged as before (:func:`~kinelab.ik.analytic.branches.judged_roots`)."""
     arm, req = general_class(robot).arm, make_request("frdm", tol_pos=1e-6, tol_rot=1e-6)
@@ -66,7 +66,7 @@ def _python_route(robot: Robot) -> Call:
     return call
 
 
-def _ssik(robot: Robot, first: pin.SE3) -> Call | None:
+def _ssik(robot: Chain, first: pin.SE3) -> Call | None:
     """ssik's solver for the robot's URDF, or None without ssik or when its second call on the first pose takes
     SSIK_CAP or more."""
     try:
@@ -86,7 +86,7 @@ def _ssik(robot: Robot, first: pin.SE3) -> Call | None:
     return call if time.perf_counter() - t0 < SSIK_CAP else None
 
 
-def _batch(robot: Robot, rng: np.random.Generator) -> dict[str, Any]:
+def _batch(robot: Chain, rng: np.random.Generator) -> dict[str, Any]:
     """``solve_all_batch``'s poses per second on all cores: median of three and (lowest, highest)."""
     H = robot.fk_batch(np.array([robot.random_q(rng) for _ in range(BATCH)]))
     all_branches_batch(robot, H[:2])

@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from kinelab.geometry import wrap_to_pi
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 FOUND_HARD = 1e-6  # [rad] the own configuration is an answer to this on the surface (a double root: met to ~1e-8)
 FOUND_EXACT = 5e-8  # [rad] and to this elsewhere: simple roots, refined to ~1e-8 even 1e-7 rad from a fold, where
@@ -33,7 +33,7 @@ OFFSETS = (0.0, 1e-7, 1e-4)  # [rad] off the singular surface
 SURFACE_JOINTS = (1, 2, 4)  # joints 2, 3, 5: the shoulder, elbow and wrist singularities of a 6R
 
 
-def on_surface(robot: Robot, q: np.ndarray, joint: int) -> np.ndarray | None:
+def on_surface(robot: Chain, q: np.ndarray, joint: int) -> np.ndarray | None:
     """q with ``joint`` moved onto det J = 0 (world Jacobian of the tool), or None when det J keeps its sign
     along that joint."""
     def det(x: float) -> float:
@@ -56,7 +56,7 @@ def on_surface(robot: Robot, q: np.ndarray, joint: int) -> np.ndarray | None:
     return out
 
 
-def poses(robot: Robot, n: int, seed: int) -> list[tuple[str, np.ndarray]]:
+def poses(robot: Chain, n: int, seed: int) -> list[tuple[str, np.ndarray]]:
     """n hard configurations (kind, q): a quarter on the surface, a quarter each 1e-7 and 1e-4 rad beside it, a
     quarter with one joint at a limit."""
     rng = np.random.default_rng(seed)
@@ -79,7 +79,7 @@ def poses(robot: Robot, n: int, seed: int) -> list[tuple[str, np.ndarray]]:
     return out[:n]
 
 
-def measure(robot: Robot, n: int, seed: int) -> dict[str, Any]:
+def measure(robot: Chain, n: int, seed: int) -> dict[str, Any]:
     """Every hard pose solved: per kind, how many had the own configuration among the answers, how many sets were
     certified, how many said they were not (with the reasons counted), and the failures listed with their q."""
     from kinelab.ik import solve_all

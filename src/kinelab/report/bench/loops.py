@@ -23,13 +23,13 @@ from kinelab.ik.prepared import IK
 from kinelab.ik.request import unmeetable_tolerances
 from kinelab.report.bench import peers
 from kinelab.report.bench.protocol import DEFAULT_ROBOTS, TOL_POS, TOL_ROT, cases, path_set
-from kinelab.robot import Robot, load
+from kinelab.robot import Chain, load
 
 Runner = Callable[[], tuple[np.ndarray, float]]  # → (answers (N, n), seconds)
 RESTARTS = 50  # throughput: the same search effort per target in the loop (5 ms budget too) and the batch
 
 
-def _judge(robot: Robot, Q: np.ndarray, targets: list[pin.SE3]) -> np.ndarray:
+def _judge(robot: Chain, Q: np.ndarray, targets: list[pin.SE3]) -> np.ndarray:
     """Per answer: Pinocchio confirms both tolerances within the limits."""
     ok = np.zeros(len(targets), dtype=bool)
     for k, (q, target) in enumerate(zip(Q, targets, strict=True)):
@@ -50,7 +50,7 @@ def _blocks(runners: dict[str, Runner], repeats: int) -> dict[str, list[tuple[np
     return out
 
 
-def throughput(robot: Robot, n: int = 2000, seed: int = 0, start: str = "warm", sigma: float = 0.02,
+def throughput(robot: Chain, n: int = 2000, seed: int = 0, start: str = "warm", sigma: float = 0.02,
                repeats: int = 3) -> list[dict[str, Any]]:
     """Solves per second of a solve() loop, solve_batch and (if installed) an ik_LM loop on n problems."""
     problems = cases(robot, n, seed, start, sigma)
@@ -91,7 +91,7 @@ def throughput(robot: Robot, n: int = 2000, seed: int = 0, start: str = "warm", 
     return rows
 
 
-def tracking(robot: Robot, seed: int = 0, paths: int = 20, samples: int = 200,
+def tracking(robot: Chain, seed: int = 0, paths: int = 20, samples: int = 200,
              repeats: int = 3) -> list[dict[str, Any]]:
     """Generated smooth paths (:func:`~kinelab.report.bench.protocol.path_set`: cosine blends and sinusoids)
     followed by track() and, if installed, a loop of one ik_LM search per sample from the previous answer
@@ -137,7 +137,7 @@ def tracking(robot: Robot, seed: int = 0, paths: int = 20, samples: int = 200,
     return rows
 
 
-def budgets(robot: Robot, budget: float = 0.005, n: int = 200, seed: int = 0,
+def budgets(robot: Chain, budget: float = 0.005, n: int = 200, seed: int = 0,
             solvers: tuple[str, ...] = ("frdm", "biquat", "dls")) -> list[dict[str, Any]]:
     """How well every path keeps ``time_budget`` [s]: n calls that cannot succeed (tolerances of 1e-300) from
     random starts, paths interleaved per problem; the wall time of each call, outside kinelab. The paths: each
@@ -163,7 +163,7 @@ def budgets(robot: Robot, budget: float = 0.005, n: int = 200, seed: int = 0,
             for name, t in times.items()]
 
 
-def _budget_paths(robot: Robot, budget: float, solvers: tuple[str, ...]) -> dict[str, Callable[..., Any]]:
+def _budget_paths(robot: Chain, budget: float, solvers: tuple[str, ...]) -> dict[str, Callable[..., Any]]:
     """One call per path, (case, seed, tolerance) → anything, each with ``budget``."""
     def single(name: str) -> Callable[..., Any]:
         return lambda case, seed, tol: solve(robot, case.oMtarget, solver=name, q0=case.q_start, seed=seed,
@@ -194,7 +194,7 @@ def _budget_paths(robot: Robot, budget: float, solvers: tuple[str, ...]) -> dict
     return paths
 
 
-def _analytic_paths(robot: Robot, budget: float) -> dict[str, Callable[..., Any]]:
+def _analytic_paths(robot: Chain, budget: float) -> dict[str, Callable[..., Any]]:
     """The closed form's paths where the robot has one: ``solve`` and a batch of 100 with solver "analytic",
     ``solve_all_batch`` of 1,000 (a 6R chain in a class), and ``solve_all`` with ``redundancy=`` 64 samples and a
     SEW angle (a 7R arm with a swept form)."""
@@ -235,7 +235,7 @@ def budgets_run(robots: list[str] | None, seed: int = 0, n: int = 200,
     return rows
 
 
-def _has_collision_geometry(robot: Robot) -> bool:
+def _has_collision_geometry(robot: Chain) -> bool:
     """The robot's files give it collision geometry (the self-collision check can run)."""
     try:
         collision_model(robot, Collisions())

@@ -23,13 +23,13 @@ import numpy as np
 from kinelab.errors import KinelabError
 from kinelab.ik.chain import PRISMATIC, chain_model
 from kinelab.report.bench.protocol import TOL_POS, TOL_ROT, Case, Prepare, SolveFn
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 from kinelab.scratch import scratch_dir
 
 PEERS = {"rtb-ik_LM": "roboticstoolbox", "trac-ik": "pytracik", "ikpy": "ikpy", "pink": "pink"}
 
 
-def kinematic_urdf(robot: Robot) -> Path:
+def kinematic_urdf(robot: Chain) -> Path:
     """A copy of the robot's URDF without visual, collision, inertial, gazebo or transmission elements."""
     if robot.urdf_path is None:
         raise KinelabError(f"{robot.name} was made from an in-memory model: the peers read a URDF file")
@@ -47,14 +47,14 @@ def kinematic_urdf(robot: Robot) -> Path:
     return out
 
 
-def tool_link(robot: Robot) -> str:
+def tool_link(robot: Chain) -> str:
     """The URDF link the tool frame sits on (the peers take a link, not a frame)."""
     from kinelab.analysis.oracles import tool_link as _tool_link
 
     return _tool_link(robot)
 
 
-def rtb_ets(robot: Robot) -> Any:
+def rtb_ets(robot: Chain) -> Any:
     """roboticstoolbox's ETS of the robot's base → tool chain (its URDF import), checked for the joint count.
 
     Raises:
@@ -64,13 +64,13 @@ def rtb_ets(robot: Robot) -> Any:
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        ets = rtb.Robot.URDF(str(kinematic_urdf(robot))).ets(end=tool_link(robot))
+        ets = rtb.Chain.URDF(str(kinematic_urdf(robot))).ets(end=tool_link(robot))
     if ets.n != robot.n:
         raise ValueError(f"roboticstoolbox sees {ets.n} joints, kinelab {robot.n}")
     return ets
 
 
-def rtb_chain_ets(robot: Robot) -> Any:
+def rtb_chain_ets(robot: Chain) -> Any:
     """roboticstoolbox's ETS built from kinelab's own joint data (placements, axes, limits), for chains
     whose URDF rtb imports wrongly (axes not along x, y or z): each joint is SE3(placement · A) · Rz(q)
     (or tz(q)) · SE3(Aᵀ), A a rotation taking z onto the joint axis. Checked against Pinocchio's FK.
@@ -113,7 +113,7 @@ TASKS = {"rtb-ik_LM": ("pose", "position", "orientation"), "trac-ik": ("pose",),
          "pink": ("pose",)}
 
 
-def _rtb(robot: Robot, budget: float) -> SolveFn:
+def _rtb(robot: Chain, budget: float) -> SolveFn:
     ets = rtb_ets(robot)
 
     def run(case: Case, seed: int):
@@ -125,7 +125,7 @@ def _rtb(robot: Robot, budget: float) -> SolveFn:
     return run
 
 
-def _tracik(robot: Robot, budget: float) -> SolveFn:
+def _tracik(robot: Chain, budget: float) -> SolveFn:
     from trac_ik.trac_ik import TracIK
 
     solver = TracIK(robot.base, tool_link(robot), str(kinematic_urdf(robot)), timeout=budget, epsilon=5e-7)
@@ -140,7 +140,7 @@ def _tracik(robot: Robot, budget: float) -> SolveFn:
     return run
 
 
-def _ikpy(robot: Robot, budget: float) -> SolveFn:
+def _ikpy(robot: Chain, budget: float) -> SolveFn:
     from ikpy.chain import Chain
 
     with warnings.catch_warnings():
@@ -166,7 +166,7 @@ def _ikpy(robot: Robot, budget: float) -> SolveFn:
     return run
 
 
-def _pink(robot: Robot, budget: float) -> SolveFn:
+def _pink(robot: Chain, budget: float) -> SolveFn:
     import pink
     from pink.tasks import FrameTask
 

@@ -22,7 +22,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.ik.tasks import Task
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 
 TOL_POS = 1e-6  # [m]
 TOL_ROT = 1e-6  # [rad]
@@ -53,7 +53,7 @@ def round_plan(count: int, names: list[str], r: int) -> list[tuple[int, str]]:
             [(k, name) for name in order for k in range(count)])
 
 
-def cases(robot: Robot, n: int, seed: int, start: str = "random", sigma: float = 0.2,
+def cases(robot: Chain, n: int, seed: int, start: str = "random", sigma: float = 0.2,
           task: str = "pose") -> list[Case]:
     """``n`` seeded problems: targets drawn uniformly within the joint limits; starts drawn uniformly
     (``start="random"``) or the target's configuration plus N(0, sigma²) per joint, clipped into the
@@ -75,7 +75,7 @@ def cases(robot: Robot, n: int, seed: int, start: str = "random", sigma: float =
     return out
 
 
-def check_solution(robot: Robot, q: np.ndarray | None, oMtarget: pin.SE3, elapsed: float, budget: float = BUDGET,
+def check_solution(robot: Chain, q: np.ndarray | None, oMtarget: pin.SE3, elapsed: float, budget: float = BUDGET,
                    tol_pos: float = TOL_POS, tol_rot: float = TOL_ROT, task: str = "pose") -> tuple[bool, str]:
     """The protocol's verdict on one answer: (solved, reason). Pinocchio's FK is the judge."""
     if q is None:
@@ -96,10 +96,10 @@ def check_solution(robot: Robot, q: np.ndarray | None, oMtarget: pin.SE3, elapse
 
 # A solver under test: prepare(robot, budget) → solve(case, seed) → (q or None, iterations or -1)
 SolveFn = Callable[[Case, int], tuple[np.ndarray | None, int]]
-Prepare = Callable[[Robot, float], SolveFn]
+Prepare = Callable[[Chain, float], SolveFn]
 
 
-def smooth_path(robot: Robot, seed: int, samples: int = 2000, amplitude: float = 0.6) -> np.ndarray:
+def smooth_path(robot: Chain, seed: int, samples: int = 2000, amplitude: float = 0.6) -> np.ndarray:
     """A smooth joint-space path (samples × n): each joint a sinusoid of seeded phase and rate (0.5–1.5 periods)
     over ± ``amplitude`` of its range about mid-range (continuous joints: of [−π, π]). The tracking
     protocol's targets are its FK; its own largest joint step is the yardstick of a branch jump."""
@@ -110,7 +110,7 @@ def smooth_path(robot: Robot, seed: int, samples: int = 2000, amplitude: float =
     return (lo + hi) / 2 + amplitude * (hi - lo) / 2 * np.sin(np.outer(t, rate) + phase)
 
 
-def blend_path(robot: Robot, seed: int, samples: int = 200, amplitude: float = 0.6) -> np.ndarray:
+def blend_path(robot: Chain, seed: int, samples: int = 200, amplitude: float = 0.6) -> np.ndarray:
     """A smooth joint-space path (samples × n) from one seeded configuration to another, both drawn within
     ± ``amplitude`` of each joint's range about mid-range (continuous joints: of [−π, π]), blended by a cosine
     (zero joint speed at both ends)."""
@@ -122,7 +122,7 @@ def blend_path(robot: Robot, seed: int, samples: int = 200, amplitude: float = 0
     return qa + np.outer(s, qb - qa)
 
 
-def path_set(robot: Robot, seed: int, count: int, samples: int = 200) -> list[np.ndarray]:
+def path_set(robot: Chain, seed: int, count: int, samples: int = 200) -> list[np.ndarray]:
     """``count`` seeded joint-space paths, cosine blends and sinusoids in turn (path k from seed + k): the set
     the tracking protocol and its test follow."""
     return [(blend_path if k % 2 == 0 else smooth_path)(robot, seed + k, samples) for k in range(count)]

@@ -34,7 +34,7 @@ from kinelab.report.bench.protocol import (
     cases,
     check_solution,
 )
-from kinelab.robot import Robot, load
+from kinelab.robot import Chain, load
 
 
 @dataclass
@@ -56,7 +56,7 @@ class Row:
 class _Tally:
     """Per-problem (time, verdict, iterations) of one (robot, solver) pair, the fastest of its repeats kept."""
 
-    def __init__(self, robot: Robot, name: str, solve_fn: SolveFn, n: int):
+    def __init__(self, robot: Chain, name: str, solve_fn: SolveFn, n: int):
         self.robot, self.name, self.solve_fn = robot, name, solve_fn
         self.best: list[tuple[float, bool, str, int] | None] = [None] * n
 
@@ -87,7 +87,7 @@ class _Tally:
                    float(np.median([b[3] for b in best])), failures)
 
 
-def run_robot(robot: Robot, solvers: dict[str, Prepare], problems: list[Case], budget: float, seed: int,
+def run_robot(robot: Chain, solvers: dict[str, Prepare], problems: list[Case], budget: float, seed: int,
               missing: dict[str, str], repeats: int = REPEATS, schedule: str = "blocked") -> list[Row]:
     """Every solver on every problem of one robot, ``repeats`` times over; per problem the fastest run
     counts, with its verdict. ``blocked``: the solvers take turns over the whole set (the order rotating
@@ -111,7 +111,7 @@ def run_robot(robot: Robot, solvers: dict[str, Prepare], problems: list[Case], b
     return [t.row() for t in tallies]
 
 
-def _prepared(robot: Robot, solvers: dict[str, Prepare], problems: list[Case], budget: float, seed: int,
+def _prepared(robot: Chain, solvers: dict[str, Prepare], problems: list[Case], budget: float, seed: int,
               missing: dict[str, str]) -> list[_Tally]:
     """A tally per solver that could load the robot, each warmed up (compilation, caches)."""
     tallies = []

@@ -18,7 +18,7 @@ from kinelab.ik.api import solve
 from kinelab.ik.chain import chain_model
 from kinelab.ik.frdm import kernel
 from kinelab.report.bench import peers
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 from kinelab.robot.build import build_file
 from kinelab.scratch import scratch_dir
 
@@ -48,14 +48,14 @@ def synthetic_urdf(n: int, seed: int = 0, link: float | None = None) -> str:
     return "\n".join(parts)
 
 
-def synthetic_robot(n: int, seed: int = 0) -> Robot:
+def synthetic_robot(n: int, seed: int = 0) -> Chain:
     """A synthetic n-link chain (every fourth joint prismatic), loaded from a temporary URDF."""
     path = scratch_dir("kinelab-chain-") / f"chain{n}.urdf"
     path.write_text(synthetic_urdf(n, seed))
-    return Robot(build_file(path, name=f"chain{n}"))
+    return Chain(build_file(path, name=f"chain{n}"))
 
 
-def time_per_sweep(robot: Robot, sweeps: int = 500, repeats: int = 30) -> float:
+def time_per_sweep(robot: Chain, sweeps: int = 500, repeats: int = 30) -> float:
     """Seconds per plain FRDM sweep (kernel only, FK resync included), best of ``repeats`` (the minimum
     is what the code costs; a shared machine only ever adds to it)."""
     cm = chain_model(robot)
@@ -75,7 +75,7 @@ def time_per_sweep(robot: Robot, sweeps: int = 500, repeats: int = 30) -> float:
     return best
 
 
-def time_per_solve(robot: Robot, count: int = 20, seed: int = 0, solver: str = "frdm") -> tuple[float, float]:
+def time_per_solve(robot: Chain, count: int = 20, seed: int = 0, solver: str = "frdm") -> tuple[float, float]:
     """(median seconds per solve, success rate) of :func:`kinelab.solve` on reachable random targets (0.5 s
     budget each), or of roboticstoolbox's ``ik_LM`` on an ETS built from the same chain (``solver="ik_LM"``),
     every answer judged by Pinocchio."""
@@ -93,7 +93,7 @@ def time_per_solve(robot: Robot, count: int = 20, seed: int = 0, solver: str = "
     return float(np.median(times)), ok / count
 
 
-def _ik_lm(robot: Robot) -> Callable[[pin.SE3, np.ndarray], np.ndarray]:
+def _ik_lm(robot: Chain) -> Callable[[pin.SE3, np.ndarray], np.ndarray]:
     ets = peers.rtb_chain_ets(robot)
 
     def run(target: pin.SE3, q0: np.ndarray) -> np.ndarray:

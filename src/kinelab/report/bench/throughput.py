@@ -24,7 +24,7 @@ from kinelab.ik.analytic import held
 from kinelab.ik.analytic.classify import classify
 from kinelab.ik.api import solve_batch
 from kinelab.ik.starts import start_table
-from kinelab.robot import Robot, load
+from kinelab.robot import Chain, load
 
 TARGETS = 2000
 ARMS = ("panda", "ur5", "xarm7", "youbot")
@@ -36,7 +36,7 @@ PUBLISHED = (  # (library, hardware, what, targets/s): their own papers' figures
 )
 
 
-def _round(robot: Robot, seed: int, first: str, closed: bool) -> dict[str, dict[str, float]]:
+def _round(robot: Chain, seed: int, first: str, closed: bool) -> dict[str, dict[str, float]]:
     """One round: the two start modes on one set of targets, ``first`` first, then (``closed``) the closed form's
     branch nearest a random start per target."""
     rng = np.random.default_rng(seed)
@@ -54,7 +54,7 @@ def _round(robot: Robot, seed: int, first: str, closed: bool) -> dict[str, dict[
     return found
 
 
-def measure(robot: Robot, rounds: int, seed: int) -> dict[str, Any]:
+def measure(robot: Chain, rounds: int, seed: int) -> dict[str, Any]:
     """The arm's row: per start mode, each round's figures; the table's build time [ms] and size [MB]."""
     t0 = time.perf_counter()
     table = start_table(robot)
@@ -67,7 +67,7 @@ def measure(robot: Robot, rounds: int, seed: int) -> dict[str, Any]:
             "table_mb": table.nbytes / 2**20, "modes": modes}
 
 
-def collision_free(robot: Robot, rounds: int, seed: int) -> dict[str, Any]:
+def collision_free(robot: Chain, rounds: int, seed: int) -> dict[str, Any]:
     """Collision-free batches: per round TARGETS targets, each the tool pose of a random configuration clear of the
     arm itself and of a floor and a table, solved by ``solve_batch(..., collisions=)``; targets/s, the success rate,
     and how many successes Pinocchio's ``computeCollisions`` finds colliding (:func:`_by_pinocchio`)."""
@@ -89,7 +89,7 @@ def collision_free(robot: Robot, rounds: int, seed: int) -> dict[str, Any]:
             "success": success, "colliding": int(colliding)}
 
 
-def _by_pinocchio(robot: Robot, geom: Any, Q: np.ndarray) -> int:
+def _by_pinocchio(robot: Chain, geom: Any, Q: np.ndarray) -> int:
     """How many configurations of Q Pinocchio's ``computeCollisions`` finds colliding: the geometry's pairs on
     geometry data of its own (no margin, none of the batch's checks' history)."""
     import pinocchio as pin

@@ -26,14 +26,14 @@ from kinelab.ik.api import solve
 from kinelab.ik.prepared import IK
 from kinelab.report.bench import peers
 from kinelab.report.bench.protocol import DEFAULT_ROBOTS, TOL_POS, TOL_ROT, round_plan
-from kinelab.robot import Robot, load
+from kinelab.robot import Chain, load
 
 PROTOCOLS = (("floor", 0.0), ("warm", 0.02), ("warm", 0.2), ("random", 0.0))
 BUDGET = 0.005  # [s] per solve, kinelab's; ik_LM runs its own default search limit
 Solver = Callable[[pin.SE3, np.ndarray, int], np.ndarray]
 
 
-def problems(robot: Robot, n: int, seed: int, start: str, sigma: float) -> list[tuple[pin.SE3, np.ndarray]]:
+def problems(robot: Chain, n: int, seed: int, start: str, sigma: float) -> list[tuple[pin.SE3, np.ndarray]]:
     """n seeded (target, start) pairs: the target the FK of a random configuration, the start as the protocol
     says."""
     rng = np.random.default_rng(seed)
@@ -48,7 +48,7 @@ def problems(robot: Robot, n: int, seed: int, start: str, sigma: float) -> list[
     return out
 
 
-def solvers(robot: Robot) -> dict[str, Solver]:
+def solvers(robot: Chain) -> dict[str, Solver]:
     """The contenders: the prepared call, the plain call, the prepared biquaternion solver, the closed form where the
     arm has one (the branch nearest the start) and (if installed) ik_LM."""
     ik = IK(robot, time_budget=BUDGET)
@@ -69,7 +69,7 @@ def solvers(robot: Robot) -> dict[str, Solver]:
     return out
 
 
-def _timed(robot: Robot, fn: Solver, target: pin.SE3, q0: np.ndarray, seed: int) -> tuple[float, bool]:
+def _timed(robot: Chain, fn: Solver, target: pin.SE3, q0: np.ndarray, seed: int) -> tuple[float, bool]:
     t0 = time.perf_counter()
     q = fn(target, q0, seed)
     elapsed = time.perf_counter() - t0
@@ -77,7 +77,7 @@ def _timed(robot: Robot, fn: Solver, target: pin.SE3, q0: np.ndarray, seed: int)
     return elapsed, bool(dp <= TOL_POS and dr <= TOL_ROT and robot.within_limits(q))
 
 
-def rounds(robot: Robot, cases: list[tuple[pin.SE3, np.ndarray]], contenders: dict[str, Solver], repeats: int,
+def rounds(robot: Chain, cases: list[tuple[pin.SE3, np.ndarray]], contenders: dict[str, Solver], repeats: int,
            seed: int) -> dict[str, list[tuple[np.ndarray, np.ndarray]]]:
     """Per contender and round: (times [s], verdicts) over the cases; even rounds interleaved, odd blocked."""
     names = list(contenders)
@@ -93,7 +93,7 @@ def rounds(robot: Robot, cases: list[tuple[pin.SE3, np.ndarray]], contenders: di
     return out
 
 
-def compare(robot: Robot, n: int = 60, seed: int = 0, repeats: int = 4) -> list[dict[str, Any]]:
+def compare(robot: Chain, n: int = 60, seed: int = 0, repeats: int = 4) -> list[dict[str, Any]]:
     """One row per (protocol, kinelab call): medians, p95, success and the ratios to ik_LM with their spread."""
     contenders = solvers(robot)
     for fn in contenders.values():  # compile, load and warm every contender outside the figures

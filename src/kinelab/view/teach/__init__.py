@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 from kinelab.view.teach.server import TeachServer
 from kinelab.view.teach.session import TeachOptions, TeachSession
 
@@ -21,7 +21,7 @@ class Teach:
     ``teach.close()`` stops the server.
     """
 
-    def __init__(self, robot: Robot, q: Any = None, options: TeachOptions | None = None, port: int = 0):
+    def __init__(self, robot: Chain, q: Any = None, options: TeachOptions | None = None, port: int = 0):
         self.session = TeachSession(robot, q, options)
         self.server = TeachServer(self.session, port).start()
 
@@ -45,7 +45,7 @@ class Teach:
         self.close()
 
 
-def teach(robot: Robot, q: Any = None, options: TeachOptions | None = None, port: int = 0) -> Teach:
+def teach(robot: Chain, q: Any = None, options: TeachOptions | None = None, port: int = 0) -> Teach:
     """Serve a teach page for ``robot`` on 127.0.0.1 in the background and return it (shown in a notebook cell).
 
     Args:

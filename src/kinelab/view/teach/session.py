@@ -18,7 +18,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.errors import KinelabError, TargetError
-from kinelab.robot import Robot
+from kinelab.robot import Chain
 from kinelab.view.teach.recorder import RecordingWindow
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -68,7 +68,7 @@ class TeachOptions:
 class TeachSession:
     """A robot to move by hand: joint values set directly, or a target pose the robot follows by IK."""
 
-    def __init__(self, robot: Robot, q: Any = None, options: TeachOptions | None = None):
+    def __init__(self, robot: Chain, q: Any = None, options: TeachOptions | None = None):
         import meshcat
 
         from kinelab.view.scene import Scene

@@ -1,4 +1,5 @@
-"""Robot: a URDF loaded into Pinocchio, reduced to the serial chain from the base to a tool frame.
+"""Chain: a robot's serial chain from a base to a tool frame — a view of the whole robot
+(:class:`~kinelab.robot.tree.Robot`, ``chain.robot``) with a model reduced to the chain, everything off it held.
 
 Coordinates. kinelab speaks "one number per joint" (``q``, length ``robot.n``): an angle in rad for
 revolute and continuous joints, a displacement in m for prismatic ones, in chain order base → tool.
@@ -17,35 +18,37 @@ import itertools
 import operator
 import warnings
 from collections.abc import Callable
-from pathlib import Path
-from typing import Any, TypeVar, cast
+from typing import TYPE_CHECKING, Any, TypeVar, cast
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from kinelab.core._joints import PinForm, plain_q
-from kinelab.errors import ConfigurationError, JointLimitError, JointNotFoundError, OptionError, SRDFError
+from kinelab.errors import ChainError, ConfigurationError, JointLimitError, JointNotFoundError, OptionError, SRDFError
 from kinelab.geometry import pose_error, wrap_to_pi
-from kinelab.robot import catalog, descriptions, xacro
-from kinelab.robot.build import LIMIT_SLACK, Built, build_file, build_model, frame_id
+from kinelab.robot import xacro
+from kinelab.robot.build import LIMIT_SLACK, Built, build_model, frame_id
 from kinelab.robot.certificate import ChainArrays, FKCertificate, certify, chain_arrays
 from kinelab.robot.joints import Joint, Mimic
 from kinelab.robot.meshes import build_visual_model
 from kinelab.robot.mjcf import is_mjcf, meshes_outside
+from kinelab.robot.space import MAX_SAMPLE_BYTES, SAMPLE_TURNS, generator, uniform
 from kinelab.scratch import own
 
+if TYPE_CHECKING:
+    from kinelab.robot import Robot  # the package: tree.py imports this module
+
 T = TypeVar("T")
-MAX_SAMPLE_BYTES = 8 * 2**30  # the most memory one random_qs call fills
-SAMPLE_TURNS = 4  # random configurations keep revolute joints within ±4 turns (see Robot.random_q)
-__all__ = ["LIMIT_SLACK", "Joint", "Mimic", "Robot", "load"]
+__all__ = ["LIMIT_SLACK", "Chain", "Joint", "Mimic"]
 
 
-class Robot:
+class Chain:
     """A serial chain base → tool, with Pinocchio as the kinematic reference: a model, its joint space, its
-    kinematics.
+    kinematics. It is a view of the whole robot (``robot``, built on first use where the chain came from a file;
+    ``q_index`` places its joints in the whole robot's q).
 
-    Build with :func:`kinelab.load` (a file or a registered name) or :meth:`Robot.from_model` (an in-memory
+    Build with :func:`kinelab.load` (a file or a registered name) or :meth:`Chain.from_model` (an in-memory
     ``pin.Model``); :mod:`kinelab.robot.build` makes every decision of the build, this class uses the result.
     Attributes: ``name``, ``source`` and ``urdf_path`` (None for an in-memory model), ``model``, ``data``,
     ``tool`` (frame name), ``tool_frame_id``, ``base``, ``joints``, ``joint_names``, ``lower``, ``upper``
@@ -53,7 +56,7 @@ class Robot:
     """
 
     def __init__(self, built: Built):
-        """A Robot over a build's result (:func:`kinelab.load` and :meth:`from_model` make one).
+        """A Chain over a build's result (:func:`kinelab.load` and :meth:`from_model` make one).
 
         Args:
             built: the frozen result of :mod:`kinelab.robot.build`.
@@ -71,13 +74,15 @@ class Robot:
         self._index_joints()
         self._length: float | None = None
         self._derived: dict[str, Any] = {}
+        self._whole: Robot | None = None
+        self._whole_factory: Callable[[], Robot] | None = None
         self.display_pose: np.ndarray | None = None
         """The registered pose to show the robot in (:meth:`display_q`), or None."""
 
     @classmethod
     def from_model(cls, model: pin.Model, *, tool: str | None = None, base: str | None = None,
-                   locked: dict[str, float] | None = None, name: str | None = None) -> Robot:
-        """A Robot from an in-memory Pinocchio model (what pink and mink take), reduced to base → tool.
+                   locked: dict[str, float] | None = None, name: str | None = None) -> Chain:
+        """A Chain from an in-memory Pinocchio model (what pink and mink take), reduced to base → tool.
 
         Args:
             model: the whole robot's ``pin.Model`` (copied; yours is left as it is).
@@ -87,12 +92,60 @@ class Robot:
             name: the robot's name (default: the model's).
 
         Returns:
-            The Robot (no file behind it: ``source`` and ``urdf_path`` are None, the viewer draws a stick figure).
+            The Chain (no file behind it: ``source`` and ``urdf_path`` are None, the viewer draws a stick figure).
 
         Raises:
             ChainError, FrameNotFoundError, JointNotFoundError, ConfigurationError, JointLimitError: named.
         """
         return cls(build_model(model, tool=tool, locked=locked, name=name, base=base))
+
+    def attach(self, robot: Robot | Callable[[], Robot]) -> Chain:
+        """Make ``robot`` (the whole model this chain was cut from, or how to build it on first use) the chain's
+        ``robot``; returns self."""
+        if callable(robot) and not hasattr(robot, "model"):
+            self._whole_factory = robot
+        else:
+            self._whole = cast("Robot", robot)
+        return self
+
+    @property
+    def robot(self) -> Robot:
+        """The whole robot this chain is a view of (a file's built on first use, fixed base).
+
+        Raises:
+            ChainError: a chain cut from an in-memory model by ``Chain.from_model`` (``Robot.from_model(model)
+                .chain(base, tool)`` keeps its robot).
+        """
+        if self._whole is None:
+            if self._whole_factory is None:
+                raise ChainError(f"{self.name} was cut from an in-memory model with Chain.from_model; "
+                                 "kinelab.Robot.from_model(model).chain(base, tool) keeps the whole robot")
+            self._whole = self._whole_factory()
+        return self._whole
+
+    @property
+    def q_index(self) -> np.ndarray:
+        """(n,) the index in the whole robot's q of each chain joint (its first entry: a continuous joint has two,
+        cos then sin)."""
+        model = self.robot.model
+        return np.array([model.joints[model.getJointId(name)].idx_q for name in self.joint_names], dtype=int)
+
+    def in_whole(self, q: ArrayLike, q_whole: ArrayLike | None = None) -> np.ndarray:
+        """The whole robot's q with this chain's joints at q [rad or m] (the others as in ``q_whole``, default
+        the whole robot's neutral configuration).
+
+        Raises:
+            ConfigurationError: q is not a configuration of this chain, or q_whole not one of the robot.
+        """
+        whole = self.robot
+        out = whole.neutral() if q_whole is None else whole.check_q(q_whole, what="q_whole").copy()
+        values = self.check_q(q)
+        for k, i in enumerate(self.q_index):
+            if self.joint_kinds[k] == "continuous":
+                out[i], out[i + 1] = np.cos(values[k]), np.sin(values[k])
+            else:
+                out[i] = values[k]
+        return out
 
     def _index_joints(self) -> None:
         """Names, kinds, limits and the index maps between kinelab's q and Pinocchio's."""
@@ -130,9 +183,9 @@ class Robot:
             return "xacro"
         return "MJCF" if is_mjcf(self.urdf_path) else "URDF"
 
-    def derived(self, key: str, build: Callable[[Robot], T]) -> T:
+    def derived(self, key: str, build: Callable[[Chain], T]) -> T:
         """Data derived from this robot (a solver's chain arrays, say), built on first use and kept here,
-        so it lives exactly as long as the Robot."""
+        so it lives exactly as long as the Chain."""
         if key not in self._derived:
             self._derived[key] = build(self)
         return cast(T, self._derived[key])
@@ -305,7 +358,7 @@ class Robot:
         """A configuration drawn uniformly within the limits (continuous joints on [−π, π]; a revolute joint
         whose limits lie beyond ±SAMPLE_TURNS turns, such as a rotor declared with ±1e16 rad, on ±SAMPLE_TURNS
         turns: every pose it can take, at angles where rounding does not swamp a step)."""
-        return _uniform(_generator(rng), *self.sample_bounds, None)
+        return uniform(generator(rng), *self.sample_bounds, None)
 
     def random_qs(self, count: int, rng: np.random.Generator | int | None = None) -> np.ndarray:
         """``count`` configurations (rows) drawn as :meth:`random_q` draws one.
@@ -318,7 +371,7 @@ class Robot:
         if int(count) * self.n * 8 > MAX_SAMPLE_BYTES:
             raise OptionError("count", count, f"at most {MAX_SAMPLE_BYTES // (8 * self.n)} configurations of "
                               f"{self.name} (their rows would take more than {MAX_SAMPLE_BYTES >> 30} GiB)")
-        return _uniform(_generator(rng), *self.sample_bounds, (int(count), self.n))
+        return uniform(generator(rng), *self.sample_bounds, (int(count), self.n))
 
     @functools.cached_property
     def sample_bounds(self) -> tuple[np.ndarray, np.ndarray]:
@@ -527,30 +580,17 @@ class Robot:
         return float(np.mean(positive)) if positive else 1.0
 
     def __repr__(self) -> str:
-        return f"Robot({self.name!r}, n={self.n}, tool={self.tool!r}, urdf={str(self.urdf_path)!r})"
+        return f"Chain({self.name!r}, n={self.n}, tool={self.tool!r}, urdf={str(self.urdf_path)!r})"
 
 
-def _judge_arrays(robot: Robot) -> ChainArrays | None:
+def _judge_arrays(robot: Chain) -> ChainArrays | None:
     arrays = chain_arrays(robot) if robot.fk_certificate.certified else None
     return arrays if isinstance(arrays, ChainArrays) else None
 
 
-def _compiled_judge(robot: Robot) -> Any:
+def _compiled_judge(robot: Chain) -> Any:
     arrays = robot._judge_arrays()
     return None if arrays is None else arrays.judge()
-
-
-def _generator(rng: object) -> np.random.Generator:
-    """A numpy Generator from what ``random_q`` accepts: None, a whole number ≥ 0, or a Generator.
-
-    Raises:
-        OptionError: anything else (named).
-    """
-    if isinstance(rng, np.random.Generator):
-        return rng
-    if rng is None or (isinstance(rng, int | np.integer) and not isinstance(rng, bool) and rng >= 0):
-        return np.random.default_rng(rng)
-    raise OptionError("rng", rng, "None, a whole number ≥ 0 (a seed) or a numpy Generator")
 
 
 def _read_only(arr: np.ndarray) -> np.ndarray:
@@ -558,7 +598,7 @@ def _read_only(arr: np.ndarray) -> np.ndarray:
     return arr
 
 
-def _best_conditioned(robot: Robot) -> np.ndarray:
+def _best_conditioned(robot: Chain) -> np.ndarray:
     rng = np.random.default_rng(0)
     lo = np.where(np.isfinite(robot.lower), robot.lower, -np.pi)
     hi = np.where(np.isfinite(robot.upper), robot.upper, np.pi)
@@ -574,98 +614,3 @@ def _best_conditioned(robot: Robot) -> np.ndarray:
         if ratio > best_ratio:
             best, best_ratio = q, ratio
     return best
-
-
-def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, float] | None = None,
-         base: str | None = None, package_dirs: list[str] | None = None, srdf: str | Path | None = None,
-         group: str | None = None, xacro_args: dict[str, str] | None = None, *,
-         trust_xacro: bool = False) -> Robot:
-    """Load a registered robot (``kinelab.robots()``) or a URDF file as a :class:`Robot`.
-
-    Args:
-        name_or_path: a registered name such as ``"era"`` or ``"panda"``, a path to a URDF, xacro or MJCF
-            file, or ``"rd:NAME"``: a description of robot_descriptions (the extra
-            ``kinelab[descriptions]``), read from its cache (:mod:`~kinelab.robot.descriptions`).
-        tool: the tool frame; default: the registered tool, else a frame named ``tool``, else the
-            single leaf link (an error lists the leaves when there are several).
-        locked: joints to hold fixed, name → value (rad or m): chain joints, or joints off the chain (held
-            at zero, clipped into their limits, when not named).
-        base: the frame the chain starts from (default: the URDF root); it must lie on the root → tool
-            path. Joints above it are locked, and every pose (FK, targets) is expressed in this frame.
-        package_dirs: directories where ``package://NAME/...`` mesh URIs resolve (as ``DIR/NAME/...``, or
-            DIR itself when it is the package NAME), before ``ROS_PACKAGE_PATH``'s and example-robot-data's.
-            Kinematics never read meshes; the viewer does.
-        srdf: an SRDF file: its named configurations (:meth:`Robot.named_q`), its groups, and the values at
-            which joints off the chain are held (the first configuration naming a joint; ``locked`` wins).
-        group: an SRDF group whose chain (base → tip), end effector or last joint gives base and tool.
-        xacro_args: arguments of a ``.xacro`` source (name → value), expanded with xacrodoc (the extra
-            ``kinelab[xacro]``); MJCF sources (root ``<mujoco>``) are read by Pinocchio's MJCF parser.
-        trust_xacro: let a ``.xacro`` source run what xacro runs (``$(eval ...)``, ``$(env ...)``,
-            ``load_yaml``); without it those are refused with their line (:mod:`~kinelab.robot.xacro`).
-
-    Raises:
-        RobotNotFoundError, DescriptionError, URDFError, SRDFError, ChainError, FrameNotFoundError: named.
-        JointNotFoundError: a locked joint that does not exist (the valid names listed).
-    """
-    _check_load_arguments(name_or_path, tool, locked, base, package_dirs, srdf, group, xacro_args, trust_xacro)
-    if str(name_or_path).startswith(descriptions.PREFIX):
-        found = descriptions.resolve(str(name_or_path))
-        return Robot(build_file(found.path, tool=tool, locked=locked, name=found.name, base=base,
-                                package_dirs=[*(package_dirs or []), *found.package_dirs], srdf=srdf, group=group))
-    path, entry = catalog.resolve(name_or_path)
-    if entry is not None and not group:
-        tool, base = tool or entry.tool, base or entry.base
-        if entry.group and not (tool or base):
-            group = entry.group
-        srdf = srdf or catalog.srdf_path(entry)
-    robot = Robot(build_file(path, tool=tool, locked=locked, name=entry.name if entry else None, base=base,
-                             package_dirs=package_dirs, srdf=srdf, group=group, xacro_args=xacro_args,
-                             trust_xacro=trust_xacro))
-    if entry is not None and entry.display is not None and robot.n == len(entry.display):
-        robot.display_pose = np.array(entry.display)
-    return robot
-
-
-def _check_load_arguments(source: Any, tool: Any, locked: Any, base: Any, package_dirs: Any, srdf: Any,
-                          group: Any, xacro_args: Any, trust_xacro: Any) -> None:
-    """Refuse an argument of the wrong type, naming it and what it takes (before any file is read)."""
-    checks = (
-        ("name_or_path", source, _is_path(source), "a registered name, a file path or 'rd:NAME'"),
-        ("tool", tool, tool is None or _is_name(tool), "a frame name, or None"),
-        ("base", base, base is None or _is_name(base), "a frame name, or None"),
-        ("group", group, group is None or _is_name(group), "an SRDF group name, or None"),
-        ("srdf", srdf, srdf is None or _is_path(srdf), "a path to an SRDF file, or None"),
-        ("package_dirs", package_dirs, package_dirs is None or (isinstance(package_dirs, list | tuple)
-                                                                and all(map(_is_path, package_dirs))),
-         "a list of folder paths, or None"),
-        ("locked", locked, locked is None or _is_named_table(locked), "a dict joint name → value [rad or m], or None"),
-        ("xacro_args", xacro_args, xacro_args is None or _is_named_table(xacro_args),
-         "a dict argument name → value, or None"),
-        ("trust_xacro", trust_xacro, isinstance(trust_xacro, bool), "True or False"),
-    )
-    for name, value, ok, valid in checks:
-        if not ok:
-            raise OptionError(name, value, valid)
-
-
-def _uniform(rng: np.random.Generator, lower: np.ndarray, upper: np.ndarray, size: Any) -> np.ndarray:
-    """Uniform draws between lower and upper, also where upper − lower overflows (a prismatic joint declared with
-    ±1e308 m: numpy's uniform refuses that range)."""
-    if (upper / 2 - lower / 2 < 0.5 * np.finfo(float).max).all():  # the width fits a float
-        drawn: np.ndarray = rng.uniform(lower, upper, size)
-        return drawn
-    u = rng.random(size if size is not None else lower.shape)
-    return np.asarray(lower * (1.0 - u) + upper * u)
-
-
-def _is_path(value: Any) -> bool:
-    """A Path, or a string that names one (an empty string names nothing, though Path("") is the current folder)."""
-    return isinstance(value, Path) or _is_name(value)
-
-
-def _is_name(value: Any) -> bool:
-    return isinstance(value, str) and value.strip() != ""
-
-
-def _is_named_table(value: Any) -> bool:
-    return isinstance(value, dict) and all(isinstance(k, str) for k in value)

@@ -1,0 +1,178 @@
+"""Loading: a registered name or a model file → a chain (:class:`~kinelab.robot.chain.Chain`, what an arm's user
+gets) or the whole robot (:class:`~kinelab.robot.tree.Robot`: a humanoid, a two-armed robot, a quadruped).
+
+Which one: a registered arm's name (``"panda"``, ``"talos_left"``) or a file with a tool frame gives a chain; a
+registered whole robot's name (``"talos"``, ``"g1"``, ``"baxter"``), ``whole=True`` or ``floating=True`` gives the
+whole robot. Every decision of a build is :mod:`kinelab.robot.build`'s.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from kinelab.errors import OptionError
+from kinelab.robot import catalog, descriptions
+from kinelab.robot.build import Built, build_file, whole_model
+from kinelab.robot.chain import Chain
+from kinelab.robot.meshes import build_visual_model, mesh_package_dirs
+from kinelab.robot.mjcf import is_mjcf
+from kinelab.robot.tree import Robot
+
+__all__ = ["load", "whole_of"]
+
+
+def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, float] | None = None,
+         base: str | None = None, package_dirs: list[str] | None = None, srdf: str | Path | None = None,
+         group: str | None = None, xacro_args: dict[str, str] | None = None, *,
+         trust_xacro: bool = False, whole: bool | None = None, floating: bool | None = None) -> Any:
+    """Load a registered robot (``kinelab.robots()``) or a model file: a :class:`~kinelab.robot.chain.Chain`
+    (an arm) or the whole :class:`~kinelab.robot.tree.Robot` (see the module's docstring).
+
+    Args:
+        name_or_path: a registered name such as ``"era"``, ``"panda"`` or ``"talos"``, a path to a URDF, xacro
+            or MJCF file, or ``"rd:NAME"``: a description of robot_descriptions (the extra
+            ``kinelab[descriptions]``), read from its cache (:mod:`~kinelab.robot.descriptions`).
+        tool: the chain's tool frame; default: the registered tool, else a frame named ``tool``, else the
+            single leaf link (an error lists the leaves when there are several).
+        locked: joints to hold fixed, name → value (rad or m): chain joints, or joints off the chain (held
+            at zero, clipped into their limits, when not named).
+        base: the frame the chain starts from (default: the URDF root); it must lie on the root → tool
+            path. Joints above it are locked, and every pose (FK, targets) is expressed in this frame.
+        package_dirs: directories where ``package://NAME/...`` mesh URIs resolve (as ``DIR/NAME/...``, or
+            DIR itself when it is the package NAME), before ``ROS_PACKAGE_PATH``'s and example-robot-data's.
+            Kinematics never read meshes; the viewer does.
+        srdf: an SRDF file: its named configurations (``named_q``), its groups, and the values at which
+            joints off the chain are held (the first configuration naming a joint; ``locked`` wins).
+        group: an SRDF group whose chain (base → tip), end effector or last joint gives base and tool.
+        xacro_args: arguments of a ``.xacro`` source (name → value), expanded with xacrodoc (the extra
+            ``kinelab[xacro]``); MJCF sources (root ``<mujoco>``) are read by Pinocchio's MJCF parser.
+        trust_xacro: let a ``.xacro`` source run what xacro runs (``$(eval ...)``, ``$(env ...)``,
+            ``load_yaml``); without it those are refused with their line (:mod:`~kinelab.robot.xacro`).
+        whole: True: the whole robot (no chain is cut); None (default): whole for a registered whole robot.
+        floating: the whole robot with a free-flyer at its root (implies ``whole``); None: the registered
+            robot's own choice (a humanoid's or quadruped's base floats), else fixed.
+
+    Returns:
+        A Chain, or the whole Robot.
+
+    Raises:
+        RobotNotFoundError, DescriptionError, URDFError, SRDFError, ChainError, FrameNotFoundError: named.
+        JointNotFoundError: a locked joint that does not exist (the valid names listed).
+        OptionError: a chain's setting (tool, base, locked, group) given with the whole robot.
+    """
+    _check_load_arguments(name_or_path, tool, locked, base, package_dirs, srdf, group, xacro_args, trust_xacro)
+    _check_flag("whole", whole)
+    _check_flag("floating", floating)
+    name: str | None
+    if str(name_or_path).startswith(descriptions.PREFIX):
+        found = descriptions.resolve(str(name_or_path))
+        name, path, entry = found.name, found.path, None
+        package_dirs = [*(package_dirs or []), *found.package_dirs]
+    else:
+        path, entry = catalog.resolve(name_or_path)
+        name = entry.name if entry else None
+    if whole or floating or (whole is None and entry is not None and entry.whole):
+        return _whole(path, entry, name, package_dirs, srdf, xacro_args, trust_xacro, floating,
+                      (tool, base, locked, group))
+    return _chain(path, entry, name, tool, locked, base, package_dirs, srdf, group, xacro_args, trust_xacro)
+
+
+def _chain(path: Path, entry: catalog.Entry | None, name: str | None, tool: str | None,
+           locked: dict[str, float] | None, base: str | None, package_dirs: list[str] | None,
+           srdf: str | Path | None, group: str | None, xacro_args: dict[str, str] | None,
+           trust_xacro: bool) -> Chain:
+    """:func:`load`'s chain: the registered tool, base or group where the entry has them."""
+    if entry is not None and not group:
+        tool, base = tool or entry.tool, base or entry.base
+        if entry.group and not (tool or base):
+            group = entry.group
+        srdf = srdf or catalog.srdf_path(entry)
+    chain = Chain(build_file(path, tool=tool, locked=locked, name=name, base=base, package_dirs=package_dirs,
+                             srdf=srdf, group=group, xacro_args=xacro_args, trust_xacro=trust_xacro))
+    chain.attach(partial(whole_of, chain))
+    if entry is not None and entry.display is not None and chain.n == len(entry.display):
+        chain.display_pose = np.array(entry.display)
+    return chain
+
+
+def _whole(path: Path, entry: catalog.Entry | None, name: str | None, package_dirs: list[str] | None,
+           srdf: str | Path | None, xacro_args: dict[str, str] | None, trust_xacro: bool, floating: bool | None,
+           chain_settings: tuple[Any, ...]) -> Robot:
+    """:func:`load`'s whole robot."""
+    for key, value in zip(("tool", "base", "locked", "group"), chain_settings, strict=True):
+        if value is not None:
+            raise OptionError(key, value, "None with the whole robot (a chain of it: robot.chain(base, tool))")
+    if floating is None:
+        floating = bool(entry is not None and entry.floating)
+    srdf = srdf or (catalog.srdf_path(entry) if entry is not None else None)
+    made = whole_model(path, floating=floating, name=name, package_dirs=package_dirs, srdf=srdf,
+                       xacro_args=xacro_args, trust_xacro=trust_xacro)
+    chains = partial(_chain, path, None, made.name, package_dirs=package_dirs, srdf=srdf, group=None,
+                     xacro_args=xacro_args, trust_xacro=trust_xacro)
+    return Robot(made.model, name=made.name, source=made.source, srdf=made.srdf,
+                 chain_source=lambda tool, base, locked: chains(tool, locked, base),
+                 geometry=partial(_geometry, made.model, made.urdf_path, mesh_package_dirs(package_dirs)))
+
+
+def _geometry(model: Any, urdf_path: Path, package_dirs: list[str], kind: str) -> Any:
+    """The whole robot's geometry of ``kind`` ("visual" or "collision")."""
+    import pinocchio as pin
+
+    if is_mjcf(urdf_path):
+        return pin.GeometryModel()  # Pinocchio builds an MJCF's geometry for its own model only (the chain's view)
+    return build_visual_model(model, urdf_path, package_dirs, kind)
+
+
+def whole_of(chain: Chain) -> Robot:
+    """The whole robot a chain was cut from: its file's whole model (fixed base), or its in-memory model."""
+    built: Built = chain._built
+    if built.source is not None:
+        path = built.source
+        return _whole(path, None, chain.name, chain.package_dirs, None if chain.srdf is None else chain.srdf.path,
+                      chain.xacro_args or None, chain.trust_xacro, False, (None, None, None, None))
+    assert built.full is not None  # an in-memory chain keeps the model it was cut from
+    return Robot.from_model(built.full, name=chain.name)
+
+
+def _check_flag(name: str, value: Any) -> None:
+    if value is not None and not isinstance(value, bool):
+        raise OptionError(name, value, "True, False or None")
+
+
+def _check_load_arguments(source: Any, tool: Any, locked: Any, base: Any, package_dirs: Any, srdf: Any,
+                          group: Any, xacro_args: Any, trust_xacro: Any) -> None:
+    """Refuse an argument of the wrong type, naming it and what it takes (before any file is read)."""
+    checks = (
+        ("name_or_path", source, _is_path(source), "a registered name, a file path or 'rd:NAME'"),
+        ("tool", tool, tool is None or _is_name(tool), "a frame name, or None"),
+        ("base", base, base is None or _is_name(base), "a frame name, or None"),
+        ("group", group, group is None or _is_name(group), "an SRDF group name, or None"),
+        ("srdf", srdf, srdf is None or _is_path(srdf), "a path to an SRDF file, or None"),
+        ("package_dirs", package_dirs, package_dirs is None or (isinstance(package_dirs, list | tuple)
+                                                                and all(map(_is_path, package_dirs))),
+         "a list of folder paths, or None"),
+        ("locked", locked, locked is None or _is_named_table(locked), "a dict joint name → value [rad or m], or None"),
+        ("xacro_args", xacro_args, xacro_args is None or _is_named_table(xacro_args),
+         "a dict argument name → value, or None"),
+        ("trust_xacro", trust_xacro, isinstance(trust_xacro, bool), "True or False"),
+    )
+    for name, value, ok, valid in checks:
+        if not ok:
+            raise OptionError(name, value, valid)
+
+
+def _is_path(value: Any) -> bool:
+    """A Path, or a string that names one (an empty string names nothing, though Path("") is the current folder)."""
+    return isinstance(value, Path) or _is_name(value)
+
+
+def _is_name(value: Any) -> bool:
+    return isinstance(value, str) and value.strip() != ""
+
+
+def _is_named_table(value: Any) -> bool:
+    return isinstance(value, dict) and all(isinstance(k, str) for k in value)
