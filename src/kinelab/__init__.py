@@ -28,11 +28,22 @@ from kinelab.lazy import loader
 # the robot (and with it Pinocchio) and the solvers load on first use (kinelab.lazy): ``kinelab --help`` and
 # ``kinelab robots`` need neither
 _LAZY = {
-    "load": ("kinelab.robot.model", "load"),
-    "Robot": ("kinelab.robot.model", "Robot"),
-    "Joint": ("kinelab.robot.model", "Joint"),
+    "load": ("kinelab.robot.load", "load"),
+    "Robot": ("kinelab.robot.tree", "Robot"),
+    "Chain": ("kinelab.robot.chain", "Chain"),
+    "Joint": ("kinelab.robot.joints", "Joint"),
     "robots": ("kinelab.robot.catalog", "names"),
-    "solve": ("kinelab.ik.api", "solve"),
+    "solve": ("kinelab.wholebody.api", "solve"),
+    "step": ("kinelab.wholebody.step", "step"),
+    "FrameTask": ("kinelab.wholebody.tasks", "FrameTask"),
+    "RelativeFrameTask": ("kinelab.wholebody.tasks", "RelativeFrameTask"),
+    "ComTask": ("kinelab.wholebody.tasks", "ComTask"),
+    "PostureTask": ("kinelab.wholebody.tasks", "PostureTask"),
+    "CouplingTask": ("kinelab.wholebody.tasks", "CouplingTask"),
+    "Limits": ("kinelab.wholebody.limits", "Limits"),
+    "StepOptions": ("kinelab.wholebody.step", "StepOptions"),
+    "StepResult": ("kinelab.wholebody.step", "StepResult"),
+    "WholeBodyResult": ("kinelab.wholebody.solve", "WholeBodyResult"),
     "solve_all": ("kinelab.ik.api", "solve_all"),
     "solve_all_batch": ("kinelab.ik.api", "solve_all_batch"),
     "BranchBatch": ("kinelab.ik.analytic.branches", "BranchBatch"),
@@ -68,7 +79,7 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
     from kinelab.collision.obstacles import Environment, Obstacle
     from kinelab.ik.analytic.branches import BranchBatch
     from kinelab.ik.analytic.sew import SEW, sew_angle
-    from kinelab.ik.api import solve, solve_all, solve_all_batch, solve_batch, track
+    from kinelab.ik.api import solve_all, solve_all_batch, solve_batch, track
     from kinelab.ik.batch import BatchIKResult
     from kinelab.ik.frdm.options import FRDMOptions
     from kinelab.ik.prepared import IK
@@ -85,16 +96,35 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
     from kinelab.ik.targets import from_xyz_rpy as target_from_xyz_rpy
     from kinelab.maps.batch import BatchSpec, solve_batch_on_cluster
     from kinelab.robot.catalog import names as robots
-    from kinelab.robot.model import Joint, Robot, load
+    from kinelab.robot.chain import Chain
+    from kinelab.robot.joints import Joint
+    from kinelab.robot.load import load
+    from kinelab.robot.tree import Robot
+    from kinelab.wholebody.api import solve
+    from kinelab.wholebody.limits import Limits
+    from kinelab.wholebody.solve import WholeBodyResult
+    from kinelab.wholebody.step import StepOptions, StepResult, step
+    from kinelab.wholebody.tasks import ComTask, CouplingTask, FrameTask, PostureTask, RelativeFrameTask
 
 
 __all__ = [
     "BatchIKResult",
+    "ComTask",
+    "CouplingTask",
+    "FrameTask",
+    "Limits",
+    "PostureTask",
+    "RelativeFrameTask",
+    "StepOptions",
+    "StepResult",
+    "WholeBodyResult",
+    "step",
     "BatchSpec",
     "BiquatDiagnostics",
     "BiquaternionError",
     "BranchBatch",
     "Branches",
+    "Chain",
     "ChainError",
     "Collisions",
     "ConfigurationError",

@@ -1,0 +1,82 @@
+"""The iterated differential step: Gauss–Newton on every task at once at dt = 1 s, within the position limits and
+a cap on each joint's change per iteration (what keeps the linearization honest far from the answer). The
+converged solve (:mod:`kinelab.wholebody.solve`) and FRDM's finish (:mod:`kinelab.wholebody.frdm`) run it.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from kinelab.ik import options as opt
+from kinelab.ik.result import Status
+from kinelab.robot.tree import Robot
+from kinelab.wholebody.limits import Limits
+from kinelab.wholebody.step import StepOptions, TaskError, _step
+from kinelab.wholebody.tasks import PostureTask, Task
+
+SOLVERS = ("step", "frdm")
+STALL = 1e-3  # a step that takes off less than this share of the error, ten times running, is a stall
+
+
+@dataclass(frozen=True)
+class SolveSettings:
+    """The solve's checked settings (see :func:`solve`)."""
+
+    solver: str = "step"
+    tol_pos: float = 1e-6
+    tol_rot: float = 1e-6
+    max_iterations: int = 100
+    max_restarts: int = 20
+    time_budget: float | None = 1.0
+    damping: float = 1e-12
+    max_step: float = 1.0  # [rad or m] the largest joint change of one iteration: keeps Gauss–Newton's linearization
+
+    def __post_init__(self) -> None:
+        """Check every field.
+
+        Raises:
+            OptionError: a field out of what it accepts (named).
+        """
+        opt.choice("solver", self.solver, SOLVERS)
+        for name in ("tol_pos", "tol_rot"):
+            opt.positive(name, getattr(self, name))
+        opt.positive("max_iterations", self.max_iterations, integer=True)
+        opt.positive("max_restarts", self.max_restarts, integer=True, zero=True)
+        opt.positive("time_budget", self.time_budget, allow_none=True)
+        opt.positive("damping", self.damping, zero=True)
+
+
+def posture_second(tasks: tuple[Task, ...]) -> tuple[Task, ...]:
+    """The tasks with every posture asked for second (priority 2): a converged solve meets the others exactly."""
+    return tuple(replace(t, priority=2) if isinstance(t, PostureTask) else t for t in tasks)
+
+
+def iterate(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, settings: SolveSettings, limits: Limits,
+             deadline: float) -> tuple[np.ndarray, int, Status]:
+    """The step at dt = 1 s, full gain, until the tasks are met, it stalls, or the iterations or time run out."""
+    options = StepOptions(damping=settings.damping)
+    limits = replace(limits, velocity=settings.max_step) if limits.velocity is None else limits
+    worst, still = math.inf, 0
+    for k in range(settings.max_iterations):
+        if time.perf_counter() > deadline:
+            return q, k, Status.TIME_BUDGET
+        result = _step(robot, q, tasks, 1.0, limits, options, None)
+        size = _size(result.errors, tasks, settings)
+        if size <= 1.0:
+            return q, k, Status.CONVERGED
+        still = still + 1 if size > worst * (1.0 - STALL) else 0
+        worst = min(worst, size)
+        if still >= 10 or not result.solved:
+            return q, k + 1, Status.STALLED
+        q = result.q
+    return q, settings.max_iterations, Status.MAX_ITERATIONS
+
+
+def _size(errors: tuple[TaskError, ...], tasks: tuple[Task, ...], settings: SolveSettings) -> float:
+    """The largest error in units of its tolerance (1: at tolerance), a posture left out."""
+    return max((max(e.position / settings.tol_pos, e.rotation / settings.tol_rot)
+                for e, t in zip(errors, tasks, strict=True) if not isinstance(t, PostureTask)), default=0.0)

@@ -1,0 +1,151 @@
+"""Limits a whole-body step holds exactly: joint positions, velocities, accelerations — bounds on the step's
+velocity v [nv], so that q ⊕ v·dt stays within every bounded joint's limits and |v| within the velocity limits.
+
+A start outside its position limits is brought back at the velocity limit (at once where there is none): the
+bounds of that joint are moved to ask for the return, never made infeasible; the step says which joints
+(``StepResult.returning``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from kinelab.errors import OptionError
+from kinelab.robot.space import LIMIT_SLACK, Space
+
+
+@dataclass(frozen=True)
+class Limits:
+    """What the step holds (all exactly, at every step).
+
+    Attributes:
+        position: hold each bounded joint within its position limits.
+        velocity: True: the file's velocity limits (where it gives them); False or None: none; a number: that
+            limit [rad/s or m/s] on every joint but a free-flyer's; (nv,) numbers: one per velocity.
+        acceleration: None (none), a number or (nv,) numbers [rad/s² or m/s²]: |v − v_prev| ≤ a·dt, where the
+            step is given the velocity before it.
+        collisions: None (no distance constraint). (Collision avoidance as a constraint of the step is not in this
+            version: the converged solve checks answers with ``collisions=`` instead.)
+    """
+
+    position: bool = True
+    velocity: Any = True
+    acceleration: Any = None
+    collisions: Any = None
+
+    def __post_init__(self) -> None:
+        """Check every field.
+
+        Raises:
+            OptionError: a field out of what it accepts (named).
+        """
+        if not isinstance(self.position, bool):
+            raise OptionError("position", self.position, "True or False")
+        for name in ("velocity", "acceleration"):
+            value = getattr(self, name)
+            if value is None or isinstance(value, bool):
+                continue
+            arr = np.asarray(value, dtype=float) if _numeric(value) else None
+            if arr is None or arr.ndim > 1 or not (np.all(arr > 0) and not np.any(np.isnan(arr))):
+                raise OptionError(name, value, "True, False, None, a number > 0 or one per velocity")
+        if self.acceleration is True:
+            raise OptionError("acceleration", True, "None, a number > 0 or one per velocity (no file gives them)")
+        if self.collisions is not None:
+            raise OptionError("collisions", self.collisions, "None (distance constraints are not in this version)")
+
+
+def _numeric(value: Any) -> bool:
+    try:
+        np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        return False
+    return True
+
+
+def velocity_bounds(limits: Limits, space: Space) -> np.ndarray:
+    """(nv,) the velocity limit of each velocity [rad/s or m/s] (inf where none).
+
+    Raises:
+        OptionError: per-velocity limits of another length.
+    """
+    given = limits.velocity
+    if given is True:
+        return space.velocity
+    if given is None or given is False:
+        return np.full(space.nv, np.inf)
+    arr = np.asarray(given, dtype=float)
+    if arr.ndim == 0:
+        out = np.full(space.nv, float(arr))
+        if space.floating:
+            out[:6] = np.inf
+        return out
+    if arr.shape != (space.nv,):
+        raise OptionError("velocity", given, f"a number, or nv = {space.nv} numbers")
+    return arr
+
+
+def acceleration_bounds(limits: Limits, space: Space) -> np.ndarray | None:
+    """(nv,) the acceleration limit of each velocity, or None.
+
+    Raises:
+        OptionError: per-velocity limits of another length.
+    """
+    given = limits.acceleration
+    if given is None or given is False:
+        return None
+    arr = np.asarray(given, dtype=float)
+    if arr.ndim == 0:
+        return np.full(space.nv, float(arr))
+    if arr.shape != (space.nv,):
+        raise OptionError("acceleration", given, f"a number, or nv = {space.nv} numbers")
+    return arr
+
+
+def bounds(space: Space, q: np.ndarray, dt: float, vmax: np.ndarray, position: bool, amax: np.ndarray | None,
+           v_prev: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(lower, upper) on v [nv] and the joints brought back into their limits (a bool per velocity).
+
+    Args:
+        space: the robot's joint space.
+        q: the configuration (Pinocchio's q).
+        dt: the step [s].
+        vmax: velocity limits (inf: none).
+        position: hold position limits.
+        amax: acceleration limits, or None.
+        v_prev: the velocity before the step (needed with amax).
+    """
+    lo, hi = -vmax.copy(), vmax.copy()
+    returning = np.zeros(space.nv, dtype=bool)
+    if position:
+        qb = q[space.bounded_q]
+        pl = (space.lower[space.bounded_q] - qb) / dt
+        pu = (space.upper[space.bounded_q] - qb) / dt
+        idx = np.flatnonzero(space.bounded_v)
+        vl, vu = lo[idx], hi[idx]
+        slack = LIMIT_SLACK / dt  # a joint at its limit to rounding is not outside it
+        below, above = pl > slack, pu < -slack  # outside its limits: only a return is allowed, at most at the limit
+        new_lo = np.where(below, np.minimum(pl, vu), np.maximum(pl, vl))
+        new_hi = np.where(above, np.maximum(pu, vl), np.minimum(pu, vu))
+        lo[idx], hi[idx] = new_lo, new_hi
+        returning[idx] = below | above
+    if amax is not None and v_prev is not None:
+        lo, hi = np.maximum(lo, v_prev - amax * dt), np.minimum(hi, v_prev + amax * dt)
+        crossed = lo > hi  # the acceleration cannot keep within the others: the position's bound wins
+        lo[crossed] = hi[crossed]
+    return lo, hi, returning
+
+
+def is_positive_time(dt: Any) -> float:
+    """``dt`` [s] as a float > 0.
+
+    Raises:
+        OptionError: anything else.
+    """
+    if isinstance(dt, bool) or not isinstance(dt, int | float | np.number) or not math.isfinite(float(dt)) \
+            or float(dt) <= 0:
+        raise OptionError("dt", dt, "a finite time > 0 [s]")
+    return float(dt)

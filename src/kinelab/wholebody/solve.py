@@ -1,0 +1,214 @@
+"""The converged whole-body solve: a configuration that meets every task at once, judged per task by Pinocchio.
+
+Two solvers. "step": the differential step iterated at dt = 1 s with full gain (a Gauss–Newton step of every task
+at once, within the position limits), the posture asked for second (in the null space of the rest, so that it
+never holds a task off its target). "frdm": FRDM carried to the tree (:mod:`kinelab.wholebody.frdm`). Either
+restarts from random configurations (the base left where the start has it) when it stalls, within the budget.
+
+A task is met when its error is within ``tol_pos`` [m] and ``tol_rot`` [rad] (a posture is a preference: never
+judged; a coupling within ``tol_pos``); the answer is a success when every task is met within the limits.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab.errors import ChainError, OptionError
+from kinelab.ik.result import Status
+from kinelab.robot.space import generator
+from kinelab.robot.tree import Robot
+from kinelab.wholebody import evaluate as ev
+from kinelab.wholebody.iterate import SolveSettings, iterate, posture_second
+from kinelab.wholebody.limits import Limits
+from kinelab.wholebody.tasks import (
+    ComTask,
+    CouplingTask,
+    FrameTask,
+    PostureTask,
+    RelativeFrameTask,
+    Task,
+    as_tasks,
+)
+
+
+@dataclass(frozen=True)
+class TaskVerdict:
+    """One task judged at the answer by Pinocchio: its errors [m, rad] and whether they are within tolerance."""
+
+    label: str
+    position_error: float
+    rotation_error: float
+    met: bool
+
+
+@dataclass(frozen=True)
+class WholeBodyResult:
+    """A converged solve's answer.
+
+    Attributes:
+        q: (nq,) the configuration (Pinocchio's q); success: every task met within the limits.
+        status: ``converged``, ``outside_limits``, ``stalled``, ``max_iterations`` or ``time_budget``.
+        tasks: each task's verdict (Pinocchio's FK and centre of mass), in the order given.
+        iterations: steps (or FRDM sweeps) in all; restarts: random restarts after the first start.
+        wall_time [s]; solver: "step" or "frdm"; judge: whose FK judged.
+    """
+
+    q: np.ndarray
+    success: bool
+    status: Status
+    tasks: tuple[TaskVerdict, ...]
+    iterations: int
+    restarts: int
+    wall_time: float
+    solver: str
+    judge: str = "Pinocchio FK"
+
+    @property
+    def message(self) -> str:
+        """The tasks not met, in words ("" when every one is)."""
+        return "; ".join(f"{t.label}: {t.position_error:.3g} m, {t.rotation_error:.3g} rad" for t in self.tasks
+                         if not t.met)
+
+
+def solve(robot: Robot, tasks: Any, *, q0: Any = None, solver: str = "step", seed: int | None = None,
+          tol_pos: float = 1e-6, tol_rot: float = 1e-6, max_iterations: int = 100, max_restarts: int = 20,
+          time_budget: float | None = 1.0, limits: Limits | None = None) -> WholeBodyResult:
+    """A configuration that meets every task (see the module's docstring).
+
+    Args:
+        robot: the whole robot.
+        tasks: a task or a list of them.
+        q0: the start (Pinocchio's q; None: the robot's neutral configuration).
+        solver: "step" (the iterated differential step) or "frdm" (FRDM on the tree).
+        seed: seed of the random restarts (None: fresh entropy).
+        tol_pos: position tolerance [m] of every task.
+        tol_rot: rotation tolerance [rad].
+        max_iterations: steps (or sweeps) per start.
+        max_restarts: random restarts after the first start.
+        time_budget: wall-clock budget [s] of the whole solve (None: none).
+        limits: the limits every step holds (default: the position limits; velocities mean nothing at dt = 1 s).
+
+    Returns:
+        The :class:`WholeBodyResult`, every task judged by Pinocchio.
+
+    Raises:
+        ChainError: not a whole robot. OptionError, TargetError, ConfigurationError, FrameNotFoundError,
+            JointNotFoundError: bad input, named.
+    """
+    if not isinstance(robot, Robot):
+        raise ChainError(f"a whole-body solve takes a whole robot (kinelab.load('talos')), got {type(robot).__name__}")
+    found = as_tasks(tasks)
+    settings = SolveSettings(solver, tol_pos, tol_rot, max_iterations, max_restarts, time_budget)
+    limits = Limits(velocity=None) if limits is None else limits
+    if not isinstance(limits, Limits):
+        raise OptionError("limits", limits, "a kinelab.Limits(...), or None")
+    start = robot.neutral() if q0 is None else robot.check_q(q0, what="q0")
+    for t in found:  # a bad frame or joint named before any work
+        _check_names(robot, t)
+    return _run(robot, found, start, settings, limits, seed)
+
+
+def _check_names(robot: Robot, task: Task) -> None:
+    if isinstance(task, FrameTask):
+        robot.frame_id(task.frame)
+    elif isinstance(task, RelativeFrameTask):
+        robot.frame_id(task.frame), robot.frame_id(task.root)
+    elif isinstance(task, CouplingTask):
+        ev.coupling_row(robot, task, robot.neutral(), 1.0)
+
+
+def _run(robot: Robot, tasks: tuple[Task, ...], start: np.ndarray, settings: SolveSettings, limits: Limits,
+         seed: int | None) -> WholeBodyResult:
+    """Starts until one meets every task, the restarts or the budget run out; the best answer is returned."""
+    t0 = time.perf_counter()
+    deadline = math.inf if settings.time_budget is None else t0 + settings.time_budget
+    rng = generator(seed)
+    ordered = posture_second(tasks)
+    best: tuple[float, np.ndarray, Status] | None = None
+    iterations, restarts = 0, 0
+    q = start
+    while True:
+        if settings.solver == "frdm":
+            from kinelab.wholebody.frdm import frdm_solve
+
+            q, used, status = frdm_solve(robot, tasks, q, settings, deadline)
+        else:
+            q, used, status = iterate(robot, ordered, q, settings, limits, deadline)
+        iterations += used
+        verdicts = judge(robot, tasks, q, settings.tol_pos, settings.tol_rot)
+        score = _score(verdicts)
+        if best is None or score < best[0]:
+            best = (score, q, status)
+        if all(v.met for v in verdicts) or restarts >= settings.max_restarts or time.perf_counter() > deadline:
+            break
+        restarts += 1
+        q = _restart(robot, start, rng)
+    _, q, status = best
+    verdicts = judge(robot, tasks, q, settings.tol_pos, settings.tol_rot)
+    met = all(v.met for v in verdicts)
+    within = robot.within_limits(q)
+    final = Status.CONVERGED if met and within else Status.OUTSIDE_LIMITS if met else status
+    return WholeBodyResult(q, met and within, final, verdicts, iterations, restarts, time.perf_counter() - t0,
+                           settings.solver)
+
+
+def _restart(robot: Robot, start: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """A random configuration with the start's free-flyer (the base stays where the tasks put it)."""
+    q = robot.random_q(rng)
+    if robot.floating:
+        q[:7] = start[:7]
+    return q
+
+
+def _score(verdicts: tuple[TaskVerdict, ...]) -> float:
+    return sum(v.position_error + v.rotation_error for v in verdicts if not v.met)
+
+
+def judge(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, tol_pos: float, tol_rot: float,
+          ) -> tuple[TaskVerdict, ...]:
+    """Each task's errors at q by Pinocchio's own FK (``framesForwardKinematics``) and centre of mass
+    (``centerOfMass``), and whether they are within tolerance (a posture is never judged: met)."""
+    model, data = robot.model, robot.model.createData()
+    pin.framesForwardKinematics(model, data, q)
+    com = pin.centerOfMass(model, data, q) if any(isinstance(t, ComTask) for t in tasks) else None
+    out = []
+    for task in tasks:
+        dp, dr = _judged_errors(robot, data, task, q, com)
+        met = isinstance(task, PostureTask) or (dp <= tol_pos and dr <= tol_rot)
+        out.append(TaskVerdict(task.label, dp, dr, met))
+    return tuple(out)
+
+
+def _judged_errors(robot: Robot, data: Any, task: Task, q: np.ndarray, com: np.ndarray | None,
+                   ) -> tuple[float, float]:
+    """(position [m], rotation [rad]) error of one task from Pinocchio's placements."""
+    if isinstance(task, FrameTask):
+        oMf = data.oMf[robot.frame_id(task.frame)]
+        return _frame_gap(oMf, task.target, task.task, "xyz".index(task.axis))
+    if isinstance(task, RelativeFrameTask):
+        rMf = data.oMf[robot.frame_id(task.root)].actInv(data.oMf[robot.frame_id(task.frame)])
+        return _frame_gap(rMf, task.target, "pose", 0)
+    if isinstance(task, ComTask):
+        assert com is not None
+        return float(np.linalg.norm((com - task.target)[list(task.index)])), 0.0
+    if isinstance(task, PostureTask):
+        return float(np.abs(ev.posture_error(robot, task, q)[ev.posture_mask(robot, task)]).max(initial=0.0)), 0.0
+    a, c = ev.coupling_row(robot, task, q, 1.0)
+    return abs(c), 0.0
+
+
+def _frame_gap(M: pin.SE3, target: pin.SE3, kind: str, axis: int) -> tuple[float, float]:
+    """(position, rotation) error of pose M against target for a frame task of ``kind``."""
+    dp = 0.0 if kind == "orientation" else float(np.linalg.norm(M.translation - target.translation))
+    if kind == "position":
+        return dp, 0.0
+    if kind == "axis":
+        u, v = M.rotation[:, axis], target.rotation[:, axis]
+        return dp, float(math.atan2(np.linalg.norm(np.cross(u, v)), float(u @ v)))
+    return dp, float(np.linalg.norm(pin.log3(M.rotation.T @ target.rotation)))

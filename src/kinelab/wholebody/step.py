@@ -1,0 +1,204 @@
+"""One differential whole-body step: the velocity v [nv] that best does every task in dt, within the limits.
+
+The step solves one QP (two with tasks of priority 2): minimize Σ w‖A v + gain·e/dt‖² over the tasks (each
+weighted row by row), plus the posture's pull and a small damping λ‖v‖², subject to the limits as bounds on v
+(:mod:`kinelab.wholebody.limits`) and the couplings as equalities. Tasks of priority 2 are solved second, with the
+priority-1 tasks' rates A₁v held at the first answer's (they act in its null space). The new configuration is
+q ⊕ v·dt through ``pin.integrate``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab.errors import ChainError, OptionError
+from kinelab.robot.tree import Robot
+from kinelab.wholebody import evaluate as ev
+from kinelab.wholebody import qp
+from kinelab.wholebody.limits import Limits, acceleration_bounds, bounds, is_positive_time, velocity_bounds
+from kinelab.wholebody.tasks import ComTask, CouplingTask, PostureTask, Task, as_tasks
+
+
+@dataclass(frozen=True)
+class StepOptions:
+    """How the step solves.
+
+    Attributes:
+        damping: λ, the weight of ‖v‖² (keeps the QP well posed at a singular configuration) [1/(rad/s)²].
+        solver: "daqp" (default) or "proxsuite".
+    """
+
+    damping: float = 1e-9
+    solver: str = "daqp"
+
+    def __post_init__(self) -> None:
+        """Check every field.
+
+        Raises:
+            OptionError: a field out of what it accepts.
+        """
+        if isinstance(self.damping, bool) or not isinstance(self.damping, int | float) \
+                or not math.isfinite(self.damping) or self.damping < 0:
+            raise OptionError("damping", self.damping, "a finite number ≥ 0")
+        if self.solver not in qp.SOLVERS:
+            raise OptionError("solver", self.solver, " or ".join(qp.SOLVERS))
+
+
+@dataclass(frozen=True)
+class TaskError:
+    """One task's error at a configuration: position [m] and rotation [rad] (0 where the task has none; a posture's
+    and a coupling's in ``position``, their largest joint gap [rad or m])."""
+
+    label: str
+    position: float
+    rotation: float
+
+
+@dataclass(frozen=True)
+class StepResult:
+    """A step's answer.
+
+    Attributes:
+        v: (nv,) the velocities [rad/s or m/s]; q: (nq,) the configuration after dt (Pinocchio's q).
+        status: the QP's status ("solved", "infeasible", ...); solved: it is solved (else v is zero and q unmoved).
+        errors: each task's error at the start of the step, in the order given.
+        returning: the joints outside their limits at the start, brought back at the velocity limit.
+        iterations: the QP's iterations (both levels).
+    """
+
+    v: np.ndarray
+    q: np.ndarray
+    status: str
+    solved: bool
+    errors: tuple[TaskError, ...]
+    returning: tuple[str, ...] = ()
+    iterations: int = 0
+    extra: dict[str, Any] = field(default_factory=dict, repr=False)
+
+
+DEFAULT_LIMITS = Limits()
+DEFAULT_OPTIONS = StepOptions()
+
+
+def step(robot: Robot, q: Any, tasks: Any, dt: float, *, limits: Limits = DEFAULT_LIMITS,
+         options: StepOptions = DEFAULT_OPTIONS, v_prev: Any = None) -> StepResult:
+    """One differential step of whole-body kinematics (see the module's docstring).
+
+    Args:
+        robot: the whole robot (:func:`kinelab.load`).
+        q: the configuration (Pinocchio's q, nq numbers); it may lie outside the limits (brought back).
+        tasks: a task or a list of them (:mod:`kinelab.wholebody.tasks`).
+        dt: the step [s].
+        limits: what the step holds (:class:`Limits`).
+        options: the QP's damping and solver (:class:`StepOptions`).
+        v_prev: the velocity before the step (nv), for acceleration limits.
+
+    Returns:
+        The :class:`StepResult`.
+
+    Raises:
+        ChainError: not a whole robot. ConfigurationError: a bad q. OptionError, TargetError: a bad task, limit or
+            option, named. FrameNotFoundError, JointNotFoundError: an unknown frame or joint.
+    """
+    if not isinstance(robot, Robot):
+        raise ChainError(f"step takes a whole robot (kinelab.load('talos'), or load(path, whole=True)), got "
+                         f"{type(robot).__name__}")
+    if not isinstance(limits, Limits):
+        raise OptionError("limits", limits, "a kinelab.Limits(...)")
+    if not isinstance(options, StepOptions):
+        raise OptionError("options", options, "a kinelab.StepOptions(...)")
+    q = robot.check_q(q)
+    found, dt = as_tasks(tasks), is_positive_time(dt)
+    prev = None if v_prev is None else np.asarray(v_prev, dtype=float)
+    return _step(robot, q, found, dt, limits, options, prev)
+
+
+def _step(robot: Robot, q: np.ndarray, tasks: tuple[Task, ...], dt: float, limits: Limits, options: StepOptions,
+          v_prev: np.ndarray | None) -> StepResult:
+    """:func:`step` once its arguments are checked."""
+    ev.forward(robot, q, com=any(isinstance(t, ComTask) for t in tasks))
+    levels, errors, eq = _levels(robot, q, tasks, dt)
+    vmax = velocity_bounds(limits, robot.space)
+    lower, upper, returning = bounds(robot.space, q, dt, vmax, limits.position,
+                                     acceleration_bounds(limits, robot.space), v_prev)
+    A_eq, b_eq = (np.array([a for a, _ in eq]), np.array([c for _, c in eq])) if eq else (None, None)
+    solution = _solve_level(levels[0], options, lower, upper, A_eq, b_eq)
+    iterations = solution.iterations
+    if solution.solved and len(levels) > 1:
+        A1 = np.vstack(levels[0].A) if levels[0].A else np.zeros((0, robot.nv))
+        A_eq2 = A1 if A_eq is None else np.vstack([A_eq, A1])
+        b_eq2 = A1 @ solution.v if b_eq is None else np.concatenate([b_eq, A1 @ solution.v])
+        second = _solve_level(levels[1], options, lower, upper, A_eq2, b_eq2)
+        iterations += second.iterations
+        solution = second if second.solved else solution
+    v = solution.v if solution.solved else np.zeros(robot.nv)
+    q_next = np.asarray(pin.integrate(robot.model, q, v * dt), dtype=float) if solution.solved else q.copy()
+    names = tuple(robot.space.names_v[i] for i in np.flatnonzero(returning))
+    return StepResult(v, q_next, solution.status, solution.solved, tuple(errors), names, iterations)
+
+
+def _levels(robot: Robot, q: np.ndarray, tasks: tuple[Task, ...], dt: float,
+            ) -> tuple[list[ev.Rows], list[TaskError], list[tuple[np.ndarray, float]]]:
+    """The rows of each priority level, each task's error, and the couplings' equalities."""
+    levels = [ev.Rows([], [], [], np.zeros(robot.nv), np.zeros(robot.nv)) for _ in range(2)]
+    errors: list[TaskError] = []
+    eq: list[tuple[np.ndarray, float]] = []
+    for task in tasks:
+        if isinstance(task, CouplingTask):
+            a, c = ev.coupling_row(robot, task, q, dt)
+            eq.append((a, c))
+            errors.append(TaskError(task.label, abs(c * dt), 0.0))  # |joint − ratio · leader − offset|
+            continue
+        rows = levels[task.priority - 1]
+        if isinstance(task, PostureTask):
+            e = ev.posture_error(robot, task, q)
+            mask = ev.posture_mask(robot, task)
+            rows.diag[mask] += task.weight
+            rows.target[mask] += task.weight * (-task.gain * e[mask] / dt)
+            errors.append(TaskError(task.label, float(np.abs(e[mask]).max(initial=0.0)), 0.0))
+            continue
+        A, e, w, gap = ev.task_rows(robot, task)
+        rows.A.append(A)
+        rows.b.append(-task.gain * e / dt)
+        rows.w.append(w)
+        errors.append(_error(task, e, gap))
+    used = [lv for lv in levels if lv.A or lv.diag.any()]
+    return used or levels[:1], errors, eq
+
+
+def _error(task: Task, e: np.ndarray, gap: np.ndarray | None) -> TaskError:
+    """A task's error in m and rad from its error vector: a pose's rotation is its log's angular part and its
+    position the gap's length (``gap``: the frame-to-target translation, the error's linear part elsewhere); an
+    axis's angle from the two unit axes' difference."""
+    lin = e[:3] if gap is None else gap
+    dp = math.hypot(*lin) if getattr(task, "task", "pose") != "orientation" else 0.0
+    if isinstance(task, ComTask):
+        return TaskError(task.label, math.hypot(*e), 0.0)
+    kind = getattr(task, "task", "pose")
+    if kind == "position":
+        return TaskError(task.label, dp, 0.0)
+    if kind == "axis":
+        return TaskError(task.label, dp, 2.0 * math.asin(min(1.0, math.hypot(*e[3:]) / 2.0)))
+    rot = e[3:] if kind == "pose" else e
+    return TaskError(task.label, dp, math.hypot(*rot))
+
+
+def _solve_level(rows: ev.Rows, options: StepOptions, lower: np.ndarray, upper: np.ndarray,
+                 A_eq: np.ndarray | None, b_eq: np.ndarray | None) -> qp.Solution:
+    """One level's QP: H = Σ Aᵀ W A + diag + λI, f = −Σ Aᵀ W b − target."""
+    nv = lower.shape[0]
+    H = np.diag(rows.diag + options.damping)
+    f = -rows.target.copy()
+    if rows.A:
+        A, b, w = np.vstack(rows.A), np.concatenate(rows.b), np.concatenate(rows.w)
+        WA = A * w[:, None]
+        H += A.T @ WA
+        f -= WA.T @ b
+    elif not rows.diag.any():
+        H += np.eye(nv) * max(options.damping, 1e-12)
+    return qp.solve(H, f, lower, upper, A_eq, b_eq, options.solver)

@@ -1,0 +1,312 @@
+"""Tasks of whole-body kinematics: frozen values, each asking one thing of the robot's configuration.
+
+Every task gives, at a configuration, its error ``e`` and a matrix ``A`` such that a velocity v [nv] changes the
+error at the rate ``A v`` (first order): the step asks ``A v = −gain · e / dt`` of every task, weighted, and the
+converged solve drives every ``e`` to zero. Units: errors in m and rad (posture: rad or m per joint), Jacobians per
+unit velocity. Frames are Pinocchio's; a target pose is ``oM*`` in the world frame (a RelativeFrameTask's in its
+root frame).
+
+- :class:`FrameTask`: a frame's pose, position, one axis (and the position), or orientation.
+- :class:`RelativeFrameTask`: a frame's pose in another frame (one hand in the other's).
+- :class:`ComTask`: the centre of mass (all three coordinates, or some: "xy" over the feet).
+- :class:`PostureTask`: a reference configuration (the joints not asked for elsewhere).
+- :class:`CouplingTask`: one joint a linear function of another (mimic joints, gears), held exactly.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab.errors import OptionError, TargetError
+
+FRAME_TASKS = ("pose", "position", "axis", "orientation")
+AXES = "xyz"
+
+
+def _weight(name: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float | np.number) or not math.isfinite(float(value)) \
+            or float(value) < 0:
+        raise OptionError(name, value, "a finite number ≥ 0")
+    return float(value)
+
+
+def _priority(value: Any) -> int:
+    if value not in (1, 2) or isinstance(value, bool):
+        raise OptionError("priority", value, "1 (first) or 2 (in the first's null space)")
+    return int(value)
+
+
+def _pose(value: Any, what: str) -> pin.SE3:
+    """A target pose: an SE3 or a 4 × 4 homogeneous matrix, finite, its rotation a rotation.
+
+    Raises:
+        TargetError: anything else (named).
+    """
+    if isinstance(value, pin.SE3):
+        H = value.homogeneous
+    else:
+        try:
+            H = np.asarray(value, dtype=float).reshape(4, 4)
+        except (TypeError, ValueError):
+            raise TargetError(f"{what} must be a pin.SE3 or a 4 × 4 homogeneous matrix, got {value!r}") from None
+    R = H[:3, :3]
+    if not np.isfinite(H).all() or abs(np.linalg.det(R) - 1.0) > 1e-6 or np.abs(R.T @ R - np.eye(3)).max() > 1e-6:
+        raise TargetError(f"{what} is not a finite pose with a proper rotation (orthonormal within 1e-6, det +1)")
+    return pin.SE3(R.copy(), H[:3, 3].copy())
+
+
+def _vector(value: Any, size: int, what: str) -> np.ndarray:
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise TargetError(f"{what} must be {size} numbers, got {value!r}") from None
+    if arr.shape != (size,) or not np.isfinite(arr).all():
+        raise TargetError(f"{what} must be {size} finite numbers, got shape {arr.shape}")
+    return arr
+
+
+@dataclass(frozen=True)
+class FrameTask:
+    """A frame's pose (or part of it) at a target, in the world frame.
+
+    Attributes:
+        frame: the frame's name.
+        target: oM* (``pin.SE3`` or 4 × 4); for task "position" three numbers [m] may stand for it.
+        task: "pose", "position", "axis" (the position and one axis of the frame along the target's same axis,
+            free to turn about it) or "orientation".
+        axis: the frame axis of task "axis": "x", "y" or "z".
+        weight: the weight of the position error [1/m]; orientation_weight: of the rotation error [1/rad] (None:
+            the same number).
+        gain: the share of the error the step asks to close in ``dt`` (1: all of it).
+        priority: 1, or 2 (in the null space of the priority-1 tasks).
+    """
+
+    frame: str
+    target: Any
+    task: str = "pose"
+    axis: str = "z"
+    weight: float = 1.0
+    orientation_weight: float | None = None
+    gain: float = 1.0
+    priority: int = 1
+
+    def __post_init__(self) -> None:
+        """Check every field.
+
+        Raises:
+            OptionError, TargetError: a field out of what it accepts (named).
+        """
+        if not isinstance(self.frame, str):
+            raise OptionError("frame", self.frame, "a frame name")
+        if self.task not in FRAME_TASKS:
+            raise OptionError("task", self.task, ", ".join(FRAME_TASKS))
+        if not isinstance(self.axis, str) or self.axis not in AXES:
+            raise OptionError("axis", self.axis, "'x', 'y' or 'z'")
+        target = self.target
+        if self.task == "position" and not isinstance(target, pin.SE3) and np.size(target) == 3:
+            target = pin.SE3(np.eye(3), _vector(target, 3, f"target of {self.frame!r}"))
+        object.__setattr__(self, "target", _pose(target, f"the target of frame {self.frame!r}"))
+        object.__setattr__(self, "weight", _weight("weight", self.weight))
+        ow = self.weight if self.orientation_weight is None else self.orientation_weight
+        object.__setattr__(self, "orientation_weight", _weight("orientation_weight", ow))
+        object.__setattr__(self, "gain", _weight("gain", self.gain))
+        object.__setattr__(self, "priority", _priority(self.priority))
+
+    @property
+    def rows(self) -> int:
+        """How many rows the task adds to the step's least squares."""
+        return {"pose": 6, "position": 3, "axis": 6, "orientation": 3}[self.task]
+
+    @property
+    def label(self) -> str:
+        """The task in words (results and messages)."""
+        return f"{self.task} of {self.frame}" + (f" ({self.axis} axis)" if self.task == "axis" else "")
+
+
+@dataclass(frozen=True)
+class RelativeFrameTask:
+    """A frame's pose in another frame (``root``) at a target: one hand held in the other's frame.
+
+    Attributes:
+        frame: the moving frame; root: the frame the target is in.
+        target: rootM* (``pin.SE3`` or 4 × 4).
+        weight, orientation_weight, gain, priority: as :class:`FrameTask`'s.
+    """
+
+    frame: str
+    root: str
+    target: Any
+    weight: float = 1.0
+    orientation_weight: float | None = None
+    gain: float = 1.0
+    priority: int = 1
+
+    def __post_init__(self) -> None:
+        """Check every field.
+
+        Raises:
+            OptionError, TargetError: a field out of what it accepts (named).
+        """
+        if not isinstance(self.frame, str) or not isinstance(self.root, str):
+            raise OptionError("frame", (self.frame, self.root), "two frame names")
+        object.__setattr__(self, "target", _pose(self.target, f"the target of {self.frame!r} in {self.root!r}"))
+        object.__setattr__(self, "weight", _weight("weight", self.weight))
+        ow = self.weight if self.orientation_weight is None else self.orientation_weight
+        object.__setattr__(self, "orientation_weight", _weight("orientation_weight", ow))
+        object.__setattr__(self, "gain", _weight("gain", self.gain))
+        object.__setattr__(self, "priority", _priority(self.priority))
+
+    rows = 6
+
+    @property
+    def label(self) -> str:
+        """The task in words."""
+        return f"pose of {self.frame} in {self.root}"
+
+
+@dataclass(frozen=True)
+class ComTask:
+    """The centre of mass at a target [m], world frame: all three coordinates, or those ``axes`` names.
+
+    Attributes:
+        target: three numbers [m] (the coordinates not in ``axes`` are read but not asked for).
+        axes: "xyz", or a part such as "xy" (the CoM over a point of the floor).
+        weight [1/m], gain, priority: as :class:`FrameTask`'s.
+    """
+
+    target: Any
+    axes: str = "xyz"
+    weight: float = 1.0
+    gain: float = 1.0
+    priority: int = 1
+    index: tuple[int, ...] = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        """Check every field.
+
+        Raises:
+            OptionError, TargetError: a field out of what it accepts (named).
+        """
+        object.__setattr__(self, "target", _vector(self.target, 3, "the centre of mass's target"))
+        if not isinstance(self.axes, str) or not self.axes or any(a not in AXES for a in self.axes) \
+                or len(set(self.axes)) != len(self.axes):
+            raise OptionError("axes", self.axes, "'xyz' or a part of it ('xy', 'z', ...)")
+        object.__setattr__(self, "index", tuple(AXES.index(a) for a in self.axes))
+        object.__setattr__(self, "weight", _weight("weight", self.weight))
+        object.__setattr__(self, "gain", _weight("gain", self.gain))
+        object.__setattr__(self, "priority", _priority(self.priority))
+
+    @property
+    def rows(self) -> int:
+        """How many rows the task adds."""
+        return len(self.index)
+
+    @property
+    def label(self) -> str:
+        """The task in words."""
+        return f"centre of mass ({self.axes})"
+
+
+@dataclass(frozen=True)
+class PostureTask:
+    """A reference configuration: every joint pulled toward ``q_ref`` (Pinocchio's q, nq numbers).
+
+    Attributes:
+        q_ref: the reference (None: the robot's neutral configuration, within its limits).
+        weight: [1/rad or 1/m] per joint; base: include the free-flyer's six velocities (default: not, the base is
+            placed by the other tasks).
+        gain, priority: as :class:`FrameTask`'s.
+    """
+
+    q_ref: Any = None
+    weight: float = 1e-3
+    base: bool = False
+    gain: float = 1.0
+    priority: int = 1
+
+    def __post_init__(self) -> None:
+        """Check every field.
+
+        Raises:
+            OptionError: a field out of what it accepts (named).
+        """
+        if self.q_ref is not None:
+            try:
+                arr = np.array(self.q_ref, dtype=float)
+            except (TypeError, ValueError):
+                raise OptionError("q_ref", self.q_ref, "nq numbers (Pinocchio's q), or None") from None
+            arr.flags.writeable = False
+            object.__setattr__(self, "q_ref", arr)
+        object.__setattr__(self, "weight", _weight("weight", self.weight))
+        if not isinstance(self.base, bool):
+            raise OptionError("base", self.base, "True or False")
+        object.__setattr__(self, "gain", _weight("gain", self.gain))
+        object.__setattr__(self, "priority", _priority(self.priority))
+
+    label = "posture"
+
+
+@dataclass(frozen=True)
+class CouplingTask:
+    """Joint ``joint`` held at ``ratio · leader + offset`` [rad or m], exactly (an equality of the step): a mimic
+    joint or a gear that the file does not declare.
+
+    Attributes:
+        joint, leader: 1-DoF joints' names; ratio: the factor; offset: [rad or m].
+    """
+
+    joint: str
+    leader: str
+    ratio: float = 1.0
+    offset: float = 0.0
+
+    def __post_init__(self) -> None:
+        """Check every field.
+
+        Raises:
+            OptionError: a field out of what it accepts (named).
+        """
+        if not isinstance(self.joint, str) or not isinstance(self.leader, str) or self.joint == self.leader:
+            raise OptionError("joint", (self.joint, self.leader), "two different joint names")
+        for name in ("ratio", "offset"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int | float | np.number) \
+                    or not math.isfinite(float(value)):
+                raise OptionError(name, value, "a finite number")
+            object.__setattr__(self, name, float(value))
+
+    priority = 0  # held exactly, above every weighted task
+    rows = 1
+
+    @property
+    def label(self) -> str:
+        """The task in words."""
+        return f"{self.joint} = {self.ratio:g} × {self.leader} + {self.offset:g}"
+
+
+Task = FrameTask | RelativeFrameTask | ComTask | PostureTask | CouplingTask
+TASK_TYPES = (FrameTask, RelativeFrameTask, ComTask, PostureTask, CouplingTask)
+
+
+def as_tasks(tasks: Any) -> tuple[Task, ...]:
+    """The tasks of a call: one task or a sequence of them.
+
+    Raises:
+        OptionError: anything else (named), or no task at all.
+    """
+    items = (tasks,) if isinstance(tasks, TASK_TYPES) else tasks
+    try:
+        found = tuple(items)
+    except TypeError:
+        raise OptionError("tasks", tasks, "a task (FrameTask, RelativeFrameTask, ComTask, PostureTask, CouplingTask) "
+                          "or a list of them") from None
+    bad = [t for t in found if not isinstance(t, TASK_TYPES)]
+    if bad or not found:
+        raise OptionError("tasks", bad[0] if bad else tasks, "FrameTask, RelativeFrameTask, ComTask, PostureTask or "
+                          "CouplingTask values (at least one)")
+    return found
