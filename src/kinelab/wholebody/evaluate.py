@@ -1,9 +1,10 @@
 """Each task's error and rate matrix at a configuration, from one Pinocchio pass (``computeJointJacobians``).
 
-A task gives ``(A, e)``: its error e (m, rad) and A with ``de/dt = A v`` to first order (v: nv velocities). The
-frame errors are Pinocchio's logarithms of the frame's pose against its target, in the frame (``log6``, ``log3``),
-with the Jacobian of the logarithm (``Jlog6``, ``Jlog3``), as Pinocchio's inverse-kinematics example writes them; a
-position error is the frame origin's offset in world axes, an axis error the difference of the two unit axes.
+A task gives ``(A, e)``: its error e (m, rad) and A with ``de/dt = A v`` to first order (v: nv velocities). A frame's
+pose error is its position's and its rotation's, apart: the frame origin's offset from the target's in world axes
+[m], and Pinocchio's logarithm of the rotation between them, in the frame's axes (``log3``), with the Jacobian of the
+logarithm (``Jlog3``) in A; an axis error is the difference of the two unit axes. A relative pose's error is the same
+in the root frame's axes.
 """
 
 from __future__ import annotations
@@ -56,8 +57,10 @@ def frame_rows(robot: Robot, task: FrameTask) -> Rowset:
     J = pin.getFrameJacobian(robot.model, robot.data, fid, LOCAL)
     wp, wo = task.weight, task.orientation_weight
     if task.task == "pose":
-        E = oMf.actInv(task.target)
-        return -pin.Jlog6(E.inverse()) @ J, pin.log6(E).vector, np.array([wp, wp, wp, wo, wo, wo]), E.translation
+        E_R = oMf.rotation.T @ task.target.rotation
+        A = np.vstack([oMf.rotation @ J[:3], -pin.Jlog3(E_R.T) @ J[3:]])
+        e = np.concatenate([oMf.translation - task.target.translation, pin.log3(E_R)])
+        return A, e, np.array([wp, wp, wp, wo, wo, wo]), None
     if task.task == "position":
         return oMf.rotation @ J[:3], oMf.translation - task.target.translation, np.full(3, wp), None
     if task.task == "orientation":
@@ -74,12 +77,15 @@ def relative_rows(robot: Robot, task: RelativeFrameTask) -> Rowset:
     """(A, e, per-row weight) of a relative frame task: the frame's body velocity less the root's, in the frame."""
     fid, rid = robot.frame_id(task.frame), robot.frame_id(task.root)
     oMf, oMr = robot.data.oMf[fid], robot.data.oMf[rid]
-    fMr = oMf.actInv(oMr)
-    E = fMr * task.target
-    J = pin.getFrameJacobian(robot.model, robot.data, fid, LOCAL) \
-        - fMr.action @ pin.getFrameJacobian(robot.model, robot.data, rid, LOCAL)
+    Jf = pin.getFrameJacobian(robot.model, robot.data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+    Jr = pin.getFrameJacobian(robot.model, robot.data, rid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+    Rr, Rf = oMr.rotation, oMf.rotation
+    gap = oMf.translation - oMr.translation
+    E_R = Rf.T @ Rr @ task.target.rotation
+    A = np.vstack([Rr.T @ (Jf[:3] - Jr[:3] + skew(gap) @ Jr[3:]), -pin.Jlog3(E_R.T) @ Rf.T @ (Jf[3:] - Jr[3:])])
+    e = np.concatenate([Rr.T @ gap - task.target.translation, pin.log3(E_R)])
     wp, wo = task.weight, task.orientation_weight
-    return -pin.Jlog6(E.inverse()) @ J, pin.log6(E).vector, np.array([wp, wp, wp, wo, wo, wo]), E.translation
+    return A, e, np.array([wp, wp, wp, wo, wo, wo]), None
 
 
 def com_rows(robot: Robot, task: ComTask) -> Rowset:
@@ -96,8 +102,8 @@ def posture_mask(robot: Robot, task: PostureTask) -> np.ndarray:
     return mask
 
 
-def posture_error(robot: Robot, task: PostureTask, q: np.ndarray) -> np.ndarray:
-    """q ⊖ q_ref (nv) [rad or m].
+def checked_ref(robot: Robot, task: PostureTask) -> np.ndarray:
+    """A posture's reference q (the robot's neutral one for None).
 
     Raises:
         ConfigurationError: a q_ref that is not a configuration of the robot.
@@ -106,7 +112,16 @@ def posture_error(robot: Robot, task: PostureTask, q: np.ndarray) -> np.ndarray:
     if q_ref.shape != (robot.nq,):
         raise ConfigurationError(f"PostureTask.q_ref must have nq = {robot.nq} numbers for {robot.name}, got "
                                  f"{q_ref.shape[0]}")
-    return np.asarray(pin.difference(robot.model, q_ref, q), dtype=float)
+    return q_ref
+
+
+def posture_error(robot: Robot, task: PostureTask, q: np.ndarray) -> np.ndarray:
+    """q ⊖ q_ref (nv) [rad or m].
+
+    Raises:
+        ConfigurationError: a q_ref that is not a configuration of the robot.
+    """
+    return np.asarray(pin.difference(robot.model, checked_ref(robot, task), q), dtype=float)
 
 
 def coupling_row(robot: Robot, task: CouplingTask, q: np.ndarray, dt: float) -> tuple[np.ndarray, float]:

@@ -10,7 +10,7 @@ q ⊕ v·dt through ``pin.integrate``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -21,7 +21,7 @@ from kinelab.robot.tree import Robot
 from kinelab.wholebody import evaluate as ev
 from kinelab.wholebody import qp
 from kinelab.wholebody.limits import Limits, acceleration_bounds, bounds, is_positive_time, velocity_bounds
-from kinelab.wholebody.tasks import ComTask, CouplingTask, PostureTask, Task, as_tasks
+from kinelab.wholebody.tasks import ComTask, CouplingTask, FrameTask, PostureTask, RelativeFrameTask, Task, as_tasks
 
 
 @dataclass(frozen=True)
@@ -33,7 +33,7 @@ class StepOptions:
         solver: "daqp" (default) or "proxsuite".
     """
 
-    damping: float = 1e-9
+    damping: float = 1e-6
     solver: str = "daqp"
 
     def __post_init__(self) -> None:
@@ -59,26 +59,44 @@ class TaskError:
     rotation: float
 
 
-@dataclass(frozen=True)
 class StepResult:
     """A step's answer.
 
     Attributes:
         v: (nv,) the velocities [rad/s or m/s]; q: (nq,) the configuration after dt (Pinocchio's q).
         status: the QP's status ("solved", "infeasible", ...); solved: it is solved (else v is zero and q unmoved).
-        errors: each task's error at the start of the step, in the order given.
+        errors: each task's error at the start of the step, in the order given (:class:`TaskError`).
         returning: the joints outside their limits at the start, brought back at the velocity limit.
         iterations: the QP's iterations (both levels).
     """
 
-    v: np.ndarray
-    q: np.ndarray
-    status: str
-    solved: bool
-    errors: tuple[TaskError, ...]
-    returning: tuple[str, ...] = ()
-    iterations: int = 0
-    extra: dict[str, Any] = field(default_factory=dict, repr=False)
+    __slots__ = ("v", "q", "status", "solved", "iterations", "_errors", "_labels", "_returning", "_names")
+
+    def __init__(self, v: np.ndarray, q: np.ndarray, status: str, solved: bool, errors: Any,
+                 returning: Any = (), iterations: int = 0, labels: tuple[str, ...] = (),
+                 names: tuple[str, ...] = ()):
+        """A step's answer (``errors``: TaskErrors, or an (ntasks, 2) array with ``labels``; ``returning``: joint
+        names, or a bool mask over the velocities with ``names``)."""
+        self.v, self.q, self.status, self.solved, self.iterations = v, q, status, solved, iterations
+        self._errors, self._labels, self._returning, self._names = errors, labels, returning, names
+
+    @property
+    def errors(self) -> tuple[TaskError, ...]:
+        """Each task's error at the start of the step, in the order given."""
+        if isinstance(self._errors, np.ndarray):
+            self._errors = tuple(TaskError(label, float(p), float(r))
+                                 for label, (p, r) in zip(self._labels, self._errors.tolist(), strict=True))
+        return tuple(self._errors)
+
+    @property
+    def returning(self) -> tuple[str, ...]:
+        """The joints outside their limits at the start, brought back at the velocity limit."""
+        if isinstance(self._returning, np.ndarray):
+            self._returning = tuple(self._names[i] for i in np.flatnonzero(self._returning))
+        return tuple(self._returning)
+
+    def __repr__(self) -> str:
+        return f"StepResult(status={self.status!r}, v={self.v!r}, q={self.q!r})"
 
 
 DEFAULT_LIMITS = Limits()
@@ -112,10 +130,107 @@ def step(robot: Robot, q: Any, tasks: Any, dt: float, *, limits: Limits = DEFAUL
         raise OptionError("limits", limits, "a kinelab.Limits(...)")
     if not isinstance(options, StepOptions):
         raise OptionError("options", options, "a kinelab.StepOptions(...)")
-    q = robot.check_q(q)
-    found, dt = as_tasks(tasks), is_positive_time(dt)
+    dt = is_positive_time(dt)
+    fast = _compiled(robot, q, tasks, dt, limits, options, v_prev)
+    if fast is not None:
+        return fast
+    q, found = robot.check_q(q), as_tasks(tasks)
     prev = None if v_prev is None else np.asarray(v_prev, dtype=float)
     return _step(robot, q, found, dt, limits, options, prev)
+
+
+MAX_PACKED = 32  # task structures kept per robot (a caller sweeping weights: the memory stays bounded)
+NO_LIMIT = np.empty(0)
+
+
+def _compiled(robot: Robot, q: Any, tasks: Any, dt: float, limits: Limits, options: StepOptions,
+              v_prev: Any) -> StepResult | None:
+    """The step in one compiled call (:mod:`kinelab.wholebody.compiled`), or None where that path does not serve (a
+    q or task list to check and name, another QP solver, a tree it does not take): the readable step then answers,
+    alike."""
+    packed = _packed(robot, tasks, options)
+    if packed is None:
+        return None
+    arr = q if type(q) is np.ndarray and q.dtype == np.float64 and q.flags.c_contiguous else None
+    if arr is None or arr.shape != (robot.nq,):
+        return None
+    vmax, amax = _velocity_limits(robot, limits)
+    prev = NO_LIMIT if v_prev is None else np.ascontiguousarray(v_prev, dtype=float)
+    if amax.size and prev.shape != (robot.nv,):
+        return None
+    q_out, v_out, errors = np.empty(robot.nq), np.empty(robot.nv), np.empty((len(packed.labels), 2))
+    returning = np.empty(robot.nv, dtype=np.uint8)
+    flag, iterations = packed.step.step(arr, dt, vmax, limits.position, amax, prev, options.damping, q_out, v_out,
+                                        errors, returning)
+    if flag == -100:  # not a configuration: the readable path names what is wrong
+        return None
+    return StepResult(v_out, q_out, "solved" if flag in (1, 2) else qp.DAQP_STATUS.get(flag, str(flag)),
+                      flag in (1, 2), errors, returning.view(bool), iterations, packed.labels, robot.space.names_v)
+
+
+def _velocity_limits(robot: Robot, limits: Limits) -> tuple[np.ndarray, np.ndarray]:
+    """(vmax, amax) of ``limits`` for the robot (amax empty: none), kept per limits object."""
+    table: dict[int, tuple[Limits, np.ndarray, np.ndarray]] = robot.derived("compiled limits", _new_table)
+    found = table.get(id(limits))
+    if found is None or found[0] is not limits:
+        if len(table) >= MAX_PACKED:
+            table.clear()
+        a = acceleration_bounds(limits, robot.space)
+        found = table[id(limits)] = (limits, np.ascontiguousarray(velocity_bounds(limits, robot.space), dtype=float),
+                                     NO_LIMIT if a is None else np.ascontiguousarray(a, dtype=float))
+    return found[1], found[2]
+
+
+def _new_table(_: Robot) -> dict[Any, Any]:
+    return {}
+
+
+def _packed(robot: Robot, tasks: Any, options: StepOptions) -> Any:
+    """The compiled problem of this task list with its targets set, or None (see :func:`_compiled`). The same task
+    objects as a call before take that call's problem as it is (tasks are frozen: their targets are those set)."""
+    from kinelab.wholebody import compiled as cp
+
+    if options.solver != "daqp" or not cp.daqp_linked():
+        return None
+    try:
+        ids = tuple(map(id, tasks))
+    except TypeError:
+        return None
+    recent: dict[tuple[int, ...], Any] = robot.derived("compiled recent", _new_table)
+    hit = recent.get(ids)
+    if hit is not None and hit[1].current == ids:
+        return hit[1]
+    found = as_tasks(tasks)
+    tree = robot.derived("compiled tree", cp.pack_tree)
+    key = None if tree is None else cp.structure(found)
+    if tree is None or key is None:
+        return None
+    table: dict[Any, Any] = robot.derived("compiled steps", _new_table)
+    packed = table.get(key)
+    if packed is None:
+        _check_names(robot, found)
+        if len(table) >= MAX_PACKED:
+            table.clear()
+        packed = table[key] = cp.pack(robot, tree, found)
+    cp.set_targets(robot, packed, found)
+    if len(recent) >= MAX_PACKED:
+        recent.clear()
+    recent[ids] = (found, packed)  # the task objects held: their ids stay theirs
+    packed.current = ids
+    return packed
+
+
+def _check_names(robot: Robot, tasks: tuple[Task, ...]) -> None:
+    """Name a bad frame or joint before a task list is packed."""
+    for t in tasks:
+        if isinstance(t, CouplingTask):
+            ev.coupling_row(robot, t, robot.neutral(), 1.0)
+        elif isinstance(t, FrameTask | RelativeFrameTask):
+            robot.frame_id(t.frame)
+            if isinstance(t, RelativeFrameTask):
+                robot.frame_id(t.root)
+        elif isinstance(t, PostureTask):
+            ev.checked_ref(robot, t)
 
 
 def _step(robot: Robot, q: np.ndarray, tasks: tuple[Task, ...], dt: float, limits: Limits, options: StepOptions,
@@ -130,9 +245,9 @@ def _step(robot: Robot, q: np.ndarray, tasks: tuple[Task, ...], dt: float, limit
     solution = _solve_level(levels[0], options, lower, upper, A_eq, b_eq)
     iterations = solution.iterations
     if solution.solved and len(levels) > 1:
-        A1 = np.vstack(levels[0].A) if levels[0].A else np.zeros((0, robot.nv))
-        A_eq2 = A1 if A_eq is None else np.vstack([A_eq, A1])
-        b_eq2 = A1 @ solution.v if b_eq is None else np.concatenate([b_eq, A1 @ solution.v])
+        held = np.vstack(levels[0].A) if levels[0].A else np.zeros((0, robot.nv))
+        A_eq2 = held if A_eq is None else np.vstack([A_eq, held])
+        b_eq2 = held @ solution.v if b_eq is None else np.concatenate([b_eq, held @ solution.v])
         second = _solve_level(levels[1], options, lower, upper, A_eq2, b_eq2)
         iterations += second.iterations
         solution = second if second.solved else solution

@@ -1,0 +1,223 @@
+"""The step's compiled path (:mod:`kinelab.core._body`): the robot's tree packed once and certified against
+Pinocchio, the tasks' structure packed once per structure, the targets set per call.
+
+A robot's tree serves only once certified: at CERTIFY_SAMPLES seeded configurations its joint placements, the
+Jacobians of every body frame, its centre of mass and Jacobian, and its integration equal Pinocchio's within
+CERTIFY_TOL; a tree with a joint of another kind (spherical, planar, ...) or a failed certificate is served by the
+readable step (:mod:`kinelab.wholebody.step`), which gives the same answers. DAQP's C interface is taken from the
+installed module (its version checked); another version, or none, leaves the readable path.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import importlib.metadata
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab.core import _body
+from kinelab.robot.tree import Robot
+from kinelab.wholebody.tasks import ComTask, CouplingTask, FrameTask, PostureTask, RelativeFrameTask, Task
+
+CERTIFY_SAMPLES = 20
+CERTIFY_TOL = 1e-10  # [m, rad] compiled against Pinocchio
+DAQP_VERSIONS = ("0.11.",)  # the C interface's layout these declarations match
+KINDS = {"pose": 0, "position": 1, "orientation": 2, "axis": 3}
+T_RELATIVE, T_COM = 4, 5
+REVOLUTE, PRISMATIC, CONTINUOUS, FREEFLYER, MIMIC_REVOLUTE, MIMIC_PRISMATIC = range(6)
+
+
+def daqp_linked() -> bool:
+    """True once DAQP's C functions are taken from the installed module (a supported version), else False."""
+    if _body.daqp_ready():
+        return True
+    try:
+        import daqp
+
+        if not importlib.metadata.version("daqp").startswith(DAQP_VERSIONS):
+            return False
+        lib = ctypes.CDLL(daqp.__file__)
+        quadprog = ctypes.cast(lib.daqp_quadprog, ctypes.c_void_p).value
+        defaults = ctypes.cast(lib.daqp_default_settings, ctypes.c_void_p).value
+    except (ImportError, OSError, AttributeError, importlib.metadata.PackageNotFoundError):
+        return False
+    if not quadprog or not defaults:
+        return False
+    _body.set_daqp(quadprog, defaults)
+    return True
+
+
+def _joint(model: pin.Model, jid: int) -> tuple[int, np.ndarray, float, float] | None:
+    """(kind, unit axis in the joint's frame, ratio, offset) of joint jid, or None for a kind not compiled."""
+    jm = model.joints[jid]
+    short = jm.shortname()
+    if short == "JointModelFreeFlyer":
+        return FREEFLYER, np.zeros(3), 1.0, 0.0
+    ratio, offset, mimic = 1.0, 0.0, short == "JointModelMimic"
+    if mimic:
+        inner = jm.extract()
+        ratio, offset = float(inner.scaling), float(inner.offset)
+    elif jm.nv != 1:
+        return None
+    data = jm.createData()
+    jm.calc(data, pin.neutral(model))
+    S = np.asarray(data.S, dtype=float).ravel() / (ratio if mimic and ratio else 1.0)
+    if not mimic and jm.nq == 2:
+        return CONTINUOUS, S[3:] / np.linalg.norm(S[3:]), 1.0, 0.0
+    prismatic = np.linalg.norm(S[3:]) < 0.5 * np.linalg.norm(S)
+    axis = S[:3] if prismatic else S[3:]
+    kind = (MIMIC_PRISMATIC if prismatic else MIMIC_REVOLUTE) if mimic else (PRISMATIC if prismatic else REVOLUTE)
+    return kind, axis / np.linalg.norm(axis), ratio, offset
+
+
+def _pose(M: pin.SE3) -> np.ndarray:
+    return np.concatenate([M.rotation.ravel(), M.translation])
+
+
+def pack_tree(robot: Robot) -> _body.Tree | None:
+    """The robot's tree for the compiled step, or None (a joint kind not compiled, or the certificate failed)."""
+    model = robot.model
+    nj = model.njoints - 1
+    parent, kind = np.zeros(nj + 1, dtype=np.intc), np.zeros(nj + 1, dtype=np.intc)
+    iq, iv = np.zeros(nj + 1, dtype=np.intc), np.zeros(nj + 1, dtype=np.intc)
+    ratio, offset, mass = np.ones(nj + 1), np.zeros(nj + 1), np.zeros(nj + 1)
+    place, axis, lever = np.zeros((nj + 1, 12)), np.zeros((nj + 1, 3)), np.zeros((nj + 1, 3))
+    for j in range(1, nj + 1):
+        found = _joint(model, j)
+        if found is None:
+            return None
+        kind[j], axis[j], ratio[j], offset[j] = found
+        parent[j], iq[j], iv[j] = model.parents[j], model.joints[j].idx_q, model.joints[j].idx_v
+        place[j] = _pose(model.jointPlacements[j])
+        mass[j], lever[j] = model.inertias[j].mass, model.inertias[j].lever
+    qlo, qhi = np.array(robot.lower, dtype=float), np.array(robot.upper, dtype=float)  # writable copies
+    tree = _body.Tree(parent, kind, iq, iv, ratio, offset, place, axis, mass, lever, model.nq, model.nv, qlo, qhi)
+    return tree if certified(robot, tree) else None
+
+
+def certified(robot: Robot, tree: _body.Tree) -> bool:
+    """The compiled tree's placements, body-frame Jacobians, centre of mass and integration equal Pinocchio's at
+    CERTIFY_SAMPLES seeded configurations (CERTIFY_TOL)."""
+    model, data = robot.model, robot.model.createData()
+    rng = np.random.default_rng(20261205)
+    bodies = [i for i, f in enumerate(model.frames) if f.type == pin.FrameType.BODY][:40]
+    for _ in range(CERTIFY_SAMPLES):
+        q, v = robot.random_q(rng), rng.normal(size=model.nv)
+        pin.computeJointJacobians(model, data, q)
+        pin.updateFramePlacements(model, data)
+        placed = tree.forward_placements(q)
+        worst = max(np.abs(placed[j] - _pose(data.oMi[j])).max() for j in range(1, model.njoints))
+        for fid in bodies:
+            f = model.frames[fid]
+            pose, J = tree.frame_jacobian(q, f.parentJoint, _pose(f.placement))
+            ref = pin.getFrameJacobian(model, data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+            worst = max(worst, np.abs(pose - _pose(data.oMf[fid])).max(), np.abs(J - ref).max())
+        if robot.mass > 0:
+            c, Jc = tree.center_of_mass(q)
+            worst = max(worst, np.abs(c - pin.centerOfMass(model, data, q)).max(),
+                        np.abs(Jc - pin.jacobianCenterOfMass(model, data, q)).max())
+        moved = tree.integrated(q, v, 0.01)
+        worst = max(worst, np.abs(pin.difference(model, pin.integrate(model, q, 0.01 * v), moved)).max())
+        if not worst <= CERTIFY_TOL:
+            return False
+    return True
+
+
+@dataclass
+class Packed:
+    """A task list's compiled problem: the Step and, per task, what to copy into it each call."""
+
+    step: _body.Step
+    targets: tuple[int, ...]  # indices of the tasks whose target is set per call (frames, relative, CoM)
+    posture: int  # index of the posture task, or -1
+    post_ref: np.ndarray  # the posture's reference, which the Step reads (written per call)
+    labels: tuple[str, ...]  # each task's label, in order
+    current: Any = None  # the ids of the task objects whose targets the Step holds
+
+
+def structure(tasks: tuple[Task, ...]) -> tuple[Any, ...] | None:
+    """The key of a task list's compiled problem (everything but the targets and the posture's reference), or None
+    where the compiled step does not take it (more than one posture, a posture on the free-flyer)."""
+    key: list[Any] = []
+    postures = 0
+    for t in tasks:
+        if isinstance(t, FrameTask):
+            key.append(("f", t.frame, t.task, t.axis, t.weight, t.orientation_weight, t.gain, t.priority))
+        elif isinstance(t, RelativeFrameTask):
+            key.append(("r", t.frame, t.root, t.weight, t.orientation_weight, t.gain, t.priority))
+        elif isinstance(t, ComTask):
+            key.append(("c", t.axes, t.weight, t.gain, t.priority))
+        elif isinstance(t, PostureTask):
+            postures += 1
+            if t.base or postures > 1:
+                return None
+            key.append(("p", t.weight, t.gain, t.priority))
+        else:
+            key.append(("k", t.joint, t.leader, t.ratio, t.offset))
+    return tuple(key)
+
+
+def pack(robot: Robot, tree: _body.Tree, tasks: tuple[Task, ...]) -> Packed:
+    """The compiled problem of a task list (see :func:`structure`)."""
+    weighted = [t for t in tasks if not isinstance(t, PostureTask | CouplingTask)]
+    n = len(weighted)
+    kind, joint, root = np.zeros(n, dtype=np.intc), np.zeros(n, dtype=np.intc), np.zeros(n, dtype=np.intc)
+    axis, priority = np.zeros(n, dtype=np.intc), np.ones(n, dtype=np.intc)
+    place, root_place = np.zeros((n, 12)), np.zeros((n, 12))
+    wp, wo, gain = np.zeros(n), np.zeros(n), np.zeros(n)
+    for k, t in enumerate(weighted):
+        priority[k], gain[k], wp[k] = t.priority, t.gain, t.weight
+        if isinstance(t, ComTask):
+            kind[k], axis[k] = T_COM, sum(1 << i for i in t.index)
+            continue
+        frame = robot.model.frames[robot.frame_id(t.frame)]
+        joint[k], place[k], wo[k] = frame.parentJoint, _pose(frame.placement), float(t.orientation_weight or 0.0)
+        if isinstance(t, RelativeFrameTask):
+            other = robot.model.frames[robot.frame_id(t.root)]
+            kind[k], root[k], root_place[k] = T_RELATIVE, other.parentJoint, _pose(other.placement)
+        else:
+            kind[k], axis[k] = KINDS[t.task], "xyz".index(t.axis)
+    post = next((t for t in tasks if isinstance(t, PostureTask)), None)
+    post_w = np.zeros(robot.nv)
+    if post is not None:
+        mask = np.ones(robot.nv, dtype=bool)
+        if robot.floating:
+            mask[:6] = False
+        post_w[mask] = post.weight
+    couplings = [t for t in tasks if isinstance(t, CouplingTask)]
+    ids = [[robot.model.joints[robot.model.getJointId(n)] for n in (c.joint, c.leader)] for c in couplings]
+    cq = np.array([a.idx_q for a, _ in ids], dtype=np.intc)
+    cv = np.array([a.idx_v for a, _ in ids], dtype=np.intc)
+    lq = np.array([b.idx_q for _, b in ids], dtype=np.intc)
+    lv = np.array([b.idx_v for _, b in ids], dtype=np.intc)
+    post_ref = robot.neutral()
+    targets = tuple(i for i, t in enumerate(tasks) if not isinstance(t, PostureTask | CouplingTask))
+    posture = next((i for i, t in enumerate(tasks) if isinstance(t, PostureTask)), -1)
+    cslot = np.array([i for i, t in enumerate(tasks) if isinstance(t, CouplingTask)], dtype=np.intc)
+    step = _body.Step(tree, kind, joint, root, axis, priority, place, root_place, wp, wo, gain, post_ref,
+                      post_w, 0.0 if post is None else post.gain, 0 if post is None else post.priority, cq, cv, lq, lv,
+                      np.array([c.ratio for c in couplings]), np.array([c.offset for c in couplings]),
+                      np.array(targets, dtype=np.intc), posture, cslot)
+    return Packed(step, targets, posture, post_ref, tuple(t.label for t in tasks))
+
+
+def set_targets(robot: Robot, packed: Packed, tasks: tuple[Task, ...]) -> None:
+    """Copy each task's target (and the posture's reference) into the packed problem."""
+    for k, i in enumerate(packed.targets):
+        packed.step.set_target(k, target_of(tasks[i]))
+    if packed.posture >= 0:
+        posture = tasks[packed.posture]
+        assert isinstance(posture, PostureTask)
+        packed.post_ref[:] = robot.neutral() if posture.q_ref is None else posture.q_ref
+
+
+def target_of(task: Task) -> np.ndarray:
+    """A task's target as the compiled step reads it: 12 numbers (R row-major, t), a CoM's in the last three."""
+    if isinstance(task, ComTask):
+        out = np.zeros(12)
+        out[9:] = task.target
+        return out
+    return _pose(task.target)  # type: ignore[union-attr]
