@@ -161,9 +161,8 @@ def test_the_compiled_step_gives_the_readable_steps_answer(name):
     q where v agrees."""
     import importlib
 
-    from kinelab.wholebody import RelativeFrameTask
+    from kinelab.wholebody import RelativeFrameTask, compiled
     from kinelab.wholebody import evaluate as ev
-    from kinelab.wholebody import compiled
 
     readable = importlib.import_module("kinelab.wholebody.step")._step
     robot = robot_of(name)
