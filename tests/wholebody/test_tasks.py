@@ -9,8 +9,8 @@ import kinelab
 from kinelab.wholebody import ComTask, FrameTask, PostureTask, RelativeFrameTask
 from kinelab.wholebody import evaluate as ev
 
-ROBOTS = {"talos": ("left_sole_link", "gripper_right_base_link"), "g1": ("left_ankle_roll_link", "right_wrist_yaw_link"),
-          "baxter": ("left_gripper", "right_gripper")}
+ROBOTS = {"talos": ("left_sole_link", "gripper_right_base_link"),
+          "g1": ("left_ankle_roll_link", "right_wrist_yaw_link"), "baxter": ("left_gripper", "right_gripper")}
 
 
 @pytest.fixture(scope="module", params=list(ROBOTS))
