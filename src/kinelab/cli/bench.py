@@ -57,6 +57,10 @@ def add(sub: Any) -> None:
     s.add_argument("--startup", action="store_true",
                    help="also how long --help, robots, fk, info and ik take from the shell against python -c "
                         "\"import pinocchio\" (best of --repeats + 4 rounds, interleaved)")
+    s.add_argument("--whole-body", action="store_true",
+                   help="instead of the arm protocol: the whole-body step side by side with pink and mink (--robots "
+                        "among panda, baxter, talos, g1; default all four), --repeats rounds, and the converged "
+                        "solve against pink iterated (--n targets per robot)")
     s.add_argument("--budgets", action="store_true",
                    help="also measure how every entry point with a budget keeps 5 ms (p50, p99, max per robot)")
     s.add_argument("--out", help="write bench.json, bench.md and bench.png here")
@@ -71,6 +75,8 @@ def run(args: argparse.Namespace) -> int:
 
     if args.out:
         check_output_folder(args.out, "bench")
+    if args.whole_body:
+        return _whole_body(args)
     first = _before_the_peers(args)
     result = bench.run(robots=args.robots, n=args.n, seed=args.seed, solvers=args.solvers,
                        budget=args.budget_ms / 1e3, progress=not args.json, repeats=args.repeats, start=args.start,
@@ -123,6 +129,23 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def _whole_body(args: argparse.Namespace) -> int:
+    """``--whole-body``: its protocol alone (its tables, JSON or files)."""
+    from kinelab.report import render
+    from kinelab.report.bench import runner, wholebody
+
+    result = runner.header()
+    result["whole_body"] = wholebody.run(args.robots, rounds=args.repeats, solves=args.n, seed=args.seed,
+                                         progress=not args.json)
+    if args.out:
+        render.write_bench(result, args.out)
+    if args.json:
+        print_json(result)
+    else:
+        print(wholebody.markdown(result["whole_body"]))
+    return 0
+
+
 def _before_the_peers(args: argparse.Namespace) -> dict[str, Any]:
     """The timings that run before the main bench: the peers' solver threads and caches would disturb them."""
     first: dict[str, Any] = {}
@@ -162,6 +185,11 @@ def _print_tables(result: dict[str, Any]) -> None:
 
         print()
         print(loops.budget_markdown(result["budgets"]))
+    if "whole_body" in result:
+        from kinelab.report.bench import wholebody
+
+        print()
+        print(wholebody.markdown(result["whole_body"]))
     if "versus" in result:
         from kinelab.report.bench import versus
 

@@ -120,7 +120,7 @@ def load_robot(args: argparse.Namespace) -> Chain:
 
     return load(args.robot, tool=args.tool, base=args.base, srdf=args.srdf, group=args.group,
                 package_dirs=args.package_dir, xacro_args=_pairs(args.xacro_arg, "--xacro-arg"),
-                trust_xacro=args.trust_xacro, locked=_locked(args.lock))
+                trust_xacro=args.trust_xacro, locked=_locked(args.lock), whole=False)
 
 
 def _pairs(items: list[str] | None, flag: str) -> dict[str, str] | None:

@@ -99,6 +99,7 @@ def set_daqp(size_t quadprog, size_t defaults):
     global _quadprog
     _quadprog = <quadprog_t> quadprog
     (<defaults_t> defaults)(&_settings)
+    _settings.presolve = 0  # a continuous QP: nothing for the mixed-integer presolve to do
 
 
 def daqp_ready():
@@ -564,6 +565,17 @@ cdef class Step:
     def set_target(self, int t, const double[::1] target):
         """Task t's target: a pose (12: R row-major, t) or a centre of mass (3, in the last three)."""
         memcpy(&self.target[t, 0], &target[0], target.shape[0] * sizeof(double))
+
+    def set_pose(self, int t, const double[:, ::1] H):
+        """Task t's target pose from its 4 × 4 homogeneous matrix."""
+        cdef int i
+        for i in range(3):
+            self.target[t, 3 * i], self.target[t, 3 * i + 1], self.target[t, 3 * i + 2] = H[i, 0], H[i, 1], H[i, 2]
+            self.target[t, 9 + i] = H[i, 3]
+
+    def set_point(self, int t, const double[::1] p):
+        """Task t's target point (a centre of mass) [m]."""
+        self.target[t, 9], self.target[t, 10], self.target[t, 11] = p[0], p[1], p[2]
 
     def step(self, const double[::1] q, double dt, const double[::1] vmax, bint position, const double[::1] amax,
              const double[::1] v_prev, double damping, double[::1] q_out, double[::1] v_out, double[:, ::1] errors,

@@ -146,7 +146,7 @@ def write_bench(result: dict[str, Any], out: str | Path) -> Path:
 
 def _write_bench_files(result: dict[str, Any], folder: Path) -> None:
     write_output(folder / "bench.json", json.dumps(result, indent=2))
-    sections = [bench_markdown(result)]
+    sections = [bench_markdown(result)] if "rows" in result else []
     if "scaling" in result:
         sections.append(scaling.markdown(result["scaling"]))
     if "tracking" in result:
@@ -156,10 +156,15 @@ def _write_bench_files(result: dict[str, Any], folder: Path) -> None:
                                        result["loops"]["budgets"]))
     if "budgets" in result:
         sections.append(loops.budget_markdown(result["budgets"]))
+    if "whole_body" in result:
+        from kinelab.report.bench import wholebody
+
+        sections.append(wholebody.markdown(result["whole_body"]))
     if "versus" in result:
         sections.append(versus.markdown(result["versus"]))
     write_output(folder / "bench.md", "\n\n".join(sections) + "\n")
-    bench_figure(result, folder / "bench.png")
+    if "rows" in result:
+        bench_figure(result, folder / "bench.png")
 
 
 def bench_figure(result: dict[str, Any], path: str | Path) -> None:

@@ -20,7 +20,7 @@ import pinocchio as pin
 
 from kinelab.core import _body
 from kinelab.robot.tree import Robot
-from kinelab.wholebody.tasks import ComTask, CouplingTask, FrameTask, PostureTask, RelativeFrameTask, Task
+from kinelab.wholebody.tasks import ComTask, CouplingTask, PostureTask, RelativeFrameTask, Task
 
 CERTIFY_SAMPLES = 20
 CERTIFY_TOL = 1e-10  # [m, rad] compiled against Pinocchio
@@ -139,25 +139,14 @@ class Packed:
 
 
 def structure(tasks: tuple[Task, ...]) -> tuple[Any, ...] | None:
-    """The key of a task list's compiled problem (everything but the targets and the posture's reference), or None
-    where the compiled step does not take it (more than one posture, a posture on the free-flyer)."""
-    key: list[Any] = []
-    postures = 0
-    for t in tasks:
-        if isinstance(t, FrameTask):
-            key.append(("f", t.frame, t.task, t.axis, t.weight, t.orientation_weight, t.gain, t.priority))
-        elif isinstance(t, RelativeFrameTask):
-            key.append(("r", t.frame, t.root, t.weight, t.orientation_weight, t.gain, t.priority))
-        elif isinstance(t, ComTask):
-            key.append(("c", t.axes, t.weight, t.gain, t.priority))
-        elif isinstance(t, PostureTask):
-            postures += 1
-            if t.base or postures > 1:
-                return None
-            key.append(("p", t.weight, t.gain, t.priority))
-        else:
-            key.append(("k", t.joint, t.leader, t.ratio, t.offset))
-    return tuple(key)
+    """The key of a task list's compiled problem (everything but the targets and the posture's reference: each
+    task's :meth:`shape`), or None where the compiled step does not take it (more than one posture, a posture on
+    the free-flyer)."""
+    key = tuple(t.shape() for t in tasks)
+    postures = [k for k in key if k[0] == "p"]
+    if len(postures) > 1 or any(k[-1] for k in postures):
+        return None
+    return key
 
 
 def pack(robot: Robot, tree: _body.Tree, tasks: tuple[Task, ...]) -> Packed:
@@ -206,8 +195,13 @@ def pack(robot: Robot, tree: _body.Tree, tasks: tuple[Task, ...]) -> Packed:
 
 def set_targets(robot: Robot, packed: Packed, tasks: tuple[Task, ...]) -> None:
     """Copy each task's target (and the posture's reference) into the packed problem."""
+    step = packed.step
     for k, i in enumerate(packed.targets):
-        packed.step.set_target(k, target_of(tasks[i]))
+        task = tasks[i]
+        if isinstance(task, ComTask):
+            step.set_point(k, task.target)
+        else:
+            step.set_pose(k, task.target.homogeneous)  # type: ignore[union-attr]
     if packed.posture >= 0:
         posture = tasks[packed.posture]
         assert isinstance(posture, PostureTask)

@@ -26,7 +26,7 @@ from kinelab.wholebody.iterate import SolveSettings, iterate, posture_second
 from kinelab.wholebody.limits import Limits
 from kinelab.wholebody.tasks import ComTask, CouplingTask, FrameTask, PostureTask, RelativeFrameTask, Task
 
-FALL = 1e-4  # a sweep that takes off less than this share of the weighted error ends the sweeps
+FALL = 0.2  # a sweep that takes off less than this share of the weighted error ends the sweeps
 HANDOVER = 1e-2  # [m or rad] below this error the Gauss–Newton finish takes over
 
 
@@ -40,46 +40,56 @@ class Points:
     t: np.ndarray
     w: np.ndarray
     direction: np.ndarray
+    carrier: np.ndarray  # the frame whose motion moves the target (a relative task's root), or -1: fixed
+    free: np.ndarray  # (n, 3): 1 where the target follows the point (a centre of mass's unconstrained coordinates)
 
 
 def task_points(robot: Robot, tasks: tuple[Task, ...], data: pin.Data, com: np.ndarray | None) -> Points:
     """Every task's points at the configuration in ``data`` (frame placements updated)."""
-    frame, p, t, w, direction = [], [], [], [], []
+    frame, p, t, w, direction, carrier, free = [], [], [], [], [], [], []
 
-    def add(fid: int, pos: np.ndarray, target: np.ndarray, weight: float, is_direction: bool) -> None:
+    def add(fid: int, pos: np.ndarray, target: np.ndarray, weight: float, is_direction: bool, by: int = -1,
+            follows: np.ndarray | None = None) -> None:
+        free.append(np.zeros(3) if follows is None else follows)
         frame.append(fid)
         p.append(pos)
         t.append(target)
         w.append(weight)
         direction.append(is_direction)
+        carrier.append(by)
 
     for task in tasks:
         if isinstance(task, FrameTask | RelativeFrameTask):
             fid = robot.frame_id(task.frame)
             oMf = data.oMf[fid]
-            target = task.target if isinstance(task, FrameTask) else data.oMf[robot.frame_id(task.root)] * task.target
+            by = -1 if isinstance(task, FrameTask) else robot.frame_id(task.root)
+            target = task.target if by < 0 else data.oMf[by] * task.target
             kind = task.task if isinstance(task, FrameTask) else "pose"
             if kind != "orientation":
-                add(fid, oMf.translation, target.translation, task.weight, False)
+                add(fid, oMf.translation, target.translation, task.weight, False, by)
             axes: list[int] = list(range(3)) if kind in ("pose", "orientation") else []
             if isinstance(task, FrameTask) and kind == "axis":
                 axes = ["xyz".index(task.axis)]
             for k in axes:
-                add(fid, oMf.rotation[:, k], target.rotation[:, k], 0.5 * float(task.orientation_weight or 0.0), True)
+                add(fid, oMf.rotation[:, k], target.rotation[:, k], 0.5 * float(task.orientation_weight or 0.0), True,
+                    by)
         elif isinstance(task, ComTask):
             assert com is not None
             goal = com.copy()
             goal[list(task.index)] = task.target[list(task.index)]  # free coordinates: their current values
-            add(-1, com, goal, task.weight, False)
-    return Points(np.array(frame, dtype=int), np.array(p).reshape(-1, 3), np.array(t).reshape(-1, 3),
-                  np.array(w, dtype=float), np.array(direction, dtype=bool))
+            follows = np.ones(3)
+            follows[list(task.index)] = 0.0
+            add(-1, com, goal, task.weight, False, follows=follows)
+    return Points(np.array(frame, dtype=int), np.array(p, dtype=float).reshape(-1, 3),
+                  np.array(t, dtype=float).reshape(-1, 3), np.array(w, dtype=float), np.array(direction, dtype=bool),
+                  np.array(carrier, dtype=int), np.array(free, dtype=float).reshape(-1, 3))
 
 
 def _rotation_angle(a: np.ndarray, b: np.ndarray, w: np.ndarray, u: np.ndarray) -> float:
     """θ maximizing Σ w bᵀR(u, θ)a: atan2(B, A) (a, b relative to a point of the axis, or directions)."""
     ua, ub = a @ u, b @ u
     A = float(w @ (np.einsum("ij,ij->i", a, b) - ua * ub))
-    B = float(w @ np.einsum("ij,ij->i", b, np.cross(u, a)))
+    B = float(w @ np.einsum("ij,ij->i", b, a @ pin.skew(u).T))
     return math.atan2(B, A) if A or B else 0.0
 
 
@@ -105,6 +115,7 @@ class TreeJoint:
     continuous: bool
     frames: np.ndarray  # frame ids in its subtree (bool mask over the model's frames)
     mass_share: float  # the subtree's share of the robot's mass
+    ancestors: tuple[int, ...]  # the joints above it, the universe (0) first
 
 
 def tree_joints(robot: Robot) -> list[TreeJoint]:
@@ -120,39 +131,103 @@ def tree_joints(robot: Robot) -> list[TreeJoint]:
         frames = np.array([f.parentJoint in below for f in model.frames], dtype=bool)
         share = sum(model.inertias[j].mass for j in below) / mass if mass > 0 else 0.0
         kind = joint.shortname()
-        out.append(TreeJoint(jid, joint.idx_q, joint.idx_v, "JointModelP" in kind, joint.nq == 2, frames, share))
+        above = tuple(int(j) for j in model.supports[jid] if j != jid)
+        out.append(TreeJoint(jid, joint.idx_q, joint.idx_v, "JointModelP" in kind, joint.nq == 2, frames, share,
+                             above))
     return out
 
 
 def sweep(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, joints: list[TreeJoint], data: pin.Data) -> None:
     """One sweep, tip to base, over the joints; then the free-flyer's optimal rigid motion (q changed in place)."""
-    model = robot.model
-    has_com = any(isinstance(t, ComTask) for t in tasks)
-    for joint in joints:
-        pin.framesForwardKinematics(model, data, q)
-        com = pin.centerOfMass(model, data, q) if has_com else None
-        points = task_points(robot, tasks, data, com)
-        mine = joint.frames[np.maximum(points.frame, 0)] & (points.frame >= 0)
-        com_rows = points.frame < 0
-        if not mine.any() and not (com_rows.any() and joint.mass_share > 0):
-            continue
-        _move_joint(robot, joint, q, data, points, mine, com_rows, com)
+    sweep_joints(robot, tasks, q, joints, data)
     if robot.floating:
-        pin.framesForwardKinematics(model, data, q)
-        com = pin.centerOfMass(model, data, q) if has_com else None
+        pin.framesForwardKinematics(robot.model, data, q)
+        has_com = any(isinstance(t, ComTask) for t in tasks)
+        com = pin.centerOfMass(robot.model, data, q) if has_com else None
         _move_base(robot, q, task_points(robot, tasks, data, com))
     _couple(robot, tasks, q)
 
 
-def _move_joint(robot: Robot, joint: TreeJoint, q: np.ndarray, data: pin.Data, points: Points, mine: np.ndarray,
-                com_rows: np.ndarray, com: np.ndarray | None) -> None:
-    """Joint ``joint``'s optimal finite rotation or displacement for the points it moves, within its limits."""
-    oMi = data.oMi[joint.jid]
-    u, o = oMi.rotation @ _axis(robot, joint), oMi.translation
+def sweep_joints(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, joints: list[TreeJoint],
+                 data: pin.Data) -> Points:
+    """The joints' turns of one sweep, tip to base (q changed in place).
+
+    One forward kinematics a sweep: a joint's placement depends on its ancestors alone, which turn after it, so
+    each turn moves only the task points (and subtree centres of mass) below it, updated here as rigid motions.
+
+    Returns:
+        The task points at the new q (as Pinocchio's FK there gives them).
+    """
+    model = robot.model
+    has_com = any(isinstance(t, ComTask) for t in tasks)
+    pin.framesForwardKinematics(model, data, q)
+    com = pin.centerOfMass(model, data, q) if has_com else None
+    points = task_points(robot, tasks, data, com)
+    coms = _subtree_coms(data) if has_com else np.zeros((0, 3))
+    masses = np.asarray(data.mass, dtype=float)
+    for joint in joints:
+        mine = (points.frame >= 0) & joint.frames[np.maximum(points.frame, 0)]
+        com_rows = points.frame < 0
+        if not mine.any() and not (com_rows.any() and joint.mass_share > 0):
+            continue
+        oMi = data.oMi[joint.jid]
+        u, o = oMi.rotation @ _axis(robot, joint), np.array(oMi.translation)
+        lever = joint.mass_share * (coms[joint.jid] - o) if has_com else np.zeros(3)
+        R, shift = _move_joint(robot, joint, q, u, o, points, mine, com_rows, lever)
+        _carry(points, joint, mine, R, o, shift)
+        if has_com:
+            _carry_masses(coms, masses, joint, points, R, o, shift)
+    return points
+
+
+def _subtree_coms(data: pin.Data) -> np.ndarray:
+    """Each joint's subtree centre of mass in the world frame [m] (Pinocchio keeps it in the joint's own frame)."""
+    return np.array([np.asarray(data.com[0], dtype=float)]
+                    + [np.asarray(data.oMi[i].act(data.com[i]), dtype=float) for i in range(1, len(data.com))])
+
+
+def _moved(x: np.ndarray, R: np.ndarray, o: np.ndarray, shift: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """Points (rows of x; directions only turned) after the rigid motion x → o + R (x − o) + shift."""
+    turned = (x - np.where(direction[:, None], 0.0, o)) @ R.T
+    return turned + np.where(direction[:, None], 0.0, o + shift)
+
+
+def _carry(points: Points, joint: TreeJoint, mine: np.ndarray, R: np.ndarray, o: np.ndarray,
+           shift: np.ndarray) -> None:
+    """The task points and targets the joint's subtree carries, moved with it."""
+    if mine.any():
+        points.p[mine] = _moved(points.p[mine], R, o, shift, points.direction[mine])
+    carried = (points.carrier >= 0) & joint.frames[np.maximum(points.carrier, 0)]
+    if carried.any():
+        points.t[carried] = _moved(points.t[carried], R, o, shift, points.direction[carried])
+
+
+def _carry_masses(coms: np.ndarray, masses: np.ndarray, joint: TreeJoint, points: Points, R: np.ndarray,
+                  o: np.ndarray, shift: np.ndarray) -> None:
+    """The subtree centres of mass above the joint, and the centre-of-mass points, after its motion."""
+    before = coms[joint.jid].copy()
+    coms[joint.jid] = o + R @ (before - o) + shift
+    for a in joint.ancestors:
+        if masses[a] > 0:
+            coms[a] += masses[joint.jid] / masses[a] * (coms[joint.jid] - before)
+    rows = points.frame < 0
+    if rows.any():
+        moved = coms[0] - points.p[rows]
+        points.p[rows] = coms[0]
+        points.t[rows] += moved * points.free[rows]
+
+
+def _move_joint(robot: Robot, joint: TreeJoint, q: np.ndarray, u: np.ndarray, o: np.ndarray, points: Points,
+                mine: np.ndarray, com_rows: np.ndarray, lever: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Joint ``joint``'s optimal finite rotation or displacement for the points it moves, within its limits
+    (q changed in place).
+
+    Returns:
+        (R, shift): the motion it gave its subtree, a turn R about the axis through o, then a shift [m].
+    """
     a, b, w, d = points.p[mine], points.t[mine], points.w[mine], points.direction[mine]
-    if com_rows.any() and com is not None and joint.mass_share > 0:
+    if com_rows.any() and joint.mass_share > 0:
         # the centre of mass moves as a point at o + share·(c_subtree − o) would (its target shifted alike)
-        lever = joint.mass_share * (np.asarray(data.com[joint.jid], dtype=float) - o)
         k = np.flatnonzero(com_rows)
         a = np.vstack([a, np.tile(lever + o, (len(k), 1))])
         b = np.vstack([b, points.t[k] - points.p[k] + lever + o])
@@ -162,8 +237,9 @@ def _move_joint(robot: Robot, joint: TreeJoint, q: np.ndarray, data: pin.Data, p
     if joint.prismatic:
         moved = ~d
         step = float(w[moved] @ ((b[moved] - a[moved]) @ u)) / float(w[moved].sum()) if moved.any() else 0.0
-        q[joint.iq] += min(max(step, lo), hi)
-        return
+        step = min(max(step, lo), hi)
+        q[joint.iq] += step
+        return np.eye(3), step * u
     rel_a = np.where(d[:, None], a, a - o)
     rel_b = np.where(d[:, None], b, b - o)
     theta = _rotation_angle(rel_a, rel_b, w, u)
@@ -173,6 +249,7 @@ def _move_joint(robot: Robot, joint: TreeJoint, q: np.ndarray, data: pin.Data, p
         q[joint.iq], q[joint.iq + 1] = math.cos(angle), math.sin(angle)
     else:
         q[joint.iq] += theta
+    return pin.exp3(theta * u), np.zeros(3)
 
 
 def _axis(robot: Robot, joint: TreeJoint) -> np.ndarray:

@@ -10,6 +10,7 @@ import time
 from dataclasses import dataclass, replace
 
 import numpy as np
+import pinocchio as pin
 
 from kinelab.ik import options as opt
 from kinelab.ik.result import Status
@@ -30,9 +31,9 @@ class SolveSettings:
     tol_pos: float = 1e-6
     tol_rot: float = 1e-6
     max_iterations: int = 100
-    max_restarts: int = 20
+    max_restarts: int = 200
     time_budget: float | None = 1.0
-    damping: float = 1e-12
+    damping: float = 1e-6
     max_step: float = 1.0  # [rad or m] the largest joint change of one iteration: keeps Gauss–Newton's linearization
 
     def __post_init__(self) -> None:
@@ -56,27 +57,46 @@ def posture_second(tasks: tuple[Task, ...]) -> tuple[Task, ...]:
 
 
 def iterate(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, settings: SolveSettings, limits: Limits,
-             deadline: float) -> tuple[np.ndarray, int, Status]:
-    """The step at dt = 1 s, full gain, until the tasks are met, it stalls, or the iterations or time run out."""
+            deadline: float) -> tuple[np.ndarray, int, Status]:
+    """The step at dt = 1 s, full gain, until the tasks are met, it stalls, or the iterations or time run out. A step
+    that does not lower the merit (Σ of every error squared, each in units of its tolerance) is cut in half along
+    the same direction from where it started: full Gauss–Newton steps circle a solution near a singularity."""
     options = StepOptions(damping=settings.damping)
     limits = replace(limits, velocity=settings.max_step) if limits.velocity is None else limits
-    worst, still = math.inf, 0
+    accepted: tuple[np.ndarray, np.ndarray, float] | None = None  # (q, its full step's q, merit)
+    share, still, best = 1.0, 0, math.inf
     for k in range(settings.max_iterations):
         if time.perf_counter() > deadline:
             return q, k, Status.TIME_BUDGET
         result = _step(robot, q, tasks, 1.0, limits, options, None)
-        size = _size(result.errors, tasks, settings)
+        size, merit = _size(result.errors, tasks, settings)
         if size <= 1.0:
             return q, k, Status.CONVERGED
-        still = still + 1 if size > worst * (1.0 - STALL) else 0
-        worst = min(worst, size)
-        if still >= 10 or not result.solved:
+        if not result.solved:
             return q, k + 1, Status.STALLED
+        if accepted is not None and merit > accepted[2] * (1.0 - 1e-4):
+            share /= 2.0  # worse than where it stood: a shorter step the same way
+            if share < 1e-3:
+                return accepted[0], k + 1, Status.STALLED
+            q = _toward(robot, accepted[0], accepted[1], share)
+            continue
+        still = still + 1 if merit > best * (1.0 - STALL) else 0
+        best = min(best, merit)
+        if still >= 10:
+            return q, k + 1, Status.STALLED
+        accepted, share = (q, result.q, merit), 1.0
         q = result.q
     return q, settings.max_iterations, Status.MAX_ITERATIONS
 
 
-def _size(errors: tuple[TaskError, ...], tasks: tuple[Task, ...], settings: SolveSettings) -> float:
-    """The largest error in units of its tolerance (1: at tolerance), a posture left out."""
-    return max((max(e.position / settings.tol_pos, e.rotation / settings.tol_rot)
-                for e, t in zip(errors, tasks, strict=True) if not isinstance(t, PostureTask)), default=0.0)
+def _toward(robot: Robot, q: np.ndarray, q_full: np.ndarray, share: float) -> np.ndarray:
+    """The configuration ``share`` of the way from ``q`` to ``q_full`` on the model's manifold."""
+    model = robot.model
+    return pin.integrate(model, q, share * pin.difference(model, q, q_full))
+
+
+def _size(errors: tuple[TaskError, ...], tasks: tuple[Task, ...], settings: SolveSettings) -> tuple[float, float]:
+    """(the largest error, the sum of the errors squared), each in units of its tolerance, a posture left out."""
+    scaled = [(e.position / settings.tol_pos, e.rotation / settings.tol_rot)
+              for e, t in zip(errors, tasks, strict=True) if not isinstance(t, PostureTask)]
+    return max((max(p, r) for p, r in scaled), default=0.0), sum(p * p + r * r for p, r in scaled)

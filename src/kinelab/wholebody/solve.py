@@ -77,7 +77,7 @@ class WholeBodyResult:
 
 
 def solve(robot: Robot, tasks: Any, *, q0: Any = None, solver: str = "step", seed: int | None = None,
-          tol_pos: float = 1e-6, tol_rot: float = 1e-6, max_iterations: int = 100, max_restarts: int = 20,
+          tol_pos: float = 1e-6, tol_rot: float = 1e-6, max_iterations: int = 100, max_restarts: int = 200,
           time_budget: float | None = 1.0, limits: Limits | None = None) -> WholeBodyResult:
     """A configuration that meets every task (see the module's docstring).
 

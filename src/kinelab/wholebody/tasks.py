@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from kinelab.core._verdict import pose_defect
 from kinelab.errors import OptionError, TargetError
 
 FRAME_TASKS = ("pose", "position", "axis", "orientation")
@@ -29,6 +30,8 @@ AXES = "xyz"
 
 
 def _weight(name: str, value: Any) -> float:
+    if type(value) is float and 0.0 <= value < math.inf:  # the usual call, checked at once
+        return value
     if isinstance(value, bool) or not isinstance(value, int | float | np.number) or not math.isfinite(float(value)) \
             or float(value) < 0:
         raise OptionError(name, value, "a finite number ≥ 0")
@@ -54,10 +57,10 @@ def _pose(value: Any, what: str) -> pin.SE3:
             H = np.asarray(value, dtype=float).reshape(4, 4)
         except (TypeError, ValueError):
             raise TargetError(f"{what} must be a pin.SE3 or a 4 × 4 homogeneous matrix, got {value!r}") from None
-    R = H[:3, :3]
-    if not np.isfinite(H).all() or abs(np.linalg.det(R) - 1.0) > 1e-6 or np.abs(R.T @ R - np.eye(3)).max() > 1e-6:
-        raise TargetError(f"{what} is not a finite pose with a proper rotation (orthonormal within 1e-6, det +1)")
-    return pin.SE3(R.copy(), H[:3, 3].copy())
+    if pose_defect(H):  # compiled: finite, orthonormal within 1e-6 with det +1, last row 0 0 0 1
+        raise TargetError(f"{what} is not a finite pose with a proper rotation (orthonormal within 1e-6, det +1, "
+                          "last row 0, 0, 0, 1)")
+    return pin.SE3(H)
 
 
 def _vector(value: Any, size: int, what: str) -> np.ndarray:
@@ -122,6 +125,27 @@ class FrameTask:
         """How many rows the task adds to the step's least squares."""
         return {"pose": 6, "position": 3, "axis": 6, "orientation": 3}[self.task]
 
+    def shape(self) -> tuple[Any, ...]:
+        """Everything but the target: what a compiled step is packed for (kept on the task)."""
+        found = self.__dict__.get("_shape")
+        if found is None:
+            found = self.__dict__["_shape"] = ("f", self.frame, self.task, self.axis, self.weight,
+                                               self.orientation_weight, self.gain, self.priority)
+        return found
+
+    def moved(self, target: Any) -> FrameTask:
+        """The same task at another target (checked), its other settings taken as they are: a path's samples.
+
+        Raises:
+            TargetError: a target that is not a pose (named).
+        """
+        made = object.__new__(FrameTask)
+        made.__dict__.update(self.__dict__)
+        if self.task == "position" and not isinstance(target, pin.SE3) and np.size(target) == 3:
+            target = pin.SE3(np.eye(3), _vector(target, 3, f"target of {self.frame!r}"))
+        made.__dict__["target"] = _pose(target, f"the target of frame {self.frame!r}")
+        return made
+
     @property
     def label(self) -> str:
         """The task in words (results and messages)."""
@@ -168,6 +192,10 @@ class RelativeFrameTask:
         """The task in words."""
         return f"pose of {self.frame} in {self.root}"
 
+    def shape(self) -> tuple[Any, ...]:
+        """Everything but the target: what a compiled step is packed for."""
+        return ("r", self.frame, self.root, self.weight, self.orientation_weight, self.gain, self.priority)
+
 
 @dataclass(frozen=True)
 class ComTask:
@@ -211,6 +239,10 @@ class ComTask:
         """The task in words."""
         return f"centre of mass ({self.axes})"
 
+    def shape(self) -> tuple[Any, ...]:
+        """Everything but the target: what a compiled step is packed for."""
+        return ("c", self.axes, self.weight, self.gain, self.priority)
+
 
 @dataclass(frozen=True)
 class PostureTask:
@@ -250,6 +282,10 @@ class PostureTask:
 
     label = "posture"
 
+    def shape(self) -> tuple[Any, ...]:
+        """Everything but the reference: what a compiled step is packed for (``base`` last)."""
+        return ("p", self.weight, self.gain, self.priority, self.base)
+
 
 @dataclass(frozen=True)
 class CouplingTask:
@@ -287,6 +323,10 @@ class CouplingTask:
     def label(self) -> str:
         """The task in words."""
         return f"{self.joint} = {self.ratio:g} × {self.leader} + {self.offset:g}"
+
+    def shape(self) -> tuple[Any, ...]:
+        """What a compiled step is packed for (the whole coupling)."""
+        return ("k", self.joint, self.leader, self.ratio, self.offset, False)
 
 
 Task = FrameTask | RelativeFrameTask | ComTask | PostureTask | CouplingTask

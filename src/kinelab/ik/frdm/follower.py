@@ -67,7 +67,7 @@ def follow(robot: Chain, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: 
                    np.ascontiguousarray(points, dtype=float), np.ascontiguousarray(rotations, dtype=float),
                    opts.settings(), order, int(max_sweeps), float(rest_weight), REST_SWEEPS, _centre(cm, q0),
                    CENTRE_PULL, LM_ITERATIONS if opts.polish else 0, seed_state(seed), deadline, codes, sweeps)
-    dp, dr, ok = _judged(robot, Q, points, rotations, task, tol_pos, tol_rot)
+    dp, dr, ok = judged_path(robot, Q, points, rotations, task, tol_pos, tol_rot)
     per_sample = (time.perf_counter() - t0) / count  # the kernel and Pinocchio's check of every answer
     return TrackResult(Q, dp, dr, _statuses(ok, codes), sweeps, np.full(count, per_sample), _stall_events(codes), [],
                        mode=opts.label + ("+lm" if opts.polish else "") + " (compiled follower)")
@@ -108,7 +108,7 @@ def _objective(cm: Any, opts: FRDMOptions, tol_pos: float, tol_rot: float) -> An
                             opts.mode != "orientation", opts.mode != "position", kernel.no_rest(cm.n), 0.0, -1)
 
 
-def _judged(robot: Chain, Q: np.ndarray, points: np.ndarray, rotations: np.ndarray, task: Task, tol_pos: float,
+def judged_path(robot: Chain, Q: np.ndarray, points: np.ndarray, rotations: np.ndarray, task: Task, tol_pos: float,
             tol_rot: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The judge's word on every sample the follower started (the others are NaN rows): position errors [m],
     rotation errors [rad], and whether the task's components are met within the limits. A joint past a limit by

@@ -148,7 +148,7 @@ def run(robots: list[str] | None = None, n: int = 200, seed: int = 0, solvers: l
         raise KinelabError(f"bench takes start in {STARTS}, schedule in {SCHEDULES} and 0 < sigma < 10 rad "
                            f"(got {start!r}, {schedule!r}, {sigma})")
     names = list(robots or DEFAULT_ROBOTS)
-    loaded = [load(name) for name in names]
+    loaded = [load(name, whole=False) for name in names]
     table, missing = available_solvers()
     if solvers:
         unknown = [s for s in solvers if s not in table]
@@ -162,16 +162,21 @@ def run(robots: list[str] | None = None, n: int = 200, seed: int = 0, solvers: l
         problems = cases(robot, n, seed, start, sigma, task)
         rows += run_robot(robot, table, problems, budget, seed, missing, repeats, schedule)
     return {
-        "date": time.strftime("%Y-%m-%d %H:%M:%S"),
-        "machine": {"platform": platform.platform(), "processor": platform.processor() or platform.machine(),
-                    "python": platform.python_version()},
-        "versions": _versions(),
+        **header(),
         "protocol": {"n": n, "seed": seed, "repeats": repeats, "budget_s": budget, "tol_pos_m": TOL_POS,
                      "tol_rot_rad": TOL_ROT, "start": start, "sigma": sigma if start == "warm" else None,
                      "schedule": schedule, "task": task},
         "rows": [asdict(r) for r in rows],
         "not_run": missing,
     }
+
+
+def header() -> dict[str, Any]:
+    """The date, the machine and the libraries' versions every bench result opens with."""
+    return {"date": time.strftime("%Y-%m-%d %H:%M:%S"),
+            "machine": {"platform": platform.platform(), "processor": platform.processor() or platform.machine(),
+                        "python": platform.python_version()},
+            "versions": _versions()}
 
 
 def _taking(table: dict[str, Prepare], task: str, missing: dict[str, str]) -> dict[str, Prepare]:

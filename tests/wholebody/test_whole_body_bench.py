@@ -1,0 +1,43 @@
+"""#59: ``kinelab bench --whole-body``. What it measures must be the same problem in the three libraries: MuJoCo's
+model compiled from the URDF places every task frame where Pinocchio does, the q maps go both ways, and kinelab's
+steps on the bench's moving targets hold the limits and track. Times are the bench's business, not a test's."""
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from kinelab import cli
+from kinelab.report.bench import wholebody as wb
+
+
+@pytest.mark.parametrize("name", ["panda", "talos"])
+def test_mujoco_places_every_task_frame_where_pinocchio_does(name):
+    mujoco = pytest.importorskip("mujoco")
+    scenario, robot = wb.SCENARIOS[name], wb.whole(wb.SCENARIOS[name].robot)
+    model = wb.mujoco_model(robot)
+    maps = wb.Maps(robot, model)
+    data = mujoco.MjData(model)
+    rng = np.random.default_rng(2)
+    for _ in range(5):
+        q = robot.random_q(rng)
+        assert np.abs(pin.difference(robot.model, q, maps.from_mujoco(maps.to_mujoco(q)))).max() <= 1e-12
+        data.qpos[:] = maps.to_mujoco(q)
+        mujoco.mj_kinematics(model, data)
+        frames = scenario.moving + scenario.held
+        for frame, oMf in zip(frames, robot.frame_placements(q, frames), strict=True):
+            body = model.body(frame).id
+            assert np.abs(data.xpos[body] - oMf.translation).max() <= 1e-9
+            assert np.abs(data.xmat[body].reshape(3, 3) - oMf.rotation).max() <= 1e-9
+
+
+def test_kinelab_follows_the_bench_targets_within_its_limits():
+    rows = wb.run_steps("panda", steps=60, rounds=1)
+    mine = next(r for r in rows if r["library"] == "kinelab")
+    assert mine["steps"] == 60 and mine["violations"] == 0
+    assert mine["max_tracking_error_m"] <= 2e-3  # a 5 cm circle in 2 s, followed at dt = 5 ms
+
+
+def test_a_robot_without_a_scenario_is_named_with_the_valid_ones(capsys):
+    code = cli.main(["bench", "--whole-body", "--robots", "ur5"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "'ur5'" in err[0] and "talos" in err[0]
