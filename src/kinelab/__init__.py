@@ -50,7 +50,7 @@ _LAZY = {
     "solve_batch": ("kinelab.ik.api", "solve_batch"),
     "solve_batch_on_cluster": ("kinelab.maps.batch", "solve_batch_on_cluster"),
     "BatchSpec": ("kinelab.maps.batch", "BatchSpec"),
-    "track": ("kinelab.ik.api", "track"),
+    "track": ("kinelab.wholebody.api", "track"),
     "BatchIKResult": ("kinelab.ik.batch", "BatchIKResult"),
     "Branches": ("kinelab.ik.result", "Branches"),
     "FRDMOptions": ("kinelab.ik.frdm.options", "FRDMOptions"),
@@ -79,7 +79,7 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
     from kinelab.collision.obstacles import Environment, Obstacle
     from kinelab.ik.analytic.branches import BranchBatch
     from kinelab.ik.analytic.sew import SEW, sew_angle
-    from kinelab.ik.api import solve_all, solve_all_batch, solve_batch, track
+    from kinelab.ik.api import solve_all, solve_all_batch, solve_batch
     from kinelab.ik.batch import BatchIKResult
     from kinelab.ik.frdm.options import FRDMOptions
     from kinelab.ik.prepared import IK
@@ -100,7 +100,7 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
     from kinelab.robot.joints import Joint
     from kinelab.robot.load import load
     from kinelab.robot.tree import Robot
-    from kinelab.wholebody.api import solve
+    from kinelab.wholebody.api import solve, track
     from kinelab.wholebody.limits import Limits
     from kinelab.wholebody.solve import WholeBodyResult
     from kinelab.wholebody.step import StepOptions, StepResult, step

@@ -4,27 +4,10 @@ path's own largest step) is an event in the result."""
 
 import numpy as np
 import pytest
+from helpers import cosine_path, joint_line
 
 import kinelab
 from kinelab.ik.result import Status
-
-
-def cosine_path(robot, rng, samples=2000, share=0.6):
-    """The issue's path: two random configurations pulled to ``share`` of every joint's range about its middle,
-    joined by a cosine blend."""
-    mid = (robot.lower + robot.upper) / 2
-    qa, qb = (mid + share * (rng.uniform(robot.lower, robot.upper) - mid) for _ in range(2))
-    s = (1 - np.cos(np.pi * np.linspace(0, 1, samples))) / 2
-    return qa + s[:, None] * (qb - qa)
-
-
-def joint_line(robot, rng, samples=400, step=0.025):
-    """A straight joint-space line of ``samples`` samples, no joint moving more than ``step`` between two."""
-    mid = (robot.lower + robot.upper) / 2
-    qa, qb = (mid + 0.6 * (rng.uniform(robot.lower, robot.upper) - mid) for _ in range(2))
-    d = qb - qa
-    d *= min(1.0, step * (samples - 1) / np.abs(d).max())
-    return qa + np.linspace(0, 1, samples)[:, None] * d
 
 
 def assert_jumps_are_not_successes(res, q0, jump_limit=0.2):

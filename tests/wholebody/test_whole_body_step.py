@@ -176,7 +176,9 @@ def test_the_compiled_step_gives_the_readable_steps_answer(name):
                  for f, T in zip(frames, placed, strict=True)]
         if len(frames) > 1:
             tasks.append(RelativeFrameTask(frames[0], frames[1], placed[1].inverse() * placed[0]))
-        tasks += [ComTask(robot.com(qt), axes="xy"), PostureTask(robot.random_q(rng), weight=1e-2, priority=1 + k % 2)]
+        weight = 1e-2 if k % 3 else rng.uniform(0.0, 1e-2, robot.nv)  # one weight, or one per velocity
+        tasks += [ComTask(robot.com(qt), axes="xy"), PostureTask(robot.random_q(rng), weight=weight,
+                                                                 priority=1 + k % 2)]
         fast = step(robot, q, tasks, 0.05)
         slow = readable(robot, q, tuple(tasks), 0.05, Limits(), StepOptions(), None)
         assert fast.solved and slow.solved
@@ -186,3 +188,21 @@ def test_the_compiled_step_gives_the_readable_steps_answer(name):
             assert np.abs(A @ (fast.v - slow.v)).max() <= 1e-6 * max(1.0, np.abs(A @ slow.v).max()), task.label
         for a, b in zip(fast.errors, slow.errors, strict=True):
             assert a.label == b.label and abs(a.position - b.position) <= 1e-12 and abs(a.rotation - b.rotation) <= 1e-9
+
+
+def test_a_posture_weighs_each_velocity_as_asked():
+    """Per-velocity weights: a joint weighted zero is not pulled, the others are, exactly as a QP with that diagonal
+    says: with nothing else asked, v = gain·(q_ref ⊖ q)/dt on the weighted joints and 0 on the others."""
+    panda = kinelab.load("panda").robot
+    q, q_ref = panda.random_q(1), panda.random_q(2)
+    weight = np.ones(panda.nv)
+    weight[[1, 4]] = 0.0
+    res = step(panda, q, PostureTask(q_ref, weight=weight), 1.0, limits=Limits(position=False, velocity=None),
+               options=StepOptions(damping=1e-12))
+    want = np.asarray(pin.difference(panda.model, q, q_ref))
+    want[[1, 4]] = 0.0
+    assert np.abs(res.v - want).max() <= 1e-6
+    with pytest.raises(kinelab.KinelabError, match="nv = "):
+        step(panda, q, PostureTask(q_ref, weight=np.ones(3)), 1.0)
+    with pytest.raises(kinelab.KinelabError, match="one per velocity"):
+        PostureTask(q_ref, weight=[1.0, -1.0])

@@ -1,18 +1,21 @@
-"""``kinelab.solve``: one entry point for a target and for tasks.
+"""``kinelab.solve`` and ``kinelab.track``: one entry point for a target and for tasks, one for a path.
 
 ``solve(chain, oMtarget, ...)`` places a chain's tool (:func:`kinelab.ik.api.solve`, every option of it);
 ``solve(robot, [tasks...], ...)`` meets several tasks on the whole tree (:func:`kinelab.wholebody.solve.solve`).
 A whole robot with a single target, or a chain with tasks, is answered by name with the way to ask.
+``track(chain, targets, ...)`` follows a path with FRDM's compiled follower (:func:`kinelab.ik.api.track`), or
+with ``follower="step"`` by the whole-body step (:func:`kinelab.wholebody.follow.track`).
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-from kinelab.errors import ChainError
+from kinelab.errors import ChainError, OptionError
 from kinelab.ik import api as chain_api
 from kinelab.robot.chain import Chain
 from kinelab.robot.tree import Robot
+from kinelab.wholebody import follow
 from kinelab.wholebody import solve as wholebody
 from kinelab.wholebody.tasks import TASK_TYPES
 
@@ -53,3 +56,37 @@ def solve(robot: Chain | Robot, target: Any, *positional: Any, **settings: Any) 
         raise ChainError(f"{robot.name} is a whole robot: ask for a frame with a task (kinelab.solve(robot, "
                          "[FrameTask(frame, oMtarget)])), or take a chain of it (robot.chain(base, tool))")
     return chain_api.solve(robot, target, *positional, **settings)
+
+
+FOLLOWERS = ("frdm", "step")
+STEP_SETTINGS = ("q0", "seed", "tol_pos", "tol_rot", "time_budget", "task", "axis", "jump_limit")
+
+
+def track(robot: Chain, targets: Any, *positional: Any, follower: str = "frdm", **settings: Any) -> Any:
+    """Follow a path: each target in turn, from the answer before.
+
+    Args:
+        robot: the chain.
+        targets: oMtarget per sample (a sequence of ``pin.SE3`` or an (N, 4, 4) array, base frame).
+        positional: nothing: every setting is keyword-only.
+        follower: "frdm" (FRDM's compiled follower and its monitored loop: every option of
+            :func:`kinelab.ik.api.track`) or "step" (the whole-body step: a posture and a box about each sample,
+            :func:`kinelab.wholebody.follow.track`, which takes the settings ``STEP_SETTINGS`` names).
+        settings: the follower's keywords.
+
+    Returns:
+        A :class:`~kinelab.ik.result.TrackResult`.
+
+    Raises:
+        OptionError: an unknown follower, or a setting the step follower does not take (the valid ones named).
+            Otherwise as the follower taken.
+    """
+    if follower not in FOLLOWERS:
+        raise OptionError("follower", follower, "'frdm' or 'step'")
+    if follower == "frdm":
+        return chain_api.track(robot, targets, *positional, **settings)
+    chain_api.check_entry(robot, "track", positional)
+    extra = [k for k in settings if k not in STEP_SETTINGS]
+    if extra:
+        raise OptionError(extra[0], settings[extra[0]], f"a setting of follower='step': {', '.join(STEP_SETTINGS)}")
+    return follow.track(robot, targets, **settings)

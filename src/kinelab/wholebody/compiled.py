@@ -20,6 +20,7 @@ import pinocchio as pin
 
 from kinelab.core import _body
 from kinelab.robot.tree import Robot
+from kinelab.wholebody import evaluate as ev
 from kinelab.wholebody.tasks import ComTask, CouplingTask, PostureTask, RelativeFrameTask, Task
 
 CERTIFY_SAMPLES = 20
@@ -134,6 +135,7 @@ class Packed:
     targets: tuple[int, ...]  # indices of the tasks whose target is set per call (frames, relative, CoM)
     posture: int  # index of the posture task, or -1
     post_ref: np.ndarray  # the posture's reference, which the Step reads (written per call)
+    post_w: np.ndarray  # the posture's weight per velocity, which the Step reads (written per call)
     labels: tuple[str, ...]  # each task's label, in order
     current: Any = None  # the ids of the task objects whose targets the Step holds
 
@@ -170,12 +172,7 @@ def pack(robot: Robot, tree: _body.Tree, tasks: tuple[Task, ...]) -> Packed:
         else:
             kind[k], axis[k] = KINDS[t.task], "xyz".index(t.axis)
     post = next((t for t in tasks if isinstance(t, PostureTask)), None)
-    post_w = np.zeros(robot.nv)
-    if post is not None:
-        mask = np.ones(robot.nv, dtype=bool)
-        if robot.floating:
-            mask[:6] = False
-        post_w[mask] = post.weight
+    post_w = np.zeros(robot.nv) if post is None else ev.posture_weight(robot, post)
     couplings = [t for t in tasks if isinstance(t, CouplingTask)]
     ids = [[robot.model.joints[robot.model.getJointId(n)] for n in (c.joint, c.leader)] for c in couplings]
     cq = np.array([a.idx_q for a, _ in ids], dtype=np.intc)
@@ -190,7 +187,7 @@ def pack(robot: Robot, tree: _body.Tree, tasks: tuple[Task, ...]) -> Packed:
                       post_w, 0.0 if post is None else post.gain, 0 if post is None else post.priority, cq, cv, lq, lv,
                       np.array([c.ratio for c in couplings]), np.array([c.offset for c in couplings]),
                       np.array(targets, dtype=np.intc), posture, cslot)
-    return Packed(step, targets, posture, post_ref, tuple(t.label for t in tasks))
+    return Packed(step, targets, posture, post_ref, post_w, tuple(t.label for t in tasks))
 
 
 def set_targets(robot: Robot, packed: Packed, tasks: tuple[Task, ...]) -> None:
@@ -206,6 +203,8 @@ def set_targets(robot: Robot, packed: Packed, tasks: tuple[Task, ...]) -> None:
         posture = tasks[packed.posture]
         assert isinstance(posture, PostureTask)
         packed.post_ref[:] = robot.neutral() if posture.q_ref is None else posture.q_ref
+        if isinstance(posture.weight, np.ndarray):
+            packed.post_w[:] = ev.posture_weight(robot, posture)
 
 
 def target_of(task: Task) -> np.ndarray:

@@ -102,6 +102,22 @@ def posture_mask(robot: Robot, task: PostureTask) -> np.ndarray:
     return mask
 
 
+def posture_weight(robot: Robot, task: PostureTask) -> np.ndarray:
+    """(nv,) the posture's weight per velocity (zero where it does not pull: a free-flyer's six unless ``base``).
+
+    Raises:
+        OptionError: per-velocity weights of another length than nv.
+    """
+    if isinstance(task.weight, np.ndarray):
+        if task.weight.shape != (robot.nv,):
+            raise OptionError("weight", task.weight, f"a number, or nv = {robot.nv} numbers for {robot.name}")
+        weight = task.weight.copy()
+    else:
+        weight = np.full(robot.nv, float(task.weight))
+    weight[~posture_mask(robot, task)] = 0.0
+    return weight
+
+
 def checked_ref(robot: Robot, task: PostureTask) -> np.ndarray:
     """A posture's reference q (the robot's neutral one for None).
 

@@ -21,7 +21,16 @@ from kinelab.robot.tree import Robot
 from kinelab.wholebody import evaluate as ev
 from kinelab.wholebody import qp
 from kinelab.wholebody.limits import Limits, acceleration_bounds, bounds, is_positive_time, velocity_bounds
-from kinelab.wholebody.tasks import ComTask, CouplingTask, FrameTask, PostureTask, RelativeFrameTask, Task, as_tasks
+from kinelab.wholebody.tasks import (
+    TASK_TYPES,
+    ComTask,
+    CouplingTask,
+    FrameTask,
+    PostureTask,
+    RelativeFrameTask,
+    Task,
+    as_tasks,
+)
 
 
 @dataclass(frozen=True)
@@ -192,6 +201,8 @@ def _packed(robot: Robot, tasks: Any, options: StepOptions) -> Any:
 
     if options.solver != "daqp" or not cp.daqp_linked():
         return None
+    if isinstance(tasks, TASK_TYPES):
+        tasks = (tasks,)
     try:
         ids = tuple(map(id, tasks))
     except TypeError:
@@ -231,6 +242,7 @@ def _check_names(robot: Robot, tasks: tuple[Task, ...]) -> None:
                 robot.frame_id(t.root)
         elif isinstance(t, PostureTask):
             ev.checked_ref(robot, t)
+            ev.posture_weight(robot, t)
 
 
 def _step(robot: Robot, q: np.ndarray, tasks: tuple[Task, ...], dt: float, limits: Limits, options: StepOptions,
@@ -272,10 +284,10 @@ def _levels(robot: Robot, q: np.ndarray, tasks: tuple[Task, ...], dt: float,
         rows = levels[task.priority - 1]
         if isinstance(task, PostureTask):
             e = ev.posture_error(robot, task, q)
-            mask = ev.posture_mask(robot, task)
-            rows.diag[mask] += task.weight
-            rows.target[mask] += task.weight * (-task.gain * e[mask] / dt)
-            errors.append(TaskError(task.label, float(np.abs(e[mask]).max(initial=0.0)), 0.0))
+            weight = ev.posture_weight(robot, task)
+            rows.diag += weight
+            rows.target += weight * (-task.gain * e / dt)
+            errors.append(TaskError(task.label, float(np.abs(e[weight > 0]).max(initial=0.0)), 0.0))  # what it pulls
             continue
         A, e, w, gap = ev.task_rows(robot, task)
         rows.A.append(A)

@@ -16,7 +16,7 @@ root frame).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -36,6 +36,20 @@ def _weight(name: str, value: Any) -> float:
             or float(value) < 0:
         raise OptionError(name, value, "a finite number ≥ 0")
     return float(value)
+
+
+def _weights(value: Any) -> float | np.ndarray:
+    """A posture's weight: one number, or one per velocity (a read-only array), each finite and ≥ 0."""
+    if isinstance(value, list | tuple | np.ndarray):
+        try:
+            arr = np.array(value, dtype=float)
+        except (TypeError, ValueError):
+            arr = np.array([np.nan])
+        if arr.ndim != 1 or not np.all(np.isfinite(arr)) or np.any(arr < 0):
+            raise OptionError("weight", value, "a finite number ≥ 0, or one per velocity (nv numbers ≥ 0)")
+        arr.flags.writeable = False
+        return arr
+    return _weight("weight", value)
 
 
 def _priority(value: Any) -> int:
@@ -250,13 +264,14 @@ class PostureTask:
 
     Attributes:
         q_ref: the reference (None: the robot's neutral configuration, within its limits).
-        weight: [1/rad or 1/m] per joint; base: include the free-flyer's six velocities (default: not, the base is
-            placed by the other tasks).
+        weight: [1/rad or 1/m] every joint's, or one per velocity (nv numbers ≥ 0; a free-flyer's six are read
+            only with ``base``); base: include the free-flyer's six velocities (default: not, the base is placed by
+            the other tasks).
         gain, priority: as :class:`FrameTask`'s.
     """
 
     q_ref: Any = None
-    weight: float = 1e-3
+    weight: Any = 1e-3
     base: bool = False
     gain: float = 1.0
     priority: int = 1
@@ -274,7 +289,7 @@ class PostureTask:
                 raise OptionError("q_ref", self.q_ref, "nq numbers (Pinocchio's q), or None") from None
             arr.flags.writeable = False
             object.__setattr__(self, "q_ref", arr)
-        object.__setattr__(self, "weight", _weight("weight", self.weight))
+        object.__setattr__(self, "weight", _weights(self.weight))
         if not isinstance(self.base, bool):
             raise OptionError("base", self.base, "True or False")
         object.__setattr__(self, "gain", _weight("gain", self.gain))
@@ -283,8 +298,19 @@ class PostureTask:
     label = "posture"
 
     def shape(self) -> tuple[Any, ...]:
-        """Everything but the reference: what a compiled step is packed for (``base`` last)."""
-        return ("p", self.weight, self.gain, self.priority, self.base)
+        """Everything but the reference and per-velocity weights: what a compiled step is packed for (``base``
+        last)."""
+        weight = ("per velocity", self.weight.size) if isinstance(self.weight, np.ndarray) else self.weight
+        return ("p", weight, self.gain, self.priority, self.base)
+
+    def moved(self, q_ref: Any, weight: Any = None) -> PostureTask:
+        """The same task toward another reference (and with other weights when given), checked: a follower's
+        samples.
+
+        Raises:
+            OptionError: a reference or weights that are not numbers.
+        """
+        return replace(self, q_ref=q_ref, weight=self.weight if weight is None else weight)
 
 
 @dataclass(frozen=True)
