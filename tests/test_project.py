@@ -123,3 +123,15 @@ def test_a_load_fk_robots_or_help_imports_no_solver_and_no_jit(script):
     done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-1000:]
     assert done.stdout.strip() == "", done.stdout
+
+
+def test_load_is_the_function_whichever_way_it_was_reached_first():
+    """``kinelab.load`` first, then ``from kinelab.robot import load``: while the module was named ``load`` too, the
+    second gave the module (a CLI command after a notebook cell: 'module' object is not callable)."""
+    import subprocess
+    import sys
+
+    code = ("import kinelab; kinelab.load; from kinelab.robot import load; import kinelab.robot as r; "
+            "assert callable(load) and callable(r.load), (load, r.load)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr

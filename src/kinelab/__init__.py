@@ -28,7 +28,7 @@ from kinelab.lazy import loader
 # the robot (and with it Pinocchio) and the solvers load on first use (kinelab.lazy): ``kinelab --help`` and
 # ``kinelab robots`` need neither
 _LAZY = {
-    "load": ("kinelab.robot.load", "load"),
+    "load": ("kinelab.robot.loading", "load"),
     "Robot": ("kinelab.robot.tree", "Robot"),
     "Chain": ("kinelab.robot.chain", "Chain"),
     "Joint": ("kinelab.robot.joints", "Joint"),
@@ -98,7 +98,7 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
     from kinelab.robot.catalog import names as robots
     from kinelab.robot.chain import Chain
     from kinelab.robot.joints import Joint
-    from kinelab.robot.load import load
+    from kinelab.robot.loading import load
     from kinelab.robot.tree import Robot
     from kinelab.wholebody.api import solve, track
     from kinelab.wholebody.limits import Limits

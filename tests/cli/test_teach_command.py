@@ -59,3 +59,28 @@ def test_user_errors_are_one_line_and_exit_2(capsys):
         code = cli.main(["teach", *argv])
         err = capsys.readouterr().err
         assert code == 2 and len(err.strip().splitlines()) == 1 and words in err, (argv, err)
+
+
+def test_a_whole_robot_s_page_is_served_with_a_target_per_hand():
+    proc, url, _ = start("baxter")
+    try:
+        with urllib.request.urlopen(url, timeout=60) as reply:
+            page = reply.read().decode("utf-8")
+        assert "<title>baxter · teach — kinelab</title>" in page and '"targets": ["target_0", "target_1"]' in page
+        with urllib.request.urlopen(url + "state?since=0", timeout=30) as reply:
+            hands = json.load(reply)["readout"]["hands"]
+        assert [h["frame"] for h in hands] == ["left_gripper", "right_gripper"]
+        assert all(h["position_error_m"] == 0.0 for h in hands)  # the targets start on the hands
+    finally:
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=30)
+    assert proc.returncode == 0 and "Traceback" not in err
+
+
+def test_a_whole_robot_s_page_refuses_a_chain_s_flags_by_name(capsys):
+    for argv, words in ((["talos", "--collisions"], "checks no collisions"),
+                        (["talos", "--hands", "no_such_frame"], "no_such_frame"),
+                        (["ur5", "--hands", "tool0", "--tool", "tool0"], "drop --tool")):
+        code = cli.main(["teach", *argv])
+        err = capsys.readouterr().err
+        assert code == 2 and len(err.strip().splitlines()) == 1 and words in err, (argv, err)

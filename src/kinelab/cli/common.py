@@ -119,11 +119,11 @@ def load_robot(args: argparse.Namespace) -> Chain:
     from kinelab.robot import load
 
     return load(args.robot, tool=args.tool, base=args.base, srdf=args.srdf, group=args.group,
-                package_dirs=args.package_dir, xacro_args=_pairs(args.xacro_arg, "--xacro-arg"),
+                package_dirs=args.package_dir, xacro_args=pairs(args.xacro_arg, "--xacro-arg"),
                 trust_xacro=args.trust_xacro, locked=_locked(args.lock), whole=False)
 
 
-def _pairs(items: list[str] | None, flag: str) -> dict[str, str] | None:
+def pairs(items: list[str] | None, flag: str) -> dict[str, str] | None:
     """NAME=VALUE flags as a dict (a flag without '=' is refused)."""
     if not items:
         return None
@@ -135,13 +135,13 @@ def _pairs(items: list[str] | None, flag: str) -> dict[str, str] | None:
 
 def _locked(items: list[str] | None) -> dict[str, float] | None:
     """--lock JOINT=VALUE flags as load()'s ``locked`` (rad or m)."""
-    pairs = _pairs(items, "--lock")
-    if pairs is None:
+    found = pairs(items, "--lock")
+    if found is None:
         return None
-    bad = [f"{name}={value}" for name, value in pairs.items() if not _is_number(value)]
+    bad = [f"{name}={value}" for name, value in found.items() if not _is_number(value)]
     if bad:
         raise KinelabError(f"--lock {bad[0]}: the value is not a number (rad or m)")
-    return {name: float(value) for name, value in pairs.items()}
+    return {name: float(value) for name, value in found.items()}
 
 
 def robot_arguments(s: argparse.ArgumentParser, q_help: str | None = None, limits: bool = True) -> None:

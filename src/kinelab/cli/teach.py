@@ -6,7 +6,7 @@ import argparse
 import sys
 from typing import Any
 
-from kinelab.cli.common import collision_arguments, collisions_of, load_robot, q_from_cli, robot_arguments
+from kinelab.cli.common import collision_arguments, collisions_of, load_robot, pairs, q_from_cli, robot_arguments
 from kinelab.errors import KinelabError
 from kinelab.progress import step
 
@@ -14,13 +14,18 @@ from kinelab.progress import step
 def add(sub: Any) -> None:
     """The ``teach`` subcommand."""
     s = sub.add_parser("teach", help="move a robot by hand in the browser: joint sliders, a target to drag that it "
-                                     "follows by IK, its branches, σ_min and the velocity ellipsoid (127.0.0.1)")
+                                     "follows by IK, its branches, σ_min and the velocity ellipsoid (127.0.0.1); a "
+                                     "whole robot (talos, g1, baxter, ...): a target per hand, its feet held")
     robot_arguments(s, "start configuration within the limits (default: the robot's reference configuration)",
                     limits=False)
     collision_arguments(s)
     s.add_argument("--port", type=int, default=0, help="port on 127.0.0.1 (default 0: a free one)")
-    s.add_argument("--time-budget", type=float, default=0.05,
-                   help="seconds one follow of the target may take (default 0.05)")
+    s.add_argument("--time-budget", type=float, default=None,
+                   help="seconds one follow of the target may take (default 0.05; a whole robot's 0.5)")
+    s.add_argument("--hands", nargs="+", metavar="FRAME",
+                   help="the whole robot's frames to drag (default: its registered hands; implies the whole robot)")
+    s.add_argument("--feet", nargs="*", metavar="FRAME",
+                   help="the whole robot's frames held where they stand (default: its registered feet)")
     s.add_argument("--open", action="store_true", help="open the page in the default browser")
     s.set_defaults(func=run_teach)
 
@@ -29,23 +34,16 @@ def run_teach(args: argparse.Namespace) -> int:
     """Serve the teach page until Ctrl-C (or SIGTERM)."""
     import signal
 
-    from kinelab.view.teach import TeachOptions, TeachServer, TeachSession
+    from kinelab.view.teach import TeachServer
 
     if not 0 <= args.port <= 65535:
         raise KinelabError(f"--port {args.port} is not a port: give 1–65535, or 0 for a free one")
-    if not 0 < args.time_budget <= 60:
+    if args.time_budget is not None and not 0 < args.time_budget <= 60:
         raise KinelabError(f"--time-budget {args.time_budget:g} s: give a time in (0, 60] s")
-    robot = load_robot(args)
-    q = q_from_cli(robot, args.q, args.deg) if args.q else None
-    spec = collisions_of(args)
-    options = TeachOptions(time_budget=args.time_budget, collisions=spec)  # None: the switch checks self-collisions
-    step(f"drawing {robot.name} (its meshes load)")
-    session = TeachSession(robot, q, options)
-    if spec is not None:
-        session.set_collisions(True)
+    session = _whole_session(args) if _wants_whole(args) else _chain_session(args)
     server = TeachServer(session, args.port)
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))  # so that the finally below frees the port
-    print(f"kinelab teach is serving {robot.name} on {server.url} (Ctrl-C to stop)", flush=True)
+    print(f"kinelab teach is serving {session.robot.name} on {server.url} (Ctrl-C to stop)", flush=True)
     print(f"  start: {session.start}", flush=True)
     if args.open:
         import webbrowser
@@ -58,3 +56,47 @@ def run_teach(args: argparse.Namespace) -> int:
     finally:
         server.close()
     return 0
+
+
+def _wants_whole(args: argparse.Namespace) -> bool:
+    """A whole robot's page: --hands or --feet given, or a registered whole robot named without a chain's flags."""
+    if args.hands is not None or args.feet is not None:
+        return True
+    from kinelab.robot import catalog
+
+    entry = catalog.ENTRIES.get(args.robot)
+    return bool(entry is not None and entry.whole and not (args.tool or args.base or args.group or args.lock))
+
+
+def _chain_session(args: argparse.Namespace) -> Any:
+    """A chain's page: its sliders, the target its tool follows, the collision switch."""
+    from kinelab.view.teach import TeachOptions, TeachSession
+
+    robot = load_robot(args)
+    q = q_from_cli(robot, args.q, args.deg) if args.q else None
+    spec = collisions_of(args)
+    options = TeachOptions(time_budget=args.time_budget or 0.05, collisions=spec)  # None: the switch checks self
+    step(f"drawing {robot.name} (its meshes load)")
+    session = TeachSession(robot, q, options)
+    if spec is not None:
+        session.set_collisions(True)
+    return session
+
+
+def _whole_session(args: argparse.Namespace) -> Any:
+    """A whole robot's page: a target per hand, the feet held."""
+    from kinelab.robot import load
+    from kinelab.view.teach import TeachOptions, WholeTeachSession
+
+    if args.q or args.collisions or args.obstacles is not None:
+        raise KinelabError("a whole robot's page starts standing and checks no collisions: drop Q, --collisions "
+                           "and --obstacles (or name a chain with --tool)")
+    if args.tool or args.base or args.group or args.lock:
+        raise KinelabError("--hands and --feet are a whole robot's: drop --tool, --base, --group and --lock")
+    robot = load(args.robot, whole=True, srdf=args.srdf, package_dirs=args.package_dir,
+                 xacro_args=pairs(args.xacro_arg, "--xacro-arg"), trust_xacro=args.trust_xacro)
+    step(f"drawing {robot.name} (its meshes load)")
+    options = TeachOptions(time_budget=args.time_budget or 0.5)
+    hands = None if args.hands is None else tuple(args.hands)
+    feet = None if args.feet is None else tuple(args.feet)
+    return WholeTeachSession(robot, None, options, hands, feet)

@@ -30,6 +30,8 @@ class Entry:
     display: tuple[float, ...] | None = None  # a well-conditioned pose to show [rad, m] (None: computed)
     whole: bool = False  # the name loads the whole robot (a humanoid, a two-armed robot, a quadruped), not a chain
     floating: bool = False  # the whole robot's base floats (a free-flyer at its root)
+    hands: tuple[str, ...] = ()  # a whole robot's frames a user moves first (teach's targets, the notebook's)
+    feet: tuple[str, ...] = ()  # a whole robot's frames that stand on the floor (held where they are)
 
     @property
     def chain(self) -> str:
@@ -99,27 +101,39 @@ ERD_ARMS = (
 )
 
 
-def _whole(name: str, relpath: str, description: str, srdf: str | None = None, floating: bool = True) -> Entry:
-    return Entry(name, "example-robot-data", relpath, None, description, srdf=srdf, whole=True, floating=floating)
+def _whole(name: str, relpath: str, description: str, srdf: str | None = None, floating: bool = True,
+           hands: tuple[str, ...] = (), feet: tuple[str, ...] = (), paws: tuple[str, ...] = ()) -> Entry:
+    """A whole robot's entry; a quadruped's ``paws``: its first moved (a hand), the other three on the floor."""
+    if paws:
+        hands, feet = paws[:1], paws[1:]
+    return Entry(name, "example-robot-data", relpath, None, description, srdf=srdf, whole=True, floating=floating,
+                 hands=hands, feet=feet)
 
 
 # the whole robots of example-robot-data: humanoids and quadrupeds on a free-flyer, two-armed robots on a fixed base
 ERD_WHOLE = (
     _whole("talos", "talos_data/robots/talos_reduced.urdf", "PAL TALOS humanoid, 32 joints (reduced: no fingers)",
-           "talos_data/srdf/talos.srdf"),
-    _whole("g1", "g1_description/urdf/g1_29dof_rev_1_0.urdf", "Unitree G1 humanoid, 29 joints"),
-    _whole("romeo", "romeo_description/urdf/romeo.urdf", "Aldebaran Romeo humanoid"),  # its SRDF: other joints
+           "talos_data/srdf/talos.srdf", hands=("gripper_left_base_link", "gripper_right_base_link"),
+           feet=("left_sole_link", "right_sole_link")),
+    _whole("g1", "g1_description/urdf/g1_29dof_rev_1_0.urdf", "Unitree G1 humanoid, 29 joints",
+           hands=("left_wrist_yaw_link", "right_wrist_yaw_link"),
+           feet=("left_ankle_roll_link", "right_ankle_roll_link")),
+    _whole("romeo", "romeo_description/urdf/romeo.urdf", "Aldebaran Romeo humanoid",  # its SRDF: other joints
+           hands=("LWristYawLink", "RWristYawLink"), feet=("l_sole", "r_sole")),
     _whole("icub", "icub_description/robots/icub_reduced.urdf", "iCub humanoid (reduced)",
-           "icub_description/srdf/icub.srdf"),
+           "icub_description/srdf/icub.srdf", hands=("l_hand", "r_hand"), feet=("l_sole", "r_sole")),
     _whole("baxter", "baxter_description/urdf/baxter.urdf", "Rethink Baxter, both arms and the head, fixed base",
-           floating=False),
+           floating=False, hands=("left_gripper", "right_gripper")),
     _whole("pr2", "pr2_description/urdf/pr2.urdf", "PR2, both arms, torso and head, fixed base",
-           "pr2_description/srdf/pr2.srdf", floating=False),
-    _whole("solo12", "solo_description/robots/solo12.urdf", "Solo-12 quadruped"),  # its SRDF names missing groups
+           "pr2_description/srdf/pr2.srdf", floating=False, hands=("l_gripper_tool_frame", "r_gripper_tool_frame")),
+    _whole("solo12", "solo_description/robots/solo12.urdf", "Solo-12 quadruped",  # its SRDF names missing groups
+           paws=("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")),
     _whole("anymal", "anymal_b_simple_description/robots/anymal.urdf", "ANYmal B quadruped",
-           "anymal_b_simple_description/srdf/anymal.srdf"),
-    _whole("go2", "go2_description/urdf/go2.urdf", "Unitree Go2 quadruped", "go2_description/srdf/go2.srdf"),
-    _whole("hyq", "hyq_description/robots/hyq_no_sensors.urdf", "IIT HyQ quadruped"),
+           "anymal_b_simple_description/srdf/anymal.srdf", paws=("LF_FOOT", "RF_FOOT", "LH_FOOT", "RH_FOOT")),
+    _whole("go2", "go2_description/urdf/go2.urdf", "Unitree Go2 quadruped", "go2_description/srdf/go2.srdf",
+           paws=("FL_foot", "FR_foot", "RL_foot", "RR_foot")),
+    _whole("hyq", "hyq_description/robots/hyq_no_sensors.urdf", "IIT HyQ quadruped",
+           paws=("lf_foot", "rf_foot", "lh_foot", "rh_foot")),
 )
 
 ENTRIES = {e.name: e for e in BUNDLED + ERD_ARMS + ERD_WHOLE}

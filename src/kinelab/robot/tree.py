@@ -64,6 +64,8 @@ class Robot:
         self._frames = {f.name: i for i, f in reversed(list(enumerate(model.frames)))}  # the first of a name wins
         self._bodies = {f.name: i for i, f in reversed(list(enumerate(model.frames))) if f.type == pin.FrameType.BODY}
         self._derived: dict[str, Any] = {}
+        self.hands: tuple[str, ...] = ()  # the frames a user moves first (a registered robot's; teach's targets)
+        self.feet: tuple[str, ...] = ()  # the frames standing on the floor (held where they are by teach)
 
     @overload
     @classmethod

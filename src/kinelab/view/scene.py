@@ -112,15 +112,8 @@ class Scene:
     def _aim(self, points: np.ndarray, fill: float = FILL) -> Scene:
         """Frame ``points`` (base frame): meshcat turns its camera about the viewer's origin, so the scene
         moves to put their centre there, the grid under the base, the camera at the framing distance."""
-        import meshcat.geometry as g
-
         self._framed = (points, fill)
-        view = frame_points(points, floor_z=0.0, margin=0.05 * self.robot.characteristic_length(), fill=fill)
-        self.viewer.set_transform(view.scene_shift())
-        self.viewer["/Grid"].set_property("visible", False)
-        self.viewer["floor"].set_object(g.LineSegments(g.PointsGeometry(view.floor_segments()),
-                                                       g.LineBasicMaterial(color=0x9A9A9A)))
-        self.viewer["/Cameras/default/rotated/<object>"].set_property("position", view.camera_position(self.aspect))
+        view = aim_camera(self.viewer, points, 0.05 * self.robot.characteristic_length(), fill, self.aspect)
         self.legend["floor"] = f"floor grid: {view.cell:g} m cells, at the base's height"
         return self
 
@@ -293,6 +286,26 @@ class Scene:
         if self.server is not None:
             self.server.stop()
 
+
+
+def aim_camera(viewer: Any, points: np.ndarray, margin: float, fill: float = FILL, aspect: float = PAGE_ASPECT,
+               floor_z: float = 0.0) -> Any:
+    """Frame ``points`` (rows [m], base frame) in a meshcat viewer: meshcat turns its camera about the viewer's
+    origin, so the scene moves to put their centre there, a floor grid at ``floor_z``, the camera at the framing
+    distance for a page of ``aspect`` (width / height).
+
+    Returns:
+        The :class:`~kinelab.view.framing.Framing` used (its ``cell``: the grid's cell [m]).
+    """
+    import meshcat.geometry as g
+
+    view = frame_points(points, floor_z=floor_z, margin=margin, fill=fill)
+    viewer.set_transform(view.scene_shift())
+    viewer["/Grid"].set_property("visible", False)
+    viewer["floor"].set_object(g.LineSegments(g.PointsGeometry(view.floor_segments()),
+                                              g.LineBasicMaterial(color=0x9A9A9A)))
+    viewer["/Cameras/default/rotated/<object>"].set_property("position", view.camera_position(aspect))
+    return view
 
 
 def side_by_side(robot: Chain, qs: list, spacing: float | None = None, viewer: Any = None,

@@ -1,5 +1,6 @@
 """``kinelab teach``: move a robot by hand in the browser — a slider per joint, a target to drag that the robot
-follows by IK, its branches, collisions, and the tool pose, σ_min, manipulability and velocity ellipsoid read live.
+follows by IK, its branches, collisions, and the tool pose, σ_min, manipulability and velocity ellipsoid read live;
+for a whole robot, a target per hand, its feet and centre of mass held (:mod:`kinelab.view.teach.whole`).
 
 The page is served on 127.0.0.1 only; in a notebook, :func:`teach` shows it in the cell.
 """
@@ -8,9 +9,12 @@ from __future__ import annotations
 
 from typing import Any
 
+from kinelab.errors import OptionError
 from kinelab.robot import Chain
+from kinelab.robot.tree import Robot
 from kinelab.view.teach.server import TeachServer
 from kinelab.view.teach.session import TeachOptions, TeachSession
+from kinelab.view.teach.whole import WholeTeachSession
 
 
 class Teach:
@@ -21,8 +25,15 @@ class Teach:
     ``teach.close()`` stops the server.
     """
 
-    def __init__(self, robot: Chain, q: Any = None, options: TeachOptions | None = None, port: int = 0):
-        self.session = TeachSession(robot, q, options)
+    def __init__(self, robot: Chain | Robot, q: Any = None, options: TeachOptions | None = None, port: int = 0,
+                 hands: tuple[str, ...] | None = None, feet: tuple[str, ...] | None = None):
+        self.session: TeachSession | WholeTeachSession
+        if isinstance(robot, Robot):
+            self.session = WholeTeachSession(robot, q, options, hands, feet)
+        else:
+            if hands is not None or feet is not None:
+                raise OptionError("hands", hands, "None for a chain (its target is its tool's)")
+            self.session = TeachSession(robot, q, options)
         self.server = TeachServer(self.session, port).start()
 
     @property
@@ -45,14 +56,18 @@ class Teach:
         self.close()
 
 
-def teach(robot: Chain, q: Any = None, options: TeachOptions | None = None, port: int = 0) -> Teach:
+def teach(robot: Chain | Robot, q: Any = None, options: TeachOptions | None = None, port: int = 0,
+          hands: tuple[str, ...] | None = None, feet: tuple[str, ...] | None = None) -> Teach:
     """Serve a teach page for ``robot`` on 127.0.0.1 in the background and return it (shown in a notebook cell).
 
     Args:
-        robot: the robot (:func:`kinelab.load`).
-        q: the start [rad or m], within the limits (default: the robot's reference configuration).
+        robot: a chain or a whole robot (:func:`kinelab.load`).
+        q: the start [rad or m], within the limits (default: the robot's reference configuration; a whole
+            robot's SRDF "half_sitting", its feet on the floor).
         options: how the target is followed (:class:`TeachOptions`).
         port: the port (0: a free one).
+        hands: a whole robot's frames to drag (default: its registered hands).
+        feet: a whole robot's frames held where they stand (default: its registered feet).
 
     Returns:
         The :class:`Teach` page (``url``, ``session``, ``close``).
@@ -61,7 +76,7 @@ def teach(robot: Chain, q: Any = None, options: TeachOptions | None = None, port
         ConfigurationError: q of the wrong length, not finite or outside the limits.
         KinelabError: the port is taken.
     """
-    return Teach(robot, q, options, port)
+    return Teach(robot, q, options, port, hands, feet)
 
 
-__all__ = ["Teach", "TeachOptions", "TeachServer", "TeachSession", "teach"]
+__all__ = ["Teach", "TeachOptions", "TeachServer", "TeachSession", "WholeTeachSession", "teach"]

@@ -26,6 +26,7 @@ from urllib.parse import parse_qs, urlparse
 from kinelab.errors import KinelabError
 from kinelab.view.caption import tab_title
 from kinelab.view.teach.session import TeachSession, pose_from_matrix
+from kinelab.view.teach.whole import WholeTeachSession
 
 LOOPBACK = "127.0.0.1"
 MAX_BODY = 1 << 16  # [bytes] an action's JSON is a few hundred
@@ -86,7 +87,7 @@ class TeachServer:
     or whose ``Origin`` is another page's, is refused (403); a POST must carry JSON.
     """
 
-    def __init__(self, session: TeachSession, port: int = 0):
+    def __init__(self, session: TeachSession | WholeTeachSession, port: int = 0):
         self.session = session
         self.lock = session.lock  # a request's action and the reply it reads are one step
         self.files = {"/": _page(session).encode("utf-8"), "/meshcat.js": _meshcat_script(),
@@ -152,10 +153,10 @@ class TeachServer:
         """
         s = self.session
         if action == "q":
-            s.set_q(_numbers(body.get("q"), f"q is a list of {s.robot.n} numbers (rad or m)"))
+            s.set_q(_numbers(body.get("q"), f"q is a list of {len(s.q)} numbers (rad or m)"))
         elif action == "target":
             s.set_target(pose_from_matrix(_numbers(body.get("matrix"), "a target is 16 numbers: a 4 × 4 homogeneous "
-                                                                       "matrix, rows first")))
+                                                                       "matrix, rows first")), body.get("index", 0))
         elif action == "branch":
             s.step_branch(body.get("step", 1))
         elif action == "snap":
@@ -266,17 +267,10 @@ def _int(text: Any) -> int:
         return 0
 
 
-def _page(session: TeachSession) -> str:
+def _page(session: TeachSession | WholeTeachSession) -> str:
     """The page with its title (robot and view) and the robot's joints for the sliders."""
     robot = session.robot
-    joints = [{"name": j.name, "kind": j.kind, "lower": j.lower, "upper": j.upper} for j in robot.joints]
-    legend = (f"Tool frame: x red, y green, z blue; target: the longer triad with the gold ball. Blue ellipsoid: the "
-              f"tool point's velocities for unit joint speeds (J_v's singular values), 1 m/rad drawn as "
-              f"{session.scale:.3g} m (fixed at the start). "
-              f"σ_min and manipulability of the Jacobian with its linear rows divided by L = "
-              f"{robot.characteristic_length():.3g} m (dimensionless). Start: {session.start}."
-              + (f" Obstacles: {session.scene.legend['obstacles']}." if "obstacles" in session.scene.legend else ""))
-    config = {"q": session.q.tolist(), "joints": joints, "heading": f"kinelab teach — {robot.name}", "legend": legend}
+    config = session.page_config()
     text = resources.files(__package__).joinpath("teach.html").read_text(encoding="utf-8")
     return (text.replace("__TITLE__", html.escape(tab_title(robot.name, "teach")))
             .replace("__CONFIG__", json.dumps(config).replace("<", "\\u003c")))  # no tag can end the script

@@ -113,14 +113,17 @@ class TeachSession:
         self._draw()
 
     @_locked
-    def set_target(self, oMtarget: pin.SE3) -> None:
+    def set_target(self, oMtarget: pin.SE3, index: int = 0) -> None:
         """Move the target to a pose (base frame) and follow it: FRDM from the current q (the answer's revolute
         angles the turns nearest it), with collisions when switched on; q stays where it was when no answer meets
         the target within the tolerances, and the status says why.
 
         Raises:
-            TargetError: a pose that is not finite or whose rotation is not one.
+            TargetError: a pose that is not finite or whose rotation is not one. KinelabError: an index other than
+                0 (a chain has one target).
         """
+        if isinstance(index, bool) or index != 0:
+            raise KinelabError(f"a chain's page has one target, index 0, not {_short(repr(index))}")
         self.target = _checked_pose(oMtarget)
         self.branches, self.branch = None, -1
         self._follow()
@@ -195,6 +198,21 @@ class TeachSession:
                 "status": self.status, "branch": self.branch + 1,
                 "branches": None if self.branches is None else len(self.branches),
                 "collisions": self.collisions_on, "contacts": [str(c) for c in self.contacts]}
+
+    def page_config(self) -> dict[str, Any]:
+        """What the page is built from: a slider per joint (its index in q), the target, the heading and the
+        legend."""
+        robot = self.robot
+        joints = [{"name": j.name, "kind": j.kind, "iq": k, "lower": j.lower, "upper": j.upper}
+                  for k, j in enumerate(robot.joints)]
+        legend = (f"Tool frame: x red, y green, z blue; target: the longer triad with the gold ball. Blue ellipsoid: "
+                  f"the tool point's velocities for unit joint speeds (J_v's singular values), 1 m/rad drawn as "
+                  f"{self.scale:.3g} m (fixed at the start). "
+                  f"σ_min and manipulability of the Jacobian with its linear rows divided by L = "
+                  f"{robot.characteristic_length():.3g} m (dimensionless). Start: {self.start}."
+                  + (f" Obstacles: {self.scene.legend['obstacles']}." if "obstacles" in self.scene.legend else ""))
+        return {"q": self.q.tolist(), "joints": joints, "targets": ["target"], "heading": f"kinelab teach — "
+                f"{robot.name}", "legend": legend, "whole": False}
 
     # -- internals ------------------------------------------------------------------------------
     def _follow(self) -> None:

@@ -7,8 +7,9 @@ const state = { seq: 0, busy: false, pending: new Map(), dragging: null, readout
 window.kinelab = state;  // what the browser tests and the console read
 
 const node = (path) => viewer.scene_tree.find(path).object;
-const targetNode = () => node(["meshcat", "frames", "target"]);
-const handleNode = () => node(["meshcat", "frames", "target", "handle", "<object>"]);
+// one target per name in cfg.targets: a chain's "target", a whole robot's "target_0", "target_1", ...
+const targetNode = (k = 0) => node(["meshcat", "frames", cfg.targets[k]]);
+const handleNode = (k = 0) => node(["meshcat", "frames", cfg.targets[k], "handle", "<object>"]);
 
 function bytes(b64) {
   const text = atob(b64), out = new Uint8Array(text.length);
@@ -26,16 +27,17 @@ function apply(reply) {
   state.replies += 1;
 }
 
-function post(action, body) {
-  state.pending.set(action, body);
+// the latest request of each key waits while one is in flight (a drag sends many: only its last one matters)
+function post(action, body, key = action) {
+  state.pending.set(key, { action, body });
   if (!state.busy) pump();
 }
 
 async function pump() {
   state.busy = true;
   while (state.pending.size) {
-    const [action, body] = state.pending.entries().next().value;
-    state.pending.delete(action);
+    const [key, { action, body }] = state.pending.entries().next().value;
+    state.pending.delete(key);
     try {
       const r = await fetch(action, { method: "POST", headers: { "Content-Type": "application/json" },
                                       body: JSON.stringify({ ...body, since: state.seq }) });
@@ -76,7 +78,8 @@ function buildSliders() {
     // a robot file's names are text, never markup: every string reaches the page through textContent
     row.append(element("span", j.name), element("span", "", "value"));
     const s = document.createElement("input");
-    Object.assign(s, { type: "range", min: j.lower, max: j.upper, step: (j.upper - j.lower) / 2000, value: cfg.q[k] });
+    Object.assign(s, { type: "range", min: j.lower, max: j.upper, step: (j.upper - j.lower) / 2000,
+                       value: cfg.q[j.iq] });
     s.id = `kinelab-joint-${k}`;
     s.addEventListener("pointerdown", () => { s.dataset.active = "1"; });
     s.addEventListener("pointerup", () => { delete s.dataset.active; });
@@ -84,7 +87,7 @@ function buildSliders() {
       row.querySelector(".value").textContent = jointText(j, Number(s.value));
       // the other joints as the server has them: a slider rounds its value to its step
       const q = (state.readout ? state.readout.q : cfg.q).slice();
-      q[k] = Number(s.value);
+      q[j.iq] = Number(s.value);
       post("q", { q });
     });
     row.appendChild(s);
@@ -96,12 +99,17 @@ function buildSliders() {
 // -- readings -----------------------------------------------------------------------------------
 function show(r) {
   state.readout = r;
-  r.q.forEach((v, k) => {
-    const s = sliders[k];
+  cfg.joints.forEach((j, k) => {
+    const s = sliders[k], v = r.q[j.iq];
     if (!s.dataset.active) s.value = v;
-    s.parentNode.querySelector(".value").textContent = jointText(cfg.joints[k], v);
+    s.parentNode.querySelector(".value").textContent = jointText(j, v);
   });
   document.getElementById("kinelab-q").textContent = `q = [${r.q.map((v) => fmt(v, 6)).join(", ")}]`;
+  document.getElementById("kinelab-status").textContent = r.status;
+  if (r.rows) {  // a whole robot's page: its rows as the server words them
+    table(r.rows);
+    return;
+  }
   const deg = (a) => a.map((x) => fmt(x * 180 / Math.PI, 2)).join(", ");
   const rows = [
     ["tool position", r.tool.position_m.map((x) => fmt(x, 4)).join(", ") + " m"],
@@ -113,10 +121,13 @@ function show(r) {
     ["ellipsoid radii", r.ellipsoid_radii_m_per_rad.map((x) => fmt(x, 3)).join(", ") + " m/rad"],
     ["contacts", r.collisions ? (r.contacts.length ? r.contacts.join("; ") : "none") : "not checked"],
   ];
+  table(rows);
+  document.getElementById("kinelab-collisions").checked = r.collisions;
+}
+
+function table(rows) {
   document.getElementById("kinelab-readout").replaceChildren(
     ...rows.map(([k, v]) => { const tr = element("tr"); tr.append(element("td", k), element("td", v)); return tr; }));
-  document.getElementById("kinelab-status").textContent = r.status;
-  document.getElementById("kinelab-collisions").checked = r.collisions;
 }
 
 // -- the target: drag to move, Shift+drag to turn -----------------------------------------------
@@ -129,31 +140,36 @@ function ray(event) {
   return raycaster;
 }
 
-function sendTarget() {
-  const e = targetNode().matrix.elements;  // column-major
+function sendTarget(k) {
+  const e = targetNode(k).matrix.elements;  // column-major
   const rows = [];
   for (let r = 0; r < 4; r++) for (let c = 0; c < 4; c++) rows.push(e[c * 4 + r]);
-  post("target", { matrix: rows });
+  post("target", { index: k, matrix: rows }, `target ${k}`);
 }
 
 function onDown(event) {
   if (event.button !== 0) return;
-  const hit = ray(event).intersectObject(handleNode(), true)[0];
-  if (!hit) return;
+  const r = ray(event);
+  let best = null;  // the nearest handle under the pointer
+  cfg.targets.forEach((_, k) => {
+    const hit = r.intersectObject(handleNode(k), true)[0];
+    if (hit && (!best || hit.distance < best.hit.distance)) best = { k, hit };
+  });
+  if (!best) return;
   event.stopPropagation();
   event.preventDefault();
   viewer.controls.enabled = false;
   const normal = viewer.camera.getWorldDirection(new THREE.Vector3());
-  const centre = handleNode().getWorldPosition(new THREE.Vector3());
-  state.dragging = { turn: event.shiftKey, x: event.clientX, y: event.clientY,
+  const centre = handleNode(best.k).getWorldPosition(new THREE.Vector3());
+  state.dragging = { index: best.k, turn: event.shiftKey, x: event.clientX, y: event.clientY,
                      plane: new THREE.Plane().setFromNormalAndCoplanarPoint(normal, centre),
-                     offset: centre.clone().sub(hit.point) };
+                     offset: centre.clone().sub(best.hit.point) };
 }
 
 function onMove(event) {
   const d = state.dragging;
   if (!d) return;
-  const t = targetNode();
+  const t = targetNode(d.index);
   if (d.turn) {
     const dx = event.clientX - d.x, dy = event.clientY - d.y;
     if (dx === 0 && dy === 0) return;
@@ -170,7 +186,7 @@ function onMove(event) {
   }
   t.updateMatrix();
   viewer.set_dirty();
-  sendTarget();
+  sendTarget(d.index);
 }
 
 function onUp() {
@@ -181,8 +197,8 @@ function onUp() {
 }
 
 // where the handle is on the screen (CSS pixels), for a test that drags it
-state.handleOnScreen = () => {
-  const p = handleNode().getWorldPosition(new THREE.Vector3()).project(viewer.camera);
+state.handleOnScreen = (k = 0) => {
+  const p = handleNode(k).getWorldPosition(new THREE.Vector3()).project(viewer.camera);
   const rect = viewer.renderer.domElement.getBoundingClientRect();
   return [rect.left + (p.x + 1) / 2 * rect.width, rect.top + (1 - p.y) / 2 * rect.height];
 };
@@ -196,6 +212,15 @@ state.idle = () => !state.busy && state.pending.size === 0 && !state.dragging;
 
 document.getElementById("kinelab-heading").textContent = cfg.heading;
 document.getElementById("kinelab-legend").textContent = cfg.legend;
+if (cfg.whole) {  // a whole robot's page: no branches, no collision switch; the snap puts every target back
+  for (const id of ["kinelab-prev", "kinelab-next", "kinelab-collisions-label"]) {
+    document.getElementById(id).hidden = true;
+  }
+  document.getElementById("kinelab-snap").textContent = "targets to hands";
+  document.getElementById("kinelab-help").textContent = "Drag a gold ball to move that hand's target (Shift+drag "
+    + "turns it); the whole robot follows, its feet and centre of mass held. Drag elsewhere to turn the view, "
+    + "right-drag to pan, wheel to zoom.";
+}
 document.getElementById("kinelab-prev").addEventListener("click", () => post("branch", { step: -1 }));
 document.getElementById("kinelab-next").addEventListener("click", () => post("branch", { step: 1 }));
 document.getElementById("kinelab-snap").addEventListener("click", () => post("snap", {}));

@@ -113,9 +113,12 @@ def _whole(path: Path, entry: catalog.Entry | None, name: str | None, package_di
                        xacro_args=xacro_args, trust_xacro=trust_xacro)
     chains = partial(_chain, path, None, made.name, package_dirs=package_dirs, srdf=srdf, group=None,
                      xacro_args=xacro_args, trust_xacro=trust_xacro)
-    return Robot(made.model, name=made.name, source=made.source, srdf=made.srdf,
-                 chain_source=lambda tool, base, locked: chains(tool, locked, base),
-                 geometry=partial(_geometry, made.model, made.urdf_path, mesh_package_dirs(package_dirs)))
+    robot = Robot(made.model, name=made.name, source=made.source, srdf=made.srdf,
+                  chain_source=lambda tool, base, locked: chains(tool, locked, base),
+                  geometry=partial(_geometry, made.model, made.urdf_path, mesh_package_dirs(package_dirs)))
+    if entry is not None:
+        robot.hands, robot.feet = entry.hands, entry.feet
+    return robot
 
 
 def _geometry(model: Any, urdf_path: Path, package_dirs: list[str], kind: str) -> Any:

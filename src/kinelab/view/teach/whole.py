@@ -1,0 +1,282 @@
+"""The teach page of a whole robot: a target per hand to drag, the feet held where they stand, the centre of mass
+held over them and drawn with its support polygon; every drag is met by the whole-body solve from where the robot
+stands (:func:`kinelab.wholebody.solve.solve`, no restart: the robot moves, it does not jump to another posture).
+
+The support polygon is the convex hull of a ``SOLE`` rectangle under each foot frame (its x along the foot), on the
+floor; the centre of mass is held at its start's horizontal place (``ComTask`` on x and y), drawn as a red ball with
+its shadow on the floor, green inside the polygon, red outside.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from kinelab.errors import KinelabError, OptionError
+from kinelab.robot.tree import Robot
+from kinelab.view.teach.recorder import RecordingWindow
+from kinelab.view.teach.session import TeachOptions, _checked_pose, _locked, _pose, _short
+
+SOLE = (0.20, 0.10)  # [m] the sole drawn under each foot frame for the support polygon: length (x), width (y)
+GOLD, COM, INSIDE, OUTSIDE = 0xF2B01E, 0xD62728, 0x2CA02C, 0xD62728
+
+
+class WholeTeachSession:
+    """A whole robot to move by hand: its hands' targets dragged, its feet and centre of mass held."""
+
+    def __init__(self, robot: Robot, q: Any = None, options: TeachOptions | None = None,
+                 hands: tuple[str, ...] | None = None, feet: tuple[str, ...] | None = None):
+        """Draw the robot standing at q and its targets on its hands.
+
+        Raises:
+            OptionError: no hand to drag (name them), or a frame that is not the robot's.
+            ConfigurationError: a q that is not the robot's, or outside its limits.
+        """
+        import meshcat
+
+        self.robot, self.options = robot, options or TeachOptions(time_budget=0.5)
+        self.lock = threading.RLock()
+        self.hands = tuple(robot.hands if hands is None else hands)
+        self.feet = tuple(robot.feet if feet is None else feet)
+        if not self.hands:
+            raise OptionError("hands", hands, f"the frames to drag: {robot.name} names none (teach(robot, "
+                              "hands=[frame, ...]))")
+        for name in self.hands + self.feet:
+            robot.frame_id(name)
+        self.q, self.start = standing(robot, self.feet) if q is None else (robot.check_q(q, limits=True), "given")
+        self.rest = self.q.copy()
+        self.targets = list(robot.frame_placements(self.q, self.hands))
+        self.pins = robot.frame_placements(self.q, self.feet)
+        self.com_target = robot.com(self.q) if robot.floating and self.feet else None
+        self.support = support_polygon(self.pins)
+        self.window = RecordingWindow()
+        self.viewer = meshcat.Visualizer(window=self.window)
+        self.frame_length = 0.25 * robot.characteristic_length()
+        self.status = f"standing ({self.start}); drag a gold ball to move that hand"
+        self._draw_robot()
+        self._draw()
+
+    # -- actions --------------------------------------------------------------------------------
+    @_locked
+    def set_q(self, q: Any) -> None:
+        """Put the robot at q (Pinocchio's q, within the limits); the targets stay.
+
+        Raises:
+            ConfigurationError: q of the wrong length, not finite or outside the limits (named).
+        """
+        self.q = self.robot.check_q(q, limits=True)
+        self.status = "joints set"
+        self._draw()
+
+    @_locked
+    def set_target(self, oMtarget: pin.SE3, index: int = 0) -> None:
+        """Move hand ``index``'s target (base frame) and meet every task from where the robot stands; q stays where
+        it was when the solve does not meet them all, and the status says which.
+
+        Raises:
+            TargetError: a pose that is not finite or whose rotation is not one. KinelabError: no such hand.
+        """
+        self.targets[_index(index, len(self.hands))] = _checked_pose(oMtarget)
+        self._follow()
+        self._draw()
+
+    @_locked
+    def snap_target(self) -> None:
+        """Put every target on its hand as it is."""
+        self.targets = list(self.robot.frame_placements(self.q, self.hands))
+        self.status = "targets put on the hands"
+        self._draw()
+
+    def step_branch(self, step: int = 1) -> None:
+        """A whole robot has no branches to step through.
+
+        Raises:
+            KinelabError: always, saying what to do instead.
+        """
+        raise KinelabError("a whole robot's page has no branches: drag a hand's gold ball")
+
+    def set_collisions(self, on: Any) -> None:
+        """Collisions are not checked on a whole robot's page.
+
+        Raises:
+            KinelabError: always.
+        """
+        raise KinelabError("collisions are not checked on a whole robot's page in this version")
+
+    # -- what the page shows --------------------------------------------------------------------
+    @_locked
+    def readout(self) -> dict[str, Any]:
+        """The numbers of the page: q, each hand's pose and error against its target (Pinocchio's FK), the centre of
+        mass and whether it is over the support polygon, the status."""
+        placed = self.robot.frame_placements(self.q, self.hands)
+        hands = [{"frame": name, "pose": _pose(M), "target": _pose(T),
+                  "position_error_m": float(np.linalg.norm(M.translation - T.translation)),
+                  "rotation_error_rad": float(np.linalg.norm(pin.log3(M.rotation.T @ T.rotation)))}
+                 for name, M, T in zip(self.hands, placed, self.targets, strict=True)]
+        com = self.robot.com(self.q)
+        inside = None if self.support is None else bool(inside_polygon(com[:2], self.support))
+        rows = [[f"{h['frame']} error", f"{h['position_error_m']:.2e} m, {h['rotation_error_rad']:.2e} rad"]
+                for h in hands]
+        rows.append(["centre of mass", ", ".join(f"{x:.4f}" for x in com) + " m"
+                     + ("" if inside is None else (" — over the feet" if inside else " — NOT over the feet"))])
+        return {"robot": self.robot.name, "q": self.q.tolist(), "hands": hands, "com_m": com.tolist(),
+                "com_over_support": inside, "rows": rows, "status": self.status}
+
+    def page_config(self) -> dict[str, Any]:
+        """What the page is built from: the sliders (bounded one-coordinate joints, their index in q), the targets,
+        the heading and the legend."""
+        model, space = self.robot.model, self.robot.space
+        joints = []
+        for jid in range(1, model.njoints):
+            joint = model.joints[jid]
+            if joint.nq == 1 and np.isfinite(space.lower[joint.idx_q]) and np.isfinite(space.upper[joint.idx_q]):
+                kind = "prismatic" if "JointModelP" in joint.shortname() else "revolute"
+                joints.append({"name": model.names[jid], "kind": kind, "iq": joint.idx_q,
+                               "lower": float(space.lower[joint.idx_q]), "upper": float(space.upper[joint.idx_q])})
+        legend = (f"Gold balls: the targets of {', '.join(self.hands)} (drag one; Shift+drag turns it); the triads "
+                  f"on the hands: their frames. "
+                  + (f"Held: {', '.join(self.feet)} where they stand; support polygon: the hull of a "
+                     f"{SOLE[0]:g} × {SOLE[1]:g} m sole under each. " if self.feet else "")
+                  + ("Red ball: the centre of mass (held over the floor at its start); its shadow green over the "
+                     "polygon, red off it. " if self.com_target is not None else "")
+                  + f"Start: {self.start}.")
+        return {"q": self.q.tolist(), "joints": joints, "targets": [f"target_{k}" for k in range(len(self.hands))],
+                "heading": f"kinelab teach — {self.robot.name} (whole robot)", "legend": legend, "whole": True}
+
+    # -- internals ------------------------------------------------------------------------------
+    def tasks(self) -> list[Any]:
+        """Every hand at its target, every foot where it stands, the centre of mass over its start, a posture."""
+        from kinelab.wholebody.tasks import ComTask, FrameTask, PostureTask
+
+        tasks: list[Any] = [FrameTask(h, T) for h, T in zip(self.hands, self.targets, strict=True)]
+        tasks += [FrameTask(f, M) for f, M in zip(self.feet, self.pins, strict=True)]
+        if self.com_target is not None:
+            tasks.append(ComTask(self.com_target, axes="xy"))
+        return [*tasks, PostureTask(self.rest, weight=1e-3)]
+
+    def _follow(self) -> None:
+        from kinelab.wholebody.solve import solve
+
+        o = self.options
+        res = solve(self.robot, self.tasks(), q0=self.q, seed=0, tol_pos=o.tol_pos, tol_rot=o.tol_rot,
+                    max_restarts=0, time_budget=o.time_budget)
+        if res.success:
+            self.q = np.array(res.q)
+            self.status = f"following: every task met within {o.tol_pos:g} m, {o.tol_rot:g} rad"
+        else:
+            missed = [v.label for v in res.tasks if not v.met]
+            self.status = f"not reached ({res.status}): {_short(', '.join(missed), 120)}; q kept"
+
+    def _draw_robot(self) -> None:
+        import meshcat.geometry as g
+        from pinocchio.visualize import MeshcatVisualizer
+
+        from kinelab.view.scene import AXIS_COLORS, aim_camera, on_top
+
+        self.viz = MeshcatVisualizer(self.robot.model, pin.GeometryModel(), self.robot.visual_model())
+        self.viz.initViewer(viewer=self.viewer)
+        self.viz.loadViewerModel(rootNodeName=self.robot.name)
+        self.viewer["/Axes"].set_property("visible", False)
+        for k in range(len(self.hands)):
+            for name, length in ((f"target_{k}", 1.3 * self.frame_length), (f"hand_{k}", self.frame_length)):
+                for axis, color in enumerate(AXIS_COLORS):
+                    end = np.zeros((3, 2))
+                    end[axis, 1] = length
+                    self.viewer["frames"][name][f"axis{axis}"].set_object(
+                        g.Line(g.PointsGeometry(end), g.MeshBasicMaterial(color=color, linewidth=4)))
+            self.viewer["frames"][f"target_{k}"]["handle"].set_object(g.Sphere(0.3 * self.frame_length),
+                                                                      on_top(GOLD, 0.9))
+        if self.support is not None:
+            loop = np.vstack([self.support, self.support[:1]])
+            points = np.vstack([loop.T, np.full(loop.shape[0], self.floor + 0.002)])  # just above the floor grid
+            self.viewer["support"].set_object(g.Line(g.PointsGeometry(points), _over(INSIDE)))
+        if self.com_target is not None:
+            self.viewer["com"].set_object(g.Sphere(0.12 * self.frame_length), on_top(COM, 0.9))
+        self.viz.display(self.q)
+        aim_camera(self.viewer, self._points(), 0.1 * self.robot.characteristic_length(), floor_z=self.floor)
+
+    def _points(self) -> np.ndarray:
+        """Where the robot is at q: its joints' origins and its visuals' [m], for the camera."""
+        model, data = self.robot.model, self.robot.model.createData()
+        pin.forwardKinematics(model, data, self.q)
+        gdata = pin.GeometryData(self.viz.visual_model)
+        pin.updateGeometryPlacements(model, data, self.viz.visual_model, gdata)
+        return np.array([*(M.translation for M in data.oMi[1:]), *(M.translation for M in gdata.oMg)])
+
+    @property
+    def floor(self) -> float:
+        """The floor's height [m]: the lowest foot's (0 without feet)."""
+        return min((M.translation[2] for M in self.pins), default=0.0)
+
+    def _draw(self) -> None:
+        import meshcat.geometry as g
+
+        self.viz.display(self.q)
+        for k, (M, T) in enumerate(zip(self.robot.frame_placements(self.q, self.hands), self.targets, strict=True)):
+            self.viewer["frames"][f"hand_{k}"].set_transform(M.homogeneous)
+            self.viewer["frames"][f"target_{k}"].set_transform(T.homogeneous)
+        if self.com_target is not None:
+            com = self.robot.com(self.q)
+            self.viewer["com"].set_transform(pin.SE3(np.eye(3), com).homogeneous)
+            over = self.support is not None and inside_polygon(com[:2], self.support)
+            shadow = np.array([[com[0], com[0]], [com[1], com[1]], [com[2], self.floor]])
+            self.viewer["com_shadow"].set_object(g.Line(g.PointsGeometry(shadow), _over(INSIDE if over else OUTSIDE)))
+
+
+def _over(color: int) -> Any:
+    """A line's material drawn over the robot (no depth test), 3 px wide."""
+    import meshcat.geometry as g
+
+    return g.MeshBasicMaterial(color=color, linewidth=3, depthTest=False)
+
+
+def standing(robot: Robot, feet: tuple[str, ...]) -> tuple[np.ndarray, str]:
+    """Where a whole robot starts: its SRDF's "half_sitting" (else its neutral configuration) with, on a free-flyer,
+    its lowest foot on the floor (z = 0).
+
+    Returns:
+        (q, how it was chosen, in words).
+    """
+    try:
+        q, how = robot.named_q("half_sitting"), "the SRDF's half_sitting"
+    except KinelabError:
+        q, how = robot.neutral(), "the neutral configuration"
+    q = robot.check_q(q)
+    if robot.floating and feet:
+        q[2] -= min(M.translation[2] for M in robot.frame_placements(q, feet))
+    return q, how
+
+
+def support_polygon(feet: list[pin.SE3]) -> np.ndarray | None:
+    """The convex hull (counter-clockwise (x, y) rows [m]) of a SOLE rectangle under each foot, or None without
+    feet."""
+    if not feet:
+        return None
+    from scipy.spatial import ConvexHull
+
+    half = np.array([SOLE[0], SOLE[1]]) / 2
+    corners = np.array([[sx * half[0], sy * half[1], 0.0] for sx in (-1, 1) for sy in (-1, 1)])
+    points = np.vstack([(M.rotation @ corners.T).T + M.translation for M in feet])[:, :2]
+    hull = ConvexHull(points)
+    return np.asarray(points[hull.vertices], dtype=float)
+
+
+def inside_polygon(point: np.ndarray, polygon: np.ndarray) -> bool:
+    """Whether a point (x, y) lies inside a convex polygon given counter-clockwise."""
+    edges = np.roll(polygon, -1, axis=0) - polygon
+    rel = point - polygon
+    return bool(np.all(edges[:, 0] * rel[:, 1] - edges[:, 1] * rel[:, 0] >= 0.0))
+
+
+def _index(index: Any, count: int) -> int:
+    """A hand's index, checked.
+
+    Raises:
+        KinelabError: not an integer in [0, count).
+    """
+    if isinstance(index, bool) or not isinstance(index, int | np.integer) or not 0 <= index < count:
+        raise KinelabError(f"a target index is an integer from 0 to {count - 1}, not {_short(repr(index))}")
+    return int(index)

@@ -1,0 +1,74 @@
+"""#59: the whole robot's teach session without a browser: each hand's target met with the feet held and the centre
+of mass kept over them, judged again by Pinocchio; what the page cannot do on a whole robot is said by name."""
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import kinelab
+from kinelab.errors import KinelabError, OptionError
+from kinelab.view.teach import teach
+from kinelab.view.teach.whole import inside_polygon, support_polygon
+
+
+@pytest.fixture(scope="module")
+def talos_page():
+    with teach(kinelab.load("talos")) as served:
+        yield served
+
+
+def test_a_moved_hand_is_met_and_the_feet_and_centre_of_mass_stay(talos_page):
+    s = talos_page.session
+    talos = s.robot
+    feet = talos.frame_placements(s.q, talos.feet)
+    com = talos.com(s.q)
+    goal = pin.SE3(s.targets[1].rotation, s.targets[1].translation + np.array([0.04, -0.03, 0.06]))
+    s.set_target(goal, 1)
+    assert s.status.startswith("following")
+    model, data = talos.model, talos.model.createData()
+    pin.framesForwardKinematics(model, data, s.q)
+    hand = data.oMf[model.getFrameId(talos.hands[1])]
+    assert np.linalg.norm(pin.log6(hand.actInv(goal)).vector) <= 2e-6
+    for name, M in zip(talos.feet, feet, strict=True):
+        assert np.linalg.norm(pin.log6(data.oMf[model.getFrameId(name)].actInv(M)).vector) <= 2e-6
+    assert np.linalg.norm(pin.centerOfMass(model, data, s.q)[:2] - com[:2]) <= 1e-6
+    r = s.readout()
+    assert r["com_over_support"] and r["hands"][1]["position_error_m"] <= 1e-6
+
+
+def test_a_hand_out_of_reach_keeps_q_and_names_the_missed_task(talos_page):
+    s = talos_page.session
+    before = s.q.copy()
+    s.set_target(pin.SE3(np.eye(3), np.array([3.0, 0.0, 1.0])), 0)
+    assert np.array_equal(s.q, before) and "not reached" in s.status and s.robot.hands[0] in s.status
+
+
+def test_what_a_whole_robot_s_page_does_not_do_is_said(talos_page):
+    s = talos_page.session
+    with pytest.raises(KinelabError, match="no branches"):
+        s.step_branch(1)
+    with pytest.raises(KinelabError, match="collisions are not checked"):
+        s.set_collisions(True)
+    with pytest.raises(KinelabError, match="from 0 to 1"):
+        s.set_target(s.targets[0], 2)
+    with pytest.raises(OptionError, match="hands"):
+        teach(kinelab.load("talos"), hands=())
+
+
+def test_the_sliders_name_each_bounded_joint_at_its_place_in_q(talos_page):
+    s = talos_page.session
+    config = s.page_config()
+    model = s.robot.model
+    assert config["targets"] == ["target_0", "target_1"] and config["whole"]
+    for j in config["joints"]:
+        joint = model.joints[model.getJointId(j["name"])]
+        assert j["iq"] == joint.idx_q and j["lower"] == s.robot.lower[joint.idx_q]
+    assert len(config["joints"]) == model.nq - 7  # every joint of TALOS but the free-flyer
+
+
+def test_the_support_polygon_holds_both_soles_and_the_test_of_inside_is_right():
+    feet = [pin.SE3(np.eye(3), np.array([0.0, 0.1, 0.0])), pin.SE3(np.eye(3), np.array([0.0, -0.1, 0.0]))]
+    hull = support_polygon(feet)
+    assert np.allclose(sorted(hull[:, 0]), [-0.1, -0.1, 0.1, 0.1]) and np.allclose(sorted(hull[:, 1]),
+                                                                                    [-0.15, -0.15, 0.15, 0.15])
+    assert inside_polygon(np.array([0.05, 0.0]), hull) and not inside_polygon(np.array([0.15, 0.0]), hull)
