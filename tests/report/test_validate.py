@@ -62,6 +62,18 @@ def test_json_alone_writes_no_report_folder(tmp_path, monkeypatch, capsys):
     assert list(tmp_path.iterdir()) == []  # no ./kinelab-report
 
 
+def test_a_whole_robot_takes_the_whole_body_checks(capsys):
+    """#59: validate's whole-body section on TALOS: the compiled tree, every task's Jacobian, the limits over 2000
+    steps and the converged solve, each against Pinocchio; all pass, each a number with its limit."""
+    code = cli.main(["validate", "--robots", "talos", "--n", "5", "--json"])
+    report = json.loads(capsys.readouterr().out)
+    names = [c["name"] for c in report["checks"]]
+    assert code == 0 and report["passed"] and all(n.startswith("whole body: ") for n in names)
+    assert {"whole body: limit violations over the steps", "whole body: false successes (frdm)",
+            "whole body: task Jacobians vs differences of Pinocchio's FK"} <= set(names)
+    assert validate.DEFAULT_ROBOTS[-2:] == ("talos", "baxter")
+
+
 def _report_with_one_failure():
     ok = validate.Check("era", "FK position: yourdfpy vs Pinocchio", 2e-16, 1e-9, "m", "200 random q")
     bad = validate.Check("era", "seed 000 wrist, q5, q6 < 80°: worst tool error", 2e-6, 1e-6, "m")

@@ -206,3 +206,26 @@ def test_a_posture_weighs_each_velocity_as_asked():
         step(panda, q, PostureTask(q_ref, weight=np.ones(3)), 1.0)
     with pytest.raises(kinelab.KinelabError, match="one per velocity"):
         PostureTask(q_ref, weight=[1.0, -1.0])
+
+
+@pytest.mark.parametrize("dropped", ["position", "velocity"])
+def test_the_limit_check_fails_when_a_bound_is_dropped(monkeypatch, dropped):
+    """The check `kinelab validate` runs (2000 steps, starts outside the limits) must see a step that leaves out a
+    bound: the readable step with its position (or velocity) bounds dropped makes it count violations."""
+    import importlib
+
+    from kinelab.report.wholebody_checks import limits_check
+
+    step_module = importlib.import_module("kinelab.wholebody.step")  # the module (the package exports the function)
+    baxter = kinelab.load("baxter")
+    assert limits_check(baxter, 10, 0)[0].value == 0  # as built: none
+    original = step_module.bounds
+
+    def without(space, q, dt, vmax, position, amax, v_prev):
+        if dropped == "velocity":
+            vmax = np.full_like(vmax, np.inf)
+        return original(space, q, dt, vmax, position and dropped != "position", amax, v_prev)
+
+    monkeypatch.setattr(step_module, "_compiled", lambda *args: None)  # the readable step, whose bounds are patched
+    monkeypatch.setattr(step_module, "bounds", without)
+    assert limits_check(baxter, 10, 0)[0].value > 0

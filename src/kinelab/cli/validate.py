@@ -13,7 +13,8 @@ from kinelab.report.outfolder import check_output_folder
 def add(sub: Any) -> None:
     """The ``validate`` subcommand."""
     s = sub.add_parser("validate", help="check every kinelab computation against Pinocchio on the bundled robots")
-    s.add_argument("--robots", nargs="+", default=None, help="robots to check (default: the embedded set)")
+    s.add_argument("--robots", nargs="+", default=None,
+                   help="robots to check (default: stanford era youbot panda ur5 talos baxter)")
     s.add_argument("--n", type=int, default=None, help="random configurations per check (default: each check's own)")
     seed_argument(s)
     s.add_argument("--out", default=None,

@@ -22,7 +22,7 @@ from kinelab.report.provenance import provenance
 from kinelab.robot import Chain, load
 from kinelab.studies import paper001_stanford as seed001
 
-DEFAULT_ROBOTS = ("stanford", "era", "youbot", "panda", "ur5")
+DEFAULT_ROBOTS = ("stanford", "era", "youbot", "panda", "ur5", "talos", "baxter")  # the last two whole
 DEFAULT_N = 200
 
 
@@ -451,7 +451,11 @@ GENERAL_CHECKS = [model_checks, biquaternion_checks, solver_checks, analytic_che
 
 
 def run(robots: list[str] | None = None, n: int | None = None, seed: int = 0, progress: bool = False) -> Report:
-    """Run every check on ``robots`` (default: stanford, era, youbot, panda, ur5)."""
+    """Run every check on ``robots`` (default: stanford, era, youbot, panda, ur5, and the whole talos and baxter:
+    a whole robot takes the whole-body checks, :mod:`kinelab.report.wholebody_checks`)."""
+    from kinelab.report.wholebody_checks import WHOLE_CHECKS
+    from kinelab.robot.tree import Robot
+
     check_seed(seed)
     names = list(robots or DEFAULT_ROBOTS)
     n = DEFAULT_N if n is None else n
@@ -459,7 +463,9 @@ def run(robots: list[str] | None = None, n: int | None = None, seed: int = 0, pr
         raise KinelabError(f"validate needs n ≥ 1 configurations per check, got {n!r}")
     loaded = [load(name) for name in names]  # fail early, before any work, on a bad name
     report = Report(robots=names, n=n, seed=seed)
-    steps = [(robot, fn) for robot in loaded for fn in [*GENERAL_CHECKS, *PAPER_CHECKS.get(robot.name, [])]]
+    steps: list[tuple[Any, Any]] = [
+        (robot, fn) for robot in loaded
+        for fn in (WHOLE_CHECKS if isinstance(robot, Robot) else [*GENERAL_CHECKS, *PAPER_CHECKS.get(robot.name, [])])]
     for robot, fn in tqdm(steps, desc="validate (check groups)", disable=not progress, unit="group"):
         report.checks.extend(fn(robot, n, seed))
     return report

@@ -195,7 +195,8 @@ def _taking(table: dict[str, Prepare], task: str, missing: dict[str, str]) -> di
 
 def _versions() -> dict[str, str]:
     out = {}
-    for dist in ("kinelab", "pin", "numpy", "scipy", "roboticstoolbox-python", "pytracik", "ikpy", "pin-pink"):
+    for dist in ("kinelab", "pin", "numpy", "scipy", "roboticstoolbox-python", "pytracik", "ikpy", "pin-pink", "mink",
+                 "mujoco", "daqp", "proxsuite"):
         with contextlib.suppress(md.PackageNotFoundError):
             out[dist] = md.version(dist)
     return out
