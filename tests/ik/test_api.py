@@ -86,7 +86,7 @@ def test_every_entry_point_refuses_a_bad_value_with_the_same_message(ur5, name, 
 def test_an_unknown_solver_lists_each_solver_once():
     with pytest.raises(kinelab.SolverNotFoundError) as err:
         kinelab.solve(kinelab.load("ur5"), kinelab.target_from_xyz_rpy([0.3, 0.1, 0.4]), solver="nope")
-    assert str(err.value).endswith("solvers are: analytic, biquat, dls, frdm")
+    assert str(err.value).endswith("solvers are: analytic, auto, biquat, dls, frdm")
 
 
 def test_prefer_refuses_what_it_would_ignore(ur5):

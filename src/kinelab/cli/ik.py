@@ -59,8 +59,9 @@ def add(sub: Any) -> None:
     s = sub.add_parser("ik", help="inverse kinematics to a target pose or configuration")
     s.add_argument("robot", help="registered name or model file (URDF, xacro, MJCF)")
     s.add_argument("--solver", default="frdm",
-                   help="frdm, biquat, dls (the Pinocchio reference) or analytic (the closed form or 1-D search, "
-                        "for the arms `kinelab info` names one for: the branch nearest --start-q); default frdm")
+                   help="frdm, biquat, dls (the Pinocchio reference), analytic (the closed form or 1-D search, "
+                        "for the arms `kinelab info` names one for: the branch nearest --start-q) or auto (the "
+                        "fastest of these for the arm, docs/route.md); default frdm")
     target_arguments(s)
     s.add_argument("--task", choices=TASKS, default="pose",
                    help="the components to meet: pose (all, the default), position, axis (point and one tool axis, "

@@ -21,6 +21,7 @@ import pinocchio as pin
 
 from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
+from kinelab.ik.auto import resolved
 from kinelab.ik.batch import BatchIKResult, prepare, prepare_robot
 from kinelab.ik.branches import UNSEEN, Route, find_all, route_of, usual_closed_form
 from kinelab.ik.chain import chain_model
@@ -83,8 +84,10 @@ def solve(robot: Chain, target: Any, *positional: Any, solver: str = "frdm", q0:
         robot: the robot (:func:`kinelab.load`).
         target: oMtarget, the wanted tool pose in the base frame (three numbers [m] for task "position").
         positional: nothing: every argument after the target is keyword-only.
-        solver: "frdm", "biquat", "dls" (the Pinocchio reference) or "analytic": the closed form's branch nearest
-            ``q0`` (else the first), where the chain has one (docs/analytic.md), refused by name elsewhere.
+        solver: "frdm", "biquat", "dls" (the Pinocchio reference), "analytic": the closed form's branch nearest
+            ``q0`` (else the first), where the chain has one (docs/analytic.md), refused by name elsewhere; or
+            "auto": the fastest of these with the same guarantees for this robot and task
+            (:mod:`kinelab.ik.auto`; ``result.solver`` and ``result.mode`` name the route taken).
         q0: first start (one number per joint, rad or m); default a seeded random configuration.
         seed: seed of the random starts, an int ≥ 0 (None: fresh entropy). A solve that does not run out of
             budget returns the same answer for the same seed in any process; one that does depends on speed.
@@ -117,6 +120,7 @@ def solve(robot: Chain, target: Any, *positional: Any, solver: str = "frdm", q0:
         SolverNotFoundError, OptionError, TargetError, ConfigurationError: bad input, named.
     """
     check_entry(robot, "solve", positional)
+    solver = resolved(robot, solver, task, collisions, options is not None or bool(solver_options))
     if prefer is None:  # the prepared solver's own route: solve is IK(robot, **settings).solve(target)
         key = (solver, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options, task, axis,
                collisions, *solver_options.items())
@@ -231,6 +235,7 @@ def solve_batch(robot: Chain, targets: Any, *positional: Any, solver: str = "frd
         OptionError, SolverNotFoundError: a bad option or argument.
     """
     check_entry(robot, "solve_batch", positional)
+    solver = resolved(robot, solver, task, collisions, options is not None or bool(solver_options))
     kind = one_answer(solver)
     if kind.closed_form:
         return _closed_form_batch(robot, targets, q0, collisions, options or solver_options,

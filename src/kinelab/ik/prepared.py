@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 from kinelab.core._engine import Engine
 from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
+from kinelab.ik.auto import resolved
 from kinelab.ik.batch import BatchIKResult, run_batch
 from kinelab.ik.branches import UNSEEN, find_all, route_of
 from kinelab.ik.driver import prepare_solver, solve_one
@@ -78,6 +79,7 @@ class IK:
                             f"solver={positional[0]!r}")
         check_robot(robot)
         self.robot = robot
+        solver = resolved(robot, solver, task, collisions, options is not None or bool(solver_options))
         kind = capabilities(solver)
         self.analytic = kind.closed_form
         self.route = route_of(kind, options is not None or bool(solver_options))  # of solve_all, as kinelab's

@@ -94,7 +94,7 @@ def capabilities(name: str) -> Capabilities:
     if found is None:
         found = BUILTIN_CAPABILITIES.get(name) if isinstance(name, str) else None
     if found is None:
-        raise SolverNotFoundError(str(name), [*names(), "analytic"])
+        raise SolverNotFoundError(str(name), [*names(), "analytic", "auto"])
     return found
 
 
@@ -127,7 +127,7 @@ def solver_module(name: str) -> Any:
     module = SOLVERS.get(name) if isinstance(name, str) else None
     if module is None:
         if not isinstance(name, str) or name not in BUILTIN:
-            raise SolverNotFoundError(str(name), [*names(), "analytic"])  # the closed form: by the entry points
+            raise SolverNotFoundError(str(name), [*names(), "analytic", "auto"])  # routes the entry points take
         module = SOLVERS[name] = importlib.import_module(BUILTIN[name])
     return module
 

@@ -1,0 +1,44 @@
+"""``solver="auto"`` where one answer is asked for (``solve``, ``solve_batch``, ``IK``): the fastest route with the
+same guarantees — every answer judged within the limits by the certified FK, the branch nearest the start when a
+start is given.
+
+A chain in a closed-form class (docs/analytic.md) answers a pose in closed form, a 7R arm whose six are in one
+with its end joint held at the start's value; both are 2–7× FRDM's batch throughput on the registered arms
+(``kinelab bench``). Everywhere else FRDM answers: another task, a collision check, solver options, a chain whose
+class is a 1-D search (the CRX-10iA's: 3k targets/s against FRDM's 45k; Baxter's six with a joint held), or the
+general elimination. docs/route.md has the table of every registered arm. (``solve_all``'s "auto" chooses among every
+branch: :mod:`kinelab.ik.registry`.)
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from kinelab.robot.chain import Chain
+
+AUTO = "auto"
+
+
+def resolved(robot: Chain, solver: Any, task: Any, collisions: Any, has_options: bool) -> Any:
+    """The solver ``solver`` stands for on this robot: itself, unless it is "auto" (see the module's docstring)."""
+    if solver != AUTO:
+        return solver
+    if task != "pose" or collisions is not None or has_options:
+        return "frdm"
+    return "analytic" if closed_form_serves(robot) else "frdm"
+
+
+def closed_form_serves(robot: Chain) -> bool:
+    """True when the chain's closed form (or its held-joint form) answers a pose."""
+    from kinelab.ik.analytic import held
+    from kinelab.ik.analytic.classify import classify
+    from kinelab.ik.analytic.kernel import SEARCH_6R
+
+    def closed(r: Chain) -> bool:
+        arm = classify(r).arm
+        return arm is not None and arm.kind < SEARCH_6R
+
+    def serves(r: Chain) -> bool:
+        return closed(r) or (held.applies(r) and closed(held.held_robot(r)))
+
+    return robot.derived("auto: closed form serves", serves)

@@ -1,0 +1,38 @@
+"""#58 goal 2: ``solver="auto"`` for one answer takes the fastest route with the same guarantees — the closed form
+where the chain has one (a 7R arm's with its end joint held), FRDM elsewhere — and every answer is judged again here
+by Pinocchio; the prepared object takes the same route as the function."""
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from helpers import pinocchio_tool
+
+import kinelab
+
+ROUTES = {"ur5": "analytic", "kinova": "analytic", "panda": "analytic", "era": "analytic", "crx10ia": "frdm"}
+
+
+@pytest.mark.parametrize("name", list(ROUTES))
+def test_auto_takes_the_stated_route_and_every_answer_meets_its_pose(name):
+    robot = kinelab.load(name)
+    qs = robot.random_qs(100, np.random.default_rng(3))
+    targets = robot.fk_batch(qs)
+    res = kinelab.solve_batch(robot, targets, solver="auto", seed=0)
+    assert res.mode.startswith(ROUTES[name]) and res.success.all()
+    for q, H in zip(res.q, targets, strict=True):
+        M = pinocchio_tool(robot, q)
+        assert np.linalg.norm(M.translation - H[:3, 3]) <= 1e-6
+        assert np.linalg.norm(pin.log3(M.rotation.T @ H[:3, :3])) <= 1e-6
+    assert robot.within_limits_batch(res.q).all()
+    prepared = kinelab.IK(robot, solver="auto").solve_batch(targets, seed=0)
+    assert prepared.mode.split(" ")[0] == res.mode.split(" ")[0]
+    one = kinelab.solve(robot, pin.SE3(targets[0]), solver="auto", seed=0)
+    assert one.success and one.solver == ROUTES[name]
+
+
+def test_auto_leaves_the_closed_form_where_it_cannot_answer():
+    ur5 = kinelab.load("ur5")
+    target = ur5.fk(ur5.random_q(4))
+    assert kinelab.solve(ur5, target, solver="auto", task="position", seed=0).solver == "frdm"
+    assert kinelab.solve(ur5, target, solver="auto", collisions="self", seed=0).solver == "frdm"
+    assert kinelab.solve(ur5, target, solver="auto", max_sweeps=500, seed=0).solver == "frdm"
