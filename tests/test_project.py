@@ -135,3 +135,14 @@ def test_load_is_the_function_whichever_way_it_was_reached_first():
             "assert callable(load) and callable(r.load), (load, r.load)")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
+
+
+def test_the_readme_names_the_youbot_joints_as_the_cli_takes_them():
+    """#60 item 4: the README and `robots` named the youBot's joints X_C, Y_C, θ, θ1..θ5, the CLI wants platform_x,
+    ..., arm_joint_5."""
+    import kinelab
+
+    row = next(line for line in (ROOT / "README.md").read_text().splitlines() if line.startswith("| `youbot` |"))
+    names = [j.name for j in kinelab.load("youbot").joints]
+    assert names[:3] == ["platform_x", "platform_y", "platform_yaw"] and names[-1] == "arm_joint_5"
+    assert all(n in row for n in ("platform_x", "platform_y", "platform_yaw", "arm_joint_1", "arm_joint_5"))

@@ -485,18 +485,19 @@ def test_ik_starts_from_the_middle_of_the_limits_and_answers_the_turn_nearest_it
     ur5 = kinelab.load("ur5")
     words = ["0", "-1.57", "1.57", "0", "0", "0"]
     target = ur5.fk(np.array(words, dtype=float))
-    start = 0.5 * (ur5.lower + ur5.upper)
+    start, how = ur5.reference_q()  # #60 item 1: the UR5's middle (all zeros) is singular, its display pose serves
+    assert how.startswith("a well-conditioned configuration") and np.array_equal(start, ur5.display_q())
     for seed in range(5):
         code, out, _ = run(capsys, "ik", "ur5", "--target-q", *words, "--seed", str(seed), "--json")
         res = json.loads(out)
         q = np.array(res["q"])
         assert code == 0 and res["success"] and res["start"]["q"] == start.tolist()
-        assert res["start"]["from"].startswith("the middle of the joint limits")
+        assert res["start"]["from"].startswith("a well-conditioned configuration")
         assert np.all(np.abs(q - start) <= np.pi + 1e-12) and ur5.within_limits(q, slack=0.0)
         assert max(ur5.tool_error(q, target)) <= 1e-6
         assert res["position_error_m"] == pytest.approx(ur5.tool_error(q, target)[0], abs=1e-12)
     code, out, _ = run(capsys, "ik", "ur5", "--target-q", *words)
-    assert code == 0 and "start: the middle of the joint limits" in out
+    assert code == 0 and "start: a well-conditioned configuration" in out
     code, out, _ = run(capsys, "ik", "ur5", "--target-q", *words, "--start-q", "random", "--seed", "1")
     assert code == 0 and "start: drawn at random from the seed" in out
 
@@ -511,8 +512,11 @@ def test_a_robot_with_an_srdf_home_starts_from_it(tmp_path):
     robot = kinelab.load(str(ur5.urdf_path), tool=ur5.tool, srdf=str(srdf))
     q, how = robot.reference_q()
     assert q.tolist() == home and how == "the SRDF's 'home' configuration"
-    q, how = ur5.reference_q()
-    assert np.allclose(q, 0.5 * (ur5.lower + ur5.upper)) and how == "the middle of the joint limits"
+    q, how = ur5.reference_q()  # without the SRDF: not its singular middle (#60 item 1)
+    assert np.array_equal(q, ur5.display_q()) and how.startswith("a well-conditioned configuration")
+    panda = kinelab.load("panda")
+    q, how = panda.reference_q()  # a middle that is well conditioned stays the start
+    assert np.allclose(q, 0.5 * (panda.lower + panda.upper)) and how == "the middle of the joint limits"
 
 
 def _told_before(capsys, monkeypatch, argv, slow):

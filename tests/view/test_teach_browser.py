@@ -121,3 +121,16 @@ def test_the_branch_button_goes_to_another_branch_of_the_same_target(page):
     assert np.abs(q - before).max() > 1e-3
     assert_meets(robot, q, target)
     assert p.eval("window.kinelab.readout.status").startswith("branch 2 of ")
+
+
+def test_without_a_start_the_page_opens_at_a_well_conditioned_pose_and_says_so():
+    """#60 item 1: `kinelab teach ur5` opened at all zeros, "σ_min 1.473e-17 — singular: rank 5 of 6"."""
+    ur5 = kinelab.load("ur5")
+    with teach(ur5) as served, open_page(served.url) as p:
+        p.wait_for("window.kinelab && window.kinelab.ready", 90)
+        settle(p)
+        r = p.eval("window.kinelab.readout")
+        assert r["rank"] == r["full_rank"] == 6
+        shown = p.eval("document.getElementById('kinelab-readout').textContent")
+        assert "singular" not in shown
+        assert "well-conditioned" in p.eval("document.getElementById('kinelab-legend').textContent")

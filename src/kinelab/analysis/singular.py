@@ -21,9 +21,9 @@ import numpy as np
 
 from kinelab.errors import OptionError
 from kinelab.robot import Chain
+from kinelab.robot.chain import NEAR_SINGULAR as NEAR_SINGULAR  # σ_min/σ_max below: near-singular (one threshold)
 
 RANK_RTOL = 1e-6  # singular values below RANK_RTOL × σ_max count as zero
-NEAR_SINGULAR = 1e-2  # σ_min/σ_max below this: worth refining onto the singular set
 
 
 @dataclass

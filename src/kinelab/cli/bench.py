@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from kinelab.cli.common import count, positive_number, print_json, seed_argument
+from kinelab.cli.common import count, positive_number, print_json, progress_of, seed_argument
 from kinelab.ik.words import TASKS
 from kinelab.report.outfolder import check_output_folder
 
@@ -79,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
         return _whole_body(args)
     first = _before_the_peers(args)
     result = bench.run(robots=args.robots, n=args.n, seed=args.seed, solvers=args.solvers,
-                       budget=args.budget_ms / 1e3, progress=not args.json, repeats=args.repeats, start=args.start,
+                       budget=args.budget_ms / 1e3, progress=progress_of(args), repeats=args.repeats, start=args.start,
                        sigma=args.sigma, schedule=args.schedule, task=args.task)
     result.update(first)
     if args.tracking:
@@ -89,35 +89,35 @@ def run(args: argparse.Namespace) -> int:
     if args.loops:
         from kinelab.report.bench import loops
 
-        result["loops"] = loops.run(args.robots, seed=args.seed, repeats=args.repeats, progress=not args.json)
+        result["loops"] = loops.run(args.robots, seed=args.seed, repeats=args.repeats, progress=progress_of(args))
     if args.budgets:
         from kinelab.report.bench import loops
 
-        result["budgets"] = loops.budgets_run(args.robots, seed=args.seed, n=args.n, progress=not args.json)
+        result["budgets"] = loops.budgets_run(args.robots, seed=args.seed, n=args.n, progress=progress_of(args))
     if args.versus:
         from kinelab.report.bench import versus
 
         result["versus"] = versus.run(args.robots, seed=args.seed, repeats=max(args.repeats, 2),
-                                      progress=not args.json)
+                                      progress=progress_of(args))
     if args.branches:
         from kinelab.report.bench import branches
 
         result["branches"] = branches.run(args.robots, seed=args.seed, repeats=max(args.repeats, 2),
-                                          progress=not args.json)
+                                          progress=progress_of(args))
     if args.completeness:
         from kinelab.report.bench import completeness
 
-        result["completeness"] = completeness.run(seed=args.seed, progress=not args.json)
+        result["completeness"] = completeness.run(seed=args.seed, progress=progress_of(args))
     if args.throughput:
         from kinelab.report.bench import throughput
 
         result["throughput"] = throughput.run(args.robots, seed=args.seed, repeats=args.repeats,
-                                              progress=not args.json)
+                                              progress=progress_of(args))
     if args.collisions:
         from kinelab.report.bench import collisions
 
         result["collisions"] = collisions.run(None, seed=args.seed, repeats=max(args.repeats, 2),
-                                              progress=not args.json)
+                                              progress=progress_of(args))
     if args.out:
         render.write_bench(result, args.out)
     if args.json:
@@ -136,7 +136,7 @@ def _whole_body(args: argparse.Namespace) -> int:
 
     result = runner.header()
     result["whole_body"] = wholebody.run(args.robots, rounds=args.repeats, solves=args.n, seed=args.seed,
-                                         progress=not args.json)
+                                         progress=progress_of(args))
     if args.out:
         render.write_bench(result, args.out)
     if args.json:
@@ -156,7 +156,7 @@ def _before_the_peers(args: argparse.Namespace) -> dict[str, Any]:
     if args.scaling:
         from kinelab.report.bench import scaling
 
-        first["scaling"] = scaling.run(progress=not args.json)
+        first["scaling"] = scaling.run(progress=progress_of(args))
     return first
 
 

@@ -257,3 +257,11 @@ class Interrupted(KeyboardInterrupt):
     def __init__(self, note: str):
         super().__init__(note)
         self.note = note
+
+
+def progress_of(args: argparse.Namespace) -> bool:
+    """Whether a command shows its progress bars: not with --json, and only where someone watches (a terminal or
+    Jupyter, :func:`kinelab.progress.interactive`): never bar frames in a log file."""
+    from kinelab.progress import interactive
+
+    return not getattr(args, "json", False) and interactive()

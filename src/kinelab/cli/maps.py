@@ -9,7 +9,16 @@ from pathlib import Path
 from typing import Any
 
 from kinelab.cli import common
-from kinelab.cli.common import Interrupted, Parser, load_robot, plural, print_json, seed_argument, source_arguments
+from kinelab.cli.common import (
+    Interrupted,
+    Parser,
+    load_robot,
+    plural,
+    print_json,
+    progress_of,
+    seed_argument,
+    source_arguments,
+)
 from kinelab.errors import KinelabError
 from kinelab.files import write_output
 from kinelab.progress import step
@@ -111,7 +120,7 @@ def run_singular(args: argparse.Namespace) -> int:
 
     robot = load_robot(args)
     result = maps.singularity(robot, samples=args.samples, seed=args.seed, method="grid" if args.grid else "random",
-                              progress=not args.json)
+                              progress=progress_of(args))
     ratio = result.sigma_ratio
     summary = {"robot": robot.name, "samples": int(len(ratio)), "rank_deficient": int(result.rank_deficient.sum()),
                "near_singular": int((ratio < NEAR_SINGULAR).sum()), "median_sigma_ratio": float(np.median(ratio))}
@@ -159,7 +168,8 @@ def run_reach(args: argparse.Namespace) -> int:
         client = cluster.client_for(args.scheduler, args.workers)
     t0 = time.perf_counter()
     try:
-        result = maps.reachability(robot, spec, out=args.out, force=args.force, progress=not args.json, client=client)
+        result = maps.reachability(robot, spec, out=args.out, force=args.force, progress=progress_of(args),
+                                   client=client)
     except KeyboardInterrupt:
         raise Interrupted(_kept(args)) from None
     finally:

@@ -56,7 +56,7 @@ def _sweep(robot: Any, args: argparse.Namespace) -> int:
     from kinelab.analysis import families, singular
 
     families.check_sweep_size(robot, args.sweep, force=args.force)
-    result = families.sweep(robot, samples=args.sweep, seed=args.seed, progress=not args.json,
+    result = families.sweep(robot, samples=args.sweep, seed=args.seed, progress=common.progress_of(args),
                             method="grid" if args.grid else "random")
     out = {"robot": robot.name, **result.to_dict()}
     if args.json:

@@ -6,7 +6,7 @@ import argparse
 import shutil
 from typing import Any
 
-from kinelab.cli.common import json_flag, print_json, seed_argument
+from kinelab.cli.common import json_flag, print_json, progress_of, seed_argument
 from kinelab.report.outfolder import check_output_folder
 
 
@@ -31,7 +31,7 @@ def run(args: argparse.Namespace) -> int:
     out = args.out or (None if args.json else "kinelab-report")  # --json alone writes no folder
     if out:
         check_output_folder(out, "validate")  # before the work, not after it
-    report = validate.run(robots=args.robots, n=args.n, seed=args.seed, progress=not args.json)
+    report = validate.run(robots=args.robots, n=args.n, seed=args.seed, progress=progress_of(args))
     if out:
         render.write_validate_report(report, out)
     if args.json:

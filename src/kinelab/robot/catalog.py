@@ -53,7 +53,8 @@ BUNDLED = (
           "European Robotic Arm, 7R symmetric, approximate geometry (seed 000)",
           display=(0.3, 0.5, -0.6, -1.3, 0.6, 0.4, 0.2)),
     Entry("youbot", "kinelab", "youbot.urdf", "tool",
-          "KUKA youBot arm on its planar base, Q = (X_C, Y_C, theta, theta1..theta5) (seed 003)",
+          "KUKA youBot arm on its planar base: platform_x, platform_y, platform_yaw, arm_joint_1..5 (the paper's "
+          "X_C, Y_C, theta, theta1..theta5; seed 003)",
           display=(0.0, 0.0, 0.0, 0.3, 0.5, 0.9, 0.7, 0.0)),
     Entry("xarm6", "kinelab", "xarm6.urdf", "link_eef",
           "UFACTORY xArm6, 6R without three axes meeting, from the maker's DH table"),

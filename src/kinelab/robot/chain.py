@@ -346,13 +346,20 @@ class Chain:
         """The configuration a command starts from when given none [rad, m], and where it comes from in words: the
         SRDF's configuration named "home" (or "ready") when the robot was loaded with an SRDF that has one, else
         the middle of each joint's limits (0 for a continuous joint, and for a revolute joint whose limits span
-        more turns than :meth:`random_q` draws from)."""
+        more turns than :meth:`random_q` draws from) when it is well conditioned, else :meth:`display_q` (a UR5's
+        middle is all zeros: stretched flat, singular). Well conditioned: σ_min/σ_max of the tool Jacobian (linear
+        rows divided by the characteristic length) at least ``NEAR_SINGULAR``, the threshold of
+        :mod:`kinelab.analysis.singular`."""
         if self.srdf is not None:
             for name in ("home", "ready"):
                 if name in self.srdf.states:
                     return self.named_q(name), f"the SRDF's {name!r} configuration"
         lower, upper = self.sample_bounds
-        return 0.5 * (lower + upper), "the middle of the joint limits"
+        middle = 0.5 * (lower + upper)
+        if conditioning(self, middle) >= NEAR_SINGULAR:
+            return middle, "the middle of the joint limits"
+        return self.display_q(), ("a well-conditioned configuration (the middle of the joint limits is near a "
+                                  "singular one)")
 
     def random_q(self, rng: np.random.Generator | int | None = None) -> np.ndarray:
         """A configuration drawn uniformly within the limits (continuous joints on [−π, π]; a revolute joint
@@ -598,19 +605,27 @@ def _read_only(arr: np.ndarray) -> np.ndarray:
     return arr
 
 
+NEAR_SINGULAR = 1e-2  # σ_min/σ_max below this: near a singular configuration (kinelab.analysis.singular's)
+
+
+def conditioning(robot: Chain, q: np.ndarray) -> float:
+    """σ_min/σ_max of the tool Jacobian at q (local world-aligned, linear rows divided by the characteristic
+    length; σ_min the min(n, 6)-th singular value): 0 at a singular configuration, 1 at an isotropic one."""
+    J = robot.jacobian_local_world_aligned(q)
+    J[:3] /= robot.characteristic_length()
+    s = np.linalg.svd(J, compute_uv=False)
+    return float(s[min(robot.n, 6) - 1] / s[0]) if s[0] > 0 else 0.0
+
+
 def _best_conditioned(robot: Chain) -> np.ndarray:
     rng = np.random.default_rng(0)
     lo = np.where(np.isfinite(robot.lower), robot.lower, -np.pi)
     hi = np.where(np.isfinite(robot.upper), robot.upper, np.pi)
     mid, half = (lo + hi) / 2, np.minimum((hi - lo) / 4, np.pi / 2)
-    length = robot.characteristic_length()
     best, best_ratio = robot.neutral(), -1.0
     for _ in range(64):
         q = mid + rng.uniform(-1.0, 1.0, robot.n) * half
-        J = robot.jacobian_local_world_aligned(q)
-        J[:3] /= length
-        s = np.linalg.svd(J, compute_uv=False)
-        ratio = s[min(robot.n, 6) - 1] / s[0] if s[0] > 0 else 0.0
+        ratio = conditioning(robot, q)
         if ratio > best_ratio:
             best, best_ratio = q, ratio
     return best

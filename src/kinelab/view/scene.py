@@ -20,6 +20,7 @@ import pinocchio as pin
 from kinelab.errors import ConfigurationError
 from kinelab.files import write_output
 from kinelab.robot import Chain
+from kinelab.robot.chain import NEAR_SINGULAR
 from kinelab.view.caption import Table, tab_title, titled, with_caption
 from kinelab.view.framing import FILL, frame_points
 from kinelab.view.labels import draw_number
@@ -240,12 +241,12 @@ class Scene:
                     _arrow(self.viewer["singular"][f"lost{k}_{kind}"], oMtool.translation, np.array(axis),
                            scale * share, 0.04 * self.frame_length, color)
         ratio = float(a.singular_values[a.full_rank - 1] / a.singular_values[0])
-        level = min(1.0, max(0.0, (np.log10(max(ratio, 1e-12)) + 6) / 5))  # 1e-6 → red, 0.1 → green
-        color = int(255 * (1 - level)) << 16 | int(255 * level) << 8
-        self.viewer["singular"]["sigma"].set_object(g.Sphere(0.3 * self.frame_length), on_top(color, 0.75))
+        self.viewer["singular"]["sigma"].set_object(g.Sphere(0.3 * self.frame_length),
+                                                    on_top(sigma_colour(ratio), 0.75))
         self.viewer["singular"]["sigma"].set_transform(pin.SE3(np.eye(3), oMtool.translation).homogeneous)
-        self.legend["sigma"] = (f"sphere at the tool: σ_min/σ_max = {ratio:.3g} (red at 1e-6 and below, green at 0.1 "
-                                f"and above); rank {a.rank} of {a.full_rank}")
+        self.legend["sigma"] = (f"sphere at the tool: σ_min/σ_max = {ratio:.3g} — {sigma_words(ratio)} (red to "
+                                f"orange below {NEAR_SINGULAR:g}, near-singular as `kinelab singular` says; "
+                                f"yellow-green to green above); rank {a.rank} of {a.full_rank}")
         if "translation" in kinds:
             self.legend["lost_translation"] = ("magenta arrow: a tool direction the arm cannot move in "
                                                "(length: its share)")
@@ -286,6 +287,21 @@ class Scene:
         if self.server is not None:
             self.server.stop()
 
+
+
+def sigma_colour(ratio: float) -> int:
+    """The σ_min/σ_max sphere's colour (0xRRGGBB): red at 1e-6 and below to orange just under NEAR_SINGULAR (the
+    one near-singular threshold), yellow-green at it to green at 0.1 and above."""
+    if ratio < NEAR_SINGULAR:
+        level = min(1.0, max(0.0, (np.log10(max(ratio, 1e-12)) + 6) / (np.log10(NEAR_SINGULAR) + 6)))
+        return 0xFF << 16 | int(0x99 * level) << 8  # red → orange
+    level = min(1.0, (np.log10(ratio) - np.log10(NEAR_SINGULAR)) / (-1 - np.log10(NEAR_SINGULAR)))
+    return int(0xB0 * (1 - level)) << 16 | int(0xC0 + 0x30 * level) << 8  # yellow-green → green
+
+
+def sigma_words(ratio: float) -> str:
+    """The σ_min/σ_max ratio in the words `kinelab singular` uses."""
+    return "near-singular" if ratio < NEAR_SINGULAR else "away from a singular configuration"
 
 
 def aim_camera(viewer: Any, points: np.ndarray, margin: float, fill: float = FILL, aspect: float = PAGE_ASPECT,
