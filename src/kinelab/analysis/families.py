@@ -6,6 +6,7 @@ See :mod:`kinelab.analysis.singular` for units and frames (the scaled Jacobian, 
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -61,10 +62,12 @@ class Relation:
     sign: tuple[int, ...]
     value: float
     text: str
+    period: float | None = None  # 2π for a relation of angles (its value taken modulo 2π), None for a slide's
 
     def residual(self, q) -> float:
-        """How far q is from meeting the family's relations (0 on them)."""
-        return abs(sum(s * q[i] for i, s in zip(self.index, self.sign, strict=True)) - self.value)
+        """How far q is from meeting the family's relations (0 on them; a relation of angles modulo 2π)."""
+        gap = sum(s * q[i] for i, s in zip(self.index, self.sign, strict=True)) - self.value
+        return abs(math.remainder(gap, self.period)) if self.period else abs(gap)
 
 
 def _label(c: float) -> str:
@@ -109,7 +112,10 @@ def joint_relations(robot: Chain, q, tol: float = RELATION_TOL) -> list[Relation
             continue
         lhs = names[index[0]] + "".join(f" {'+' if s > 0 else '−'} {names[i]}"
                                         for i, s in zip(index[1:], sign[1:], strict=True))
-        out.append(Relation(index, sign, float(c), f"{lhs} = {_label(c)}"))
+        angular = all(robot.joint_kinds[i] != "prismatic" for i in index) and c in SPECIAL_VALUES
+        if angular:  # one family for every turn: 2π is 0, −π is π
+            c = math.remainder(c, 2 * np.pi) if abs(abs(math.remainder(c, 2 * np.pi)) - np.pi) > 1e-12 else np.pi
+        out.append(Relation(index, sign, float(c), f"{lhs} = {_label(c)}", 2 * np.pi if angular else None))
         if len(index) == 1:
             fixed.add(index[0])
     return out
@@ -175,6 +181,29 @@ def _merge_coincidences(groups: dict[tuple, list]) -> dict[tuple, list]:
         rel, verified = key
         home = next((k for k in merged if k[0] and verified and k[1] and set(k[0]) < set(rel)), None)
         merged.setdefault(home or key, []).extend(groups[key])
+    return merged
+
+
+def _merge_half_turns(groups: dict[tuple, list]) -> dict[tuple, list]:
+    """Two verified families of one angle relation whose values differ by π (a wrist at 0 and at π: its axes
+    parallel either way) are one family, "= 0 or π"; the singular configurations no simple relation explains are
+    one family (the relations that hold at each by chance do not split it)."""
+    merged: dict[tuple, list] = {}
+    for key in sorted(groups, key=lambda k: [r.value for r in k[0]]):
+        rel, verified = key
+        if not verified:
+            merged.setdefault(((), False), []).extend(groups[key])
+            continue
+        partner = next((k for k in merged if verified and k[1] and len(rel) == len(k[0]) == 1
+                        and rel[0].period and (k[0][0].index, k[0][0].sign) == (rel[0].index, rel[0].sign)
+                        and abs(abs(k[0][0].value - rel[0].value) - np.pi) < 1e-9), None)
+        if partner is None:
+            merged[key] = list(groups[key])
+            continue
+        first = partner[0][0]
+        both = Relation(first.index, first.sign, first.value,
+                        f"{first.text} or {_label(rel[0].value)}", np.pi)
+        merged[((both,), True)] = merged.pop(partner) + list(groups[key])
     return merged
 
 
@@ -294,7 +323,8 @@ def sweep(robot: Chain, samples: int = 5000, seed: int = 0, refine_top: int = 40
     order = [i for i in np.argsort(ratios) if ratios[i] < NEAR_SINGULAR]
     groups, refined, singular_count = _refine_samples(robot, qs, order, lower, upper, L, refine_top, progress)
     families = []
-    for (rel, verified), members in sorted(_merge_coincidences(groups).items(), key=lambda kv: -len(kv[1])):
+    merged = _merge_half_turns(_merge_coincidences(groups))
+    for (rel, verified), members in sorted(merged.items(), key=lambda kv: -len(kv[1])):
         a = analyze(robot, members[0], L)
         families.append(Family(list(rel), len(members), members[0], a.rank,
                                float(a.singular_values[a.full_rank - 1] / a.singular_values[0]), verified))

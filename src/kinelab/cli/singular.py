@@ -9,6 +9,12 @@ from kinelab.cli import common
 from kinelab.errors import KinelabError
 
 
+def reading(value: float, digits: int = 4) -> str:
+    """A number rounded for reading (no "-0.0000": a rounded zero has no sign)."""
+    text = f"{value:.{digits}f}"
+    return text[1:] if text.startswith("-") and float(text) == 0.0 else text
+
+
 def add(sub: Any) -> None:
     """The ``singular`` subcommand."""
     s = sub.add_parser("singular", help="rank, singular values, lost directions; or a sweep for singular families")
@@ -67,8 +73,8 @@ def _sweep(robot: Any, args: argparse.Namespace) -> int:
     asked = f" (a grid of {args.sweep} asked for)" if result.samples != args.sweep else ""
     print(f"{robot.name}: {common.plural(result.samples, 'sample')}{asked}, {out['near_singular']} near-singular "
           f"(σ_min/σ_max < {singular.NEAR_SINGULAR:g}), {out['refined']} refined, {out['singular']} singular "
-          "after refinement")
+          "after refinement (relations of angles hold modulo 2π; q rounded to 4 decimals, --json has every digit)")
     for f in result.families:
         print(f"  rank {f.rank}, {f.count:4d} found: {f.text}")
-        print(f"      e.g. q = {' '.join(repr(float(v)) for v in f.representative)}")
+        print(f"      e.g. q = {' '.join(reading(v) for v in f.representative)}")
     return 0
