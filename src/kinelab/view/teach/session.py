@@ -65,7 +65,31 @@ class TeachOptions:
             as_collisions(self.collisions)
 
 
-class TeachSession:
+class Session:
+    """What every teach page's session shares: the robot, q, a status line, the lock its actions hold, and
+    setting q directly (``robot.check_q``'s q: a chain's joints, or a whole robot's Pinocchio q)."""
+
+    robot: Any
+    q: np.ndarray
+    status: str
+    lock: threading.RLock
+
+    @_locked
+    def set_q(self, q: Any) -> None:
+        """Put the robot at q (within the limits, rad or m); the targets stay.
+
+        Raises:
+            ConfigurationError: q of the wrong length, not finite or outside the limits (named).
+        """
+        self.q = self.robot.check_q(q, limits=True)
+        self.status = "joints set"
+        self._draw()
+
+    def _draw(self) -> None:
+        raise NotImplementedError
+
+
+class TeachSession(Session):
     """A robot to move by hand: joint values set directly, or a target pose the robot follows by IK."""
 
     def __init__(self, robot: Chain, q: Any = None, options: TeachOptions | None = None):
@@ -101,17 +125,6 @@ class TeachSession:
         self._draw()
 
     # -- actions --------------------------------------------------------------------------------
-    @_locked
-    def set_q(self, q: Any) -> None:
-        """Put the robot at q (one value per joint [rad or m], within the limits); the target stays.
-
-        Raises:
-            ConfigurationError: q of the wrong length, not finite or outside the limits (named).
-        """
-        self.q = self.robot.check_q(q, limits=True)
-        self.status = "joints set"
-        self._draw()
-
     @_locked
     def set_target(self, oMtarget: pin.SE3, index: int = 0) -> None:
         """Move the target to a pose (base frame) and follow it: FRDM from the current q (the answer's revolute

@@ -18,13 +18,13 @@ import pinocchio as pin
 from kinelab.errors import KinelabError, OptionError
 from kinelab.robot.tree import Robot
 from kinelab.view.teach.recorder import RecordingWindow
-from kinelab.view.teach.session import TeachOptions, _checked_pose, _locked, _pose, _short
+from kinelab.view.teach.session import Session, TeachOptions, _checked_pose, _locked, _pose, _short
 
 SOLE = (0.20, 0.10)  # [m] the sole drawn under each foot frame for the support polygon: length (x), width (y)
 GOLD, COM, INSIDE, OUTSIDE = 0xF2B01E, 0xD62728, 0x2CA02C, 0xD62728
 
 
-class WholeTeachSession:
+class WholeTeachSession(Session):
     """A whole robot to move by hand: its hands' targets dragged, its feet and centre of mass held."""
 
     def __init__(self, robot: Robot, q: Any = None, options: TeachOptions | None = None,
@@ -60,17 +60,6 @@ class WholeTeachSession:
         self._draw()
 
     # -- actions --------------------------------------------------------------------------------
-    @_locked
-    def set_q(self, q: Any) -> None:
-        """Put the robot at q (Pinocchio's q, within the limits); the targets stay.
-
-        Raises:
-            ConfigurationError: q of the wrong length, not finite or outside the limits (named).
-        """
-        self.q = self.robot.check_q(q, limits=True)
-        self.status = "joints set"
-        self._draw()
-
     @_locked
     def set_target(self, oMtarget: pin.SE3, index: int = 0) -> None:
         """Move hand ``index``'s target (base frame) and meet every task from where the robot stands; q stays where
