@@ -11,7 +11,8 @@ import base64
 import html
 import platform
 
-from kinelab.report.validate import Check, Report
+from kinelab.report.check import Check
+from kinelab.report.validate import Report
 
 CAPTIONS = {
     "era_elbow.png": "Seed 000, ERA elbow passage: joint angles θ3–θ5 along the path without the bypass (left: the "

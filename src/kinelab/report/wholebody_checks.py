@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from kinelab.report.validate import Check
+from kinelab.report.check import Check
 from kinelab.robot.tree import Robot
 
 FD = 1e-6  # [rad or m] the central difference's step
