@@ -16,4 +16,4 @@ def test_a_ur5_sweep_lists_each_family_once_in_words_and_rounded(capsys):
     assert len(families) == len(set(families)) <= 3
     for line in re.findall(r"e\.g\. q = (.*)", out):
         values = line.split()
-        assert all(re.fullmatch(r"-?\d+\.\d{4}", v) for v in values) and "-0.0000" not in values
+        assert all(re.fullmatch(r"-?\d+\.\d{8}", v) for v in values) and "-0.00000000" not in values

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import shlex
+import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -147,6 +148,20 @@ def _kept(args: argparse.Namespace) -> str:
             f"kinelab {shlex.join(args.command_line)}")
 
 
+def _say_resumed(args: argparse.Namespace) -> None:
+    """One line on stderr when --out holds chunks of an unfinished map (a run that resumes it)."""
+    if not args.out:
+        return
+    from kinelab.maps import store
+
+    try:
+        done = int(sum(store.load(args.out, check=False).done[:]))
+    except KinelabError:
+        return
+    if done:
+        print(f"kinelab: map (resumed: {done} chunks already in {args.out})", file=sys.stderr, flush=True)
+
+
 def run_reach(args: argparse.Namespace) -> int:
     """Build (or resume) the reachability map and print its summary."""
     import numpy as np
@@ -167,9 +182,11 @@ def run_reach(args: argparse.Namespace) -> int:
     if args.scheduler is not None or args.workers:
         client = cluster.client_for(args.scheduler, args.workers)
     t0 = time.perf_counter()
+    shown = progress_of(args)
+    if not shown:  # the bar says it where someone watches; a log file gets the one line
+        _say_resumed(args)
     try:
-        result = maps.reachability(robot, spec, out=args.out, force=args.force, progress=progress_of(args),
-                                   client=client)
+        result = maps.reachability(robot, spec, out=args.out, force=args.force, progress=shown, client=client)
     except KeyboardInterrupt:
         raise Interrupted(_kept(args)) from None
     finally:

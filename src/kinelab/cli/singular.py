@@ -73,8 +73,9 @@ def _sweep(robot: Any, args: argparse.Namespace) -> int:
     asked = f" (a grid of {args.sweep} asked for)" if result.samples != args.sweep else ""
     print(f"{robot.name}: {common.plural(result.samples, 'sample')}{asked}, {out['near_singular']} near-singular "
           f"(σ_min/σ_max < {singular.NEAR_SINGULAR:g}), {out['refined']} refined, {out['singular']} singular "
-          "after refinement (relations of angles hold modulo 2π; q rounded to 4 decimals, --json has every digit)")
+          "after refinement (relations of angles hold modulo 2π; q to 8 decimals, still singular when pasted back; "
+          "--json has every digit)")
     for f in result.families:
         print(f"  rank {f.rank}, {f.count:4d} found: {f.text}")
-        print(f"      e.g. q = {' '.join(reading(v) for v in f.representative)}")
+        print(f"      e.g. q = {' '.join(reading(v, 8) for v in f.representative)}")
     return 0
