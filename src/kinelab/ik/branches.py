@@ -108,11 +108,14 @@ def find_all(robot: Chain, target: Any, req: Request, q_ref: Any = None, max_sol
         if isinstance(redundancy, SEW):
             return sew_all(robot, target, req, redundancy, ref, max_solutions)
         return redundant_all(robot, target, req, redundancy, ref, max_solutions)
+    spent = 0.0
     if method is not Route.MULTISTART:
+        t0 = time.perf_counter()
         found = _closed_form_all(robot, target, req, ref, max_solutions, method)
         if found is not None:
             return found
-    return _multistart_all(robot, target, req, ref, max_solutions, stop_below)
+        spent = time.perf_counter() - t0  # the search after a 1-D search that found nothing has what is left
+    return _multistart_all(robot, target, req, ref, max_solutions, stop_below, spent)
 
 
 def _closed_form_all(robot: Chain, target: Any, req: Request, ref: Any, max_solutions: int | None,
@@ -192,10 +195,11 @@ def _check_search(method: Route, max_solutions: int | None, stop_below: float | 
 
 
 def _multistart_all(robot: Chain, target: Any, req: Request, ref: np.ndarray | None, max_solutions: int | None,
-                    stop_below: float | None) -> Branches:
-    """Every solution rounds of seeded starts find (see :func:`find_all`), nearest ``ref`` first when given."""
+                    stop_below: float | None, spent: float = 0.0) -> Branches:
+    """Every solution rounds of seeded starts find (see :func:`find_all`), nearest ``ref`` first when given;
+    ``spent`` [s] of the budget already gone."""
     prepare(robot, req)  # before the budget's clock
-    t0 = time.perf_counter()
+    t0 = time.perf_counter() - spent
     found, rounds = _search(robot, target, req, max_solutions, stop_below, t0)
     elapsed = time.perf_counter() - t0
     if ref is not None:
