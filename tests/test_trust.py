@@ -59,6 +59,15 @@ def test_a_package_uri_cannot_climb_out_of_its_package_and_only_meshes_resolve(t
     assert resolve_uri("package://arm/meshes/../../../secret.stl", package, dirs) is None
     assert resolve_uri("/etc/passwd", package, dirs) is None  # an absolute path, but no mesh
     assert resolve_uri(str(secret), package, dirs) == secret  # an absolute mesh the file's author named
+    # "package:///" (an empty host, as TALOS's full URDF writes it) names the same package, and climbs no higher
+    assert resolve_uri("package:///arm/meshes/link.stl", package, dirs) == package / "meshes" / "link.stl"
+    assert resolve_uri("package:////../secret.stl", package, dirs) is None
+
+
+def test_talos_full_urdf_draws_every_visual_mesh():
+    talos_left = kinelab.load("talos_left")  # its URDF names its meshes "package:///example-robot-data/..."
+    assert talos_left.missing_meshes() == []
+    assert talos_left.visual_model().ngeoms >= 50
 
 
 def test_an_unknown_solver_is_listed_once():

@@ -79,7 +79,7 @@ def resolve_uri(uri: str, urdf_dir: str | Path, package_dirs: list[str] | None =
     """
     dirs = mesh_package_dirs() if package_dirs is None else list(package_dirs)
     if uri.startswith("package://"):
-        rest = uri[len("package://"):]
+        rest = uri[len("package://"):].lstrip("/")  # "package:///name/..." (TALOS full v2) names the same file
         candidates = _package_candidates(rest, dirs) + [(Path(urdf_dir) / rest.split("/", 1)[-1], Path(urdf_dir))]
         found = [c for c, folder in candidates if _within(c, folder)]
     else:

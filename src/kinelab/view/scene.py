@@ -24,6 +24,7 @@ from kinelab.robot.chain import NEAR_SINGULAR
 from kinelab.view.caption import Table, tab_title, titled, with_caption
 from kinelab.view.framing import FILL, frame_points
 from kinelab.view.labels import draw_number
+from kinelab.view.meshes import load_robot
 from kinelab.view.server import Server
 
 SPREAD_FILL = 1.1  # side-by-side copies stand on a wide flat patch: its sphere may overfill the frame's height
@@ -54,7 +55,7 @@ class Scene:
         self.pinviz = MeshcatVisualizer(robot.model, pin.GeometryModel(), self.geom)
         self.pinviz.initViewer(viewer=self.viewer)
         self.root = name or robot.name
-        self.pinviz.loadViewerModel(rootNodeName=self.root)
+        load_robot(self.pinviz, self.root)
         self.frame_length = frame_length or 0.5 * robot.characteristic_length()
         self._reach = self._arm_reach()
         self.title = robot.name

@@ -163,11 +163,12 @@ class WholeTeachSession(Session):
         import meshcat.geometry as g
         from pinocchio.visualize import MeshcatVisualizer
 
+        from kinelab.view.meshes import load_robot
         from kinelab.view.scene import AXIS_COLORS, aim_camera, on_top
 
         self.viz = MeshcatVisualizer(self.robot.model, pin.GeometryModel(), self.robot.visual_model())
         self.viz.initViewer(viewer=self.viewer)
-        self.viz.loadViewerModel(rootNodeName=self.robot.name)
+        load_robot(self.viz, self.robot.name)
         self.viewer["/Axes"].set_property("visible", False)
         for k in range(len(self.hands)):
             for name, length in ((f"target_{k}", 1.3 * self.frame_length), (f"hand_{k}", self.frame_length)):
