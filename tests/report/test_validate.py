@@ -1,4 +1,5 @@
 import json
+import os
 import re
 from pathlib import Path
 
@@ -105,7 +106,8 @@ def test_the_html_report_puts_the_verdict_first_and_a_section_per_paper_with_cap
     assert "<tr class='failed'>" in page and page.count("<tr class='failed'>") == 1
     section = page[page.index("Seed paper 000"):]
     assert "<figcaption>Figure: Seed 000, ERA wrist passage" in section and "data:image/png;base64," in section
-    assert page.index("Machine and versions") > page.index("<figcaption>")  # the machine last
+    # #60 item 7: what the run ran on right under the verdict, before the first check (it was 6,700 px down)
+    assert page.index("class='verdict fail'") < page.index("Machine and versions") < page.index("<table><tr><th>robot")
     assert "<script" not in page and "http" not in page  # self-contained
 
 
@@ -126,12 +128,12 @@ def test_a_browser_shows_the_verdict_banner_at_the_top_of_the_report(tmp_path):
             pytest.fail("CI must have chromium: .ci/run installs Debian's chromium")
         pytest.skip("Debian's chromium is not installed here")
     (tmp_path / "report.html").write_text(validate_html(_report_with_one_failure(), {}))
-    png = browser.screenshot(tmp_path / "report.html", tmp_path / "report.png", size=(900, 700))
+    png = browser.screenshot(tmp_path / "report.html", tmp_path / "report.png", size=(900, 1400))
     rgb = np.asarray(Image.open(png).convert("RGB"), dtype=int)
     red = (np.abs(rgb - (0xB3, 0x26, 0x1E)).max(axis=2) < 12)
     tint = (np.abs(rgb - (0xFD, 0xEC, 0xEA)).max(axis=2) < 6)
     assert red[:160].sum() > 5000  # the banner, first thing on the page
-    assert tint.sum() > 2000  # the failed check's row
+    assert tint.sum() > 2000  # the failed check's row (under the machine and versions)
 
 
 def test_the_closed_form_checks_hold_on_ur5_and_fail_when_a_branch_is_missing(monkeypatch):
@@ -143,7 +145,7 @@ def test_the_closed_form_checks_hold_on_ur5_and_fail_when_a_branch_is_missing(mo
     ur5 = kinelab.load("ur5")
     rows = validate.analytic_checks(ur5, 40, 0)
     assert [r.name for r in rows] == ["closed form: every branch met (Pinocchio-checked)",
-                                      *(f"{s}: every answer is one of the closed form's branches"
+                                      *(f"{s}: answers off the closed form's branches"
                                         for s in ("frdm", "biquat", "dls")),
                                       "completeness: the pose's own configuration among the branches, to 1e-06 rad"]
     assert all(r.passed for r in rows) and "on the branch nearest its start" in rows[1].detail
@@ -185,8 +187,8 @@ def test_the_collision_checks_hold_on_panda_and_fail_when_the_check_sees_nothing
 
     panda = kinelab.load("panda")
     rows = validate.collision_checks(panda, 40, 0)
-    assert [r.name for r in rows] == ["collisions: the check agrees with Pinocchio's distances",
-                                      "collisions: no success collides"]
+    assert [r.name for r in rows] == ["collisions: configurations where the check and Pinocchio's distances disagree",
+                                      "collisions: successes that collide"]
     assert all(r.passed for r in rows)
     assert validate.collision_checks(kinelab.load("stanford"), 40, 0) == []  # no collision geometry: no check
     monkeypatch.setattr(CollisionModel, "colliding_pair", lambda self, q, first_test=True: None)
@@ -249,23 +251,57 @@ def test_the_report_says_when_with_what_code_libraries_processor_and_command_it_
     assert p["date"] in line and "kinelab validate --robots ur5" in line and p["processor"] in line
 
 
-def test_shares_carry_their_wilson_interval_and_sample_in_every_form_of_the_report(tmp_path):
+def test_shares_carry_their_wilson_interval_and_pass_on_its_bound_in_every_form_of_the_report(tmp_path):
     """#43 item 5: success rates had no interval and the headline one sample size for every check. The Wilson
-    interval of 50 successes in 100 is 40.4–59.6 % and of 50 in 50 is 92.9–100 % (n / (n + z²) for no failure)."""
+    interval of 50 successes in 100 is 40.4–59.6 % and of 50 in 50 is 92.9–100 % (n / (n + z²) for no failure).
+    #60 item 7: a share is a fraction (unit "share", not "%" over a fraction) and passes on its 95 % lower bound:
+    50 of 50 does not show 95 %, 100 of 100 (96.3 % at least) does."""
     assert validate.wilson(0.5, 100) == pytest.approx((0.40383, 0.59617), abs=1e-5)
     assert validate.wilson(1.0, 50) == pytest.approx((50 / (50 + 1.959963984540054**2), 1.0), abs=1e-12)
-    share = validate.Check("ur5", "frdm: targets solved (Pinocchio-checked)", 1.0, 0.95, "%", "50 targets",
+    short = validate.Check("ur5", "frdm: targets solved (Pinocchio-checked)", 1.0, 0.95, "share", "50 targets",
                            at_least=True, samples=50)
+    enough = validate.Check("ur5", "biquat: targets solved (Pinocchio-checked)", 1.0, 0.95, "share", "100 targets",
+                            at_least=True, samples=100)
     error = validate.Check("ur5", "FK position: yourdfpy vs Pinocchio", 2e-16, 1e-9, "m", "200 random q")
-    report = validate.Report(robots=["ur5"], checks=[share, error], n=200)
-    assert report.to_dict()["checks"][0]["interval_95"] == pytest.approx(validate.wilson(1.0, 50))
-    assert report.to_dict()["checks"][1]["interval_95"] is None
+    assert not short.passed and enough.passed and error.passed
+    report = validate.Report(robots=["ur5"], checks=[short, enough, error], n=200)
+    checks = report.to_dict()["checks"]
+    assert checks[0]["interval_95"] == pytest.approx(validate.wilson(1.0, 50)) and checks[0]["unit"] == "share"
+    assert checks[0]["value"] == 1.0 and checks[2]["interval_95"] is None
     render._write_validate_files(report, tmp_path)
     md = (tmp_path / "report.md").read_text()
-    assert "| 100.0 % (95 %: 92.9–100.0 %, n = 50) | ≥ 95 % | PASS |" in md
-    assert "each other check stating its own sample" in md
+    assert "| 100.0 % (95 %: 92.9–100.0 %, n = 50) | ≥ 95 % | FAIL |" in md
+    assert "| 100.0 % (95 %: 96.3–100.0 %, n = 100) | ≥ 95 % | PASS |" in md
+    assert "each other check stating its own sample" in md and "pass on its bound" in md
     page = (tmp_path / "report.html").read_text()
     assert "(95 %: 92.9–100.0 %, n = 50)" in page and "configurations per check" not in page
+
+
+def test_samples_for_a_bar_are_the_least_whose_bound_clears_it():
+    from kinelab.report.check import samples_for
+
+    for bar, misses in ((0.9, 0), (0.95, 2), (0.98, 1), (0.995, 0)):
+        n = samples_for(bar, misses)
+        assert validate.wilson((n - misses) / n, n)[0] >= bar > validate.wilson((n - 1 - misses) / (n - 1), n - 1)[0]
+    assert samples_for(0.95) == 73  # n / (n + z²) ≥ 0.95 first at n = 73: z² · 19 = 72.99
+
+
+def test_provenance_names_the_machine_and_what_defines_the_robots_and_the_reference():
+    """#60 item 7: the processor's model and cores, and the versions of example-robot-data, yourdfpy, SciPy and
+    coal, in the JSON (first), the Markdown and the page (at the top)."""
+    from importlib import metadata
+
+    from kinelab.report.provenance import provenance
+
+    p = provenance()
+    assert p["cores"] == os.cpu_count()
+    for key, dist in (("example-robot-data", "example-robot-data"), ("yourdfpy", "yourdfpy"), ("scipy", "scipy"),
+                      ("coal", "coal"), ("pinocchio", "pin")):
+        assert p[key] == metadata.version(dist)
+    report = validate.Report(robots=["ur5"], checks=[], n=10)
+    assert next(iter(report.to_dict())) == "provenance"
+    line = render.provenance_line(report.provenance)
+    assert f"example-robot-data {p['example-robot-data']}" in line and f"{p['cores']} cores" in line
 
 
 def test_every_joint_of_the_era_passage_figures_can_be_seen(tmp_path):

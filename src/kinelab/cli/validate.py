@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import shutil
+import textwrap
 from typing import Any
 
 from kinelab.cli.common import json_flag, print_json, progress_of, seed_argument
@@ -37,6 +38,8 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(report.to_dict())
     else:
-        print(render.validate_table(report, width=shutil.get_terminal_size((120, 24)).columns))
+        width = shutil.get_terminal_size((120, 24)).columns
+        print(textwrap.fill(render.provenance_line(report.provenance), width), end="\n\n")
+        print(render.validate_table(report, width=width))
         print(f"report written to {out}")
     return 0 if report.passed else 1

@@ -12,6 +12,7 @@ import html
 import platform
 
 from kinelab.report.check import Check
+from kinelab.report.provenance import LIBRARIES
 from kinelab.report.validate import Report
 
 CAPTIONS = {
@@ -51,19 +52,19 @@ def validate_html(report: Report, figures: dict[str, bytes]) -> str:
     failed = [c for c in report.checks if not c.passed]
     summary = (f"{len(report.checks) - len(failed)} of {len(report.checks)} checks passed on "
                f"{', '.join(report.robots)} ({report.n} configurations for the FK checks, each other check its own "
-               f"sample; shares with their 95 % Wilson interval; seed {report.seed}).")
+               f"sample; shares with their 95 % Wilson interval, passing on its bound; seed {report.seed}).")
     if failed:
         summary += " Failed: " + "; ".join(f"{c.robot}: {c.name}" for c in failed) + "."
     parts = [f"<!doctype html><html><head><meta charset='utf-8'><title>kinelab validate: {verdict}</title>",
              f"<style>{STYLE}</style></head><body><h1>kinelab validate</h1>",
-             f"<div class='verdict {verdict.lower()}'>{verdict}</div><p>{html.escape(summary)}</p>"]
+             f"<div class='verdict {verdict.lower()}'>{verdict}</div><p>{html.escape(summary)}</p>",
+             _machine(report.provenance)]
     general = [c for c in report.checks if not any(c.name.startswith(key) for key, _, _ in SECTIONS)]
     parts.append(_section("Models and solvers, checked against Pinocchio", general, {}))
     for key, title, prefix in SECTIONS:
         checks = [c for c in report.checks if c.name.startswith(key)]
         if checks:
             parts.append(_section(title, checks, {n: b for n, b in figures.items() if n.startswith(prefix)}))
-    parts.append(_machine(report.provenance))
     return "".join(parts) + "</body></html>"
 
 
@@ -90,6 +91,7 @@ def _machine(p: dict) -> str:
     rows = {"date (UTC)": p["date"], "command": p["command"], "kinelab": p["kinelab"],
             "commit": p.get("commit") or "not a git checkout", "compiled core": p["core"],
             "machine": f"{platform.platform()} ({platform.machine()})", "processor": p["processor"],
-            "Python": p["python"], "Pinocchio": p["pinocchio"], "NumPy": p["numpy"]}
+            "logical processors": str(p.get("cores", "?")), "Python": p["python"],
+            **{name: str(p[name]) for name in LIBRARIES if name in p}}
     items = "".join(f"<tr><th>{html.escape(k)}</th><td>{html.escape(v)}</td></tr>" for k, v in rows.items())
     return f"<h2>Machine and versions</h2><table class='meta'>{items}</table>"

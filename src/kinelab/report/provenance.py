@@ -7,28 +7,41 @@ run. Outside a checkout it is None.
 
 from __future__ import annotations
 
+import os
 import platform
 import shlex
 import sys
 from datetime import datetime, timezone
+from importlib import metadata
 from pathlib import Path
 from typing import Any
 
+# the distributions that define the robots (example-robot-data, yourdfpy) and the reference (Pinocchio, coal,
+# NumPy, SciPy): their versions go into every report
+LIBRARIES = {"pinocchio": "pin", "coal": "coal", "example-robot-data": "example-robot-data",
+             "yourdfpy": "yourdfpy", "numpy": "numpy", "scipy": "scipy"}
+
 
 def provenance() -> dict[str, Any]:
-    """The run's provenance: ``date`` (UTC, ISO 8601), ``command``, ``kinelab``, ``commit`` (or None),
-    ``pinocchio``, ``numpy``, ``core`` (the compiled core's source SHA-256, first 12 hex digits), ``processor``
-    and ``python``."""
-    import numpy as np
-    import pinocchio as pin
-
+    """The run's provenance: ``date`` (UTC, ISO 8601), ``command``, ``kinelab``, ``commit`` (or None), the
+    version of each of :data:`LIBRARIES` by its key (``pinocchio``, ``coal``, ``example-robot-data``,
+    ``yourdfpy``, ``numpy``, ``scipy``; "not installed" when absent), ``core`` (the compiled core's source
+    SHA-256, first 12 hex digits), ``processor`` (its model), ``cores`` (logical processors) and ``python``."""
     import kinelab
     from kinelab.core import _built
 
     return {"date": datetime.now(timezone.utc).isoformat(timespec="seconds"), "command": shlex.join(sys.argv),
             "kinelab": kinelab.__version__, "commit": commit_of(Path(__file__).resolve().parent),
-            "pinocchio": pin.__version__, "numpy": np.__version__, "core": _built.SOURCE_SHA256[:12],
-            "processor": processor(), "python": platform.python_version()}
+            **{key: _version(dist) for key, dist in LIBRARIES.items()}, "core": _built.SOURCE_SHA256[:12],
+            "processor": processor(), "cores": os.cpu_count() or 0, "python": platform.python_version()}
+
+
+def _version(distribution: str) -> str:
+    """The installed version of a distribution, or "not installed"."""
+    try:
+        return metadata.version(distribution)
+    except metadata.PackageNotFoundError:
+        return "not installed"
 
 
 def commit_of(start: Path) -> str | None:

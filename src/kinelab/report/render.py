@@ -18,6 +18,7 @@ from kinelab.files import write_output
 from kinelab.report.bench import loops, scaling, versus
 from kinelab.report.outfolder import atomic_folder
 from kinelab.report.page import CAPTIONS, validate_html
+from kinelab.report.provenance import LIBRARIES
 from kinelab.report.validate import Report
 from kinelab.studies import paper000_era as ep
 from kinelab.studies import paper001_stanford as seed001
@@ -95,9 +96,10 @@ def write_validate_report(report: Report, out: str | Path) -> Path:
 def provenance_line(p: dict[str, Any]) -> str:
     """What the run ran on, in one sentence (:func:`kinelab.report.provenance.provenance`)."""
     commit = f", commit {p['commit'][:12]}" if p.get("commit") else ""
-    return (f"Run {p['date']} with kinelab {p['kinelab']}{commit} (compiled core {p['core']}), Pinocchio "
-            f"{p['pinocchio']}, numpy {p['numpy']}, Python {p['python']}, on {p['processor']}; command: "
-            f"`{p['command']}`.")
+    libraries = ", ".join(f"{name} {p[name]}" for name in LIBRARIES if name in p)
+    cores = f", {p['cores']} cores" if p.get("cores") else ""
+    return (f"Run {p['date']} with kinelab {p['kinelab']}{commit} (compiled core {p['core']}), {libraries}, "
+            f"Python {p['python']}, on {p['processor']}{cores}; command: `{p['command']}`.")
 
 
 def _write_validate_files(report: Report, folder: Path) -> None:
@@ -105,7 +107,7 @@ def _write_validate_files(report: Report, folder: Path) -> None:
     write_output(folder / "report.json", json.dumps(report.to_dict(), indent=2))
     md = ["# kinelab validate", "", f"Robots: {', '.join(report.robots)}; n = {report.n} configurations for the FK "
           f"checks, each other check stating its own sample; seed = {report.seed}. Shares carry their 95 % Wilson "
-          "interval.", "",
+          "interval and pass on its bound (a share ≥ its bar passes when the interval's lower end is).", "",
           provenance_line(report.provenance), "",
           "| robot | check | measured | limit | result |", "|---|---|---|---|---|"]
     md += [f"| {c.robot} | {c.name} | {' '.join(filter(None, (c.measured, c.unit_shown)))}{c.interval_shown} | "
