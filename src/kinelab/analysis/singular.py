@@ -23,6 +23,12 @@ from kinelab.errors import OptionError
 from kinelab.robot import Chain
 from kinelab.robot.chain import NEAR_SINGULAR as NEAR_SINGULAR  # σ_min/σ_max below: near-singular (one threshold)
 
+
+def sigma_words(ratio: float) -> str:
+    """σ_min/σ_max in the words every page and message uses, by the one threshold NEAR_SINGULAR."""
+    return "near-singular" if ratio < NEAR_SINGULAR else "away from a singular configuration"
+
+
 RANK_RTOL = 1e-6  # singular values below RANK_RTOL × σ_max count as zero
 
 
@@ -45,6 +51,17 @@ class Analysis:
         """True when the rank is below the full rank."""
         return self.rank < self.full_rank
 
+    @property
+    def sigma_ratio(self) -> float:
+        """σ_min/σ_max of the scaled Jacobian, σ_min the full rank's last singular value (0 when singular)."""
+        top = float(self.singular_values[0]) if len(self.singular_values) else 0.0
+        return float(self.singular_values[self.full_rank - 1]) / top if top > 0 else 0.0
+
+    @property
+    def near_singular(self) -> bool:
+        """σ_min/σ_max below NEAR_SINGULAR: what every page and message calls near-singular."""
+        return self.sigma_ratio < NEAR_SINGULAR
+
     def to_dict(self) -> dict:
         """The JSON form (``kinelab singular --json``)."""
         return {
@@ -53,6 +70,8 @@ class Analysis:
             "rank": self.rank,
             "full_rank": self.full_rank,
             "singular": self.singular,
+            "sigma_ratio": self.sigma_ratio,
+            "near_singular": self.near_singular,
             "manipulability": self.manipulability,
             "condition": self.condition if np.isfinite(self.condition) else None,
             "characteristic_length_m": self.length,

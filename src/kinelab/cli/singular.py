@@ -45,7 +45,8 @@ def run(args: argparse.Namespace) -> int:
         return 0
     print(f"{robot.name}: rank {a.rank} of {a.full_rank}{' (SINGULAR)' if a.singular else ''}; "
           f"σ = {common.shown(a.singular_values, precision=4)} (linear rows / L = {a.length:.4g} m)")
-    print(f"  manipulability {a.manipulability:.4g}, condition {a.condition:.4g}")
+    print(f"  σ_min/σ_max {a.sigma_ratio:.3g}: {singular.sigma_words(a.sigma_ratio)} (near-singular below "
+          f"{singular.NEAR_SINGULAR:g}); manipulability {a.manipulability:.4g}, condition {a.condition:.4g}")
     for d in a.lost_directions:
         parts = []
         if d.translation_axis is not None:

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from kinelab.analysis.singular import sigma_words as sigma_words  # the page's words are `kinelab singular`'s
 from kinelab.errors import ConfigurationError
 from kinelab.files import write_output
 from kinelab.robot import Chain
@@ -241,7 +242,7 @@ class Scene:
                     kinds.add(kind)
                     _arrow(self.viewer["singular"][f"lost{k}_{kind}"], oMtool.translation, np.array(axis),
                            scale * share, 0.04 * self.frame_length, color)
-        ratio = float(a.singular_values[a.full_rank - 1] / a.singular_values[0])
+        ratio = a.sigma_ratio
         self.viewer["singular"]["sigma"].set_object(g.Sphere(0.3 * self.frame_length),
                                                     on_top(sigma_colour(ratio), 0.75))
         self.viewer["singular"]["sigma"].set_transform(pin.SE3(np.eye(3), oMtool.translation).homogeneous)
@@ -299,10 +300,6 @@ def sigma_colour(ratio: float) -> int:
     level = min(1.0, (np.log10(ratio) - np.log10(NEAR_SINGULAR)) / (-1 - np.log10(NEAR_SINGULAR)))
     return int(0xB0 * (1 - level)) << 16 | int(0xC0 + 0x30 * level) << 8  # yellow-green → green
 
-
-def sigma_words(ratio: float) -> str:
-    """The σ_min/σ_max ratio in the words `kinelab singular` uses."""
-    return "near-singular" if ratio < NEAR_SINGULAR else "away from a singular configuration"
 
 
 def aim_camera(viewer: Any, points: np.ndarray, margin: float, fill: float = FILL, aspect: float = PAGE_ASPECT,
