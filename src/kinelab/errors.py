@@ -32,6 +32,14 @@ def did_you_mean(name: str, valid: Iterable[str], words: Mapping[str, str] | Non
     return f" (did you mean {found!r}?)" if found is not None and found != name else ""
 
 
+def count_of(shape: tuple[int, ...]) -> str:
+    """What an array of ``shape`` holds, in words for an error message: "none", "3 numbers", "an array of shape
+    (2, 3)"."""
+    if len(shape) == 1:
+        return "none" if shape[0] == 0 else "1 number" if shape[0] == 1 else f"{shape[0]} numbers"
+    return "one number" if shape == () else f"an array of shape {shape}"
+
+
 def _listing(options: Iterable[str], most: int = 40) -> str:
     names = list(options)
     shown = ", ".join(names[:most])

@@ -54,7 +54,7 @@ def test_info_json_is_stable(capsys):
 def test_info_names_the_closed_form_the_search_or_the_joint_a_7r_arm_holds(capsys):
     lines = {}
     for name in ("ur5", "kinova", "panda", "youbot", "xarm6", "baxter_left"):
-        code, out, _ = run(capsys, "info", name)
+        code, out, _ = run(capsys, "info", name, "--verbose")  # the class and its method: the solver's terms
         assert code == 0
         lines[name] = next(line for line in out.splitlines() if line.startswith("branches: "))
     assert lines["ur5"] == ("branches: 6R, axes 2, 3, 4 parallel, axes 5 and 6 meeting: every branch in closed form "
@@ -111,8 +111,26 @@ def test_ik_says_what_its_time_measured_and_prints_frdm_s_monitor_for_frdm_alone
     q = ["0.3", "-1.2", "1.0", "-0.5", "0.8", "0.2"]
     code, out, _ = run(capsys, "ik", "ur5", "--target-q", *q, "--solver", "analytic")
     assert code == 0 and "ms (one call, first-call costs included" in out and "monitor" not in out
-    code, out, _ = run(capsys, "ik", "ur5", "--target-q", *q, "--seed", "0", "--start-q", "random")
+    code, out, _ = run(capsys, "ik", "ur5", "--target-q", *q, "--seed", "0", "--start-q", "random", "--verbose")
     assert code == 0 and "ms (one call, first-call costs included" in out and "monitor did not fire" in out
+    assert "method frdm" in out
+
+
+def test_ik_and_info_speak_plain_words_unless_verbose(capsys):
+    """#60 item 3: "mode frdm+newton", "monitor did not fire", "no class holds to its tolerances" were routine
+    output; they are the solver's terms, printed under --verbose (and kept in JSON)."""
+    code, out, _ = run(capsys, "ik", "era", "--target-xyz", "4", "2", "6")
+    assert code == 0 and "mode" not in out and "method" not in out and "monitor" not in out
+    code, out, _ = run(capsys, "info", "youbot")
+    assert "no class holds" not in out and "no formula fits this arm's geometry" in out
+    code, out, _ = run(capsys, "info", "youbot", "--verbose")
+    assert "no class holds to its tolerances" in out
+    code, out, _ = run(capsys, "branches", "crx10ia", "--target-q", "0.3", "0.5", "0.2", "0.4", "0.6", "0.1")
+    assert "complete:" not in out and "not proved" in out and "one-dimensional search" in out
+    code, out, err = run(capsys, "fk", "ur5")
+    assert code == 2 and "shape" not in err and "got none" in err
+    code, out, err = run(capsys, "fk", "ur5", "1", "2", "3")
+    assert code == 2 and "got 3 numbers" in err
 
 
 def test_ik_beyond_reach_is_unreachable_with_exit_1(capsys):

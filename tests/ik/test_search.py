@@ -282,7 +282,7 @@ def test_a_calibrated_ur10e_fits_no_class_and_is_solved_by_the_elimination_certi
     from kinelab import cli
 
     arm = kinelab.load("ur10e_calibrated")
-    assert cli.main(["info", "ur10e_calibrated"]) == 0
+    assert cli.main(["info", "ur10e_calibrated", "--verbose"]) == 0
     out = capsys.readouterr().out
     assert "no class holds to its tolerances (1e-05 rad between parallel axes, 1e-05 m" in out
     assert "general 6R: every branch by algebraic elimination" in out

@@ -17,6 +17,7 @@ from kinelab.cli.common import (
     seed_argument,
     source_arguments,
     target_arguments,
+    verbose_flag,
 )
 from kinelab.errors import KinelabError, OptionError
 from kinelab.progress import step
@@ -49,6 +50,7 @@ def add(sub: Any) -> None:
     s.add_argument("--html", help="also write the branches side by side, labelled, as a self-contained page")
     source_arguments(s)
     json_flag(s, "the branches")
+    verbose_flag(s)
     s.set_defaults(func=run)
 
 
@@ -113,13 +115,32 @@ def _completeness(found: Branches) -> str:
     return f"{COMPLETENESS.get(found.method, found.method)} (complete: {how})"
 
 
+PLAIN = {  # how sure the list is to hold every branch, in plain words, by method
+    "closed form": "every branch, from a formula; each one proved",
+    "sweep": "every branch at each value of the swept joint, from a formula",
+    "search": "every branch a one-dimensional search finds (checked complete on thousands of poses, not proved)",
+    "elimination": "every branch, from the general six-joint elimination; each one proved",
+}
+
+
+def _completeness_words(found: Branches) -> str:
+    """:func:`_completeness` in plain words (``--verbose`` prints the solver's own)."""
+    if not found:
+        return f"no branch ({found.status.value}): {found.message}"
+    unseen = found[0].diagnostics.unseen
+    if found.method == "multistart" and unseen is not None:
+        return (f"found from many random starts; one more start would find yet another branch with a chance of "
+                f"about {100 * unseen:.2g} %")
+    return PLAIN.get(found.method, found.method)
+
+
 def _print_branches(robot: Chain, args: argparse.Namespace, found: Branches, ref: Any) -> None:
     """One line per branch: its configuration and Pinocchio's errors (nearest ``ref`` first when given)."""
     import numpy as np
 
     unit = " [deg, m]" if args.deg else " [rad, m]"
     print(f"{robot.name}: {len(found)} branch{'es' if len(found) != 1 else ''}, {_method(found)}")
-    print(f"  {_completeness(found)}")
+    print(f"  {_completeness(found) if args.verbose else _completeness_words(found)}")
     if ref is not None:
         print("  nearest --ref-q first (revolute joints compared modulo 2π)")
     for k, r in enumerate(found):

@@ -205,6 +205,13 @@ def json_flag(s: argparse.ArgumentParser, what: str = "the result") -> None:
     s.add_argument("--json", action="store_true", help=f"print {what} as JSON")
 
 
+def verbose_flag(s: argparse.ArgumentParser) -> None:
+    """--verbose: the solver's own terms (methods, monitor, completeness) beside the plain words."""
+    s.add_argument("--verbose", action="store_true",
+                   help="also print the solver's own terms: method, singularity monitor, how complete a set is "
+                        "(docs/glossary.md)")
+
+
 def seed_argument(s: argparse.ArgumentParser) -> None:
     """--seed, the same on every command."""
     s.add_argument("--seed", type=int, default=0, help="seed of the random starts or samples (an integer ≥ 0)")

@@ -20,6 +20,7 @@ from kinelab.cli.common import (
     shown,
     source_arguments,
     target_arguments,
+    verbose_flag,
 )
 from kinelab.errors import KinelabError
 from kinelab.ik.frdm.policy import SWITCHABLE, bypass_plan
@@ -93,6 +94,7 @@ def add(sub: Any) -> None:
     collision_arguments(s)
     source_arguments(s)
     json_flag(s)
+    verbose_flag(s)
     s.set_defaults(func=run)
 
 
@@ -245,14 +247,18 @@ def _print_ik(robot: Chain, args: argparse.Namespace, result: IKResult) -> None:
           f"{' (free)' if free[1] else ''} (Pinocchio FK)")
     print(f"  {plural(result.iterations, 'iteration')}, {plural(result.restarts, 'restart')}, "
           f"{result.wall_time * 1e3:.2f} ms (one call, first-call costs included; `kinelab bench` times repeated "
-          f"calls), mode {result.mode}")
+          f"calls)" + (f", method {result.mode}" if args.verbose else ""))
     diag = result.diagnostics
     if isinstance(diag, BiquatDiagnostics) and diag.model_time:
         m0 = diag.M0
         print(f"  model time {diag.model_time:.4g} s, final M0 = "
               + (f"{m0:+.6f}" if m0 is not None else "n/a (give --target-q for the sign of N)"))
     if capabilities(args.solver).monitored:  # only a solver with the singularity monitor has events to tell
-        _print_events(result)
+        if args.verbose or args.kick or args.interval or args.freeze:  # the user's own bypasses: what they did
+            _print_events(result)
+        elif fired := sum(e.count or 1 for e in result.singular_events):
+            print(f"  passed near a singular configuration {plural(fired, 'time')} on the way (--verbose: what the "
+                  "solver did about it)")
     if result.success and result.diagnostics.clear_after is not None:
         print(f"  clear of collisions ({plural(result.diagnostics.clear_after, 'colliding answer')} found before)")
     if result.message:

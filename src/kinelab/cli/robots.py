@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import TYPE_CHECKING, Any
 
-from kinelab.cli.common import json_flag, load_robot, print_json, robot_arguments
+from kinelab.cli.common import json_flag, load_robot, print_json, robot_arguments, verbose_flag
 from kinelab.robot import catalog
 
 if TYPE_CHECKING:
@@ -22,6 +22,7 @@ def add(sub: Any) -> None:
     s.add_argument("--collisions", action="store_true",
                    help="also build the self-collision model (loads the collision meshes) and say what it checks")
     json_flag(s)
+    verbose_flag(s)
     s.set_defaults(func=run_info)
 
 
@@ -55,7 +56,10 @@ def run_info(args: argparse.Namespace) -> int:
     """The robot's chain: base, tool, joints with their limits, the locked joints."""
     import numpy as np
 
-    from kinelab.ik.analytic.redundancy import closed_form_summary  # the solvers load for info only, not for --help
+    from kinelab.ik.analytic.redundancy import (  # the solvers load for info only, not for --help
+        closed_form_summary,
+        closed_form_words,
+    )
 
     robot = load_robot(args)
     info = {"robot": robot.name, "urdf": str(robot.urdf_path), "base": robot.base, "tool": robot.tool,
@@ -79,7 +83,7 @@ def run_info(args: argparse.Namespace) -> int:
         print(f"mimic: {name} follows {m.leader}")
     if robot.locked:
         print(f"locked: {', '.join(f'{k}={v:g}' for k, v in robot.locked.items())}")
-    print(f"branches: {info['closed_form']}")
+    print(f"branches: {info['closed_form'] if args.verbose else closed_form_words(robot)}")
     print(f"answers judged by: {info['judge']}")
     print(f"collisions: {info['collisions'] or 'not built (add --collisions: loads the meshes, counts the pairs)'}")
     return 0

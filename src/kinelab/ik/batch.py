@@ -16,7 +16,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.core import _blas, threads
-from kinelab.errors import ConfigurationError
+from kinelab.errors import ConfigurationError, count_of
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.driver import prepare_solver, solve_one
 from kinelab.ik.frdm import batch as frdm_batch
@@ -182,7 +182,7 @@ def _starts(robot: Chain, q0: Any, count: int) -> np.ndarray | None:
         arr = np.broadcast_to(arr, (count, robot.n))
     if arr.shape != (count, robot.n):
         raise ConfigurationError(f"q0 must be None, {robot.n} numbers or ({count}, {robot.n}) for {count} targets "
-                                 f"of {robot.name}, got shape {arr.shape}")
+                                 f"of {robot.name}, got {count_of(arr.shape)}")
     for b in np.flatnonzero(~np.isfinite(arr).all(axis=1) | ~robot.within_limits_batch(arr)):
         robot.check_q(arr[b], limits=True, what=f"q0[{b}]")
     return np.array(arr, dtype=float)

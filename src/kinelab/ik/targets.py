@@ -12,7 +12,7 @@ from numpy.typing import ArrayLike
 
 from kinelab.core._verdict import NOT_A_ROTATION, NOT_FINITE, NOT_HOMOGENEOUS, first_defect, pose_defect
 from kinelab.dq.algebra import DualQuat
-from kinelab.errors import TargetError
+from kinelab.errors import TargetError, count_of
 from kinelab.robot import Chain
 
 
@@ -102,7 +102,7 @@ def _finite(values: ArrayLike, size: int, what: str) -> np.ndarray:
     except (TypeError, ValueError):
         raise TargetError(f"{what} must be {size} real numbers, got {values!r}") from None
     if arr.shape != (size,):
-        raise TargetError(f"{what} must have {size} numbers, got shape {arr.shape}")
+        raise TargetError(f"{what} must have {size} numbers, got {count_of(arr.shape)}")
     if not np.all(np.isfinite(arr)):
         raise TargetError(f"{what} has NaN or infinite entries: {arr}")
     return arr

@@ -25,7 +25,15 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from kinelab.core._joints import PinForm, plain_q
-from kinelab.errors import ChainError, ConfigurationError, JointLimitError, JointNotFoundError, OptionError, SRDFError
+from kinelab.errors import (
+    ChainError,
+    ConfigurationError,
+    JointLimitError,
+    JointNotFoundError,
+    OptionError,
+    SRDFError,
+    count_of,
+)
 from kinelab.geometry import pose_error, wrap_to_pi
 from kinelab.robot import xacro
 from kinelab.robot.build import LIMIT_SLACK, Built, build_model, frame_id
@@ -225,7 +233,7 @@ class Chain:
             raise ConfigurationError(f"{what} must be {self.n} numbers (real), got {q!r}") from None
         if raw.shape != (self.n,):
             raise ConfigurationError(f"{what} must have {self.n} numbers ({', '.join(self.joint_names)}) for "
-                                     f"{self.name}, got shape {raw.shape}")
+                                     f"{self.name}, got {count_of(raw.shape)}")
         return raw.astype(float)
 
     def check_q(self, q: ArrayLike, *, limits: bool = False, what: str = "q") -> np.ndarray:
@@ -243,7 +251,7 @@ class Chain:
         if arr.shape != (self.n,):
             raise ConfigurationError(
                 f"{what} must have {self.n} numbers ({', '.join(self.joint_names)}) for {self.name}, "
-                f"got shape {arr.shape}"
+                f"got {count_of(arr.shape)}"
             )
         bad = ~np.isfinite(arr)
         if bad.any():
@@ -316,7 +324,7 @@ class Chain:
         """Pinocchio's q → one number per joint (continuous joints as atan2(sin, cos) in (−π, π])."""
         q_pin = np.asarray(q_pin, dtype=float)
         if q_pin.shape != (self.nq,):
-            raise ConfigurationError(f"Pinocchio q must have nq = {self.nq} entries, got shape {q_pin.shape}")
+            raise ConfigurationError(f"Pinocchio q must have nq = {self.nq} entries, got {count_of(q_pin.shape)}")
         out = np.empty(self.n)
         out[self._scalar_pos] = q_pin[self._scalar_idx]
         out[self._cont_pos] = np.arctan2(q_pin[self._cont_idx + 1], q_pin[self._cont_idx])

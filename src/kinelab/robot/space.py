@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from kinelab.errors import ConfigurationError, JointLimitError, OptionError
+from kinelab.errors import ConfigurationError, JointLimitError, OptionError, count_of
 
 LIMIT_SLACK = 1e-9  # joint values this far past a limit still count as within it (rad or m)
 SAMPLE_TURNS = 4  # random configurations keep unbounded revolute joints within ±4 turns
@@ -118,7 +118,7 @@ def check_v(space: Space, v: Any, what: str = "v") -> np.ndarray:
     except (TypeError, ValueError):
         raise ConfigurationError(f"{what} must be {space.nv} numbers (velocities), got {v!r}") from None
     if arr.shape != (space.nv,) or not np.isfinite(arr).all():
-        raise ConfigurationError(f"{what} must be nv = {space.nv} finite numbers, got shape {arr.shape}")
+        raise ConfigurationError(f"{what} must be nv = {space.nv} finite numbers, got {count_of(arr.shape)}")
     return np.ascontiguousarray(arr)
 
 

@@ -23,7 +23,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.core._verdict import pose_defect
-from kinelab.errors import OptionError, TargetError
+from kinelab.errors import OptionError, TargetError, count_of
 
 FRAME_TASKS = ("pose", "position", "axis", "orientation")
 AXES = "xyz"
@@ -83,7 +83,7 @@ def _vector(value: Any, size: int, what: str) -> np.ndarray:
     except (TypeError, ValueError):
         raise TargetError(f"{what} must be {size} numbers, got {value!r}") from None
     if arr.shape != (size,) or not np.isfinite(arr).all():
-        raise TargetError(f"{what} must be {size} finite numbers, got shape {arr.shape}")
+        raise TargetError(f"{what} must be {size} finite numbers, got {count_of(arr.shape)}")
     return arr
 
 

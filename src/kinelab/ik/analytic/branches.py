@@ -22,7 +22,7 @@ import pinocchio as pin
 from kinelab.core import threads
 from kinelab.core._analytic import ROW_NOT_STARTED, ClosedForm
 from kinelab.core._joints import turn_distances
-from kinelab.errors import ConfigurationError, OptionError
+from kinelab.errors import ConfigurationError, OptionError, count_of
 from kinelab.geometry import pose_errors, stack_homogeneous, wrap_to_pi
 from kinelab.ik.analytic import pieper
 from kinelab.ik.analytic.certify import (
@@ -755,7 +755,7 @@ def batch_starts(robot: Chain, q0: Any, count: int) -> np.ndarray | None:
     starts = None if q0 is None else robot.check_qs(np.atleast_2d(q0), what="q0")
     if starts is not None and starts.shape[0] not in (1, count):
         raise ConfigurationError(f"q0 must be None, {robot.n} numbers or ({count}, {robot.n}) for {count} targets of "
-                                 f"{robot.name}, got shape {np.shape(q0)}")
+                                 f"{robot.name}, got {count_of(np.shape(q0))}")
     return None if starts is None else np.broadcast_to(starts, (count, robot.n))
 
 

@@ -323,8 +323,8 @@ def _arm_words(arm: ArmClass | str) -> str:
 
 
 def closed_form_summary(robot: Chain) -> str:
-    """One line on the robot's every-branch method and how complete its sets are (``kinelab info``): its class,
-    the joint a 7R arm holds, the general 6R elimination, or none."""
+    """One line on the robot's every-branch method and how complete its sets are (``kinelab info --verbose`` and
+    JSON): its class, the joint a 7R arm holds, the general 6R elimination, or none."""
     arm = classify(robot).arm
     if arm is not None:
         return f"{arm.name}: {arm.method} ({COMPLETE['search' if arm.searched else 'closed form']})"
@@ -338,6 +338,22 @@ def closed_form_summary(robot: Chain) -> str:
     if general is not None:
         return f"{none}; {general.name}: {general.method} ({COMPLETE['elimination']})"
     return f"{none} — the numeric multistart; solver='analytic' names the failed tests"
+
+
+def closed_form_words(robot: Chain) -> str:
+    """The same in plain words (``kinelab info``): how every branch of a pose is found, and how sure the set is."""
+    arm = classify(robot).arm
+    if arm is not None:
+        return ("every branch by a one-dimensional search, checked complete on thousands of poses" if arm.searched
+                else "every branch in closed form, each one proved")
+    if has_swept_form(robot):
+        sw = swept_arm(robot)
+        return (f"every branch in closed form with joint {sw.joint + 1} ({robot.joints[sw.joint].name}) held at a "
+                "value; the arm has one more joint than a pose needs")
+    if general_class(robot).arm is not None:
+        return "every branch by the general six-joint elimination, each one proved"
+    return ("no formula fits this arm's geometry: its branches are found from many random starts (--verbose says "
+            "which geometric tests fail)")
 
 
 COMPLETE = {  # how complete each method's sets are, in words (kinelab info)
