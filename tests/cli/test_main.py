@@ -127,6 +127,8 @@ def test_ik_and_info_speak_plain_words_unless_verbose(capsys):
     assert "no class holds to its tolerances" in out
     code, out, _ = run(capsys, "branches", "crx10ia", "--target-q", "0.3", "0.5", "0.2", "0.4", "0.6", "0.1")
     assert "complete:" not in out and "not proved" in out and "one-dimensional search" in out
+    code, out, _ = run(capsys, "branches", "panda", "--target-q", "0", "-0.5", "0", "-2", "0", "1.5", "0.7")
+    assert "its configurations form a continuum" in out and "--redundancy K" in out  # samples, not "the" branches
     code, out, err = run(capsys, "fk", "ur5")
     assert code == 2 and "shape" not in err and "got none" in err
     code, out, err = run(capsys, "fk", "ur5", "1", "2", "3")

@@ -141,6 +141,9 @@ def _print_branches(robot: Chain, args: argparse.Namespace, found: Branches, ref
     unit = " [deg, m]" if args.deg else " [rad, m]"
     print(f"{robot.name}: {len(found)} branch{'es' if len(found) != 1 else ''}, {_method(found)}")
     print(f"  {_completeness(found) if args.verbose else _completeness_words(found)}")
+    if found.method == "multistart" and robot.n > 6:
+        print(f"  {robot.name} has {robot.n} joints for a 6-number pose: its configurations form a continuum, of "
+              "which these are samples; --redundancy K or --sew PSI lists every branch at chosen values")
     if ref is not None:
         print("  nearest --ref-q first (revolute joints compared modulo 2π)")
     for k, r in enumerate(found):
