@@ -12,7 +12,6 @@ bounded too.
 from __future__ import annotations
 
 import json
-import subprocess
 import sys
 from pathlib import Path
 from typing import Any
@@ -34,6 +33,8 @@ def run(path: Path, job: dict[str, Any]) -> None:
     Raises:
         URDFError: the expansion's own refusal or failure, or a limit passed (named, with its value).
     """
+    import subprocess  # start-up: a URDF robot never expands a xacro file (3 ms of every command)
+
     try:
         done = subprocess.run([sys.executable, "-m", "kinelab.robot.xacro_child"], input=json.dumps(job),
                               capture_output=True, text=True, timeout=SECONDS)
