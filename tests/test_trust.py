@@ -268,3 +268,39 @@ def test_a_robot_file_that_is_not_a_regular_file_is_refused_before_reading(tmp_p
 
     with no_hang(20), pytest.raises(kinelab.URDFError, match="not a regular file"):
         kinelab.load(where if where != "folder" else tmp_path)
+
+
+def test_the_multistart_after_a_closed_form_that_found_nothing_gets_only_what_is_left(monkeypatch):
+    """solve(prefer=) on crx10ia: the 1-D search found nothing at unmeetable tolerances and the multistart after
+    it then counted a budget of its own from zero (p99 7.9 ms at 5 ms). Checked on a clock that moves 1 ms per
+    reading: the multistart's budget starts where the closed form's time began, not after it."""
+    from kinelab.ik import branches
+    from kinelab.ik.request import make_request
+
+    class Clock:
+        now = 100.0
+
+        def perf_counter(self) -> float:
+            self.now += 0.001
+            return self.now
+
+    clock = Clock()
+    monkeypatch.setattr(branches, "time", clock)
+
+    def closed_form_spending_3_ms(*args, **kwargs):
+        for _ in range(3):
+            clock.perf_counter()
+        return None  # "the multistart is to answer instead"
+
+    seen: list[float] = []
+
+    def spy_search(robot, target, req, max_solutions, stop_below, t0):
+        seen.append(clock.now - t0)
+        return [], 0
+
+    monkeypatch.setattr(branches, "_closed_form_all", closed_form_spending_3_ms)
+    monkeypatch.setattr(branches, "_search", spy_search)
+    crx = kinelab.load("crx10ia")
+    req = make_request("frdm", 0, 1e-6, 1e-6, 0.005, 0, "refuse", None, "pose", "z", {})
+    branches.find_all(crx, crx.fk(crx.random_q(0)), req, method=branches.Route.EITHER)
+    assert len(seen) == 1 and seen[0] >= 0.004 - 1e-12  # the 3 ms spent and the closing reading, counted
