@@ -108,6 +108,22 @@ def test_shift_dragging_turns_the_target_and_the_robot_meets_it(page):
     assert_meets(robot, assert_drawn_tool_is_pinocchio_fk(p, robot), target)
 
 
+def test_a_reply_overtaken_by_a_newer_one_draws_nothing_old(page):
+    """A poll sent before a drag's answer and answered after it carried the older state: drawn last, the tool
+    stood where the arm had been while the readout gave the new q (seen once as a 1 cm gap under load)."""
+    robot, _, p = page
+    old_seq = p.eval("fetch('state?since=0').then((r) => r.json()).then((j) => { window.kinelab.old = j; "
+                     "return j.seq; })")
+    p.eval("(() => { const s = document.getElementById('kinelab-joint-2'); s.value = Number(s.value) - 0.3; "
+           "s.dispatchEvent(new Event('input')); })()")
+    settle(p)
+    assert p.eval("window.kinelab.seq") > old_seq
+    now = drawn(p, "tool")
+    p.eval("window.kinelab.apply(window.kinelab.old)")
+    assert np.abs(drawn(p, "tool") - now).max() == 0.0
+    assert_drawn_tool_is_pinocchio_fk(p, robot)
+
+
 def test_the_branch_button_goes_to_another_branch_of_the_same_target(page):
     robot, _, p = page
     target, before = drawn(p, "target"), np.array(p.eval("window.kinelab.readout.q"))

@@ -3,7 +3,8 @@
 const cfg = JSON.parse(document.getElementById("kinelab-config").textContent);
 const THREE = MeshCat.THREE;
 const viewer = new MeshCat.Viewer(document.getElementById("kinelab-viewer"));
-const state = { seq: 0, busy: false, pending: new Map(), dragging: null, readout: null, replies: 0, drags: 0 };
+const state = { seq: 0, busy: false, polling: false, pending: new Map(), dragging: null, readout: null, replies: 0,
+                drags: 0 };
 window.kinelab = state;  // what the browser tests and the console read
 
 const node = (path) => viewer.scene_tree.find(path).object;
@@ -18,6 +19,9 @@ function bytes(b64) {
 }
 
 function apply(reply) {
+  // a reply older than one already applied (a poll overtaken by a drag's answer) would draw an earlier state over
+  // the newer one; every reply carries everything since the seq its request gave, so a stale one adds nothing
+  if (typeof reply.seq === "number" && reply.seq < state.seq) return;
   for (const c of reply.commands || []) viewer.handle_command_bytearray(bytes(c));
   if (reply.seq >= state.seq) {
     state.seq = reply.seq;
@@ -51,7 +55,9 @@ async function pump() {
 
 async function poll() {
   if (!state.busy && !state.dragging) {
+    state.polling = true;
     try { apply(await (await fetch("state?since=" + state.seq)).json()); } catch (e) { /* the server stopped */ }
+    state.polling = false;
   }
   setTimeout(poll, 500);
 }
@@ -208,7 +214,8 @@ state.drawnPose = (name) => {
   for (let r = 0; r < 4; r++) for (let c = 0; c < 4; c++) rows.push(e[c * 4 + r]);
   return rows;
 };
-state.idle = () => !state.busy && state.pending.size === 0 && !state.dragging;
+state.apply = apply;  // a test replays an old reply through it
+state.idle = () => !state.busy && !state.polling && state.pending.size === 0 && !state.dragging;
 
 document.getElementById("kinelab-heading").textContent = cfg.heading;
 document.getElementById("kinelab-legend").textContent = cfg.legend;
