@@ -1,6 +1,6 @@
 """Builds kinelab's compiled core (``src/kinelab/core/*.pyx``, Cython) when kinelab is installed.
 
-Everything else about the package is in ``pyproject.toml``. The build records the SHA-256 of the sources it
+Everything else about the package is in ``pyproject.toml``. The build records the SHA-256 and CRC-32 of the sources it
 compiled in ``src/kinelab/core/_built.py`` (generated, not tracked), which ``kinelab.core`` compares with the
 sources beside it at import: a stale build is refused, never run.
 """
@@ -16,15 +16,16 @@ ROOT = Path(__file__).resolve().parent
 CORE = ROOT / "src" / "kinelab" / "core"
 
 
-def _digest() -> str:
+def _digest():
     spec = importlib.util.spec_from_file_location("kinelab_core_digest", CORE / "digest.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    return module.source_sha256(CORE)
+    return module
 
 
 (CORE / "_built.py").write_text(f'"""Written by setup.py: the sources the compiled core was built from."""\n\n'
-                                f'SOURCE_SHA256 = "{_digest()}"\n')
+                                f'SOURCE_SHA256 = "{_digest().source_sha256(CORE)}"\n'
+                                f'SOURCE_CRC32 = "{_digest().source_crc32(CORE)}"\n')
 # OpenMP runs the batches' rows in parallel (prange); -O3 without -ffast-math keeps IEEE arithmetic, so the kernels
 # compute what their reference computes, bit for bit
 # NumPy's C API (headers from the numpy that builds) lets an engine make its result arrays without a Python call

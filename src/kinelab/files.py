@@ -9,7 +9,6 @@ from __future__ import annotations
 import contextlib
 import os
 import stat
-import tempfile
 from pathlib import Path
 
 from kinelab.errors import KinelabError
@@ -179,6 +178,8 @@ def write_output(path: str | Path, data: str | bytes, what: str = "file") -> Pat
     except FileNotFoundError:
         mode = 0o666 & ~umask()
     raw = data.encode("utf-8") if isinstance(data, str) else data
+    import tempfile  # only a write needs it: every command imports this module for its checks
+
     tmp: str | None = None
     try:
         fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.")

@@ -99,3 +99,33 @@ def test_the_subpackages_are_attributes_of_the_package_as_before():
         import kinelab
 
         kinelab.nosuch  # noqa: B018
+
+
+BLAS_PROBE = """
+import sys
+import numpy as np
+import kinelab
+from kinelab.core import _blas
+{patch}
+robot = kinelab.load("ur5")
+q = np.array([0.3, -1.2, 1.4, -0.5, 0.9, 0.2])
+r = kinelab.solve(robot, robot.fk(q), seed=1)
+err = float(np.linalg.norm(robot.fk(r.q).translation - robot.fk(q).translation))
+print(_blas.source(), "scipy" in sys.modules, r.success, err < 1e-6)
+"""
+
+
+def _blas_run(patch: str = "") -> list[str]:
+    done = subprocess.run([sys.executable, "-c", BLAS_PROBE.format(patch=patch)], capture_output=True, text=True,
+                          timeout=120, check=True)
+    return done.stdout.split()
+
+
+def test_a_solve_takes_blas_from_scipys_bundled_openblas_without_importing_scipy():
+    if _blas_run("print(_blas._bundled_library() is not None)")[0] != "True":
+        pytest.skip("this SciPy bundles no OpenBLAS (the capsules serve: the next test)")
+    assert _blas_run() == ["bundled", "OpenBLAS", "False", "True", "True"]
+
+
+def test_without_a_bundled_openblas_the_capsules_serve_the_same_answers():
+    assert _blas_run("_blas._bundled_library = lambda: None") == ["SciPy's", "capsules", "True", "True", "True"]

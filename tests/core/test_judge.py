@@ -77,9 +77,27 @@ def test_a_stale_compiled_core_is_refused_with_the_rebuild_command(monkeypatch):
     from kinelab.core import _built
 
     kinelab.core._check_fresh()  # the build matches its sources
-    monkeypatch.setattr(_built, "SOURCE_SHA256", "0" * 64)  # as after an edit of a .pyx without a rebuild
+    monkeypatch.setattr(_built, "SOURCE_CRC32", "0" * 8)  # as after an edit of a .pyx without a rebuild
     with pytest.raises(kinelab.KinelabError, match=r"older than its sources .*pip install -e \."):
         kinelab.core._check_fresh()
+    monkeypatch.delattr(_built, "SOURCE_CRC32")  # a build recorded before the CRC was
+    with pytest.raises(kinelab.KinelabError, match=r"older than its sources"):
+        kinelab.core._check_fresh()
+
+
+def test_both_fingerprints_change_with_one_byte_of_one_source(tmp_path):
+    from kinelab.core import digest
+
+    (tmp_path / "a.pyx").write_bytes(b"cdef int x = 1\n")
+    (tmp_path / "b.pxd").write_bytes(b"cdef int y\n")
+    (tmp_path / "notes.txt").write_bytes(b"not a source")
+    before = digest.source_crc32(tmp_path), digest.source_sha256(tmp_path)
+    (tmp_path / "notes.txt").write_bytes(b"still not a source")
+    assert (digest.source_crc32(tmp_path), digest.source_sha256(tmp_path)) == before
+    (tmp_path / "a.pyx").write_bytes(b"cdef int x = 2\n")
+    after = digest.source_crc32(tmp_path), digest.source_sha256(tmp_path)
+    assert after[0] != before[0] and after[1] != before[1]
+    assert len(after[0]) == 8 and len(after[1]) == 64
 
 
 def _general_fk(arrays, q):

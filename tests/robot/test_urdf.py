@@ -129,6 +129,20 @@ def test_the_cli_says_one_line_even_when_pinocchios_parser_complains(tmp_path):
         assert "Error" not in proc.stderr
 
 
+def test_what_c_code_writes_on_descriptor_2_is_read_back_and_the_descriptor_restored():
+    import os
+
+    from kinelab.robot.meshes import c_stderr_captured
+
+    before = os.fstat(2)
+    said: list[str] = []
+    with c_stderr_captured(said):
+        os.write(2, b"Error: first complaint\n\n  second complaint \n")  # as urdfdom writes, below Python
+    assert said == ["Error: first complaint", "second complaint"]
+    after = os.fstat(2)
+    assert (after.st_dev, after.st_ino) == (before.st_dev, before.st_ino)
+
+
 # What Pinocchio's parser reads, kinelab loads: each case once, in a file written here.
 def test_a_comment_nested_in_a_comment_loads(tmp_path):
     body = "<!-- outer <!-- inner --> tail of the outer -->" + _chain(revolute("j1", "a", "b"))

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from kinelab.core.digest import source_sha256
+from kinelab.core.digest import source_crc32
 from kinelab.errors import KinelabError
 
 REBUILD = "pip install -e . (or python setup.py build_ext --inplace)"
@@ -22,7 +22,7 @@ def _check_fresh() -> None:
     except ImportError:
         raise KinelabError(f"kinelab's compiled core is not built in {Path(__file__).parent}: {REBUILD}") from None
     folder = Path(__file__).parent
-    if any(folder.glob("*.pyx")) and source_sha256(folder) != _built.SOURCE_SHA256:
+    if any(folder.glob("*.pyx")) and source_crc32(folder) != getattr(_built, "SOURCE_CRC32", None):
         raise KinelabError(f"kinelab's compiled core is older than its sources in {folder} (a .pyx changed since "
                            f"the build): {REBUILD}")
 

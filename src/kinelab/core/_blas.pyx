@@ -1,14 +1,17 @@
 # cython: language_level=3, boundscheck=False, wraparound=False
-"""BLAS and LAPACK for the compiled kernels: SciPy's (``scipy.linalg.cython_blas`` and ``cython_lapack``, the very
-functions NumPy's matmul, solve and svd reach through SciPy-linked code), taken on first use.
+"""BLAS and LAPACK for the compiled kernels: SciPy's (the functions ``scipy.linalg.cython_blas`` and
+``cython_lapack`` wrap, which NumPy's matmul, solve and svd reach through SciPy-linked code), taken on first use.
 
-Loading them imports SciPy, a tenth of a second or more: ``kinelab fk``, ``info`` and ``robots`` never need them,
-so every entry point that may reach a kernel using them calls :func:`ready` first (the packed solve does, in
-:class:`kinelab.core._frdm.Packed`). They are read from the two extension modules directly, without running
-``scipy.linalg``'s package import (three times as long); where that is not possible the plain import serves.
+Where SciPy's wheel bundles its OpenBLAS (``scipy.libs/libscipy_openblas-*.so``, 32-bit integers: the library
+``cython_blas`` itself links), the functions are looked up in that library directly, a few milliseconds; SciPy is
+not imported. Anywhere else (another layout, another BLAS) they come from the two extension modules' capsules,
+which imports SciPy (a few tens of milliseconds). ``kinelab fk``, ``info`` and ``robots`` never need them, so every
+entry point that may reach a kernel using them calls :func:`ready` first (the packed solve does, in
+:class:`kinelab.core._frdm.Packed`).
 """
 
 from cpython.pycapsule cimport PyCapsule_GetName, PyCapsule_GetPointer
+from posix.dlfcn cimport RTLD_LOCAL, RTLD_NOW, dlopen, dlsym
 
 ctypedef void (*dgemm_t)(char*, char*, int*, int*, int*, double*, double*, int*, double*, int*, double*, double*,
                          int*) noexcept nogil
@@ -116,19 +119,86 @@ cdef void* _pointer(dict table, str name) except NULL:
     return PyCapsule_GetPointer(capsule, PyCapsule_GetName(capsule))
 
 
+_SOURCE = None
+cdef list _NAMES = ["dgemm", "dgemv", "ddot", "dgesv", "dgetrf", "dgesdd", "dgetrs", "dgecon", "dgeev", "dggev"]
+
+
+def _bundled_library():
+    """The path of SciPy's bundled 32-bit-integer OpenBLAS, or None (not a wheel that bundles one)."""
+    import importlib.util
+    from pathlib import Path
+
+    spec = importlib.util.find_spec("scipy")  # finds the package without importing it
+    if spec is None or spec.origin is None:
+        return None
+    found = sorted(p for p in (Path(spec.origin).parent.parent / "scipy.libs").glob("libscipy_openblas-*.so*")
+                   if "64_" not in p.name)
+    return str(found[0]) if len(found) == 1 else None
+
+
+cdef dict _from_library():
+    """Name → function pointer from the bundled OpenBLAS (its exports carry a ``scipy_`` prefix), or None."""
+    path = _bundled_library()
+    if path is None:
+        return None
+    cdef void* handle = dlopen(path.encode(), RTLD_NOW | RTLD_LOCAL)
+    if handle == NULL:
+        return None
+    cdef void* f
+    table = {}
+    for name in _NAMES:
+        f = dlsym(handle, f"scipy_{name}_".encode())
+        if f == NULL:
+            return None
+        table[name] = <size_t> f
+    return table
+
+
+cdef dict _from_capsules():
+    """Name → function pointer from SciPy's ``cython_blas`` and ``cython_lapack`` capsules (imports them)."""
+    blas, lapack = _module("cython_blas").__pyx_capi__, _module("cython_lapack").__pyx_capi__
+    return {name: <size_t> _pointer(blas if name in ("dgemm", "dgemv", "ddot") else lapack, name)
+            for name in _NAMES}
+
+
+cdef bint _answers(dict table):
+    """Whether the functions compute what they should on a small case (a library whose integers are not the
+    C ints these declarations pass would not)."""
+    cdef double a[4]
+    cdef double b[4]
+    cdef double c[4]
+    cdef int n = 2, one = 1
+    cdef char* no = b"N"
+    cdef double alpha = 1.0, beta = 0.0
+    a[:] = [1.0, 3.0, 2.0, 4.0]  # column-major [[1, 2], [3, 4]]
+    b[:] = [5.0, 7.0, 6.0, 8.0]
+    c[:] = [0.0, 0.0, 0.0, 0.0]
+    (<dgemm_t> <size_t> table["dgemm"])(no, no, &n, &n, &n, &alpha, a, &n, b, &n, &beta, c, &n)
+    if (<ddot_t> <size_t> table["ddot"])(&n, a, &one, b, &one) != 26.0:
+        return False
+    return c[0] == 19.0 and c[1] == 43.0 and c[2] == 22.0 and c[3] == 50.0
+
+
 cpdef void ready() except *:
     """Take BLAS and LAPACK from SciPy, once per process (a no-op afterwards)."""
-    global _dgemm, _dgemv, _ddot, _dgesv, _dgetrf, _dgesdd, _dgetrs, _dgecon, _dgeev, _dggev
+    global _dgemm, _dgemv, _ddot, _dgesv, _dgetrf, _dgesdd, _dgetrs, _dgecon, _dgeev, _dggev, _SOURCE
     if _dggev != NULL:
         return
-    blas, lapack = _module("cython_blas").__pyx_capi__, _module("cython_lapack").__pyx_capi__
-    _dgemm = <dgemm_t> _pointer(blas, "dgemm")
-    _dgemv = <dgemv_t> _pointer(blas, "dgemv")
-    _ddot = <ddot_t> _pointer(blas, "ddot")
-    _dgesv = <dgesv_t> _pointer(lapack, "dgesv")
-    _dgetrf = <dgetrf_t> _pointer(lapack, "dgetrf")
-    _dgesdd = <dgesdd_t> _pointer(lapack, "dgesdd")
-    _dgetrs = <dgetrs_t> _pointer(lapack, "dgetrs")
-    _dgecon = <dgecon_t> _pointer(lapack, "dgecon")
-    _dgeev = <dgeev_t> _pointer(lapack, "dgeev")
-    _dggev = <dggev_t> _pointer(lapack, "dggev")
+    table, _SOURCE = _from_library(), "bundled OpenBLAS"
+    if table is None or not _answers(table):
+        table, _SOURCE = _from_capsules(), "SciPy's capsules"
+    _dgemm = <dgemm_t> <size_t> table["dgemm"]
+    _dgemv = <dgemv_t> <size_t> table["dgemv"]
+    _ddot = <ddot_t> <size_t> table["ddot"]
+    _dgesv = <dgesv_t> <size_t> table["dgesv"]
+    _dgetrf = <dgetrf_t> <size_t> table["dgetrf"]
+    _dgesdd = <dgesdd_t> <size_t> table["dgesdd"]
+    _dgetrs = <dgetrs_t> <size_t> table["dgetrs"]
+    _dgecon = <dgecon_t> <size_t> table["dgecon"]
+    _dgeev = <dgeev_t> <size_t> table["dgeev"]
+    _dggev = <dggev_t> <size_t> table["dggev"]
+
+
+def source():
+    """Where :func:`ready` took the functions from: "bundled OpenBLAS" or "SciPy's capsules" (None before)."""
+    return _SOURCE

@@ -2,7 +2,7 @@
 
 A Chain's chain (base → tool, joints in series) is packed into plain arrays and run through the compiled FK of
 :mod:`kinelab.core` (built when kinelab is installed). Before it judges anything, it is compared with Pinocchio's
-FK on that robot at seeded configurations: random ones over the joints' ranges and, for every joint, its lower
+FK on that robot at fixed configurations: evenly spread ones over the joints' ranges and, for every joint, its lower
 and its upper limit. It is *certified* when every tool pose agrees within :data:`TOLERANCE` (m, and rad of the
 rotation between them); the certificate is kept on the Chain (``robot.fk_certificate``). A chain that is not a
 plain series of 1-DoF joints (a mimic joint) or that fails the comparison is judged by Pinocchio's FK, and its
@@ -17,10 +17,12 @@ from typing import Any
 
 import numpy as np
 
+from kinelab.robot.space import spread_points
+
 Chain = Any  # a kinelab.Chain (the model module imports this one, so the type is not imported back)
 
 TOLERANCE = 1e-12  # [m] and [rad]: the compiled FK and Pinocchio's agree to rounding (measured: ≤ 6e-15 on ERA)
-RANDOM_CONFIGURATIONS = 64  # and two per joint at its limits
+RANDOM_CONFIGURATIONS = 64  # spread ones, and two per joint at its limits
 
 
 @dataclass(frozen=True)
@@ -123,10 +125,10 @@ def certify(robot: Chain) -> FKCertificate:
 
 
 def _configurations(robot: Chain) -> np.ndarray:
-    """Seeded random configurations, then each joint at its lower and its upper limit (the others random)."""
-    rng = np.random.default_rng(0)
-    Q = robot.random_qs(RANDOM_CONFIGURATIONS + 2 * robot.n, rng)
+    """Evenly spread configurations over the sampling bounds, then each joint at its lower and its upper limit (the
+    others spread)."""
     lower, upper = robot.sample_bounds
+    Q = lower + (spread_points(RANDOM_CONFIGURATIONS + 2 * robot.n, robot.n) + 1.0) / 2.0 * (upper - lower)
     for i in range(robot.n):
         Q[RANDOM_CONFIGURATIONS + 2 * i, i] = lower[i]
         Q[RANDOM_CONFIGURATIONS + 2 * i + 1, i] = upper[i]

@@ -41,7 +41,7 @@ from kinelab.robot.certificate import ChainArrays, FKCertificate, certify, chain
 from kinelab.robot.joints import Joint, Mimic
 from kinelab.robot.meshes import build_visual_model
 from kinelab.robot.mjcf import is_mjcf, meshes_outside
-from kinelab.robot.space import MAX_SAMPLE_BYTES, SAMPLE_TURNS, generator, uniform
+from kinelab.robot.space import MAX_SAMPLE_BYTES, SAMPLE_TURNS, generator, spread_points, uniform
 from kinelab.scratch import own
 
 if TYPE_CHECKING:
@@ -343,7 +343,7 @@ class Chain:
 
     def display_q(self) -> np.ndarray:
         """A pose to show the robot in when none is given [rad, m]: the registered display pose, else the
-        best-conditioned of 64 seeded configurations in the middle half of each joint's range (largest
+        best-conditioned of 64 evenly spread configurations in the middle half of each joint's range (largest
         σ_min/σ_max of the tool Jacobian, linear rows divided by the characteristic length). All-zero poses
         are often singular (a stretched arm), which makes a poor first picture."""
         if self.display_pose is not None:
@@ -626,13 +626,12 @@ def conditioning(robot: Chain, q: np.ndarray) -> float:
 
 
 def _best_conditioned(robot: Chain) -> np.ndarray:
-    rng = np.random.default_rng(0)
     lo = np.where(np.isfinite(robot.lower), robot.lower, -np.pi)
     hi = np.where(np.isfinite(robot.upper), robot.upper, np.pi)
     mid, half = (lo + hi) / 2, np.minimum((hi - lo) / 4, np.pi / 2)
     best, best_ratio = robot.neutral(), -1.0
-    for _ in range(64):
-        q = mid + rng.uniform(-1.0, 1.0, robot.n) * half
+    for u in spread_points(64, robot.n):
+        q = mid + u * half
         ratio = conditioning(robot, q)
         if ratio > best_ratio:
             best, best_ratio = q, ratio

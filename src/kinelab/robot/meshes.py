@@ -9,11 +9,11 @@ from __future__ import annotations
 import contextlib
 import os
 import sys
-import tempfile
 import warnings
 import xml.etree.ElementTree as ET
 from collections.abc import Iterator
 from pathlib import Path
+from typing import BinaryIO
 
 import numpy as np
 import pinocchio as pin
@@ -142,6 +142,8 @@ def build_visual_model(
                       "package_dirs= (CLI --package-dir) or set ROS_PACKAGE_PATH", stacklevel=2)
     geometry_type = pin.GeometryType.COLLISION if kind == "collision" else pin.GeometryType.VISUAL
     said: list[str] = []
+    import tempfile  # the view's path only: loading a robot for kinematics need not import it
+
     with tempfile.TemporaryDirectory(prefix="kinelab-") as folder:  # Pinocchio reads it once, here
         resolved = _with_resolved_meshes(urdf_path, dirs, Path(folder), kind)
         with c_stderr_captured(said):  # urdfdom prints its complaints on the process's stderr
@@ -173,12 +175,22 @@ def _check_vertices(geom: pin.GeometryModel, urdf_path: Path, kind: str) -> None
                             "finite number; fix the mesh file")
 
 
+def _anonymous_file() -> BinaryIO:
+    """A file with no name, for reading back what C code wrote: in memory on Linux (memfd), else a temporary
+    file (whose module every URDF load would otherwise import)."""
+    if hasattr(os, "memfd_create"):
+        return os.fdopen(os.memfd_create("kinelab-stderr", os.MFD_CLOEXEC), "w+b")
+    import tempfile
+
+    return tempfile.TemporaryFile(mode="w+b")
+
+
 @contextlib.contextmanager
 def c_stderr_captured(said: list[str]) -> Iterator[None]:
-    """File descriptor 2 redirected to a temporary file for the block; its lines appended to ``said``."""
+    """File descriptor 2 redirected to an anonymous file for the block; its lines appended to ``said``."""
     sys.stderr.flush()
     saved = os.dup(2)
-    with tempfile.TemporaryFile(mode="w+b") as sink:
+    with _anonymous_file() as sink:
         os.dup2(sink.fileno(), 2)
         try:
             yield
