@@ -74,12 +74,17 @@ def test_info_builds_the_collision_model_only_with_collisions():
 
 
 def test_the_startup_table_calls_met_only_what_every_round_meets():
-    rows = [{"command": "a", "best_ms": 50.0, "ratio": 0.4, "lowest": 0.35, "highest": 0.45, "goal": 1.3},
-            {"command": "b", "best_ms": 160.0, "ratio": 1.25, "lowest": 1.2, "highest": 1.4, "goal": 1.3},
-            {"command": "c", "best_ms": 230.0, "ratio": 1.7, "lowest": 1.65, "highest": 1.8, "goal": 1.6}]
+    rows = [{"command": "a", "best_ms": 50.0, "ratio": 0.4, "median_ratio": 0.42, "lowest": 0.35, "highest": 0.45,
+             "goal": 1.3},
+            {"command": "b", "best_ms": 160.0, "ratio": 1.25, "median_ratio": 1.35, "lowest": 1.2, "highest": 1.4,
+             "goal": 1.3},
+            {"command": "c", "best_ms": 230.0, "ratio": 1.7, "median_ratio": 1.75, "lowest": 1.65, "highest": 1.8,
+             "goal": 1.6},
+            {"command": "d", "best_ms": 150.0, "ratio": 1.1, "median_ratio": 1.2, "lowest": 1.05, "highest": 1.5,
+             "goal": 1.3}]
     table = startup.markdown({"baseline": startup.BASELINE, "baseline_ms": 130.0, "rounds": 7, "commands": rows})
     verdicts = [line.rsplit("(", 1)[1].rstrip(") |") for line in table.splitlines() if line.startswith("| `")]
-    assert verdicts == ["met", "best met", "missed"]
+    assert verdicts == ["met", "best met", "missed", "best and median met"]
 
 
 def test_a_command_that_fails_is_an_error_not_a_time():

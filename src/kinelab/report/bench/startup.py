@@ -4,14 +4,15 @@ Each command runs as a user runs it: the ``kinelab`` script installed beside thi
 kinelab.cli``), a new process each time, its output discarded. A round runs the Pinocchio import and every command
 once, in an order turned by one place each round (no command always follows the same one); the first round warms
 the file caches (and writes the byte code a fresh install has not compiled yet) and is not counted. Per command:
-its best time [ms] over the rounds, the ratio of that best to the import's best, and the spread of the per-round
-ratios (each round's command over the same round's import). The goals are #43's: ``--help``, ``robots`` and ``fk``
-within 1.3× the import, ``ik`` and ``info`` within 1.6×.
+its best time [ms] over the rounds, the ratio of that best to the import's best, the ratio of the medians, and
+the spread of the per-round ratios (each round's command over the same round's import). The goals: ``--help``,
+``robots`` and ``fk`` within 1.3× the import, ``ik`` and ``info`` within 1.6×.
 """
 
 from __future__ import annotations
 
 import os
+import statistics
 import subprocess
 import sys
 import time
@@ -66,16 +67,21 @@ def run(rounds: int = 7) -> dict[str, Any]:
     for name, _, goal in COMMANDS:
         ratios = [t / b for t, b in zip(times[name], base, strict=True)]
         rows.append({"command": name, "best_ms": 1e3 * min(times[name]), "ratio": min(times[name]) / min(base),
+                     "median_ratio": statistics.median(times[name]) / statistics.median(base),
                      "lowest": min(ratios), "highest": max(ratios), "goal": goal})
     return {"baseline": BASELINE, "baseline_ms": 1e3 * min(base), "rounds": len(base), "commands": rows}
 
 
 def markdown(result: dict[str, Any]) -> str:
-    """The table: best time, best over best, the per-round ratios' spread, and the goal."""
+    """The table: best time, best over best, median over median, the per-round ratios' spread, and the goal: "met"
+    where every round meets it, "best and median met" or "best met" where only those do, else "missed"."""
     lines = [f"Start-up, best of {result['rounds']} rounds; {result['baseline']}: {result['baseline_ms']:.0f} ms.",
-             "", "| command | best | best / import's best | per round | goal |", "|---|---|---|---|---|"]
+             "", "| command | best | best / import's best | median / import's median | per round | goal |",
+             "|---|---|---|---|---|---|"]
     for r in result["commands"]:
-        verdict = "met" if r["highest"] <= r["goal"] else ("best met" if r["ratio"] <= r["goal"] else "missed")
-        lines.append(f"| `{r['command']}` | {r['best_ms']:.0f} ms | {r['ratio']:.2f}× | "
+        median = r.get("median_ratio", float("nan"))
+        verdict = "met" if r["highest"] <= r["goal"] else ("missed" if r["ratio"] > r["goal"] else
+                                                          "best and median met" if median <= r["goal"] else "best met")
+        lines.append(f"| `{r['command']}` | {r['best_ms']:.0f} ms | {r['ratio']:.2f}× | {median:.2f}× | "
                      f"{r['lowest']:.2f}–{r['highest']:.2f}× | ≤ {r['goal']}× ({verdict}) |")
     return "\n".join(lines)
