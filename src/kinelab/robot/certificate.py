@@ -128,7 +128,8 @@ def _configurations(robot: Chain) -> np.ndarray:
     """Evenly spread configurations over the sampling bounds, then each joint at its lower and its upper limit (the
     others spread)."""
     lower, upper = robot.sample_bounds
-    Q = lower + (spread_points(RANDOM_CONFIGURATIONS + 2 * robot.n, robot.n) + 1.0) / 2.0 * (upper - lower)
+    mid, half = lower / 2 + upper / 2, upper / 2 - lower / 2  # halves first: ±1e308 m limits do not overflow
+    Q = mid + spread_points(RANDOM_CONFIGURATIONS + 2 * robot.n, robot.n) * half
     for i in range(robot.n):
         Q[RANDOM_CONFIGURATIONS + 2 * i, i] = lower[i]
         Q[RANDOM_CONFIGURATIONS + 2 * i + 1, i] = upper[i]
