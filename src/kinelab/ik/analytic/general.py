@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kinelab.core import _blas
 from kinelab.geometry import wrap_to_pi
 from kinelab.ik.analytic.certify import Loop, Proof, beside_fold, chain_pose, inverse_pose, kantorovich, polish
 from kinelab.ik.limits import nearest_inside
@@ -250,9 +251,7 @@ def solve(g: General6R, H: np.ndarray) -> tuple[np.ndarray, Eigen]:
 def _ggev(A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """LAPACK's QZ (``dggev``) of the pencil (A, B): homogeneous eigenvalues α (complex), β (real) and the left and
     right eigenvectors as complex columns (LAPACK packs a complex pair's as two real ones)."""
-    from scipy.linalg.lapack import dggev  # here: scipy.linalg's import costs ~0.3 s, paid at a first general pose
-
-    alphar, alphai, beta, vl, vr, _, info = dggev(A, B, 1, 1)
+    alphar, alphai, beta, vl, vr, info = _blas.ggev(A, B)
     if info != 0:
         raise np.linalg.LinAlgError(f"dggev failed (info {info})")
     return alphar + 1j * alphai, beta.astype(complex), _unpacked(vl, alphai), _unpacked(vr, alphai)
