@@ -4,9 +4,11 @@ One vocabulary: the robot and the target (or targets) positionally, everything e
 same names, defaults and meanings everywhere — ``solver``, ``q0``, ``seed``, ``tol_pos`` [m], ``tol_rot``
 [rad], ``time_budget`` [s, the whole call], ``max_restarts``, ``start_outside_limits``, ``task``, ``axis``,
 and the solver's options as ``options=`` (a ``FRDMOptions``, ``BiquatOptions`` or ``DLSOptions``) or as
-their fields by keyword. Each entry point builds one validated :class:`~kinelab.ik.request.Request` and hands
-it to the driver (:mod:`kinelab.ik.driver`), the batch (:mod:`kinelab.ik.batch`), the branch search
-(:mod:`kinelab.ik.branches`) or the path follower (:mod:`kinelab.ik.frdm.tracking`).
+their fields by keyword. :func:`solve`, :func:`solve_batch` and :func:`track` are calls on the prepared solver
+(:class:`kinelab.ik.prepared.IK`) kept on the robot for their settings, which routes them (the compiled engine,
+the closed form, a 7R arm's held joint, the multistart, the collision check); ``solve(prefer=)`` and
+:func:`solve_all` still build their own :class:`~kinelab.ik.request.Request` and hand it to the branch search
+(:mod:`kinelab.ik.branches`).
 """
 
 from __future__ import annotations
@@ -16,28 +18,22 @@ from collections.abc import Sequence
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-import pinocchio as pin
-
 from kinelab.errors import OptionError
-from kinelab.geometry import stack_homogeneous
 from kinelab.ik.auto import resolved
-from kinelab.ik.batch import BatchIKResult, prepare, prepare_robot
+from kinelab.ik.batch import BatchIKResult, prepare
 from kinelab.ik.branches import UNSEEN, Route, find_all, route_of, usual_closed_form
-from kinelab.ik.chain import chain_model
 from kinelab.ik.options import flag
-from kinelab.ik.prepared import batch_clear_of, clear_of, collision_check, kept_solver, prepared, solve_clear_of
+from kinelab.ik.prepared import clear_of, collision_check, kept_solver, prepared, solve_clear_of
 from kinelab.ik.registry import Capabilities, capabilities, one_answer, refuse_options
 from kinelab.ik.request import Request, check_robot, make_request
 from kinelab.ik.result import Branches, IKResult, TrackResult
-from kinelab.ik.targets import as_target, as_target_arrays
+from kinelab.ik.targets import as_target
 from kinelab.robot import Chain
 
 if TYPE_CHECKING:  # the collision model and the closed forms load when a call asks for them
     from kinelab.collision.model import CollisionModel
     from kinelab.ik.analytic.branches import BranchBatch
     from kinelab.ik.analytic.sew import SEW
-    from kinelab.ik.frdm.tracking import PathSettings
 
 # The order of the arguments after (robot, target) in kinelab 0.1's positional signatures: a call that still
 # passes them positionally is told which keyword its value was
@@ -235,32 +231,10 @@ def solve_batch(robot: Chain, targets: Any, *positional: Any, solver: str = "frd
         OptionError, SolverNotFoundError: a bad option or argument.
     """
     check_entry(robot, "solve_batch", positional)
-    solver = resolved(robot, solver, task, collisions, options is not None or bool(solver_options))
-    kind = one_answer(solver)
-    if kind.closed_form:
-        return _closed_form_batch(robot, targets, q0, collisions, options or solver_options,
-                                  make_request(kind.request_solver(solver), seed, tol_pos, tol_rot, time_budget,
-                                               max_restarts, start_outside_limits, None, task, axis, None))
-    req = make_request(solver, seed, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options,
-                       task, axis, solver_options)
-    return batch_clear_of(robot, targets, q0, req, collision_check(robot, collisions))
-
-
-def _closed_form_batch(robot: Chain, targets: Any, q0: Any, collisions: Any, options: Any,
-                       req: Request) -> BatchIKResult:
-    """``solve_batch(solver="analytic")``: each row the branch nearest its start, from the closed form (a 7R arm's
-    with its swept joint held at the start's value, :mod:`kinelab.ik.analytic.held`)."""
-    from kinelab.ik.analytic import held
-    from kinelab.ik.analytic.branches import nearest_batch
-
-    refuse_options(options)
-    if held.applies(robot):
-        if collisions is not None:
-            raise OptionError("collisions", collisions, "None with solver='analytic' on a 7R arm (solver='frdm' "
-                              "takes collisions=)")
-        return held.nearest_held(robot, targets, q0, req)
-    held.refuse_7r(robot)
-    return nearest_batch(robot, targets, q0, req, collision_check(robot, collisions))
+    settings = dict(solver=solver, tol_pos=tol_pos, tol_rot=tol_rot, time_budget=time_budget,
+                    max_restarts=max_restarts, start_outside_limits=start_outside_limits, options=options, task=task,
+                    axis=axis, collisions=collisions, **solver_options)
+    return prepared(robot, settings).solve_batch(targets, q0=q0, seed=seed)
 
 
 def solve_all_batch(robot: Chain, targets: Any, *positional: Any, tol_pos: float = 1e-6,
@@ -428,43 +402,8 @@ def track(robot: Chain, targets: Sequence[Any] | Any, *positional: Any, q0: Any 
         ConfigurationError, JointLimitError, TargetError: a bad q0 or target, named.
     """
     check_entry(robot, "track", positional)
-    chain_model(robot)  # the follower's chain and the judge are built once per robot, on no budget's clock
-    prepare_robot(robot)
-    t_start = time.perf_counter()  # the budget counts from here, the checks of the call included
-    if not capabilities(solver).follows_paths:
-        raise OptionError("solver", solver, "'frdm' (track follows a path with FRDM's warm-started sweeps)")
-    from kinelab.ik.frdm.tracking import PathSettings, path_options  # the path follower loads with a path
-
-    settings = PathSettings(jump_limit, restrict, hold, rest_weight)
-    req = make_request(solver, seed, tol_pos, tol_rot, time_budget, 0, "refuse", options, task, axis,
-                       path_options(options, solver_options))
-    points, rotations = as_target_arrays(targets)
-    return _follow_path(robot, points, rotations, q0, req, settings, collision_check(robot, collisions), t_start)
-
-
-def _follow_path(robot: Chain, points: np.ndarray, rotations: np.ndarray, q0: Any, req: Request,
-                 settings: PathSettings, check: CollisionModel | None, t_start: float) -> TrackResult:
-    """:func:`track` once its settings and targets (points [m], rotations) are checked: the start (the first
-    target's answer when q0 is None), the path, and the collision check of every answer when ``check`` is given."""
-    if q0 is None:
-        q0 = _first_answer(robot, pin.SE3(rotations[0], points[0]), req, check)
-    from kinelab.ik.clear import clear_track
-    from kinelab.ik.frdm.tracking import run_track
-
-    path = run_track(robot, stack_homogeneous(points, rotations), robot.check_q(q0, limits=True, what="q0"), req,
-                     settings, t_start)
-    return path if check is None else clear_track(path, check)
-
-
-def _first_answer(robot: Chain, target: pin.SE3, req: Request, check: CollisionModel | None) -> np.ndarray:
-    """Where a path without q0 starts: the answer to its first target, with the path's seed, tolerances and task
-    (clear of collisions when the path checks them)."""
-    first = solve(robot, target, seed=req.seed, tol_pos=req.tol_pos, tol_rot=req.tol_rot, task=req.task.name,
-                  axis="xyz"[req.task.axis] if req.task.axis >= 0 else "z",
-                  collisions=None if check is None else check.spec)
-    if not first.success:
-        raise OptionError("q0", None, "a start configuration: the path's first target could not be solved "
-                          f"({first.status.value}: {first.message})")
-    q: np.ndarray = first.q
-    return q
+    settings = dict(solver=solver, tol_pos=tol_pos, tol_rot=tol_rot, time_budget=time_budget, options=options,
+                    task=task, axis=axis, collisions=collisions, **solver_options)
+    return prepared(robot, settings).track(targets, q0=q0, seed=seed, jump_limit=jump_limit, restrict=restrict,
+                                           hold=hold, rest_weight=rest_weight)
 

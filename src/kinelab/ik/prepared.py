@@ -23,22 +23,27 @@ import time
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+import pinocchio as pin
+
 from kinelab.core._engine import Engine
 from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.auto import resolved
-from kinelab.ik.batch import BatchIKResult, run_batch
+from kinelab.ik.batch import BatchIKResult, prepare_robot, run_batch
 from kinelab.ik.branches import UNSEEN, find_all, route_of
+from kinelab.ik.chain import chain_model
 from kinelab.ik.driver import prepare_solver, solve_one
 from kinelab.ik.registry import capabilities, refuse_options
 from kinelab.ik.request import Request, check_robot, check_seed, make_request
-from kinelab.ik.result import Branches, IKResult
+from kinelab.ik.result import Branches, IKResult, TrackResult
 from kinelab.ik.targets import as_target, as_target_arrays
 from kinelab.robot import Chain
 
 if TYPE_CHECKING:
     from kinelab.collision.model import CollisionModel
     from kinelab.ik.analytic.branches import NearestBranch
+    from kinelab.ik.frdm.tracking import PathSettings
 
 
 class IK:
@@ -87,6 +92,8 @@ class IK:
             refuse_options(options or solver_options)
         self.request: Request = make_request(kind.request_solver(solver), None, tol_pos, tol_rot, time_budget,
                                              max_restarts, start_outside_limits, options, task, axis, solver_options)
+        self._given = (solver, options, dict(solver_options), task, axis)  # what a path's request is made of
+        self._path_request: Request | None = None
         self.collisions = collision_check(robot, collisions)
         self._nearest: NearestBranch | None = None
         self.held = False  # solver "analytic" on a 7R arm: its six at the held joint's start value (_prepare)
@@ -187,7 +194,7 @@ class IK:
         if self.analytic:
             from kinelab.ik.analytic.branches import nearest_batch
 
-            return nearest_batch(self.robot, targets, q0, self.request, self.collisions)
+            return nearest_batch(self.robot, targets, q0, req, self.collisions)
         return batch_clear_of(self.robot, targets, q0, req, self.collisions)
 
     def solve_all(self, target: Any, *, seed: int | None = None, q_ref: Any = None,
@@ -211,6 +218,80 @@ class IK:
                          max_solutions=max_solutions, stop_below=stop_below,
                          method=self.route)
         return clear_of(found, self.collisions, drop=False)
+
+    def track(self, targets: Any, *, q0: Any = None, seed: int | None = None, jump_limit: float | None = 0.2,
+              restrict: tuple[str, ...] = (), hold: int = 10, rest_weight: float | None = None) -> TrackResult:
+        """Follow a path, as :func:`kinelab.track` with these settings (solver "frdm"; the path's option defaults
+        under the options given here; no restarts; starts outside the limits refused).
+
+        Args:
+            targets: oMtarget per sample (a sequence of ``pin.SE3`` or an (N, 4, 4) array, base frame).
+            q0: the configuration at the start of the path [rad or m] (None: the first target's answer).
+            seed: seed of the first solve and of the restarts that recover a missed sample.
+            jump_limit: largest joint step [rad or m] before the jump monitor fires (None: off).
+            restrict: restrictions ("intervals", "freeze") held on every sample.
+            hold: samples a restriction stays on after the monitor switched it on.
+            rest_weight: compiled follower only: weight of the rest term (None: its default).
+
+        Returns:
+            The :class:`TrackResult`, every sample judged.
+
+        Raises:
+            OptionError, ConfigurationError, JointLimitError, TargetError: named.
+        """
+        chain_model(self.robot)  # the follower's chain and the judge are built once per robot, on no budget's clock
+        prepare_robot(self.robot)
+        t_start = time.perf_counter()  # the budget counts from here, the checks of the call included
+        req = self._path(seed)
+        from kinelab.ik.frdm.tracking import PathSettings  # the path follower loads with a path
+
+        points, rotations = as_target_arrays(targets)
+        settings = PathSettings(jump_limit, restrict, hold, rest_weight)
+        return follow_path(self.robot, points, rotations, q0, req, settings, self.collisions, t_start)
+
+    def _path(self, seed: int | None) -> Request:
+        """The request of a path: the path's option defaults under the options given, no restarts, starts refused."""
+        solver, options, solver_options, task, axis = self._given
+        if not capabilities(self.request.solver).follows_paths:
+            raise OptionError("solver", solver, "'frdm' (track follows a path with FRDM's warm-started sweeps)")
+        if self._path_request is None:
+            from kinelab.ik.frdm.tracking import path_options
+
+            req = self.request
+            self._path_request = make_request(req.solver, None, req.tol_pos, req.tol_rot, req.time_budget, 0, "refuse",
+                                              options, task, axis, path_options(options, solver_options))
+        if seed is None:
+            return self._path_request
+        check_seed(seed)
+        return replace(self._path_request, seed=int(seed))
+
+
+def follow_path(robot: Chain, points: np.ndarray, rotations: np.ndarray, q0: Any, req: Request,
+                settings: PathSettings, check: CollisionModel | None, t_start: float) -> TrackResult:
+    """A path once its settings and targets (points [m], rotations) are checked: the start (the first target's
+    answer when q0 is None), the path, and the collision check of every answer when ``check`` is given."""
+    if q0 is None:
+        q0 = _first_answer(robot, pin.SE3(rotations[0], points[0]), req, check)
+    from kinelab.ik.clear import clear_track
+    from kinelab.ik.frdm.tracking import run_track
+
+    path = run_track(robot, stack_homogeneous(points, rotations), robot.check_q(q0, limits=True, what="q0"), req,
+                     settings, t_start)
+    return path if check is None else clear_track(path, check)
+
+
+def _first_answer(robot: Chain, target: pin.SE3, req: Request, check: CollisionModel | None) -> np.ndarray:
+    """Where a path without q0 starts: the answer to its first target, with the path's seed, tolerances and task
+    (clear of collisions when the path checks them)."""
+    settings = dict(solver="frdm", tol_pos=req.tol_pos, tol_rot=req.tol_rot, task=req.task.name,
+                    axis="xyz"[req.task.axis] if req.task.axis >= 0 else "z",
+                    collisions=None if check is None else check.spec)
+    first = prepared(robot, settings).solve(target, seed=req.seed)
+    if not first.success:
+        raise OptionError("q0", None, "a start configuration: the path's first target could not be solved "
+                          f"({first.status.value}: {first.message})")
+    q: np.ndarray = first.q
+    return q
 
 
 def collision_check(robot: Chain, collisions: Any) -> CollisionModel | None:
