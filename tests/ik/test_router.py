@@ -106,3 +106,22 @@ def test_track_without_a_start_begins_at_the_first_targets_answer_through_the_ro
     assert path.reached.all() and spy["track"] == 1 and spy["solve"] == 1  # the first answer: a kept solver's solve
     with pytest.raises(kinelab.OptionError, match="'frdm' \\(track follows a path"):
         kinelab.track(robot, targets, solver="biquat")
+
+
+@pytest.mark.parametrize(("name", "extra"), [
+    ("ur5", {}), ("crx10ia", {}), ("panda", {}), ("panda", {"redundancy": 4}), ("kinova", {"solver": "frdm"}),
+    ("ur5", {"collisions": "self", "drop_colliding": True}), ("ur10", {"solver": "analytic"}),
+])
+def test_solve_all_is_the_kept_prepared_solvers_call(spy, name, extra):
+    robot = kinelab.load(name)
+    q = robot.display_q()
+    target = robot.fk(q)
+    found = [kinelab.solve_all(robot, target, seed=2, **extra) for _ in range(2)]
+    assert spy["solve_all"] == 2 and spy["built"] == 1
+    for branches in found:
+        assert len(branches) >= 1 and branches.status == kinelab.Status.CONVERGED
+        for b in branches:  # every branch meets the target within the limits, by Pinocchio's FK
+            dp, dr = robot.tool_error(b.q, target)
+            assert dp <= 1e-6 and dr <= 1e-6 and np.all(b.q >= robot.lower - 1e-9) and np.all(b.q <= robot.upper + 1e-9)
+    if name in ("ur5", "ur10", "crx10ia"):  # every branch in closed form or by the 1-D search: the pose's own too
+        assert any(np.abs(b.q - q).max() < 1e-6 for b in found[0])

@@ -4,11 +4,11 @@ One vocabulary: the robot and the target (or targets) positionally, everything e
 same names, defaults and meanings everywhere — ``solver``, ``q0``, ``seed``, ``tol_pos`` [m], ``tol_rot``
 [rad], ``time_budget`` [s, the whole call], ``max_restarts``, ``start_outside_limits``, ``task``, ``axis``,
 and the solver's options as ``options=`` (a ``FRDMOptions``, ``BiquatOptions`` or ``DLSOptions``) or as
-their fields by keyword. :func:`solve`, :func:`solve_batch` and :func:`track` are calls on the prepared solver
-(:class:`kinelab.ik.prepared.IK`) kept on the robot for their settings, which routes them (the compiled engine,
-the closed form, a 7R arm's held joint, the multistart, the collision check); ``solve(prefer=)`` and
-:func:`solve_all` still build their own :class:`~kinelab.ik.request.Request` and hand it to the branch search
-(:mod:`kinelab.ik.branches`).
+their fields by keyword. :func:`solve`, :func:`solve_batch`, :func:`solve_all` and :func:`track` are calls on the
+prepared solver (:class:`kinelab.ik.prepared.IK`) kept on the robot for their settings, which routes them (the
+compiled engine, the closed form, a 7R arm's held joint, the 1-D search, the multistart, the collision check);
+``solve(prefer=)`` still builds its own :class:`~kinelab.ik.request.Request` for the branch search
+(:mod:`kinelab.ik.branches`), and :func:`solve_all_batch` is the closed forms' batch alone.
 """
 
 from __future__ import annotations
@@ -21,8 +21,7 @@ from typing import TYPE_CHECKING, Any
 from kinelab.errors import OptionError
 from kinelab.ik.auto import resolved
 from kinelab.ik.batch import BatchIKResult, prepare
-from kinelab.ik.branches import UNSEEN, Route, find_all, route_of, usual_closed_form
-from kinelab.ik.options import flag
+from kinelab.ik.branches import UNSEEN, Route, find_all
 from kinelab.ik.prepared import clear_of, collision_check, kept_solver, prepared, solve_clear_of
 from kinelab.ik.registry import Capabilities, capabilities, one_answer, refuse_options
 from kinelab.ik.request import Request, check_robot, make_request
@@ -322,37 +321,23 @@ def solve_all(robot: Chain, target: Any, *positional: Any, solver: str = "auto",
         TargetError, ConfigurationError, OptionError: bad input, named.
     """
     check_entry(robot, "solve_all", positional)
-    flag("drop_colliding", drop_colliding)
     if isinstance(time_budget, str):
         if time_budget != AUTO:
             raise OptionError("time_budget", time_budget, "a finite number > 0 [s], None (none) or 'auto'")
         time_budget = AUTO_BUDGET if redundancy is None else AUTO_REDUNDANT_BUDGET
-    budget: float | None = time_budget
-    if options is None and not solver_options and _usual_all(q_ref, max_solutions, collisions, redundancy, task,
-                                                             axis):
-        found = usual_closed_form(robot, target, seed, (solver, tol_pos, tol_rot, budget, stop_below))
-        if found is not None:
-            return found
-    kind, given = capabilities(solver), options is not None or bool(solver_options)
-    if kind.closed_form and given:  # refusing says so rather than ignoring them
+    kind = capabilities(solver)
+    if kind.closed_form and (options is not None or solver_options):  # refusing says so rather than ignoring them
         refuse_options(options or solver_options)
-    req = make_request(kind.request_solver(solver), seed, tol_pos, tol_rot, budget, 0, "refuse", options, task,
-                       axis, solver_options)
-    check = collision_check(robot, collisions)
-    found = find_all(robot, target, req, q_ref=q_ref, max_solutions=max_solutions, stop_below=stop_below,
-                     method=route_of(kind, given), redundancy=redundancy)
-    return clear_of(found, check, drop=bool(drop_colliding))
+    settings = dict(solver=solver, tol_pos=tol_pos, tol_rot=tol_rot, time_budget=time_budget, options=options,
+                    task=task, axis=axis, collisions=collisions, **solver_options)
+    return prepared(robot, settings).solve_all(target, seed=seed, q_ref=q_ref, max_solutions=max_solutions,
+                                               stop_below=stop_below, redundancy=redundancy,
+                                               drop_colliding=drop_colliding)
 
 
 AUTO = "auto"  # solve_all's default time_budget: the route's own (below)
 AUTO_BUDGET = 0.05  # [s] solve_all's multistart when no budget is named
 AUTO_REDUNDANT_BUDGET = 5.0  # [s] a 7R arm's redundancy= searches when no budget is named (≈ 0.2-0.9 s a pose)
-
-
-def _usual_all(q_ref: Any, max_solutions: Any, collisions: Any, redundancy: Any, task: Any, axis: Any) -> bool:
-    """:func:`solve_all`'s usual call, which the closed form's one compiled call serves: none of these given."""
-    return q_ref is None and max_solutions is None and collisions is None and redundancy is None \
-        and task == "pose" and axis == "z"
 
 
 def track(robot: Chain, targets: Sequence[Any] | Any, *positional: Any, q0: Any = None, solver: str = "frdm",

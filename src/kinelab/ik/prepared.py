@@ -31,9 +31,10 @@ from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.auto import resolved
 from kinelab.ik.batch import BatchIKResult, prepare_robot, run_batch
-from kinelab.ik.branches import UNSEEN, find_all, route_of
+from kinelab.ik.branches import UNSEEN, find_all, route_of, usual_closed_form
 from kinelab.ik.chain import chain_model
 from kinelab.ik.driver import prepare_solver, solve_one
+from kinelab.ik.options import flag
 from kinelab.ik.registry import capabilities, refuse_options
 from kinelab.ik.request import Request, check_robot, check_seed, make_request
 from kinelab.ik.result import Branches, IKResult, TrackResult
@@ -43,6 +44,7 @@ from kinelab.robot import Chain
 if TYPE_CHECKING:
     from kinelab.collision.model import CollisionModel
     from kinelab.ik.analytic.branches import NearestBranch
+    from kinelab.ik.analytic.sew import SEW
     from kinelab.ik.frdm.tracking import PathSettings
 
 
@@ -84,15 +86,18 @@ class IK:
                             f"solver={positional[0]!r}")
         check_robot(robot)
         self.robot = robot
-        solver = resolved(robot, solver, task, collisions, options is not None or bool(solver_options))
+        given = options is not None or bool(solver_options)
+        # solve_all's route is the named solver's, as kinelab.solve_all's ("auto" there: the closed form or the 1-D
+        # search, the multistart where they find nothing); the other calls take what "auto" stands for here
+        self.route = route_of(capabilities(solver), given)
+        self._given = (solver, options, dict(solver_options), task, axis)  # what solve_all and a path are made of
+        solver = resolved(robot, solver, task, collisions, given)
         kind = capabilities(solver)
         self.analytic = kind.closed_form
-        self.route = route_of(kind, options is not None or bool(solver_options))  # of solve_all, as kinelab's
         if self.analytic:
             refuse_options(options or solver_options)
         self.request: Request = make_request(kind.request_solver(solver), None, tol_pos, tol_rot, time_budget,
                                              max_restarts, start_outside_limits, options, task, axis, solver_options)
-        self._given = (solver, options, dict(solver_options), task, axis)  # what a path's request is made of
         self._path_request: Request | None = None
         self.collisions = collision_check(robot, collisions)
         self._nearest: NearestBranch | None = None
@@ -198,8 +203,10 @@ class IK:
         return batch_clear_of(self.robot, targets, q0, req, self.collisions)
 
     def solve_all(self, target: Any, *, seed: int | None = None, q_ref: Any = None,
-                  max_solutions: int | None = None, stop_below: float | None = UNSEEN) -> Branches:
-        """The distinct branches of ``target`` found within the time budget, as :func:`kinelab.solve_all`.
+                  max_solutions: int | None = None, stop_below: float | None = UNSEEN,
+                  redundancy: int | dict[str, float] | SEW | None = None, drop_colliding: bool = False) -> Branches:
+        """The distinct branches of ``target`` found within the time budget, as :func:`kinelab.solve_all` with these
+        settings.
 
         Args:
             target: oMtarget.
@@ -207,6 +214,8 @@ class IK:
             q_ref: sort the branches by distance to this configuration.
             max_solutions: stop at this many branches.
             stop_below: the stopping rule's threshold, as :func:`kinelab.solve_all` (None: the whole budget).
+            redundancy: a 7R arm's, as :func:`kinelab.solve_all` (K, ``{joint: value}`` or ``SEW(ψ)``).
+            drop_colliding: leave colliding branches out instead of marking them (with ``collisions``).
 
         Returns:
             One result per distinct branch.
@@ -214,10 +223,19 @@ class IK:
         Raises:
             TargetError, ConfigurationError, OptionError: named.
         """
+        flag("drop_colliding", drop_colliding)
+        solver, options, solver_options, task, axis = self._given
+        req = self.request
+        if options is None and not solver_options and q_ref is None and max_solutions is None \
+                and self.collisions is None and redundancy is None and task == "pose" and axis == "z":
+            found = usual_closed_form(self.robot, target, seed, (solver, req.tol_pos, req.tol_rot, req.time_budget,
+                                                                  stop_below))
+            if found is not None:  # the usual call: every branch in one compiled call
+                return found
         found = find_all(self.robot, target, replace(self._request(seed), max_restarts=0), q_ref=q_ref,
-                         max_solutions=max_solutions, stop_below=stop_below,
-                         method=self.route)
-        return clear_of(found, self.collisions, drop=False)
+                         max_solutions=max_solutions, stop_below=stop_below, method=self.route,
+                         redundancy=redundancy)
+        return clear_of(found, self.collisions, drop=bool(drop_colliding))
 
     def track(self, targets: Any, *, q0: Any = None, seed: int | None = None, jump_limit: float | None = 0.2,
               restrict: tuple[str, ...] = (), hold: int = 10, rest_weight: float | None = None) -> TrackResult:
