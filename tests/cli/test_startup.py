@@ -134,3 +134,14 @@ def test_a_solve_takes_blas_from_scipys_bundled_openblas_without_importing_scipy
 
 def test_without_a_bundled_openblas_the_capsules_serve_the_same_answers():
     assert _blas_run("_blas._bundled_library = lambda: None") == ["SciPy's", "capsules", "True", "True", "True"]
+
+
+def test_the_router_table_calls_met_only_what_every_round_meets():
+    from kinelab.report.bench import router
+
+    rows = [{"robot": "ur5", "solver": "frdm", "entry": "solve_batch", "ratio": 1.01, "lowest": 0.97, "highest": 1.05},
+            {"robot": "ur5", "solver": "frdm", "entry": "track", "ratio": 0.99, "lowest": 0.90, "highest": 1.10},
+            {"robot": "ur5", "solver": "auto", "entry": "solve_all", "ratio": 0.80, "lowest": 0.70, "highest": 0.90}]
+    table = router.markdown(rows).splitlines()
+    verdicts = [line.rsplit("|", 2)[1].strip() for line in table if line.startswith("| ur5")]
+    assert verdicts == ["met", "median met", "missed"]

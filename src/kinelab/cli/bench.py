@@ -61,6 +61,9 @@ def add(sub: Any) -> None:
                    help="instead of the arm protocol: the whole-body step side by side with pink and mink (--robots "
                         "among panda, baxter, talos, g1; default all four), --repeats rounds, and the converged "
                         "solve against pink iterated (--n targets per robot)")
+    s.add_argument("--router", action="store_true",
+                   help="instead of the arm protocol: kinelab.IK(...).solve_batch, .solve_all and .track against "
+                        "the module functions (--robots; default ur5 panda kinova crx10ia era), --repeats rounds")
     s.add_argument("--budgets", action="store_true",
                    help="also measure how every entry point with a budget keeps 5 ms (p50, p99, max per robot)")
     s.add_argument("--out", help="write bench.json, bench.md and bench.png here")
@@ -77,6 +80,8 @@ def run(args: argparse.Namespace) -> int:
         check_output_folder(args.out, "bench")
     if args.whole_body:
         return _whole_body(args)
+    if args.router:
+        return _router(args)
     first = _before_the_peers(args)
     result = bench.run(robots=args.robots, n=args.n, seed=args.seed, solvers=args.solvers,
                        budget=args.budget_ms / 1e3, progress=progress_of(args), repeats=args.repeats, start=args.start,
@@ -126,6 +131,22 @@ def run(args: argparse.Namespace) -> int:
     _print_tables(result)
     if args.out:
         print(f"results written to {args.out}")
+    return 0
+
+
+def _router(args: argparse.Namespace) -> int:
+    """``--router``: the prepared solver against the module functions, alone (its table, JSON or files)."""
+    from kinelab.report import render
+    from kinelab.report.bench import router, runner
+
+    result = runner.header()
+    result["router"] = router.run(args.robots, seed=args.seed, repeats=args.repeats, progress=progress_of(args))
+    if args.out:
+        render.write_bench(result, args.out)
+    if args.json:
+        print_json(result)
+    else:
+        print(router.markdown(result["router"]))
     return 0
 
 
