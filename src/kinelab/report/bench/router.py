@@ -28,6 +28,7 @@ GOAL = 0.95  # the prepared solver's throughput over the function's, in every ro
 BATCH = 256  # targets per solve_batch problem
 PROBLEMS = 8  # problems per entry point and round
 ALL_BUDGET = 0.05  # [s] solve_all's multistart (its default)
+REDUNDANCY = 16  # a 7R arm's solve_all with solver "analytic": every branch at this many values of its swept joint
 Call = Callable[[Any, int], Any]  # a problem and a seed → an answer
 
 
@@ -53,11 +54,13 @@ def _pairs(robot: Chain, solver: str) -> dict[str, tuple[Call, Call]]:
     """Per entry point: (the module function, the prepared solver's method), each called as (problem, seed)."""
     batch_ik = IK(robot, solver=solver, time_budget=None, start_outside_limits="refuse")
     all_ik = IK(robot, solver=solver, time_budget=ALL_BUDGET)
+    swept = REDUNDANCY if solver == "analytic" and robot.n == 7 else None  # a 7R arm's closed form sweeps a joint
     pairs: dict[str, tuple[Call, Call]] = {
         "solve_batch": (lambda T, s: solve_batch(robot, T, solver=solver, seed=s),
                         lambda T, s: batch_ik.solve_batch(T, seed=s)),
-        "solve_all": (lambda T, s: solve_all(robot, T, solver=solver, seed=s, time_budget=ALL_BUDGET),
-                      lambda T, s: all_ik.solve_all(T, seed=s))}
+        "solve_all": (lambda T, s: solve_all(robot, T, solver=solver, seed=s, time_budget=ALL_BUDGET,
+                                             redundancy=swept),
+                      lambda T, s: all_ik.solve_all(T, seed=s, redundancy=swept))}
     if solver == "frdm":
         path_ik = IK(robot, time_budget=None)
         pairs["track"] = (lambda P, s: track(robot, P, q0=_start(robot, P), seed=s),
