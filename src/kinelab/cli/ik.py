@@ -232,10 +232,20 @@ def _split_spec(spec: str, flag: str, form: str) -> tuple[str, str]:
 
 def _print_ik(robot: Chain, args: argparse.Namespace, result: IKResult) -> None:
     """The text form of an IK result: status, q, Pinocchio's errors on the task's components, effort."""
-    import numpy as np
+    from kinelab.ik.result import Status
 
-    from kinelab.ik.registry import capabilities
-    from kinelab.ik.result import BiquatDiagnostics, Status
+    _print_answer(robot, args, result)
+    _print_solver_notes(args, result)
+    if result.message:
+        print("  " + re.sub(r"task='(\w+)'", r"--task \1", result.message))
+    if not result.success and result.status is not Status.OUTSIDE_LIMITS and args.task != "position" \
+            and args.target_xyz is not None and args.target_rpy is None:
+        print("  (no --target-rpy: the target rotation is the identity; --task position ignores it)")
+
+
+def _print_answer(robot: Chain, args: argparse.Namespace, result: IKResult) -> None:
+    """Status, q (degrees with --deg), the errors on the task's components and the effort."""
+    import numpy as np
 
     q_show = np.where([k != "prismatic" for k in robot.joint_kinds], np.rad2deg(result.q), result.q) \
         if args.deg else result.q
@@ -248,6 +258,13 @@ def _print_ik(robot: Chain, args: argparse.Namespace, result: IKResult) -> None:
     print(f"  {plural(result.iterations, 'iteration')}, {plural(result.restarts, 'restart')}, "
           f"{result.wall_time * 1e3:.2f} ms (one call, first-call costs included; `kinelab bench` times repeated "
           f"calls)" + (f", method {result.mode}" if args.verbose else ""))
+
+
+def _print_solver_notes(args: argparse.Namespace, result: IKResult) -> None:
+    """What the solver adds: the biquaternion model's time and M0, the singularity monitor, the collision retries."""
+    from kinelab.ik.registry import capabilities
+    from kinelab.ik.result import BiquatDiagnostics
+
     diag = result.diagnostics
     if isinstance(diag, BiquatDiagnostics) and diag.model_time:
         m0 = diag.M0
@@ -261,11 +278,6 @@ def _print_ik(robot: Chain, args: argparse.Namespace, result: IKResult) -> None:
                   "solver did about it)")
     if result.success and result.diagnostics.clear_after is not None:
         print(f"  clear of collisions ({plural(result.diagnostics.clear_after, 'colliding answer')} found before)")
-    if result.message:
-        print("  " + re.sub(r"task='(\w+)'", r"--task \1", result.message))
-    if not result.success and result.status is not Status.OUTSIDE_LIMITS and args.task != "position" \
-            and args.target_xyz is not None and args.target_rpy is None:
-        print("  (no --target-rpy: the target rotation is the identity; --task position ignores it)")
 
 
 def _print_events(result: IKResult) -> None:

@@ -21,7 +21,7 @@ import pinocchio as pin
 from kinelab.core import _body
 from kinelab.robot.tree import Robot
 from kinelab.wholebody import evaluate as ev
-from kinelab.wholebody.tasks import ComTask, CouplingTask, PostureTask, RelativeFrameTask, Task
+from kinelab.wholebody.tasks import ComTask, CouplingTask, FrameTask, PostureTask, RelativeFrameTask, Task
 
 CERTIFY_SAMPLES = 20
 CERTIFY_TOL = 1e-10  # [m, rad] compiled against Pinocchio
@@ -153,7 +153,29 @@ def structure(tasks: tuple[Task, ...]) -> tuple[Any, ...] | None:
 
 def pack(robot: Robot, tree: _body.Tree, tasks: tuple[Task, ...]) -> Packed:
     """The compiled problem of a task list (see :func:`structure`)."""
-    weighted = [t for t in tasks if not isinstance(t, PostureTask | CouplingTask)]
+    rows = _weighted_rows(robot, [t for t in tasks if isinstance(t, FrameTask | RelativeFrameTask | ComTask)])
+    post = next((t for t in tasks if isinstance(t, PostureTask)), None)
+    post_w = np.zeros(robot.nv) if post is None else ev.posture_weight(robot, post)
+    couplings = [t for t in tasks if isinstance(t, CouplingTask)]
+    post_ref = robot.neutral()
+    targets = tuple(i for i, t in enumerate(tasks) if not isinstance(t, PostureTask | CouplingTask))
+    posture = next((i for i, t in enumerate(tasks) if isinstance(t, PostureTask)), -1)
+    cslot = np.array([i for i, t in enumerate(tasks) if isinstance(t, CouplingTask)], dtype=np.intc)
+    step = _body.Step(tree, *rows, post_ref, post_w, 0.0 if post is None else post.gain,
+                      0 if post is None else post.priority, *_coupling_indices(robot, couplings),
+                      np.array([c.ratio for c in couplings]), np.array([c.offset for c in couplings]),
+                      np.array(targets, dtype=np.intc), posture, cslot)
+    return Packed(step, targets, posture, post_ref, post_w, tuple(t.label for t in tasks))
+
+
+Rows = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+             np.ndarray, np.ndarray]
+
+
+def _weighted_rows(robot: Robot, weighted: list[FrameTask | RelativeFrameTask | ComTask]) -> Rows:
+    """The compiled step's arrays of the weighted tasks (frames and the CoM), one entry per task: kind, joint,
+    root joint, axis (or the CoM's component bits), priority, placement, root placement, position weight,
+    orientation weight, gain."""
     n = len(weighted)
     kind, joint, root = np.zeros(n, dtype=np.intc), np.zeros(n, dtype=np.intc), np.zeros(n, dtype=np.intc)
     axis, priority = np.zeros(n, dtype=np.intc), np.ones(n, dtype=np.intc)
@@ -171,23 +193,15 @@ def pack(robot: Robot, tree: _body.Tree, tasks: tuple[Task, ...]) -> Packed:
             kind[k], root[k], root_place[k] = T_RELATIVE, other.parentJoint, _pose(other.placement)
         else:
             kind[k], axis[k] = KINDS[t.task], "xyz".index(t.axis)
-    post = next((t for t in tasks if isinstance(t, PostureTask)), None)
-    post_w = np.zeros(robot.nv) if post is None else ev.posture_weight(robot, post)
-    couplings = [t for t in tasks if isinstance(t, CouplingTask)]
+    return kind, joint, root, axis, priority, place, root_place, wp, wo, gain
+
+
+def _coupling_indices(robot: Robot,
+                      couplings: list[CouplingTask]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Each coupled joint's and its leader's q and velocity indices: (joint q, joint v, leader q, leader v)."""
     ids = [[robot.model.joints[robot.model.getJointId(n)] for n in (c.joint, c.leader)] for c in couplings]
-    cq = np.array([a.idx_q for a, _ in ids], dtype=np.intc)
-    cv = np.array([a.idx_v for a, _ in ids], dtype=np.intc)
-    lq = np.array([b.idx_q for _, b in ids], dtype=np.intc)
-    lv = np.array([b.idx_v for _, b in ids], dtype=np.intc)
-    post_ref = robot.neutral()
-    targets = tuple(i for i, t in enumerate(tasks) if not isinstance(t, PostureTask | CouplingTask))
-    posture = next((i for i, t in enumerate(tasks) if isinstance(t, PostureTask)), -1)
-    cslot = np.array([i for i, t in enumerate(tasks) if isinstance(t, CouplingTask)], dtype=np.intc)
-    step = _body.Step(tree, kind, joint, root, axis, priority, place, root_place, wp, wo, gain, post_ref,
-                      post_w, 0.0 if post is None else post.gain, 0 if post is None else post.priority, cq, cv, lq, lv,
-                      np.array([c.ratio for c in couplings]), np.array([c.offset for c in couplings]),
-                      np.array(targets, dtype=np.intc), posture, cslot)
-    return Packed(step, targets, posture, post_ref, post_w, tuple(t.label for t in tasks))
+    return (np.array([a.idx_q for a, _ in ids], dtype=np.intc), np.array([a.idx_v for a, _ in ids], dtype=np.intc),
+            np.array([b.idx_q for _, b in ids], dtype=np.intc), np.array([b.idx_v for _, b in ids], dtype=np.intc))
 
 
 def set_targets(robot: Robot, packed: Packed, tasks: tuple[Task, ...]) -> None:
