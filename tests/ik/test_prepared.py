@@ -132,3 +132,29 @@ def test_a_start_given_as_a_list_or_another_real_dtype_takes_the_one_call(ur5, m
                        ([[0.0] * 6], "6 numbers")):
         with pytest.raises(kinelab.ConfigurationError, match=error):
             ik.solve(target, q0=bad)
+
+
+def test_the_engine_says_why_it_declines_and_the_general_route_then_answers():
+    """#58: the one-call engine answered None for every call it leaves to the general route; it names the reason."""
+    import pinocchio as pin
+
+    from kinelab.ik.spec import Decline
+
+    robot = kinelab.load("ur5")
+    ik = kinelab.IK(robot, time_budget=None)
+    q = np.array([0.3, -1.2, 1.4, -0.5, 0.9, 0.2])
+    target = robot.fk(q)
+    far = pin.SE3(np.eye(3), np.array([5.0, 0.0, 0.0]))
+    outside = q.copy()
+    outside[1] = robot.upper[1] + 0.5
+    cases = [(target.homogeneous, None, 0, Decline.TARGET), (far, None, 0, Decline.TARGET),
+             (target, ["a"] * 6, 0, Decline.START), (target, q[:5], 0, Decline.START),
+             (target, outside, 0, Decline.OUTSIDE), (target, q, -1, Decline.SEED), (target, q, 1.5, Decline.SEED)]
+    for tgt, q0, seed, why in cases:
+        assert ik.engine.solve(tgt, q0, seed) == why
+    assert not isinstance(ik.engine.solve(target, q, 0), int)  # the usual call: a result
+    far_result = ik.solve(far, q0=q, seed=0)  # the general route answers what the engine declined
+    assert far_result.status == kinelab.Status.UNREACHABLE and not far_result.success
+    with pytest.warns(UserWarning, match="outside"):  # the start projected into the limits, with a warning
+        projected = ik.solve(target, q0=outside, seed=0)
+    assert projected.success and max(robot.tool_error(projected.q, target)) <= 1e-6

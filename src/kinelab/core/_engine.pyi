@@ -2,15 +2,21 @@ from typing import Any
 
 from kinelab.core._chain import Judge
 from kinelab.core._frdm import Packed
+from kinelab.ik.spec import BiquatSpec, EngineSpec, FRDMSpec
 
 SEED_LIMIT: int
+DECLINE_TARGET: int
+DECLINE_START: int
+DECLINE_OUTSIDE: int
+DECLINE_SEED: int
+DECLINE_EMPTY: int
 
 class Engine:
-    def __init__(self, judge: Judge, spec: Any) -> None: ...
+    def __init__(self, judge: Judge, spec: EngineSpec) -> None: ...
     def solve(self, target: Any, q0: Any, seed: Any) -> Any: ...
 
 class FRDMEngine(Engine):
-    def __init__(self, packed: Packed, judge: Judge, spec: Any) -> None: ...
+    def __init__(self, packed: Packed, judge: Judge, spec: FRDMSpec) -> None: ...
 
 class BiquatEngine(Engine):
-    def __init__(self, packed: Packed, judge: Judge, spec: Any) -> None: ...
+    def __init__(self, packed: Packed, judge: Judge, spec: BiquatSpec) -> None: ...

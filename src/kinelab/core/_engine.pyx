@@ -5,9 +5,10 @@ answer with the certified compiled FK (turned into the limits by whole turns whe
 One engine interface (:class:`Engine`: the checks, the verdict and the result, written once) over the kernels'
 timed multistarts: :class:`FRDMEngine` and :class:`BiquatEngine` each supply only their run. The prepared solver
 (:class:`kinelab.IK`) builds an engine once; per call only the target, the start, the seed and the clock change.
-An unusual call (a target that is not a ``pin.SE3``, a start that is not n real numbers within the limits, a target
-beyond the reach bound, a seed that is not a whole number in [0, 2⁶⁴)) gets None, and the caller takes the general
-route, which names what is wrong: the engine changes the cost, never the answer.
+An unusual call gets the code of why the engine declines it (an int: :class:`kinelab.ik.spec.Decline` names them —
+a target that is not a ``pin.SE3`` of a proper pose within the reach bound, a start that is not n real numbers, a
+start outside the limits, a seed that is not a whole number in [0, 2⁶⁴)), and the caller takes the general route,
+which names what is wrong: the engine changes the cost, never the answer.
 """
 
 import os
@@ -35,6 +36,12 @@ cdef int REVOLUTE = 0
 # biquaternion preset's steps)
 cdef int T_ATTEMPTS = 0, T_ITERATIONS = 1
 SEED_LIMIT = 1 << 64
+# why Engine.solve declines a call (kinelab.ik.spec.Decline names them; the general route serves it)
+DECLINE_TARGET = 1  # not a pin.SE3, or not a proper pose, or beyond the reach bound
+DECLINE_START = 2  # q0 is not n real numbers
+DECLINE_OUTSIDE = 3  # q0 lies outside the limits
+DECLINE_SEED = 4  # not a whole number in [0, 2^64)
+DECLINE_EMPTY = 5  # a chain without joints
 
 
 cdef unsigned long long splitmix(unsigned long long x) noexcept nogil:
@@ -105,7 +112,7 @@ cdef class Engine:
             raise MemoryError(f"{type(self).__name__}: no memory for one configuration")
 
     def solve(self, target, q0, seed):
-        """The usual call (see the module's docstring), or None for the general route.
+        """The usual call (see the module's docstring), or the code of why it declines (the general route serves).
 
         Args:
             target: oMtarget (base frame).
@@ -114,26 +121,30 @@ cdef class Engine:
 
         Returns:
             The result: built here for a converged answer the judge confirms (the answer turned into the limits
-            where whole turns do it; its diagnostics made when first read), else by ``unmet``; None for an unusual
-            call.
+            where whole turns do it; its diagnostics made when first read), else by ``unmet``; for an unusual call,
+            an int: why the engine declines it (``DECLINE_TARGET`` ... ``DECLINE_EMPTY``).
         """
         cdef double t_start = now()
         cdef const double* start = NULL
-        if type(target) is not self.se3 or self.n == 0:
-            return None
+        if self.n == 0:
+            return DECLINE_EMPTY
+        if type(target) is not self.se3:
+            return DECLINE_TARGET
         if q0 is not None:
             start = self._start(q0)
             if start == NULL:
                 q0 = _as_start(q0, self.n)  # a list, a float32 or integer array: the same values as float64
                 if q0 is None:
-                    return None
+                    return DECLINE_START
                 start = self._start(q0)
         if seed is None:
             seed = int.from_bytes(os.urandom(8), "little")
         elif type(seed) is not int or not 0 <= seed < SEED_LIMIT:
-            return None
-        if not self._aim(target.homogeneous) or (start != NULL and not self._within(start)):
-            return None
+            return DECLINE_SEED
+        if not self._aim(target.homogeneous):
+            return DECLINE_TARGET
+        if start != NULL and not self._within(start):
+            return DECLINE_OUTSIDE
         cdef cnp.npy_intp n = self.n
         cdef cnp.ndarray best = cnp.PyArray_EMPTY(1, &n, cnp.NPY_FLOAT64, 0)
         cdef double* q = <double*> cnp.PyArray_DATA(best)

@@ -123,7 +123,7 @@ def solve(robot: Chain, target: Any, *positional: Any, solver: str = "frdm", q0:
         if ik is not None:
             engine = ik.engine
             res = None if engine is None else engine.solve(target, q0, seed)  # the usual call: one compiled call
-            return ik.solve(target, q0=q0, seed=seed) if res is None else res
+            return ik.solve(target, q0=q0, seed=seed) if res is None or type(res) is int else res
     kind = one_answer(solver)
     settings = dict(solver=solver, tol_pos=tol_pos, tol_rot=tol_rot, time_budget=time_budget,
                     max_restarts=max_restarts, start_outside_limits=start_outside_limits, options=options, task=task,

@@ -12,8 +12,7 @@ import time
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from types import SimpleNamespace
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 import pinocchio as pin
@@ -21,10 +20,13 @@ import pinocchio as pin
 from kinelab.ik.limits import turned_verdict, wrap_q
 from kinelab.ik.request import Request, verdict_reserve
 from kinelab.ik.result import Attempt, BypassRecord, IKResult, SingularEvent, Status
+from kinelab.ik.spec import EngineSpec
 from kinelab.ik.targets import as_target, out_of_reach, reach_bound
 from kinelab.ik.tasks import COMPONENTS, POSE, Task
 from kinelab.robot import Chain
 from kinelab.robot.chain import _compiled_judge
+
+S = TypeVar("S", bound=EngineSpec)  # an engine's spec type
 
 
 class _LazyRng:
@@ -217,7 +219,7 @@ def compiled_result(pb: Call, att: Attempt, restarts: int, success: bool, dp: fl
 
 def engine_spec(robot: Chain, req: Request, cm: Any,
                 attempt_of: Callable[[int, np.ndarray, np.ndarray, float], Attempt], mode: str,
-                diagnostics: Callable[[np.ndarray], Any], **kernel: Any) -> SimpleNamespace:
+                diagnostics: Callable[[np.ndarray], Any], spec_type: type[S], **kernel: Any) -> S:
     """What a solver's one-call engine (:class:`kinelab.core._engine.Engine`) reads from its prepared solver: the
     checks' bounds, the reach bound, the budget, the verdict's tolerances and components, the converged result's
     shared fields, and ``unmet``, which builds any other outcome's result exactly as the general route does.
@@ -229,7 +231,9 @@ def engine_spec(robot: Chain, req: Request, cm: Any,
         attempt_of: (the kernel's code, q, statistics, deadline [s]) → the :class:`Attempt` the general route builds.
         mode: the converged result's ``mode``.
         diagnostics: statistics → the result's diagnostics (called when they are first read).
-        kernel: the engine's own settings (its kernel's arrays and constants).
+        spec_type: the engine's spec (:class:`kinelab.ik.spec.FRDMSpec`, :class:`~kinelab.ik.spec.BiquatSpec`).
+        kernel: the engine's own settings (its kernel's arrays and constants: the spec type's own fields, and
+            ``pstar``, ``Rstar``, ``wrap_continuous``).
     """
     task, tol_pos, tol_rot = req.task, float(req.tol_pos), float(req.tol_rot)
 
@@ -244,7 +248,7 @@ def engine_spec(robot: Chain, req: Request, cm: Any,
     fields = dict(success=True, status=Status.CONVERGED, solver=req.solver, mode=mode, message="",
                   task=req.task_label, judge=robot.fk_certificate.judge)
     radius = float(radius) if task.position else np.inf  # a point the task ignores is never out of reach
-    return SimpleNamespace(
+    return spec_type(
         kind=cm.kind, draw_lower=cm.lower, draw_upper=cm.upper, check_lower=lower, check_upper=upper,
         turn_lower=np.asarray(robot.lower, dtype=float), turn_upper=np.asarray(robot.upper, dtype=float),
         anchor=np.array(anchor, dtype=float), radius=radius, attempts=req.max_restarts + 1, budget=budget,

@@ -155,9 +155,9 @@ class IK:
         Raises:
             TargetError, ConfigurationError, JointLimitError, OptionError: a bad target, start or seed.
         """
-        if self.engine is not None:  # the usual call, in one compiled call (None: the driver's general route)
+        if self.engine is not None:  # the usual call, in one compiled call (an int: why it declines)
             res = self.engine.solve(target, q0, seed)
-            if res is not None:
+            if type(res) is not int:
                 return res
         elif self.analytic:
             return self._nearest_branch(target, q0)

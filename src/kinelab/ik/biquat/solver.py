@@ -31,6 +31,7 @@ from kinelab.ik.limits import wrap_q
 from kinelab.ik.multistart import clock_chunk
 from kinelab.ik.request import Request
 from kinelab.ik.result import Attempt, BiquatDiagnostics, Status
+from kinelab.ik.spec import BiquatSpec
 from kinelab.robot import Chain
 
 Options = BiquatOptions
@@ -200,7 +201,8 @@ def engine(robot: Chain, req: Request) -> BiquatEngine | None:
     tol_pos, tol_rot = float(req.tol_pos), float(req.tol_rot)
     spec = engine_spec(
         robot, req, cm, partial(compiled_attempt, damping=damping, k=k), compiled_mode(k),
-        partial(compiled_diagnostics, damping=damping), wrap_continuous=False, pstar=np.zeros(3), Rstar=np.eye(3),
+        partial(compiled_diagnostics, damping=damping), BiquatSpec, wrap_continuous=False, pstar=np.zeros(3),
+        Rstar=np.eye(3),
         k=float(k), max_step=0.5, max_steps=_max_steps(opts), eps_rot=0.5 * tol_rot, eps_dual=0.5 * tol_pos,
         damping=float(damping), first_chunk=clock_chunk(JOINT_STEPS_PER_LOOK, cm.n),
         later_chunk=clock_chunk(JOINT_STEPS_PER_LATER_LOOK, cm.n), wide=restarts.wide_base(cm).astype(np.uint8),

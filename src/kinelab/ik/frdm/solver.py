@@ -29,6 +29,7 @@ from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.multistart import clock_chunk
 from kinelab.ik.request import Request
 from kinelab.ik.result import Attempt, FRDMDiagnostics, SingularEvent, Status
+from kinelab.ik.spec import FRDMSpec
 from kinelab.robot import Chain
 
 Options = FRDMOptions
@@ -120,7 +121,7 @@ def engine(robot: Chain, req: Request) -> FRDMEngine | None:
     if judge is None:
         return None
     ctx = _Context(robot, opts, float(req.tol_pos), float(req.tol_rot))
-    spec = engine_spec(robot, req, ctx.cm, ctx.attempt, ctx.mode, ctx.diagnostics_of, wrap_continuous=True,
+    spec = engine_spec(robot, req, ctx.cm, ctx.attempt, ctx.mode, ctx.diagnostics_of, FRDMSpec, wrap_continuous=True,
                        pstar=ctx.pstar, Rstar=ctx.Rstar, order=ctx.order, cap=ctx.cap, first_chunk=ctx.chunk,
                        later_chunk=ctx.later_chunk, stall_events=ctx.stall_events)
     return FRDMEngine(ctx.packed, judge, spec)
