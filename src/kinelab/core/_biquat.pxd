@@ -2,13 +2,9 @@
 
 from kinelab.core._frdm cimport Chain
 
-# codes of an attempt, and statistics slots of a multistart, written once (kinelab.ik.biquat.kernel imports them)
-cpdef enum Code:
-    CONVERGED = 0
-    SINGULAR = 1
-    MAX_STEPS = 2
-    OUTSIDE_LIMITS = 3
-    BUDGET = 4
+# codes of an attempt: the kernels' one table (kinelab.core._frdm's Code); statistics slots of a multistart, written
+# once (kinelab.ik.biquat.kernel imports them)
+from kinelab.core._frdm cimport BUDGET, CONVERGED, MAX_STEPS, OUTSIDE_LIMITS, SINGULAR
 
 cdef enum:
     T_ATTEMPTS = 0

@@ -1,14 +1,6 @@
-from enum import IntEnum
 from typing import Any
 
 import numpy as np
-
-class Code(IntEnum):
-    CONVERGED = 0
-    SINGULAR = 1
-    MAX_STEPS = 2
-    OUTSIDE_LIMITS = 3
-    BUDGET = 4
 
 def run_timed(q: np.ndarray, chain: Any, lower: np.ndarray, upper: np.ndarray, control: Any, rng_state: np.ndarray,
               attempts: int, first_chunk: int, later_chunk: int, deadline: float, restart_lower: np.ndarray,

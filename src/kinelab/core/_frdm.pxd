@@ -12,12 +12,17 @@ cpdef enum Order:
     ALTERNATE = 2
     MIXED = 3  # per restart, in turn
 
-# what run() and the multistarts return (NOT_STARTED, STOPPED: a batch row the deadline cut before or while it ran)
+# what every compiled kernel's run and multistart return, one table for FRDM's and the biquaternion preset's (the
+# engine of either reads the same CONVERGED and BUDGET); NOT_STARTED, STOPPED: a batch row the deadline cut before
+# or while it ran
 cpdef enum Code:
     CONVERGED = 0
-    STALL_STEP = 1
-    STALL_WINDOW = 2
-    BUDGET = 3
+    STALL_STEP = 1  # FRDM: a sweep moved no joint
+    STALL_WINDOW = 2  # FRDM: the error stopped falling over the stall window
+    BUDGET = 3  # the iterations or the time chunk ran out (the caller resumes or stops)
+    SINGULAR = 4  # the biquaternion law met a singular configuration
+    MAX_STEPS = 5  # the biquaternion preset took its steps without converging
+    OUTSIDE_LIMITS = 6  # the biquaternion preset's answer lies outside the limits
     NOT_STARTED = -2
     STOPPED = -3
 

@@ -19,6 +19,9 @@ class Code(IntEnum):
     STALL_STEP = 1
     STALL_WINDOW = 2
     BUDGET = 3
+    SINGULAR = 4
+    MAX_STEPS = 5
+    OUTSIDE_LIMITS = 6
     NOT_STARTED = -2
     STOPPED = -3
 

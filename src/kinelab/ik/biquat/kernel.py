@@ -11,11 +11,11 @@ from typing import NamedTuple
 
 import numpy as np
 
-from kinelab.core._biquat import Code
 from kinelab.core._biquat import run_integrate as integrate
 from kinelab.core._biquat import run_timed as timed
+from kinelab.core._frdm import Code
 
-# the preset's return codes: the compiled core's enum, as ints
+# the preset's return codes: the compiled kernels' one table, as ints
 CONVERGED, SINGULAR, MAX_STEPS = int(Code.CONVERGED), int(Code.SINGULAR), int(Code.MAX_STEPS)
 OUTSIDE_LIMITS, BUDGET = int(Code.OUTSIDE_LIMITS), int(Code.BUDGET)
 # slots of a multistart's statistics array

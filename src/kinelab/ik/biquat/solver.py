@@ -26,6 +26,7 @@ from kinelab.ik.biquat import kernel, laws
 from kinelab.ik.biquat.integrators import Stop, System, Trajectory, adaptive, fixed
 from kinelab.ik.biquat.options import BiquatOptions
 from kinelab.ik.chain import chain_model
+from kinelab.ik.codes import status_of
 from kinelab.ik.driver import engine_judge, engine_spec
 from kinelab.ik.limits import wrap_q
 from kinelab.ik.multistart import clock_chunk
@@ -167,7 +168,7 @@ def compiled_attempt(code: int, q: np.ndarray, stats: np.ndarray, deadline: floa
     elif time.perf_counter() > deadline:
         status = Status.TIME_BUDGET
     else:
-        status = Status.SINGULAR if code == kernel.SINGULAR else Status.MAX_ITERATIONS
+        status = status_of(code)  # singular, or max_iterations (its steps or its chunk spent)
     return Attempt(q, status, int(stats[kernel.T_STEPS]), diagnostics=compiled_diagnostics(stats, damping),
                    mode=compiled_mode(k))
 

@@ -15,14 +15,13 @@ import numpy as np
 from kinelab.core import _frdm, threads
 from kinelab.geometry import wrap_to_pi
 from kinelab.ik.chain import CONTINUOUS, chain_model
+from kinelab.ik.codes import NOT_STARTED, STOPPED
 from kinelab.ik.frdm import solver
 from kinelab.ik.frdm.kernel import CONVERGED, STATS_SIZE, T_ATTEMPTS, T_STALLS, T_SWEEPS, Objective, no_rest
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.multistart import clock_chunk, first_start
 from kinelab.ik.result import Status
 from kinelab.robot import Chain
-
-NOT_STARTED, STOPPED = -2, -3  # a row's code when the budget ran out before it started, or while it ran
 
 
 @dataclass

@@ -10,6 +10,7 @@ import numpy as np
 from kinelab.core import _follow
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.chain import chain_model
+from kinelab.ik.codes import CONVERGED, status_of
 from kinelab.ik.frdm import kernel
 from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.limits import wrap_q
@@ -20,14 +21,10 @@ from kinelab.ik.targets import as_target_arrays
 from kinelab.ik.tasks import POSE, Task
 from kinelab.robot import Chain
 
-NOT_STARTED = -2  # the follower's code for a sample the time budget left unstarted
 REST_WEIGHT = 0.01  # objective units (the weighted pose error is ~1 at a chain length's distance)
 REST_SWEEPS = 10  # sweeps of the first phase of a sample
 LM_ITERATIONS = 20  # Levenberg–Marquardt steps of the polish (mode "frdm+lm")
 CENTRE_PULL = 0.01  # share of the way from the previous answer to mid-range taken as the rest configuration
-# any other code (a kernel's converged that Pinocchio does not confirm, the polish's −1): max_iterations
-_STATUS = {kernel.STALL_STEP: Status.STALLED, kernel.STALL_WINDOW: Status.STALLED, kernel.BUDGET: Status.MAX_ITERATIONS,
-           NOT_STARTED: Status.TIME_BUDGET}
 
 
 def follow(robot: Chain, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: float, max_sweeps: int,
@@ -82,7 +79,8 @@ def _deadline(time_budget: float | None, t_start: float, count: int) -> float:
 
 def _statuses(ok: np.ndarray, codes: np.ndarray) -> np.ndarray:
     """Each sample's Status code: converged where the judge confirmed it, else why the kernel stopped."""
-    return np.array([Status.CONVERGED.code if ok[k] else _STATUS.get(int(codes[k]), Status.MAX_ITERATIONS).code
+    return np.array([Status.CONVERGED.code if ok[k]
+                     else (Status.MAX_ITERATIONS if codes[k] == CONVERGED else status_of(codes[k])).code
                      for k in range(codes.shape[0])], dtype=np.int8)
 
 
