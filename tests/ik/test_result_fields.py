@@ -79,3 +79,38 @@ def test_each_solver_s_diagnostics_are_its_own_record():
     assert type(branch) is kinelab.Diagnostics and branch.branches == len(kinelab.solve_all(robot, target))
     assert not hasattr(branch, "sweeps") and not hasattr(branch, "steps")
     assert "sweeps" in frdm.to_dict() and "steps" in biquat.to_dict() and repr(biquat).startswith("BiquatDiagnostics(")
+
+
+def test_a_result_is_frozen_and_its_copies_keep_their_diagnostics():
+    """#58: one result family, frozen; the compiled routes' factory builds the same type as the general route."""
+    import copy
+    import pickle
+
+    robot = kinelab.load("ur5")
+    q = np.array([0.3, -1.2, 1.4, -0.5, 0.9, 0.2])
+    compiled = kinelab.solve(robot, robot.fk(q), seed=0)  # the engine's fast factory
+    branch = kinelab.solve_all(robot, robot.fk(q))[0]  # the closed form's rows, the same factory
+    general = kinelab.solve(robot, robot.fk(q), seed=0, solver="dls")  # the general route's constructor
+    for res in (compiled, branch, general):
+        assert type(res) is kinelab.IKResult and res.success
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            res.success = False
+        changed = dataclasses.replace(res, message="edited")
+        assert changed.message == "edited" and res.message != "edited" and changed.diagnostics == res.diagnostics
+        for again in (pickle.loads(pickle.dumps(res)), copy.deepcopy(res)):
+            assert np.array_equal(again.q, res.q) and again.diagnostics == res.diagnostics
+
+
+def test_how_branches_were_found_and_how_complete_they_are_are_enums_that_read_as_words():
+    import kinelab.ik.result as result
+
+    ur5, panda = load("ur5"), load("panda")
+    closed = kinelab.solve_all(ur5, ur5.fk(np.array([0.3, -1.2, 1.4, -0.5, 0.9, 0.2])))
+    multi = kinelab.solve_all(panda, panda.fk(panda.display_q()), seed=0)
+    assert closed.method is result.Method.CLOSED_FORM and multi.method is result.Method.MULTISTART
+    assert closed.complete in (result.Completeness.CERTIFIED, result.Completeness.SEARCH)
+    assert multi.complete is result.Completeness.ESTIMATE
+    for word in (closed.method, multi.complete, Status.CONVERGED):  # a word: equal, hashed, printed as its string
+        assert word == word.value and {word.value: 1}[word] == 1 and f"{word}" == str(word) == word.value
+        assert json.loads(json.dumps({"w": word}))["w"] == word.value
+    assert "method='closed form'" in repr(closed)

@@ -1,8 +1,10 @@
-from typing import Any
+from typing import Any, TypeVar
 
 from kinelab.core._chain import Judge
 from kinelab.core._frdm import Packed
 from kinelab.ik.spec import BiquatSpec, EngineSpec, FRDMSpec
+
+R = TypeVar("R")
 
 SEED_LIMIT: int
 DECLINE_TARGET: int
@@ -10,6 +12,8 @@ DECLINE_START: int
 DECLINE_OUTSIDE: int
 DECLINE_SEED: int
 DECLINE_EMPTY: int
+
+def fast_result(cls: type[R], shared: dict[str, Any], values: dict[str, Any]) -> R: ...
 
 class Engine:
     def __init__(self, judge: Judge, spec: EngineSpec) -> None: ...

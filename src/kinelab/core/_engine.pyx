@@ -232,18 +232,11 @@ cdef class Engine:
         return self._within(q)
 
     cdef object _converged(self, object best, const double* stats, double dp, double dr, double t_start):
-        """The result of a converged answer the judge confirmed."""
-        made = self.result.__new__(self.result)
-        values = made.__dict__
-        values.update(self.fields)
-        values["q"], values["position_error"], values["rotation_error"] = best, dp, dr
-        values["iterations"] = <int> stats[T_ITERATIONS]
-        values["restarts"] = max(0, <int> stats[T_ATTEMPTS] - 1)
-        values["singular_events"] = self._events(stats)
-        values["bypasses"] = []
-        values["_make_diagnostics"] = partial(self.diagnostics, _array(stats, STATS_SIZE))
-        values["wall_time"] = now() - t_start
-        return made
+        """The result of a converged answer the judge confirmed (the result type's ``fast`` factory)."""
+        return fast_result(self.result, self.fields, {
+            "q": best, "position_error": dp, "rotation_error": dr, "iterations": <int> stats[T_ITERATIONS],
+            "restarts": max(0, <int> stats[T_ATTEMPTS] - 1), "singular_events": self._events(stats), "bypasses": [],
+            "_make_diagnostics": partial(self.diagnostics, _array(stats, STATS_SIZE)), "wall_time": now() - t_start})
 
     def __dealloc__(self):
         free(self.q)
@@ -345,6 +338,23 @@ cdef class BiquatEngine(Engine):
 
     def __dealloc__(self):
         free(self.scratch)
+
+
+cpdef object fast_result(type cls, dict shared, dict values):
+    """A result of type ``cls`` (:class:`kinelab.ik.result.IKResult`) from its fields, without ``__init__``'s work:
+    the compiled routes' one factory (this engine's converged answers, the closed form's rows).
+
+    Args:
+        cls: the result type.
+        shared: the fields every result of the route shares (success, status, solver, mode, task, judge, ...).
+        values: this result's own (q, errors, wall time, ...); ``_make_diagnostics``, a callable, stands for
+            ``diagnostics`` until they are first read.
+    """
+    made = cls.__new__(cls)
+    fields = made.__dict__
+    fields.update(shared)
+    fields.update(values)
+    return made
 
 
 cdef object _as_start(object q0, int n):

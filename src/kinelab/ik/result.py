@@ -10,7 +10,21 @@ from typing import Any, TypeVar, overload
 import numpy as np
 
 
-class Status(str, Enum):
+class _Word(str, Enum):
+    """A word of kinelab's vocabulary: compares equal to its string, hashes as it (a dict keyed by the word finds
+    the member) and prints as it."""
+
+    def __hash__(self) -> int:
+        return str.__hash__(self)
+
+    def __str__(self) -> str:
+        return str(self.value)
+
+    def __format__(self, spec: str) -> str:
+        return format(str(self.value), spec)
+
+
+class Status(_Word):
     """Why a solve ended. Only ``converged`` goes with success, and only after Pinocchio's check."""
 
     CONVERGED = "converged"
@@ -23,12 +37,6 @@ class Status(str, Enum):
     COLLISION = "collision"  # the pose is met, but every answer found collides (``collisions=``)
     NOT_FOUND = "not_found"  # a search found no answer, and none is proved not to exist
     JUMP = "jump"  # a tracked sample met its pose, but by a joint step larger than the path's jump limit
-
-    def __str__(self) -> str:
-        return str(self.value)
-
-    def __format__(self, spec: str) -> str:
-        return format(str(self.value), spec)
 
     @property
     def code(self) -> int:
@@ -52,6 +60,26 @@ class Status(str, Enum):
 
 _MEMBERS = np.array(list(Status), dtype=object)
 _CODES = {s: k for k, s in enumerate(Status)}
+
+
+class Method(_Word):
+    """How a set of branches was found (:attr:`Branches.method`)."""
+
+    CLOSED_FORM = "closed form"  # every branch, from the chain's closed form
+    SEARCH = "search"  # the 1-D search: every branch, measured complete
+    ELIMINATION = "elimination"  # the general 6R elimination
+    MULTISTART = "multistart"  # those seeded starts found
+    SWEEP = "sweep"  # a redundant arm's joint swept: every branch at each sampled value
+    UNKNOWN = ""
+
+
+class Completeness(_Word):
+    """How complete a set of branches is known to be (:attr:`Branches.complete`)."""
+
+    CERTIFIED = "certified"  # every branch proved a root and the set proved to be every root within the limits
+    SEARCH = "search"  # every branch a search or a closed form found, not proved complete
+    ESTIMATE = "estimate"  # the multistart: ``unseen`` estimates what it missed
+    UNKNOWN = ""
 
 
 @dataclass(frozen=True)
@@ -265,9 +293,10 @@ class _Deferred:
         return made
 
 
-@dataclass
+@dataclass(frozen=True)
 class IKResult:
-    """The outcome of :func:`kinelab.solve`.
+    """The outcome of :func:`kinelab.solve` (frozen: ``dataclasses.replace`` makes a changed copy; the compiled
+    routes build it with :func:`kinelab.core._engine.fast_result`).
 
     ``position_error`` [m] and ``rotation_error`` [rad] are measured by the FK of the returned ``q`` that
     ``judge`` names — Pinocchio's, or kinelab's compiled chain FK where the robot's certificate found it equal to
@@ -347,7 +376,7 @@ class Branches(Sequence[IKResult]):
     """
 
     def __init__(self, found: Iterable[IKResult] = (), status: Status | None = None, message: str = "",
-                 method: str = "", unseen: float | None = None):
+                 method: Method | str = "", unseen: float | None = None):
         results = list(found)
         self._results: list[IKResult] | None = results
         self._make_row: Callable[[Any, int], IKResult] = _called
@@ -356,33 +385,34 @@ class Branches(Sequence[IKResult]):
         self.position_error = np.array([r.position_error for r in results], dtype=float)
         self.rotation_error = np.array([r.rotation_error for r in results], dtype=float)
         self.status = status if status is not None else Status.CONVERGED if results else Status.TIME_BUDGET
-        self.message, self.method, self.unseen = message, method, unseen
+        self.message, self.method, self.unseen = message, Method(method), unseen
         self._certify: Any = None
 
     @classmethod
     def from_arrays(cls, q: np.ndarray, position_error: np.ndarray, rotation_error: np.ndarray,
                     make: Callable[[int], IKResult], status: Status | None = None, message: str = "",
-                    method: str = "", unseen: float | None = None) -> Branches:
+                    method: Method | str = "", unseen: float | None = None) -> Branches:
         """The branches as arrays (q: (k, n), the errors: (k,)); ``make(i)`` builds the i-th result when the set is
         first indexed or iterated."""
         made = cls.__new__(cls)
         made.q, made.position_error, made.rotation_error = q, position_error, rotation_error
         made._results, made._make_row, made._data = None, _called, make
         made.status = status if status is not None else Status.CONVERGED if len(q) else Status.TIME_BUDGET
-        made.message, made.method, made.unseen = message, method, unseen
+        made.message, made.method, made.unseen = message, Method(method), unseen
         made._certify = None
         return made
 
     @classmethod
     def of_rows(cls, q: np.ndarray, position_error: np.ndarray, rotation_error: np.ndarray,
-                make_row: Callable[[Any, int], IKResult], data: Any, method: str, unseen: float | None) -> Branches:
+                make_row: Callable[[Any, int], IKResult], data: Any, method: Method | str,
+                unseen: float | None) -> Branches:
         """A set of at least one branch as arrays (q: (k, n), the errors: (k,)); ``make_row(data, i)`` builds the
         i-th result when the set is first indexed or iterated (a solver's row maker, made once, and this set's
         data: nothing is built per call that a reader may never ask for)."""
         made = cls.__new__(cls)
         made.q, made.position_error, made.rotation_error = q, position_error, rotation_error
         made._results, made._make_row, made._data = None, make_row, data
-        made.status, made.message, made.method, made.unseen = Status.CONVERGED, "", method, unseen
+        made.status, made.message, made.method, made.unseen = Status.CONVERGED, "", Method(method), unseen
         made._certify = None
         return made
 
@@ -393,9 +423,9 @@ class Branches(Sequence[IKResult]):
         return self
 
     @property
-    def complete(self) -> str:
+    def complete(self) -> Completeness:
         """"certified", "search", "estimate" or "" (see the class)."""
-        return self._completeness()[0]
+        return Completeness(self._completeness()[0])
 
     @property
     def complete_reason(self) -> str:
@@ -439,7 +469,7 @@ class Branches(Sequence[IKResult]):
     __hash__ = None  # type: ignore[assignment]
 
     def __repr__(self) -> str:
-        return f"Branches({len(self)} branches, status={self.status.value!r}, method={self.method!r})"
+        return f"Branches({len(self)} branches, status={self.status.value!r}, method={self.method.value!r})"
 
     def __getstate__(self) -> dict[str, Any]:
         """The arrays, the results and the completeness, built (a pickle never carries the maker or the

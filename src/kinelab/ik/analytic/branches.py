@@ -21,6 +21,7 @@ import pinocchio as pin
 
 from kinelab.core import threads
 from kinelab.core._analytic import ROW_NOT_STARTED, ClosedForm
+from kinelab.core._engine import fast_result
 from kinelab.core._joints import turn_distances
 from kinelab.errors import ConfigurationError, OptionError, count_of
 from kinelab.geometry import pose_errors, stack_homogeneous, wrap_to_pi
@@ -561,14 +562,12 @@ def _filled(fields: dict[str, Any], rows: Rows, k: int, wall_time: float, branch
             unseen: float | None = None) -> IKResult:
     """Row k of ``rows`` as an IKResult (``branches``: how many the pose has), its diagnostics built when first
     read."""
-    made = IKResult.__new__(IKResult)
-    made.__dict__.update(fields, q=rows.q[k].copy(), position_error=float(rows.position_error[k]),
-                         rotation_error=float(rows.rotation_error[k]), wall_time=wall_time,
-                         message=CONTINUUM if rows.continuum[k] else "", singular_events=[], bypasses=[],
-                         _make_diagnostics=partial(Diagnostics, path="compiled", branches=branches,
-                                                   found=int(rows.merged[k]), unseen=unseen,
-                                                   polished=1 if rows.finished[k] else None))
-    return made
+    return fast_result(IKResult, fields, {
+        "q": rows.q[k].copy(), "position_error": float(rows.position_error[k]),
+        "rotation_error": float(rows.rotation_error[k]), "wall_time": wall_time,
+        "message": CONTINUUM if rows.continuum[k] else "", "singular_events": [], "bypasses": [],
+        "_make_diagnostics": partial(Diagnostics, path="compiled", branches=branches, found=int(rows.merged[k]),
+                                     unseen=unseen, polished=1 if rows.finished[k] else None)})
 
 
 class OneCall:
