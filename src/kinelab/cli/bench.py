@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from collections.abc import Callable
 from typing import Any
 
 from kinelab.cli.common import count, positive_number, print_json, progress_of, seed_argument
@@ -136,34 +137,35 @@ def run(args: argparse.Namespace) -> int:
 
 def _router(args: argparse.Namespace) -> int:
     """``--router``: the prepared solver against the module functions, alone (its table, JSON or files)."""
-    from kinelab.report import render
-    from kinelab.report.bench import router, runner
+    from kinelab.report.bench import router
 
-    result = runner.header()
-    result["router"] = router.run(args.robots, seed=args.seed, repeats=args.repeats, progress=progress_of(args))
-    if args.out:
-        render.write_bench(result, args.out)
-    if args.json:
-        print_json(result)
-    else:
-        print(router.markdown(result["router"]))
-    return 0
+    return _alone(args, "router", lambda: router.run(args.robots, seed=args.seed, repeats=args.repeats,
+                                                     progress=progress_of(args)), router.markdown)
 
 
 def _whole_body(args: argparse.Namespace) -> int:
     """``--whole-body``: its protocol alone (its tables, JSON or files)."""
+    from kinelab.report.bench import wholebody
+
+    return _alone(args, "whole_body", lambda: wholebody.run(args.robots, rounds=args.repeats, solves=args.n,
+                                                            seed=args.seed, progress=progress_of(args)),
+                  wholebody.markdown)
+
+
+def _alone(args: argparse.Namespace, key: str, run: Callable[[], Any], markdown: Callable[[Any], str]) -> int:
+    """A protocol run alone (``run()``): its figures under ``key`` after the bench header (taken first), written
+    with --out, printed as JSON or as its table."""
     from kinelab.report import render
-    from kinelab.report.bench import runner, wholebody
+    from kinelab.report.bench import runner
 
     result = runner.header()
-    result["whole_body"] = wholebody.run(args.robots, rounds=args.repeats, solves=args.n, seed=args.seed,
-                                         progress=progress_of(args))
+    found = result[key] = run()
     if args.out:
         render.write_bench(result, args.out)
     if args.json:
         print_json(result)
     else:
-        print(wholebody.markdown(result["whole_body"]))
+        print(markdown(found))
     return 0
 
 
