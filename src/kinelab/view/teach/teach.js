@@ -210,7 +210,11 @@ state.handleOnScreen = (k = 0) => {
 };
 // a drawn frame's pose in the base frame, rows first
 state.drawnPose = (name) => {
-  const e = node(["meshcat", "frames", name]).matrix.elements, rows = [];
+  // meshcat sets a transform as position, quaternion and scale; three.js composes the matrix at the next render,
+  // which a busy machine's page may not have reached yet: composed here, it is what that render draws
+  const o = node(["meshcat", "frames", name]);
+  o.updateMatrix();
+  const e = o.matrix.elements, rows = [];
   for (let r = 0; r < 4; r++) for (let c = 0; c < 4; c++) rows.push(e[c * 4 + r]);
   return rows;
 };
