@@ -125,3 +125,21 @@ def test_solve_all_is_the_kept_prepared_solvers_call(spy, name, extra):
             assert dp <= 1e-6 and dr <= 1e-6 and np.all(b.q >= robot.lower - 1e-9) and np.all(b.q <= robot.upper + 1e-9)
     if name in ("ur5", "ur10", "crx10ia"):  # every branch in closed form or by the 1-D search: the pose's own too
         assert any(np.abs(b.q - q).max() < 1e-6 for b in found[0])
+
+
+@pytest.mark.parametrize(("name", "solver"), [("ur5", "frdm"), ("ur5", "analytic"), ("panda", "frdm"),
+                                              ("kinova", "auto")])
+def test_solve_preferring_a_branch_is_the_kept_prepared_solvers_call(spy, name, solver):
+    robot = kinelab.load(name)
+    q = robot.display_q()
+    target = robot.fk(q)
+    near = q + 0.05  # the pose's own branch is the one nearest a reference beside it
+    results = [kinelab.solve(robot, target, solver=solver, seed=3, prefer=near) for _ in range(2)]
+    assert spy["solve"] == 2 and spy["built"] == 1
+    ours = kinelab.IK(robot, solver=solver).solve(target, seed=3, prefer=near)
+    for res in (*results, ours):
+        assert res.success and max(robot.tool_error(res.q, target)) <= 1e-6
+        # the branch nearest the reference: the pose's own (a 7R arm's continuum: the sampled one nearest it)
+        assert np.abs(res.q - q).max() < (0.1 if robot.n > 6 else 1e-5)
+    with pytest.raises(kinelab.OptionError, match="q0|prefer"):
+        kinelab.solve(robot, target, solver=solver, q0=q, prefer=near)

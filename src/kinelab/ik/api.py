@@ -6,31 +6,26 @@ same names, defaults and meanings everywhere — ``solver``, ``q0``, ``seed``, `
 and the solver's options as ``options=`` (a ``FRDMOptions``, ``BiquatOptions`` or ``DLSOptions``) or as
 their fields by keyword. :func:`solve`, :func:`solve_batch`, :func:`solve_all` and :func:`track` are calls on the
 prepared solver (:class:`kinelab.ik.prepared.IK`) kept on the robot for their settings, which routes them (the
-compiled engine, the closed form, a 7R arm's held joint, the 1-D search, the multistart, the collision check);
-``solve(prefer=)`` still builds its own :class:`~kinelab.ik.request.Request` for the branch search
-(:mod:`kinelab.ik.branches`), and :func:`solve_all_batch` is the closed forms' batch alone.
+compiled engine, the closed form, a 7R arm's held joint, the 1-D search, the multistart, the collision check;
+``solve(prefer=)`` too); :func:`solve_all_batch` is the closed forms' batch alone.
 """
 
 from __future__ import annotations
 
-import time
 from collections.abc import Sequence
-from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 from kinelab.errors import OptionError
 from kinelab.ik.auto import resolved
-from kinelab.ik.batch import BatchIKResult, prepare
-from kinelab.ik.branches import UNSEEN, Route, find_all
-from kinelab.ik.prepared import clear_of, collision_check, kept_solver, prepared, solve_clear_of
-from kinelab.ik.registry import Capabilities, capabilities, one_answer, refuse_options
-from kinelab.ik.request import Request, check_robot, make_request
+from kinelab.ik.batch import BatchIKResult
+from kinelab.ik.branches import UNSEEN
+from kinelab.ik.prepared import kept_solver, prepared
+from kinelab.ik.registry import capabilities, one_answer, refuse_options
+from kinelab.ik.request import check_robot
 from kinelab.ik.result import Branches, IKResult, TrackResult
-from kinelab.ik.targets import as_target
 from kinelab.robot import Chain
 
 if TYPE_CHECKING:  # the collision model and the closed forms load when a call asks for them
-    from kinelab.collision.model import CollisionModel
     from kinelab.ik.analytic.branches import BranchBatch
     from kinelab.ik.analytic.sew import SEW
 
@@ -124,68 +119,13 @@ def solve(robot: Chain, target: Any, *positional: Any, solver: str = "frdm", q0:
             engine = ik.engine
             res = None if engine is None else engine.solve(target, q0, seed)  # the usual call: one compiled call
             return ik.solve(target, q0=q0, seed=seed) if res is None or type(res) is int else res
-    kind = one_answer(solver)
+    one_answer(solver)
     settings = dict(solver=solver, tol_pos=tol_pos, tol_rot=tol_rot, time_budget=time_budget,
                     max_restarts=max_restarts, start_outside_limits=start_outside_limits, options=options, task=task,
                     axis=axis, collisions=collisions, **solver_options)
     if prefer is None:
         return prepared(robot, settings, key).solve(target, q0=q0, seed=seed)
-    return _solve_preferring(robot, target, q0, seed, prefer, settings, kind)
-
-
-def _solve_preferring(robot: Chain, target: Any, q0: Any, seed: int | None, prefer: Any,
-                      settings: dict[str, Any], kind: Capabilities) -> IKResult:
-    """``solve(prefer=...)`` with the rest of ``solve``'s settings (``settings``: its keywords but q0, seed and
-    prefer; ``kind``: what the solver can do): the nearest branch in closed form for solver "analytic", else among
-    those :func:`find_all` finds."""
-    rest = dict(settings)
-    solver, options, collisions = rest.pop("solver"), rest.pop("options"), rest.pop("collisions")
-    task, axis = rest.pop("task"), rest.pop("axis")
-    tol_pos, tol_rot, budget, restarts, outside = (
-        rest.pop(k) for k in ("tol_pos", "tol_rot", "time_budget", "max_restarts", "start_outside_limits"))
-    if kind.closed_form:
-        req = make_request(kind.request_solver(solver), seed, tol_pos, tol_rot, budget, restarts, outside, None, task,
-                           axis, None)
-        return _closed_form_one(robot, target, q0, prefer, collisions, options or rest, req)
-    req = make_request(solver, seed, tol_pos, tol_rot, budget, restarts, outside, options, task, axis, rest)
-    check = collision_check(robot, collisions)
-    if q0 is not None:
-        raise OptionError("q0", "given", "None with prefer= (the branch search draws its own starts)")
-    closed = kind.stands_in and options is None and not rest
-    return _preferred(robot, target, req, prefer, check, Route.EITHER if closed else Route.MULTISTART)
-
-
-def _preferred(robot: Chain, target: Any, req: Request, prefer: Any, check: CollisionModel | None,
-               method: Route) -> IKResult:
-    """``solve(prefer=)``: the (clear) branch nearest ``prefer`` among every branch found."""
-    prepare(robot, req)  # not the budget's time
-    t0 = time.perf_counter()
-    found = find_all(robot, target, req, q_ref=prefer, method=method)
-    found = clear_of(found, check, drop=True)
-    if found:
-        return replace(found[0], diagnostics=replace(found[0].diagnostics, branches=len(found)))
-    # no (clear) branch met the tolerances: the best single answer, in what is left of the same budget (at
-    # least one attempt's worth, so that there is an answer to return)
-    left = None if req.time_budget is None else max(req.time_budget - (time.perf_counter() - t0), 1e-4)
-    return solve_clear_of(robot, target, None, replace(req, time_budget=left), check)
-
-
-def _closed_form_one(robot: Chain, target: Any, q0: Any, prefer: Any, collisions: Any, options: Any,
-                     req: Request) -> IKResult:
-    """``solve(solver="analytic")``: the branch nearest q0 (or ``prefer``), from the closed form."""
-    from kinelab.ik.analytic import held
-    from kinelab.ik.analytic.branches import analytic_one
-
-    refuse_options(options)
-    if q0 is not None and prefer is not None:
-        raise OptionError("prefer", "given with q0", "one reference: q0 or prefer, with solver='analytic'")
-    ref = q0 if q0 is not None else prefer
-    if held.applies(robot) and collisions is None:
-        return held.nearest_held_one(robot, as_target(target, req.task.name),
-                                     None if ref is None else robot.check_q(ref, what="q0"), req)
-    held.refuse_7r(robot)
-    return analytic_one(robot, as_target(target, req.task.name), req,
-                        None if ref is None else robot.check_q(ref, what="q0"), collision_check(robot, collisions))
+    return prepared(robot, settings).solve(target, q0=q0, seed=seed, prefer=prefer)
 
 
 def solve_batch(robot: Chain, targets: Any, *positional: Any, solver: str = "frdm", q0: Any = None,

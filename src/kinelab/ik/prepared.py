@@ -30,8 +30,8 @@ from kinelab.core._engine import Engine
 from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.auto import resolved
-from kinelab.ik.batch import BatchIKResult, prepare_robot, run_batch
-from kinelab.ik.branches import UNSEEN, find_all, route_of, usual_closed_form
+from kinelab.ik.batch import BatchIKResult, prepare, prepare_robot, run_batch
+from kinelab.ik.branches import UNSEEN, Route, find_all, route_of, usual_closed_form
 from kinelab.ik.chain import chain_model
 from kinelab.ik.driver import prepare_solver, solve_one
 from kinelab.ik.options import flag
@@ -141,13 +141,15 @@ class IK:
         check_seed(seed)
         return replace(self.request, seed=seed)
 
-    def solve(self, target: Any, *, q0: Any = None, seed: int | None = None) -> IKResult:
+    def solve(self, target: Any, *, q0: Any = None, seed: int | None = None, prefer: Any = None) -> IKResult:
         """IK for one target (oMtarget in the base frame), as :func:`kinelab.solve` with these settings.
 
         Args:
             target: oMtarget (a ``pin.SE3``; three numbers [m] for task "position").
             q0: the first start [rad or m] (None: a seeded random one).
             seed: seed of the random starts (None: fresh entropy).
+            prefer: a reference configuration [rad or m]: the branch nearest it among every branch found (the
+                closed form's nearest for solver "analytic"); ``q0`` is refused with it.
 
         Returns:
             The result, judged on the task's components within the limits (by the FK ``result.judge`` names).
@@ -155,6 +157,8 @@ class IK:
         Raises:
             TargetError, ConfigurationError, JointLimitError, OptionError: a bad target, start or seed.
         """
+        if prefer is not None:
+            return self._preferring(target, q0, seed, prefer)
         if self.engine is not None:  # the usual call, in one compiled call (an int: why it declines)
             res = self.engine.solve(target, q0, seed)
             if type(res) is not int:
@@ -162,6 +166,21 @@ class IK:
         elif self.analytic:
             return self._nearest_branch(target, q0)
         return solve_clear_of(self.robot, target, q0, self._request(seed), self.collisions)
+
+    def _preferring(self, target: Any, q0: Any, seed: int | None, prefer: Any) -> IKResult:
+        """``solve(prefer=)``: the closed form's branch nearest ``prefer`` for solver "analytic", else the (clear)
+        branch nearest it among those the branch search finds (in closed form where the solver stands in for one
+        and runs without options)."""
+        if self.analytic:
+            if q0 is not None:
+                raise OptionError("prefer", "given with q0", "one reference: q0 or prefer, with solver='analytic'")
+            return self._nearest_branch(target, prefer)
+        if q0 is not None:
+            raise OptionError("q0", "given", "None with prefer= (the branch search draws its own starts)")
+        _, options, solver_options, _, _ = self._given
+        closed = capabilities(self.request.solver).stands_in and options is None and not solver_options
+        return preferred(self.robot, target, self._request(seed), prefer, self.collisions,
+                         Route.EITHER if closed else Route.MULTISTART)
 
     def _nearest_branch(self, target: Any, q0: Any) -> IKResult:
         """Solver "analytic": the branch nearest q0 in one compiled call where that serves, else root by root."""
@@ -282,6 +301,21 @@ class IK:
             return self._path_request
         check_seed(seed)
         return replace(self._path_request, seed=int(seed))
+
+
+def preferred(robot: Chain, target: Any, req: Request, prefer: Any, check: CollisionModel | None,
+              method: Route) -> IKResult:
+    """``solve(prefer=)``: the (clear) branch nearest ``prefer`` among every branch found."""
+    prepare(robot, req)  # not the budget's time
+    t0 = time.perf_counter()
+    found = find_all(robot, target, req, q_ref=prefer, method=method)
+    found = clear_of(found, check, drop=True)
+    if found:
+        return replace(found[0], diagnostics=replace(found[0].diagnostics, branches=len(found)))
+    # no (clear) branch met the tolerances: the best single answer, in what is left of the same budget (at
+    # least one attempt's worth, so that there is an answer to return)
+    left = None if req.time_budget is None else max(req.time_budget - (time.perf_counter() - t0), 1e-4)
+    return solve_clear_of(robot, target, None, replace(req, time_budget=left), check)
 
 
 def follow_path(robot: Chain, points: np.ndarray, rotations: np.ndarray, q0: Any, req: Request,
