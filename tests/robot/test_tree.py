@@ -133,3 +133,19 @@ def test_from_model_gives_the_whole_robot_or_a_chain():
 def test_bad_input_to_the_whole_robot_is_named(call, error, needle):
     with pytest.raises(error, match=needle):
         call(kinelab.load("talos"))
+
+
+@pytest.mark.parametrize("name", [e.name for e in catalog.BUNDLED + catalog.ERD_ARMS])
+def test_a_registered_arm_and_its_view_of_the_whole_robot_answer_alike_bit_for_bit(name):
+    """#58: a chain taken from the whole robot (base, tool and the arm's locked joints) is today's chain: the same
+    limits, FK and IK answers, bit for bit, at seeded configurations and seeds."""
+    arm = kinelab.load(name)
+    view = arm.robot.chain(arm.base, arm.tool, locked=dict(arm.locked) or None)
+    assert view.n == arm.n and np.array_equal(view.lower, arm.lower) and np.array_equal(view.upper, arm.upper)
+    rng = np.random.default_rng(7)
+    for seed in range(3):
+        q = arm.random_q(rng)
+        assert np.array_equal(view.fk(q).homogeneous, arm.fk(q).homogeneous)
+        ours, theirs = kinelab.solve(view, arm.fk(q), seed=seed), kinelab.solve(arm, arm.fk(q), seed=seed)
+        assert ours.status == theirs.status and np.array_equal(ours.q, theirs.q)
+        assert ours.success and max(arm.tool_error(ours.q, arm.fk(q))) <= 1e-6
