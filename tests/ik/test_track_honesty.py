@@ -60,3 +60,26 @@ def test_the_monitored_loop_marks_jumps_too():
     assert "monitored" in res.mode
     assert_jumps_are_not_successes(res, path[0], jump_limit=1e-4)
     assert (res.status == Status.JUMP).any()
+
+
+def test_self_motion_events_by_cumulative_sums_are_the_running_totals():
+    """The drift summed since the last event, as a running total reset at each event (the definition), against the
+    cumulative-sum search: the same samples, the same amounts to rounding."""
+    import numpy as np
+
+    from kinelab.ik.frdm import tracking
+
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        drift = rng.normal(scale=0.05, size=(300, 7)) + rng.normal(scale=0.01, size=7)  # a steady drift, and noise
+        largest = 0.05
+        expected, total = [], np.zeros(7)
+        for k in range(drift.shape[0]):
+            total += drift[k]
+            if np.abs(total).max() > tracking.SELF_MOTION * largest:
+                expected.append((k, float(np.abs(total).max())))
+                total[:] = 0.0
+        found = tracking._drift_events(drift, largest)
+        assert len(expected) >= 2
+        assert [e.sample for e in found] == [k for k, _ in expected]
+        assert np.allclose([e.max_joint_step for e in found], [m for _, m in expected], rtol=1e-9, atol=0)

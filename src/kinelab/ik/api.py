@@ -265,14 +265,15 @@ def solve_all(robot: Chain, target: Any, *positional: Any, solver: str = "auto",
         if time_budget != AUTO:
             raise OptionError("time_budget", time_budget, "a finite number > 0 [s], None (none) or 'auto'")
         time_budget = AUTO_BUDGET if redundancy is None else AUTO_REDUNDANT_BUDGET
-    kind = capabilities(solver)
-    if kind.closed_form and (options is not None or solver_options):  # refusing says so rather than ignoring them
+    if (options is not None or solver_options) and capabilities(solver).closed_form:  # said, not ignored
         refuse_options(options or solver_options)
-    settings = dict(solver=solver, tol_pos=tol_pos, tol_rot=tol_rot, time_budget=time_budget, options=options,
-                    task=task, axis=axis, collisions=collisions, **solver_options)
-    return prepared(robot, settings).solve_all(target, seed=seed, q_ref=q_ref, max_solutions=max_solutions,
-                                               stop_below=stop_below, redundancy=redundancy,
-                                               drop_colliding=drop_colliding)
+    key = (solver, tol_pos, tol_rot, time_budget, options, task, axis, collisions, *solver_options.items())
+    ik = kept_solver(robot, key)  # the usual loop: the same settings again, one dict lookup
+    if ik is None:
+        ik = prepared(robot, dict(solver=solver, tol_pos=tol_pos, tol_rot=tol_rot, time_budget=time_budget,
+                                  options=options, task=task, axis=axis, collisions=collisions, **solver_options), key)
+    return ik.solve_all(target, seed=seed, q_ref=q_ref, max_solutions=max_solutions, stop_below=stop_below,
+                        redundancy=redundancy, drop_colliding=drop_colliding)
 
 
 AUTO = "auto"  # solve_all's default time_budget: the route's own (below)

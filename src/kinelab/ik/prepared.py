@@ -99,6 +99,9 @@ class IK:
         self.request: Request = make_request(kind.request_solver(solver), None, tol_pos, tol_rot, time_budget,
                                              max_restarts, start_outside_limits, options, task, axis, solver_options)
         self._path_request: Request | None = None
+        req = self.request  # solve_all's usual call (no options, collisions or another task): its closed form's key
+        self._usual_all = (self._given[0], req.tol_pos, req.tol_rot, req.time_budget) if not given \
+            and collisions is None and task == "pose" and axis == "z" else None
         self.collisions = collision_check(robot, collisions)
         self._nearest: NearestBranch | None = None
         self.held = False  # solver "analytic" on a 7R arm: its six at the held joint's start value (_prepare)
@@ -242,13 +245,10 @@ class IK:
         Raises:
             TargetError, ConfigurationError, OptionError: named.
         """
-        flag("drop_colliding", drop_colliding)
-        solver, options, solver_options, task, axis = self._given
-        req = self.request
-        if options is None and not solver_options and q_ref is None and max_solutions is None \
-                and self.collisions is None and redundancy is None and task == "pose" and axis == "z":
-            found = usual_closed_form(self.robot, target, seed, (solver, req.tol_pos, req.tol_rot, req.time_budget,
-                                                                  stop_below))
+        if drop_colliding is not False:
+            flag("drop_colliding", drop_colliding)
+        if self._usual_all is not None and q_ref is None and max_solutions is None and redundancy is None:
+            found = usual_closed_form(self.robot, target, seed, (*self._usual_all, stop_below))
             if found is not None:  # the usual call: every branch in one compiled call
                 return found
         found = find_all(self.robot, target, replace(self._request(seed), max_restarts=0), q_ref=q_ref,

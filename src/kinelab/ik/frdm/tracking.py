@@ -119,13 +119,10 @@ def mark_jumps(path: TrackResult, q0: np.ndarray, jump_limit: float | None) -> N
     where it jumped to."""
     if jump_limit is None or path.q.shape[0] == 0:
         return
-    last = np.asarray(q0, dtype=float)
-    for k in range(path.q.shape[0]):
-        if path.status_code[k] != Status.CONVERGED.code:
-            continue
-        if np.abs(path.q[k] - last).max() > jump_limit:
-            path.status_code[k] = Status.JUMP.code
-        last = path.q[k]
+    met = np.flatnonzero(path.status_code == Status.CONVERGED.code)
+    before = np.vstack([np.asarray(q0, dtype=float)[None, :], path.q[met[:-1]]])  # each met sample's last met one
+    steps = np.abs(path.q[met] - before).max(axis=1) if met.size else np.empty(0)
+    path.status_code[met[steps > jump_limit]] = Status.JUMP.code
 
 
 SELF_MOTION = 5.0  # a self-motion event: the joints' drift along the task's null space beyond 5 × the path's step
@@ -155,14 +152,24 @@ def self_motion_events(robot: Chain, Q: np.ndarray, q0: np.ndarray, points: np.n
     own = np.abs(np.einsum("kji,kj->ki", J, least[..., 0])).max(axis=1)
     drift = dq - np.einsum("kji,kj->ki", J, least[..., 1])
     largest = max(float(np.nan_to_num(own).max()), 1e-12)
-    events, total = [], np.zeros(robot.n)
-    for k in range(Q.shape[0]):
-        total += drift[k]
-        if np.abs(total).max() > SELF_MOTION * largest:
-            events.append(SingularEvent("self_motion", f"the joints moved {np.abs(total).max():.3g} along the "
-                                        f"task's null space (the path's largest step: {largest:.3g})", sample=k,
-                                        max_joint_step=float(np.abs(total).max())))
-            total[:] = 0.0
+    return _drift_events(drift, largest)
+
+
+def _drift_events(drift: np.ndarray, largest: float) -> list[SingularEvent]:
+    """The self-motion events of per-sample drifts (K, n) [rad or m]: where the drift summed since the last event
+    exceeds SELF_MOTION × ``largest``. By cumulative sums, one search per event (events are few)."""
+    cum = np.cumsum(drift, axis=0)
+    events, start, base = [], 0, np.zeros(drift.shape[1])
+    while start < drift.shape[0]:
+        moved = np.abs(cum[start:] - base).max(axis=1)
+        over = np.flatnonzero(moved > SELF_MOTION * largest)
+        if over.size == 0:
+            break
+        k = start + int(over[0])
+        events.append(SingularEvent("self_motion", f"the joints moved {moved[over[0]]:.3g} along the task's null "
+                                    f"space (the path's largest step: {largest:.3g})", sample=k,
+                                    max_joint_step=float(moved[over[0]])))
+        base, start = cum[k], k + 1
     return events
 
 
