@@ -33,12 +33,12 @@ Call = Callable[[Any, int], Any]  # a problem and a seed → an answer
 
 
 def _solvers(robot: Chain) -> list[str]:
-    """FRDM, the closed form where the robot has one, and "auto"."""
+    """Every solver: FRDM, the biquaternion solver, DLS, the closed form where the robot has one, and "auto"."""
     try:
         IK(robot, solver="analytic")
     except KinelabError:
-        return ["frdm", "auto"]
-    return ["frdm", "analytic", "auto"]
+        return ["frdm", "biquat", "dls", "auto"]
+    return ["frdm", "biquat", "dls", "analytic", "auto"]
 
 
 def _problems(robot: Chain, seed: int) -> dict[str, list[Any]]:
