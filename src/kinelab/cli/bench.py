@@ -79,10 +79,8 @@ def run(args: argparse.Namespace) -> int:
 
     if args.out:
         check_output_folder(args.out, "bench")
-    if args.whole_body:
-        return _whole_body(args)
-    if args.router:
-        return _router(args)
+    if args.whole_body or args.router:  # a protocol run alone
+        return _whole_body(args) if args.whole_body else _router(args)
     first = _before_the_peers(args)
     result = bench.run(robots=args.robots, n=args.n, seed=args.seed, solvers=args.solvers,
                        budget=args.budget_ms / 1e3, progress=progress_of(args), repeats=args.repeats, start=args.start,

@@ -20,7 +20,7 @@ from kinelab.ik.auto import resolved
 from kinelab.ik.batch import BatchIKResult
 from kinelab.ik.branches import UNSEEN
 from kinelab.ik.prepared import kept_solver, prepared
-from kinelab.ik.registry import capabilities, one_answer, refuse_options
+from kinelab.ik.registry import capabilities, refuse_options
 from kinelab.ik.request import check_robot
 from kinelab.ik.result import Branches, IKResult, TrackResult
 from kinelab.robot import Chain
@@ -111,21 +111,17 @@ def solve(robot: Chain, target: Any, *positional: Any, solver: str = "frdm", q0:
     """
     check_entry(robot, "solve", positional)
     solver = resolved(robot, solver, task, collisions, options is not None or bool(solver_options))
-    if prefer is None:  # the prepared solver's own route: solve is IK(robot, **settings).solve(target)
-        key = (solver, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options, task, axis,
-               collisions, *solver_options.items())
-        ik = kept_solver(robot, key)
-        if ik is not None:
-            engine = ik.engine
-            res = None if engine is None else engine.solve(target, q0, seed)  # the usual call: one compiled call
-            return ik.solve(target, q0=q0, seed=seed) if res is None or type(res) is int else res
-    one_answer(solver)
+    key = (solver, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options, task, axis,
+           collisions, *solver_options.items())
+    ik = kept_solver(robot, key) if prefer is None else None  # solve is IK(robot, **settings).solve(target)
+    if ik is not None:
+        engine = ik.engine
+        res = None if engine is None else engine.solve(target, q0, seed)  # the usual call: one compiled call
+        return ik.solve(target, q0=q0, seed=seed) if res is None or type(res) is int else res
     settings = dict(solver=solver, tol_pos=tol_pos, tol_rot=tol_rot, time_budget=time_budget,
                     max_restarts=max_restarts, start_outside_limits=start_outside_limits, options=options, task=task,
                     axis=axis, collisions=collisions, **solver_options)
-    if prefer is None:
-        return prepared(robot, settings, key).solve(target, q0=q0, seed=seed)
-    return prepared(robot, settings).solve(target, q0=q0, seed=seed, prefer=prefer)
+    return prepared(robot, settings, key).solve(target, q0=q0, seed=seed, prefer=prefer)
 
 
 def solve_batch(robot: Chain, targets: Any, *positional: Any, solver: str = "frdm", q0: Any = None,
@@ -261,14 +257,11 @@ def solve_all(robot: Chain, target: Any, *positional: Any, solver: str = "auto",
         TargetError, ConfigurationError, OptionError: bad input, named.
     """
     check_entry(robot, "solve_all", positional)
-    if isinstance(time_budget, str):
-        if time_budget != AUTO:
-            raise OptionError("time_budget", time_budget, "a finite number > 0 [s], None (none) or 'auto'")
-        time_budget = AUTO_BUDGET if redundancy is None else AUTO_REDUNDANT_BUDGET
+    time_budget = _all_budget(time_budget, redundancy)
     if (options is not None or solver_options) and capabilities(solver).closed_form:  # said, not ignored
         refuse_options(options or solver_options)
     key = (solver, tol_pos, tol_rot, time_budget, options, task, axis, collisions, *solver_options.items())
-    ik = kept_solver(robot, key)  # the usual loop: the same settings again, one dict lookup
+    ik = kept_solver(robot, key)  # the usual loop: the same settings again, one lookup (no settings dict built)
     if ik is None:
         ik = prepared(robot, dict(solver=solver, tol_pos=tol_pos, tol_rot=tol_rot, time_budget=time_budget,
                                   options=options, task=task, axis=axis, collisions=collisions, **solver_options), key)
@@ -279,6 +272,19 @@ def solve_all(robot: Chain, target: Any, *positional: Any, solver: str = "auto",
 AUTO = "auto"  # solve_all's default time_budget: the route's own (below)
 AUTO_BUDGET = 0.05  # [s] solve_all's multistart when no budget is named
 AUTO_REDUNDANT_BUDGET = 5.0  # [s] a 7R arm's redundancy= searches when no budget is named (≈ 0.2-0.9 s a pose)
+
+
+def _all_budget(time_budget: float | str | None, redundancy: Any) -> float | None:
+    """:func:`solve_all`'s budget [s]: ``time_budget`` as given, or for "auto" its route's own.
+
+    Raises:
+        OptionError: a string other than "auto".
+    """
+    if not isinstance(time_budget, str):
+        return time_budget
+    if time_budget != AUTO:
+        raise OptionError("time_budget", time_budget, "a finite number > 0 [s], None (none) or 'auto'")
+    return AUTO_BUDGET if redundancy is None else AUTO_REDUNDANT_BUDGET
 
 
 def track(robot: Chain, targets: Sequence[Any] | Any, *positional: Any, q0: Any = None, solver: str = "frdm",

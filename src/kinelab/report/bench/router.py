@@ -42,12 +42,13 @@ def _solvers(robot: Chain) -> list[str]:
 
 
 def _problems(robot: Chain, seed: int) -> dict[str, list[Any]]:
-    """Per entry point, its problems: batches of targets, single targets, paths of 100 tool poses."""
+    """Per entry point, its problems: batches of targets, single targets, paths of 100 tool poses (with the joint
+    path's first configuration, where each starts)."""
     rng = np.random.default_rng(seed)
     poses = [robot.fk(q) for q in robot.random_qs(PROBLEMS * (BATCH + 1), rng)]
     batches = [np.stack([p.homogeneous for p in poses[k * BATCH:(k + 1) * BATCH]]) for k in range(PROBLEMS)]
-    paths = [[robot.fk(q) for q in path] for path in path_set(robot, seed, PROBLEMS, samples=100)]
-    return {"solve_batch": batches, "solve_all": poses[-PROBLEMS:], "track": paths}
+    paths = [(path[0], [robot.fk(q) for q in path]) for path in path_set(robot, seed, PROBLEMS, samples=100)]
+    return {"solve_batch": batches, "solve_all": poses[-PROBLEMS:], "track": paths}  # a path: (its start, its poses)
 
 
 def _pairs(robot: Chain, solver: str) -> dict[str, tuple[Call, Call]]:
@@ -63,18 +64,9 @@ def _pairs(robot: Chain, solver: str) -> dict[str, tuple[Call, Call]]:
                       lambda T, s: all_ik.solve_all(T, seed=s, redundancy=swept))}
     if solver == "frdm":
         path_ik = IK(robot, time_budget=None)
-        pairs["track"] = (lambda P, s: track(robot, P, q0=_start(robot, P), seed=s),
-                          lambda P, s: path_ik.track(P, q0=_start(robot, P), seed=s))
+        pairs["track"] = (lambda P, s: track(robot, P[1], q0=P[0], seed=s),
+                          lambda P, s: path_ik.track(P[1], q0=P[0], seed=s))
     return pairs
-
-
-def _start(robot: Chain, path: list[Any]) -> np.ndarray:
-    """The start of a path: FRDM's answer to its first pose, from the display pose (kept per path)."""
-    key = id(path[0])
-    starts: dict[int, np.ndarray] = robot.derived("bench router starts", lambda _: {})
-    if key not in starts:
-        starts[key] = IK(robot, time_budget=None).solve(path[0], q0=robot.display_q(), seed=0).q
-    return starts[key]
 
 
 def _ratios(problems: list[Any], pair: tuple[Call, Call], repeats: int) -> list[float]:
