@@ -16,7 +16,7 @@ from libc.math cimport acos, asin, atan2, cos, fabs, sin, sqrt, M_PI
 from libc.string cimport memcpy, memset
 
 from kinelab.core._blas cimport dgemm, ready
-from kinelab.core._geometry cimport rotm
+from kinelab.core._geometry cimport log3, rotm
 
 cdef enum:
     REVOLUTE = 0
@@ -145,39 +145,6 @@ cdef inline void cross(const double* a, const double* b, double* c) noexcept nog
 
 cdef inline double norm3(const double* a) noexcept nogil:
     return sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
-
-
-cdef void log3(const double* R, double* w) noexcept nogil:
-    """Pinocchio's log3: ω with exp3(ω) = R, |ω| ≤ π."""
-    cdef double tr = R[0] + R[4] + R[8], c = 0.5 * (tr - 1.0), theta, s, k, axis[3]
-    cdef int i, big
-    if c > 1.0:
-        c = 1.0
-    elif c < -1.0:
-        c = -1.0
-    theta = acos(c)
-    w[0], w[1], w[2] = R[7] - R[5], R[2] - R[6], R[3] - R[1]
-    if theta < 1e-4:  # θ/(2 sin θ) by its series
-        k = 0.5 + theta * theta / 12.0
-        w[0], w[1], w[2] = k * w[0], k * w[1], k * w[2]
-        return
-    if theta < M_PI - 1e-3:
-        k = theta / (2.0 * sin(theta))
-        w[0], w[1], w[2] = k * w[0], k * w[1], k * w[2]
-        return
-    # near a half turn: the axis from the symmetric part, its sign from the antisymmetric one
-    big = 0
-    for i in range(1, 3):
-        if R[4 * i] > R[4 * big]:
-            big = i
-    axis[big] = sqrt(max((R[4 * big] - c) / (1.0 - c), 0.0))
-    for i in range(3):
-        if i != big:
-            axis[i] = (R[3 * big + i] + R[3 * i + big]) / (2.0 * axis[big] * (1.0 - c))
-    if axis[0] * w[0] + axis[1] * w[1] + axis[2] * w[2] < 0.0:
-        axis[0], axis[1], axis[2] = -axis[0], -axis[1], -axis[2]
-    s = norm3(axis)
-    w[0], w[1], w[2] = theta * axis[0] / s, theta * axis[1] / s, theta * axis[2] / s
 
 
 cdef void jlog3(const double* w, double* J) noexcept nogil:

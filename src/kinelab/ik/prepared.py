@@ -38,7 +38,7 @@ from kinelab.ik.options import flag
 from kinelab.ik.registry import capabilities, refuse_options
 from kinelab.ik.request import Request, check_robot, check_seed, make_request
 from kinelab.ik.result import Branches, IKResult, TrackResult
-from kinelab.ik.targets import as_target, as_target_arrays
+from kinelab.ik.targets import TargetArrays, as_target, as_target_arrays
 from kinelab.robot import Chain
 
 if TYPE_CHECKING:
@@ -327,7 +327,7 @@ def follow_path(robot: Chain, points: np.ndarray, rotations: np.ndarray, q0: Any
     from kinelab.ik.clear import clear_track
     from kinelab.ik.frdm.tracking import run_track
 
-    path = run_track(robot, stack_homogeneous(points, rotations), robot.check_q(q0, limits=True, what="q0"), req,
+    path = run_track(robot, TargetArrays(points, rotations), robot.check_q(q0, limits=True, what="q0"), req,
                      settings, t_start)
     return path if check is None else clear_track(path, check)
 

@@ -4,7 +4,7 @@ meets, and the reach bound (a cheap, certain test that a target position is out 
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import pinocchio as pin
@@ -108,7 +108,14 @@ def _finite(values: ArrayLike, size: int, what: str) -> np.ndarray:
     return arr
 
 
-def as_target_arrays(targets: Any) -> tuple[np.ndarray, np.ndarray]:
+class TargetArrays(NamedTuple):
+    """Checked targets, base frame: the path or batch once read (what the solvers and followers take)."""
+
+    points: np.ndarray  # (N, 3) [m]
+    rotations: np.ndarray  # (N, 3, 3)
+
+
+def as_target_arrays(targets: Any) -> TargetArrays:
     """Check a sequence of targets; returns (points (N, 3) [m], rotations (N, 3, 3)), base frame.
 
     ``targets`` is a sequence of ``pin.SE3`` (or unit biquaternions), or an (N, 4, 4) array of
@@ -124,7 +131,7 @@ def as_target_arrays(targets: Any) -> tuple[np.ndarray, np.ndarray]:
         why = {NOT_FINITE: "has NaN or infinite entries", NOT_HOMOGENEOUS: "its last row is not (0, 0, 0, 1)",
                NOT_A_ROTATION: "its rotation is not a rotation matrix (RᵀR ≠ I or det R < 0)"}[defect]
         raise TargetError(f"targets[{k}] {why}")
-    return np.ascontiguousarray(H[:, :3, 3]), np.ascontiguousarray(H[:, :3, :3])
+    return TargetArrays(np.ascontiguousarray(H[:, :3, 3]), np.ascontiguousarray(H[:, :3, :3]))
 
 
 def _stack(targets: Any) -> np.ndarray:

@@ -457,7 +457,8 @@ class Chain:
         Args:
             Q: (B, n) configurations [rad or m].
             frame: "local" (tool frame), "world" (base frame, v at the base origin) or
-                "local_world_aligned" (base axes at the tool origin).
+                "local_world_aligned" (base axes at the tool origin: from the compiled chain where it is this
+                robot's certified judge, Pinocchio's to rounding; else Pinocchio's own, as the other two are).
 
         Raises:
             ConfigurationError: Q not (B, n) finite numbers; OptionError: an unknown frame.
@@ -466,6 +467,9 @@ class Chain:
         if frame not in frames:
             raise OptionError("frame", frame, f"one of {sorted(frames)}")
         Q = self.check_qs(Q)
+        arrays = self._judge_arrays() if frame == "local_world_aligned" and self.n else None
+        if arrays is not None:
+            return arrays.jacobian_batch(Q)
         return np.stack([self._jacobian(q, frames[frame]) for q in Q]) if Q.shape[0] else np.empty((0, 6, self.n))
 
     def check_qs(self, Q: np.ndarray, what: str = "Q") -> np.ndarray:

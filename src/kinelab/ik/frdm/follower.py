@@ -17,7 +17,7 @@ from kinelab.ik.limits import wrap_q
 from kinelab.ik.multistart import seed_state
 from kinelab.ik.request import verdict_reserve
 from kinelab.ik.result import SingularEvent, Status, TrackResult
-from kinelab.ik.targets import as_target_arrays
+from kinelab.ik.targets import TargetArrays
 from kinelab.ik.tasks import POSE, Task
 from kinelab.robot import Chain
 
@@ -27,14 +27,14 @@ LM_ITERATIONS = 20  # Levenberg–Marquardt steps of the polish (mode "frdm+lm")
 CENTRE_PULL = 0.01  # share of the way from the previous answer to mid-range taken as the rest configuration
 
 
-def follow(robot: Chain, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: float, max_sweeps: int,
+def follow(robot: Chain, targets: TargetArrays, q0: np.ndarray, tol_pos: float, tol_rot: float, max_sweeps: int,
            rest_weight: float | None, opts: FRDMOptions, task: Task = POSE, seed: int | None = None,
            time_budget: float | None = None, t_start: float | None = None) -> TrackResult:
     """Solve every sample of a path in the compiled follower; each answer judged by Pinocchio.
 
     Args:
         robot: the robot.
-        targets: oMtarget per sample (see :func:`~kinelab.ik.targets.as_target_arrays`).
+        targets: oMtarget per sample, checked (:func:`~kinelab.ik.targets.as_target_arrays`).
         q0: checked start configuration [rad or m].
         tol_pos: per-sample position tolerance [m].
         tol_rot: per-sample rotation tolerance [rad].
@@ -53,7 +53,7 @@ def follow(robot: Chain, targets: Any, q0: np.ndarray, tol_pos: float, tol_rot: 
     """
     if rest_weight is None:
         rest_weight = REST_WEIGHT if robot.n > 6 else 0.0
-    points, rotations = as_target_arrays(targets)
+    points, rotations = targets
     cm = chain_model(robot)
     count = points.shape[0]
     Q, codes, sweeps = np.empty((count, robot.n)), np.empty(count, dtype=np.int64), np.empty(count, dtype=np.int64)
@@ -78,16 +78,20 @@ def _deadline(time_budget: float | None, t_start: float, count: int) -> float:
 
 
 def _statuses(ok: np.ndarray, codes: np.ndarray) -> np.ndarray:
-    """Each sample's Status code: converged where the judge confirmed it, else why the kernel stopped."""
-    return np.array([Status.CONVERGED.code if ok[k]
-                     else (Status.MAX_ITERATIONS if codes[k] == CONVERGED else status_of(codes[k])).code
-                     for k in range(codes.shape[0])], dtype=np.int8)
+    """Each sample's Status code: converged where the judge confirmed it, else why the kernel stopped (a kernel
+    that converged where the judge did not agree: max_iterations)."""
+    out = np.full(codes.shape[0], Status.CONVERGED.code, dtype=np.int8)
+    failed = ~ok
+    for code in np.unique(codes[failed]):
+        status = Status.MAX_ITERATIONS if code == CONVERGED else status_of(int(code))
+        out[failed & (codes == code)] = status.code
+    return out
 
 
 def _stall_events(codes: np.ndarray) -> list[SingularEvent]:
     """One undiagnosed stall event per sample at which the follower's monitor fired."""
-    return [SingularEvent("stall", "not diagnosed (compiled follower)", sample=k)
-            for k in range(codes.shape[0]) if codes[k] in (kernel.STALL_STEP, kernel.STALL_WINDOW)]
+    return [SingularEvent("stall", "not diagnosed (compiled follower)", sample=int(k))
+            for k in np.flatnonzero((codes == kernel.STALL_STEP) | (codes == kernel.STALL_WINDOW))]
 
 
 def _centre(cm: Any, q0: np.ndarray) -> np.ndarray:

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from kinelab.core._chain import rotation_steps, running_events
 from kinelab.errors import OptionError
 from kinelab.ik import options as opt
 from kinelab.ik.frdm import solver
@@ -31,7 +32,7 @@ from kinelab.ik.frdm.options import FRDMOptions
 from kinelab.ik.limits import wrap_q
 from kinelab.ik.request import Request
 from kinelab.ik.result import Attempt, BypassRecord, SingularEvent, Status, TrackResult
-from kinelab.ik.targets import as_target_arrays
+from kinelab.ik.targets import TargetArrays
 from kinelab.ik.tasks import Task
 from kinelab.robot import Chain
 
@@ -74,13 +75,13 @@ def path_options(options: Any, solver_options: dict[str, Any]) -> dict[str, Any]
     return solver_options if options is not None else {**PATH_DEFAULTS, **solver_options}
 
 
-def run_track(robot: Chain, targets: Any, q0: np.ndarray, req: Request, settings: PathSettings,
+def run_track(robot: Chain, targets: TargetArrays, q0: np.ndarray, req: Request, settings: PathSettings,
               t_start: float | None = None) -> TrackResult:
     """Solve each target in turn, warm-started from the previous answer, each sample judged by Pinocchio.
 
     Args:
         robot: the robot.
-        targets: oMtarget per sample (base frame).
+        targets: oMtarget per sample (base frame), checked.
         q0: the checked configuration at the start of the path [rad or m].
         req: the validated request (solver "frdm"; its options hold the bypass tables and the policy).
         settings: the path's own settings.
@@ -94,7 +95,7 @@ def run_track(robot: Chain, targets: Any, q0: np.ndarray, req: Request, settings
     """
     opts: FRDMOptions = req.options
     _check_restrict(settings.restrict, opts.intervals, opts.freeze)
-    points, rotations = as_target_arrays(targets)
+    points, rotations = targets
     if _followable(opts) and not settings.restrict:
         followed = follow(robot, targets, q0, req.tol_pos, req.tol_rot, opts.sweep_cap, settings.rest_weight, opts,
                           req.task, req.seed, req.time_budget, t_start)
@@ -137,40 +138,46 @@ def self_motion_events(robot: Chain, Q: np.ndarray, q0: np.ndarray, points: np.n
     if robot.n <= task.dimension or Q.shape[0] < 2:
         return []
     prev = np.vstack([q0, Q[:-1]])
-    finite = np.isfinite(prev).all(axis=1)
-    J = np.zeros((Q.shape[0], 6, robot.n))
-    for row in np.flatnonzero(finite):
-        J[row] = robot.jacobian_local_world_aligned(prev[row])
-    J = J[:, task.rows]
     dx = np.zeros((Q.shape[0], 6))
     dx[:, :3] = np.diff(np.vstack([points[:1], points]), axis=0)
-    dx[1:, 3:] = [a @ pin.log3(a.T @ b) for a, b in zip(rotations[:-1], rotations[1:], strict=True)]
+    rotation_steps(np.ascontiguousarray(rotations, dtype=float), dx[:, 3:])
+    arrays = robot._judge_arrays()
+    drift, own = (null_drift(robot, prev, Q, dx, task.rows) if arrays is None
+                  else arrays.null_drift(prev, Q, dx, tuple(task.rows)))
+    return _drift_events(drift, max(float(own.max()), 1e-12))
+
+
+def null_drift(robot: Chain, prev: np.ndarray, Q: np.ndarray, dx: np.ndarray, rows: Any
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """The joint motion along the task's null space, sample by sample, with Pinocchio's Jacobians (a chain the
+    compiled FK does not judge): with J the task's rows of the tool Jacobian at prev[k] (base axes at the tool origin)
+    and J⁺v = Jᵀ(JJᵀ + 1e-12 I)⁻¹v, the drift dq − J⁺J dq (dq = Q[k] − prev[k], NaN taken as 0) and the least-norm
+    step max|J⁺dx[k]| [rad or m]; both 0 where prev is not finite.
+
+    Returns:
+        (drift (K, n), own (K,)).
+    """
+    finite = np.isfinite(prev).all(axis=1)
+    J = np.zeros((Q.shape[0], 6, robot.n))
+    J[finite] = robot.jacobian_batch(prev[finite], frame="local_world_aligned")
+    J = J[:, rows]
     dq = np.nan_to_num(Q - prev)
-    # least-norm steps by the damped normal equations: J⁺v = Jᵀ(JJᵀ + λ²I)⁻¹v, batched
-    JJt = J @ J.transpose(0, 2, 1) + 1e-12 * np.eye(len(task.rows))
-    least = np.linalg.solve(JJt, np.stack([dx[:, task.rows], np.einsum("kij,kj->ki", J, dq)], axis=2))
+    JJt = J @ J.transpose(0, 2, 1) + 1e-12 * np.eye(len(rows))
+    least = np.linalg.solve(JJt, np.stack([dx[:, rows], np.einsum("kij,kj->ki", J, dq)], axis=2))
     own = np.abs(np.einsum("kji,kj->ki", J, least[..., 0])).max(axis=1)
     drift = dq - np.einsum("kji,kj->ki", J, least[..., 1])
-    largest = max(float(np.nan_to_num(own).max()), 1e-12)
-    return _drift_events(drift, largest)
+    drift[~finite] = 0.0
+    return drift, np.nan_to_num(own)
 
 
 def _drift_events(drift: np.ndarray, largest: float) -> list[SingularEvent]:
     """The self-motion events of per-sample drifts (K, n) [rad or m]: where the drift summed since the last event
-    exceeds SELF_MOTION × ``largest``. By cumulative sums, one search per event (events are few)."""
-    cum = np.cumsum(drift, axis=0)
-    events, start, base = [], 0, np.zeros(drift.shape[1])
-    while start < drift.shape[0]:
-        moved = np.abs(cum[start:] - base).max(axis=1)
-        over = np.flatnonzero(moved > SELF_MOTION * largest)
-        if over.size == 0:
-            break
-        k = start + int(over[0])
-        events.append(SingularEvent("self_motion", f"the joints moved {moved[over[0]]:.3g} along the task's null "
-                                    f"space (the path's largest step: {largest:.3g})", sample=k,
-                                    max_joint_step=float(moved[over[0]])))
-        base, start = cum[k], k + 1
-    return events
+    exceeds SELF_MOTION × ``largest`` (a running total, reset at each event, in one compiled pass)."""
+    sample, moved = np.empty(drift.shape[0], dtype=np.int64), np.empty(drift.shape[0])
+    count = running_events(np.ascontiguousarray(drift, dtype=float), SELF_MOTION * largest, sample, moved)
+    return [SingularEvent("self_motion", f"the joints moved {m:.3g} along the task's null space (the path's largest "
+                          f"step: {largest:.3g})", sample=int(k), max_joint_step=float(m))
+            for k, m in zip(sample[:count], moved[:count], strict=True)]
 
 
 def jump_events(Q: np.ndarray, q0: np.ndarray, jump_limit: float | None) -> list[SingularEvent]:
