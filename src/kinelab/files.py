@@ -10,8 +10,15 @@ import contextlib
 import os
 import stat
 from pathlib import Path
+from typing import TYPE_CHECKING
 
+from kinelab import lazy
 from kinelab.errors import KinelabError
+
+if TYPE_CHECKING:
+    import tempfile
+else:
+    tempfile = lazy.module("tempfile", globals())
 
 MAX_BYTES = 64 * 2**20  # [bytes] the largest robot, SRDF, obstacle or metadata file read (URDFs are kilobytes)
 
@@ -178,7 +185,6 @@ def write_output(path: str | Path, data: str | bytes, what: str = "file") -> Pat
     except FileNotFoundError:
         mode = 0o666 & ~umask()
     raw = data.encode("utf-8") if isinstance(data, str) else data
-    import tempfile  # only a write needs it: every command imports this module for its checks
 
     tmp: str | None = None
     try:

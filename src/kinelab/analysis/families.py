@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
+from scipy.optimize import minimize
 
 from kinelab.analysis.singular import NEAR_SINGULAR, analyze, scaled_jacobian
 from kinelab.errors import KinelabError
@@ -39,8 +40,6 @@ def sigma_ratio_batch(robot: Chain, qs: np.ndarray, length: float | None = None,
 
 def refine(robot: Chain, q0, lower=None, upper=None, length: float | None = None) -> np.ndarray:
     """Move q0 onto the singular set: minimise σ_min/σ_max within the joint box (L-BFGS-B)."""
-    from scipy.optimize import minimize
-
     L = length or robot.characteristic_length()
     lo = robot.lower if lower is None else lower
     hi = robot.upper if upper is None else upper

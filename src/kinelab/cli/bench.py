@@ -4,11 +4,43 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from kinelab import lazy
 from kinelab.cli.common import count, positive_number, print_json, progress_of, seed_argument
 from kinelab.ik.words import TASKS
 from kinelab.report.outfolder import check_output_folder
+
+if TYPE_CHECKING:
+    from kinelab.report import render
+    from kinelab.report.bench import (
+        branches,
+        collisions,
+        completeness,
+        loops,
+        router,
+        runner,
+        scaling,
+        startup,
+        throughput,
+        versus,
+        wholebody,
+    )
+    from kinelab.studies import paper000_era
+else:
+    branches = lazy.module("kinelab.report.bench.branches", globals())
+    collisions = lazy.module("kinelab.report.bench.collisions", globals())
+    completeness = lazy.module("kinelab.report.bench.completeness", globals())
+    loops = lazy.module("kinelab.report.bench.loops", globals())
+    paper000_era = lazy.module("kinelab.studies.paper000_era", globals())
+    render = lazy.module("kinelab.report.render", globals())
+    router = lazy.module("kinelab.report.bench.router", globals())
+    runner = lazy.module("kinelab.report.bench.runner", globals())
+    scaling = lazy.module("kinelab.report.bench.scaling", globals())
+    startup = lazy.module("kinelab.report.bench.startup", globals())
+    throughput = lazy.module("kinelab.report.bench.throughput", globals())
+    versus = lazy.module("kinelab.report.bench.versus", globals())
+    wholebody = lazy.module("kinelab.report.bench.wholebody", globals())
 
 
 def add(sub: Any) -> None:
@@ -74,52 +106,33 @@ def add(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run the protocols asked for, print their tables (or JSON), write the files with --out."""
-    from kinelab.report import render
-    from kinelab.report.bench import runner as bench
-
     if args.out:
         check_output_folder(args.out, "bench")
     if args.whole_body or args.router:  # a protocol run alone
         return _whole_body(args) if args.whole_body else _router(args)
     first = _before_the_peers(args)
-    result = bench.run(robots=args.robots, n=args.n, seed=args.seed, solvers=args.solvers,
-                       budget=args.budget_ms / 1e3, progress=progress_of(args), repeats=args.repeats, start=args.start,
-                       sigma=args.sigma, schedule=args.schedule, task=args.task)
+    result = runner.run(robots=args.robots, n=args.n, seed=args.seed, solvers=args.solvers,
+                        budget=args.budget_ms / 1e3, progress=progress_of(args), repeats=args.repeats,
+                        start=args.start, sigma=args.sigma, schedule=args.schedule, task=args.task)
     result.update(first)
     if args.tracking:
-        from kinelab.studies import paper000_era
-
         result["tracking"] = paper000_era.tracking_bench(repeats=args.repeats)
     if args.loops:
-        from kinelab.report.bench import loops
-
         result["loops"] = loops.run(args.robots, seed=args.seed, repeats=args.repeats, progress=progress_of(args))
     if args.budgets:
-        from kinelab.report.bench import loops
-
         result["budgets"] = loops.budgets_run(args.robots, seed=args.seed, n=args.n, progress=progress_of(args))
     if args.versus:
-        from kinelab.report.bench import versus
-
         result["versus"] = versus.run(args.robots, seed=args.seed, repeats=max(args.repeats, 2),
                                       progress=progress_of(args))
     if args.branches:
-        from kinelab.report.bench import branches
-
         result["branches"] = branches.run(args.robots, seed=args.seed, repeats=max(args.repeats, 2),
                                           progress=progress_of(args))
     if args.completeness:
-        from kinelab.report.bench import completeness
-
         result["completeness"] = completeness.run(seed=args.seed, progress=progress_of(args))
     if args.throughput:
-        from kinelab.report.bench import throughput
-
         result["throughput"] = throughput.run(args.robots, seed=args.seed, repeats=args.repeats,
                                               progress=progress_of(args))
     if args.collisions:
-        from kinelab.report.bench import collisions
-
         result["collisions"] = collisions.run(None, seed=args.seed, repeats=max(args.repeats, 2),
                                               progress=progress_of(args))
     if args.out:
@@ -135,16 +148,12 @@ def run(args: argparse.Namespace) -> int:
 
 def _router(args: argparse.Namespace) -> int:
     """``--router``: the prepared solver against the module functions, alone (its table, JSON or files)."""
-    from kinelab.report.bench import router
-
     return _alone(args, "router", lambda: router.run(args.robots, seed=args.seed, repeats=args.repeats,
                                                      progress=progress_of(args)), router.markdown)
 
 
 def _whole_body(args: argparse.Namespace) -> int:
     """``--whole-body``: its protocol alone (its tables, JSON or files)."""
-    from kinelab.report.bench import wholebody
-
     return _alone(args, "whole_body", lambda: wholebody.run(args.robots, rounds=args.repeats, solves=args.n,
                                                             seed=args.seed, progress=progress_of(args)),
                   wholebody.markdown)
@@ -153,9 +162,6 @@ def _whole_body(args: argparse.Namespace) -> int:
 def _alone(args: argparse.Namespace, key: str, run: Callable[[], Any], markdown: Callable[[Any], str]) -> int:
     """A protocol run alone (``run()``): its figures under ``key`` after the bench header (taken first), written
     with --out, printed as JSON or as its table."""
-    from kinelab.report import render
-    from kinelab.report.bench import runner
-
     result = runner.header()
     found = result[key] = run()
     if args.out:
@@ -171,63 +177,35 @@ def _before_the_peers(args: argparse.Namespace) -> dict[str, Any]:
     """The timings that run before the main bench: the peers' solver threads and caches would disturb them."""
     first: dict[str, Any] = {}
     if args.startup:  # on a quiet process: nothing of the bench's own yet competes for the cores
-        from kinelab.report.bench import startup
-
         first["startup"] = startup.run(rounds=args.repeats + 4)
     if args.scaling:
-        from kinelab.report.bench import scaling
-
         first["scaling"] = scaling.run(progress=progress_of(args))
     return first
 
 
 def _print_tables(result: dict[str, Any]) -> None:
-    from kinelab.report import render
-
     print(render.bench_markdown(result))
     if "scaling" in result:
-        from kinelab.report.bench import scaling
-
         print(scaling.markdown(result["scaling"]))
     if "startup" in result:
-        from kinelab.report.bench import startup
-
         print(startup.markdown(result["startup"]))
     if "tracking" in result:
-        from kinelab.studies import paper000_era
-
         print(paper000_era.tracking_markdown(result["tracking"]))
     if "loops" in result:
-        from kinelab.report.bench import loops
-
         print(loops.markdown(result["loops"]["throughput"], result["loops"]["tracking"], result["loops"]["budgets"]))
     if "budgets" in result:
-        from kinelab.report.bench import loops
-
         print()
         print(loops.budget_markdown(result["budgets"]))
     if "whole_body" in result:
-        from kinelab.report.bench import wholebody
-
         print()
         print(wholebody.markdown(result["whole_body"]))
     if "versus" in result:
-        from kinelab.report.bench import versus
-
         print(versus.markdown(result["versus"]))
     if "branches" in result:
-        from kinelab.report.bench import branches
-
         print(branches.markdown(result["branches"]))
     if "throughput" in result:
-        from kinelab.report.bench import throughput
-
         print(throughput.markdown(result["throughput"]))
     if "collisions" in result:
-        from kinelab.report.bench import collisions
-
         print(collisions.markdown(result["collisions"]))
     if "completeness" in result:
-        from kinelab.report.bench import completeness
-
         print(completeness.markdown(result["completeness"]))

@@ -7,6 +7,7 @@ import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
+from kinelab import lazy
 from kinelab.cli.common import (
     json_flag,
     load_robot,
@@ -19,13 +20,27 @@ from kinelab.cli.common import (
     target_arguments,
     verbose_flag,
 )
+from kinelab.cli.ik import target_of
 from kinelab.errors import KinelabError, OptionError
 from kinelab.progress import step
 
 if TYPE_CHECKING:
-    from kinelab.ik.analytic.sew import SEW
+    import numpy as np
+
+    from kinelab import ik
+    from kinelab.ik import limits
+    from kinelab.ik.analytic import sew
     from kinelab.ik.result import Branches, IKResult
     from kinelab.robot import Chain
+    from kinelab.view import caption
+    from kinelab.view import scene as scene_module
+else:
+    caption = lazy.module("kinelab.view.caption", globals())
+    ik = lazy.module("kinelab.ik", globals())
+    limits = lazy.module("kinelab.ik.limits", globals())
+    np = lazy.module("numpy", globals())
+    scene_module = lazy.module("kinelab.view.scene", globals())
+    sew = lazy.module("kinelab.ik.analytic.sew", globals())
 
 
 def add(sub: Any) -> None:
@@ -56,15 +71,12 @@ def add(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Find, print (or print as JSON), and with --html draw, every branch; exit 0 when there is one, 1 when none."""
-    from kinelab.cli.ik import target_of
-    from kinelab.ik import solve_all
-
     robot = load_robot(args)
     target = target_of(robot, args)
     ref = None if args.ref_q is None else q_from_cli(robot, args.ref_q, args.deg, "--ref-q")
     budget = "auto" if args.time_budget is None else args.time_budget
-    found = solve_all(robot, target, solver=args.solver, seed=args.seed, time_budget=budget, q_ref=ref,
-                      redundancy=_redundancy(args))
+    found = ik.solve_all(robot, target, solver=args.solver, seed=args.seed, time_budget=budget, q_ref=ref,
+                         redundancy=_redundancy(args))
     if args.json:
         print_json({"robot": robot.name, "target": pose_dict(target), "method": _method(found),
                     "completeness": _completeness(found), "complete": found.complete,
@@ -76,19 +88,17 @@ def run(args: argparse.Namespace) -> int:
     return 0 if found else 1
 
 
-def _redundancy(args: argparse.Namespace) -> int | SEW | None:
+def _redundancy(args: argparse.Namespace) -> int | sew.SEW | None:
     """--redundancy K or --sew PSI (one of them) as solve_all's ``redundancy``.
 
     Raises:
         OptionError: both given.
     """
-    from kinelab.ik.analytic.sew import SEW
-
     if args.sew is None:
         return args.redundancy
     if args.redundancy is not None:
         raise OptionError("--sew", args.sew, "either --sew PSI or --redundancy K, not both")
-    return SEW(math.radians(args.sew) if args.deg else args.sew)
+    return sew.SEW(math.radians(args.sew) if args.deg else args.sew)
 
 
 def _method(found: Sequence[IKResult]) -> str:
@@ -136,8 +146,6 @@ def _completeness_words(found: Branches) -> str:
 
 def _print_branches(robot: Chain, args: argparse.Namespace, found: Branches, ref: Any) -> None:
     """One line per branch: its configuration and Pinocchio's errors (nearest ``ref`` first when given)."""
-    import numpy as np
-
     unit = " [deg, m]" if args.deg else " [rad, m]"
     print(f"{robot.name}: {len(found)} branch{'es' if len(found) != 1 else ''}, {_method(found)}")
     print(f"  {_completeness(found) if args.verbose else _completeness_words(found)}")
@@ -159,15 +167,13 @@ def _print_branches(robot: Chain, args: argparse.Namespace, found: Branches, ref
 def _write_page(robot: Chain, found: Sequence[IKResult], path: str, target: Any, ref: Any, deg: bool) -> None:
     """The branches side by side, numbered in the scene as in the table of their joints under the caption (the
     target's point marked at each; with ``ref``, the nearest first, orange, its distance in the table)."""
-    from kinelab.view.scene import side_by_side
-
     if not found:
         raise KinelabError("no branch to draw: the pose has none within the joint limits")
     labels = [f"branch {k + 1}" + (" (nearest --ref-q)" if ref is not None and k == 0 else "")
               for k in range(len(found))]
     step(f"drawing {len(found)} branches side by side and writing {path}")
-    scene = side_by_side(robot, [r.q for r in found], labels=labels, highlight=None if ref is None else 0,
-                         target=target)
+    scene = scene_module.side_by_side(robot, [r.q for r in found], labels=labels, highlight=None if ref is None else 0,
+                                      target=target)
     scene.title = f"{robot.name}: {len(found)} branch{'es' if len(found) != 1 else ''} of one pose, {_method(found)}"
     scene.view = "branches"
     scene.put_table(_joint_table(robot, found, ref, deg))
@@ -182,11 +188,6 @@ def _write_page(robot: Chain, found: Sequence[IKResult], path: str, target: Any,
 def _joint_table(robot: Chain, found: Sequence[IKResult], ref: Any, deg: bool) -> Any:
     """Every branch's joints (rad and m; degrees and m with ``deg``), and with ``ref`` each one's distance to it
     (the largest joint difference, revolute joints modulo 2π), the nearest marked."""
-    import numpy as np
-
-    from kinelab.ik.limits import distance
-    from kinelab.view.caption import Table
-
     angular = np.array([k != "prismatic" for k in robot.joint_kinds])
     unit = "deg" if deg else "rad"
     header = ("#", *(f"q{i + 1} [{unit if a else 'm'}]" for i, a in enumerate(angular)),
@@ -194,8 +195,8 @@ def _joint_table(robot: Chain, found: Sequence[IKResult], ref: Any, deg: bool) -
     rows = []
     for k, r in enumerate(found):
         q = np.where(angular, np.rad2deg(r.q), r.q) if deg else r.q
-        gap = () if ref is None else (distance(robot, r.q, ref),)
+        gap = () if ref is None else (limits.distance(robot, r.q, ref),)
         rows.append((str(k + 1), *(f"{v:.4f}" for v in rounded(q, 4)),
                      *(f"{v:.4f}" for v in rounded([np.rad2deg(d) if deg else d for d in gap], 4))))
     names = ", ".join(f"q{i + 1} {j.name}" for i, j in enumerate(robot.joints))
-    return Table(header, tuple(rows), None if ref is None else 0, note=f"joints: {names}")
+    return caption.Table(header, tuple(rows), None if ref is None else 0, note=f"joints: {names}")

@@ -14,13 +14,23 @@ import json
 import math
 from typing import TYPE_CHECKING, Any, NoReturn
 
+from kinelab import lazy
 from kinelab.errors import ConfigurationError, KinelabError
 
 if TYPE_CHECKING:
     import numpy as np
     import pinocchio as pin
 
+    from kinelab import collision, geometry, progress
+    from kinelab import robot as robot_module
     from kinelab.robot import Chain
+else:
+    collision = lazy.module("kinelab.collision", globals())
+    geometry = lazy.module("kinelab.geometry", globals())
+    np = lazy.module("numpy", globals())
+    pin = lazy.module("pinocchio", globals())
+    progress = lazy.module("kinelab.progress", globals())
+    robot_module = lazy.module("kinelab.robot", globals())
 
 
 class Parser(argparse.ArgumentParser):
@@ -83,8 +93,6 @@ def q_from_cli(robot: Chain, values: list[str], deg: bool, what: str = "q") -> n
     Raises:
         ConfigurationError: a value that is not a number, or the wrong count.
     """
-    import numpy as np
-
     if len(values) == 1 and not _is_number(values[0]):
         return robot.named_q(values[0])
     numbers = []
@@ -116,11 +124,9 @@ def _is_number(text: str) -> bool:
 def load_robot(args: argparse.Namespace) -> Chain:
     """The robot a per-robot command names, with its --tool, --base, --srdf, --group, --package-dir and
     --xacro-arg."""
-    from kinelab.robot import load
-
-    return load(args.robot, tool=args.tool, base=args.base, srdf=args.srdf, group=args.group,
-                package_dirs=args.package_dir, xacro_args=pairs(args.xacro_arg, "--xacro-arg"),
-                trust_xacro=args.trust_xacro, locked=_locked(args.lock), whole=False)
+    return robot_module.load(args.robot, tool=args.tool, base=args.base, srdf=args.srdf, group=args.group,
+                             package_dirs=args.package_dir, xacro_args=pairs(args.xacro_arg, "--xacro-arg"),
+                             trust_xacro=args.trust_xacro, locked=_locked(args.lock), whole=False)
 
 
 def pairs(items: list[str] | None, flag: str) -> dict[str, str] | None:
@@ -194,10 +200,9 @@ def collisions_of(args: argparse.Namespace) -> Any:
         if args.margin:
             raise KinelabError("--margin is a collision clearance: give --collisions or --obstacles FILE")
         return None
-    from kinelab.collision import Collisions, Environment
 
-    env = None if args.obstacles is None else Environment.from_file(args.obstacles)
-    return Collisions(environment=env, margin=args.margin)
+    env = None if args.obstacles is None else collision.Environment.from_file(args.obstacles)
+    return collision.Collisions(environment=env, margin=args.margin)
 
 
 def json_flag(s: argparse.ArgumentParser, what: str = "the result") -> None:
@@ -219,14 +224,10 @@ def seed_argument(s: argparse.ArgumentParser) -> None:
 
 def pose_dict(oMtool: pin.SE3) -> dict[str, Any]:
     """The JSON form of a pose: position [m], rotation matrix, quat_wxyz, rpy [rad]."""
-    import pinocchio as pin
-
-    from kinelab.geometry import quat_wxyz_from_matrix
-
     return {
         "position_m": oMtool.translation.tolist(),
         "rotation_matrix": oMtool.rotation.tolist(),
-        "quat_wxyz": quat_wxyz_from_matrix(oMtool.rotation).tolist(),
+        "quat_wxyz": geometry.quat_wxyz_from_matrix(oMtool.rotation).tolist(),
         "rpy_rad": pin.rpy.matrixToRpy(oMtool.rotation).tolist(),
     }
 
@@ -238,8 +239,6 @@ def print_json(obj: Any) -> None:
 
 def rounded(values: Any, digits: int) -> list[float]:
     """Rounded for printing, without the −0.0 that rounding a tiny negative number leaves."""
-    import numpy as np
-
     out: list[float] = (np.round(np.asarray(values, dtype=float), digits) + 0.0).tolist()
     return out
 
@@ -252,8 +251,6 @@ def plural(count: int, word: str, plural_form: str | None = None) -> str:
 def shown(values: Any, precision: int = 6, prefix: str = "") -> str:
     """Numbers as the CLI prints them: ``precision`` digits, rounding noise below 1e-12 as 0, no "-0", one line
     per row however many joints (``prefix``: the text before the array, for the rows after the first)."""
-    import numpy as np
-
     clean = np.round(np.asarray(values, dtype=float), precision) + 0.0  # + 0.0 turns the −0 of rounding into 0
     return np.array2string(clean, precision=precision, suppress_small=True, max_line_width=10_000, prefix=prefix)
 
@@ -269,6 +266,4 @@ class Interrupted(KeyboardInterrupt):
 def progress_of(args: argparse.Namespace) -> bool:
     """Whether a command shows its progress bars: not with --json, and only where someone watches (a terminal or
     Jupyter, :func:`kinelab.progress.interactive`): never bar frames in a log file."""
-    from kinelab.progress import interactive
-
-    return not getattr(args, "json", False) and interactive()
+    return not getattr(args, "json", False) and progress.interactive()

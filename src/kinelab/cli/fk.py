@@ -3,9 +3,16 @@
 from __future__ import annotations
 
 import argparse
-from typing import Any
+from dataclasses import asdict
+from typing import TYPE_CHECKING, Any
 
+from kinelab import lazy
 from kinelab.cli import common
+
+if TYPE_CHECKING:
+    from kinelab import collision
+else:
+    collision = lazy.module("kinelab.collision", globals())
 
 
 def add(sub: Any) -> None:
@@ -27,11 +34,7 @@ def run(args: argparse.Namespace) -> int:
            "outside_limits": outside}
     spec, contacts = common.collisions_of(args), []
     if spec is not None:
-        from dataclasses import asdict
-
-        from kinelab.collision import collision_model
-
-        contacts = collision_model(robot, spec).contacts(q)  # every pair in contact, as the view colours them
+        contacts = collision.collision_model(robot, spec).contacts(q)  # every pair in contact, as the view colours them
         out["collision"] = asdict(contacts[0]) if contacts else None
         out["contacts"] = [asdict(c) for c in contacts]
     if args.json:

@@ -7,6 +7,7 @@ import re
 from dataclasses import fields
 from typing import TYPE_CHECKING, Any
 
+from kinelab import lazy
 from kinelab.cli.common import (
     collision_arguments,
     collisions_of,
@@ -29,8 +30,20 @@ from kinelab.ik.words import AXES, TASKS
 if TYPE_CHECKING:
     import numpy as np
 
+    from kinelab import ik
+    from kinelab.dq import kinematics as biquat_kinematics
+    from kinelab.ik import registry, targets, turns
+    from kinelab.ik import result as result_module
     from kinelab.ik.result import IKResult
     from kinelab.robot import Chain
+else:
+    biquat_kinematics = lazy.module("kinelab.dq.kinematics", globals())
+    ik = lazy.module("kinelab.ik", globals())
+    np = lazy.module("numpy", globals())
+    registry = lazy.module("kinelab.ik.registry", globals())
+    result_module = lazy.module("kinelab.ik.result", globals())
+    targets = lazy.module("kinelab.ik.targets", globals())
+    turns = lazy.module("kinelab.ik.turns", globals())
 
 SOLVER_FLAGS = (("--polish", "polish", "polish"), ("--law", "law", "law"), ("--integrator", "integrator", "integrator"),
                 ("--step", "step", "step"), ("--gain", "gain", "k"))  # (flag, its argparse name, the option field)
@@ -47,12 +60,10 @@ def option_fields(solver: str) -> frozenset[str]:
     Raises:
         SolverNotFoundError: an unknown solver, the valid ones named.
     """
-    from kinelab.ik.registry import capabilities, solver_module
-
-    kind = capabilities(solver)
+    kind = registry.capabilities(solver)
     if kind.closed_form:
         return frozenset()
-    return frozenset(f.name for f in fields(solver_module(kind.request_solver(solver)).Options))
+    return frozenset(f.name for f in fields(registry.solver_module(kind.request_solver(solver)).Options))
 
 
 def add(sub: Any) -> None:
@@ -100,19 +111,16 @@ def add(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Solve, print the result (or its JSON form); exit 0 when reached, 1 when not."""
-    from kinelab.ik import solve
-    from kinelab.ik.turns import nearest_turns
-
     robot = load_robot(args)
     target, options = _target(robot, args)
     q0, start = _start(robot, args)
     _refuse_other_solvers_flags(args)
     options.update(_bypass_options(robot, args))
     options.update({field: getattr(args, dest) for _, dest, field in SOLVER_FLAGS if _given(getattr(args, dest))})
-    result = solve(robot, target, solver=args.solver, q0=q0, seed=args.seed, tol_pos=args.tol_pos,
-                   tol_rot=args.tol_rot, time_budget=args.time_budget, task=args.task, axis=args.axis,
-                   collisions=collisions_of(args), **options)
-    result = nearest_turns(robot, result, q0, target, args.task, args.axis, args.tol_pos, args.tol_rot)
+    result = ik.solve(robot, target, solver=args.solver, q0=q0, seed=args.seed, tol_pos=args.tol_pos,
+                      tol_rot=args.tol_rot, time_budget=args.time_budget, task=args.task, axis=args.axis,
+                      collisions=collisions_of(args), **options)
+    result = turns.nearest_turns(robot, result, q0, target, args.task, args.axis, args.tol_pos, args.tol_rot)
     if args.json:
         print_json({"robot": robot.name, "target": pose_dict(target),
                     "start": {"q": None if q0 is None else q0.tolist(), "from": start},
@@ -142,32 +150,23 @@ def target_of(robot: Chain, args: argparse.Namespace) -> Any:
 
 def _target(robot: Chain, args: argparse.Namespace) -> tuple[Any, dict[str, Any]]:
     """The target pose, and the biquaternion solver's signed target when it is given as a configuration."""
-    import numpy as np
-
-    from kinelab.ik import target_from_xyz_rpy
-    from kinelab.ik.targets import DEGREES_LIKELY
-
     if (args.target_q is None) == (args.target_xyz is None):
         raise KinelabError("give the target as --target-q Q... or as --target-xyz X Y Z [--target-rpy R P Y]")
     options: dict[str, Any] = {}
     if args.target_q is None:
         rpy = np.array(args.target_rpy if args.target_rpy is not None else [0.0, 0.0, 0.0])
-        if not args.deg and np.abs(rpy).max() > DEGREES_LIKELY:
+        if not args.deg and np.abs(rpy).max() > targets.DEGREES_LIKELY:
             raise KinelabError(f"--target-rpy {' '.join(f'{v:g}' for v in rpy)} looks like degrees (an angle beyond "
                                "±2π rad): add --deg, or give radians")
-        return target_from_xyz_rpy(args.target_xyz, rpy, degrees=args.deg), options
+        return ik.target_from_xyz_rpy(args.target_xyz, rpy, degrees=args.deg), options
     q_target = robot.check_q(q_from_cli(robot, args.target_q, args.deg, "--target-q"), limits=True,
                              what="--target-q")
     if "target_biquaternion" in option_fields(args.solver):  # a solver that wants the signed target gets it
-        from kinelab.dq import kinematics as biquat_kinematics
-
         options["target_biquaternion"] = biquat_kinematics.pose(robot, q_target)  # N with its sign
     return robot.fk(q_target), options
 
 
 def _bypass_value(robot: Chain, joint: str, text: str, deg: bool, flag: str) -> float:
-    import numpy as np
-
     try:
         value = float(text)
     except ValueError:
@@ -179,13 +178,11 @@ def _bypass_value(robot: Chain, joint: str, text: str, deg: bool, flag: str) -> 
 def _refuse_other_solvers_flags(args: argparse.Namespace) -> None:
     """A flag of another solver's is a mistake, said (it used to be dropped without a word); --axis goes with
     --task axis only."""
-    from kinelab.ik.registry import names
-
     mine = option_fields(args.solver)
     given = [(flag, field) for flag, dest, field in SOLVER_FLAGS if _given(getattr(args, dest)) and field not in mine]
     if given:
         flag, field = given[0]
-        owners = [name for name in names() if field in option_fields(name)]
+        owners = [name for name in registry.names() if field in option_fields(name)]
         raise KinelabError(f"{flag} is an option of --solver {' or '.join(owners)}, not of --solver {args.solver}")
     if args.axis != "z" and args.task != "axis":
         raise KinelabError(f"--axis {args.axis} names the tool axis of --task axis; the task is {args.task}")
@@ -200,9 +197,7 @@ def _bypass_options(robot: Chain, args: argparse.Namespace) -> dict[str, Any]:
             raise KinelabError("--on-singular switches bypasses given by --kick, --interval or --freeze; none is")
         return {}
     if "kicks" not in option_fields(args.solver):
-        from kinelab.ik.registry import names
-
-        owners = " or ".join(name for name in names() if "kicks" in option_fields(name))
+        owners = " or ".join(name for name in registry.names() if "kicks" in option_fields(name))
         raise KinelabError(f"--kick, --interval and --freeze are bypasses of --solver {owners}, not of "
                            f"--solver {args.solver}")
     out: dict[str, Any] = {}
@@ -232,21 +227,17 @@ def _split_spec(spec: str, flag: str, form: str) -> tuple[str, str]:
 
 def _print_ik(robot: Chain, args: argparse.Namespace, result: IKResult) -> None:
     """The text form of an IK result: status, q, Pinocchio's errors on the task's components, effort."""
-    from kinelab.ik.result import Status
-
     _print_answer(robot, args, result)
     _print_solver_notes(args, result)
     if result.message:
         print("  " + re.sub(r"task='(\w+)'", r"--task \1", result.message))
-    if not result.success and result.status is not Status.OUTSIDE_LIMITS and args.task != "position" \
+    if not result.success and result.status is not result_module.Status.OUTSIDE_LIMITS and args.task != "position" \
             and args.target_xyz is not None and args.target_rpy is None:
         print("  (no --target-rpy: the target rotation is the identity; --task position ignores it)")
 
 
 def _print_answer(robot: Chain, args: argparse.Namespace, result: IKResult) -> None:
     """Status, q (degrees with --deg), the errors on the task's components and the effort."""
-    import numpy as np
-
     q_show = np.where([k != "prismatic" for k in robot.joint_kinds], np.rad2deg(result.q), result.q) \
         if args.deg else result.q
     print(f"{robot.name} {args.solver}, task {result.task}: {result.status.value} (success: {result.success})")
@@ -262,15 +253,12 @@ def _print_answer(robot: Chain, args: argparse.Namespace, result: IKResult) -> N
 
 def _print_solver_notes(args: argparse.Namespace, result: IKResult) -> None:
     """What the solver adds: the biquaternion model's time and M0, the singularity monitor, the collision retries."""
-    from kinelab.ik.registry import capabilities
-    from kinelab.ik.result import BiquatDiagnostics
-
     diag = result.diagnostics
-    if isinstance(diag, BiquatDiagnostics) and diag.model_time:
+    if isinstance(diag, result_module.BiquatDiagnostics) and diag.model_time:
         m0 = diag.M0
         print(f"  model time {diag.model_time:.4g} s, final M0 = "
               + (f"{m0:+.6f}" if m0 is not None else "n/a (give --target-q for the sign of N)"))
-    if capabilities(args.solver).monitored:  # only a solver with the singularity monitor has events to tell
+    if registry.capabilities(args.solver).monitored:  # only a solver with the singularity monitor has events to tell
         if args.verbose or args.kick or args.interval or args.freeze:  # the user's own bypasses: what they did
             _print_events(result)
         elif fired := sum(e.count or 1 for e in result.singular_events):

@@ -17,6 +17,7 @@ import warnings
 from collections.abc import Sequence
 from typing import Any
 
+import kinelab
 from kinelab.cli.common import Parser
 from kinelab.errors import KinelabError
 from kinelab.files import output_target
@@ -32,8 +33,6 @@ class _Version(argparse.Action):
 
     def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace, values: Any,
                  option_string: str | None = None) -> None:
-        import kinelab
-
         print(f"kinelab {kinelab.__version__}")  # on stdout, as argparse's own version action prints it
         parser.exit()
 

@@ -7,8 +7,9 @@ import shlex
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from kinelab import lazy
 from kinelab.cli import common
 from kinelab.cli.common import (
     Interrupted,
@@ -23,6 +24,26 @@ from kinelab.cli.common import (
 from kinelab.errors import KinelabError
 from kinelab.files import write_output
 from kinelab.progress import step
+from kinelab.robot.catalog import names
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from kinelab import ik, maps
+    from kinelab import robot as robot_module
+    from kinelab.analysis import singular
+    from kinelab.maps import base, cluster, store
+    from kinelab.view import maps as maps_module
+else:
+    base = lazy.module("kinelab.maps.base", globals())
+    cluster = lazy.module("kinelab.maps.cluster", globals())
+    ik = lazy.module("kinelab.ik", globals())
+    maps = lazy.module("kinelab.maps", globals())
+    maps_module = lazy.module("kinelab.view.maps", globals())
+    np = lazy.module("numpy", globals())
+    robot_module = lazy.module("kinelab.robot", globals())
+    singular = lazy.module("kinelab.analysis.singular", globals())
+    store = lazy.module("kinelab.maps.store", globals())
 
 
 def add(sub: Any) -> None:
@@ -85,13 +106,9 @@ def _add_base(kinds: Any) -> None:
 
 def run_base(args: argparse.Namespace) -> int:
     """The platform positions that reach the grasp, best manipulability first."""
-    from kinelab import maps
-    from kinelab.ik import target_from_xyz_rpy
-    from kinelab.maps.base import check_count
-
-    check_count(args.top)  # before the map's work
+    base.check_count(args.top)  # before the map's work
     robot = load_robot(args)
-    grasp = target_from_xyz_rpy(args.grasp[:3], args.grasp[3:])
+    grasp = ik.target_from_xyz_rpy(args.grasp[:3], args.grasp[3:])
     result = maps.base_map(robot, grasp, step=args.step, seed=args.seed)
     best = result.ranked(args.top)
     rows = [{"x": float(result.poses[i, 0]), "y": float(result.poses[i, 1]), "yaw": float(result.poses[i, 2]),
@@ -114,23 +131,19 @@ def run_base(args: argparse.Namespace) -> int:
 
 def run_singular(args: argparse.Namespace) -> int:
     """σ_min/σ_max over samples: how many near-singular, how many rank-deficient."""
-    import numpy as np
-
-    from kinelab import maps
-    from kinelab.analysis.singular import NEAR_SINGULAR
-
     robot = load_robot(args)
     result = maps.singularity(robot, samples=args.samples, seed=args.seed, method="grid" if args.grid else "random",
                               progress=progress_of(args))
     ratio = result.sigma_ratio
     summary = {"robot": robot.name, "samples": int(len(ratio)), "rank_deficient": int(result.rank_deficient.sum()),
-               "near_singular": int((ratio < NEAR_SINGULAR).sum()), "median_sigma_ratio": float(np.median(ratio))}
+               "near_singular": int((ratio < singular.NEAR_SINGULAR).sum()),
+               "median_sigma_ratio": float(np.median(ratio))}
     if args.json:
         print_json(summary)
     else:
         print(f"{robot.name}: {plural(len(ratio), 'sample')}; {summary['near_singular']} near-singular "
-              f"(σ_min/σ_max < {NEAR_SINGULAR:g}), {summary['rank_deficient']} rank-deficient; median σ_min/σ_max "
-              f"{summary['median_sigma_ratio']:.3g}")
+              f"(σ_min/σ_max < {singular.NEAR_SINGULAR:g}), {summary['rank_deficient']} rank-deficient; "
+              f"median σ_min/σ_max {summary['median_sigma_ratio']:.3g}")
     return 0
 
 
@@ -138,7 +151,6 @@ def _kept(args: argparse.Namespace) -> str:
     """What an interrupted map kept, and the command that resumes it."""
     if not args.out:
         return "nothing was kept (no --out): give --out DIR to keep the chunks and resume"
-    from kinelab.maps import store
 
     try:
         done = store.load(args.out, check=False).done[:]
@@ -152,7 +164,6 @@ def _say_resumed(args: argparse.Namespace) -> None:
     """One line on stderr when --out holds chunks of an unfinished map (a run that resumes it)."""
     if not args.out:
         return
-    from kinelab.maps import store
 
     try:
         done = int(sum(store.load(args.out, check=False).done[:]))
@@ -164,17 +175,12 @@ def _say_resumed(args: argparse.Namespace) -> None:
 
 def run_reach(args: argparse.Namespace) -> int:
     """Build (or resume) the reachability map and print its summary."""
-    import numpy as np
-
-    from kinelab import maps
-
     robot = load_robot(args)
     spec = maps.MapSpec(voxel=args.voxel, orientations=args.orientations, task=args.task, restarts=args.restarts,
                         seed=args.seed, chunk_voxels=args.chunk, method=args.method,
                         collisions=common.collisions_of(args))
     if args.scheduler and args.workers:
         raise KinelabError("give --scheduler ADDRESS or --workers N, not both")
-    from kinelab.maps import cluster
 
     if args.workers is not None and not 1 <= args.workers <= cluster.cores():
         raise KinelabError(f"--workers must be 1 to {cluster.cores()} (the cores here), got {args.workers}")
@@ -215,12 +221,6 @@ def run_reach(args: argparse.Namespace) -> int:
 
 def run_view(args: argparse.Namespace) -> int:
     """Write the page of a stored map (its robot loaded by the name the map records, or --robot)."""
-    from kinelab import maps
-    from kinelab.maps.store import model_sha256
-    from kinelab.robot import load
-    from kinelab.robot.catalog import names
-    from kinelab.view.maps import map_page
-
     rmap = maps.load(args.store)
     if Path(args.store).resolve() in (html := Path(args.html).resolve(), *html.parents):
         raise KinelabError(f"--html {args.html} lies inside the map {args.store}: the page would overwrite it; give a "
@@ -229,12 +229,12 @@ def run_view(args: argparse.Namespace) -> int:
     if args.robot is None and meta["robot"] not in names():  # a store is data: it names no file to be read
         raise KinelabError(f"the map at {args.store} names its robot {meta['robot']!r}, which is not a registered "
                            "robot (kinelab robots): give its model file with --robot")
-    robot = load(args.robot or meta["robot"], base=meta.get("base"), tool=meta.get("tool"))
-    if model_sha256(robot) != meta["source_sha256"]:
+    robot = robot_module.load(args.robot or meta["robot"], base=meta.get("base"), tool=meta.get("tool"))
+    if store.model_sha256(robot) != meta["source_sha256"]:
         raise KinelabError(f"{robot.name}'s model file is not the one the map at {args.store} was computed for: "
                            "give that robot with --robot")
     step(f"drawing the map of {robot.name} and its slices")
-    page = map_page(robot, rmap)
+    page = maps_module.map_page(robot, rmap)
     write_output(args.html, page, "page")
     print(f"wrote {args.html}: {robot.name}, {int((rmap.array('reachability') > 0).sum())} reached voxels of "
           f"{meta['voxels']}, {meta['spec']['voxel']:g} m")

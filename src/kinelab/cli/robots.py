@@ -5,11 +5,20 @@ from __future__ import annotations
 import argparse
 from typing import TYPE_CHECKING, Any
 
+from kinelab import lazy
 from kinelab.cli.common import json_flag, load_robot, print_json, robot_arguments, verbose_flag
 from kinelab.robot import catalog
 
 if TYPE_CHECKING:
+    import numpy as np
+
+    from kinelab import collision
+    from kinelab.ik.analytic import redundancy
     from kinelab.robot import Joint
+else:
+    collision = lazy.module("kinelab.collision", globals())
+    np = lazy.module("numpy", globals())
+    redundancy = lazy.module("kinelab.ik.analytic.redundancy", globals())
 
 
 def add(sub: Any) -> None:
@@ -44,8 +53,6 @@ def run_robots(args: argparse.Namespace) -> int:
 
 
 def _joint_row(j: Joint) -> dict[str, Any]:
-    import numpy as np
-
     row: dict[str, Any] = {"name": j.name, "type": j.kind, "lower": j.lower, "upper": j.upper, "unit": j.unit}
     if j.kind != "prismatic":
         row["lower_deg"], row["upper_deg"] = float(np.rad2deg(j.lower)), float(np.rad2deg(j.upper))
@@ -54,19 +61,12 @@ def _joint_row(j: Joint) -> dict[str, Any]:
 
 def run_info(args: argparse.Namespace) -> int:
     """The robot's chain: base, tool, joints with their limits, the locked joints."""
-    import numpy as np
-
-    from kinelab.ik.analytic.redundancy import (  # the solvers load for info only, not for --help
-        closed_form_summary,
-        closed_form_words,
-    )
-
     robot = load_robot(args)
     info = {"robot": robot.name, "urdf": str(robot.urdf_path), "base": robot.base, "tool": robot.tool,
             "dof": robot.n, "nq": robot.nq, "nv": robot.nv, "joints": [_joint_row(j) for j in robot.joints],
             "locked": robot.locked, "mimics": {name: m.leader for name, m in robot.mimics.items()},
             "format": robot.source_format, "collisions": _collision_summary(robot) if args.collisions else None,
-            "closed_form": closed_form_summary(robot), "judge": str(robot.fk_certificate)}
+            "closed_form": redundancy.closed_form_summary(robot), "judge": str(robot.fk_certificate)}
     if args.json:
         print_json(info)
         return 0
@@ -83,7 +83,7 @@ def run_info(args: argparse.Namespace) -> int:
         print(f"mimic: {name} follows {m.leader}")
     if robot.locked:
         print(f"locked: {', '.join(f'{k}={v:g}' for k, v in robot.locked.items())}")
-    print(f"branches: {info['closed_form'] if args.verbose else closed_form_words(robot)}")
+    print(f"branches: {info['closed_form'] if args.verbose else redundancy.closed_form_words(robot)}")
     print(f"answers judged by: {info['judge']}")
     print(f"collisions: {info['collisions'] or 'not built (add --collisions: loads the meshes, counts the pairs)'}")
     return 0
@@ -91,9 +91,7 @@ def run_info(args: argparse.Namespace) -> int:
 
 def _collision_summary(robot: Any) -> str:
     """What a self-collision check of this robot uses, or why it cannot run."""
-    from kinelab.collision import CollisionError, Collisions, collision_model
-
     try:
-        return collision_model(robot, Collisions()).summary
-    except CollisionError as err:
+        return collision.collision_model(robot, collision.Collisions()).summary
+    except collision.CollisionError as err:
         return f"none ({err})"

@@ -3,10 +3,17 @@
 from __future__ import annotations
 
 import argparse
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from kinelab import lazy
 from kinelab.cli import common
 from kinelab.errors import KinelabError
+
+if TYPE_CHECKING:
+    from kinelab.analysis import families, singular
+else:
+    families = lazy.module("kinelab.analysis.families", globals())
+    singular = lazy.module("kinelab.analysis.singular", globals())
 
 
 def reading(value: float, digits: int = 4) -> str:
@@ -29,8 +36,6 @@ def add(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """The analysis at one q, or the sweep's families."""
-    from kinelab.analysis import singular
-
     robot = common.load_robot(args)
     if args.sweep is not None:
         if args.q:
@@ -60,8 +65,6 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _sweep(robot: Any, args: argparse.Namespace) -> int:
-    from kinelab.analysis import families, singular
-
     families.check_sweep_size(robot, args.sweep, force=args.force)
     result = families.sweep(robot, samples=args.sweep, seed=args.seed, progress=common.progress_of(args),
                             method="grid" if args.grid else "random")

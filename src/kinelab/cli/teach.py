@@ -4,11 +4,25 @@ from __future__ import annotations
 
 import argparse
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from kinelab import lazy
 from kinelab.cli.common import collision_arguments, collisions_of, load_robot, pairs, q_from_cli, robot_arguments
 from kinelab.errors import KinelabError
 from kinelab.progress import step
+from kinelab.robot import catalog
+
+if TYPE_CHECKING:
+    import signal
+    import webbrowser
+
+    from kinelab import robot as robot_module
+    from kinelab.view import teach
+else:
+    robot_module = lazy.module("kinelab.robot", globals())
+    signal = lazy.module("signal", globals())
+    teach = lazy.module("kinelab.view.teach", globals())
+    webbrowser = lazy.module("webbrowser", globals())
 
 
 def add(sub: Any) -> None:
@@ -32,22 +46,16 @@ def add(sub: Any) -> None:
 
 def run_teach(args: argparse.Namespace) -> int:
     """Serve the teach page until Ctrl-C (or SIGTERM)."""
-    import signal
-
-    from kinelab.view.teach import TeachServer
-
     if not 0 <= args.port <= 65535:
         raise KinelabError(f"--port {args.port} is not a port: give 1–65535, or 0 for a free one")
     if args.time_budget is not None and not 0 < args.time_budget <= 60:
         raise KinelabError(f"--time-budget {args.time_budget:g} s: give a time in (0, 60] s")
     session = _whole_session(args) if _wants_whole(args) else _chain_session(args)
-    server = TeachServer(session, args.port)
+    server = teach.TeachServer(session, args.port)
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))  # so that the finally below frees the port
     print(f"kinelab teach is serving {session.robot.name} on {server.url} (Ctrl-C to stop)", flush=True)
     print(f"  start: {session.start}", flush=True)
     if args.open:
-        import webbrowser
-
         webbrowser.open(server.url)
     try:
         server.serve_forever()
@@ -62,7 +70,6 @@ def _wants_whole(args: argparse.Namespace) -> bool:
     """A whole robot's page: --hands or --feet given, or a registered whole robot named without a chain's flags."""
     if args.hands is not None or args.feet is not None:
         return True
-    from kinelab.robot import catalog
 
     entry = catalog.ENTRIES.get(args.robot)
     return bool(entry is not None and entry.whole and not (args.tool or args.base or args.group or args.lock))
@@ -70,14 +77,12 @@ def _wants_whole(args: argparse.Namespace) -> bool:
 
 def _chain_session(args: argparse.Namespace) -> Any:
     """A chain's page: its sliders, the target its tool follows, the collision switch."""
-    from kinelab.view.teach import TeachOptions, TeachSession
-
     robot = load_robot(args)
     q = q_from_cli(robot, args.q, args.deg) if args.q else None
     spec = collisions_of(args)
-    options = TeachOptions(time_budget=args.time_budget or 0.05, collisions=spec)  # None: the switch checks self
+    options = teach.TeachOptions(time_budget=args.time_budget or 0.05, collisions=spec)  # None: the switch checks self
     step(f"drawing {robot.name} (its meshes load)")
-    session = TeachSession(robot, q, options)
+    session = teach.TeachSession(robot, q, options)
     if spec is not None:
         session.set_collisions(True)
     return session
@@ -85,18 +90,15 @@ def _chain_session(args: argparse.Namespace) -> Any:
 
 def _whole_session(args: argparse.Namespace) -> Any:
     """A whole robot's page: a target per hand, the feet held."""
-    from kinelab.robot import load
-    from kinelab.view.teach import TeachOptions, WholeTeachSession
-
     if args.q or args.collisions or args.obstacles is not None:
         raise KinelabError("a whole robot's page starts standing and checks no collisions: drop Q, --collisions "
                            "and --obstacles (or name a chain with --tool)")
     if args.tool or args.base or args.group or args.lock:
         raise KinelabError("--hands and --feet are a whole robot's: drop --tool, --base, --group and --lock")
-    robot = load(args.robot, whole=True, srdf=args.srdf, package_dirs=args.package_dir,
-                 xacro_args=pairs(args.xacro_arg, "--xacro-arg"), trust_xacro=args.trust_xacro)
+    robot = robot_module.load(args.robot, whole=True, srdf=args.srdf, package_dirs=args.package_dir,
+                              xacro_args=pairs(args.xacro_arg, "--xacro-arg"), trust_xacro=args.trust_xacro)
     step(f"drawing {robot.name} (its meshes load)")
-    options = TeachOptions(time_budget=args.time_budget or 0.5)
+    options = teach.TeachOptions(time_budget=args.time_budget or 0.5)
     hands = None if args.hands is None else tuple(args.hands)
     feet = None if args.feet is None else tuple(args.feet)
-    return WholeTeachSession(robot, None, options, hands, feet)
+    return teach.WholeTeachSession(robot, None, options, hands, feet)

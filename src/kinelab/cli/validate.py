@@ -5,10 +5,17 @@ from __future__ import annotations
 import argparse
 import shutil
 import textwrap
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from kinelab import lazy
 from kinelab.cli.common import json_flag, print_json, progress_of, seed_argument
 from kinelab.report.outfolder import check_output_folder
+
+if TYPE_CHECKING:
+    from kinelab.report import render, validate
+else:
+    render = lazy.module("kinelab.report.render", globals())
+    validate = lazy.module("kinelab.report.validate", globals())
 
 
 def add(sub: Any) -> None:
@@ -27,8 +34,6 @@ def add(sub: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run the checks, print the table, write the report; exit 1 when a check fails."""
-    from kinelab.report import render, validate
-
     out = args.out or (None if args.json else "kinelab-report")  # --json alone writes no folder
     if out:
         check_output_folder(out, "validate")  # before the work, not after it

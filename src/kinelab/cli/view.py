@@ -5,11 +5,29 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from typing import Any
+import time
+from typing import TYPE_CHECKING, Any
 
+from kinelab import lazy
 from kinelab.cli.common import collision_arguments, collisions_of, load_robot, plural, q_from_cli, robot_arguments
 from kinelab.errors import KinelabError
 from kinelab.progress import step
+
+if TYPE_CHECKING:
+    import signal
+
+    from kinelab import collision
+    from kinelab import robot as robot_module
+    from kinelab.studies import paper000_era
+    from kinelab.view import collisions
+    from kinelab.view import scene as viz
+else:
+    collision = lazy.module("kinelab.collision", globals())
+    collisions = lazy.module("kinelab.view.collisions", globals())
+    paper000_era = lazy.module("kinelab.studies.paper000_era", globals())
+    robot_module = lazy.module("kinelab.robot", globals())
+    signal = lazy.module("signal", globals())
+    viz = lazy.module("kinelab.view.scene", globals())
 
 MIN_DT, MAX_DT = 1e-3, 60.0  # [s] per animation sample
 
@@ -32,8 +50,6 @@ def add(sub: Any) -> None:
 
 def run_view(args: argparse.Namespace) -> int:
     """Draw the robot at q (any finite q; joints outside their limits are noted)."""
-    from kinelab.view import scene as viz
-
     robot = load_robot(args)
     q = robot.check_q(q_from_cli(robot, args.q, args.deg) if args.q else robot.display_q())
     if not args.ignore_limits:
@@ -45,26 +61,19 @@ def run_view(args: argparse.Namespace) -> int:
         scene.singular_directions(q)
     spec = collisions_of(args)
     if spec is not None:
-        from kinelab.collision import collision_model
-        from kinelab.view.collisions import draw_collisions
-
-        contacts = draw_collisions(scene, collision_model(robot, spec), q)
+        contacts = collisions.draw_collisions(scene, collision.collision_model(robot, spec), q)
         print(f"{len(contacts)} contact(s)" + "".join(f"\n  {c}" for c in contacts))
     return _publish(scene, args.html)
 
 
 def run_animate(args: argparse.Namespace) -> int:
     """Animate one ERA passage with or without the paper's bypass."""
-    from kinelab.robot import load
-    from kinelab.studies import paper000_era
-    from kinelab.view import scene as viz
-
     passages = {f"era-{name}": build for name, build in paper000_era.PASSAGES.items()}
     if args.passage not in passages:
         raise KinelabError(f"unknown passage {args.passage!r}; passages are: {', '.join(passages)}")
     if not (math.isfinite(args.dt) and MIN_DT <= args.dt <= MAX_DT):
         raise KinelabError(f"--dt {args.dt} is not valid: seconds per sample, between {MIN_DT:g} and {MAX_DT:g}")
-    robot = load("era")
+    robot = robot_module.load("era")
     passage = passages[args.passage](robot)
     step(f"solving {args.passage} with and without the paper's bypass")
     run = paper000_era.run(passage, robot)
@@ -104,9 +113,6 @@ def _print_caption(scene: Any) -> None:
 
 
 def _serve(scene: Any) -> int:
-    import signal
-    import time
-
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(0))  # so that the finally below stops the server
     print(f"meshcat is serving on {scene.url} (Ctrl-C to stop)", flush=True)
     _print_caption(scene)

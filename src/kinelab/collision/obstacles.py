@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import coal
 import numpy as np
 import pinocchio as pin
 
@@ -101,8 +102,6 @@ class Obstacle:
 
     def geometry(self) -> Any:
         """The obstacle as a coal shape, in its own frame."""
-        import coal
-
         if self.shape == "plane":
             return coal.Halfspace(np.array([0.0, 0.0, 1.0]), 0.0)
         if self.shape == "box":

@@ -15,6 +15,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
+from kinelab import lazy
 from kinelab.errors import OptionError
 from kinelab.ik.auto import resolved
 from kinelab.ik.batch import BatchIKResult
@@ -26,8 +27,11 @@ from kinelab.ik.result import Branches, IKResult, TrackResult
 from kinelab.robot import Chain
 
 if TYPE_CHECKING:  # the collision model and the closed forms load when a call asks for them
+    from kinelab.ik.analytic import branches
     from kinelab.ik.analytic.branches import BranchBatch
     from kinelab.ik.analytic.sew import SEW
+else:
+    branches = lazy.module("kinelab.ik.analytic.branches", globals())
 
 # The order of the arguments after (robot, target) in kinelab 0.1's positional signatures: a call that still
 # passes them positionally is told which keyword its value was
@@ -203,9 +207,8 @@ def solve_all_batch(robot: Chain, targets: Any, *positional: Any, tol_pos: float
             chain none of those take (named: its branches come from ``solve_all`` one target at a time).
     """
     check_entry(robot, "solve_all_batch", positional)
-    from kinelab.ik.analytic.branches import all_branches_batch
 
-    return all_branches_batch(robot, targets, tol_pos, tol_rot, time_budget)
+    return branches.all_branches_batch(robot, targets, tol_pos, tol_rot, time_budget)
 
 
 def solve_all(robot: Chain, target: Any, *positional: Any, solver: str = "auto", seed: int | None = None,

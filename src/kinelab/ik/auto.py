@@ -12,9 +12,18 @@ branch: :mod:`kinelab.ik.registry`.)
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from kinelab import lazy
 from kinelab.robot.chain import Chain
+
+if TYPE_CHECKING:
+    from kinelab.ik.analytic import classify as classify_module
+    from kinelab.ik.analytic import held, kernel
+else:
+    classify_module = lazy.module("kinelab.ik.analytic.classify", globals())
+    held = lazy.module("kinelab.ik.analytic.held", globals())
+    kernel = lazy.module("kinelab.ik.analytic.kernel", globals())
 
 AUTO = "auto"
 
@@ -30,13 +39,9 @@ def resolved(robot: Chain, solver: Any, task: Any, collisions: Any, has_options:
 
 def closed_form_serves(robot: Chain) -> bool:
     """True when the chain's closed form (or its held-joint form) answers a pose."""
-    from kinelab.ik.analytic import held
-    from kinelab.ik.analytic.classify import classify
-    from kinelab.ik.analytic.kernel import SEARCH_6R
-
     def closed(r: Chain) -> bool:
-        arm = classify(r).arm
-        return arm is not None and arm.kind < SEARCH_6R
+        arm = classify_module.classify(r).arm
+        return arm is not None and arm.kind < kernel.SEARCH_6R
 
     def serves(r: Chain) -> bool:
         return closed(r) or (held.applies(r) and closed(held.held_robot(r)))

@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
 
+from kinelab import lazy
 from kinelab.core import _blas, threads
 from kinelab.errors import ConfigurationError, count_of
 from kinelab.geometry import stack_homogeneous
@@ -28,6 +29,11 @@ from kinelab.ik.request import Request
 from kinelab.ik.result import Status, status_counts
 from kinelab.ik.targets import as_target_arrays, reach_bound
 from kinelab.robot import Chain
+
+if TYPE_CHECKING:
+    from kinelab.ik import starts as starts_module
+else:
+    starts_module = lazy.module("kinelab.ik.starts", globals())
 
 # [s] kept out of the solvers' share of a budget: Pinocchio's FK and error per row (about 7 µs on a busy 2-core
 # machine), and the fixed cost of a call's arrays and thread start
@@ -166,9 +172,7 @@ def _from_table(robot: Chain, req: Request, q0: str | None) -> bool:
 
 def _table_starts(robot: Chain, points: np.ndarray, rotations: np.ndarray) -> np.ndarray:
     """Each row's first start from the robot's start table (built, with SciPy's k-d tree, on first use)."""
-    from kinelab.ik.starts import start_table
-
-    return start_table(robot).nearest(stack_homogeneous(points, rotations))
+    return starts_module.start_table(robot).nearest(stack_homogeneous(points, rotations))
 
 
 def _starts(robot: Chain, q0: Any, count: int) -> np.ndarray | None:

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
+from kinelab import lazy
 from kinelab.errors import OptionError
 from kinelab.ik.batch import fresh_seed, prepare, run_batch
 from kinelab.ik.limits import distance as distance  # exported: the branch distance users sort by
@@ -26,8 +27,13 @@ from kinelab.ik.targets import as_target, beyond_reach
 from kinelab.robot import Chain
 
 if TYPE_CHECKING:  # the closed forms load when a route asks for them: a multistart solve does without
+    from kinelab.ik.analytic import branches, sew
+    from kinelab.ik.analytic import redundancy as redundancy_module
     from kinelab.ik.analytic.branches import EveryBranch
-    from kinelab.ik.analytic.sew import SEW
+else:
+    branches = lazy.module("kinelab.ik.analytic.branches", globals())
+    redundancy_module = lazy.module("kinelab.ik.analytic.redundancy", globals())
+    sew = lazy.module("kinelab.ik.analytic.sew", globals())
 
 SAME = 1e-3  # [rad or m] two answers closer than this, joint by joint, are one solution (answers met to 1e-6 m
 # near a singular point differ by up to ~2e-4 rad; distinct branches by far more)
@@ -64,7 +70,7 @@ def route_of(kind: Capabilities, options_given: bool) -> Route:
 
 def find_all(robot: Chain, target: Any, req: Request, q_ref: Any = None, max_solutions: int | None = None,
              stop_below: float | None = UNSEEN, method: Route = Route.MULTISTART,
-             redundancy: int | dict[str, float] | SEW | None = None) -> Branches:
+             redundancy: int | dict[str, float] | sew.SEW | None = None) -> Branches:
     """The distinct solutions of ``target``, each checked by Pinocchio: every branch in closed form where the
     chain's class allows it (:mod:`kinelab.ik.analytic`), else those seeded starts find within the request's
     time budget.
@@ -102,12 +108,10 @@ def find_all(robot: Chain, target: Any, req: Request, q_ref: Any = None, max_sol
         if method is Route.MULTISTART:
             raise OptionError("redundancy", redundancy, f"None with solver={req.solver!r} and options (redundancy= "
                               "sweeps a joint of the closed form: solver 'auto' or 'analytic', no options)")
-        from kinelab.ik.analytic.redundancy import redundant_all
-        from kinelab.ik.analytic.sew import SEW, sew_all
 
-        if isinstance(redundancy, SEW):
-            return sew_all(robot, target, req, redundancy, ref, max_solutions)
-        return redundant_all(robot, target, req, redundancy, ref, max_solutions)
+        if isinstance(redundancy, sew.SEW):
+            return sew.sew_all(robot, target, req, redundancy, ref, max_solutions)
+        return redundancy_module.redundant_all(robot, target, req, redundancy, ref, max_solutions)
     spent = 0.0
     if method is not Route.MULTISTART:
         t0 = time.perf_counter()
@@ -122,14 +126,12 @@ def _closed_form_all(robot: Chain, target: Any, req: Request, ref: Any, max_solu
                      method: Route) -> Branches | None:
     """Every branch in closed form (or by the 1-D search or the general elimination) where the route and the chain
     allow it; None where the multistart is to answer instead."""
-    from kinelab.ik.analytic.branches import analytic_all, arm_of, has_closed_form, has_general_form
-
-    if method is Route.CLOSED_FORM or (method is Route.EITHER and (has_closed_form(robot, req)
-                                                                    or has_general_form(robot, req))):
-        found = analytic_all(robot, target, req, q_ref=ref, max_solutions=max_solutions)
+    if method is Route.CLOSED_FORM or (method is Route.EITHER and (branches.has_closed_form(robot, req)
+                                                                    or branches.has_general_form(robot, req))):
+        found = branches.analytic_all(robot, target, req, q_ref=ref, max_solutions=max_solutions)
         # the 1-D search is measured complete, not proved so: a pose within reach it finds nothing for is searched
         # again by the multistart rather than called unreachable (and so is an elimination's uncertified empty set)
-        if found or found.complete == "certified" or not arm_of(robot, req).searched \
+        if found or found.complete == "certified" or not branches.arm_of(robot, req).searched \
                 or beyond_reach(robot, target.translation):
             return found
     return None
@@ -160,23 +162,21 @@ def usual_closed_form(robot: Chain, target: Any, seed: Any, settings: tuple[Any,
     return entry.solve(target)  # None: a root to finish, a bad pose or none, which the general route says
 
 
-def _usual_entry(robot: Chain, settings: tuple[Any, ...]) -> EveryBranch | Literal[False]:
+def _usual_entry(robot: Chain, settings: tuple[Any, ...]) -> branches.EveryBranch | Literal[False]:
     """The one-call solver of every branch for these settings, or False when the usual call does not apply.
 
     Raises:
         OptionError: a bad setting, named (as the general route would).
     """
-    from kinelab.ik.analytic.branches import EveryBranch, has_closed_form, has_general_form, prepared_form
-
     solver, tol_pos, tol_rot, time_budget, stop_below = settings
     if not capabilities(solver).picks:
         return False
     req = make_request("frdm", None, tol_pos, tol_rot, time_budget, 0, "refuse", None, "pose", "z", {})
     _check_search(Route.EITHER, None, stop_below)
-    if not (has_closed_form(robot, req) or has_general_form(robot, req)):
+    if not (branches.has_closed_form(robot, req) or branches.has_general_form(robot, req)):
         return False
-    form = prepared_form(robot, req)
-    return False if form is None else EveryBranch(robot, req, form)
+    form = branches.prepared_form(robot, req)
+    return False if form is None else branches.EveryBranch(robot, req, form)
 
 
 def _new_kept(_: Chain) -> dict[tuple[Any, ...], Any]:

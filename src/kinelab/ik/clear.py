@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
+from kinelab.ik.analytic.branches import arm_of, has_closed_form, nearest_roots
 from kinelab.ik.batch import BatchIKResult, fresh_seed
 from kinelab.ik.driver import solve_one
 from kinelab.ik.request import Request
@@ -47,8 +48,6 @@ def solve_clear(robot: Chain, target: Any, q0: Any, req: Request, model: Collisi
         The clear answer (``diagnostics.clear_after``: the colliding answers before it), or the solver's own
         failure, or a failure with status ``collision`` (``diagnostics.contact`` and the message name the pair).
     """
-    from kinelab.ik.analytic.branches import has_closed_form  # the closed forms load with the first collision check
-
     t0 = time.perf_counter()
     seed = fresh_seed() if req.seed is None else req.seed
     collided: IKResult | None = None
@@ -84,8 +83,6 @@ def _from_branches(robot: Chain, target: Any, collided: IKResult, q0: Any, req: 
                    t0: float) -> IKResult:
     """The solver run again from the pose's clear branches (closed form), nearest ``q0`` or the colliding answer
     first; a failure with status ``collision`` when every branch within the limits collides."""
-    from kinelab.ik.analytic.branches import arm_of, nearest_roots
-
     ref = collided.q if q0 is None else np.asarray(q0, dtype=float)  # q0 passed the first run's checks
     q, _, _, order = nearest_roots(robot, arm_of(robot, req), target, req, ref)
     for k in order:

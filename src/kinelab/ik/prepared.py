@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pinocchio as pin
 
+from kinelab import lazy
 from kinelab.core._engine import Engine
 from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
@@ -42,10 +43,20 @@ from kinelab.ik.targets import TargetArrays, as_target, as_target_arrays
 from kinelab.robot import Chain
 
 if TYPE_CHECKING:
+    from kinelab.collision import model
     from kinelab.collision.model import CollisionModel
+    from kinelab.ik import clear
+    from kinelab.ik.analytic import branches, held
     from kinelab.ik.analytic.branches import NearestBranch
     from kinelab.ik.analytic.sew import SEW
+    from kinelab.ik.frdm import tracking
     from kinelab.ik.frdm.tracking import PathSettings
+else:
+    branches = lazy.module("kinelab.ik.analytic.branches", globals())
+    clear = lazy.module("kinelab.ik.clear", globals())
+    held = lazy.module("kinelab.ik.analytic.held", globals())
+    model = lazy.module("kinelab.collision.model", globals())
+    tracking = lazy.module("kinelab.ik.frdm.tracking", globals())
 
 
 class IK:
@@ -114,21 +125,18 @@ class IK:
         here, by name) and its one-call form, or the solver's model."""
         robot, req = self.robot, self.request
         if self.analytic:
-            from kinelab.ik.analytic import held
-            from kinelab.ik.analytic.branches import NearestBranch, arm_of, prepared_form
-
             self.held = held.applies(robot)
             if self.held:  # a 7R arm: its six in closed form at the held joint's start value
                 if self.collisions is not None:
                     raise OptionError("collisions", "given", "None with solver='analytic' on a 7R arm "
                                       "(solver='frdm' takes collisions=)")
-                arm_of(held.held_robot(robot), req)  # the task is "pose" (named otherwise)
+                branches.arm_of(held.held_robot(robot), req)  # the task is "pose" (named otherwise)
                 return
             held.refuse_7r(robot)
-            arm_of(robot, req)
+            branches.arm_of(robot, req)
             if self.collisions is None:  # the usual call's one compiled call: branches found and judged together
-                form = prepared_form(robot, req)
-                self._nearest = None if form is None else NearestBranch(robot, req, form)
+                form = branches.prepared_form(robot, req)
+                self._nearest = None if form is None else branches.NearestBranch(robot, req, form)
             return
         prepare_solver(req.module, robot, req.options)
 
@@ -189,15 +197,12 @@ class IK:
         """Solver "analytic": the branch nearest q0 in one compiled call where that serves, else root by root."""
         ref = None if q0 is None else self.robot.check_q(q0, what="q0")
         if self.held:
-            from kinelab.ik.analytic.held import nearest_held_one
-
-            return nearest_held_one(self.robot, as_target(target, self.request.task.name), ref, self.request)
+            return held.nearest_held_one(self.robot, as_target(target, self.request.task.name), ref, self.request)
         found = None if self._nearest is None else self._nearest.solve(target, ref)
         if found is not None:  # the usual call: nothing imported on its way (an import costs 8 % of a 13 µs call)
             return found
-        from kinelab.ik.analytic.branches import analytic_one
-
-        return analytic_one(self.robot, as_target(target, self.request.task.name), self.request, ref, self.collisions)
+        return branches.analytic_one(self.robot, as_target(target, self.request.task.name), self.request, ref,
+                                     self.collisions)
 
     def solve_batch(self, targets: Any, *, q0: Any = None, seed: int | None = None) -> BatchIKResult:
         """Every target of a batch, as :func:`kinelab.solve_batch` with these settings (row b: seed + b).
@@ -215,13 +220,9 @@ class IK:
         """
         req = replace(self._request(seed), start_outside_limits="refuse")
         if self.held:
-            from kinelab.ik.analytic.held import nearest_held
-
-            return nearest_held(self.robot, targets, q0, req)
+            return held.nearest_held(self.robot, targets, q0, req)
         if self.analytic:
-            from kinelab.ik.analytic.branches import nearest_batch
-
-            return nearest_batch(self.robot, targets, q0, req, self.collisions)
+            return branches.nearest_batch(self.robot, targets, q0, req, self.collisions)
         return batch_clear_of(self.robot, targets, q0, req, self.collisions)
 
     def solve_all(self, target: Any, *, seed: int | None = None, q_ref: Any = None,
@@ -280,10 +281,9 @@ class IK:
         prepare_robot(self.robot)
         t_start = time.perf_counter()  # the budget counts from here, the checks of the call included
         req = self._path(seed)
-        from kinelab.ik.frdm.tracking import PathSettings  # the path follower loads with a path
 
         points, rotations = as_target_arrays(targets)
-        settings = PathSettings(jump_limit, restrict, hold, rest_weight)
+        settings = tracking.PathSettings(jump_limit, restrict, hold, rest_weight)
         return follow_path(self.robot, points, rotations, q0, req, settings, self.collisions, t_start)
 
     def _path(self, seed: int | None) -> Request:
@@ -292,11 +292,9 @@ class IK:
         if not capabilities(self.request.solver).follows_paths:
             raise OptionError("solver", solver, "'frdm' (track follows a path with FRDM's warm-started sweeps)")
         if self._path_request is None:
-            from kinelab.ik.frdm.tracking import path_options
-
             req = self.request
             self._path_request = make_request(req.solver, None, req.tol_pos, req.tol_rot, req.time_budget, 0, "refuse",
-                                              options, task, axis, path_options(options, solver_options))
+                                              options, task, axis, tracking.path_options(options, solver_options))
         if seed is None:
             return self._path_request
         check_seed(seed)
@@ -324,12 +322,10 @@ def follow_path(robot: Chain, points: np.ndarray, rotations: np.ndarray, q0: Any
     answer when q0 is None), the path, and the collision check of every answer when ``check`` is given."""
     if q0 is None:
         q0 = _first_answer(robot, pin.SE3(rotations[0], points[0]), req, check)
-    from kinelab.ik.clear import clear_track
-    from kinelab.ik.frdm.tracking import run_track
 
-    path = run_track(robot, TargetArrays(points, rotations), robot.check_q(q0, limits=True, what="q0"), req,
-                     settings, t_start)
-    return path if check is None else clear_track(path, check)
+    path = tracking.run_track(robot, TargetArrays(points, rotations), robot.check_q(q0, limits=True, what="q0"), req,
+                              settings, t_start)
+    return path if check is None else clear.clear_track(path, check)
 
 
 def _first_answer(robot: Chain, target: pin.SE3, req: Request, check: CollisionModel | None) -> np.ndarray:
@@ -351,10 +347,9 @@ def collision_check(robot: Chain, collisions: Any) -> CollisionModel | None:
     None: the collision package (coal's geometry, the robot's meshes) loads only for a solve that checks."""
     if collisions is None:
         return None
-    from kinelab.collision.model import as_collisions, collision_model
 
-    spec = as_collisions(collisions)
-    return None if spec is None else collision_model(robot, spec)
+    spec = model.as_collisions(collisions)
+    return None if spec is None else model.collision_model(robot, spec)
 
 
 def solve_clear_of(robot: Chain, target: Any, q0: Any, req: Request, check: CollisionModel | None) -> IKResult:
@@ -362,9 +357,8 @@ def solve_clear_of(robot: Chain, target: Any, q0: Any, req: Request, check: Coll
     loads with the first solve that checks)."""
     if check is None:
         return solve_one(robot, target, q0, req)
-    from kinelab.ik.clear import solve_clear
 
-    return solve_clear(robot, target, q0, req, check)
+    return clear.solve_clear(robot, target, q0, req, check)
 
 
 def batch_clear_of(robot: Chain, targets: Any, q0: Any, req: Request, check: CollisionModel | None) -> BatchIKResult:
@@ -373,18 +367,16 @@ def batch_clear_of(robot: Chain, targets: Any, q0: Any, req: Request, check: Col
     res = run_batch(robot, targets, q0, req)
     if check is None:
         return res
-    from kinelab.ik.clear import clear_batch
 
-    return clear_batch(robot, stack_homogeneous(*as_target_arrays(targets)), res, req, check, t0)
+    return clear.clear_batch(robot, stack_homogeneous(*as_target_arrays(targets)), res, req, check, t0)
 
 
 def clear_of(found: Branches, check: CollisionModel | None, drop: bool) -> Branches:
     """The branches with the colliding ones dropped (``drop``) or marked, by ``check`` (None: as found)."""
     if check is None:
         return found
-    from kinelab.ik.clear import mark_colliding
 
-    return mark_colliding(found, check, drop=drop)
+    return clear.mark_colliding(found, check, drop=drop)
 
 
 PREPARED_PER_ROBOT = 16  # a caller sweeping settings: the prepared solvers kept stay bounded

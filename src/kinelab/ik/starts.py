@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from kinelab.robot import Chain
 
@@ -57,8 +58,6 @@ def start_table(robot: Chain) -> StartTable:
 
 
 def _build(robot: Chain) -> StartTable:
-    from scipy.spatial import cKDTree
-
     q = robot.random_qs(SIZE, np.random.default_rng(SEED))
     length = max(robot.characteristic_length(), 1e-3)
     H = robot.fk_batch(q)

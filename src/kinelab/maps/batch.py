@@ -20,11 +20,16 @@ from typing import Any
 
 import numpy as np
 
+from kinelab.core import threads
 from kinelab.errors import KinelabError, OptionError
 from kinelab.files import as_path
 from kinelab.geometry import stack_homogeneous
+from kinelab.ik.api import solve_batch
 from kinelab.ik.batch import BatchIKResult
 from kinelab.ik.targets import as_target_arrays
+from kinelab.maps.cluster import client_for, recipe, worker_robot
+from kinelab.maps.store import _zarr, model_sha256
+from kinelab.progress import bar
 from kinelab.robot import Chain
 
 CHUNK = 10_000  # targets per task: ~0.3 s of a panda worker, 1.3 MB of targets sent
@@ -71,10 +76,6 @@ class ClusterRun:
 def chunk_task(how: dict, spec: BatchSpec, targets: np.ndarray, index: int) -> tuple[int, dict[str, np.ndarray]]:
     """Chunk ``index`` on a worker: (index, its rows' arrays). One kernel thread: the cluster gives the parallelism
     (the rows do not depend on it)."""
-    from kinelab.core import threads
-    from kinelab.ik.api import solve_batch
-    from kinelab.maps.cluster import worker_robot
-
     threads.set_count(1)
     res = solve_batch(worker_robot(how), targets, seed=spec.seed + index * spec.chunk, tol_pos=spec.tol_pos,
                       tol_rot=spec.tol_rot, max_restarts=spec.max_restarts)
@@ -92,8 +93,6 @@ def _open(out: str | Path, robot: Chain, H: np.ndarray, spec: BatchSpec) -> Any:
     Raises:
         KinelabError: zarr missing, ``out`` not writable, or holding another run (the differing item named).
     """
-    from kinelab.maps.store import _zarr, model_sha256
-
     zarr, path = _zarr(), as_path(out, "the batch's out", KinelabError)
     meta = {"robot": robot.name, "source_sha256": model_sha256(robot), "targets_sha256": targets_sha256(H),
             "targets": int(len(H)), "joints": int(robot.n), **asdict(spec)}
@@ -144,8 +143,6 @@ def solve_batch_on_cluster(robot: Chain, targets: Any, out: str | Path, spec: Ba
         KinelabError: the cluster extra missing (with the install hint), ``out`` unusable or another run's.
         TargetError, OptionError: bad targets or settings, named.
     """
-    from kinelab.maps.cluster import client_for
-
     spec = spec or BatchSpec()
     t0 = time.perf_counter()
     H = stack_homogeneous(*as_target_arrays(targets))
@@ -172,9 +169,6 @@ def _run(client: Any, robot: Chain, H: np.ndarray, spec: BatchSpec, group: Any, 
          progress: bool | None) -> None:
     """Submit the chunks ``todo``; write each one's rows, then its flag, as it arrives."""
     from dask.distributed import as_completed
-
-    from kinelab.maps.cluster import recipe
-    from kinelab.progress import bar
 
     how, K = recipe(robot), spec.chunk
     futures = [client.submit(chunk_task, how, spec, H[c * K:(c + 1) * K], c, key=f"kinelab-batch-{c}-{time.time_ns()}")

@@ -20,9 +20,12 @@ from typing import Any
 
 import numpy as np
 
+from kinelab.core import threads
 from kinelab.errors import KinelabError
+from kinelab.maps.chunk import compute_chunk
 from kinelab.maps.store import model_sha256
-from kinelab.robot import Chain
+from kinelab.progress import bar
+from kinelab.robot import Chain, catalog, load
 
 INSTALL_HINT = "pip install 'kinelab[cluster]' (dask.distributed, cryptography)"
 CONNECT_TIMEOUT = 5.0  # [s] to reach a scheduler before giving up
@@ -33,8 +36,6 @@ _ROBOTS: dict[tuple, Chain] = {}  # per worker process: robots already loaded, b
 def recipe(robot: Chain) -> dict:
     """How a worker loads the same robot: its registered name or model file, tool and base, and the hash the
     worker's copy must have."""
-    from kinelab.robot import catalog
-
     if robot.source is None:
         raise KinelabError(f"{robot.name} was made from an in-memory model, which Dask workers cannot load: save "
                            "it as a URDF and load that, or run the map in this process")
@@ -45,8 +46,6 @@ def recipe(robot: Chain) -> dict:
 
 def worker_robot(how: dict) -> Chain:
     """The robot ``how`` (:func:`recipe`) names, loaded once per worker process and checked to be the client's."""
-    from kinelab.robot import load
-
     key = (how["source"], how["tool"], how["base"], how["sha256"], how["trust_xacro"],
            tuple(sorted(how["xacro_args"].items())))
     if key not in _ROBOTS:
@@ -63,9 +62,6 @@ def worker_robot(how: dict) -> Chain:
 
 def chunk_task(how: dict, spec: Any, centres: np.ndarray, index: int) -> tuple[int, dict]:
     """One chunk on a worker: (index, values). One kernel thread per task: the cluster gives the parallelism."""
-    from kinelab.core import threads
-    from kinelab.maps.chunk import compute_chunk
-
     threads.set_count(1)
     return index, compute_chunk(worker_robot(how), spec, centres, index)
 
@@ -186,8 +182,6 @@ def run_chunks(client: Any, robot: Chain, spec: Any, centres: np.ndarray, todo: 
                progress: bool | None = None) -> None:
     """Submit the chunks ``todo`` and write each into ``target`` as it arrives."""
     from dask.distributed import as_completed
-
-    from kinelab.progress import bar
 
     how = recipe(robot)
     scattered = client.scatter(centres, broadcast=True)

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+import kinelab
 from kinelab.errors import KinelabError, OptionError
 from kinelab.files import as_path, output_folder
 from kinelab.robot import Chain
@@ -40,11 +41,9 @@ def model_sha256(robot: Chain) -> str:
 
 def metadata(robot: Chain, spec: Any, voxels: int) -> dict:
     """What identifies a map: the robot, its model file's hash, the spec and the kinelab version."""
-    from kinelab import __version__
-
     return {"robot": robot.name, "source_sha256": model_sha256(robot),
             "spec": spec.to_dict(), "solver": "analytic" if spec.closed_form(robot) else "frdm",
-            "voxels": int(voxels), "kinelab": __version__,
+            "voxels": int(voxels), "kinelab": kinelab.__version__,
             "base": robot.base, "tool": robot.tool}
 
 
@@ -217,8 +216,6 @@ def load(path: str | Path, check: bool = True) -> ReachabilityMap:
         KinelabError: no map there, a map written by another kinelab version (named), or (with ``check``)
             chunks whose values no longer match their checksums (running the same map again recomputes them).
     """
-    from kinelab import __version__
-
     if not isinstance(check, bool):
         raise OptionError("check", check, "True or False (verify every finished chunk's checksum)")
     zarr, path = _zarr(), as_path(path, "a reachability map", KinelabError)
@@ -228,8 +225,8 @@ def load(path: str | Path, check: bool = True) -> ReachabilityMap:
         arrays = {k: group[k] for k in ("centres", "done", "checksums", *VALUES)}
     except (KeyError, ValueError, TypeError, OSError, zarr.errors.GroupNotFoundError):
         raise KinelabError(f"{path} is not a kinelab reachability map (or its metadata is damaged)") from None
-    if meta.get("kinelab") != __version__:
-        raise KinelabError(f"{path} was written by kinelab {meta.get('kinelab')}, this is {__version__}: "
+    if meta.get("kinelab") != kinelab.__version__:
+        raise KinelabError(f"{path} was written by kinelab {meta.get('kinelab')}, this is {kinelab.__version__}: "
                            "compute the map again")
     _check_layout(meta, arrays, path)
     found = ReachabilityMap(meta, arrays, path)

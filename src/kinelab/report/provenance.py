@@ -16,6 +16,9 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
+import kinelab
+from kinelab.core import _built
+
 # the distributions that define the robots (example-robot-data, yourdfpy) and the reference (Pinocchio, coal,
 # NumPy, SciPy): their versions go into every report
 LIBRARIES = {"pinocchio": "pin", "coal": "coal", "example-robot-data": "example-robot-data",
@@ -27,9 +30,6 @@ def provenance() -> dict[str, Any]:
     version of each of :data:`LIBRARIES` by its key (``pinocchio``, ``coal``, ``example-robot-data``,
     ``yourdfpy``, ``numpy``, ``scipy``; "not installed" when absent), ``core`` (the compiled core's source
     SHA-256, first 12 hex digits), ``processor`` (its model), ``cores`` (logical processors) and ``python``."""
-    import kinelab
-    from kinelab.core import _built
-
     return {"date": datetime.now(timezone.utc).isoformat(timespec="seconds"), "command": shlex.join(sys.argv),
             "kinelab": kinelab.__version__, "commit": commit_of(Path(__file__).resolve().parent),
             **{key: _version(dist) for key, dist in LIBRARIES.items()}, "core": _built.SOURCE_SHA256[:12],

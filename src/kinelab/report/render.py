@@ -15,7 +15,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from kinelab.files import write_output
-from kinelab.report.bench import loops, scaling, versus
+from kinelab.report.bench import loops, scaling, versus, wholebody
 from kinelab.report.outfolder import atomic_folder
 from kinelab.report.page import CAPTIONS, validate_html
 from kinelab.report.provenance import LIBRARIES
@@ -159,8 +159,6 @@ def _write_bench_files(result: dict[str, Any], folder: Path) -> None:
     if "budgets" in result:
         sections.append(loops.budget_markdown(result["budgets"]))
     if "whole_body" in result:
-        from kinelab.report.bench import wholebody
-
         sections.append(wholebody.markdown(result["whole_body"]))
     if "versus" in result:
         sections.append(versus.markdown(result["versus"]))

@@ -14,17 +14,34 @@ import numpy as np
 import pinocchio as pin
 from tqdm import tqdm
 
+from kinelab import ik
+from kinelab.analysis import families, singular
 from kinelab.analysis import oracles as checks
+from kinelab.collision import CollisionError, Collisions, collision_model
+from kinelab.dq import kinematics as bk
+from kinelab.dq.algebra import DualQuat
 from kinelab.errors import KinelabError
 from kinelab.geometry import quat_wxyz_from_matrix
-from kinelab.ik.request import check_seed
+from kinelab.ik.analytic import redundancy
+from kinelab.ik.analytic.classify import classify, general_class
+from kinelab.ik.analytic.kernel import GENERAL_6R
+from kinelab.ik.analytic.redundancy import has_swept_form, swept_arm
+from kinelab.ik.branches import SAME
+from kinelab.ik.limits import distance
+from kinelab.ik.request import check_seed, make_request
+from kinelab.report.bench.collisions import FLOOR_AND_TABLE
+from kinelab.report.bench.completeness import FOUND, own_configuration
 from kinelab.report.check import SHARE, samples_for
 from kinelab.report.check import Z95 as Z95  # re-exported: where the reports and their tests read them
 from kinelab.report.check import Check as Check
 from kinelab.report.check import wilson as wilson
 from kinelab.report.provenance import provenance
+from kinelab.report.wholebody_checks import WHOLE_CHECKS
 from kinelab.robot import Chain, load
+from kinelab.robot.tree import Robot
+from kinelab.studies import paper000_era as ep
 from kinelab.studies import paper001_stanford as seed001
+from kinelab.studies import paper003_youbot as yb
 
 DEFAULT_ROBOTS = ("stanford", "era", "youbot", "panda", "ur5", "talos", "baxter")  # the last two whole
 DEFAULT_N = 200
@@ -83,9 +100,6 @@ def stanford_paper_checks(robot: Chain, n: int, seed: int) -> list[Check]:
 
 def biquaternion_checks(robot: Chain, n: int, seed: int) -> list[Check]:
     """Λ(q) by the chain product and A(q) by screw transforms against Pinocchio."""
-    from kinelab.dq import kinematics as bk
-    from kinelab.dq.algebra import DualQuat
-
     worst_pose = worst_A = 0.0
     for q in robot.random_qs(max(10, n // 10), seed + 1):
         lam, ref = bk.pose(robot, q).as_array(), DualQuat.from_se3(robot.fk(q)).as_array()
@@ -99,8 +113,6 @@ def biquaternion_checks(robot: Chain, n: int, seed: int) -> list[Check]:
 
 def solver_checks(robot: Chain, n: int, seed: int) -> list[Check]:
     """FRDM and the biquaternion solver on seeded reachable targets, every answer checked by Pinocchio."""
-    from kinelab.ik import solve
-
     rows = []
     for solver, allowed in (("frdm", 0.02), ("biquat", 0.05)):
         count = max(n // 4, samples_for(1 - allowed, SLACK))
@@ -110,7 +122,7 @@ def solver_checks(robot: Chain, n: int, seed: int) -> list[Check]:
             target = robot.fk(robot.random_q(rng))
             # the paper's methods as published: FRDM without the Newton finish
             pure: dict[str, Any] = {"finish": "none"} if solver == "frdm" else {}
-            res = solve(robot, target, solver=solver, seed=k, time_budget=0.2, **pure)
+            res = ik.solve(robot, target, solver=solver, seed=k, time_budget=0.2, **pure)
             dp, dr = robot.tool_error(res.q, target)  # the check, independent of the solver's own
             ok = res.success and dp <= 1e-6 and dr <= 1e-6 and robot.within_limits(res.q)
             failures += not ok
@@ -127,18 +139,12 @@ def solver_checks(robot: Chain, n: int, seed: int) -> list[Check]:
 def analytic_checks(robot: Chain, n: int, seed: int) -> list[Check]:
     """Where the arm has a closed form: its branches confirmed by Pinocchio, and every FRDM, biquaternion and DLS
     answer from a random start is one of them (with the share of FRDM answers on the branch nearest the start)."""
-    from kinelab.ik import solve_all
-    from kinelab.ik.analytic.classify import classify, general_class
-    from kinelab.ik.analytic.kernel import GENERAL_6R
-    from kinelab.ik.branches import SAME
-    from kinelab.ik.limits import distance
-
     arm = classify(robot).arm or general_class(robot).arm
     if arm is None:
         return _swept_checks(robot, n, seed) + completeness_checks(robot, seed)
     form = "elimination" if arm.kind == GENERAL_6R else "1-D search" if arm.searched else "closed form"
     targets = _closed_form_targets(robot, n, seed)
-    branches = [solve_all(robot, t, solver="analytic") for t in targets]
+    branches = [ik.solve_all(robot, t, solver="analytic") for t in targets]
     rows = [Check(robot.name, f"{form}: every branch met (Pinocchio-checked)", _worst(robot, targets, branches),
                   1e-6, "m or rad", f"{len(targets)} targets, {np.mean([len(b) for b in branches]):.2f} branches "
                   "each within the limits")]
@@ -168,10 +174,6 @@ def completeness_checks(robot: Chain, seed: int) -> list[Check]:
     COMPLETENESS_POSES seeded poses whose own configuration is among the branches Pinocchio confirms, its 95 %
     lower bound COMPLETENESS_BAR at least (a double root is met to the square root of rounding only: its misses
     are counted apart)."""
-    from kinelab.ik.analytic.classify import classify, general_class
-    from kinelab.ik.analytic.redundancy import has_swept_form
-    from kinelab.report.bench.completeness import FOUND, own_configuration
-
     if classify(robot).arm is None and general_class(robot).arm is None and not has_swept_form(robot):
         return []
     r = own_configuration(robot, COMPLETENESS_POSES, seed)
@@ -186,20 +188,13 @@ def _swept_checks(robot: Chain, n: int, seed: int) -> list[Check]:
     confirmed by Pinocchio, and every FRDM and DLS answer from a random start one of the branches at its own
     value of that joint, to SAME (95 % at least: an answer within the tolerances can sit at a limit whose exact
     root lies just beyond it, or near a singular shoulder several 1e-3 rad along the near-continuum)."""
-    from kinelab.ik import solve_all
-    from kinelab.ik.analytic.kernel import GENERAL_6R
-    from kinelab.ik.analytic.redundancy import at_value, has_swept_form, swept_arm
-    from kinelab.ik.branches import SAME
-    from kinelab.ik.limits import distance
-    from kinelab.ik.request import make_request
-
     if not has_swept_form(robot):
         return []
     held = swept_arm(robot).joint
     form = "elimination" if swept_arm(robot).arm.kind == GENERAL_6R else "closed form"
     # a share's sample for the 95 % bar, and a tenth more for the targets a random start does not reach
     targets = _closed_form_targets(robot, n, seed, at_least=int(1.1 * samples_for(SWEPT_BAR, SLACK)) + 1)
-    found = [solve_all(robot, t, redundancy=16) for t in targets]
+    found = [ik.solve_all(robot, t, redundancy=16) for t in targets]
     rows = [Check(robot.name, f"{form}, joint {held + 1} swept: every branch met (Pinocchio-checked)",
                   _worst(robot, targets, found), 1e-6, "m or rad",
                   f"{len(targets)} targets, {np.mean([len(f) for f in found]):.1f} answers each at 16 samples")]
@@ -208,7 +203,7 @@ def _swept_checks(robot: Chain, n: int, seed: int) -> list[Check]:
         on_branch = solved = 0
         for k, _, res in _solved_from_random_starts(robot, targets, solver, seed):
             solved += 1
-            branches = [a[0] for a in at_value(robot, targets[k], req, float(res.q[held]))]
+            branches = [a[0] for a in redundancy.at_value(robot, targets[k], req, float(res.q[held]))]
             on_branch += any(distance(robot, b, res.q) <= SAME for b in branches)
         rows.append(Check(robot.name, f"{solver}: every answer is a {form} branch at its own joint {held + 1}",
                           on_branch / max(solved, 1), SWEPT_BAR, SHARE,
@@ -230,12 +225,10 @@ def _worst(robot: Chain, targets: list[Any], answers: Sequence[Sequence[Any]]) -
 def _solved_from_random_starts(robot: Chain, targets: list[Any], solver: str,
                                seed: int) -> list[tuple[int, np.ndarray, Any]]:
     """(target index, start, answer) of each target that ``solver`` solves from its seeded random start."""
-    from kinelab.ik import solve
-
     out = []
     for k, target in enumerate(targets):
         start = robot.random_q(np.random.default_rng(seed + 1000 + k))
-        res = solve(robot, target, solver=solver, q0=start, seed=k, time_budget=0.2)
+        res = ik.solve(robot, target, solver=solver, q0=start, seed=k, time_budget=0.2)
         if res.success:
             out.append((k, start, res))
     return out
@@ -245,12 +238,6 @@ def collision_checks(robot: Chain, n: int, seed: int) -> list[Check]:
     """Where the robot has collision geometry: the check (sphere, hull and exact tests) agrees with Pinocchio's
     distance computation on every pair, and no success of a solve with collisions= collides (a floor and a
     table around it)."""
-    import pinocchio as pin
-
-    from kinelab.collision import CollisionError, Collisions, collision_model
-    from kinelab.ik import solve
-    from kinelab.report.bench.collisions import FLOOR_AND_TABLE
-
     env = FLOOR_AND_TABLE
     try:
         model = collision_model(robot, Collisions(environment=env))
@@ -272,7 +259,7 @@ def collision_checks(robot: Chain, n: int, seed: int) -> list[Check]:
         q = robot.random_q(rng)
         if model.colliding_pair(q, first_test=False) is not None:
             continue
-        res = solve(robot, robot.fk(q), seed=k, collisions=env, time_budget=0.5)
+        res = ik.solve(robot, robot.fk(q), seed=k, collisions=env, time_budget=0.5)
         solved += res.success
         clear += res.success and model.contact(res.q, first_test=False) is None
     return [Check(robot.name, "collisions: configurations where the check and Pinocchio's distances disagree",
@@ -300,9 +287,6 @@ def seed001_run_checks(robot: Chain, n: int, seed: int) -> list[Check]:
 
 def youbot_checks(robot: Chain, n: int, seed: int) -> list[Check]:
     """Seed 003: the paper's J and Pinocchio's rank at θ2 = θ3 = 0, the box, and the families of a sweep."""
-    from kinelab.analysis import families, singular
-    from kinelab.studies import paper003_youbot as yb
-
     rng = np.random.default_rng(seed + 3)
     count = max(20, n // 5)
     sing = [yb.singular_configuration(rng) for _ in range(count)]
@@ -332,8 +316,6 @@ def youbot_checks(robot: Chain, n: int, seed: int) -> list[Check]:
 
 def era_checks(robot: Chain, n: int, seed: int) -> list[Check]:
     """Seed 000: the three ERA passages with and without the paper's bypass."""
-    from kinelab.studies import paper000_era as ep
-
     return _elbow_checks(robot, ep) + _lock_checks(robot, ep)
 
 
@@ -393,9 +375,6 @@ GENERAL_CHECKS = [model_checks, biquaternion_checks, solver_checks, analytic_che
 def run(robots: list[str] | None = None, n: int | None = None, seed: int = 0, progress: bool = False) -> Report:
     """Run every check on ``robots`` (default: stanford, era, youbot, panda, ur5, and the whole talos and baxter:
     a whole robot takes the whole-body checks, :mod:`kinelab.report.wholebody_checks`)."""
-    from kinelab.report.wholebody_checks import WHOLE_CHECKS
-    from kinelab.robot.tree import Robot
-
     check_seed(seed)
     names = list(robots or DEFAULT_ROBOTS)
     n = DEFAULT_N if n is None else n

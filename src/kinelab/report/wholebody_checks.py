@@ -14,6 +14,10 @@ import pinocchio as pin
 
 from kinelab.report.check import SHARE, Check, samples_for
 from kinelab.robot.tree import Robot
+from kinelab.wholebody import compiled
+from kinelab.wholebody import evaluate as ev
+from kinelab.wholebody.solve import solve
+from kinelab.wholebody.tasks import ComTask, FrameTask
 
 FD = 1e-6  # [rad or m] the central difference's step
 MET_BAR = 0.9  # reachable target sets met, by the share's 95 % lower bound
@@ -23,8 +27,6 @@ STEPS, RESTART = 2000, 200  # steps of the limits' run, a new start (every other
 
 def compiled_tree_check(robot: Robot, n: int, seed: int) -> list[Check]:
     """The compiled tree's joint placements, body-frame Jacobians and centre of mass against Pinocchio's."""
-    from kinelab.wholebody import compiled
-
     tree = robot.derived("compiled tree", compiled.pack_tree)
     if tree is None:
         return [Check(robot.name, "whole body: compiled tree (not built: the readable step serves)", 1.0, 1.0,
@@ -52,8 +54,6 @@ def compiled_tree_check(robot: Robot, n: int, seed: int) -> list[Check]:
 def task_jacobian_check(robot: Robot, n: int, seed: int) -> list[Check]:
     """Every task's Jacobian (frames of the hands and feet, the centre of mass) against central differences of
     its error through Pinocchio's FK, along random directions."""
-    from kinelab.wholebody.tasks import ComTask, FrameTask
-
     rng = np.random.default_rng(seed + 1)
     frames = (robot.hands + robot.feet) or (robot.model.frames[-1].name,)
     worst = 0.0
@@ -75,8 +75,6 @@ def task_jacobian_check(robot: Robot, n: int, seed: int) -> list[Check]:
 
 def _rows_at(robot: Robot, task: Any, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(A, e) of a task at q, from Pinocchio's pass."""
-    from kinelab.wholebody import evaluate as ev
-
     ev.forward(robot, q, com=True)
     A, e, _, _ = ev.task_rows(robot, task)
     return np.array(A), np.array(e)
@@ -114,7 +112,6 @@ def solve_checks(robot: Robot, n: int, seed: int) -> list[Check]:
     """Both solvers on TARGETS reachable target sets (the hands, the feet and the centre of mass of one random q):
     the share met, and every success met again by Pinocchio here (no false success)."""
     from kinelab.wholebody import ComTask, FrameTask, PostureTask
-    from kinelab.wholebody.solve import solve
 
     rng = np.random.default_rng(seed + 3)
     frames = (robot.hands + robot.feet) or (robot.model.frames[-1].name,)
@@ -142,8 +139,6 @@ def solve_checks(robot: Robot, n: int, seed: int) -> list[Check]:
 
 def _met_by_pinocchio(robot: Robot, tasks: list[Any], q: np.ndarray) -> bool:
     """Every frame and the centre of mass within 1e-6 of its target by Pinocchio's own calls, within the limits."""
-    from kinelab.wholebody.tasks import ComTask, FrameTask
-
     model, data = robot.model, robot.model.createData()
     pin.framesForwardKinematics(model, data, q)
     for task in tasks:

@@ -13,11 +13,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from kinelab import lazy
 from kinelab.robot.space import spread_points
+
+if TYPE_CHECKING:
+    from kinelab.core import _chain
+else:
+    _chain = lazy.module("kinelab.core._chain", globals())
 
 Chain = Any  # a kinelab.Chain (the model module imports this one, so the type is not imported back)
 
@@ -38,40 +44,32 @@ class ChainArrays:
 
     def fk_batch(self, Q: np.ndarray) -> np.ndarray:
         """oMtool of every row of Q (B × n, rad or m, already checked): (B, 4, 4)."""
-        from kinelab.core._chain import fk_batch
-
         out = np.empty((Q.shape[0], 4, 4))
-        fk_batch(self.placement_R, self.placement_t, self.axis, self.kind, self.tool_R, self.tool_t,
-                 np.ascontiguousarray(Q, dtype=float), out)
+        _chain.fk_batch(self.placement_R, self.placement_t, self.axis, self.kind, self.tool_R, self.tool_t,
+                        np.ascontiguousarray(Q, dtype=float), out)
         return out
 
     def jacobian_batch(self, Q: np.ndarray) -> np.ndarray:
         """The tool Jacobian of every row of Q (B × n, already checked), base axes at the tool origin
         (LOCAL_WORLD_ALIGNED), rows [v; ω]: (B, 6, n)."""
-        from kinelab.core._chain import jacobian_batch
-
         out = np.empty((Q.shape[0], 6, self.kind.shape[0]))
-        jacobian_batch(self.placement_R, self.placement_t, self.axis, self.kind, self.tool_R, self.tool_t,
-                       np.ascontiguousarray(Q, dtype=float), out)
+        _chain.jacobian_batch(self.placement_R, self.placement_t, self.axis, self.kind, self.tool_R, self.tool_t,
+                              np.ascontiguousarray(Q, dtype=float), out)
         return out
 
     def null_drift(self, prev: np.ndarray, Q: np.ndarray, dx: np.ndarray, rows: tuple[int, ...]
                    ) -> tuple[np.ndarray, np.ndarray]:
         """(drift (K, n), own (K,)) of :func:`kinelab.core._chain.null_drift`: each sample's joint motion along the
         task's null space at prev[k] and the least-norm step its target motion dx[k] asks for [rad or m]."""
-        from kinelab.core._chain import null_drift
-
         drift, own = np.empty(Q.shape), np.empty(Q.shape[0])
-        null_drift(self.placement_R, self.placement_t, self.axis, self.kind, self.tool_R, self.tool_t,
-                   np.ascontiguousarray(prev, dtype=float), np.ascontiguousarray(Q, dtype=float),
-                   np.ascontiguousarray(dx, dtype=float), np.asarray(rows, dtype=np.int64), drift, own)
+        _chain.null_drift(self.placement_R, self.placement_t, self.axis, self.kind, self.tool_R, self.tool_t,
+                          np.ascontiguousarray(prev, dtype=float), np.ascontiguousarray(Q, dtype=float),
+                          np.ascontiguousarray(dx, dtype=float), np.asarray(rows, dtype=np.int64), drift, own)
         return drift, own
 
     def judge(self) -> Any:
         """The compiled verdict on one answer over these arrays (:class:`kinelab.core._chain.Judge`)."""
-        from kinelab.core._chain import Judge
-
-        return Judge(self.placement_R, self.placement_t, self.axis, self.kind, self.tool_R, self.tool_t)
+        return _chain.Judge(self.placement_R, self.placement_t, self.axis, self.kind, self.tool_R, self.tool_t)
 
 
 @dataclass(frozen=True)

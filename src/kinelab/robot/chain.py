@@ -24,6 +24,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
+from kinelab import lazy
 from kinelab.core._joints import PinForm, plain_q
 from kinelab.errors import (
     ChainError,
@@ -39,13 +40,16 @@ from kinelab.robot import xacro
 from kinelab.robot.build import LIMIT_SLACK, Built, build_model, frame_id
 from kinelab.robot.certificate import ChainArrays, FKCertificate, certify, chain_arrays
 from kinelab.robot.joints import Joint, Mimic
-from kinelab.robot.meshes import build_visual_model
+from kinelab.robot.meshes import build_visual_model, missing_meshes, search_dirs
 from kinelab.robot.mjcf import is_mjcf, meshes_outside
 from kinelab.robot.space import MAX_SAMPLE_BYTES, SAMPLE_TURNS, generator, spread_points, uniform
 from kinelab.scratch import own
 
 if TYPE_CHECKING:
+    from kinelab.core import _verdict
     from kinelab.robot import Robot  # the package: tree.py imports this module
+else:
+    _verdict = lazy.module("kinelab.core._verdict", globals())
 
 T = TypeVar("T")
 __all__ = ["LIMIT_SLACK", "Chain", "Joint", "Mimic"]
@@ -443,9 +447,8 @@ class Chain:
         if judge is not None:
             found: tuple[float, float, bool] = judge.verdict(H_target, q, lower, upper, axis)
             return found
-        from kinelab.core._verdict import pose_verdict
 
-        return pose_verdict(H_target, self.tool_pose_of_float_q(q).homogeneous, q, lower, upper, axis)
+        return _verdict.pose_verdict(H_target, self.tool_pose_of_float_q(q).homogeneous, q, lower, upper, axis)
 
     def _judge_arrays(self) -> ChainArrays | None:
         """The chain's arrays when the compiled FK is this robot's judge, else None."""
@@ -570,8 +573,6 @@ class Chain:
     def missing_meshes(self, package_dirs: list[str] | None = None, kind: str = "visual") -> list[str]:
         """The mesh URIs of the file's ``<visual>`` (or ``<collision>``) elements that :meth:`visual_model`, looking
         where it looks, cannot find (none for an in-memory model or an MJCF file)."""
-        from kinelab.robot.meshes import missing_meshes, search_dirs
-
         path = self._built.urdf_path
         if path is None or is_mjcf(path):
             return []

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pinocchio as pin
 
 from kinelab.errors import OptionError
 from kinelab.robot import catalog, descriptions
@@ -123,8 +124,6 @@ def _whole(path: Path, entry: catalog.Entry | None, name: str | None, package_di
 
 def _geometry(model: Any, urdf_path: Path, package_dirs: list[str], kind: str) -> Any:
     """The whole robot's geometry of ``kind`` ("visual" or "collision")."""
-    import pinocchio as pin
-
     if is_mjcf(urdf_path):
         return pin.GeometryModel()  # Pinocchio builds an MJCF's geometry for its own model only (the chain's view)
     return build_visual_model(model, urdf_path, package_dirs, kind)

@@ -9,6 +9,7 @@ from __future__ import annotations
 import contextlib
 import os
 import sys
+import tempfile
 import warnings
 import xml.etree.ElementTree as ET
 from collections.abc import Iterator
@@ -142,7 +143,6 @@ def build_visual_model(
                       "package_dirs= (CLI --package-dir) or set ROS_PACKAGE_PATH", stacklevel=2)
     geometry_type = pin.GeometryType.COLLISION if kind == "collision" else pin.GeometryType.VISUAL
     said: list[str] = []
-    import tempfile  # the view's path only: loading a robot for kinematics need not import it
 
     with tempfile.TemporaryDirectory(prefix="kinelab-") as folder:  # Pinocchio reads it once, here
         resolved = _with_resolved_meshes(urdf_path, dirs, Path(folder), kind)
@@ -180,7 +180,6 @@ def _anonymous_file() -> BinaryIO:
     file (whose module every URDF load would otherwise import)."""
     if hasattr(os, "memfd_create"):
         return os.fdopen(os.memfd_create("kinelab-stderr", os.MFD_CLOEXEC), "w+b")
-    import tempfile
 
     return tempfile.TemporaryFile(mode="w+b")
 

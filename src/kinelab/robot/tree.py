@@ -21,6 +21,8 @@ from numpy.typing import ArrayLike
 
 from kinelab.errors import ChainError, FrameNotFoundError, OptionError, SRDFError
 from kinelab.robot import space as sp
+from kinelab.robot.build import build_model
+from kinelab.robot.chain import Chain
 
 if TYPE_CHECKING:
     from kinelab.robot.chain import Chain
@@ -98,8 +100,6 @@ class Robot:
             FrameNotFoundError, JointNotFoundError: the chain's, named.
         """
         if tool is not None or base is not None or locked is not None:
-            from kinelab.robot.chain import Chain
-
             if floating:
                 raise OptionError("floating", floating, "False with tool=, base= or locked= (a chain is fixed)")
             return Chain.from_model(model, tool=tool, base=base, locked=locked, name=name)
@@ -270,9 +270,6 @@ class Robot:
         Raises:
             ChainError, FrameNotFoundError, JointNotFoundError: named.
         """
-        from kinelab.robot.build import build_model
-        from kinelab.robot.chain import Chain
-
         if self._chain_source is not None:
             made = self._chain_source(tool=tool, base=base, locked=locked)
         else:

@@ -37,6 +37,7 @@ from kinelab.errors import OptionError, URDFError
 from kinelab.files import checked_file, read_text
 from kinelab.robot import xacro_bounded as bounded
 from kinelab.robot import xacro_eval
+from kinelab.robot.meshes import mesh_package_dirs
 from kinelab.scratch import scratch_dir
 
 INSTALL_HINT = "pip install 'kinelab[xacro]' (xacro)"
@@ -134,8 +135,6 @@ def _cut(text: str, most: int = 400) -> str:
 
 def _roots(path: Path, package_dirs: list[str]) -> list[Path]:
     """The folders an expansion may read: the file's own, its package's, and the package directories given."""
-    from kinelab.robot.meshes import mesh_package_dirs
-
     folder = path.resolve().parent
     package = next((p for p in (folder, *folder.parents) if (p / "package.xml").is_file()), None)
     return [folder, *([package] if package else []), *(Path(d).resolve() for d in mesh_package_dirs(package_dirs))]

@@ -14,9 +14,15 @@ from __future__ import annotations
 import json
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from kinelab import lazy
 from kinelab.errors import URDFError
+
+if TYPE_CHECKING:
+    import subprocess
+else:
+    subprocess = lazy.module("subprocess", globals())
 
 SECONDS = 20.0  # [s] the whole expansion, the child's start and the URDF's writing included
 MEMORY = 1 << 30  # [bytes] the address space the expansion may add to the child's own
@@ -33,8 +39,6 @@ def run(path: Path, job: dict[str, Any]) -> None:
     Raises:
         URDFError: the expansion's own refusal or failure, or a limit passed (named, with its value).
     """
-    import subprocess  # start-up: a URDF robot never expands a xacro file (3 ms of every command)
-
     try:
         done = subprocess.run([sys.executable, "-m", "kinelab.robot.xacro_child"], input=json.dumps(job),
                               capture_output=True, text=True, timeout=SECONDS)

@@ -34,13 +34,16 @@ turn in one sample. With q1 (or q7) frozen the joint path closes every lap.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
 
+from kinelab.analysis.families import refine
 from kinelab.geometry import wrap_to_pi
+from kinelab.ik import solve
 from kinelab.ik.api import track
 from kinelab.ik.frdm import solver
 from kinelab.ik.result import TrackResult
@@ -196,8 +199,6 @@ SINGULAR_KINDS = {"elbow reach": ("joint4", 0.0), "wrist gimbal lock": ("joint6"
 def singular_examples(robot: Chain | None = None, seed: int = 0) -> dict[str, np.ndarray]:
     """One configuration per kind: the defining joint held at its value, the others moved onto the singular
     set (σ_min minimised). A 7R arm needs more than one condition to lose rank; the refinement finds it."""
-    from kinelab.analysis.families import refine
-
     robot = robot or load("era")
     rng = np.random.default_rng(seed)
     out = {}
@@ -213,10 +214,6 @@ def singular_examples(robot: Chain | None = None, seed: int = 0) -> dict[str, np
 
 def dls_tracking(passage: Passage, robot: Chain | None = None) -> TrackResult:
     """The Pinocchio DLS reference along the same path, warm-started from the previous sample, no restarts."""
-    import time
-
-    from kinelab.ik import solve
-
     robot = robot or load("era")
     q = passage.q0
     rows, times, perr, rerr, status, iters = [], [], [], [], [], []

@@ -9,7 +9,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from kinelab.dq import kinematics as biquat_kinematics
+from kinelab.ik.biquat import solver as biquat
 from kinelab.ik.result import BiquatTrajectory
+from kinelab.robot import load
 
 # Target and start configurations (q1, q2, q3 [m], q4, q5, q6); angles in degrees as printed.
 TARGET_Q_DEG = (20.0, 40.0, 0.3, -35.0, 60.0, -45.0)
@@ -44,10 +47,6 @@ def reproduce(robot=None, law: str = "simple", integrator: str = "euler", step: 
     Returns the solver's Attempt; its ``diagnostics`` hold model_time [s], M0 (the scalar of N̄∘Λ at the end, the
     chain product keeping Λ continuous) and, with ``record``, the trajectory (t, q, M*, U).
     """
-    from kinelab.dq import kinematics as biquat_kinematics
-    from kinelab.ik.biquat import solver as biquat
-    from kinelab.robot import load
-
     robot = robot or load("stanford")
     N = biquat_kinematics.pose(robot, TARGET_Q)
     q0 = START_Q if start_q is None else np.asarray(start_q, dtype=float)

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from kinelab.analysis.singular import analyze
+
 # theta_i = SIGN_i * q_i + OFFSET_i [deg], for the five arm joints
 VENDOR_SIGN = np.array([-1.0, 1.0, 1.0, 1.0, -1.0])
 VENDOR_OFFSET_DEG = np.array([169.0, -65.0, 146.0, -102.5, 167.5])
@@ -92,8 +94,6 @@ def singular_configuration(rng: np.random.Generator, theta4: float | None = None
 def lost_constraint(robot, Q) -> np.ndarray:
     """The constraint w·(v; ω) = 0 that every tool twist obeys at a rank-5 Q (unscaled, base axes at E,
     unit norm): the left singular vector of the vanishing σ with its linear part divided by L."""
-    from kinelab.analysis.singular import analyze
-
     a = analyze(robot, Q)
     if not a.lost_directions:
         raise ValueError("the configuration is not singular")

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
+import coal
+import meshcat.geometry as g
 import numpy as np
 import pinocchio as pin
 
@@ -33,8 +35,6 @@ def draw_collisions(scene: Any, model: CollisionModel, q: Any) -> list[Contact]:
 def draw_obstacles(scene: Any, environment: Environment) -> Any:
     """Draw the obstacles (translucent, each its own colour, named with it in the caption; a plane as a 4 m
     square) in ``scene``; returns the scene."""
-    import meshcat.geometry as g
-
     obstacles = environment.obstacles
     named = []
     for k, obstacle in enumerate(obstacles):
@@ -56,8 +56,6 @@ def overlay_contacts(scene: Any, model: CollisionModel, names: set[str]) -> None
     """The robot's collision objects in contact, drawn red over its visuals at the placements of the last check
     (unlit: a mesh without normals would draw black under a lit material; no depth test: drawn at the mesh's own
     depth, the copy and the mesh would fight pixel by pixel, red and black stripes, and a table would hide it)."""
-    import meshcat.geometry as g
-
     scene.viewer["contacts"].delete()  # the contacts of an earlier q
     for k, obj in enumerate(model.geom.geometryObjects):
         if obj.name not in names or obj.parentJoint == 0:
@@ -73,9 +71,6 @@ def overlay_contacts(scene: Any, model: CollisionModel, names: set[str]) -> None
 
 def _mesh(geometry: Any) -> Any:
     """A coal geometry as a meshcat one (meshes as triangles; boxes, spheres, cylinders as such), else None."""
-    import coal
-    import meshcat.geometry as g
-
     if isinstance(geometry, coal.BVHModelBase):
         tris = [geometry.tri_indices(i) for i in range(geometry.num_tris)]
         return g.TriangularMeshGeometry(np.asarray(geometry.vertices()),
@@ -88,8 +83,6 @@ def _mesh(geometry: Any) -> Any:
 
 
 def _shape(obstacle: Obstacle) -> Any:
-    import meshcat.geometry as g
-
     s = obstacle.size
     if obstacle.shape == "plane":
         return g.Box([PLANE_SIDE, PLANE_SIDE, 1e-3])

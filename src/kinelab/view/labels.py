@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from typing import Any
 
+import meshcat.geometry as g
 import numpy as np
 import pinocchio as pin
 
@@ -32,8 +33,6 @@ def draw_number(node: Any, text: str, centre: np.ndarray, height: float, colour:
     Raises:
         ValueError: ``text`` holds a character that is not a digit.
     """
-    import meshcat.geometry as g
-
     if not text.isdigit():
         raise ValueError(f"draw_number draws digits only, got {text!r}")
     cell, gap = height / 2, 0.5 * height / 2  # a digit is half as wide as tall, a gap of half a digit between

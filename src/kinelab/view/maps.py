@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import base64
+import io
 from typing import Any
 
+import meshcat.geometry as g
 import numpy as np
 
 from kinelab.robot import Chain
@@ -28,8 +31,6 @@ def reachability_cloud(robot: Chain, rmap: Any, q: Any = None, viewer: Any = Non
         viewer: a meshcat viewer to draw in (default: a new one on 127.0.0.1).
         meshes: draw the robot's meshes (False: a stick figure, which keeps a saved page small).
     """
-    import meshcat.geometry as g
-
     q = robot.display_q() if q is None else q
     scene = Scene(robot, viewer=viewer).show(q)
     scene.view = "reachability map"
@@ -76,9 +77,6 @@ def map_page(robot: Chain, rmap: Any) -> str:
     """A reachability map as one self-contained page: the reached voxels in 3-D over the robot's stick figure
     (the caption says what the colours mean) and the three slices through the map's centre (x, y and z layers)
     as images in a box on the right."""
-    import base64
-    import io
-
     from matplotlib.figure import Figure
 
     scene = reachability_cloud(robot, rmap, meshes=False)

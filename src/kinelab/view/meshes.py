@@ -13,6 +13,7 @@ import functools
 import os
 from typing import Any
 
+import meshcat.geometry as g
 import numpy as np
 import pinocchio as pin
 
@@ -71,8 +72,6 @@ def draw_collada(viewer: Any, geom: pin.GeometryModel, paths: list[str]) -> None
         geom: the visual model; ``paths[i]`` is the meshcat path of ``geom.geometryObjects[i]``.
         paths: the node paths Pinocchio's visualiser gave the geometries.
     """
-    import meshcat.geometry as g
-
     for obj, path in zip(geom.geometryObjects, paths, strict=True):
         if not is_collada(obj):
             continue

@@ -14,9 +14,14 @@ import io
 from pathlib import Path
 from typing import Any
 
+import meshcat
+import meshcat.geometry as g
 import numpy as np
 import pinocchio as pin
+from meshcat.animation import Animation
+from pinocchio.visualize import MeshcatVisualizer
 
+from kinelab.analysis.singular import analyze
 from kinelab.analysis.singular import sigma_words as sigma_words  # the page's words are `kinelab singular`'s
 from kinelab.errors import ConfigurationError
 from kinelab.files import write_output
@@ -40,9 +45,6 @@ class Scene:
 
     def __init__(self, robot: Chain, viewer=None, open: bool = False, name: str | None = None,
                  frame_length: float | None = None):
-        import meshcat
-        from pinocchio.visualize import MeshcatVisualizer
-
         self.robot = robot
         self.server: Server | None = None
         if viewer is None:
@@ -164,8 +166,6 @@ class Scene:
 
     def frame(self, name: str, oMframe: pin.SE3, length: float | None = None) -> Scene:
         """A triad (x red, y green, z blue) at a pose in the base frame, under ``frames/<name>``."""
-        import meshcat.geometry as g
-
         length = length or self.frame_length
         for axis, color in enumerate(AXIS_COLORS):
             end = np.zeros((3, 2))
@@ -181,8 +181,6 @@ class Scene:
 
     def path(self, points: np.ndarray, name: str = "tool_path", color: int = 0xF58231) -> Scene:
         """A polyline through points (rows, base frame) — e.g. the tool path of a trajectory."""
-        import meshcat.geometry as g
-
         pts = np.asarray(points, dtype=float).T
         self.viewer["paths"][name].set_object(g.Line(g.PointsGeometry(pts), g.MeshBasicMaterial(color=color)))
         return self
@@ -190,8 +188,6 @@ class Scene:
     # -- animation ------------------------------------------------------------------------------
     def animate(self, qs, dt: float = 0.05, draw_path: bool = True, play: bool = True) -> Scene:
         """An animation of a joint trajectory (rows of q) with the tool path drawn as a line."""
-        from meshcat.animation import Animation
-
         self.view = "animation"
         qs = np.asarray(qs, dtype=float)
         anim = Animation(default_framerate=max(1, int(round(1.0 / dt))))
@@ -225,10 +221,6 @@ class Scene:
         """At q: the lost tool directions as arrows from the tool (translation magenta, rotation axis cyan) and a
         sphere at the tool coloured by σ_min/σ_max (red: singular, green: far from it). The marks are drawn over
         the robot (no depth test): a wrist's mesh or a joint's ball would otherwise hide them."""
-        import meshcat.geometry as g
-
-        from kinelab.analysis.singular import analyze
-
         a = analyze(self.robot, q)
         self.view = "singularity"
         oMtool = self.robot.fk(q)
@@ -311,8 +303,6 @@ def aim_camera(viewer: Any, points: np.ndarray, margin: float, fill: float = FIL
     Returns:
         The :class:`~kinelab.view.framing.Framing` used (its ``cell``: the grid's cell [m]).
     """
-    import meshcat.geometry as g
-
     view = frame_points(points, floor_z=floor_z, margin=margin, fill=fill)
     viewer.set_transform(view.scene_shift())
     viewer["/Grid"].set_property("visible", False)
@@ -387,8 +377,6 @@ def _spacing(figures: list[list[np.ndarray]], reach: float) -> float:
 
 def _target_mark(node: Any, point: np.ndarray, size: float) -> None:
     """A gold translucent sphere at the target's point."""
-    import meshcat.geometry as g
-
     node.set_object(g.Sphere(0.35 * size), g.MeshLambertMaterial(color=TARGET, opacity=0.45, transparent=True))
     node.set_transform(pin.SE3(np.eye(3), np.asarray(point, dtype=float)).homogeneous)
 
@@ -416,16 +404,12 @@ LOST_MOVE, LOST_TURN = 0xF032E6, 0x42D4F4  # magenta, cyan: a lost tool directio
 
 def on_top(color: int, opacity: float) -> Any:
     """A material drawn over everything else (no depth test; three.js draws transparent objects last)."""
-    import meshcat.geometry as g
-
     return g.MeshLambertMaterial(color=color, opacity=opacity, transparent=True, depthTest=False)
 
 
 def _arrow(node: Any, origin: np.ndarray, axis: np.ndarray, length: float, radius: float, color: int) -> None:
     """An arrow of ``length`` [m] from ``origin`` along the unit ``axis`` (base frame): a shaft and a cone, drawn
     over the robot. WebGL draws lines one pixel wide whatever their width, so the marks are solids."""
-    import meshcat.geometry as g
-
     head = min(0.35 * length, 6 * radius)
     turn = pin.Quaternion.FromTwoVectors(np.array([0.0, 1.0, 0.0]), axis).matrix()  # three.js cylinders lie along y
     for part, height, shape in (("shaft", length - head, g.Cylinder(length - head, radius)),
@@ -438,8 +422,6 @@ def _arrow(node: Any, origin: np.ndarray, axis: np.ndarray, length: float, radiu
 def _stick_figure(node, points: list[np.ndarray], size: float, colour: int = JOINTS) -> list[float]:
     """Spheres (``colour``) at the points and cylinders between consecutive ones, under the meshcat ``node``;
     returns each segment's length [m] as drawn (0: two points at one place, no cylinder)."""
-    import meshcat.geometry as g
-
     radius = 0.16 * size  # links as thick as an arm's: readable when a page holds a grid of copies
     lengths = []
     for k in range(len(points)):

@@ -17,7 +17,13 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 from typing import Any
+
+import tornado.web
+from meshcat.servers import zmqserver
+
+from kinelab.view.caption import titled
 
 LOOPBACK = "127.0.0.1"
 START_TIMEOUT = 30.0  # [s] for the child to report its URLs
@@ -80,8 +86,6 @@ def _die_with_parent() -> None:
 
 
 def _loopback_bridge() -> Any:
-    from meshcat.servers import zmqserver
-
     class LoopbackBridge(zmqserver.ZMQWebSocketBridge):
         """meshcat's bridge with its web server listening on 127.0.0.1 only."""
 
@@ -101,13 +105,6 @@ def _loopback_bridge() -> Any:
 
 def _titled_index() -> Any:
     """A handler for the viewer's page with the tab titled by ``KINELAB_TAB_TITLE`` (meshcat's says "MeshCat")."""
-    from pathlib import Path
-
-    import tornado.web
-    from meshcat.servers import zmqserver
-
-    from kinelab.view.caption import titled
-
     page = titled((Path(zmqserver.VIEWER_ROOT) / zmqserver.VIEWER_HTML).read_text(encoding="utf-8"),
                   os.environ.get("KINELAB_TAB_TITLE", "kinelab"))
 

@@ -28,9 +28,12 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.errors import OptionError
+from kinelab.ik import api as chain_api
+from kinelab.ik import options as opt
 from kinelab.ik.frdm.follower import judged_path
-from kinelab.ik.request import Request
+from kinelab.ik.request import Request, make_request
 from kinelab.ik.result import Status, TrackResult
+from kinelab.ik.targets import as_target_arrays
 from kinelab.robot.chain import Chain
 from kinelab.robot.tree import Robot
 from kinelab.wholebody.limits import Limits
@@ -193,11 +196,6 @@ def track(chain: Chain, targets: Any, *, q0: Any = None, seed: int | None = None
     Raises:
         OptionError, ConfigurationError, JointLimitError, TargetError: a bad setting, q0 or target, named.
     """
-    from kinelab.ik import api as chain_api
-    from kinelab.ik import options as opt
-    from kinelab.ik.request import make_request
-    from kinelab.ik.targets import as_target_arrays
-
     t_start = time.perf_counter()
     opt.positive("jump_limit", jump_limit, allow_none=True)
     req = make_request("frdm", seed, tol_pos, tol_rot, time_budget, 0, "refuse", None, task, axis)

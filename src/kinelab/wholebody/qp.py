@@ -8,6 +8,7 @@ other choice.
 
 from __future__ import annotations
 
+import importlib
 from ctypes import c_int
 from dataclasses import dataclass
 from typing import Any
@@ -79,8 +80,6 @@ def _proxsuite(H: np.ndarray, f: np.ndarray, lower: np.ndarray, upper: np.ndarra
 
 
 def _import(name: str) -> Any:
-    import importlib
-
     try:
         return importlib.import_module(name)
     except ImportError:

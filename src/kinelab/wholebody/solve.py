@@ -24,6 +24,7 @@ from kinelab.ik.result import Status
 from kinelab.robot.space import generator
 from kinelab.robot.tree import Robot
 from kinelab.wholebody import evaluate as ev
+from kinelab.wholebody.frdm import frdm_solve
 from kinelab.wholebody.iterate import SolveSettings, iterate, posture_second
 from kinelab.wholebody.limits import Limits
 from kinelab.wholebody.tasks import (
@@ -135,8 +136,6 @@ def _run(robot: Robot, tasks: tuple[Task, ...], start: np.ndarray, settings: Sol
     q = start
     while True:
         if settings.solver == "frdm":
-            from kinelab.wholebody.frdm import frdm_solve
-
             q, used, status = frdm_solve(robot, tasks, q, settings, deadline)
         else:
             q, used, status = iterate(robot, ordered, q, settings, limits, deadline)

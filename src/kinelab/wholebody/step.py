@@ -18,6 +18,7 @@ import pinocchio as pin
 
 from kinelab.errors import ChainError, OptionError
 from kinelab.robot.tree import Robot
+from kinelab.wholebody import compiled as cp
 from kinelab.wholebody import evaluate as ev
 from kinelab.wholebody import qp
 from kinelab.wholebody.limits import Limits, acceleration_bounds, bounds, is_positive_time, velocity_bounds
@@ -197,8 +198,6 @@ def _new_table(_: Robot) -> dict[Any, Any]:
 def _packed(robot: Robot, tasks: Any, options: StepOptions) -> Any:
     """The compiled problem of this task list with its targets set, or None (see :func:`_compiled`). The same task
     objects as a call before take that call's problem as it is (tasks are frozen: their targets are those set)."""
-    from kinelab.wholebody import compiled as cp
-
     if options.solver != "daqp" or not cp.daqp_linked():
         return None
     if isinstance(tasks, TASK_TYPES):

@@ -27,6 +27,8 @@ from typing import Any
 import numpy as np
 
 from kinelab.errors import ChainError
+from kinelab.ik.analytic.certify import loop_of
+from kinelab.ik.analytic.general import prepare, usable
 from kinelab.ik.analytic.kernel import (
     GENERAL_6R,
     MEETING_6R,
@@ -140,9 +142,6 @@ def general_vectors(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray
     elimination cannot take either way (it misses seeded configurations of the chain). A reading whose pencil is
     regular is preferred, then Pieper's decoupling where three axes at an end meet (:func:`pieper_vectors`); a
     reading whose pencil is singular is taken only when nothing else is (its sets are then never certified)."""
-    from kinelab.ik.analytic.certify import loop_of
-    from kinelab.ik.analytic.general import prepare, usable
-
     failed, singular = [], []
     for mirrored in (False, True):
         hh, oo, RR, NN = reverse(h, o, R0, N0) if mirrored else (h, o, R0, N0)

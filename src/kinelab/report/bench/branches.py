@@ -24,14 +24,18 @@ import numpy as np
 import pinocchio as pin
 from tqdm import tqdm
 
+from kinelab.ik.analytic.branches import LIMIT_SLACK, all_branches_batch, has_general_form
 from kinelab.ik.analytic.branches import SAME as CLOSED_SAME
-from kinelab.ik.analytic.branches import all_branches_batch, has_general_form
 from kinelab.ik.analytic.classify import classify
+from kinelab.ik.analytic.kernel import MAX_ROWS, branches_batch
 from kinelab.ik.analytic.redundancy import has_swept_form
 from kinelab.ik.api import solve_all
 from kinelab.ik.branches import SAME
+from kinelab.ik.chain import chain_model
 from kinelab.ik.limits import distance
 from kinelab.ik.request import make_request
+from kinelab.report.bench import general
+from kinelab.report.bench.general import GENERAL_ROBOTS, general_arm
 from kinelab.report.bench.protocol import Call, figures, warmed_rounds
 from kinelab.robot import Chain, load
 
@@ -50,7 +54,6 @@ def _eaik(robot: Chain) -> Call | None:
     arm = classify(robot).arm
     if arm is None or arm.mirrored or arm.searched:  # EAIK solves the closed-form classes alone
         return None
-    from kinelab.ik.chain import chain_model
 
     v = chain_model(robot).vectors(np.zeros(robot.n))
     bot = HPRobot(v["e"], np.vstack([v["o"][0], np.diff(v["o"], axis=0), v["N"] - v["o"][-1]]))
@@ -91,9 +94,6 @@ def analytic_arm(robot: Chain, n: int, seed: int, repeats: int) -> dict[str, Any
 
 def _throughput(robot: Chain, rng: np.random.Generator, count: int = 20_000) -> dict[str, float]:
     """Poses per second of the closed form's batch on all cores: checked by Pinocchio, and the kernel alone."""
-    from kinelab.ik.analytic.branches import LIMIT_SLACK
-    from kinelab.ik.analytic.kernel import MAX_ROWS, branches_batch
-
     H = robot.fk_batch(np.array([robot.random_q(rng) for _ in range(count)]))
     all_branches_batch(robot, H[:2])
     t0 = time.perf_counter()
@@ -147,8 +147,6 @@ def run(robots: list[str] | None = None, n: int = 100, seed: int = 0, repeats: i
         progress: bool = False) -> list[dict[str, Any]]:
     """Every arm asked for (default: the arms with a closed form or a 1-D search, the Stanford arm, the ERA, the
     Panda and Baxter), a row each."""
-    from kinelab.report.bench.general import GENERAL_ROBOTS, general_arm
-
     names = list(robots or (*ANALYTIC_ROBOTS, *GENERAL_ROBOTS, *NUMERIC_ROBOTS, *REDUNDANT_ROBOTS))
     rows = []
     for name in tqdm(names, desc="bench --branches", disable=not progress, unit="arm"):
@@ -167,8 +165,6 @@ def run(robots: list[str] | None = None, n: int = 100, seed: int = 0, repeats: i
 def markdown(rows: list[dict[str, Any]]) -> str:
     """The rows as Markdown tables (times: median over rounds [lowest–highest round]): the arms with a class, the
     multistart's and the swept ones; then the general 6R arms' (:mod:`kinelab.report.bench.general`)."""
-    from kinelab.report.bench import general
-
     generals = [r for r in rows if r.get("general")]
     rows = [r for r in rows if not r.get("general")]
 

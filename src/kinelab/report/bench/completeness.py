@@ -24,12 +24,16 @@ import numpy as np
 import pinocchio as pin
 from tqdm import tqdm
 
+from kinelab.errors import OptionError
 from kinelab.geometry import wrap_to_pi
-from kinelab.ik.analytic.branches import all_branches_batch, arm_roots
+from kinelab.ik.analytic.branches import all_branches_batch, arm_roots, certificate_of
 from kinelab.ik.analytic.certify import chain_pose
-from kinelab.ik.analytic.classify import classify, classify_vectors, general_class
+from kinelab.ik.analytic.classify import classify, classify_vectors, general_class, general_vectors, line_distance
+from kinelab.ik.analytic.general import roots_within
+from kinelab.ik.analytic.kernel import GENERAL_6R
 from kinelab.ik.analytic.redundancy import at_value, has_swept_form, swept_arm
 from kinelab.ik.request import make_request
+from kinelab.report.bench import hard_poses, sew
 from kinelab.robot import Chain, load
 
 FOUND = 1e-6  # [rad] the pose's own configuration is a branch to this
@@ -76,8 +80,6 @@ def _six(robot: Chain) -> Any:
 def _certified(robot: Chain, Q: np.ndarray, batch: Any) -> float:
     """The share of the poses of Q whose set of branches (``batch``) is certified complete, by the certificate
     ``Branches.complete`` gives the same set (docs/analytic.md, Certificates)."""
-    from kinelab.ik.analytic.branches import certificate_of
-
     if batch.uncertified is not None:  # the elimination said it per pose
         return sum(why == "" for why in batch.uncertified) / Q.shape[0]
     H, certified = robot.fk_batch(Q), 0
@@ -108,7 +110,6 @@ def against_ssik(robot: Chain, n: int, seed: int) -> dict[str, Any] | None:
         return None
     if _six(robot) is None or robot.urdf_path is None:
         return None
-    from kinelab.ik.analytic.kernel import GENERAL_6R
 
     if _six(robot).kind == GENERAL_6R:
         n = min(n, SSIK_GENERAL)
@@ -187,8 +188,6 @@ def random_general_arm(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray
     """Axes (6, 3), points on them (6, 3) [m] at q = 0 and a tool pose of a random general 6R arm: every axis
     direction uniform on the sphere, every point uniform in a 0.8 m cube, no two axes parallel or meeting (to
     1e-3 rad and 1e-3 m: redrawn otherwise), the tool at a random pose."""
-    from kinelab.ik.analytic.classify import line_distance
-
     while True:
         h = rng.normal(size=(6, 3))
         h /= np.linalg.norm(h, axis=1)[:, None]
@@ -203,8 +202,6 @@ def held_joint(robot: Chain, joint: int, n: int, seed: int) -> dict[str, Any]:
     """n seeded poses of a 7R arm with joint ``joint`` held at the pose's own value: the share whose own
     configuration is among the branches, the poses refused (the six left solved by nothing here at that value),
     and every miss's q."""
-    from kinelab.errors import OptionError
-
     Q, req = robot.random_qs(n, np.random.default_rng(seed + joint)), make_request("frdm")
     found = refused = 0
     missed: list[dict[str, Any]] = []
@@ -227,9 +224,6 @@ def random_general(arms: int, poses: int, seed: int) -> dict[str, Any]:
     """``arms`` random general 6R arms (:func:`random_general_arm`) × ``poses`` seeded configurations in (−π, π]⁶:
     the share whose own configuration is among the elimination's roots (no limits), the certified share, the arms
     the elimination refuses, and every missed pose (arm index, q)."""
-    from kinelab.ik.analytic.classify import general_vectors
-    from kinelab.ik.analytic.general import roots_within
-
     rng = np.random.default_rng(seed + 100)
     found = certified = total = refused = 0
     missed: list[dict[str, Any]] = []
@@ -258,8 +252,6 @@ def run(robots: list[str] | None = None, n: int = 10_000, peer_n: int = 1000, ar
     """Every measure for the arms asked for (default ROBOTS), the random arms of each search class and random
     general arms, ``hard`` poses per arm of HARD (:mod:`kinelab.report.bench.hard_poses`), ``held_poses`` per
     joint of HELD and ``sew_poses`` per 7R arm at its SEW angle (:mod:`kinelab.report.bench.sew`)."""
-    from kinelab.report.bench import hard_poses, sew
-
     names = list(robots or ROBOTS)
     own, peers, built = [], [], []
     for name in tqdm(names, desc="bench --completeness", disable=not progress, unit="arm"):
@@ -281,8 +273,6 @@ def run(robots: list[str] | None = None, n: int = 10_000, peer_n: int = 1000, ar
 
 def markdown(result: dict[str, Any]) -> str:
     """The tables."""
-    from kinelab.report.bench import sew
-
     lines = ["| arm | method | poses | own configuration found | misses (double roots) | certified complete | "
              "branches mean / max |", "|---|---|---|---|---|---|---|"]
     lines += [f"| {r['robot']} | {r['method']} | {r['poses']:,} | {100 * r['found']:.3f} % | {r['misses']} "

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from kinelab.geometry import wrap_to_pi
+from kinelab.ik import solve_all
 from kinelab.robot import Chain
 
 FOUND_HARD = 1e-6  # [rad] the own configuration is an answer to this on the surface (a double root: met to ~1e-8)
@@ -82,8 +83,6 @@ def poses(robot: Chain, n: int, seed: int) -> list[tuple[str, np.ndarray]]:
 def measure(robot: Chain, n: int, seed: int) -> dict[str, Any]:
     """Every hard pose solved: per kind, how many had the own configuration among the answers, how many sets were
     certified, how many said they were not (with the reasons counted), and the failures listed with their q."""
-    from kinelab.ik import solve_all
-
     kinds: dict[str, dict[str, Any]] = {}
     failures: list[dict[str, Any]] = []
     t0 = time.perf_counter()

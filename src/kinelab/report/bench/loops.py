@@ -18,7 +18,9 @@ from tqdm import tqdm
 
 from kinelab.collision.model import CollisionError, Collisions, collision_model
 from kinelab.errors import KinelabError
-from kinelab.ik.api import solve, solve_all, solve_batch, track
+from kinelab.ik.analytic.redundancy import has_swept_form
+from kinelab.ik.analytic.sew import SEW
+from kinelab.ik.api import solve, solve_all, solve_all_batch, solve_batch, track
 from kinelab.ik.prepared import IK
 from kinelab.ik.request import unmeetable_tolerances
 from kinelab.report.bench import peers
@@ -198,10 +200,6 @@ def _analytic_paths(robot: Chain, budget: float) -> dict[str, Callable[..., Any]
     """The closed form's paths where the robot has one: ``solve`` and a batch of 100 with solver "analytic",
     ``solve_all_batch`` of 1,000 (a 6R chain in a class), and ``solve_all`` with ``redundancy=`` 64 samples and a
     SEW angle (a 7R arm with a swept form)."""
-    from kinelab.ik.analytic.redundancy import has_swept_form
-    from kinelab.ik.analytic.sew import SEW
-    from kinelab.ik.api import solve_all_batch
-
     try:
         IK(robot, solver="analytic")
     except KinelabError:

@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from kinelab.analysis.oracles import tool_link as _tool_link
 from kinelab.errors import KinelabError
 from kinelab.ik.chain import PRISMATIC, chain_model
 from kinelab.report.bench.protocol import TOL_POS, TOL_ROT, Case, Prepare, SolveFn
@@ -49,8 +50,6 @@ def kinematic_urdf(robot: Chain) -> Path:
 
 def tool_link(robot: Chain) -> str:
     """The URDF link the tool frame sits on (the peers take a link, not a frame)."""
-    from kinelab.analysis.oracles import tool_link as _tool_link
-
     return _tool_link(robot)
 
 

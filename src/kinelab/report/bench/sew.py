@@ -16,6 +16,8 @@ from typing import Any
 import numpy as np
 
 from kinelab.geometry import wrap_to_pi
+from kinelab.ik.analytic.sew import SEW, arm7, sew_angle
+from kinelab.ik.api import solve_all
 from kinelab.robot import Chain
 
 FOUND = 1e-6  # [rad] the pose's own configuration is an answer to this
@@ -24,9 +26,6 @@ ARMS = ("panda", "xarm7", "tiago", "tiago_pro", "era", "baxter_left", "pr2_left"
 
 def measure(robot: Chain, n: int, seed: int) -> dict[str, Any]:
     """The SEW table's row of one 7R arm (n seeded poses)."""
-    from kinelab.ik.analytic.sew import SEW, arm7, sew_angle
-    from kinelab.ik.api import solve_all
-
     arm = arm7(robot)
     found, counts, seconds = 0, list[int](), list[float]()
     missed: list[dict[str, Any]] = []

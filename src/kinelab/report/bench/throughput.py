@@ -18,12 +18,15 @@ import time
 from typing import Any
 
 import numpy as np
+import pinocchio as pin
 from tqdm import tqdm
 
+from kinelab.collision import Collisions, collision_model
 from kinelab.ik.analytic import held
 from kinelab.ik.analytic.classify import classify
 from kinelab.ik.api import solve_batch
 from kinelab.ik.starts import start_table
+from kinelab.report.bench.collisions import FLOOR_AND_TABLE
 from kinelab.robot import Chain, load
 
 TARGETS = 2000
@@ -71,9 +74,6 @@ def collision_free(robot: Chain, rounds: int, seed: int) -> dict[str, Any]:
     """Collision-free batches: per round TARGETS targets, each the tool pose of a random configuration clear of the
     arm itself and of a floor and a table, solved by ``solve_batch(..., collisions=)``; targets/s, the success rate,
     and how many successes Pinocchio's ``computeCollisions`` finds colliding (:func:`_by_pinocchio`)."""
-    from kinelab.collision import Collisions, collision_model
-    from kinelab.report.bench.collisions import FLOOR_AND_TABLE
-
     model = collision_model(robot, Collisions(environment=FLOOR_AND_TABLE))
     per_second, success, colliding = [], [], 0
     for r in range(rounds):
@@ -92,8 +92,6 @@ def collision_free(robot: Chain, rounds: int, seed: int) -> dict[str, Any]:
 def _by_pinocchio(robot: Chain, geom: Any, Q: np.ndarray) -> int:
     """How many configurations of Q Pinocchio's ``computeCollisions`` finds colliding: the geometry's pairs on
     geometry data of its own (no margin, none of the batch's checks' history)."""
-    import pinocchio as pin
-
     data, gdata = robot.model.createData(), pin.GeometryData(geom)
     return sum(bool(pin.computeCollisions(robot.model, data, geom, gdata, robot.to_pin_q(q), True)) for q in Q)
 

@@ -23,6 +23,8 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import parse_qs, urlparse
 
+import meshcat
+
 from kinelab.errors import KinelabError
 from kinelab.view.caption import tab_title
 from kinelab.view.teach.session import TeachSession, pose_from_matrix
@@ -277,6 +279,4 @@ def _page(session: TeachSession | WholeTeachSession) -> str:
 
 
 def _meshcat_script() -> bytes:
-    import meshcat
-
     return (Path(meshcat.__file__).parent / "viewer" / "dist" / "main.min.js").read_bytes()

@@ -14,11 +14,22 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
+import meshcat
+import meshcat.geometry as g
 import numpy as np
 import pinocchio as pin
 
+from kinelab.analysis.singular import analyze
+from kinelab.collision import Collisions, collision_model
+from kinelab.collision.model import as_collisions
+from kinelab.core._verdict import NOT_FINITE, NOT_HOMOGENEOUS, first_defect
 from kinelab.errors import KinelabError, TargetError
+from kinelab.ik import options as opt
+from kinelab.ik import solve, solve_all
+from kinelab.ik.turns import nearest_turns
 from kinelab.robot import Chain
+from kinelab.view.collisions import draw_obstacles, overlay_contacts
+from kinelab.view.scene import TARGET, Scene, on_top
 from kinelab.view.teach.recorder import RecordingWindow
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -55,13 +66,9 @@ class TeachOptions:
     collisions: Any = None
 
     def __post_init__(self) -> None:
-        from kinelab.ik import options as opt
-
         for name in ("tol_pos", "tol_rot", "time_budget"):
             opt.positive(name, getattr(self, name))
         if self.collisions is not None:  # "self", an Environment or a Collisions (anything else named)
-            from kinelab.collision.model import as_collisions
-
             as_collisions(self.collisions)
 
 
@@ -93,10 +100,6 @@ class TeachSession(Session):
     """A robot to move by hand: joint values set directly, or a target pose the robot follows by IK."""
 
     def __init__(self, robot: Chain, q: Any = None, options: TeachOptions | None = None):
-        import meshcat
-
-        from kinelab.view.scene import Scene
-
         self.robot, self.options = robot, options or TeachOptions()
         self.lock = threading.RLock()  # held by each action and reading (the server's threads, a notebook)
         if q is None:
@@ -119,8 +122,6 @@ class TeachSession(Session):
         self._draw_target_objects()
         environment = getattr(self.options.collisions, "environment", None)
         if environment is not None:
-            from kinelab.view.collisions import draw_obstacles
-
             draw_obstacles(self.scene, environment)
         self._draw()
 
@@ -159,8 +160,6 @@ class TeachSession(Session):
         Raises:
             KinelabError: a step other than the integers 1 and −1 (a float, a bool, anything else).
         """
-        from kinelab.ik import solve_all
-
         if isinstance(step, bool) or not isinstance(step, int | np.integer) or step not in (1, -1):
             raise KinelabError(f"a branch step is the integer 1 (next) or -1 (previous), not {_short(repr(step))}")
         step = int(step)
@@ -198,8 +197,6 @@ class TeachSession(Session):
     def readout(self) -> dict[str, Any]:
         """The numbers of the page: q, the tool and target poses, errors, σ_min, manipulability, the velocity
         ellipsoid's radii, the status, the branch, the contacts (each with its unit in its name)."""
-        from kinelab.analysis.singular import analyze
-
         oMtool = self.robot.fk(self.q)
         a = analyze(self.robot, self.q)
         error = self.target.actInv(oMtool)
@@ -229,9 +226,6 @@ class TeachSession(Session):
 
     # -- internals ------------------------------------------------------------------------------
     def _follow(self) -> None:
-        from kinelab.ik import solve
-        from kinelab.ik.turns import nearest_turns
-
         o = self.options
         res = solve(self.robot, self.target, q0=self.q, seed=0, tol_pos=o.tol_pos, tol_rot=o.tol_rot,
                     time_budget=o.time_budget, collisions=self._spec())
@@ -245,14 +239,11 @@ class TeachSession(Session):
     def _spec(self) -> Any:
         if not self.collisions_on:
             return None
-        from kinelab.collision import Collisions
 
         return self.options.collisions or Collisions()
 
     def _model(self) -> Any:
         if self._collision_model is None:
-            from kinelab.collision import collision_model
-
             self._collision_model = collision_model(self.robot, self._spec())
         return self._collision_model
 
@@ -263,10 +254,6 @@ class TeachSession(Session):
         return U, np.pad(s, (0, 3 - s.size))
 
     def _draw_target_objects(self) -> None:
-        import meshcat.geometry as g
-
-        from kinelab.view.scene import TARGET, on_top
-
         length = self.scene.frame_length
         self.scene.target(self.target)
         handle = self.scene.viewer["frames"]["target"]["handle"]
@@ -284,8 +271,6 @@ class TeachSession(Session):
     def _draw_contacts(self) -> None:
         """List the pairs in contact at q (collisions on) and draw their links' collision objects red; a page
         with no contact, now or before, sends nothing."""
-        from kinelab.view.collisions import overlay_contacts
-
         self.contacts = self._model().contacts(self.q) if self.collisions_on else []
         names = {n for c in self.contacts for n in (c.first, c.second)}
         if names or self._drawn_contacts:
@@ -315,8 +300,6 @@ def _checked_pose(oMtarget: Any) -> pin.SE3:
 def _pose_of(H: np.ndarray) -> pin.SE3:
     """The pose of a 4 × 4 homogeneous matrix, checked as batch targets are (the compiled ``first_defect``): finite,
     its rotation orthonormal within 1e-6 with det +1, its last row 0, 0, 0, 1."""
-    from kinelab.core._verdict import NOT_FINITE, NOT_HOMOGENEOUS, first_defect
-
     H = np.ascontiguousarray(H, dtype=float)
     _, defect = first_defect(H[None])
     if defect == NOT_FINITE:

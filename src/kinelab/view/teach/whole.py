@@ -12,13 +12,21 @@ from __future__ import annotations
 import threading
 from typing import Any
 
+import meshcat
+import meshcat.geometry as g
 import numpy as np
 import pinocchio as pin
+from pinocchio.visualize import MeshcatVisualizer
+from scipy.spatial import ConvexHull
 
 from kinelab.errors import KinelabError, OptionError
 from kinelab.robot.tree import Robot
+from kinelab.view.meshes import load_robot
+from kinelab.view.scene import AXIS_COLORS, aim_camera, on_top
 from kinelab.view.teach.recorder import RecordingWindow
 from kinelab.view.teach.session import Session, TeachOptions, _checked_pose, _locked, _pose, _short
+from kinelab.wholebody.solve import solve
+from kinelab.wholebody.tasks import ComTask, FrameTask, PostureTask
 
 SOLE = (0.20, 0.10)  # [m] the sole drawn under each foot frame for the support polygon: length (x), width (y)
 GOLD, COM, INSIDE, OUTSIDE = 0xF2B01E, 0xD62728, 0x2CA02C, 0xD62728
@@ -35,8 +43,6 @@ class WholeTeachSession(Session):
             OptionError: no hand to drag (name them), or a frame that is not the robot's.
             ConfigurationError: a q that is not the robot's, or outside its limits.
         """
-        import meshcat
-
         self.robot, self.options = robot, options or TeachOptions(time_budget=0.5)
         self.lock = threading.RLock()
         self.hands = tuple(robot.hands if hands is None else hands)
@@ -138,8 +144,6 @@ class WholeTeachSession(Session):
     # -- internals ------------------------------------------------------------------------------
     def tasks(self) -> list[Any]:
         """Every hand at its target, every foot where it stands, the centre of mass over its start, a posture."""
-        from kinelab.wholebody.tasks import ComTask, FrameTask, PostureTask
-
         tasks: list[Any] = [FrameTask(h, T) for h, T in zip(self.hands, self.targets, strict=True)]
         tasks += [FrameTask(f, M) for f, M in zip(self.feet, self.pins, strict=True)]
         if self.com_target is not None:
@@ -147,8 +151,6 @@ class WholeTeachSession(Session):
         return [*tasks, PostureTask(self.rest, weight=1e-3)]
 
     def _follow(self) -> None:
-        from kinelab.wholebody.solve import solve
-
         o = self.options
         res = solve(self.robot, self.tasks(), q0=self.q, seed=0, tol_pos=o.tol_pos, tol_rot=o.tol_rot,
                     max_restarts=0, time_budget=o.time_budget)
@@ -160,12 +162,6 @@ class WholeTeachSession(Session):
             self.status = f"not reached ({res.status}): {_short(', '.join(missed), 120)}; q kept"
 
     def _draw_robot(self) -> None:
-        import meshcat.geometry as g
-        from pinocchio.visualize import MeshcatVisualizer
-
-        from kinelab.view.meshes import load_robot
-        from kinelab.view.scene import AXIS_COLORS, aim_camera, on_top
-
         self.viz = MeshcatVisualizer(self.robot.model, pin.GeometryModel(), self.robot.visual_model())
         self.viz.initViewer(viewer=self.viewer)
         load_robot(self.viz, self.robot.name)
@@ -202,8 +198,6 @@ class WholeTeachSession(Session):
         return min((M.translation[2] for M in self.pins), default=0.0)
 
     def _draw(self) -> None:
-        import meshcat.geometry as g
-
         self.viz.display(self.q)
         for k, (M, T) in enumerate(zip(self.robot.frame_placements(self.q, self.hands), self.targets, strict=True)):
             self.viewer["frames"][f"hand_{k}"].set_transform(M.homogeneous)
@@ -218,8 +212,6 @@ class WholeTeachSession(Session):
 
 def _over(color: int) -> Any:
     """A line's material drawn over the robot (no depth test), 3 px wide."""
-    import meshcat.geometry as g
-
     return g.MeshBasicMaterial(color=color, linewidth=3, depthTest=False)
 
 
@@ -245,7 +237,6 @@ def support_polygon(feet: list[pin.SE3]) -> np.ndarray | None:
     feet."""
     if not feet:
         return None
-    from scipy.spatial import ConvexHull
 
     half = np.array([SOLE[0], SOLE[1]]) / 2
     corners = np.array([[sx * half[0], sy * half[1], 0.0] for sx in (-1, 1) for sy in (-1, 1)])
