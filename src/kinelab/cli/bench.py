@@ -7,7 +7,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from kinelab import lazy
-from kinelab.cli.common import count, positive_number, print_json, progress_of, seed_argument
+from kinelab.cli.common import Subcommands, count, positive_number, print_json, progress_of, seed_argument
 from kinelab.ik.words import TASKS
 from kinelab.report.outfolder import check_output_folder
 
@@ -43,7 +43,7 @@ else:
     wholebody = lazy.module("kinelab.report.bench.wholebody", globals())
 
 
-def add(sub: Any) -> None:
+def add(sub: Subcommands) -> None:
     """The ``bench`` subcommand."""
     s = sub.add_parser("bench", help="the IK benchmark: kinelab's solvers and the installed peers")
     s.add_argument("--robots", nargs="+", default=None,

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 from kinelab import lazy
 from kinelab.cli.common import (
+    Subcommands,
     json_flag,
     load_robot,
     pose_dict,
@@ -43,7 +44,7 @@ else:
     sew = lazy.module("kinelab.ik.analytic.sew", globals())
 
 
-def add(sub: Any) -> None:
+def add(sub: Subcommands) -> None:
     """The ``branches`` subcommand."""
     s = sub.add_parser("branches", help="every inverse-kinematics branch of a pose: a table, or a page with --html")
     s.add_argument("robot", help="registered name or model file (URDF, xacro, MJCF)")

@@ -12,7 +12,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
-from typing import TYPE_CHECKING, Any, NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn, TypeAlias
 
 from kinelab import lazy
 from kinelab.errors import ConfigurationError, KinelabError
@@ -55,6 +55,11 @@ class Parser(argparse.ArgumentParser):
                 leave = " or leave the option out" if action.option_strings else ""
                 self.error(f"argument {name}: an empty value; give {action.metavar or action.dest.upper()}{leave}")
         return found, extra
+
+
+
+Subcommands: TypeAlias = "argparse._SubParsersAction[Parser]"
+"""What each command's ``add`` is handed: the ``kinelab`` parser's subcommands."""
 
 
 def positive_number(text: str) -> float:

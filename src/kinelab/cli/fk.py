@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import argparse
 from dataclasses import asdict
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from kinelab import lazy
 from kinelab.cli import common
+from kinelab.cli.common import Subcommands
 
 if TYPE_CHECKING:
     from kinelab import collision
@@ -15,7 +16,7 @@ else:
     collision = lazy.module("kinelab.collision", globals())
 
 
-def add(sub: Any) -> None:
+def add(sub: Subcommands) -> None:
     """The ``fk`` subcommand."""
     s = sub.add_parser("fk", help="tool pose at a configuration")
     common.robot_arguments(s, "one number per joint (rad and m; deg with --deg)")

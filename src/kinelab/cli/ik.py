@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 from kinelab import lazy
 from kinelab.cli.common import (
+    Subcommands,
     collision_arguments,
     collisions_of,
     json_flag,
@@ -66,7 +67,7 @@ def option_fields(solver: str) -> frozenset[str]:
     return frozenset(f.name for f in fields(registry.solver_module(kind.request_solver(solver)).Options))
 
 
-def add(sub: Any) -> None:
+def add(sub: Subcommands) -> None:
     """The ``ik`` subcommand."""
     s = sub.add_parser("ik", help="inverse kinematics to a target pose or configuration")
     s.add_argument("robot", help="registered name or model file (URDF, xacro, MJCF)")

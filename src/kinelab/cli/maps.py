@@ -14,6 +14,7 @@ from kinelab.cli import common
 from kinelab.cli.common import (
     Interrupted,
     Parser,
+    Subcommands,
     load_robot,
     plural,
     print_json,
@@ -46,7 +47,7 @@ else:
     store = lazy.module("kinelab.maps.store", globals())
 
 
-def add(sub: Any) -> None:
+def add(sub: Subcommands) -> None:
     """The ``map`` subcommand and its three kinds."""
     s = sub.add_parser("map", help="reachability, base placement and singularity maps (kinelab.maps)")
     kinds = s.add_subparsers(dest="kind", required=True, metavar="KIND", parser_class=Parser)

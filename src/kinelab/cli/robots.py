@@ -6,7 +6,7 @@ import argparse
 from typing import TYPE_CHECKING, Any
 
 from kinelab import lazy
-from kinelab.cli.common import json_flag, load_robot, print_json, robot_arguments, verbose_flag
+from kinelab.cli.common import Subcommands, json_flag, load_robot, print_json, robot_arguments, verbose_flag
 from kinelab.robot import catalog
 
 if TYPE_CHECKING:
@@ -21,7 +21,7 @@ else:
     redundancy = lazy.module("kinelab.ik.analytic.redundancy", globals())
 
 
-def add(sub: Any) -> None:
+def add(sub: Subcommands) -> None:
     """The ``robots`` and ``info`` subcommands."""
     s = sub.add_parser("robots", help="list the registered robots")
     json_flag(s)

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING, Any
 
 from kinelab import lazy
 from kinelab.cli import common
+from kinelab.cli.common import Subcommands
 from kinelab.errors import KinelabError
 
 if TYPE_CHECKING:
@@ -22,7 +23,7 @@ def reading(value: float, digits: int = 4) -> str:
     return text[1:] if text.startswith("-") and float(text) == 0.0 else text
 
 
-def add(sub: Any) -> None:
+def add(sub: Subcommands) -> None:
     """The ``singular`` subcommand."""
     s = sub.add_parser("singular", help="rank, singular values, lost directions; or a sweep for singular families")
     common.robot_arguments(s, "one number per joint (rad and m; deg with --deg)")

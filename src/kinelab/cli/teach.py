@@ -7,7 +7,15 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from kinelab import lazy
-from kinelab.cli.common import collision_arguments, collisions_of, load_robot, pairs, q_from_cli, robot_arguments
+from kinelab.cli.common import (
+    Subcommands,
+    collision_arguments,
+    collisions_of,
+    load_robot,
+    pairs,
+    q_from_cli,
+    robot_arguments,
+)
 from kinelab.errors import KinelabError
 from kinelab.progress import step
 from kinelab.robot import catalog
@@ -25,7 +33,7 @@ else:
     webbrowser = lazy.module("webbrowser", globals())
 
 
-def add(sub: Any) -> None:
+def add(sub: Subcommands) -> None:
     """The ``teach`` subcommand."""
     s = sub.add_parser("teach", help="move a robot by hand in the browser: joint sliders, a target to drag that it "
                                      "follows by IK, its branches, σ_min and the velocity ellipsoid (127.0.0.1); a "

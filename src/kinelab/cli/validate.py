@@ -5,10 +5,10 @@ from __future__ import annotations
 import argparse
 import shutil
 import textwrap
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from kinelab import lazy
-from kinelab.cli.common import json_flag, print_json, progress_of, seed_argument
+from kinelab.cli.common import Subcommands, json_flag, print_json, progress_of, seed_argument
 from kinelab.report.outfolder import check_output_folder
 
 if TYPE_CHECKING:
@@ -18,7 +18,7 @@ else:
     validate = lazy.module("kinelab.report.validate", globals())
 
 
-def add(sub: Any) -> None:
+def add(sub: Subcommands) -> None:
     """The ``validate`` subcommand."""
     s = sub.add_parser("validate", help="check every kinelab computation against Pinocchio on the bundled robots")
     s.add_argument("--robots", nargs="+", default=None,

@@ -9,7 +9,15 @@ import time
 from typing import TYPE_CHECKING, Any
 
 from kinelab import lazy
-from kinelab.cli.common import collision_arguments, collisions_of, load_robot, plural, q_from_cli, robot_arguments
+from kinelab.cli.common import (
+    Subcommands,
+    collision_arguments,
+    collisions_of,
+    load_robot,
+    plural,
+    q_from_cli,
+    robot_arguments,
+)
 from kinelab.errors import KinelabError
 from kinelab.progress import step
 
@@ -32,7 +40,7 @@ else:
 MIN_DT, MAX_DT = 1e-3, 60.0  # [s] per animation sample
 
 
-def add(sub: Any) -> None:
+def add(sub: Subcommands) -> None:
     """The ``view`` and ``animate`` subcommands."""
     s = sub.add_parser("view", help="show a robot in meshcat (live on 127.0.0.1, or --html for a static page)")
     robot_arguments(s, "configuration (default: the robot's display pose)")

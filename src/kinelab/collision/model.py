@@ -30,6 +30,7 @@ from kinelab.errors import KinelabError
 from kinelab.robot import Chain
 from kinelab.robot.meshes import mesh_package_dirs, missing_meshes
 from kinelab.robot.mjcf import is_mjcf
+from kinelab.typing import Configuration
 
 TOUCH = 1e-6  # [m] pairs this near contact count as colliding (CollisionModel.checked_margin)
 
@@ -142,7 +143,7 @@ class CollisionModel:
                 req.security_margin = self.checked_margin
         return self.hdata
 
-    def contact(self, q: Any, first_test: bool = True) -> Contact | None:
+    def contact(self, q: Configuration, first_test: bool = True) -> Contact | None:
         """The first pair at q (rad or m, one number per joint) closer than the margin, with its distance, or
         None.
 
@@ -156,7 +157,7 @@ class CollisionModel:
         k = self.colliding_pair(q, first_test)
         return None if k is None else self.contact_of(k)
 
-    def contacts(self, q: Any) -> list[Contact]:
+    def contacts(self, q: Configuration) -> list[Contact]:
         """Every pair at q closer than the margin, each with its distance (the exact test on the pairs the first
         tests leave)."""
         q = self.robot.check_q(q)
@@ -165,7 +166,7 @@ class CollisionModel:
         pin.updateGeometryPlacements(self.robot.model, self.data, self.geom, self.gdata)
         return [self.contact_of(int(k)) for k in spheres if pin.computeCollision(self.geom, self.gdata, int(k))]
 
-    def colliding_pair(self, q: Any, first_test: bool = True) -> int | None:
+    def colliding_pair(self, q: Configuration, first_test: bool = True) -> int | None:
         """The index of the first pair at q closer than the margin, or None (no distance computed: cheaper
         than :meth:`contact`)."""
         q = self.robot.check_q(q)

@@ -12,7 +12,6 @@ compiled engine, the closed form, a 7R arm's held joint, the 1-D search, the mul
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 from kinelab import lazy
@@ -25,6 +24,7 @@ from kinelab.ik.registry import capabilities, refuse_options
 from kinelab.ik.request import check_robot
 from kinelab.ik.result import Branches, IKResult, TrackResult
 from kinelab.robot import Chain
+from kinelab.typing import CollisionSpec, Configuration, SolverOptions, Target, Targets
 
 if TYPE_CHECKING:  # the collision model and the closed forms load when a call asks for them
     from kinelab.ik.analytic import branches
@@ -67,11 +67,11 @@ def refuse_positional(function: str, extra: tuple[Any, ...]) -> None:
                     f"{'s' if len(extra) > 1 else ''})")
 
 
-def solve(robot: Chain, target: Any, *positional: Any, solver: str = "frdm", q0: Any = None,
+def solve(robot: Chain, target: Target, *positional: object, solver: str = "frdm", q0: Configuration | None = None,
           seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float = 1.0,
-          max_restarts: int = 1000, start_outside_limits: str = "project", options: Any = None,
-          task: str = "pose", axis: str = "z", prefer: Any = None, collisions: Any = None,
-          **solver_options: Any) -> IKResult:
+          max_restarts: int = 1000, start_outside_limits: str = "project", options: SolverOptions = None,
+          task: str = "pose", axis: str = "z", prefer: Configuration | None = None, collisions: CollisionSpec = None,
+          **solver_options: object) -> IKResult:
     """Solve IK for the tool pose ``target`` (``pin.SE3`` in the robot's base frame).
 
     Args:
@@ -128,11 +128,12 @@ def solve(robot: Chain, target: Any, *positional: Any, solver: str = "frdm", q0:
     return prepared(robot, settings, key).solve(target, q0=q0, seed=seed, prefer=prefer)
 
 
-def solve_batch(robot: Chain, targets: Any, *positional: Any, solver: str = "frdm", q0: Any = None,
+def solve_batch(robot: Chain, targets: Targets, *positional: object, solver: str = "frdm",
+                q0: Configuration | None = None,
                 seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6,
                 time_budget: float | None = None, max_restarts: int = 1000, start_outside_limits: str = "refuse",
-                options: Any = None, task: str = "pose", axis: str = "z", collisions: Any = None,
-                **solver_options: Any) -> BatchIKResult:
+                options: SolverOptions = None, task: str = "pose", axis: str = "z", collisions: CollisionSpec = None,
+                **solver_options: object) -> BatchIKResult:
     """Solve IK for every target of a batch: row b is what :func:`solve` gives for ``targets[b]`` alone with
     ``seed = seed + b`` and start ``q0[b]``, when neither runs out of time.
 
@@ -176,7 +177,7 @@ def solve_batch(robot: Chain, targets: Any, *positional: Any, solver: str = "frd
     return prepared(robot, settings).solve_batch(targets, q0=q0, seed=seed)
 
 
-def solve_all_batch(robot: Chain, targets: Any, *positional: Any, tol_pos: float = 1e-6,
+def solve_all_batch(robot: Chain, targets: Targets, *positional: object, tol_pos: float = 1e-6,
                     tol_rot: float = 1e-6, time_budget: float | None = None) -> BranchBatch:
     """Every branch of each target, arrays in, arrays out: in closed form, by the 1-D search or by the general 6R
     elimination, compiled, on all cores.
@@ -211,12 +212,12 @@ def solve_all_batch(robot: Chain, targets: Any, *positional: Any, tol_pos: float
     return branches.all_branches_batch(robot, targets, tol_pos, tol_rot, time_budget)
 
 
-def solve_all(robot: Chain, target: Any, *positional: Any, solver: str = "auto", seed: int | None = None,
+def solve_all(robot: Chain, target: Target, *positional: object, solver: str = "auto", seed: int | None = None,
               tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float | str | None = "auto",
-              options: Any = None,
-              task: str = "pose", axis: str = "z", q_ref: Any = None, max_solutions: int | None = None,
-              stop_below: float | None = UNSEEN, collisions: Any = None, drop_colliding: bool = False,
-              redundancy: int | dict[str, float] | SEW | None = None, **solver_options: Any) -> Branches:
+              options: SolverOptions = None,
+              task: str = "pose", axis: str = "z", q_ref: Configuration | None = None, max_solutions: int | None = None,
+              stop_below: float | None = UNSEEN, collisions: CollisionSpec = None, drop_colliding: bool = False,
+              redundancy: int | dict[str, float] | SEW | None = None, **solver_options: object) -> Branches:
     """The distinct solutions (branches) of ``target``: every one in closed form where the chain's geometry
     allows it (docs/analytic.md), else those that seeded starts find, in rounds of 64, until the estimated
     chance that one more start finds a new branch falls below ``stop_below`` or ``time_budget`` is spent.
@@ -290,11 +291,11 @@ def _all_budget(time_budget: float | str | None, redundancy: Any) -> float | Non
     return AUTO_BUDGET if redundancy is None else AUTO_REDUNDANT_BUDGET
 
 
-def track(robot: Chain, targets: Sequence[Any] | Any, *positional: Any, q0: Any = None, solver: str = "frdm",
+def track(robot: Chain, targets: Targets, *positional: object, q0: Configuration | None = None, solver: str = "frdm",
           seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float | None = None,
-          options: Any = None, task: str = "pose", axis: str = "z", jump_limit: float | None = 0.2,
+          options: SolverOptions = None, task: str = "pose", axis: str = "z", jump_limit: float | None = 0.2,
           restrict: tuple[str, ...] = (), hold: int = 10, rest_weight: float | None = None,
-          collisions: Any = None, **solver_options: Any) -> TrackResult:
+          collisions: CollisionSpec = None, **solver_options: object) -> TrackResult:
     """Follow a path: solve each target in turn, warm-started from the previous answer (no restarts).
 
     With no bypass, policy or restriction named, the whole path runs in the compiled follower; otherwise

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 from kinelab import lazy
 from kinelab.robot.chain import Chain
+from kinelab.typing import CollisionSpec
 
 if TYPE_CHECKING:
     from kinelab.ik.analytic import classify as classify_module
@@ -28,7 +29,7 @@ else:
 AUTO = "auto"
 
 
-def resolved(robot: Chain, solver: Any, task: Any, collisions: Any, has_options: bool) -> Any:
+def resolved(robot: Chain, solver: Any, task: Any, collisions: CollisionSpec, has_options: bool) -> Any:
     """The solver ``solver`` stands for on this robot: itself, unless it is "auto" (see the module's docstring)."""
     if solver != AUTO:
         return solver

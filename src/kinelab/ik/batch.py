@@ -29,6 +29,7 @@ from kinelab.ik.request import Request
 from kinelab.ik.result import Status, status_counts
 from kinelab.ik.targets import as_target_arrays, reach_bound
 from kinelab.robot import Chain
+from kinelab.typing import Configuration, Targets
 
 if TYPE_CHECKING:
     from kinelab.ik import starts as starts_module
@@ -85,7 +86,7 @@ class BatchIKResult:
                 "mode": self.mode}
 
 
-def run_batch(robot: Chain, targets: Any, q0: Any, req: Request) -> BatchIKResult:
+def run_batch(robot: Chain, targets: Targets, q0: Configuration | None, req: Request) -> BatchIKResult:
     """Solve IK for every target of a batch (each a tool pose in the robot's base frame).
 
     Args:

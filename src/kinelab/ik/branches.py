@@ -25,6 +25,7 @@ from kinelab.ik.request import Request, check_seed, count_ok, make_request
 from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target, beyond_reach
 from kinelab.robot import Chain
+from kinelab.typing import Configuration, Target
 
 if TYPE_CHECKING:  # the closed forms load when a route asks for them: a multistart solve does without
     from kinelab.ik.analytic import branches, sew
@@ -68,7 +69,8 @@ def route_of(kind: Capabilities, options_given: bool) -> Route:
     return Route.EITHER if kind.picks and not options_given else Route.MULTISTART
 
 
-def find_all(robot: Chain, target: Any, req: Request, q_ref: Any = None, max_solutions: int | None = None,
+def find_all(robot: Chain, target: Target, req: Request, q_ref: Configuration | None = None,
+             max_solutions: int | None = None,
              stop_below: float | None = UNSEEN, method: Route = Route.MULTISTART,
              redundancy: int | dict[str, float] | sew.SEW | None = None) -> Branches:
     """The distinct solutions of ``target``, each checked by Pinocchio: every branch in closed form where the
@@ -140,7 +142,7 @@ def _closed_form_all(robot: Chain, target: Any, req: Request, ref: Any, max_solu
 USUAL_PER_ROBOT = 16  # a caller sweeping settings: the prepared closed forms kept stay bounded
 
 
-def usual_closed_form(robot: Chain, target: Any, seed: Any, settings: tuple[Any, ...]) -> Branches | None:
+def usual_closed_form(robot: Chain, target: Target, seed: object, settings: tuple[Any, ...]) -> Branches | None:
     """Every branch of ``target`` in one compiled call for the usual call of :func:`kinelab.solve_all` — a solver
     that picks its route ("auto") on a chain with a closed form or the general elimination and a certified compiled
     FK, a ``pin.SE3`` target, no options, references, collisions or sweeps — with ``settings`` = (solver, tol_pos,

@@ -25,6 +25,7 @@ from kinelab.ik.driver import solve_one
 from kinelab.ik.request import Request
 from kinelab.ik.result import Branches, IKResult, Status, TrackResult
 from kinelab.robot import Chain
+from kinelab.typing import Configuration, Target
 
 if TYPE_CHECKING:
     from kinelab.collision.model import CollisionModel
@@ -34,7 +35,8 @@ ROW_RUNS = 20  # runs a colliding batch row gets (each a full solve): a row with
 STRIDE = 1_000_003  # seeds between two runs: a run's restarts use seed, seed + 1, ... within one run
 
 
-def solve_clear(robot: Chain, target: Any, q0: Any, req: Request, model: CollisionModel) -> IKResult:
+def solve_clear(robot: Chain, target: Target, q0: Configuration | None, req: Request,
+                model: CollisionModel) -> IKResult:
     """The first answer that meets the target and collides with nothing ``model`` checks.
 
     Args:

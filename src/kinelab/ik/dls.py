@@ -11,7 +11,6 @@ import functools
 import math
 import time
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -58,7 +57,7 @@ class DLSOptions:
         return self if task.name == "pose" else _for_task(self, task)
 
     @classmethod
-    def of(cls, options: DLSOptions | None = None, **kwargs: Any) -> DLSOptions:
+    def of(cls, options: DLSOptions | None = None, **kwargs: object) -> DLSOptions:
         """``options`` as given, or built from keyword arguments (cached for hashable ones)."""
         return opt.resolve(cls, "dls", options, kwargs)
 
@@ -86,7 +85,7 @@ def attempt(
     tol_rot: float,
     deadline: float,
     options: DLSOptions | None = None,
-    **kwargs: Any,
+    **kwargs: object,
 ) -> Attempt:
     """Damped Gauss–Newton on the tool's log6 error in the tool frame, from ``q0``; the damping is
     ``damping`` plus 1e-3 of the squared error, and an attempt whose error stops falling ends as stalled.

@@ -25,6 +25,7 @@ from kinelab.ik.targets import as_target, out_of_reach, reach_bound
 from kinelab.ik.tasks import COMPONENTS, POSE, Task
 from kinelab.robot import Chain
 from kinelab.robot.chain import _compiled_judge
+from kinelab.typing import Configuration, SolverOptions, Target
 
 S = TypeVar("S", bound=EngineSpec)  # an engine's spec type
 
@@ -56,7 +57,7 @@ def _start(robot: Chain, q0: Any, rng: _LazyRng, on_limits: str) -> np.ndarray:
     return projected
 
 
-def solve_one(robot: Chain, target: Any, q0: Any, req: Request) -> IKResult:
+def solve_one(robot: Chain, target: Target, q0: Configuration | None, req: Request) -> IKResult:
     """Solve IK for one target.
 
     Args:
@@ -90,7 +91,7 @@ def solve_one(robot: Chain, target: Any, q0: Any, req: Request) -> IKResult:
     return _loop(module, problem, _start(robot, q0, rng, req.start_outside_limits), max_restarts, opts, rng, beyond)
 
 
-def prepare_solver(module: Any, robot: Chain, options: Any) -> None:
+def prepare_solver(module: Any, robot: Chain, options: SolverOptions) -> None:
     """The solver module's model building for this robot (its ``prepare``, where it has one): not a solve's time."""
     prepare = getattr(module, "prepare", None)
     if prepare is not None:
@@ -237,7 +238,7 @@ def engine_spec(robot: Chain, req: Request, cm: Any,
     """
     task, tol_pos, tol_rot = req.task, float(req.tol_pos), float(req.tol_rot)
 
-    def unmet(target: Any, code: int, q: np.ndarray, stats: np.ndarray, dp: float, dr: float, ok: bool,
+    def unmet(target: Target, code: int, q: np.ndarray, stats: np.ndarray, dp: float, dr: float, ok: bool,
               t_start: float, deadline: float, seed: int) -> IKResult:
         call = Call(robot, target, req.solver, tol_pos, tol_rot, t_start, deadline, seed, task, req.task_label)
         return compiled_result(call, attempt_of(code, q, stats, deadline), max(0, int(stats[ATTEMPTS]) - 1), ok, dp, dr)
@@ -259,7 +260,7 @@ def engine_spec(robot: Chain, req: Request, cm: Any,
 ATTEMPTS = 0  # the statistics slot in which every compiled multistart counts its attempts
 
 
-def engine_judge(robot: Chain, options: Any) -> Any:
+def engine_judge(robot: Chain, options: SolverOptions) -> Any:
     """The judge an engine can use for these options: the robot's certified compiled FK (``kinelab.core._chain.
     Judge``) when the options run compiled, else None (no engine: the general route serves)."""
     return robot.derived("compiled judge", _compiled_judge) if getattr(options, "compiled", False) else None

@@ -41,6 +41,7 @@ from kinelab.ik.request import Request, check_robot, check_seed, make_request
 from kinelab.ik.result import Branches, IKResult, TrackResult
 from kinelab.ik.targets import TargetArrays, as_target, as_target_arrays
 from kinelab.robot import Chain
+from kinelab.typing import CollisionSpec, Configuration, Target, Targets
 
 if TYPE_CHECKING:
     from kinelab.collision import model
@@ -152,7 +153,8 @@ class IK:
         check_seed(seed)
         return replace(self.request, seed=seed)
 
-    def solve(self, target: Any, *, q0: Any = None, seed: int | None = None, prefer: Any = None) -> IKResult:
+    def solve(self, target: Target, *, q0: Configuration | None = None, seed: int | None = None,
+              prefer: Configuration | None = None) -> IKResult:
         """IK for one target (oMtarget in the base frame), as :func:`kinelab.solve` with these settings.
 
         Args:
@@ -204,7 +206,8 @@ class IK:
         return branches.analytic_one(self.robot, as_target(target, self.request.task.name), self.request, ref,
                                      self.collisions)
 
-    def solve_batch(self, targets: Any, *, q0: Any = None, seed: int | None = None) -> BatchIKResult:
+    def solve_batch(self, targets: Targets, *, q0: Configuration | None = None,
+                    seed: int | None = None) -> BatchIKResult:
         """Every target of a batch, as :func:`kinelab.solve_batch` with these settings (row b: seed + b).
 
         Args:
@@ -225,7 +228,7 @@ class IK:
             return branches.nearest_batch(self.robot, targets, q0, req, self.collisions)
         return batch_clear_of(self.robot, targets, q0, req, self.collisions)
 
-    def solve_all(self, target: Any, *, seed: int | None = None, q_ref: Any = None,
+    def solve_all(self, target: Target, *, seed: int | None = None, q_ref: Configuration | None = None,
                   max_solutions: int | None = None, stop_below: float | None = UNSEEN,
                   redundancy: int | dict[str, float] | SEW | None = None, drop_colliding: bool = False) -> Branches:
         """The distinct branches of ``target`` found within the time budget, as :func:`kinelab.solve_all` with these
@@ -257,7 +260,8 @@ class IK:
                          redundancy=redundancy)
         return clear_of(found, self.collisions, drop=bool(drop_colliding))
 
-    def track(self, targets: Any, *, q0: Any = None, seed: int | None = None, jump_limit: float | None = 0.2,
+    def track(self, targets: Targets, *, q0: Configuration | None = None, seed: int | None = None,
+              jump_limit: float | None = 0.2,
               restrict: tuple[str, ...] = (), hold: int = 10, rest_weight: float | None = None) -> TrackResult:
         """Follow a path, as :func:`kinelab.track` with these settings (solver "frdm"; the path's option defaults
         under the options given here; no restarts; starts outside the limits refused).
@@ -301,7 +305,7 @@ class IK:
         return replace(self._path_request, seed=int(seed))
 
 
-def preferred(robot: Chain, target: Any, req: Request, prefer: Any, check: CollisionModel | None,
+def preferred(robot: Chain, target: Target, req: Request, prefer: Configuration | None, check: CollisionModel | None,
               method: Route) -> IKResult:
     """``solve(prefer=)``: the (clear) branch nearest ``prefer`` among every branch found."""
     prepare(robot, req)  # not the budget's time
@@ -316,7 +320,7 @@ def preferred(robot: Chain, target: Any, req: Request, prefer: Any, check: Colli
     return solve_clear_of(robot, target, None, replace(req, time_budget=left), check)
 
 
-def follow_path(robot: Chain, points: np.ndarray, rotations: np.ndarray, q0: Any, req: Request,
+def follow_path(robot: Chain, points: np.ndarray, rotations: np.ndarray, q0: Configuration | None, req: Request,
                 settings: PathSettings, check: CollisionModel | None, t_start: float) -> TrackResult:
     """A path once its settings and targets (points [m], rotations) are checked: the start (the first target's
     answer when q0 is None), the path, and the collision check of every answer when ``check`` is given."""
@@ -342,7 +346,7 @@ def _first_answer(robot: Chain, target: pin.SE3, req: Request, check: CollisionM
     return q
 
 
-def collision_check(robot: Chain, collisions: Any) -> CollisionModel | None:
+def collision_check(robot: Chain, collisions: CollisionSpec) -> CollisionModel | None:
     """The collision model a ``collisions=`` argument asks for (None, "self", an Environment or a Collisions), or
     None: the collision package (coal's geometry, the robot's meshes) loads only for a solve that checks."""
     if collisions is None:
@@ -352,7 +356,8 @@ def collision_check(robot: Chain, collisions: Any) -> CollisionModel | None:
     return None if spec is None else model.collision_model(robot, spec)
 
 
-def solve_clear_of(robot: Chain, target: Any, q0: Any, req: Request, check: CollisionModel | None) -> IKResult:
+def solve_clear_of(robot: Chain, target: Target, q0: Configuration | None, req: Request,
+                   check: CollisionModel | None) -> IKResult:
     """One solve through the driver, clear of collisions when ``check`` is given (:mod:`kinelab.ik.clear`, which
     loads with the first solve that checks)."""
     if check is None:
@@ -361,7 +366,8 @@ def solve_clear_of(robot: Chain, target: Any, q0: Any, req: Request, check: Coll
     return clear.solve_clear(robot, target, q0, req, check)
 
 
-def batch_clear_of(robot: Chain, targets: Any, q0: Any, req: Request, check: CollisionModel | None) -> BatchIKResult:
+def batch_clear_of(robot: Chain, targets: Targets, q0: Configuration | None, req: Request,
+                   check: CollisionModel | None) -> BatchIKResult:
     """A batch through the FRDM batch, its colliding rows solved again clear of ``check`` when given."""
     t0 = time.perf_counter()
     res = run_batch(robot, targets, q0, req)

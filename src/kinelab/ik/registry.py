@@ -13,6 +13,7 @@ import pinocchio as pin
 from kinelab.errors import OptionError, SolverNotFoundError
 from kinelab.ik.result import Attempt
 from kinelab.robot import Chain
+from kinelab.typing import SolverOptions
 
 BUILTIN = {"frdm": "kinelab.ik.frdm.solver", "biquat": "kinelab.ik.biquat.solver", "dls": "kinelab.ik.dls"}
 SOLVERS: dict[str, Any] = {}
@@ -68,7 +69,7 @@ class SolverModule(Protocol):
     Options: Any
 
     def attempt(self, robot: Chain, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol_rot: float,
-                deadline: float, options: Any = None) -> Attempt:
+                deadline: float, options: SolverOptions = None) -> Attempt:
         """One run from ``q0`` towards ``oMtarget``, before kinelab's Pinocchio check."""
 
 
@@ -132,7 +133,7 @@ def solver_module(name: str) -> Any:
     return module
 
 
-def refuse_options(options: Any) -> None:
+def refuse_options(options: SolverOptions | dict[str, object]) -> None:
     """The closed form has no settings: options given with solver="analytic" are refused by name.
 
     Raises:

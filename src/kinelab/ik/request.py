@@ -20,6 +20,7 @@ from kinelab.errors import ChainError, OptionError
 from kinelab.ik.registry import solver_module
 from kinelab.ik.tasks import POSE, Task
 from kinelab.robot import Chain
+from kinelab.typing import SolverOptions
 
 START_POLICIES = ("project", "refuse")
 TOL_FLOOR = 1e-12
@@ -87,7 +88,7 @@ def check_robot(robot: object) -> None:
 
 def make_request(solver: str = "frdm", seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6,
                  time_budget: float | None = 1.0, max_restarts: int = 1000, start_outside_limits: str = "project",
-                 options: Any = None, task: str = "pose", axis: str = "z",
+                 options: SolverOptions = None, task: str = "pose", axis: str = "z",
                  solver_options: dict[str, Any] | None = None) -> Request:
     """Check every argument once and build the :class:`Request`.
 
@@ -119,7 +120,7 @@ def for_task(solver: str, opts: Any, task: Task) -> Any:
     return opts.for_task(task)
 
 
-def check_arguments(tol_pos: Any, tol_rot: Any, time_budget: Any, max_restarts: Any, seed: Any,
+def check_arguments(tol_pos: Any, tol_rot: Any, time_budget: Any, max_restarts: Any, seed: object,
                     start_outside_limits: Any) -> None:
     """Refuse what no entry point can honour, naming the argument, the value and what is valid.
 
@@ -168,7 +169,7 @@ def _plain_counts(max_restarts: Any, seed: Any) -> bool:
         (seed is None or (type(seed) is int and seed >= 0))
 
 
-def check_seed(seed: Any, name: str = "seed") -> None:
+def check_seed(seed: object, name: str = "seed") -> None:
     """Refuse a seed that is not an integer ≥ 0 (numpy's generators take no other).
 
     Raises:

@@ -14,6 +14,7 @@ from kinelab.core._verdict import NOT_A_ROTATION, NOT_FINITE, NOT_HOMOGENEOUS, f
 from kinelab.dq.algebra import DualQuat
 from kinelab.errors import TargetError, count_of
 from kinelab.robot import Chain
+from kinelab.typing import Target, Targets
 
 
 def from_xyz_rpy(xyz: ArrayLike, rpy: ArrayLike = (0.0, 0.0, 0.0), *, degrees: bool = False) -> pin.SE3:
@@ -54,7 +55,7 @@ def from_xyz_quat_wxyz(xyz: ArrayLike, quat_wxyz: ArrayLike) -> pin.SE3:
     return pin.SE3(pin.Quaternion(w, x, y, z).toRotationMatrix(), xyz)
 
 
-def as_target(target: Any, task: str = "pose") -> pin.SE3:
+def as_target(target: Target, task: str = "pose") -> pin.SE3:
     """Check a target: a ``pin.SE3`` with finite entries and a proper rotation, or a unit biquaternion; for
     task "position" also a point (three numbers [m], base frame), taken with the identity rotation.
 
@@ -115,7 +116,7 @@ class TargetArrays(NamedTuple):
     rotations: np.ndarray  # (N, 3, 3)
 
 
-def as_target_arrays(targets: Any) -> TargetArrays:
+def as_target_arrays(targets: Targets) -> TargetArrays:
     """Check a sequence of targets; returns (points (N, 3) [m], rotations (N, 3, 3)), base frame.
 
     ``targets`` is a sequence of ``pin.SE3`` (or unit biquaternions), or an (N, 4, 4) array of

@@ -4,16 +4,16 @@ user expects to see next to where the arm stands (``kinelab ik``'s start, the te
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import Any
 
 import numpy as np
+import pinocchio as pin
 
 from kinelab.ik.limits import nearest_inside
 from kinelab.ik.result import IKResult
 from kinelab.robot import Chain
 
 
-def nearest_turns(robot: Chain, result: IKResult, q0: np.ndarray | None, target: Any, task: str = "pose",
+def nearest_turns(robot: Chain, result: IKResult, q0: np.ndarray | None, target: pin.SE3, task: str = "pose",
                   axis: str = "z", tol_pos: float = 1e-6, tol_rot: float = 1e-6) -> IKResult:
     """The result with each revolute angle moved by whole turns to the copy nearest ``q0`` within the limits.
 

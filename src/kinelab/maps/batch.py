@@ -31,6 +31,7 @@ from kinelab.maps.cluster import client_for, recipe, worker_robot
 from kinelab.maps.store import _zarr, model_sha256
 from kinelab.progress import bar
 from kinelab.robot import Chain
+from kinelab.typing import Targets
 
 CHUNK = 10_000  # targets per task: ~0.3 s of a panda worker, 1.3 MB of targets sent
 FIELDS = {"q": "f8", "success": "?", "status_code": "i1", "position_error": "f8", "rotation_error": "f8",
@@ -120,7 +121,7 @@ def _open(out: str | Path, robot: Chain, H: np.ndarray, spec: BatchSpec) -> Any:
     return group
 
 
-def solve_batch_on_cluster(robot: Chain, targets: Any, out: str | Path, spec: BatchSpec | None = None,
+def solve_batch_on_cluster(robot: Chain, targets: Targets, out: str | Path, spec: BatchSpec | None = None,
                            client: Any = None, scheduler: str | None = None, workers: int | None = None,
                            progress: bool | None = None) -> ClusterRun:
     """Solve every target on a Dask cluster (FRDM's compiled batch on each worker), writing to ``out``.

@@ -23,7 +23,7 @@ import numpy as np
 from kinelab.core import threads
 from kinelab.errors import KinelabError
 from kinelab.maps.chunk import compute_chunk
-from kinelab.maps.store import model_sha256
+from kinelab.maps.store import ReachabilityMap, model_sha256
 from kinelab.progress import bar
 from kinelab.robot import Chain, catalog, load
 
@@ -178,7 +178,7 @@ def _local_client(workers: int | None) -> Any:
     return Client(cluster, security=cluster.security)
 
 
-def run_chunks(client: Any, robot: Chain, spec: Any, centres: np.ndarray, todo: list[int], target: Any,
+def run_chunks(client: Any, robot: Chain, spec: Any, centres: np.ndarray, todo: list[int], target: ReachabilityMap,
                progress: bool | None = None) -> None:
     """Submit the chunks ``todo`` and write each into ``target`` as it arrives."""
     from dask.distributed import as_completed

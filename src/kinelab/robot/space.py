@@ -16,6 +16,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.errors import ConfigurationError, JointLimitError, OptionError, count_of
+from kinelab.typing import Configuration
 
 LIMIT_SLACK = 1e-9  # joint values this far past a limit still count as within it (rad or m)
 SAMPLE_TURNS = 4  # random configurations keep unbounded revolute joints within ±4 turns
@@ -74,7 +75,7 @@ def space_of(model: pin.Model) -> Space:
                  floating)
 
 
-def check_q(space: Space, model: pin.Model, q: Any, *, limits: bool = False, what: str = "q") -> np.ndarray:
+def check_q(space: Space, model: pin.Model, q: Configuration, *, limits: bool = False, what: str = "q") -> np.ndarray:
     """``q`` as nq finite floats (Pinocchio's q), its quaternions unit and, with ``limits``, its bounded joints
     within their limits.
 

@@ -11,6 +11,7 @@ import pinocchio as pin
 
 from kinelab.collision.model import CollisionModel, Contact
 from kinelab.collision.obstacles import Environment, Obstacle
+from kinelab.typing import Configuration
 
 OBSTACLE_COLOURS = ((0x469990, "teal"), (0x9A6324, "brown"), (0x808000, "olive"), (0x911EB4, "purple"),
                     (0xBFEF45, "lime"), (0xFABED4, "pink"))  # none red (contacts), blue (joints) or orange
@@ -18,7 +19,7 @@ CONTACT_COLOR = 0xE6194B
 PLANE_SIDE = 4.0  # [m] the square drawn for an (unbounded) plane
 
 
-def draw_collisions(scene: Any, model: CollisionModel, q: Any) -> list[Contact]:
+def draw_collisions(scene: Any, model: CollisionModel, q: Configuration) -> list[Contact]:
     """Draw ``model``'s obstacles in ``scene`` and colour red the robot's visuals on the links in contact at q
     (the robot drawn at q first); returns the contacts, which the caption lists."""
     scene.show(q)

@@ -10,6 +10,7 @@ import meshcat.geometry as g
 import numpy as np
 
 from kinelab.robot import Chain
+from kinelab.typing import Configuration
 from kinelab.view.caption import before_body
 from kinelab.view.scene import Scene, _stick_figure, chain_points
 
@@ -20,7 +21,8 @@ def colours(values: np.ndarray) -> np.ndarray:
     return np.vstack([np.clip(2 * (1 - v), 0, 1), np.clip(2 * v, 0, 1), np.zeros_like(v)])
 
 
-def reachability_cloud(robot: Chain, rmap: Any, q: Any = None, viewer: Any = None, meshes: bool = True) -> Scene:
+def reachability_cloud(robot: Chain, rmap: Any, q: Configuration | None = None, viewer: Any = None,
+                       meshes: bool = True) -> Scene:
     """The robot at q (default: its display pose) with the map's reached voxels as points coloured by their
     reachability index; the caption says what the colours mean.
 

@@ -27,6 +27,7 @@ from kinelab.errors import ConfigurationError
 from kinelab.files import write_output
 from kinelab.robot import Chain
 from kinelab.robot.chain import NEAR_SINGULAR
+from kinelab.typing import Configuration
 from kinelab.view.caption import Table, tab_title, titled, with_caption
 from kinelab.view.framing import FILL, frame_points
 from kinelab.view.labels import draw_number
@@ -393,7 +394,7 @@ def _side_by_side_legend(scene: Scene, robot: Chain, labels: list[str], highligh
         scene.legend["highlight"] = f"orange joints: {labels[highlight]}"
 
 
-def chain_points(robot: Chain, q: Any) -> list[np.ndarray]:
+def chain_points(robot: Chain, q: Configuration) -> list[np.ndarray]:
     """The joint origins and the tool point at q [m, base frame], base first."""
     return [m.translation for m in robot.joint_placements(q).values()] + [robot.fk(q).translation]
 

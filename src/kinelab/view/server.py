@@ -94,7 +94,7 @@ def _loopback_bridge() -> Any:
             app.add_handlers(r".*$", [(r"/static/(?:index\.html)?", _titled_index())])  # ahead of the files
             listen = app.listen
 
-            def loopback_listen(port: int, **kwargs: Any) -> Any:
+            def loopback_listen(port: int, **kwargs: object) -> Any:
                 return listen(port, address=LOOPBACK, **kwargs)
 
             app.listen = loopback_listen

@@ -9,25 +9,27 @@ with ``follower="step"`` by the whole-body step (:func:`kinelab.wholebody.follow
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 from kinelab.errors import ChainError, OptionError
 from kinelab.ik import api as chain_api
 from kinelab.robot.chain import Chain
 from kinelab.robot.tree import Robot
+from kinelab.typing import Target, Targets
 from kinelab.wholebody import follow
 from kinelab.wholebody import solve as wholebody
-from kinelab.wholebody.tasks import TASK_TYPES
+from kinelab.wholebody.tasks import TASK_TYPES, Task
 
 
-def is_tasks(target: Any) -> bool:
+def is_tasks(target: object) -> bool:
     """True for a task or a non-empty list or tuple of tasks."""
     if isinstance(target, TASK_TYPES):
         return True
     return isinstance(target, list | tuple) and bool(target) and all(isinstance(t, TASK_TYPES) for t in target)
 
 
-def solve(robot: Chain | Robot, target: Any, *positional: Any, **settings: Any) -> Any:
+def solve(robot: Chain | Robot, target: Target | Sequence[Task], *positional: object, **settings: Any) -> Any:
     """Inverse kinematics: a chain's tool at ``target`` (an ``IKResult``), or a whole robot's tasks (a
     ``WholeBodyResult``).
 
@@ -62,7 +64,7 @@ FOLLOWERS = ("frdm", "step")
 STEP_SETTINGS = ("q0", "seed", "tol_pos", "tol_rot", "time_budget", "task", "axis", "jump_limit")
 
 
-def track(robot: Chain, targets: Any, *positional: Any, follower: str = "frdm", **settings: Any) -> Any:
+def track(robot: Chain, targets: Targets, *positional: object, follower: str = "frdm", **settings: Any) -> Any:
     """Follow a path: each target in turn, from the answer before.
 
     Args:

@@ -36,6 +36,7 @@ from kinelab.ik.result import Status, TrackResult
 from kinelab.ik.targets import as_target_arrays
 from kinelab.robot.chain import Chain
 from kinelab.robot.tree import Robot
+from kinelab.typing import Configuration, Targets
 from kinelab.wholebody.limits import Limits
 from kinelab.wholebody.step import StepOptions, step
 from kinelab.wholebody.tasks import FrameTask, PostureTask
@@ -169,7 +170,8 @@ def preferred(robot: Robot, q: np.ndarray, v_prev: np.ndarray) -> tuple[np.ndarr
     return np.asarray(pin.integrate(robot.model, q, d), dtype=float), weight / weight.max()
 
 
-def track(chain: Chain, targets: Any, *, q0: Any = None, seed: int | None = None, tol_pos: float = 1e-6,
+def track(chain: Chain, targets: Targets, *, q0: Configuration | None = None, seed: int | None = None,
+          tol_pos: float = 1e-6,
           tol_rot: float = 1e-6, time_budget: float | None = None, task: str = "pose", axis: str = "z",
           jump_limit: float | None = 0.2) -> TrackResult:
     """Follow a path by the step (see the module's docstring): ``kinelab.track(chain, targets, follower="step")``.

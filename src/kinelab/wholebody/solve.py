@@ -23,6 +23,7 @@ from kinelab.errors import ChainError, OptionError
 from kinelab.ik.result import Status
 from kinelab.robot.space import generator
 from kinelab.robot.tree import Robot
+from kinelab.typing import Configuration
 from kinelab.wholebody import evaluate as ev
 from kinelab.wholebody.frdm import frdm_solve
 from kinelab.wholebody.iterate import SolveSettings, iterate, posture_second
@@ -77,7 +78,7 @@ class WholeBodyResult:
                          if not t.met)
 
 
-def solve(robot: Robot, tasks: Any, *, q0: Any = None, solver: str = "step", seed: int | None = None,
+def solve(robot: Robot, tasks: Any, *, q0: Configuration | None = None, solver: str = "step", seed: int | None = None,
           tol_pos: float = 1e-6, tol_rot: float = 1e-6, max_iterations: int = 100, max_restarts: int = 200,
           time_budget: float | None = 1.0, limits: Limits | None = None) -> WholeBodyResult:
     """A configuration that meets every task (see the module's docstring).

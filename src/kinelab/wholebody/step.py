@@ -18,6 +18,7 @@ import pinocchio as pin
 
 from kinelab.errors import ChainError, OptionError
 from kinelab.robot.tree import Robot
+from kinelab.typing import Configuration
 from kinelab.wholebody import compiled as cp
 from kinelab.wholebody import evaluate as ev
 from kinelab.wholebody import qp
@@ -113,7 +114,7 @@ DEFAULT_LIMITS = Limits()
 DEFAULT_OPTIONS = StepOptions()
 
 
-def step(robot: Robot, q: Any, tasks: Any, dt: float, *, limits: Limits = DEFAULT_LIMITS,
+def step(robot: Robot, q: Configuration, tasks: Any, dt: float, *, limits: Limits = DEFAULT_LIMITS,
          options: StepOptions = DEFAULT_OPTIONS, v_prev: Any = None) -> StepResult:
     """One differential step of whole-body kinematics (see the module's docstring).
 

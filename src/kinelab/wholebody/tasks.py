@@ -21,9 +21,11 @@ from typing import Any
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from kinelab.core._verdict import pose_defect
 from kinelab.errors import OptionError, TargetError, count_of
+from kinelab.typing import Configuration
 
 FRAME_TASKS = ("pose", "position", "axis", "orientation")
 AXES = "xyz"
@@ -147,7 +149,7 @@ class FrameTask:
                                                self.orientation_weight, self.gain, self.priority)
         return found
 
-    def moved(self, target: Any) -> FrameTask:
+    def moved(self, target: pin.SE3 | ArrayLike) -> FrameTask:
         """The same task at another target (checked), its other settings taken as they are: a path's samples.
 
         Raises:
@@ -303,7 +305,7 @@ class PostureTask:
         weight = ("per velocity", self.weight.size) if isinstance(self.weight, np.ndarray) else self.weight
         return ("p", weight, self.gain, self.priority, self.base)
 
-    def moved(self, q_ref: Any, weight: Any = None) -> PostureTask:
+    def moved(self, q_ref: Configuration | None, weight: Any = None) -> PostureTask:
         """The same task toward another reference (and with other weights when given), checked: a follower's
         samples.
 

@@ -46,6 +46,7 @@ from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target_arrays, beyond_reach, reach_bound
 from kinelab.robot import Chain
 from kinelab.robot.chain import _compiled_judge
+from kinelab.typing import Configuration, Target, Targets
 
 if TYPE_CHECKING:
     from kinelab.collision.model import CollisionModel
@@ -95,7 +96,7 @@ def has_general_form(robot: Chain, req: Request) -> bool:
     return req.task.name == "pose" and general_class(robot).arm is not None
 
 
-def analytic_all(robot: Chain, target: Any, req: Request, q_ref: np.ndarray | None = None,
+def analytic_all(robot: Chain, target: pin.SE3, req: Request, q_ref: np.ndarray | None = None,
                  max_solutions: int | None = None) -> Branches:
     """Every branch of the pose ``target`` (oMtarget, base frame) that Pinocchio confirms within the limits.
 
@@ -215,7 +216,7 @@ class Rows(NamedTuple):
         return Rows(*(column[order] for column in self))
 
 
-def judged_roots(robot: Chain, q: np.ndarray, found: np.ndarray, free: np.ndarray, target: Any,
+def judged_roots(robot: Chain, q: np.ndarray, found: np.ndarray, free: np.ndarray, target: pin.SE3,
                  req: Request, held: dict[str, float] | None = None) -> list[Answer]:
     """The roots q (m × n) the judge confirms, in their order: each as (q, position error [m], rotation error [rad],
     finished, roots merged, one of a continuum). Where the robot's compiled FK is certified, every root is judged in
@@ -351,7 +352,7 @@ def _six_vectors(robot: Chain) -> tuple[np.ndarray, ...] | None:
     return v["e"].copy(), v["o"].copy(), v["R"].copy(), v["N"].copy()
 
 
-def nearest_roots(robot: Chain, arm: ArmClass, target: Any, req: Request,
+def nearest_roots(robot: Chain, arm: ArmClass, target: pin.SE3, req: Request,
                   ref: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any]:
     """:func:`roots` of the pose ``target`` (copies nearest ``ref``, roots up to ``tol_rot`` past a limit tried at
     it) and the order to try them in: nearest ``ref`` first (joint by joint, modulo 2π), as found without it."""
@@ -393,7 +394,7 @@ def near_enough(dp: float, dr: float, req: Request) -> bool:
     return dp <= 1e3 * req.tol_pos + 1e-6 and dr <= 1e3 * req.tol_rot + 1e-6
 
 
-def judged(robot: Chain, q: np.ndarray, target: Any, req: Request,
+def judged(robot: Chain, q: np.ndarray, target: Target, req: Request,
            held: dict[str, float] | None = None) -> tuple[np.ndarray, float, float, bool] | None:
     """(q, position error, rotation error, finished) when Pinocchio's FK of q meets the tolerances, after a
     warm-started finish (``finished``; the joints of ``held`` frozen at their values [rad]) if the closed form
@@ -441,7 +442,7 @@ class BranchBatch:
     late: np.ndarray | None = None
 
 
-def all_branches_batch(robot: Chain, targets: Any, tol_pos: float = 1e-6, tol_rot: float = 1e-6,
+def all_branches_batch(robot: Chain, targets: Targets, tol_pos: float = 1e-6, tol_rot: float = 1e-6,
                        time_budget: float | None = None) -> BranchBatch:
     """Every branch of each pose in ``targets`` (what :func:`analytic_all` gives each, copies nearest 0), on all
     cores: where the robot's compiled FK is certified the closed form and the judge run in one compiled pass; a pose
@@ -589,7 +590,7 @@ class OneCall:
         self.unfinished = np.zeros(MAX_ROWS, dtype=np.bool_)  # the compiled form finishes no root
         self.robot = robot
 
-    def found(self, target: Any, ref: np.ndarray | None) -> tuple[Rows, float] | None:
+    def found(self, target: pin.SE3, ref: np.ndarray | None) -> tuple[Rows, float] | None:
         """(the compiled closed form's rows, the start of the clock [s]), or None where the general route must
         answer (a root to finish, no branch, a target that is not a ``pin.SE3`` or not a pose)."""
         if type(target) is not pin.SE3:
@@ -605,7 +606,7 @@ class OneCall:
 class NearestBranch(OneCall):
     """:func:`analytic_one`'s usual call: the branch nearest the reference, in one compiled call."""
 
-    def solve(self, target: Any, ref: np.ndarray | None) -> IKResult | None:
+    def solve(self, target: Target, ref: np.ndarray | None) -> IKResult | None:
         """The branch nearest ``ref`` (checked, [rad]; None: the first), or None where :func:`analytic_one` must
         answer."""
         got = self.found(target, ref)
@@ -620,7 +621,7 @@ class EveryBranch(OneCall):
     """:func:`kinelab.solve_all`'s usual call: every branch as arrays, each IKResult built when the set is first read
     (as :func:`branch_results` builds it)."""
 
-    def solve(self, target: Any) -> Branches | None:
+    def solve(self, target: Target) -> Branches | None:
         """Every branch of ``target``, or None where the general route must answer."""
         if type(target) is not pin.SE3:
             return None
@@ -642,7 +643,7 @@ class EveryBranch(OneCall):
         return _filled(self.fields, rows, i, wall_time, len(q), self.unseen)
 
 
-def analytic_one(robot: Chain, target: Any, req: Request, q0: np.ndarray | None,
+def analytic_one(robot: Chain, target: pin.SE3, req: Request, q0: np.ndarray | None,
                  model: CollisionModel | None = None) -> IKResult:
     """The branch nearest ``q0`` (each angle's copy in the limits nearest it; without q0 the first branch) that
     Pinocchio confirms — and, with a collision ``model``, the nearest that is clear.
@@ -729,7 +730,8 @@ def _no_branch(robot: Chain, target: Any, req: Request, q0: np.ndarray | None, c
                     task=req.task_label, diagnostics=Diagnostics(path="compiled", branches=0))
 
 
-def nearest_batch(robot: Chain, targets: Any, q0: Any, req: Request, model: CollisionModel | None) -> BatchIKResult:
+def nearest_batch(robot: Chain, targets: Targets, q0: Configuration | None, req: Request,
+                  model: CollisionModel | None) -> BatchIKResult:
     """:func:`analytic_one` for every target of a batch (q0: None, one start for every row, or (B, n) starts).
 
     Raises:
@@ -745,7 +747,7 @@ def nearest_batch(robot: Chain, targets: Any, q0: Any, req: Request, model: Coll
     return _nearest_rows(robot, H, starts, req, model, t0)
 
 
-def batch_starts(robot: Chain, q0: Any, count: int) -> np.ndarray | None:
+def batch_starts(robot: Chain, q0: Configuration | None, count: int) -> np.ndarray | None:
     """A batch's starts as (count, n) [rad or m] (None: none given; one start serves every row).
 
     Raises:
@@ -754,7 +756,7 @@ def batch_starts(robot: Chain, q0: Any, count: int) -> np.ndarray | None:
     starts = None if q0 is None else robot.check_qs(np.atleast_2d(q0), what="q0")
     if starts is not None and starts.shape[0] not in (1, count):
         raise ConfigurationError(f"q0 must be None, {robot.n} numbers or ({count}, {robot.n}) for {count} targets of "
-                                 f"{robot.name}, got {count_of(np.shape(q0))}")
+                                 f"{robot.name}, got {count_of(np.asarray(q0).shape)}")
     return None if starts is None else np.broadcast_to(starts, (count, robot.n))
 
 

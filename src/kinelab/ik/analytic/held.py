@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import time
 from dataclasses import replace
-from typing import Any
 
 import numpy as np
 
@@ -35,6 +34,7 @@ from kinelab.ik.request import Request, make_request, verdict_reserve
 from kinelab.ik.result import Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target_arrays
 from kinelab.robot import Chain
+from kinelab.typing import Configuration, Target, Targets
 
 SAMPLES = 32  # values of the held joint tried over its range when the start's own value has no branch
 CHECKS = 32  # seeded poses at which the six's compiled roots must meet the pose as they come
@@ -153,7 +153,7 @@ def held_rows(robot: Chain, H: np.ndarray, starts: np.ndarray | None, req: Reque
     return q, tried, False
 
 
-def nearest_held(robot: Chain, targets: Any, q0: Any, req: Request) -> BatchIKResult:
+def nearest_held(robot: Chain, targets: Targets, q0: Configuration | None, req: Request) -> BatchIKResult:
     """Solver "analytic" for every target of a 7R arm (see the module's docstring): q0 None, one start for every
     row, or (B, 7) starts [rad]; the request's budget, when it has one, bounds the whole batch (rows left when it
     runs out: NaN, status ``time_budget``).
@@ -199,7 +199,7 @@ def _by_frdm(robot: Chain, res: BatchIKResult, H: np.ndarray, starts: np.ndarray
     res.mode += f"; {rest.size} of {len(H)} rows by FRDM (no branch at any value tried)"
 
 
-def nearest_held_one(robot: Chain, target: Any, q0: np.ndarray | None, req: Request) -> IKResult:
+def nearest_held_one(robot: Chain, target: Target, q0: np.ndarray | None, req: Request) -> IKResult:
     """Solver "analytic" for one target of a 7R arm: the batch of one (:func:`nearest_held`), as a result."""
     t0 = time.perf_counter()
     res = nearest_held(robot, [target], None if q0 is None else q0[None, :], req)

@@ -39,6 +39,7 @@ from kinelab.ik.request import Request
 from kinelab.ik.result import Branches
 from kinelab.ik.targets import beyond_reach
 from kinelab.robot import Chain
+from kinelab.typing import Configuration
 
 MATCH = 1.0  # rad: a branch at one sample and its nearest at the next are one branch followed when this close
 NEWTON_STEPS = 30
@@ -196,7 +197,7 @@ def _arm7(robot: Chain) -> Arm7:
                 nearest_on(h[6], o[6], h[5], o[5]))
 
 
-def sew_angle(robot: Chain, q: Any, sew: SEW | None = None) -> float:
+def sew_angle(robot: Chain, q: Configuration, sew: SEW | None = None) -> float:
     """The SEW angle ψ [rad] of the 7R robot at q (rad), by ``sew``'s reference (None: the default one).
 
     Raises:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
-from typing import Any
 
 from kinelab.dq.algebra import DualQuat
 from kinelab.errors import OptionError
@@ -78,7 +77,7 @@ class BiquatOptions:
             raise OptionError("target_biquaternion", self.target_biquaternion, "a unit DualQuat or None")
 
     @classmethod
-    def of(cls, options: BiquatOptions | None = None, **kwargs: Any) -> BiquatOptions:
+    def of(cls, options: BiquatOptions | None = None, **kwargs: object) -> BiquatOptions:
         """``options`` as given, or built from keyword arguments (cached for hashable ones)."""
         return opt.resolve(cls, "biquat", options, kwargs)
 

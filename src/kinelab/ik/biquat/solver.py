@@ -77,7 +77,7 @@ def regular_law(M: DualQuat, T: tuple[float, float], k: float, k0: float = 0.0) 
 
 
 def attempt(robot: Chain, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol_rot: float, deadline: float,
-            options: BiquatOptions | None = None, **kwargs: Any) -> Attempt:
+            options: BiquatOptions | None = None, **kwargs: object) -> Attempt:
     """Integrate q̇ = A⁻¹U from ``q0`` until M* is within tolerance of ±1 or a limit is reached.
 
     The stopping test is |m⃗| < tol_rot/2 and |m0⃗| < tol_pos/2: near ±1, m⃗ ≈ δθ/2 and m0⃗ ≈ ½R*ᵀΔp.

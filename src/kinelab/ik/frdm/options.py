@@ -161,7 +161,7 @@ class FRDMOptions:
                 object.__setattr__(self, name, _bypass_steps(name, steps))
 
     @classmethod
-    def of(cls, options: FRDMOptions | None = None, **kwargs: Any) -> FRDMOptions:
+    def of(cls, options: FRDMOptions | None = None, **kwargs: object) -> FRDMOptions:
         """``options`` as given, or built from keyword arguments (cached for hashable ones)."""
         return opt.resolve(cls, "frdm", options, kwargs)
 

@@ -11,7 +11,6 @@ from __future__ import annotations
 import functools
 import time
 from dataclasses import replace
-from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -50,7 +49,7 @@ def prepare(robot: Chain, options: FRDMOptions | None = None) -> None:
 
 
 def attempt(robot: Chain, oMtarget: pin.SE3, q0: np.ndarray, tol_pos: float, tol_rot: float, deadline: float,
-            options: FRDMOptions | None = None, **kwargs: Any) -> Attempt:
+            options: FRDMOptions | None = None, **kwargs: object) -> Attempt:
     """One FRDM run from ``q0`` with the singularity monitor and the bypass policy.
 
     Args:

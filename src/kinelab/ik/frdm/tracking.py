@@ -35,6 +35,7 @@ from kinelab.ik.result import Attempt, BypassRecord, SingularEvent, Status, Trac
 from kinelab.ik.targets import TargetArrays
 from kinelab.ik.tasks import Task
 from kinelab.robot import Chain
+from kinelab.typing import SolverOptions
 
 RESTRICTIONS = ("intervals", "freeze")
 # FRDM's defaults on a path: a longer sweep cap and stall window than a single solve's, since a warm start
@@ -69,7 +70,7 @@ class PathSettings:
         object.__setattr__(self, "restrict", tuple(restrict))
 
 
-def path_options(options: Any, solver_options: dict[str, Any]) -> dict[str, Any]:
+def path_options(options: SolverOptions, solver_options: dict[str, Any]) -> dict[str, Any]:
     """The FRDM option keywords of a path: :data:`PATH_DEFAULTS` under the caller's (none when an options
     object is given: it is taken as it is)."""
     return solver_options if options is not None else {**PATH_DEFAULTS, **solver_options}

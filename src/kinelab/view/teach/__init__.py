@@ -12,6 +12,7 @@ from typing import Any
 from kinelab.errors import OptionError
 from kinelab.robot import Chain
 from kinelab.robot.tree import Robot
+from kinelab.typing import Configuration
 from kinelab.view.teach.server import TeachServer
 from kinelab.view.teach.session import TeachOptions, TeachSession
 from kinelab.view.teach.whole import WholeTeachSession
@@ -56,7 +57,7 @@ class Teach:
         self.close()
 
 
-def teach(robot: Chain | Robot, q: Any = None, options: TeachOptions | None = None, port: int = 0,
+def teach(robot: Chain | Robot, q: Configuration | None = None, options: TeachOptions | None = None, port: int = 0,
           hands: tuple[str, ...] | None = None, feet: tuple[str, ...] | None = None) -> Teach:
     """Serve a teach page for ``robot`` on 127.0.0.1 in the background and return it (shown in a notebook cell).
 

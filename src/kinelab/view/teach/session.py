@@ -28,6 +28,7 @@ from kinelab.ik import options as opt
 from kinelab.ik import solve, solve_all
 from kinelab.ik.turns import nearest_turns
 from kinelab.robot import Chain
+from kinelab.typing import Configuration
 from kinelab.view.collisions import draw_obstacles, overlay_contacts
 from kinelab.view.scene import TARGET, Scene, on_top
 from kinelab.view.teach.recorder import RecordingWindow
@@ -39,7 +40,7 @@ def _locked(method: F) -> F:
     """One action at a time: the page's requests come on threads of their own, a notebook's calls on its own."""
 
     @functools.wraps(method)
-    def run(self: TeachSession, *args: Any, **kwargs: Any) -> Any:
+    def run(self: TeachSession, *args: Any, **kwargs: object) -> Any:
         with self.lock:
             return method(self, *args, **kwargs)
 
@@ -82,7 +83,7 @@ class Session:
     lock: threading.RLock
 
     @_locked
-    def set_q(self, q: Any) -> None:
+    def set_q(self, q: Configuration) -> None:
         """Put the robot at q (within the limits, rad or m); the targets stay.
 
         Raises:
