@@ -55,7 +55,7 @@ def test_the_package_tree_has_no_import_cycles_and_lower_layers_import_no_higher
     import ast
 
     layers = ["errors", "files", "lazy", "scratch", "progress", "geometry", "core", "robot", "collision",
-              "dq", "ik", "wholebody", "analysis", "maps", "studies", "view", "report", "cli"]
+              "dq", "typing", "ik", "wholebody", "analysis", "maps", "studies", "view", "report", "cli"]
     rank = {name: i for i, name in enumerate(layers)}
     src = ROOT / "src" / "kinelab"
     for path in src.rglob("*.py"):

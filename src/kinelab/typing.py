@@ -1,8 +1,10 @@
 """The types of what kinelab's public calls take, named once (for readers, editors and type checkers).
 
-Each alias says what a call accepts; the call itself checks what it is given and raises a named
-:class:`~kinelab.errors.KinelabError` for anything else (a wrong shape, NaN, a rotation that is not one), so a value
-outside these types gets an error, never a wrong answer. Units: m and rad; poses in the chain's base frame.
+Each alias says what a call accepts (a solver's options object is :data:`kinelab.ik.registry.SolverOptions`); the
+call itself checks what it is given and raises a named :class:`~kinelab.errors.KinelabError` for anything else (a
+wrong shape, NaN, a rotation that is not one), so a value outside these types gets an error, never a wrong answer.
+Units: m and rad; poses in the chain's base frame. This layer sits above ``collision`` and ``dq`` (whose classes it
+names) and below ``ik``.
 """
 
 from __future__ import annotations
@@ -20,9 +22,6 @@ if TYPE_CHECKING:
     from kinelab.collision.model import Collisions
     from kinelab.collision.obstacles import Environment
     from kinelab.dq import DualQuat
-    from kinelab.ik.biquat.options import BiquatOptions
-    from kinelab.ik.dls import DLSOptions
-    from kinelab.ik.frdm.options import FRDMOptions
 
 Configuration: TypeAlias = ArrayLike
 """A configuration: one value per joint of the chain [rad or m], in the order of ``robot.joint_names``."""
@@ -38,7 +37,4 @@ CollisionSpec: TypeAlias = "Literal['self'] | Environment | Collisions | None"
 """What a solve keeps clear of: None (nothing checked), "self" (the robot's own links), an
 :class:`~kinelab.collision.Environment` of obstacles, or :class:`~kinelab.collision.Collisions` (both, a margin)."""
 
-SolverOptions: TypeAlias = "FRDMOptions | BiquatOptions | DLSOptions | None"
-"""A solver's options object, taken as it is (None: the solver's defaults under the keywords given)."""
-
-__all__ = ["CollisionSpec", "Configuration", "SolverOptions", "Target", "Targets"]
+__all__ = ["CollisionSpec", "Configuration", "Target", "Targets"]

@@ -20,6 +20,7 @@ from kinelab.errors import ConfigurationError, KinelabError
 if TYPE_CHECKING:
     import numpy as np
     import pinocchio as pin
+    from numpy.typing import ArrayLike
 
     from kinelab import collision, geometry, progress
     from kinelab import robot as robot_module
@@ -237,12 +238,12 @@ def pose_dict(oMtool: pin.SE3) -> dict[str, Any]:
     }
 
 
-def print_json(obj: Any) -> None:
+def print_json(obj: object) -> None:
     """Print ``obj`` as indented JSON."""
     print(json.dumps(obj, indent=2))
 
 
-def rounded(values: Any, digits: int) -> list[float]:
+def rounded(values: ArrayLike, digits: int) -> list[float]:
     """Rounded for printing, without the −0.0 that rounding a tiny negative number leaves."""
     out: list[float] = (np.round(np.asarray(values, dtype=float), digits) + 0.0).tolist()
     return out
@@ -253,7 +254,7 @@ def plural(count: int, word: str, plural_form: str | None = None) -> str:
     return f"{count} {word}" if count == 1 else f"{count} {plural_form or word + 's'}"
 
 
-def shown(values: Any, precision: int = 6, prefix: str = "") -> str:
+def shown(values: ArrayLike, precision: int = 6, prefix: str = "") -> str:
     """Numbers as the CLI prints them: ``precision`` digits, rounding noise below 1e-12 as 0, no "-0", one line
     per row however many joints (``prefix``: the text before the array, for the rows after the first)."""
     clean = np.round(np.asarray(values, dtype=float), precision) + 0.0  # + 0.0 turns the −0 of rounding into 0

@@ -22,6 +22,7 @@ from typing import Any
 import coal
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from kinelab.collision.obstacles import Environment
 from kinelab.collision.spheres import PLANE, Frames
@@ -30,7 +31,6 @@ from kinelab.errors import KinelabError
 from kinelab.robot import Chain
 from kinelab.robot.meshes import mesh_package_dirs, missing_meshes
 from kinelab.robot.mjcf import is_mjcf
-from kinelab.typing import Configuration
 
 TOUCH = 1e-6  # [m] pairs this near contact count as colliding (CollisionModel.checked_margin)
 
@@ -65,7 +65,7 @@ class Collisions:
             raise CollisionError("collisions with neither self_collisions nor an environment check nothing")
 
 
-def as_collisions(value: Any) -> Collisions | None:
+def as_collisions(value: object) -> Collisions | None:
     """A :class:`Collisions` from what entry points accept: None (no check), "self", an Environment (itself
     and the obstacles) or a Collisions.
 
@@ -143,7 +143,7 @@ class CollisionModel:
                 req.security_margin = self.checked_margin
         return self.hdata
 
-    def contact(self, q: Configuration, first_test: bool = True) -> Contact | None:
+    def contact(self, q: ArrayLike, first_test: bool = True) -> Contact | None:
         """The first pair at q (rad or m, one number per joint) closer than the margin, with its distance, or
         None.
 
@@ -157,7 +157,7 @@ class CollisionModel:
         k = self.colliding_pair(q, first_test)
         return None if k is None else self.contact_of(k)
 
-    def contacts(self, q: Configuration) -> list[Contact]:
+    def contacts(self, q: ArrayLike) -> list[Contact]:
         """Every pair at q closer than the margin, each with its distance (the exact test on the pairs the first
         tests leave)."""
         q = self.robot.check_q(q)
@@ -166,7 +166,7 @@ class CollisionModel:
         pin.updateGeometryPlacements(self.robot.model, self.data, self.geom, self.gdata)
         return [self.contact_of(int(k)) for k in spheres if pin.computeCollision(self.geom, self.gdata, int(k))]
 
-    def colliding_pair(self, q: Configuration, first_test: bool = True) -> int | None:
+    def colliding_pair(self, q: ArrayLike, first_test: bool = True) -> int | None:
         """The index of the first pair at q closer than the margin, or None (no distance computed: cheaper
         than :meth:`contact`)."""
         q = self.robot.check_q(q)

@@ -20,11 +20,11 @@ from kinelab.ik.auto import resolved
 from kinelab.ik.batch import BatchIKResult
 from kinelab.ik.branches import UNSEEN
 from kinelab.ik.prepared import kept_solver, prepared
-from kinelab.ik.registry import capabilities, refuse_options
+from kinelab.ik.registry import SolverOptions, capabilities, refuse_options
 from kinelab.ik.request import check_robot
 from kinelab.ik.result import Branches, IKResult, TrackResult
 from kinelab.robot import Chain
-from kinelab.typing import CollisionSpec, Configuration, SolverOptions, Target, Targets
+from kinelab.typing import CollisionSpec, Configuration, Target, Targets
 
 if TYPE_CHECKING:  # the collision model and the closed forms load when a call asks for them
     from kinelab.ik.analytic import branches
@@ -43,7 +43,7 @@ _OLD_ORDER = {
 }
 
 
-def check_entry(robot: Any, function: str, positional: tuple[Any, ...]) -> None:
+def check_entry(robot: object, function: str, positional: tuple[Any, ...]) -> None:
     """What every entry point checks first: a Chain, and nothing positional after the target.
 
     Raises:

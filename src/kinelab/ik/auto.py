@@ -12,7 +12,7 @@ branch: :mod:`kinelab.ik.registry`.)
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from kinelab import lazy
 from kinelab.robot.chain import Chain
@@ -29,7 +29,7 @@ else:
 AUTO = "auto"
 
 
-def resolved(robot: Chain, solver: Any, task: Any, collisions: CollisionSpec, has_options: bool) -> Any:
+def resolved(robot: Chain, solver: str, task: str, collisions: CollisionSpec, has_options: bool) -> str:
     """The solver ``solver`` stands for on this robot: itself, unless it is "auto" (see the module's docstring)."""
     if solver != AUTO:
         return solver

@@ -12,12 +12,13 @@ import time
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 import pinocchio as pin
 
 from kinelab.ik.limits import turned_verdict, wrap_q
+from kinelab.ik.registry import SolverOptions
 from kinelab.ik.request import Request, verdict_reserve
 from kinelab.ik.result import Attempt, BypassRecord, IKResult, SingularEvent, Status
 from kinelab.ik.spec import EngineSpec
@@ -25,7 +26,11 @@ from kinelab.ik.targets import as_target, out_of_reach, reach_bound
 from kinelab.ik.tasks import COMPONENTS, POSE, Task
 from kinelab.robot import Chain
 from kinelab.robot.chain import _compiled_judge
-from kinelab.typing import Configuration, SolverOptions, Target
+from kinelab.typing import Configuration, Target
+
+if TYPE_CHECKING:
+    from kinelab.ik.chain import ChainModel
+    from kinelab.ik.registry import SolverModule
 
 S = TypeVar("S", bound=EngineSpec)  # an engine's spec type
 
@@ -91,7 +96,7 @@ def solve_one(robot: Chain, target: Target, q0: Configuration | None, req: Reque
     return _loop(module, problem, _start(robot, q0, rng, req.start_outside_limits), max_restarts, opts, rng, beyond)
 
 
-def prepare_solver(module: Any, robot: Chain, options: SolverOptions) -> None:
+def prepare_solver(module: SolverModule, robot: Chain, options: SolverOptions) -> None:
     """The solver module's model building for this robot (its ``prepare``, where it has one): not a solve's time."""
     prepare = getattr(module, "prepare", None)
     if prepare is not None:
@@ -218,7 +223,7 @@ def compiled_result(pb: Call, att: Attempt, restarts: int, success: bool, dp: fl
     )
 
 
-def engine_spec(robot: Chain, req: Request, cm: Any,
+def engine_spec(robot: Chain, req: Request, cm: ChainModel,
                 attempt_of: Callable[[int, np.ndarray, np.ndarray, float], Attempt], mode: str,
                 diagnostics: Callable[[np.ndarray], Any], spec_type: type[S], **kernel: Any) -> S:
     """What a solver's one-call engine (:class:`kinelab.core._engine.Engine`) reads from its prepared solver: the

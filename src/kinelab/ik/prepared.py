@@ -36,7 +36,7 @@ from kinelab.ik.branches import UNSEEN, Route, find_all, route_of, usual_closed_
 from kinelab.ik.chain import chain_model
 from kinelab.ik.driver import prepare_solver, solve_one
 from kinelab.ik.options import flag
-from kinelab.ik.registry import capabilities, refuse_options
+from kinelab.ik.registry import SolverOptions, capabilities, refuse_options
 from kinelab.ik.request import Request, check_robot, check_seed, make_request
 from kinelab.ik.result import Branches, IKResult, TrackResult
 from kinelab.ik.targets import TargetArrays, as_target, as_target_arrays
@@ -89,10 +89,10 @@ class IK:
         SolverNotFoundError, OptionError: a bad setting, named (once, here).
     """
 
-    def __init__(self, robot: Chain, *positional: Any, solver: str = "frdm", tol_pos: float = 1e-6,
+    def __init__(self, robot: Chain, *positional: object, solver: str = "frdm", tol_pos: float = 1e-6,
                  tol_rot: float = 1e-6, time_budget: float | None = 1.0, max_restarts: int = 1000,
-                 start_outside_limits: str = "project", options: Any = None, task: str = "pose", axis: str = "z",
-                 collisions: Any = None, **solver_options: Any):
+                 start_outside_limits: str = "project", options: SolverOptions = None, task: str = "pose",
+                 axis: str = "z", collisions: CollisionSpec = None, **solver_options: object):
         if positional:
             raise TypeError("IK() takes the robot positionally and every setting by keyword: pass "
                             f"solver={positional[0]!r}")

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import importlib
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import TYPE_CHECKING, Any, Protocol, TypeAlias
 
 import numpy as np
 import pinocchio as pin
@@ -13,7 +13,14 @@ import pinocchio as pin
 from kinelab.errors import OptionError, SolverNotFoundError
 from kinelab.ik.result import Attempt
 from kinelab.robot import Chain
-from kinelab.typing import SolverOptions
+
+if TYPE_CHECKING:
+    from kinelab.ik.biquat.options import BiquatOptions
+    from kinelab.ik.dls import DLSOptions
+    from kinelab.ik.frdm.options import FRDMOptions
+
+SolverOptions: TypeAlias = "FRDMOptions | BiquatOptions | DLSOptions | None"
+"""A solver's options object, taken as it is (None: the solver's defaults under the keywords given)."""
 
 BUILTIN = {"frdm": "kinelab.ik.frdm.solver", "biquat": "kinelab.ik.biquat.solver", "dls": "kinelab.ik.dls"}
 SOLVERS: dict[str, Any] = {}
@@ -73,7 +80,7 @@ class SolverModule(Protocol):
         """One run from ``q0`` towards ``oMtarget``, before kinelab's Pinocchio check."""
 
 
-def register(name: str, module: Any, capabilities: Capabilities | None = None) -> None:
+def register(name: str, module: SolverModule, capabilities: Capabilities | None = None) -> None:
     """Make a solver module (see :class:`SolverModule`) available as ``solve(..., solver=name)``.
 
     Args:

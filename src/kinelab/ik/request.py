@@ -17,10 +17,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from kinelab.errors import ChainError, OptionError
-from kinelab.ik.registry import solver_module
+from kinelab.ik.registry import SolverOptions, solver_module
 from kinelab.ik.tasks import POSE, Task
 from kinelab.robot import Chain
-from kinelab.typing import SolverOptions
 
 START_POLICIES = ("project", "refuse")
 TOL_FLOOR = 1e-12
@@ -108,20 +107,21 @@ def make_request(solver: str = "frdm", seed: int | None = None, tol_pos: float =
                    None if seed is None else int(seed), start_outside_limits)
 
 
-def for_task(solver: str, opts: Any, task: Task) -> Any:
+def for_task(solver: str, opts: SolverOptions, task: Task) -> SolverOptions:
     """The solver's options for a task other than "pose" (its ``for_task``).
 
     Raises:
         OptionError: the solver meets whole poses only.
     """
-    if not hasattr(opts, "for_task"):
+    made = getattr(opts, "for_task", None)
+    if made is None:
         raise OptionError("task", task.name, f"'pose' for solver {solver!r}, which drives the whole pose; "
                           "solvers 'frdm' and 'dls' take 'position', 'axis' and 'orientation' too")
-    return opts.for_task(task)
+    return made(task)  # type: ignore[no-any-return]
 
 
-def check_arguments(tol_pos: Any, tol_rot: Any, time_budget: Any, max_restarts: Any, seed: object,
-                    start_outside_limits: Any) -> None:
+def check_arguments(tol_pos: float, tol_rot: float, time_budget: float | None, max_restarts: int, seed: object,
+                    start_outside_limits: str) -> None:
     """Refuse what no entry point can honour, naming the argument, the value and what is valid.
 
     Raises:
@@ -182,7 +182,7 @@ def check_seed(seed: object, name: str = "seed") -> None:
 MAX_RESTARTS = 10**9  # restarts a solve may ask for: more than any budget runs, and within the kernels' C ints
 
 
-def count_ok(value: Any) -> bool:
+def count_ok(value: object) -> bool:
     """An integer ≥ 0 (a bool is not a count)."""
     return not isinstance(value, bool) and isinstance(value, numbers.Integral) and int(value) >= 0
 

@@ -204,7 +204,7 @@ class Diagnostics:
     starts)."""
 
     @classmethod
-    def quick(cls: type[_D], **values: Any) -> _D:
+    def quick(cls: type[_D], **values: object) -> _D:
         """Diagnostics with these fields set (names and types the caller's own, unchecked): what a compiled
         solve builds on every call, without the frozen dataclass's per-field setattr (≈ 1 µs, not ≈ 9)."""
         made = object.__new__(cls)

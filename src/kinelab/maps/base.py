@@ -14,7 +14,6 @@ one answer per position.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -61,7 +60,7 @@ class BaseMap:
         return order[: min(count, int(self.reachable.sum()))]
 
 
-def check_count(count: Any) -> None:
+def check_count(count: object) -> None:
     """Refuse a count of best poses that is not an integer ≥ 0 (a negative one once listed the unreachable poses).
 
     Raises:

@@ -16,7 +16,7 @@ import struct
 import threading
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -26,6 +26,11 @@ from kinelab.maps.chunk import compute_chunk
 from kinelab.maps.store import ReachabilityMap, model_sha256
 from kinelab.progress import bar
 from kinelab.robot import Chain, catalog, load
+
+if TYPE_CHECKING:
+    from distributed import Client
+
+    from kinelab.maps.chunk import MapSpec
 
 INSTALL_HINT = "pip install 'kinelab[cluster]' (dask.distributed, cryptography)"
 CONNECT_TIMEOUT = 5.0  # [s] to reach a scheduler before giving up
@@ -60,7 +65,7 @@ def worker_robot(how: dict) -> Chain:
     return _ROBOTS[key]
 
 
-def chunk_task(how: dict, spec: Any, centres: np.ndarray, index: int) -> tuple[int, dict]:
+def chunk_task(how: dict, spec: MapSpec, centres: np.ndarray, index: int) -> tuple[int, dict]:
     """One chunk on a worker: (index, values). One kernel thread per task: the cluster gives the parallelism."""
     threads.set_count(1)
     return index, compute_chunk(worker_robot(how), spec, centres, index)
@@ -178,8 +183,8 @@ def _local_client(workers: int | None) -> Any:
     return Client(cluster, security=cluster.security)
 
 
-def run_chunks(client: Any, robot: Chain, spec: Any, centres: np.ndarray, todo: list[int], target: ReachabilityMap,
-               progress: bool | None = None) -> None:
+def run_chunks(client: Client, robot: Chain, spec: MapSpec, centres: np.ndarray, todo: list[int],
+               target: ReachabilityMap, progress: bool | None = None) -> None:
     """Submit the chunks ``todo`` and write each into ``target`` as it arrives."""
     from dask.distributed import as_completed
 

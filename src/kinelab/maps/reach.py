@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from kinelab.errors import KinelabError, OptionError
 from kinelab.maps import cluster, grid, store
@@ -15,10 +15,13 @@ from kinelab.maps.chunk import MAX_TARGETS, MapSpec, compute_chunk
 from kinelab.progress import bar
 from kinelab.robot import Chain
 
+if TYPE_CHECKING:
+    from distributed import Client
+
 __all__ = ["MAX_TARGETS", "MapSpec", "compute_chunk", "reachability"]
 
 
-def spec_of(spec: Any, fields: dict[str, Any]) -> MapSpec:
+def spec_of(spec: MapSpec | None, fields: dict[str, Any]) -> MapSpec:
     """The map's :class:`MapSpec`: ``spec`` as given, or one built from its fields, checked.
 
     Raises:
@@ -39,7 +42,7 @@ def spec_of(spec: Any, fields: dict[str, Any]) -> MapSpec:
 
 
 def reachability(robot: Chain, spec: MapSpec | None = None, out: str | None = None, force: bool = False,
-                 progress: bool | None = None, client: Any = None, **fields) -> Any:
+                 progress: bool | None = None, client: Client | None = None, **fields: Any) -> Any:
     """The reachability map of ``robot``, computed in this process chunk by chunk (written to ``out`` as they
     finish when given: an interrupted run resumes from the chunks already there).
 

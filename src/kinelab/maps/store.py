@@ -11,7 +11,7 @@ from __future__ import annotations
 import hashlib
 import warnings
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -19,6 +19,9 @@ import kinelab
 from kinelab.errors import KinelabError, OptionError
 from kinelab.files import as_path, output_folder
 from kinelab.robot import Chain
+
+if TYPE_CHECKING:
+    from kinelab.maps.chunk import MapSpec
 
 INSTALL_HINT = "pip install 'kinelab[maps]' (zarr)"
 VALUES = ("reachability", "manipulability", "sigma_ratio", "branches")
@@ -39,7 +42,7 @@ def model_sha256(robot: Chain) -> str:
     return hashlib.sha256(Path(robot.urdf_path).read_bytes()).hexdigest()
 
 
-def metadata(robot: Chain, spec: Any, voxels: int) -> dict:
+def metadata(robot: Chain, spec: MapSpec, voxels: int) -> dict:
     """What identifies a map: the robot, its model file's hash, the spec and the kinelab version."""
     return {"robot": robot.name, "source_sha256": model_sha256(robot),
             "spec": spec.to_dict(), "solver": "analytic" if spec.closed_form(robot) else "frdm",
@@ -168,7 +171,7 @@ class ReachabilityMap:
         return np.asarray(self.centres[:] if name == "centres" else self.values[name][:])
 
 
-def open_map(out: str | Path | None, robot: Chain, spec: Any, centres: np.ndarray) -> ReachabilityMap:
+def open_map(out: str | Path | None, robot: Chain, spec: MapSpec, centres: np.ndarray) -> ReachabilityMap:
     """A new map (in memory, or a new Zarr directory), or the unfinished one at ``out`` if it is the same map.
 
     Raises:

@@ -10,13 +10,12 @@ velocity=...>``) where it gives a positive finite one; none elsewhere (a free-fl
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from kinelab.errors import ConfigurationError, JointLimitError, OptionError, count_of
-from kinelab.typing import Configuration
 
 LIMIT_SLACK = 1e-9  # joint values this far past a limit still count as within it (rad or m)
 SAMPLE_TURNS = 4  # random configurations keep unbounded revolute joints within ±4 turns
@@ -75,7 +74,7 @@ def space_of(model: pin.Model) -> Space:
                  floating)
 
 
-def check_q(space: Space, model: pin.Model, q: Configuration, *, limits: bool = False, what: str = "q") -> np.ndarray:
+def check_q(space: Space, model: pin.Model, q: ArrayLike, *, limits: bool = False, what: str = "q") -> np.ndarray:
     """``q`` as nq finite floats (Pinocchio's q), its quaternions unit and, with ``limits``, its bounded joints
     within their limits.
 
@@ -108,7 +107,7 @@ def check_q(space: Space, model: pin.Model, q: Configuration, *, limits: bool = 
     return arr
 
 
-def check_v(space: Space, v: Any, what: str = "v") -> np.ndarray:
+def check_v(space: Space, v: ArrayLike, what: str = "v") -> np.ndarray:
     """``v`` as nv finite floats (a velocity, or a displacement over 1 s).
 
     Raises:
@@ -178,7 +177,8 @@ def spread_points(count: int, dims: int) -> np.ndarray:
     return 2.0 * np.mod(0.5 + np.outer(np.arange(1.0, count + 1.0), alpha), 1.0) - 1.0
 
 
-def uniform(rng: np.random.Generator, lower: np.ndarray, upper: np.ndarray, size: Any) -> np.ndarray:
+def uniform(rng: np.random.Generator, lower: np.ndarray, upper: np.ndarray,
+            size: int | tuple[int, ...] | None) -> np.ndarray:
     """Uniform draws between lower and upper, also where upper − lower overflows (a prismatic joint declared with
     ±1e308 m: numpy's uniform refuses that range)."""
     if (upper / 2 - lower / 2 < 0.5 * np.finfo(float).max).all():  # the width fits a float

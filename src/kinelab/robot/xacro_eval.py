@@ -117,7 +117,7 @@ def _check_statically(tree: ast.Expression) -> None:
             raise RefusedError(_described(node))
 
 
-def size(value: Any, limit: int = MAX_ITEMS) -> int:
+def size(value: object, limit: int = MAX_ITEMS) -> int:
     """Items in ``value``: a string's characters, a container's items through its nesting (1 for a scalar);
     stops counting past ``limit``."""
     if isinstance(value, str):
@@ -134,7 +134,7 @@ def size(value: Any, limit: int = MAX_ITEMS) -> int:
     return total
 
 
-def checked(value: Any) -> Any:
+def checked(value: object) -> Any:
     """``value`` when it is data within the bounds; RefusedError otherwise."""
     if value is None or isinstance(value, bool | float | str | Namespace):
         pass

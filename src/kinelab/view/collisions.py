@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import coal
 import meshcat.geometry as g
@@ -13,13 +13,16 @@ from kinelab.collision.model import CollisionModel, Contact
 from kinelab.collision.obstacles import Environment, Obstacle
 from kinelab.typing import Configuration
 
+if TYPE_CHECKING:
+    from kinelab.view.scene import Scene
+
 OBSTACLE_COLOURS = ((0x469990, "teal"), (0x9A6324, "brown"), (0x808000, "olive"), (0x911EB4, "purple"),
                     (0xBFEF45, "lime"), (0xFABED4, "pink"))  # none red (contacts), blue (joints) or orange
 CONTACT_COLOR = 0xE6194B
 PLANE_SIDE = 4.0  # [m] the square drawn for an (unbounded) plane
 
 
-def draw_collisions(scene: Any, model: CollisionModel, q: Configuration) -> list[Contact]:
+def draw_collisions(scene: Scene, model: CollisionModel, q: Configuration) -> list[Contact]:
     """Draw ``model``'s obstacles in ``scene`` and colour red the robot's visuals on the links in contact at q
     (the robot drawn at q first); returns the contacts, which the caption lists."""
     scene.show(q)
@@ -33,7 +36,7 @@ def draw_collisions(scene: Any, model: CollisionModel, q: Configuration) -> list
     return contacts
 
 
-def draw_obstacles(scene: Any, environment: Environment) -> Any:
+def draw_obstacles(scene: Scene, environment: Environment) -> Scene:
     """Draw the obstacles (translucent, each its own colour, named with it in the caption; a plane as a 4 m
     square) in ``scene``; returns the scene."""
     obstacles = environment.obstacles
@@ -53,7 +56,7 @@ def draw_obstacles(scene: Any, environment: Environment) -> Any:
     return scene
 
 
-def overlay_contacts(scene: Any, model: CollisionModel, names: set[str]) -> None:
+def overlay_contacts(scene: Scene, model: CollisionModel, names: set[str]) -> None:
     """The robot's collision objects in contact, drawn red over its visuals at the placements of the last check
     (unlit: a mesh without normals would draw black under a lit material; no depth test: drawn at the mesh's own
     depth, the copy and the mesh would fight pixel by pixel, red and black stripes, and a table would hide it)."""

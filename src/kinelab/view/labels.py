@@ -4,13 +4,16 @@ right from where the page opens."""
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING
 
 import meshcat.geometry as g
 import numpy as np
 import pinocchio as pin
 
 from kinelab.view.framing import AZIMUTH
+
+if TYPE_CHECKING:
+    import meshcat
 
 # a digit's segments as (x0, y0, x1, y1) in a cell one wide and two high, origin at its lower left
 STROKES = {"a": (0, 2, 1, 2), "b": (1, 2, 1, 1), "c": (1, 1, 1, 0), "d": (0, 0, 1, 0), "e": (0, 1, 0, 0),
@@ -26,7 +29,7 @@ def right_of_camera() -> np.ndarray:
     return np.cross([0.0, 0.0, 1.0], toward)
 
 
-def draw_number(node: Any, text: str, centre: np.ndarray, height: float, colour: int) -> None:
+def draw_number(node: meshcat.Visualizer, text: str, centre: np.ndarray, height: float, colour: int) -> None:
     """The digits of ``text`` under the meshcat ``node``, their block centred at ``centre`` [m, base frame],
     ``height`` [m] tall, upright and facing the camera.
 

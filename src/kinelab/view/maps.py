@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import base64
 import io
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import meshcat.geometry as g
 import numpy as np
@@ -14,6 +14,11 @@ from kinelab.typing import Configuration
 from kinelab.view.caption import before_body
 from kinelab.view.scene import Scene, _stick_figure, chain_points
 
+if TYPE_CHECKING:
+    import meshcat
+
+    from kinelab.maps.store import ReachabilityMap
+
 
 def colours(values: np.ndarray) -> np.ndarray:
     """(3, N) RGB in [0, 1] for values in [0, 1]: red at 0, yellow at 0.5, green at 1."""
@@ -21,7 +26,8 @@ def colours(values: np.ndarray) -> np.ndarray:
     return np.vstack([np.clip(2 * (1 - v), 0, 1), np.clip(2 * v, 0, 1), np.zeros_like(v)])
 
 
-def reachability_cloud(robot: Chain, rmap: Any, q: Configuration | None = None, viewer: Any = None,
+def reachability_cloud(robot: Chain, rmap: ReachabilityMap, q: Configuration | None = None,
+                       viewer: meshcat.Visualizer | None = None,
                        meshes: bool = True) -> Scene:
     """The robot at q (default: its display pose) with the map's reached voxels as points coloured by their
     reachability index; the caption says what the colours mean.
@@ -50,7 +56,7 @@ def reachability_cloud(robot: Chain, rmap: Any, q: Configuration | None = None, 
     return scene
 
 
-def reachability_slice(rmap: Any, axis: int = 2, value: float | None = None, ax: Any = None) -> Any:
+def reachability_slice(rmap: ReachabilityMap, axis: int = 2, value: float | None = None, ax: Any = None) -> Any:
     """The reachability index on the voxel layer nearest ``value`` [m] along base axis ``axis`` (default: the
     layer through the map's centre), as a matplotlib image; returns the axes."""
     import matplotlib.pyplot as plt
@@ -75,7 +81,7 @@ SLICES_STYLE = ("position:fixed;right:10px;top:40px;width:300px;padding:6px;bord
                 "background:rgba(255,255,255,0.92);box-shadow:0 1px 4px rgba(0,0,0,0.3);z-index:10")
 
 
-def map_page(robot: Chain, rmap: Any) -> str:
+def map_page(robot: Chain, rmap: ReachabilityMap) -> str:
     """A reachability map as one self-contained page: the reached voxels in 3-D over the robot's stick figure
     (the caption says what the colours mean) and the three slices through the map's centre (x, y and z layers)
     as images in a box on the right."""

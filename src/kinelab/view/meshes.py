@@ -11,11 +11,15 @@ from __future__ import annotations
 
 import functools
 import os
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import meshcat.geometry as g
 import numpy as np
 import pinocchio as pin
+
+if TYPE_CHECKING:
+    import meshcat
+    from pinocchio.visualize import MeshcatVisualizer
 
 COLLADA = (".dae",)
 DEFAULT_COLOUR = (0xC8C8C8, 1.0)  # a part with no material of its own and no robot-file colour
@@ -64,7 +68,7 @@ def is_collada(geometry: pin.GeometryObject) -> bool:
     return os.path.splitext(geometry.meshPath)[1].lower() in COLLADA and os.path.isfile(geometry.meshPath)
 
 
-def draw_collada(viewer: Any, geom: pin.GeometryModel, paths: list[str]) -> None:
+def draw_collada(viewer: meshcat.Visualizer, geom: pin.GeometryModel, paths: list[str]) -> None:
     """Replace what the page's loader made of each COLLADA geometry by its parts (see the module's docstring).
 
     Args:
@@ -96,7 +100,7 @@ def _file_colour(obj: pin.GeometryObject) -> tuple[int, float]:
     return (int(rgba[0] * 255) << 16) | (int(rgba[1] * 255) << 8) | int(rgba[2] * 255), float(rgba[3])
 
 
-def load_robot(viz: Any, root: str) -> None:
+def load_robot(viz: MeshcatVisualizer, root: str) -> None:
     """``viz.loadViewerModel(rootNodeName=root)`` (a Pinocchio ``MeshcatVisualizer``) with every COLLADA visual
     drawn as its file draws it."""
     viz.loadViewerModel(rootNodeName=root)

@@ -295,7 +295,8 @@ def sigma_colour(ratio: float) -> int:
 
 
 
-def aim_camera(viewer: Any, points: np.ndarray, margin: float, fill: float = FILL, aspect: float = PAGE_ASPECT,
+def aim_camera(viewer: meshcat.Visualizer, points: np.ndarray, margin: float, fill: float = FILL,
+               aspect: float = PAGE_ASPECT,
                floor_z: float = 0.0) -> Any:
     """Frame ``points`` (rows [m], base frame) in a meshcat viewer: meshcat turns its camera about the viewer's
     origin, so the scene moves to put their centre there, a floor grid at ``floor_z``, the camera at the framing
@@ -313,7 +314,7 @@ def aim_camera(viewer: Any, points: np.ndarray, margin: float, fill: float = FIL
     return view
 
 
-def side_by_side(robot: Chain, qs: list, spacing: float | None = None, viewer: Any = None,
+def side_by_side(robot: Chain, qs: list, spacing: float | None = None, viewer: meshcat.Visualizer | None = None,
                  labels: list[str] | None = None, highlight: int | None = None, target: pin.SE3 | None = None) -> Scene:
     """One scene with the robot drawn once per configuration as a stick figure (joints as spheres, the
     segments between joint origins and the tool point as cylinders), side by side on a grid, each copy numbered

@@ -10,7 +10,7 @@ with ``follower="step"`` by the whole-body step (:func:`kinelab.wholebody.follow
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, TypeGuard
 
 from kinelab.errors import ChainError, OptionError
 from kinelab.ik import api as chain_api
@@ -22,7 +22,7 @@ from kinelab.wholebody import solve as wholebody
 from kinelab.wholebody.tasks import TASK_TYPES, Task
 
 
-def is_tasks(target: object) -> bool:
+def is_tasks(target: object) -> TypeGuard[Task | Sequence[Task]]:
     """True for a task or a non-empty list or tuple of tasks."""
     if isinstance(target, TASK_TYPES):
         return True

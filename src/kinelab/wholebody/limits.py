@@ -139,7 +139,7 @@ def bounds(space: Space, q: np.ndarray, dt: float, vmax: np.ndarray, position: b
     return lo, hi, returning
 
 
-def is_positive_time(dt: Any) -> float:
+def is_positive_time(dt: object) -> float:
     """``dt`` [s] as a float > 0.
 
     Raises:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
@@ -37,6 +37,9 @@ from kinelab.wholebody.tasks import (
     Task,
     as_tasks,
 )
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
 
 
 @dataclass(frozen=True)
@@ -78,7 +81,8 @@ class WholeBodyResult:
                          if not t.met)
 
 
-def solve(robot: Robot, tasks: Any, *, q0: Configuration | None = None, solver: str = "step", seed: int | None = None,
+def solve(robot: Robot, tasks: Task | Sequence[Task], *, q0: Configuration | None = None, solver: str = "step",
+          seed: int | None = None,
           tol_pos: float = 1e-6, tol_rot: float = 1e-6, max_iterations: int = 100, max_restarts: int = 200,
           time_budget: float | None = 1.0, limits: Limits | None = None) -> WholeBodyResult:
     """A configuration that meets every task (see the module's docstring).

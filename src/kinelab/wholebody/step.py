@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
@@ -33,6 +33,11 @@ from kinelab.wholebody.tasks import (
     Task,
     as_tasks,
 )
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from numpy.typing import ArrayLike
 
 
 @dataclass(frozen=True)
@@ -83,8 +88,9 @@ class StepResult:
 
     __slots__ = ("v", "q", "status", "solved", "iterations", "_errors", "_labels", "_returning", "_names")
 
-    def __init__(self, v: np.ndarray, q: np.ndarray, status: str, solved: bool, errors: Any,
-                 returning: Any = (), iterations: int = 0, labels: tuple[str, ...] = (),
+    def __init__(self, v: np.ndarray, q: np.ndarray, status: str, solved: bool,
+                 errors: tuple[TaskError, ...] | np.ndarray, returning: tuple[str, ...] | np.ndarray = (),
+                 iterations: int = 0, labels: tuple[str, ...] = (),
                  names: tuple[str, ...] = ()):
         """A step's answer (``errors``: TaskErrors, or an (ntasks, 2) array with ``labels``; ``returning``: joint
         names, or a bool mask over the velocities with ``names``)."""
@@ -114,8 +120,8 @@ DEFAULT_LIMITS = Limits()
 DEFAULT_OPTIONS = StepOptions()
 
 
-def step(robot: Robot, q: Configuration, tasks: Any, dt: float, *, limits: Limits = DEFAULT_LIMITS,
-         options: StepOptions = DEFAULT_OPTIONS, v_prev: Any = None) -> StepResult:
+def step(robot: Robot, q: Configuration, tasks: Task | Sequence[Task], dt: float, *, limits: Limits = DEFAULT_LIMITS,
+         options: StepOptions = DEFAULT_OPTIONS, v_prev: ArrayLike | None = None) -> StepResult:
     """One differential step of whole-body kinematics (see the module's docstring).
 
     Args:

@@ -305,7 +305,7 @@ class PostureTask:
         weight = ("per velocity", self.weight.size) if isinstance(self.weight, np.ndarray) else self.weight
         return ("p", weight, self.gain, self.priority, self.base)
 
-    def moved(self, q_ref: Configuration | None, weight: Any = None) -> PostureTask:
+    def moved(self, q_ref: Configuration | None, weight: float | ArrayLike | None = None) -> PostureTask:
         """The same task toward another reference (and with other weights when given), checked: a follower's
         samples.
 
@@ -361,13 +361,13 @@ Task = FrameTask | RelativeFrameTask | ComTask | PostureTask | CouplingTask
 TASK_TYPES = (FrameTask, RelativeFrameTask, ComTask, PostureTask, CouplingTask)
 
 
-def as_tasks(tasks: Any) -> tuple[Task, ...]:
+def as_tasks(tasks: object) -> tuple[Task, ...]:
     """The tasks of a call: one task or a sequence of them.
 
     Raises:
         OptionError: anything else (named), or no task at all.
     """
-    items = (tasks,) if isinstance(tasks, TASK_TYPES) else tasks
+    items: Any = (tasks,) if isinstance(tasks, TASK_TYPES) else tasks
     try:
         found = tuple(items)
     except TypeError:

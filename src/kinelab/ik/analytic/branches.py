@@ -211,7 +211,7 @@ class Rows(NamedTuple):
                    np.array(columns[2], dtype=float), np.array(columns[3], dtype=np.bool_),
                    np.array(columns[4], dtype=np.int64), np.array(columns[5], dtype=np.bool_))
 
-    def taken(self, order: Any) -> Rows:
+    def taken(self, order: np.ndarray | list[int] | slice) -> Rows:
         """These rows in ``order`` (indices; a slice keeps the first ones)."""
         return Rows(*(column[order] for column in self))
 

@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import time
 from functools import partial
-from typing import Any
 
 import numpy as np
 import pinocchio as pin
+from numpy.typing import ArrayLike
 
 from kinelab.core._engine import BiquatEngine
 from kinelab.core._frdm import pack_chain
@@ -133,7 +133,7 @@ def _target_biquaternion(opts: BiquatOptions, oMtarget: pin.SE3) -> DualQuat:
     return N
 
 
-def paper_unit_biquaternion(real_wxyz: Any, dual_wxyz: Any) -> DualQuat:
+def paper_unit_biquaternion(real_wxyz: ArrayLike, dual_wxyz: ArrayLike) -> DualQuat:
     """A target given as printed numbers, checked: finite and unit (|λ| = 1, λ·λ0 = 0) to 1e-5."""
     lam = DualQuat(np.asarray(real_wxyz, float), np.asarray(dual_wxyz, float))
     return lam.require_unit("the target biquaternion", tol=1e-5).normalized()

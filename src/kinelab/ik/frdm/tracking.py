@@ -30,12 +30,12 @@ from kinelab.ik.frdm import solver
 from kinelab.ik.frdm.follower import follow
 from kinelab.ik.frdm.options import FRDMOptions
 from kinelab.ik.limits import wrap_q
+from kinelab.ik.registry import SolverOptions
 from kinelab.ik.request import Request
 from kinelab.ik.result import Attempt, BypassRecord, SingularEvent, Status, TrackResult
 from kinelab.ik.targets import TargetArrays
 from kinelab.ik.tasks import Task
 from kinelab.robot import Chain
-from kinelab.typing import SolverOptions
 
 RESTRICTIONS = ("intervals", "freeze")
 # FRDM's defaults on a path: a longer sweep cap and stall window than a single solve's, since a warm start
@@ -148,7 +148,7 @@ def self_motion_events(robot: Chain, Q: np.ndarray, q0: np.ndarray, points: np.n
     return _drift_events(drift, max(float(own.max()), 1e-12))
 
 
-def null_drift(robot: Chain, prev: np.ndarray, Q: np.ndarray, dx: np.ndarray, rows: Any
+def null_drift(robot: Chain, prev: np.ndarray, Q: np.ndarray, dx: np.ndarray, rows: list[int]
                ) -> tuple[np.ndarray, np.ndarray]:
     """The joint motion along the task's null space, sample by sample, with Pinocchio's Jacobians (a chain the
     compiled FK does not judge): with J the task's rows of the tool Jacobian at prev[k] (base axes at the tool origin)

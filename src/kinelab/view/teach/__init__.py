@@ -7,8 +7,6 @@ The page is served on 127.0.0.1 only; in a notebook, :func:`teach` shows it in t
 
 from __future__ import annotations
 
-from typing import Any
-
 from kinelab.errors import OptionError
 from kinelab.robot import Chain
 from kinelab.robot.tree import Robot
@@ -26,7 +24,8 @@ class Teach:
     ``teach.close()`` stops the server.
     """
 
-    def __init__(self, robot: Chain | Robot, q: Any = None, options: TeachOptions | None = None, port: int = 0,
+    def __init__(self, robot: Chain | Robot, q: Configuration | None = None, options: TeachOptions | None = None,
+                 port: int = 0,
                  hands: tuple[str, ...] | None = None, feet: tuple[str, ...] | None = None):
         self.session: TeachSession | WholeTeachSession
         if isinstance(robot, Robot):

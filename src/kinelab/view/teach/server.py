@@ -20,7 +20,7 @@ import threading
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 from urllib.parse import parse_qs, urlparse
 
 import meshcat
@@ -29,6 +29,10 @@ from kinelab.errors import KinelabError
 from kinelab.view.caption import tab_title
 from kinelab.view.teach.session import TeachSession, pose_from_matrix
 from kinelab.view.teach.whole import WholeTeachSession
+
+if TYPE_CHECKING:
+    from email.message import Message
+    from io import BufferedIOBase
 
 LOOPBACK = "127.0.0.1"
 MAX_BODY = 1 << 16  # [bytes] an action's JSON is a few hundred
@@ -126,7 +130,7 @@ class TeachServer:
             self.thread = None
         self.httpd.server_close()
 
-    def check_origin(self, headers: Any) -> None:
+    def check_origin(self, headers: Message) -> None:
         """Refuse a request that is not the page's own.
 
         Raises:
@@ -184,7 +188,7 @@ def _numbers(values: Any, valid: str) -> list[float]:
         raise KinelabError(f"{valid}; a number was too large for a float") from None
 
 
-def read_json(rfile: Any, length_header: str | None) -> dict[str, Any]:
+def read_json(rfile: BufferedIOBase, length_header: str | None) -> dict[str, Any]:
     """The request's body: a JSON object of at most :data:`MAX_BODY` bytes.
 
     Raises:

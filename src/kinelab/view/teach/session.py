@@ -100,7 +100,7 @@ class Session:
 class TeachSession(Session):
     """A robot to move by hand: joint values set directly, or a target pose the robot follows by IK."""
 
-    def __init__(self, robot: Chain, q: Any = None, options: TeachOptions | None = None):
+    def __init__(self, robot: Chain, q: Configuration | None = None, options: TeachOptions | None = None):
         self.robot, self.options = robot, options or TeachOptions()
         self.lock = threading.RLock()  # held by each action and reading (the server's threads, a notebook)
         if q is None:
@@ -179,7 +179,7 @@ class TeachSession(Session):
         self._draw()
 
     @_locked
-    def set_collisions(self, on: Any) -> None:
+    def set_collisions(self, on: object) -> None:
         """Switch the collision check on or off: with it on, no answer that collides is taken, and the contacts at
         q are listed.
 
@@ -323,7 +323,7 @@ def _short(text: str, most: int = 60) -> str:
     return text if len(text) <= most else text[: most - 1] + "…"
 
 
-def pose_from_matrix(values: Any) -> pin.SE3:
+def pose_from_matrix(values: object) -> pin.SE3:
     """A pose from 16 numbers (a 4 × 4 homogeneous matrix, rows first), as the page sends it.
 
     Raises:

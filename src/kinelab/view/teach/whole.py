@@ -10,7 +10,7 @@ its shadow on the floor, green inside the polygon, red outside.
 from __future__ import annotations
 
 import threading
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import meshcat
 import meshcat.geometry as g
@@ -28,6 +28,9 @@ from kinelab.view.teach.session import Session, TeachOptions, _checked_pose, _lo
 from kinelab.wholebody.solve import solve
 from kinelab.wholebody.tasks import ComTask, FrameTask, PostureTask
 
+if TYPE_CHECKING:
+    from kinelab.typing import Configuration
+
 SOLE = (0.20, 0.10)  # [m] the sole drawn under each foot frame for the support polygon: length (x), width (y)
 GOLD, COM, INSIDE, OUTSIDE = 0xF2B01E, 0xD62728, 0x2CA02C, 0xD62728
 
@@ -35,7 +38,7 @@ GOLD, COM, INSIDE, OUTSIDE = 0xF2B01E, 0xD62728, 0x2CA02C, 0xD62728
 class WholeTeachSession(Session):
     """A whole robot to move by hand: its hands' targets dragged, its feet and centre of mass held."""
 
-    def __init__(self, robot: Robot, q: Any = None, options: TeachOptions | None = None,
+    def __init__(self, robot: Robot, q: Configuration | None = None, options: TeachOptions | None = None,
                  hands: tuple[str, ...] | None = None, feet: tuple[str, ...] | None = None):
         """Draw the robot standing at q and its targets on its hands.
 
@@ -93,7 +96,7 @@ class WholeTeachSession(Session):
         """
         raise KinelabError("a whole robot's page has no branches: drag a hand's gold ball")
 
-    def set_collisions(self, on: Any) -> None:
+    def set_collisions(self, on: object) -> None:
         """Collisions are not checked on a whole robot's page.
 
         Raises:
