@@ -46,7 +46,7 @@ _LAZY = {
     "WholeBodyResult": ("kinelab.wholebody.solve", "WholeBodyResult"),
     "solve_all": ("kinelab.ik.api", "solve_all"),
     "solve_all_batch": ("kinelab.ik.api", "solve_all_batch"),
-    "BranchBatch": ("kinelab.ik.analytic.branches", "BranchBatch"),
+    "BranchBatch": ("kinelab.ik.analytic.batch", "BranchBatch"),
     "solve_batch": ("kinelab.ik.api", "solve_batch"),
     "solve_batch_on_cluster": ("kinelab.maps.batch", "solve_batch_on_cluster"),
     "BatchSpec": ("kinelab.maps.batch", "BatchSpec"),
@@ -77,7 +77,7 @@ __getattr__ = loader(__name__, globals(), _LAZY)
 if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and editors
     from kinelab.collision.model import Collisions
     from kinelab.collision.obstacles import Environment, Obstacle
-    from kinelab.ik.analytic.branches import BranchBatch
+    from kinelab.ik.analytic.batch import BranchBatch
     from kinelab.ik.analytic.sew import SEW, sew_angle
     from kinelab.ik.api import solve_all, solve_all_batch, solve_batch
     from kinelab.ik.batch import BatchIKResult

@@ -296,7 +296,7 @@ def test_a_double_root_is_one_branch_and_a_reference_picks_the_copies():
 
 
 def test_the_batch_gives_each_pose_the_branches_of_a_single_call_and_drops_what_pinocchio_refuses():
-    from kinelab.ik.analytic.branches import all_branches_batch
+    from kinelab.ik.analytic.batch import all_branches_batch
 
     robot = load("ur10")
     rng = np.random.default_rng(9)
@@ -506,9 +506,9 @@ def test_a_set_of_branches_is_arrays_and_builds_its_results_only_when_read(monke
     robot = load("ur5")
     target = robot.fk(robot.random_q(5))
     built = []
-    real_init, real_filled = IKResult.__init__, branches._filled  # the general route's results and the one call's
+    real_init, real_filled = IKResult.__init__, branches.filled  # the general route's results and the one call's
     monkeypatch.setattr(IKResult, "__init__", lambda self, *a, **k: built.append(1) or real_init(self, *a, **k))
-    monkeypatch.setattr(branches, "_filled", lambda *a, **k: built.append(1) or real_filled(*a, **k))
+    monkeypatch.setattr(branches, "filled", lambda *a, **k: built.append(1) or real_filled(*a, **k))
     found = kinelab.solve_all(robot, target)
     assert built == [] and found.q.shape == (len(found), 6) and len(found) >= 2
     assert found.rotation_error.shape == (len(found),) and np.all(found.position_error <= 1e-6)
@@ -551,7 +551,7 @@ def test_the_nearest_branch_in_one_compiled_call_is_the_general_route_s(name):
     """``solve(solver="analytic")``'s usual call (NearestBranch: every branch found and judged in one compiled call,
     the nearest kept) answers what the general route answers root by root with Pinocchio's FK: the same q, status and
     roots merged, the errors Pinocchio's to 1e-12, with a start near the pose, a random start and none."""
-    from kinelab.ik.analytic.branches import analytic_one
+    from kinelab.ik.analytic.nearest import analytic_one
     from kinelab.ik.request import make_request
 
     robot = load(name)

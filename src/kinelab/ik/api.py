@@ -27,11 +27,11 @@ from kinelab.robot import Chain
 from kinelab.typing import CollisionSpec, Configuration, Target, Targets
 
 if TYPE_CHECKING:  # the collision model and the closed forms load when a call asks for them
-    from kinelab.ik.analytic import branches
-    from kinelab.ik.analytic.branches import BranchBatch
+    from kinelab.ik.analytic import batch as analytic_batch
+    from kinelab.ik.analytic.batch import BranchBatch
     from kinelab.ik.analytic.sew import SEW
 else:
-    branches = lazy.module("kinelab.ik.analytic.branches", globals())
+    analytic_batch = lazy.module("kinelab.ik.analytic.batch", globals())
 
 # The order of the arguments after (robot, target) in kinelab 0.1's positional signatures: a call that still
 # passes them positionally is told which keyword its value was
@@ -197,7 +197,7 @@ def solve_all_batch(robot: Chain, targets: Targets, *positional: object, tol_pos
             when it runs out get no branch and are marked in the result's ``late``.
 
     Returns:
-        The :class:`~kinelab.ik.analytic.branches.BranchBatch`: ``q`` (B, 16, n) [rad] with the first ``count[b]``
+        The :class:`~kinelab.ik.analytic.batch.BranchBatch`: ``q`` (B, 16, n) [rad] with the first ``count[b]``
         rows of target b set (NaN after them), their errors, roots merged and continuum flags, and how complete each
         set is (``method``: "closed form", "search" or "elimination"; ``uncertified``: the elimination's reason per
         target, "" where its set is certified).
@@ -209,7 +209,7 @@ def solve_all_batch(robot: Chain, targets: Targets, *positional: object, tol_pos
     """
     check_entry(robot, "solve_all_batch", positional)
 
-    return branches.all_branches_batch(robot, targets, tol_pos, tol_rot, time_budget)
+    return analytic_batch.all_branches_batch(robot, targets, tol_pos, tol_rot, time_budget)
 
 
 def solve_all(robot: Chain, target: Target, *positional: object, solver: str = "auto", seed: int | None = None,

@@ -28,11 +28,12 @@ from kinelab.robot import Chain
 from kinelab.typing import Configuration, Target
 
 if TYPE_CHECKING:  # the closed forms load when a route asks for them: a multistart solve does without
-    from kinelab.ik.analytic import branches, sew
+    from kinelab.ik.analytic import branches, nearest, sew
     from kinelab.ik.analytic import redundancy as redundancy_module
-    from kinelab.ik.analytic.branches import EveryBranch
+    from kinelab.ik.analytic.nearest import EveryBranch
 else:
     branches = lazy.module("kinelab.ik.analytic.branches", globals())
+    nearest = lazy.module("kinelab.ik.analytic.nearest", globals())
     redundancy_module = lazy.module("kinelab.ik.analytic.redundancy", globals())
     sew = lazy.module("kinelab.ik.analytic.sew", globals())
 
@@ -164,7 +165,7 @@ def usual_closed_form(robot: Chain, target: Target, seed: object, settings: tupl
     return entry.solve(target)  # None: a root to finish, a bad pose or none, which the general route says
 
 
-def _usual_entry(robot: Chain, settings: tuple[Any, ...]) -> branches.EveryBranch | Literal[False]:
+def _usual_entry(robot: Chain, settings: tuple[Any, ...]) -> nearest.EveryBranch | Literal[False]:
     """The one-call solver of every branch for these settings, or False when the usual call does not apply.
 
     Raises:
@@ -178,7 +179,7 @@ def _usual_entry(robot: Chain, settings: tuple[Any, ...]) -> branches.EveryBranc
     if not (branches.has_closed_form(robot, req) or branches.has_general_form(robot, req)):
         return False
     form = branches.prepared_form(robot, req)
-    return False if form is None else branches.EveryBranch(robot, req, form)
+    return False if form is None else nearest.EveryBranch(robot, req, form)
 
 
 def _new_kept(_: Chain) -> dict[tuple[Any, ...], Any]:

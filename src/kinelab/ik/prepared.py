@@ -47,16 +47,19 @@ if TYPE_CHECKING:
     from kinelab.collision import model
     from kinelab.collision.model import CollisionModel
     from kinelab.ik import clear
-    from kinelab.ik.analytic import branches, held
-    from kinelab.ik.analytic.branches import NearestBranch
+    from kinelab.ik.analytic import batch as analytic_batch
+    from kinelab.ik.analytic import branches, held, nearest
+    from kinelab.ik.analytic.nearest import NearestBranch
     from kinelab.ik.analytic.sew import SEW
     from kinelab.ik.frdm import tracking
     from kinelab.ik.frdm.tracking import PathSettings
 else:
+    analytic_batch = lazy.module("kinelab.ik.analytic.batch", globals())
     branches = lazy.module("kinelab.ik.analytic.branches", globals())
     clear = lazy.module("kinelab.ik.clear", globals())
     held = lazy.module("kinelab.ik.analytic.held", globals())
     model = lazy.module("kinelab.collision.model", globals())
+    nearest = lazy.module("kinelab.ik.analytic.nearest", globals())
     tracking = lazy.module("kinelab.ik.frdm.tracking", globals())
 
 
@@ -137,7 +140,7 @@ class IK:
             branches.arm_of(robot, req)
             if self.collisions is None:  # the usual call's one compiled call: branches found and judged together
                 form = branches.prepared_form(robot, req)
-                self._nearest = None if form is None else branches.NearestBranch(robot, req, form)
+                self._nearest = None if form is None else nearest.NearestBranch(robot, req, form)
             return
         prepare_solver(req.module, robot, req.options)
 
@@ -203,8 +206,8 @@ class IK:
         found = None if self._nearest is None else self._nearest.solve(target, ref)
         if found is not None:  # the usual call: nothing imported on its way (an import costs 8 % of a 13 µs call)
             return found
-        return branches.analytic_one(self.robot, as_target(target, self.request.task.name), self.request, ref,
-                                     self.collisions)
+        return nearest.analytic_one(self.robot, as_target(target, self.request.task.name), self.request, ref,
+                                    self.collisions)
 
     def solve_batch(self, targets: Targets, *, q0: Configuration | None = None,
                     seed: int | None = None) -> BatchIKResult:
@@ -225,7 +228,7 @@ class IK:
         if self.held:
             return held.nearest_held(self.robot, targets, q0, req)
         if self.analytic:
-            return branches.nearest_batch(self.robot, targets, q0, req, self.collisions)
+            return analytic_batch.nearest_batch(self.robot, targets, q0, req, self.collisions)
         return batch_clear_of(self.robot, targets, q0, req, self.collisions)
 
     def solve_all(self, target: Target, *, seed: int | None = None, q_ref: Configuration | None = None,

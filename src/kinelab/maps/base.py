@@ -20,7 +20,7 @@ import pinocchio as pin
 
 from kinelab.analysis.singular import conditioning_batch
 from kinelab.errors import KinelabError, OptionError
-from kinelab.ik.analytic.branches import all_branches_batch
+from kinelab.ik.analytic.batch import all_branches_batch
 from kinelab.ik.analytic.classify import classify
 from kinelab.ik.api import solve_batch
 from kinelab.ik.request import check_seed

@@ -4,7 +4,7 @@ In every voxel the map asks for K tool poses (the voxel's centre, K orientations
 tool-axis directions for task "axis") and keeps per voxel the reachability index (the share of the K poses
 reached), the best manipulability among the answers and the smallest σ_min/σ_max. Where the arm has a
 closed form (:mod:`kinelab.ik.analytic`) and the task is "pose", every branch of every pose is computed
-(:func:`~kinelab.ik.analytic.branches.all_branches_batch`), the voxel also keeps the mean number of branches
+(:func:`~kinelab.ik.analytic.batch.all_branches_batch`), the voxel also keeps the mean number of branches
 within the limits, and a pose's σ ratio is its best branch's; elsewhere :func:`kinelab.solve_batch` finds one
 answer per pose (the branch count is then unknown: NaN). Every answer is checked by Pinocchio. A chunk's
 seeds are fixed by its index and no wall-clock budget cuts it, so the map is the same whatever runs it and in
@@ -21,7 +21,7 @@ import numpy as np
 from kinelab.analysis.singular import conditioning_batch
 from kinelab.collision.model import CollisionModel, Collisions, collision_model
 from kinelab.errors import KinelabError
-from kinelab.ik.analytic.branches import BranchBatch, all_branches_batch
+from kinelab.ik.analytic.batch import BranchBatch, all_branches_batch
 from kinelab.ik.analytic.classify import classify
 from kinelab.ik.api import solve_batch
 from kinelab.ik.request import check_seed

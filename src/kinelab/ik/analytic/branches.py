@@ -11,7 +11,6 @@ finished by a warm-started solve from it; one that still misses is dropped.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
 from functools import partial
 from types import SimpleNamespace
 from typing import TYPE_CHECKING, Any, NamedTuple
@@ -19,12 +18,11 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 import pinocchio as pin
 
-from kinelab.core import threads
-from kinelab.core._analytic import ROW_NOT_STARTED, ClosedForm
+from kinelab.core._analytic import ClosedForm
 from kinelab.core._engine import fast_result
 from kinelab.core._joints import turn_distances
-from kinelab.errors import ConfigurationError, OptionError, count_of
-from kinelab.geometry import pose_errors, stack_homogeneous, wrap_to_pi
+from kinelab.errors import OptionError
+from kinelab.geometry import wrap_to_pi
 from kinelab.ik.analytic import pieper
 from kinelab.ik.analytic.certify import (
     Loop,
@@ -36,20 +34,19 @@ from kinelab.ik.analytic.certify import (
 )
 from kinelab.ik.analytic.classify import ArmClass, classify, general_class, general_vectors
 from kinelab.ik.analytic.general import packed, roots_within
-from kinelab.ik.analytic.kernel import GENERAL_6R, MAX_ROWS, PIEPER_6R, branches, branches_batch
-from kinelab.ik.batch import BatchIKResult
+from kinelab.ik.analytic.kernel import GENERAL_6R, MAX_ROWS, PIEPER_6R, branches
 from kinelab.ik.chain import chain_model
 from kinelab.ik.driver import solve_one
 from kinelab.ik.limits import distance, inside_limits
-from kinelab.ik.request import Request, make_request, verdict_reserve
+from kinelab.ik.request import Request, make_request
 from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
-from kinelab.ik.targets import as_target_arrays, beyond_reach, reach_bound
+from kinelab.ik.targets import beyond_reach
 from kinelab.robot import Chain
 from kinelab.robot.chain import _compiled_judge
-from kinelab.typing import Configuration, Target, Targets
+from kinelab.typing import Target
 
 if TYPE_CHECKING:
-    from kinelab.collision.model import CollisionModel
+    pass
 
 SAME = 1e-5  # [rad] roots closer than this joint by joint are one branch (a double root split by rounding:
 # the two roots of arccos(1 − ε) are √(2ε) apart, 1.4e-6 rad at ε = 1e-12)
@@ -261,7 +258,7 @@ def branch_results(robot: Chain, rows: Rows, req: Request, mode: str, elapsed: f
         uncertified = f"the time budget ran out ({late})"
     kept = rows if max_solutions is None or max_solutions >= total else rows.taken(slice(max_solutions))
     unseen = 0.0 if method == "closed form" else None
-    make = partial(_filled, _constant_fields(robot, req, mode), kept, wall_time=elapsed, branches=total, unseen=unseen)
+    make = partial(filled, constant_fields(robot, req, mode), kept, wall_time=elapsed, branches=total, unseen=unseen)
     status, message = _empty_set(total, beyond, late, uncertified, empty)
     made = Branches.from_arrays(kept.q, kept.position_error, kept.rotation_error, make, status, message, method,
                                 unseen)
@@ -411,155 +408,13 @@ def judged(robot: Chain, q: np.ndarray, target: Target, req: Request,
     return (done.q, done.position_error, done.rotation_error, True) if done.success else None
 
 
-@dataclass(frozen=True, eq=False)
-class BranchBatch:
-    """Every branch of each pose of a batch, each confirmed by the judge within the limits.
-
-    Attributes:
-        q: (B, MAX_ROWS, n) branches [rad], the first ``count[b]`` rows of pose b; NaN after them.
-        count: (B,) branches per pose (0: none within the limits, which the closed form proves).
-        found: (B, MAX_ROWS) roots merged into each branch (2 at a double root); 0 after ``count``.
-        free: (B, MAX_ROWS) the branch is one of a continuum (a singular pose).
-        position_error: (B, MAX_ROWS) [m] and rotation_error: (B, MAX_ROWS) [rad] of each branch, by the FK
-            ``judge`` names; NaN after ``count``.
-        method: "closed form" (every branch), "search" (the 1-D search: every branch, measured complete) or
-            "elimination" (the general 6R elimination).
-        judge: whose FK judged the branches.
-        uncertified: the elimination's reason per pose that its set is not certified ("" where it is); None for
-            the other methods.
-        late: (B,) poses left unsolved when the time budget ran out (count 0, NaN); None: no budget was given.
-    """
-
-    q: np.ndarray
-    count: np.ndarray
-    found: np.ndarray
-    free: np.ndarray
-    position_error: np.ndarray
-    rotation_error: np.ndarray
-    method: str = "closed form"
-    judge: str = "Pinocchio FK"
-    uncertified: list[str] | None = None
-    late: np.ndarray | None = None
-
-
-def all_branches_batch(robot: Chain, targets: Targets, tol_pos: float = 1e-6, tol_rot: float = 1e-6,
-                       time_budget: float | None = None) -> BranchBatch:
-    """Every branch of each pose in ``targets`` (what :func:`analytic_all` gives each, copies nearest 0), on all
-    cores: where the robot's compiled FK is certified the closed form and the judge run in one compiled pass; a pose
-    with a root short of the tolerances but near them is solved by :func:`analytic_all` (which finishes it).
-
-    Args:
-        robot: a robot whose chain is in an analytic class.
-        targets: a sequence of ``pin.SE3`` or a (B, 4, 4) array of oMtarget, base frame.
-        tol_pos: position tolerance [m].
-        tol_rot: rotation tolerance [rad].
-        time_budget: wall-clock budget [s] of the whole batch (None: none); the poses not started when it runs out
-            are left with no branch and marked in ``late``.
-
-    Returns:
-        The :class:`BranchBatch`.
-
-    Raises:
-        TargetError: a bad target, its index named.
-        OptionError: the chain is in no analytic class, or a bad tolerance or budget.
-    """
-    t0 = time.perf_counter()
-    req = make_request("frdm", tol_pos=tol_pos, tol_rot=tol_rot, time_budget=time_budget)
-    arm = arm_of(robot, req)
-    H = np.ascontiguousarray(stack_homogeneous(*as_target_arrays(targets)))
-    deadline = np.inf if time_budget is None else t0 + time_budget - verdict_reserve(time_budget)
-    form = prepared_form(robot, req)
-    if form is None:
-        return _pinocchio_batch(robot, arm, H, req, deadline)
-    B, n = H.shape[0], arm.n
-    q, errors = np.full((B, MAX_ROWS, n), np.nan), np.full((B, MAX_ROWS, 2), np.nan)
-    found, free = np.zeros((B, MAX_ROWS), dtype=np.int64), np.zeros((B, MAX_ROWS), dtype=np.bool_)
-    count, near = np.zeros(B, dtype=np.int64), np.zeros(B, dtype=np.uint8)
-    form.solve_batch(H, q, errors, found, free.view(np.uint8), count, near, threads.count(), deadline)
-    late = near == ROW_NOT_STARTED
-    if arm.kind == GENERAL_6R:  # no root, or roots merged: the root-by-root route says why, or splits them
-        near |= (count == 0) | ((found > 1) & ~free).any(axis=1)
-    near &= ~beyond_reach_rows(robot, H)  # proved unreachable: no root to look for
-    for b in np.flatnonzero(near & ~late):
-        if time.perf_counter() > deadline:
-            late[b] = True
-            continue
-        one = analytic_all(robot, pin.SE3(H[b]), req)
-        k = count[b] = len(one)
-        q[b, :k], errors[b, :k, 0], errors[b, :k, 1] = one.q, one.position_error, one.rotation_error
-        found[b, :k] = [int(r.diagnostics.found or 0) for r in one]
-        free[b, :k] = [r.message == CONTINUUM for r in one]
-    return BranchBatch(q, count, found, free, errors[..., 0], errors[..., 1], _method(arm), robot.fk_certificate.judge,
-                       late=None if time_budget is None else late)
-
-
-def beyond_reach_rows(robot: Chain, H: np.ndarray) -> np.ndarray:
-    """(B,) True where pose b's point lies beyond the robot's reach bound (no configuration reaches it)."""
-    anchor, radius = reach_bound(robot)
-    return np.asarray(np.linalg.norm(H[:, :3, 3] - np.asarray(anchor), axis=1) > radius)
-
-
-def _pinocchio_batch(robot: Chain, arm: ArmClass, H: np.ndarray, req: Request, deadline: float) -> BranchBatch:
-    """:func:`all_branches_batch` where Pinocchio's FK judges: the closed form in threads, then every branch judged
-    in one FK batch; a root that falls short is dropped. Pose by pose (the elimination, Pieper's decoupling) the
-    poses not started before ``deadline`` are left."""
-    B, n = H.shape[0], arm.n
-    late, far = np.zeros(B, dtype=np.bool_), beyond_reach_rows(robot, H)
-    out = np.full((B, MAX_ROWS, n), np.nan)
-    found, free = np.zeros((B, MAX_ROWS), dtype=np.int64), np.zeros((B, MAX_ROWS), dtype=np.bool_)
-    count = np.zeros(B, dtype=np.int64)
-    reasons = None
-    if arm.kind == GENERAL_6R:  # no certified compiled FK: the elimination pose by pose, Pinocchio judging
-        reasons = []
-        for b in range(B):
-            if time.perf_counter() > deadline:
-                late[b:] = True
-                reasons += [""] * (B - b)
-                break
-            if far[b]:
-                reasons.append("")
-                continue
-            q, merged, loose, why = roots_within(arm, H[b], robot.lower, robot.upper, None, limit_slack(req.tol_rot))
-            k = count[b] = len(q)
-            out[b, :k], found[b, :k], free[b, :k] = q, merged, loose
-            reasons.append(why)
-    elif arm.kind == PIEPER_6R:  # not compiled: pose by pose
-        for b in range(B):
-            if time.perf_counter() > deadline:
-                late[b:] = True
-                break
-            if far[b]:
-                continue
-            q, merged, loose = arm_roots(arm, H[b], robot.lower, robot.upper, None, limit_slack(req.tol_rot))
-            k = count[b] = len(q)
-            out[b, :k], found[b, :k], free[b, :k] = q, merged, loose
-    else:
-        branches_batch(arm.kind, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, H, robot.lower, robot.upper, SAME,
-                       limit_slack(req.tol_rot), out, found, free, count)
-    pose, row = np.nonzero(np.arange(MAX_ROWS)[None, :] < count[:, None])
-    dp, dr = pose_errors(H[pose], robot.fk_batch(out[pose, row]))
-    ok = (dp <= req.tol_pos) & (dr <= req.tol_rot)
-    kept = np.bincount(pose[ok], minlength=B)
-    rank = np.arange(int(ok.sum())) - np.concatenate([[0], np.cumsum(kept)[:-1]])[pose[ok]]
-    q, errors = np.full_like(out, np.nan), np.full((B, MAX_ROWS, 2), np.nan)
-    q[pose[ok], rank] = out[pose[ok], row[ok]]
-    errors[pose[ok], rank, 0], errors[pose[ok], rank, 1] = dp[ok], dr[ok]
-    f, loose = np.zeros_like(found), np.zeros_like(free)
-    f[pose[ok], rank], loose[pose[ok], rank] = found[pose[ok], row[ok]], free[pose[ok], row[ok]]
-    if reasons is not None:  # a root the judge refuses leaves the set uncertified
-        reasons = [why or ("" if kept[b] == count[b] else "a root the judge does not confirm")
-                   for b, why in enumerate(reasons)]
-    return BranchBatch(q, kept, f, loose, errors[..., 0], errors[..., 1], _method(arm), robot.fk_certificate.judge,
-                       reasons, None if req.time_budget is None else late)
-
-
-def _constant_fields(robot: Chain, req: Request, mode: str) -> dict[str, Any]:
+def constant_fields(robot: Chain, req: Request, mode: str) -> dict[str, Any]:
     """The fields every closed-form answer of this robot, request and mode shares."""
     return {"success": True, "status": Status.CONVERGED, "iterations": 0, "restarts": 0, "solver": "analytic",
             "mode": mode, "task": req.task_label, "judge": robot.fk_certificate.judge}
 
 
-def _filled(fields: dict[str, Any], rows: Rows, k: int, wall_time: float, branches: int,
+def filled(fields: dict[str, Any], rows: Rows, k: int, wall_time: float, branches: int,
             unseen: float | None = None) -> IKResult:
     """Row k of ``rows`` as an IKResult (``branches``: how many the pose has), its diagnostics built when first
     read."""
@@ -569,247 +424,3 @@ def _filled(fields: dict[str, Any], rows: Rows, k: int, wall_time: float, branch
         "message": CONTINUUM if rows.continuum[k] else "", "singular_events": [], "bypasses": [],
         "_make_diagnostics": partial(Diagnostics, path="compiled", branches=branches, found=int(rows.merged[k]),
                                      unseen=unseen, polished=1 if rows.finished[k] else None)})
-
-
-class OneCall:
-    """The closed form's usual call in one compiled call: the branches of a ``pin.SE3`` target found and judged
-    together by the compiled ``ClosedForm``, no collision model; the results' constant fields made once, their
-    diagnostics when first read. :class:`NearestBranch` keeps one branch, :class:`EveryBranch` all.
-
-    Args:
-        robot: a robot whose chain is in an analytic class and whose compiled FK is certified.
-        req: the validated request (task "pose").
-        form: the robot's compiled closed form for the request's tolerances (:func:`prepared_form`).
-    """
-
-    def __init__(self, robot: Chain, req: Request, form: ClosedForm):
-        arm = arm_of(robot, req)
-        self.form, self.fields = form, _constant_fields(robot, req, arm.mode)
-        self.method = _method(arm)
-        self.unseen = 0.0 if self.method == "closed form" else None
-        self.unfinished = np.zeros(MAX_ROWS, dtype=np.bool_)  # the compiled form finishes no root
-        self.robot = robot
-
-    def found(self, target: pin.SE3, ref: np.ndarray | None) -> tuple[Rows, float] | None:
-        """(the compiled closed form's rows, the start of the clock [s]), or None where the general route must
-        answer (a root to finish, no branch, a target that is not a ``pin.SE3`` or not a pose)."""
-        if type(target) is not pin.SE3:
-            return None
-        t0 = time.perf_counter()
-        got = self.form.solve(target.homogeneous, ref)
-        if got is None or not len(got[0]):
-            return None
-        q, dp, dr, merged, continuum, _ = got
-        return Rows(q, dp, dr, self.unfinished[:len(q)], merged, continuum), t0
-
-
-class NearestBranch(OneCall):
-    """:func:`analytic_one`'s usual call: the branch nearest the reference, in one compiled call."""
-
-    def solve(self, target: Target, ref: np.ndarray | None) -> IKResult | None:
-        """The branch nearest ``ref`` (checked, [rad]; None: the first), or None where :func:`analytic_one` must
-        answer."""
-        got = self.found(target, ref)
-        if got is None:
-            return None
-        rows, t0 = got
-        k = 0 if ref is None else int(np.argmin(turn_distances(rows.q, ref)))  # the first nearest, as nearest_roots
-        return _filled(self.fields, rows, k, time.perf_counter() - t0, len(rows.q))
-
-
-class EveryBranch(OneCall):
-    """:func:`kinelab.solve_all`'s usual call: every branch as arrays, each IKResult built when the set is first read
-    (as :func:`branch_results` builds it)."""
-
-    def solve(self, target: Target) -> Branches | None:
-        """Every branch of ``target``, or None where the general route must answer."""
-        if type(target) is not pin.SE3:
-            return None
-        return self.form.every(target, self._made)  # type: ignore[no-any-return]
-
-    def _made(self, q: np.ndarray, dp: np.ndarray, dr: np.ndarray, merged: np.ndarray, continuum: np.ndarray,
-              wall_time: float, H: np.ndarray) -> Branches:
-        """The set of one pose's branches from the compiled form's arrays (q (k, n) [rad], errors [m, rad]; the
-        compiled form hands none with merged roots outside a continuum: the general route splits them)."""
-        made = Branches.of_rows(q, dp, dr, self._row, (q, dp, dr, merged, continuum, wall_time), self.method,
-                                self.unseen)
-        made.certified_by(partial(certificate_of, self.robot, self.method, H, q, merged, continuum))
-        return made
-
-    def _row(self, data: tuple[Any, ...], i: int) -> IKResult:
-        """Row i of a set :meth:`_made` made, as :func:`branch_results` builds it."""
-        q, dp, dr, merged, continuum, wall_time = data
-        rows = Rows(q, dp, dr, self.unfinished[:len(q)], merged, continuum)
-        return _filled(self.fields, rows, i, wall_time, len(q), self.unseen)
-
-
-def analytic_one(robot: Chain, target: pin.SE3, req: Request, q0: np.ndarray | None,
-                 model: CollisionModel | None = None) -> IKResult:
-    """The branch nearest ``q0`` (each angle's copy in the limits nearest it; without q0 the first branch) that
-    Pinocchio confirms — and, with a collision ``model``, the nearest that is clear.
-
-    Args:
-        robot: a robot whose chain is in an analytic class.
-        target: oMtarget (``pin.SE3``), already checked.
-        req: the validated request (task "pose").
-        q0: the reference configuration [rad], checked, or None.
-        model: a collision model, or None.
-
-    Returns:
-        The answer (``diagnostics.branches``: the branches the pose has within the limits), or a failure:
-        status ``unreachable`` when no branch meets the pose within the limits, ``collision`` when every branch
-        collides (``diagnostics.contact``: the nearest one's pair).
-
-    Raises:
-        OptionError: the chain is in no analytic class, or the task is not "pose".
-    """
-    t0 = time.perf_counter()
-    arm = arm_of(robot, req)
-    if beyond_reach(robot, target.translation):  # proved unreachable: no root to look for
-        return _no_branch(robot, target, req, q0, 0, (None, None), arm.mode, t0)
-    q, found, free, order = nearest_roots(robot, arm, target, req, q0)
-    k, verdict, collided = _first_clear(robot, q, order, target, req, model)
-    if verdict is not None:
-        answer, dp, dr, finished = verdict
-        return IKResult(q=answer, success=True, status=Status.CONVERGED, position_error=dp, rotation_error=dr,
-                        iterations=0, restarts=0, wall_time=time.perf_counter() - t0, solver="analytic",
-                        mode=arm.mode, message=CONTINUUM if free[k] else "", task=req.task_label,
-                        diagnostics=Diagnostics(path="compiled", branches=q.shape[0], found=int(found[k]),
-                                                polished=1 if finished else None,
-                                                clear_after=None if model is None else 0))
-    contact = None if collided is None or model is None else model.contact(collided[0])
-    if collided is None and arm.searched and not beyond_reach(robot, target.translation):
-        return _numeric_check(robot, target, req, q0, t0)
-    return _no_branch(robot, target, req, q0, q.shape[0], (collided, contact), arm.mode, t0)
-
-
-def _first_clear(robot: Chain, q: np.ndarray, order: Any, target: Any, req: Request,
-                 model: CollisionModel | None) -> tuple[int, Any, Any]:
-    """(index, verdict) of the first root in ``order`` the judge confirms and ``model`` finds clear ((−1, None)
-    when none is), and the verdict of the first confirmed one that collides (None when none did)."""
-    collided = None
-    for k in order:
-        verdict = judged(robot, q[k], target, req)
-        if verdict is None:
-            continue
-        if model is not None and model.colliding_pair(verdict[0]) is not None:
-            collided = collided or verdict
-            continue
-        return int(k), verdict, collided
-    return -1, None, collided
-
-
-def _numeric_check(robot: Chain, target: Any, req: Request, q0: np.ndarray | None, t0: float) -> IKResult:
-    """When the 1-D search finds no branch of a pose within reach: FRDM from q0 (or seeded starts) within what is
-    left of the budget. The search is measured complete (99.99 %), not proved so, and a reachable pose must never be
-    answered "unreachable" by it alone (2 of 6,120 poses of random arms whose axes nearly meet were)."""
-    left = None if req.time_budget is None else max(req.time_budget - (time.perf_counter() - t0), 1e-4)
-    res = solve_one(robot, target, q0, replace(req, time_budget=left))
-    note = "the 1-D search found no branch; FRDM's answer"
-    return replace(res, mode=f"{res.mode} ({note})", message=f"{res.message}; {note}" if res.message else note,
-                   wall_time=time.perf_counter() - t0)
-
-
-def _no_branch(robot: Chain, target: Any, req: Request, q0: np.ndarray | None, count: int, collided: Any, mode: str,
-               t0: float) -> IKResult:
-    """The failure of :func:`analytic_one`: the nearest colliding branch, or the reference (or zero) when the
-    closed form has no branch within the limits."""
-    if collided[0] is not None:
-        (answer, dp, dr, _), contact = collided
-        return IKResult(q=answer, success=False, status=Status.COLLISION, position_error=dp, rotation_error=dr,
-                        iterations=0, restarts=0, wall_time=time.perf_counter() - t0, solver="analytic", mode=mode,
-                        message=f"the pose is met, but every one of its {count} branch(es) collides; the nearest: "
-                                f"{contact}", task=req.task_label,
-                        diagnostics=Diagnostics(path="compiled", branches=count, contact=contact))
-    q = np.zeros(robot.n) if q0 is None else np.array(q0, dtype=float)
-    dp, dr = robot.tool_error(np.clip(q, robot.lower, robot.upper), target)
-    return IKResult(q=q, success=False, status=Status.UNREACHABLE, position_error=dp, rotation_error=dr,
-                    iterations=0, restarts=0, wall_time=time.perf_counter() - t0, solver="analytic", mode=mode,
-                    message="no branch (closed form or 1-D search) meets the pose within the joint limits: the pose is "
-                            "beyond the arm's reach, or only reached with a joint outside its limits",
-                    task=req.task_label, diagnostics=Diagnostics(path="compiled", branches=0))
-
-
-def nearest_batch(robot: Chain, targets: Targets, q0: Configuration | None, req: Request,
-                  model: CollisionModel | None) -> BatchIKResult:
-    """:func:`analytic_one` for every target of a batch (q0: None, one start for every row, or (B, n) starts).
-
-    Raises:
-        TargetError, ConfigurationError: a bad target or start, its index named.
-        OptionError: the chain is in no analytic class, or the task is not "pose".
-    """
-    t0 = time.perf_counter()
-    H = stack_homogeneous(*as_target_arrays(targets))
-    starts = batch_starts(robot, q0, len(H))
-    form = prepared_form(robot, req) if model is None else None
-    if form is not None:
-        return _compiled_nearest(robot, form, np.ascontiguousarray(H), starts, req, t0)
-    return _nearest_rows(robot, H, starts, req, model, t0)
-
-
-def batch_starts(robot: Chain, q0: Configuration | None, count: int) -> np.ndarray | None:
-    """A batch's starts as (count, n) [rad or m] (None: none given; one start serves every row).
-
-    Raises:
-        ConfigurationError: q0 of another shape, not finite or outside the limits (its row named).
-    """
-    starts = None if q0 is None else robot.check_qs(np.atleast_2d(q0), what="q0")
-    if starts is not None and starts.shape[0] not in (1, count):
-        raise ConfigurationError(f"q0 must be None, {robot.n} numbers or ({count}, {robot.n}) for {count} targets of "
-                                 f"{robot.name}, got {count_of(np.asarray(q0).shape)}")
-    return None if starts is None else np.broadcast_to(starts, (count, robot.n))
-
-
-def _compiled_nearest(robot: Chain, form: ClosedForm, H: np.ndarray, starts: np.ndarray | None, req: Request,
-                      t0: float) -> BatchIKResult:
-    """:func:`nearest_batch` in one compiled call on all cores (no collision model): each row the branch
-    ``NearestBranch`` gives its pose alone; a row the compiled form leaves (no branch, or a root to finish) by
-    :func:`analytic_one` while the budget lasts; rows not started when it runs out: NaN, status ``time_budget``."""
-    B, n = len(H), robot.n
-    deadline = np.inf if req.time_budget is None else t0 + req.time_budget - verdict_reserve(req.time_budget)
-    q, errors = np.full((B, n), np.nan), np.full((B, 2), np.nan)
-    count, near = np.zeros(B, dtype=np.int64), np.zeros(B, dtype=np.uint8)
-    refs = np.empty((0, n)) if starts is None else np.ascontiguousarray(starts, dtype=float)
-    form.nearest_batch(H, refs, q, errors, count, near, threads.count(), deadline)
-    success = count > 0
-    code = np.where(success, Status.CONVERGED.code, Status.UNREACHABLE.code).astype(np.int8)
-    code[near == ROW_NOT_STARTED] = Status.TIME_BUDGET.code
-    for b in np.flatnonzero(~success):
-        left = deadline - time.perf_counter()
-        if left <= 0:
-            code[b] = Status.TIME_BUDGET.code
-            continue
-        row = analytic_one(robot, pin.SE3(H[b]), req if req.time_budget is None else replace(req, time_budget=left),
-                           None if starts is None else starts[b], None)
-        q[b], success[b], code[b] = row.q, row.success, row.status.code
-        errors[b] = row.position_error, row.rotation_error
-    none = np.zeros(B, dtype=int)
-    return BatchIKResult(q=q, success=success, status_code=code, position_error=errors[:, 0],
-                         rotation_error=errors[:, 1], iterations=none, restarts=none.copy(), seed=0,
-                         wall_time=time.perf_counter() - t0, solver="analytic", mode=arm_of(robot, req).mode)
-
-
-def _nearest_rows(robot: Chain, H: np.ndarray, starts: np.ndarray | None, req: Request, model: CollisionModel | None,
-                  t0: float) -> BatchIKResult:
-    """:func:`analytic_one` row by row within what is left of the request's budget (counted from t0): each row gets
-    the rest of it, a row starts only while the rows so far say it fits (a search cannot stop inside a pose), and
-    the rows not started are NaN with status ``time_budget``."""
-    arm = arm_of(robot, req)
-    deadline = np.inf if req.time_budget is None else t0 + req.time_budget - verdict_reserve(req.time_budget)
-    B = len(H)
-    q, dp, dr = np.full((B, robot.n), np.nan), np.full(B, np.nan), np.full(B, np.nan)
-    success, code = np.zeros(B, dtype=bool), np.full(B, Status.TIME_BUDGET.code, dtype=np.int8)
-    t_rows = time.perf_counter()
-    for b in range(B):
-        now = time.perf_counter()
-        left = deadline - now
-        if left <= 0 or (b and left < (now - t_rows) / b):
-            break
-        row = analytic_one(robot, pin.SE3(H[b, :3, :3], H[b, :3, 3]),
-                           req if req.time_budget is None else replace(req, time_budget=left),
-                           None if starts is None else starts[b], model)
-        q[b], success[b], code[b] = row.q, row.success, row.status.code
-        dp[b], dr[b] = row.position_error, row.rotation_error
-    return BatchIKResult(q=q, success=success, status_code=code, position_error=dp, rotation_error=dr,
-                         iterations=np.zeros(B, dtype=int), restarts=np.zeros(B, dtype=int), seed=0,
-                         wall_time=time.perf_counter() - t0, solver="analytic", mode=arm.mode)

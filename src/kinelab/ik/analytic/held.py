@@ -25,7 +25,8 @@ from kinelab.core import threads
 from kinelab.core._analytic import ROW_NOT_STARTED
 from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
-from kinelab.ik.analytic.branches import arm_of, batch_starts, prepared_form
+from kinelab.ik.analytic.batch import batch_starts
+from kinelab.ik.analytic.branches import arm_of, prepared_form
 from kinelab.ik.analytic.classify import classify, general_class
 from kinelab.ik.analytic.redundancy import SweptArm, has_swept_form, samples, swept_arm
 from kinelab.ik.batch import BatchIKResult, judged_rows, prepare, run_batch

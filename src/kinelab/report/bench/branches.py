@@ -24,7 +24,8 @@ import numpy as np
 import pinocchio as pin
 from tqdm import tqdm
 
-from kinelab.ik.analytic.branches import LIMIT_SLACK, all_branches_batch, has_general_form
+from kinelab.ik.analytic.batch import all_branches_batch
+from kinelab.ik.analytic.branches import LIMIT_SLACK, has_general_form
 from kinelab.ik.analytic.branches import SAME as CLOSED_SAME
 from kinelab.ik.analytic.classify import classify
 from kinelab.ik.analytic.kernel import MAX_ROWS, branches_batch

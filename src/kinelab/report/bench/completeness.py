@@ -3,7 +3,7 @@
 Two measures, per arm with a class (closed form or 1-D search, docs/analytic.md):
 
 - **the pose's own configuration**: n seeded random configurations within the limits, their poses solved by
-  :func:`~kinelab.ik.analytic.branches.all_branches_batch` (every branch judged by Pinocchio); the share of poses
+  :func:`~kinelab.ik.analytic.batch.all_branches_batch` (every branch judged by Pinocchio); the share of poses
   whose own configuration is among the branches, to FOUND rad joint by joint (modulo 2π), and the misses named
   by how near the nearest branch came (a double root is met only to about the square root of the rounding);
 - **against ssik** (``pip install ssik``): for ``peer_n`` of those poses, ssik's answers for the same URDF
@@ -26,7 +26,8 @@ from tqdm import tqdm
 
 from kinelab.errors import OptionError
 from kinelab.geometry import wrap_to_pi
-from kinelab.ik.analytic.branches import all_branches_batch, arm_roots, certificate_of
+from kinelab.ik.analytic.batch import all_branches_batch
+from kinelab.ik.analytic.branches import arm_roots, certificate_of
 from kinelab.ik.analytic.certify import chain_pose
 from kinelab.ik.analytic.classify import classify, classify_vectors, general_class, general_vectors, line_distance
 from kinelab.ik.analytic.general import roots_within

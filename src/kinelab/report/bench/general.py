@@ -23,7 +23,8 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from kinelab.ik.analytic.branches import all_branches_batch, judged_roots
+from kinelab.ik.analytic.batch import all_branches_batch
+from kinelab.ik.analytic.branches import judged_roots
 from kinelab.ik.analytic.classify import general_class
 from kinelab.ik.analytic.general import roots_within
 from kinelab.ik.api import solve_all
