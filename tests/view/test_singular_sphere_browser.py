@@ -14,7 +14,7 @@ from devtools import open_page
 
 import kinelab
 from kinelab import cli
-from kinelab.robot.chain import NEAR_SINGULAR
+from kinelab.robot.poses import NEAR_SINGULAR
 from kinelab.view import Scene
 
 pytestmark = [pytest.mark.browser,

@@ -21,7 +21,7 @@ import numpy as np
 
 from kinelab.errors import OptionError
 from kinelab.robot import Chain
-from kinelab.robot.chain import NEAR_SINGULAR as NEAR_SINGULAR  # σ_min/σ_max below: near-singular (one threshold)
+from kinelab.robot.poses import NEAR_SINGULAR as NEAR_SINGULAR  # σ_min/σ_max below: near-singular (one threshold)
 
 
 def sigma_words(ratio: float) -> str:

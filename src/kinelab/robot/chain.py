@@ -16,7 +16,6 @@ from __future__ import annotations
 import functools
 import itertools
 import operator
-import warnings
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, TypeVar, cast
 
@@ -37,12 +36,15 @@ from kinelab.errors import (
 )
 from kinelab.geometry import pose_error, wrap_to_pi
 from kinelab.robot import xacro
-from kinelab.robot.build import LIMIT_SLACK, Built, build_model, frame_id
+from kinelab.robot.build import Built, frame_id
 from kinelab.robot.certificate import ChainArrays, FKCertificate, certify, chain_arrays
 from kinelab.robot.joints import Joint, Mimic
-from kinelab.robot.meshes import build_visual_model, missing_meshes, search_dirs
-from kinelab.robot.mjcf import is_mjcf, meshes_outside
-from kinelab.robot.space import MAX_SAMPLE_BYTES, SAMPLE_TURNS, generator, spread_points, uniform
+from kinelab.robot.meshes import geometry_model, missing_meshes, search_dirs
+from kinelab.robot.mjcf import is_mjcf
+from kinelab.robot.poses import NEAR_SINGULAR as NEAR_SINGULAR  # the threshold, defined here before
+from kinelab.robot.poses import best_conditioned, reference_of
+from kinelab.robot.reduce import build_model
+from kinelab.robot.space import LIMIT_SLACK, MAX_SAMPLE_BYTES, SAMPLE_TURNS, generator, uniform
 from kinelab.scratch import own
 
 if TYPE_CHECKING:
@@ -352,7 +354,7 @@ class Chain:
         are often singular (a stretched arm), which makes a poor first picture."""
         if self.display_pose is not None:
             return np.array(self.display_pose, dtype=float)
-        return np.array(self.derived("display_q", _best_conditioned), dtype=float)
+        return np.array(self.derived("display_q", best_conditioned), dtype=float)
 
     def reference_q(self) -> tuple[np.ndarray, str]:
         """The configuration a command starts from when given none [rad, m], and where it comes from in words: the
@@ -362,16 +364,7 @@ class Chain:
         middle is all zeros: stretched flat, singular). Well conditioned: σ_min/σ_max of the tool Jacobian (linear
         rows divided by the characteristic length) at least ``NEAR_SINGULAR``, the threshold of
         :mod:`kinelab.analysis.singular`."""
-        if self.srdf is not None:
-            for name in ("home", "ready"):
-                if name in self.srdf.states:
-                    return self.named_q(name), f"the SRDF's {name!r} configuration"
-        lower, upper = self.sample_bounds
-        middle = 0.5 * (lower + upper)
-        if conditioning(self, middle) >= NEAR_SINGULAR:
-            return middle, "the middle of the joint limits"
-        return self.display_q(), ("a well-conditioned configuration (the middle of the joint limits is near a "
-                                  "singular one)")
+        return reference_of(self)
 
     def random_q(self, rng: np.random.Generator | int | None = None) -> np.ndarray:
         """A configuration drawn uniformly within the limits (continuous joints on [−π, π]; a revolute joint
@@ -544,31 +537,7 @@ class Chain:
         ``ROS_PACKAGE_PATH``'s, then example-robot-data's); elements whose mesh cannot be found are left out
         with a warning naming the directories searched.
         """
-        if not isinstance(kind, str) or kind not in ("visual", "collision"):
-            raise OptionError("kind", kind, '"visual" or "collision"')
-        b = self._built
-        if b.urdf_path is None or b.full is None:
-            return pin.GeometryModel()  # an in-memory model brings no geometry: the viewer draws a stick figure
-        geometry_type = pin.GeometryType.COLLISION if kind == "collision" else pin.GeometryType.VISUAL
-        if is_mjcf(b.urdf_path):
-            outside = meshes_outside(b.urdf_path)
-            if outside:  # Pinocchio builds all of a file's geometry or none: none, said
-                warnings.warn(f"{b.urdf_path.name}: mesh {outside[0]!r} lies outside the file's folder; kinelab "
-                              f"reads no file outside it, so {self.name} is drawn without its {kind} geometry",
-                              stacklevel=2)
-                return pin.GeometryModel()
-            geom = pin.buildGeomFromMJCF(b.full, str(b.urdf_path), geometry_type)
-        else:
-            geom = build_visual_model(b.full, b.urdf_path, package_dirs or self.package_dirs, kind)
-        if b.lock_ids:
-            _, geom = pin.buildReducedModel(b.full, geom, list(b.lock_ids), b.q_ref)
-        if b.bMw is not None:  # re-rooted at the base frame, as the model was
-            for gid in range(geom.ngeoms):
-                obj = geom.geometryObjects[gid]
-                if obj.parentJoint == 0:
-                    obj.placement = b.bMw * obj.placement
-                    geom.geometryObjects[gid] = obj
-        return geom
+        return geometry_model(self, package_dirs, kind)
 
     def missing_meshes(self, package_dirs: list[str] | None = None, kind: str = "visual") -> list[str]:
         """The mesh URIs of the file's ``<visual>`` (or ``<collision>``) elements that :meth:`visual_model`, looking
@@ -616,28 +585,3 @@ def _compiled_judge(robot: Chain) -> Any:
 def _read_only(arr: np.ndarray) -> np.ndarray:
     arr.flags.writeable = False  # the checks derived from the limits would not see an edit
     return arr
-
-
-NEAR_SINGULAR = 1e-2  # σ_min/σ_max below this: near a singular configuration (kinelab.analysis.singular's)
-
-
-def conditioning(robot: Chain, q: np.ndarray) -> float:
-    """σ_min/σ_max of the tool Jacobian at q (local world-aligned, linear rows divided by the characteristic
-    length; σ_min the min(n, 6)-th singular value): 0 at a singular configuration, 1 at an isotropic one."""
-    J = robot.jacobian_local_world_aligned(q)
-    J[:3] /= robot.characteristic_length()
-    s = np.linalg.svd(J, compute_uv=False)
-    return float(s[min(robot.n, 6) - 1] / s[0]) if s[0] > 0 else 0.0
-
-
-def _best_conditioned(robot: Chain) -> np.ndarray:
-    lo = np.where(np.isfinite(robot.lower), robot.lower, -np.pi)
-    hi = np.where(np.isfinite(robot.upper), robot.upper, np.pi)
-    mid, half = (lo + hi) / 2, np.minimum((hi - lo) / 4, np.pi / 2)
-    best, best_ratio = robot.neutral(), -1.0
-    for u in spread_points(64, robot.n):
-        q = mid + u * half
-        ratio = conditioning(robot, q)
-        if ratio > best_ratio:
-            best, best_ratio = q, ratio
-    return best

@@ -17,10 +17,11 @@ import pinocchio as pin
 
 from kinelab.errors import OptionError
 from kinelab.robot import catalog, descriptions
-from kinelab.robot.build import Built, build_file, whole_model
+from kinelab.robot.build import Built, whole_model
 from kinelab.robot.chain import Chain
 from kinelab.robot.meshes import build_visual_model, mesh_package_dirs
 from kinelab.robot.mjcf import is_mjcf
+from kinelab.robot.reduce import build_file
 from kinelab.robot.tree import Robot
 
 __all__ = ["load", "whole_of"]

@@ -14,13 +14,17 @@ import warnings
 import xml.etree.ElementTree as ET
 from collections.abc import Iterator
 from pathlib import Path
-from typing import BinaryIO
+from typing import TYPE_CHECKING, BinaryIO
 
 import numpy as np
 import pinocchio as pin
 
-from kinelab.errors import URDFError
+from kinelab.errors import OptionError, URDFError
 from kinelab.robot import catalog
+from kinelab.robot.mjcf import is_mjcf, meshes_outside
+
+if TYPE_CHECKING:
+    from kinelab.robot.chain import Chain
 
 
 def mesh_package_dirs(user: list[str] | None = None) -> list[str]:
@@ -198,3 +202,34 @@ def c_stderr_captured(said: list[str]) -> Iterator[None]:
             os.close(saved)
             sink.seek(0)
             said.extend(line.strip() for line in sink.read().decode("utf-8", "replace").splitlines() if line.strip())
+
+
+def geometry_model(chain: Chain, package_dirs: list[str] | None, kind: str) -> pin.GeometryModel:
+    """:meth:`kinelab.Chain.visual_model`: the chain's visual (or collision) geometry matched to its model (locked
+    joints folded in, re-rooted as the model is), meshes resolved; empty for an in-memory model, or for an MJCF file
+    whose meshes lie outside its folder (said in a warning)."""
+    if not isinstance(kind, str) or kind not in ("visual", "collision"):
+        raise OptionError("kind", kind, '"visual" or "collision"')
+    b = chain._built
+    if b.urdf_path is None or b.full is None:
+        return pin.GeometryModel()  # an in-memory model brings no geometry: the viewer draws a stick figure
+    geometry_type = pin.GeometryType.COLLISION if kind == "collision" else pin.GeometryType.VISUAL
+    if is_mjcf(b.urdf_path):
+        outside = meshes_outside(b.urdf_path)
+        if outside:  # Pinocchio builds all of a file's geometry or none: none, said
+            warnings.warn(f"{b.urdf_path.name}: mesh {outside[0]!r} lies outside the file's folder; kinelab "
+                          f"reads no file outside it, so {chain.name} is drawn without its {kind} geometry",
+                          stacklevel=2)
+            return pin.GeometryModel()
+        geom = pin.buildGeomFromMJCF(b.full, str(b.urdf_path), geometry_type)
+    else:
+        geom = build_visual_model(b.full, b.urdf_path, package_dirs or chain.package_dirs, kind)
+    if b.lock_ids:
+        _, geom = pin.buildReducedModel(b.full, geom, list(b.lock_ids), b.q_ref)
+    if b.bMw is not None:  # re-rooted at the base frame, as the model was
+        for gid in range(geom.ngeoms):
+            obj = geom.geometryObjects[gid]
+            if obj.parentJoint == 0:
+                obj.placement = b.bMw * obj.placement
+                geom.geometryObjects[gid] = obj
+    return geom

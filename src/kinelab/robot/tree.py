@@ -21,8 +21,8 @@ from numpy.typing import ArrayLike
 
 from kinelab.errors import ChainError, FrameNotFoundError, OptionError, SRDFError
 from kinelab.robot import space as sp
-from kinelab.robot.build import build_model
 from kinelab.robot.chain import Chain
+from kinelab.robot.reduce import build_model
 
 if TYPE_CHECKING:
     from kinelab.robot.chain import Chain

@@ -26,7 +26,7 @@ from kinelab.analysis.singular import sigma_words as sigma_words  # the page's w
 from kinelab.errors import ConfigurationError
 from kinelab.files import write_output
 from kinelab.robot import Chain
-from kinelab.robot.chain import NEAR_SINGULAR
+from kinelab.robot.poses import NEAR_SINGULAR
 from kinelab.typing import Configuration
 from kinelab.view.caption import Table, tab_title, titled, with_caption
 from kinelab.view.framing import FILL, frame_points

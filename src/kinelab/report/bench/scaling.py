@@ -19,7 +19,7 @@ from kinelab.ik.chain import chain_model
 from kinelab.ik.frdm import kernel
 from kinelab.report.bench import peers
 from kinelab.robot import Chain
-from kinelab.robot.build import build_file
+from kinelab.robot.reduce import build_file
 from kinelab.scratch import scratch_dir
 
 LENGTHS = (7, 15, 30, 60, 100)

@@ -1,0 +1,54 @@
+"""Where a chain starts and how it is shown when the user gives no configuration: well conditioned, not the
+stretched, singular all-zero pose (a UR5's middle of its limits is all zeros: flat on the floor, rank 5 of 6)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from kinelab.robot.space import spread_points
+
+if TYPE_CHECKING:
+    from kinelab.robot.chain import Chain
+
+NEAR_SINGULAR = 1e-2  # σ_min/σ_max below this: near a singular configuration (kinelab.analysis.singular's)
+
+
+def conditioning(robot: Chain, q: np.ndarray) -> float:
+    """σ_min/σ_max of the tool Jacobian at q (local world-aligned, linear rows divided by the characteristic
+    length; σ_min the min(n, 6)-th singular value): 0 at a singular configuration, 1 at an isotropic one."""
+    J = robot.jacobian_local_world_aligned(q)
+    J[:3] /= robot.characteristic_length()
+    s = np.linalg.svd(J, compute_uv=False)
+    return float(s[min(robot.n, 6) - 1] / s[0]) if s[0] > 0 else 0.0
+
+
+def best_conditioned(robot: Chain) -> np.ndarray:
+    """The best-conditioned of 64 evenly spread configurations in the middle half of each joint's range (largest
+    :func:`conditioning`) [rad, m]: the display pose of a robot without a registered one."""
+    lo = np.where(np.isfinite(robot.lower), robot.lower, -np.pi)
+    hi = np.where(np.isfinite(robot.upper), robot.upper, np.pi)
+    mid, half = (lo + hi) / 2, np.minimum((hi - lo) / 4, np.pi / 2)
+    best, best_ratio = robot.neutral(), -1.0
+    for u in spread_points(64, robot.n):
+        q = mid + u * half
+        ratio = conditioning(robot, q)
+        if ratio > best_ratio:
+            best, best_ratio = q, ratio
+    return best
+
+
+def reference_of(robot: Chain) -> tuple[np.ndarray, str]:
+    """:meth:`kinelab.Chain.reference_q`: the configuration a command starts from when given none [rad, m], and
+    where it comes from in words."""
+    if robot.srdf is not None:
+        for name in ("home", "ready"):
+            if name in robot.srdf.states:
+                return robot.named_q(name), f"the SRDF's {name!r} configuration"
+    lower, upper = robot.sample_bounds
+    middle = 0.5 * (lower + upper)
+    if conditioning(robot, middle) >= NEAR_SINGULAR:
+        return middle, "the middle of the joint limits"
+    return robot.display_q(), ("a well-conditioned configuration (the middle of the joint limits is near a "
+                              "singular one)")
