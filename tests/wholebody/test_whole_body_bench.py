@@ -7,15 +7,16 @@ import pinocchio as pin
 import pytest
 
 from kinelab import cli
+from kinelab.report.bench import steppers
 from kinelab.report.bench import wholebody as wb
 
 
 @pytest.mark.parametrize("name", ["panda", "talos"])
 def test_mujoco_places_every_task_frame_where_pinocchio_does(name):
     mujoco = pytest.importorskip("mujoco")
-    scenario, robot = wb.SCENARIOS[name], wb.whole(wb.SCENARIOS[name].robot)
-    model = wb.mujoco_model(robot)
-    maps = wb.Maps(robot, model)
+    scenario, robot = steppers.SCENARIOS[name], steppers.whole(steppers.SCENARIOS[name].robot)
+    model = steppers.mujoco_model(robot)
+    maps = steppers.Maps(robot, model)
     data = mujoco.MjData(model)
     rng = np.random.default_rng(2)
     for _ in range(5):
