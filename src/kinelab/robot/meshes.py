@@ -24,7 +24,7 @@ from kinelab.robot import catalog
 from kinelab.robot.mjcf import is_mjcf, meshes_outside
 
 if TYPE_CHECKING:
-    from kinelab.robot.chain import Chain
+    from kinelab.robot import Chain  # the package (chain.py imports this module)
 
 
 def mesh_package_dirs(user: list[str] | None = None) -> list[str]:

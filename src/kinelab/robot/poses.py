@@ -10,7 +10,7 @@ import numpy as np
 from kinelab.robot.space import spread_points
 
 if TYPE_CHECKING:
-    from kinelab.robot.chain import Chain
+    from kinelab.robot import Chain  # the package (chain.py imports this module)
 
 NEAR_SINGULAR = 1e-2  # σ_min/σ_max below this: near a singular configuration (kinelab.analysis.singular's)
 
