@@ -28,16 +28,15 @@ from kinelab.core._joints import PinForm, plain_q
 from kinelab.errors import (
     ChainError,
     ConfigurationError,
-    JointLimitError,
     JointNotFoundError,
     OptionError,
-    SRDFError,
     count_of,
 )
 from kinelab.geometry import pose_error, wrap_to_pi
 from kinelab.robot import xacro
 from kinelab.robot.build import Built, frame_id
 from kinelab.robot.certificate import ChainArrays, FKCertificate, certify, chain_arrays
+from kinelab.robot.checks import checked_q, checked_rows, named_configuration, outside_lines, real_values, rows_within
 from kinelab.robot.joints import Joint, Mimic
 from kinelab.robot.meshes import geometry_model, missing_meshes, search_dirs
 from kinelab.robot.mjcf import is_mjcf
@@ -211,16 +210,7 @@ class Chain:
             SRDFError: no SRDF, an unknown name (the names listed), or a chain joint the configuration omits.
             JointLimitError: a value outside its joint's limits (the joint named).
         """
-        if self.srdf is None:
-            raise SRDFError(f"{self.name} was loaded without an SRDF: load(..., srdf=PATH) to use named "
-                            "configurations")
-        values = self.srdf.state(name)
-        missing = [j for j in self.joint_names if j not in values]
-        if missing:
-            raise SRDFError(f"{self.srdf.path.name}: configuration {name!r} gives no value for chain joint "
-                            f"{missing[0]!r}")
-        return self.check_q([values[j] for j in self.joint_names], limits=True,
-                            what=f"{self.srdf.path.name}'s configuration {name!r}")
+        return named_configuration(self, name)
 
     # -- coordinates ---------------------------------------------------------------------------
     def joint_index(self, name: str) -> int:
@@ -231,45 +221,14 @@ class Chain:
 
     def _values(self, q: ArrayLike, what: str) -> np.ndarray:
         """``q`` as n floats (NaN and ±inf kept); ConfigurationError for another shape or a non-real type."""
-        try:
-            raw = np.asarray(q)
-            if raw.dtype.kind not in "fiu":
-                raise TypeError
-        except (TypeError, ValueError):
-            raise ConfigurationError(f"{what} must be {self.n} numbers (real), got {q!r}") from None
-        if raw.shape != (self.n,):
-            raise ConfigurationError(f"{what} must have {self.n} numbers ({', '.join(self.joint_names)}) for "
-                                     f"{self.name}, got {count_of(raw.shape)}")
-        return raw.astype(float)
+        return real_values(self, q, what)
 
     def check_q(self, q: ArrayLike, *, limits: bool = False, what: str = "q") -> np.ndarray:
         """``q`` as a float array of length n, refusing wrong shapes, NaN/inf and (if asked) limits."""
         if not limits and plain_q(q, self.n):  # the usual call, checked in one compiled pass
             arr = cast(np.ndarray, q)
             return arr if arr.flags.c_contiguous else np.ascontiguousarray(arr)  # a strided view: the kernels' form
-        try:
-            raw = q if type(q) is np.ndarray else np.asarray(q)
-            if raw.dtype.kind not in "fiu":  # complex, bool, text and objects are not joint values
-                raise TypeError
-            arr = raw if raw.dtype == np.float64 else raw.astype(float)
-        except (TypeError, ValueError):
-            raise ConfigurationError(f"{what} must be {self.n} numbers (real), got {q!r}") from None
-        if arr.shape != (self.n,):
-            raise ConfigurationError(
-                f"{what} must have {self.n} numbers ({', '.join(self.joint_names)}) for {self.name}, "
-                f"got {count_of(arr.shape)}"
-            )
-        bad = ~np.isfinite(arr)
-        if bad.any():
-            i = int(np.flatnonzero(bad)[0])
-            raise ConfigurationError(f"{what}[{i}] ({self.joint_names[i]}) is {arr[i]}: values must be finite")
-        if limits:
-            outside = (arr < self._lower_check - LIMIT_SLACK) | (arr > self._upper_check + LIMIT_SLACK)
-            if outside.any():
-                i = int(np.flatnonzero(outside)[0])
-                j = self.joints[i]
-                raise JointLimitError(j.name, arr[i], j.lower, j.upper, j.unit)
-        return np.ascontiguousarray(arr)
+        return checked_q(self, q, limits, what)
 
     def within_limits(self, q: ArrayLike, slack: float = LIMIT_SLACK) -> bool:
         """True when every bounded joint lies within its limits (plus ``slack``); continuous joints have none; a
@@ -288,10 +247,7 @@ class Chain:
     def outside_limits(self, q: ArrayLike) -> list[str]:
         """One line per joint of ``q`` outside its limits (beyond LIMIT_SLACK), naming the joint, the value and the
         limits; empty when q is within them (continuous joints have none)."""
-        values = np.asarray(q, dtype=float)
-        lower, upper = self.check_bounds
-        return [f"{j.name} = {v:g} {j.unit} is outside its limits [{j.lower:.4g}, {j.upper:.4g}] {j.unit}"
-                for j, v, lo, hi in zip(self.joints, values.tolist(), lower, upper, strict=True) if not lo <= v <= hi]
+        return outside_lines(self, q)
 
     def within_limits_batch(self, Q: np.ndarray) -> np.ndarray:
         """:meth:`within_limits` per row of a (B, n) array (default slack): a (B,) bool array; a NaN row is within
@@ -300,14 +256,7 @@ class Chain:
         Raises:
             ConfigurationError: Q is not a (B, n) array of numbers.
         """
-        arr = np.asarray(Q) if not isinstance(Q, np.ndarray) else Q
-        if arr.dtype.kind not in "fiu" or arr.ndim != 2 or arr.shape[1] != self.n:
-            raise ConfigurationError(f"Q must be a (B, {self.n}) array of numbers for {self.name}, got "
-                                     f"{getattr(arr, 'shape', '?')} of {arr.dtype}")
-        Q = arr.astype(float, copy=False)
-        lower, upper = self.check_bounds
-        inside: np.ndarray = (lower <= Q) & (upper >= Q)
-        return np.asarray(inside.all(axis=1))
+        return rows_within(self, Q)
 
     def to_pin_q(self, q: ArrayLike) -> np.ndarray:
         """One number per joint → Pinocchio's q (continuous joints become cos, sin); a new array."""
@@ -470,16 +419,7 @@ class Chain:
 
     def check_qs(self, Q: np.ndarray, what: str = "Q") -> np.ndarray:
         """Q as a (B, n) float array of finite numbers, refusing other shapes and naming the first bad row."""
-        arr = np.asarray(Q) if not isinstance(Q, np.ndarray) else Q
-        if arr.dtype.kind not in "fiu" or arr.ndim != 2 or arr.shape[1] != self.n:
-            raise ConfigurationError(f"{what} must be a (B, {self.n}) array of numbers for {self.name}, "
-                                     f"got {getattr(arr, 'shape', '?')} of {arr.dtype}")
-        arr = np.asarray(arr, dtype=float)
-        bad = ~np.isfinite(arr).all(axis=1)
-        if bad.any():
-            b = int(np.flatnonzero(bad)[0])
-            self.check_q(arr[b], what=f"{what}[{b}]")
-        return arr
+        return checked_rows(self, Q, what)
 
     def tool_error(self, q: ArrayLike, oMtarget: pin.SE3) -> tuple[float, float]:
         """(position error [m], rotation angle error [rad]) of the tool at q against oMtarget (Pinocchio FK)."""
