@@ -21,7 +21,7 @@ from kinelab.errors import OptionError
 from kinelab.ik.batch import fresh_seed, prepare, run_batch
 from kinelab.ik.limits import distance as distance  # exported: the branch distance users sort by
 from kinelab.ik.registry import Capabilities, capabilities
-from kinelab.ik.request import Request, check_seed, count_ok, make_request
+from kinelab.ik.request import Request, count_ok, make_request
 from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
 from kinelab.ik.targets import as_target, beyond_reach
 from kinelab.robot import Chain
@@ -143,26 +143,27 @@ def _closed_form_all(robot: Chain, target: Any, req: Request, ref: Any, max_solu
 USUAL_PER_ROBOT = 16  # a caller sweeping settings: the prepared closed forms kept stay bounded
 
 
-def usual_closed_form(robot: Chain, target: Target, seed: object, settings: tuple[Any, ...]) -> Branches | None:
-    """Every branch of ``target`` in one compiled call for the usual call of :func:`kinelab.solve_all` — a solver
-    that picks its route ("auto") on a chain with a closed form or the general elimination and a certified compiled
-    FK, a ``pin.SE3`` target, no options, references, collisions or sweeps — with ``settings`` = (solver, tol_pos,
-    tol_rot, time_budget, stop_below) checked once per robot; None otherwise (the general route then answers, or
-    names what is wrong)."""
+def usual_entry(robot: Chain, settings: tuple[Any, ...]) -> EveryBranch | None:
+    """The one-call solver of every branch for the usual call of :func:`kinelab.solve_all` — a solver that picks its
+    route ("auto") on a chain with a closed form or the general elimination and a certified compiled FK, no options,
+    references, collisions or sweeps — with ``settings`` = (solver, tol_pos, tol_rot, time_budget, stop_below),
+    kept on the robot; None where the usual call does not apply (or a setting is unhashable: the general route
+    names it). Its ``solve(target)`` answers None for what the general route must answer (a root to finish, a bad
+    pose).
+
+    Raises:
+        OptionError: a bad setting, named.
+    """
     kept: dict[tuple[Any, ...], EveryBranch | Literal[False]] = robot.derived("usual closed forms", _new_kept)
     try:
         entry = kept.get(settings)
-    except TypeError:  # an unhashable setting: the general route names it
+    except TypeError:
         return None
     if entry is None:
         if len(kept) >= USUAL_PER_ROBOT:
             kept.clear()
         entry = kept[settings] = _usual_entry(robot, settings)
-    if entry is False:
-        return None
-    if seed is not None:
-        check_seed(seed)
-    return entry.solve(target)  # None: a root to finish, a bad pose or none, which the general route says
+    return entry or None
 
 
 def _usual_entry(robot: Chain, settings: tuple[Any, ...]) -> nearest.EveryBranch | Literal[False]:

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import replace
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import pinocchio as pin
@@ -32,7 +32,7 @@ from kinelab.errors import OptionError
 from kinelab.geometry import stack_homogeneous
 from kinelab.ik.auto import resolved
 from kinelab.ik.batch import BatchIKResult, prepare, prepare_robot, run_batch
-from kinelab.ik.branches import UNSEEN, Route, find_all, route_of, usual_closed_form
+from kinelab.ik.branches import UNSEEN, Route, find_all, route_of, usual_entry
 from kinelab.ik.chain import chain_model
 from kinelab.ik.driver import prepare_solver, solve_one
 from kinelab.ik.options import flag
@@ -49,7 +49,7 @@ if TYPE_CHECKING:
     from kinelab.ik import clear
     from kinelab.ik.analytic import batch as analytic_batch
     from kinelab.ik.analytic import branches, held, nearest
-    from kinelab.ik.analytic.nearest import NearestBranch
+    from kinelab.ik.analytic.nearest import EveryBranch, NearestBranch
     from kinelab.ik.analytic.sew import SEW
     from kinelab.ik.frdm import tracking
     from kinelab.ik.frdm.tracking import PathSettings
@@ -119,6 +119,7 @@ class IK:
             and collisions is None and task == "pose" and axis == "z" else None
         self.collisions = collision_check(robot, collisions)
         self._nearest: NearestBranch | None = None
+        self._every: EveryBranch | None | Literal[False] = False  # solve_all's usual call, once looked up
         self.held = False  # solver "analytic" on a 7R arm: its six at the held joint's start value (_prepare)
         self._prepare()
         # the usual call's one compiled call (kinelab.core._engine), where the solver has one
@@ -255,13 +256,26 @@ class IK:
         if drop_colliding is not False:
             flag("drop_colliding", drop_colliding)
         if self._usual_all is not None and q_ref is None and max_solutions is None and redundancy is None:
-            found = usual_closed_form(self.robot, target, seed, (*self._usual_all, stop_below))
-            if found is not None:  # the usual call: every branch in one compiled call
-                return found
+            entry = self._every_branch(stop_below)
+            if entry is not None:  # the usual call: every branch in one compiled call
+                if seed is not None and not (type(seed) is int and seed >= 0):
+                    check_seed(seed)
+                found = entry.solve(target)
+                if found is not None:
+                    return found
         found = find_all(self.robot, target, replace(self._request(seed), max_restarts=0), q_ref=q_ref,
                          max_solutions=max_solutions, stop_below=stop_below, method=self.route,
                          redundancy=redundancy)
         return clear_of(found, self.collisions, drop=bool(drop_colliding))
+
+    def _every_branch(self, stop_below: float | None) -> EveryBranch | None:
+        """solve_all's one-call solver for ``stop_below`` (kept here for the default), or None."""
+        if stop_below is UNSEEN and self._every is not False:
+            return self._every
+        entry = usual_entry(self.robot, (*self._usual_all, stop_below))  # type: ignore[misc]
+        if stop_below is UNSEEN:
+            self._every = entry
+        return entry
 
     def track(self, targets: Targets, *, q0: Configuration | None = None, seed: int | None = None,
               jump_limit: float | None = 0.2,
