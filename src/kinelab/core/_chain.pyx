@@ -101,6 +101,15 @@ cdef void fk_row(const double[:, :, ::1] placement_R, const double[:, ::1] place
                  out)
 
 
+cdef inline void _base_pose(double[3][3] R, double[3] t) noexcept nogil:
+    """(R, t) ← the base frame's own pose (identity, origin): where a chain's composition starts."""
+    cdef int i, j
+    for i in range(3):
+        t[i] = 0.0
+        for j in range(3):
+            R[i][j] = 1.0 if i == j else 0.0
+
+
 cdef void fk_chain(int n, const double* placement_R, const double* placement_t, const double* axis,
                    const long long* kind, const double* tool_R, const double* tool_t, const double* q,
                    double* out) noexcept nogil:
@@ -108,10 +117,7 @@ cdef void fk_chain(int n, const double* placement_R, const double* placement_t, 
     cdef double R[3][3]
     cdef double t[3]
     cdef int i, j
-    for i in range(3):
-        t[i] = 0.0
-        for j in range(3):
-            R[i][j] = 1.0 if i == j else 0.0
+    _base_pose(R, t)
     for i in range(n):
         _compose(R, t, placement_R + 9 * i, placement_t + 3 * i)
         if kind[i] == PRISMATIC:
@@ -153,10 +159,7 @@ cdef void jacobian_chain(int n, const double* placement_R, const double* placeme
     cdef double t[3]
     cdef double e[3]
     cdef int i, j
-    for i in range(3):
-        t[i] = 0.0
-        for j in range(3):
-            R[i][j] = 1.0 if i == j else 0.0
+    _base_pose(R, t)
     for i in range(n):
         _compose(R, t, placement_R + 9 * i, placement_t + 3 * i)
         for j in range(3):
