@@ -136,3 +136,25 @@ def test_the_shortcuts_for_coordinate_axes_and_plain_origins_give_the_general_pr
     arrays = certificate.chain_arrays(robot)
     for q in robot.random_qs(20, np.random.default_rng(5)):
         np.testing.assert_array_equal(arrays.fk_batch(q[None])[0][:3], _general_fk(arrays, q.tolist()))
+
+
+def test_the_build_loads_the_fingerprints_without_kinelab(tmp_path):
+    """setup.py loads digest.py by path in an isolated build, where kinelab is not importable (-I -S: neither
+    the working folder nor site-packages, where the editable install lives, is on the path)."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import kinelab.core
+    from kinelab.core import digest
+
+    source = Path(kinelab.core.__file__).with_name("digest.py")
+    (tmp_path / "a.pyx").write_bytes(b"cdef int x = 1\n")
+    code = ("import importlib.util, sys\n"
+            f"spec = importlib.util.spec_from_file_location('d', {str(source)!r})\n"
+            "m = importlib.util.module_from_spec(spec); spec.loader.exec_module(m)\n"
+            f"print(m.source_crc32(__import__('pathlib').Path({str(tmp_path)!r})))\n"
+            "assert 'kinelab' not in sys.modules\n")
+    done = subprocess.run([sys.executable, "-I", "-S", "-c", code], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == digest.source_crc32(tmp_path)

@@ -9,14 +9,6 @@ from __future__ import annotations
 
 import zlib
 from pathlib import Path
-from typing import TYPE_CHECKING
-
-from kinelab import lazy
-
-if TYPE_CHECKING:
-    import hashlib
-else:
-    hashlib = lazy.module("hashlib", globals())
 
 
 def _sources(folder: Path) -> list[Path]:
@@ -26,6 +18,8 @@ def _sources(folder: Path) -> list[Path]:
 
 def source_sha256(folder: Path) -> str:
     """SHA-256 over the folder's Cython sources in name order, each with its name (hex)."""
+    import hashlib  # only the build and the reports ask for the SHA: start-up, which checks the CRC, skips OpenSSL
+
     h = hashlib.sha256()
     for path in _sources(folder):
         h.update(path.name.encode() + b"\0" + path.read_bytes())
