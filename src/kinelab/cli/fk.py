@@ -4,14 +4,17 @@ from __future__ import annotations
 
 import argparse
 from dataclasses import asdict
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from kinelab import lazy
 from kinelab.cli import common
 from kinelab.cli.common import Subcommands
 
 if TYPE_CHECKING:
+    import pinocchio as pin
+
     from kinelab import collision
+    from kinelab.robot import Chain
 else:
     collision = lazy.module("kinelab.collision", globals())
 
@@ -40,9 +43,15 @@ def run(args: argparse.Namespace) -> int:
         out["contacts"] = [asdict(c) for c in contacts]
     if args.json:
         common.print_json(out)
-        return 0
+    else:
+        _print_pose(robot, oMtool, out, contacts)
+    return 0
+
+
+def _print_pose(robot: Chain, oMtool: pin.SE3, out: dict[str, Any], contacts: list[collision.Contact]) -> None:
+    """The human form of ``fk``'s answer (``out`` as printed with ``--json``)."""
     print(f"{robot.name}: pose of {robot.tool!r} in {robot.base!r}")
-    for note in outside:
+    for note in out["outside_limits"]:
         print(f"  note: {note} (the pose is computed all the same)")
     print(f"  position [m]   {common.shown(oMtool.translation)}")
     print(f"  quat_wxyz      {common.shown(out['quat_wxyz'])}")
@@ -51,4 +60,3 @@ def run(args: argparse.Namespace) -> int:
     if "collision" in out:
         pairs = f"{len(contacts)} pair{'s' if len(contacts) != 1 else ''} in contact: " if contacts else "none"
         print(f"  collision      {pairs}{'; '.join(str(c) for c in contacts)}")
-    return 0

@@ -96,13 +96,22 @@ def _chain_session(args: argparse.Namespace) -> Any:
     return session
 
 
-def _whole_session(args: argparse.Namespace) -> Any:
-    """A whole robot's page: a target per hand, the feet held."""
+def _check_whole_arguments(args: argparse.Namespace) -> None:
+    """Refuse a chain's options on a whole robot's page.
+
+    Raises:
+        KinelabError: Q, --collisions, --obstacles, --tool, --base, --group or --lock given.
+    """
     if args.q or args.collisions or args.obstacles is not None:
         raise KinelabError("a whole robot's page starts standing and checks no collisions: drop Q, --collisions "
                            "and --obstacles (or name a chain with --tool)")
     if args.tool or args.base or args.group or args.lock:
         raise KinelabError("--hands and --feet are a whole robot's: drop --tool, --base, --group and --lock")
+
+
+def _whole_session(args: argparse.Namespace) -> Any:
+    """A whole robot's page: a target per hand, the feet held."""
+    _check_whole_arguments(args)
     robot = robot_module.load(args.robot, whole=True, srdf=args.srdf, package_dirs=args.package_dir,
                               xacro_args=pairs(args.xacro_arg, "--xacro-arg"), trust_xacro=args.trust_xacro)
     step(f"drawing {robot.name} (its meshes load)")

@@ -92,13 +92,16 @@ def run_animate(args: argparse.Namespace) -> int:
     one_lap = passage.targets[: (passage.lap or passage.samples) + 1]
     for k, target in enumerate(one_lap[:: max(1, len(one_lap) // 8)]):
         scene.frame(f"target{k}", target, 0.5 * scene.frame_length)
-    summary = result.summary()
-    jumps = summary["status"].get("jump", 0)
-    print(f"{args.passage} {'without' if args.without_bypass else 'with'} bypass: {summary['reached']} of "
-          f"{summary['samples']} samples reached{f' ({jumps} met by a jump)' if jumps else ''}, largest joint step "
-          f"{summary['max_joint_step']:.3f} rad, "
-          f"{plural(summary['monitor_events'], 'monitor event')}")
+    _print_passage(f"{args.passage} {'without' if args.without_bypass else 'with'} bypass", result.summary())
     return _publish(scene, args.html)
+
+
+def _print_passage(title: str, summary: dict[str, Any]) -> None:
+    """One line on a tracked passage: samples reached, jumps, the largest joint step [rad], monitor events."""
+    jumps = summary["status"].get("jump", 0)
+    print(f"{title}: {summary['reached']} of {summary['samples']} samples reached"
+          f"{f' ({jumps} met by a jump)' if jumps else ''}, largest joint step {summary['max_joint_step']:.3f} rad, "
+          f"{plural(summary['monitor_events'], 'monitor event')}")
 
 
 def _publish(scene: Any, html: str | None) -> int:

@@ -15,6 +15,7 @@ collide, so the exact test runs only on the others. A plane's test is the sphere
 from __future__ import annotations
 
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -24,7 +25,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from kinelab.collision.obstacles import Environment
+from kinelab.collision.obstacles import Environment, Obstacle
 from kinelab.collision.spheres import PLANE, Frames
 from kinelab.collision.spheres import candidates as sphere_candidates
 from kinelab.errors import KinelabError
@@ -56,13 +57,17 @@ class Collisions:
     def __post_init__(self) -> None:
         if not isinstance(self.self_collisions, bool | np.bool_):
             raise CollisionError(f"self_collisions is True or False, got {self.self_collisions!r}")
-        if not (isinstance(self.margin, int | float) and not isinstance(self.margin, bool)
-                and np.isfinite(self.margin) and self.margin >= 0):
+        if not _is_clearance(self.margin):
             raise CollisionError(f"the collision margin is a clearance ≥ 0 m, got {self.margin!r}")
         if self.environment is not None and not isinstance(self.environment, Environment):
             raise CollisionError(f"environment must be a kinelab.Environment, got {type(self.environment).__name__}")
         if not self.self_collisions and self.environment is None:
             raise CollisionError("collisions with neither self_collisions nor an environment check nothing")
+
+
+def _is_clearance(value: object) -> bool:
+    """A finite real number ≥ 0 (not a bool)."""
+    return isinstance(value, int | float) and not isinstance(value, bool) and bool(np.isfinite(value)) and value >= 0
 
 
 def as_collisions(value: object) -> Collisions | None:
@@ -230,9 +235,7 @@ def _build(robot: Chain, collisions: Collisions) -> CollisionModel:
                              "model built in memory): collisions cannot be checked")
     own = geom.ngeoms
     obstacles = collisions.environment.obstacles if collisions.environment is not None else ()
-    for k, obstacle in enumerate(obstacles):
-        geom.addGeometryObject(pin.GeometryObject(obstacle.name or f"{obstacle.shape} {k}", 0, 0,
-                                                  obstacle.placement, obstacle.geometry()))
+    _add_obstacles(geom, obstacles)
     objects = list(geom.geometryObjects)
     joints = np.array([o.parentJoint for o in objects], dtype=int)
     pairs, left_out = _self_pairs(robot, objects, own) if collisions.self_collisions else ([], (0, 0))
@@ -245,6 +248,13 @@ def _build(robot: Chain, collisions: Collisions) -> CollisionModel:
                f"margin {collisions.margin:g} m")
     return CollisionModel(robot, geom, np.array(pairs, dtype=np.int64).reshape(-1, 2), centres, radii, normals,
                           joints.astype(np.int64), float(collisions.margin), summary, collisions, _frames(robot))
+
+
+def _add_obstacles(geom: pin.GeometryModel, obstacles: Sequence[Obstacle]) -> None:
+    """Append the obstacles to the model, fixed to the universe (joint 0, frame 0) at their placements."""
+    for k, obstacle in enumerate(obstacles):
+        geom.addGeometryObject(pin.GeometryObject(obstacle.name or f"{obstacle.shape} {k}", 0, 0,
+                                                  obstacle.placement, obstacle.geometry()))
 
 
 def _frames(robot: Chain) -> Frames | None:
@@ -293,12 +303,18 @@ def _check_meshes(robot: Chain) -> None:
             raise CollisionError(f"{robot.name}: {len(missing)} collision mesh(es) not found (first: {missing[0]}; "
                                  f"searched {', '.join(dirs) or 'no package directory'}): collisions cannot be "
                                  "checked; pass package_dirs= to kinelab.load (CLI --package-dir)")
-    if robot.srdf is not None:
-        links = {f.name for f in robot.model.frames}
-        unknown = sorted({n for pair in robot.srdf.disabled_collisions for n in pair if n not in links})
-        if unknown:
-            warnings.warn(f"{robot.srdf.path}: disable_collisions names link(s) {', '.join(unknown)} that "
-                          f"{robot.name}'s model does not have; those pairs are ignored", stacklevel=3)
+    _check_srdf_links(robot)
+
+
+def _check_srdf_links(robot: Chain) -> None:
+    """Warn of SRDF pairs that name links the model does not have (they are ignored)."""
+    if robot.srdf is None:
+        return
+    links = {f.name for f in robot.model.frames}
+    unknown = sorted({n for pair in robot.srdf.disabled_collisions for n in pair if n not in links})
+    if unknown:
+        warnings.warn(f"{robot.srdf.path}: disable_collisions names link(s) {', '.join(unknown)} that "
+                      f"{robot.name}'s model does not have; those pairs are ignored", stacklevel=4)
 
 
 def _self_pairs(robot: Chain, objects: list[Any], own: int) -> tuple[list[tuple[int, int]], tuple[int, int]]:

@@ -165,15 +165,21 @@ class Environment:
         if len(rows) > MAX_OBSTACLES:
             raise ObstacleError(f"{path} lists {len(rows)} obstacles; an environment holds at most {MAX_OBSTACLES} "
                                 "(merge small ones into a box or a mesh obstacle)")
-        out = []
-        for k, row in enumerate(rows):
-            if not isinstance(row, dict) or set(row) - {"shape", "size", "xyz", "rpy", "name", "mesh"}:
-                raise ObstacleError(f"{path}: obstacle {k} must be an object with keys shape, size, xyz, rpy, name "
-                                    "(and mesh)")
-            if "mesh" in row:
-                row = {**row, "mesh": _inside(path, row["mesh"], k)}
-            out.append(Obstacle(**{"name": f"{row.get('shape', '?')} {k}", **row}))
-        return cls(tuple(out))
+        return cls(tuple(_obstacle(path, k, row) for k, row in enumerate(rows)))
+
+
+def _obstacle(path: Path, k: int, row: object) -> Obstacle:
+    """Obstacle ``k`` of the file at ``path``, from its JSON object (a mesh resolved beside the file).
+
+    Raises:
+        ObstacleError: not an object of the known keys, or a bad obstacle.
+    """
+    if not isinstance(row, dict) or set(row) - {"shape", "size", "xyz", "rpy", "name", "mesh"}:
+        raise ObstacleError(f"{path}: obstacle {k} must be an object with keys shape, size, xyz, rpy, name "
+                            "(and mesh)")
+    if "mesh" in row:
+        row = {**row, "mesh": _inside(path, row["mesh"], k)}
+    return Obstacle(**{"name": f"{row.get('shape', '?')} {k}", **row})
 
 
 def _depth(value: Any) -> int:

@@ -119,32 +119,47 @@ def analytic_all(robot: Chain, target: pin.SE3, req: Request, q_ref: np.ndarray 
     if beyond:  # proved unreachable: no root to look for (the elimination overflows at 1e155 m)
         return branch_results(robot, Rows.of([], robot.n), req, arm.mode, time.perf_counter() - t0, max_solutions,
                               _method(arm), "", "", beyond=beyond)
-    form = prepared_form(robot, req)
-    compiled = None if form is None else form.solve(target.homogeneous, q_ref)
-    if compiled is not None and ((compiled[3] > 1) & ~compiled[4]).any():
-        compiled = None  # roots merged: perhaps two beside a fold, which the root-by-root route splits
-    if compiled is not None and arm.kind == GENERAL_6R and not len(compiled[0]):
-        compiled = None  # no root: whether that is proved, the root-by-root route says
-    uncertified = "" if arm.kind == GENERAL_6R and compiled is None else None
-    if compiled is None:  # no certified compiled FK, a root to finish or roots merged: root by root
-        if arm.kind == GENERAL_6R:
-            q, found, free, uncertified = roots_within(arm, target.homogeneous, robot.lower, robot.upper, q_ref,
-                                                       limit_slack(req.tol_rot))
-        else:
-            q, found, free = split_merged(robot_loop(robot), target.homogeneous,
-                                          *roots(robot, arm, target.homogeneous, q_ref, limit_slack(req.tol_rot)))
-            q, found, free = _inside(robot, q, found, free, limit_slack(req.tol_rot))
-        rows = Rows.of(judged_roots(robot, q, found, free, target, req), robot.n)
-        if uncertified == "" and len(rows.q) < len(q):
-            uncertified = "a root the judge does not confirm"
-    else:
-        q, dp, dr, found, free, _ = compiled
-        rows = Rows(q, dp, dr, np.zeros(len(q), dtype=np.bool_), found, free)
+    compiled = _compiled_rows(robot, target, req, arm, q_ref)
+    # no certified compiled FK, a root to finish or roots merged: root by root
+    rows, uncertified = (compiled, None) if compiled is not None else _rows_root_by_root(robot, target, req, arm,
+                                                                                          q_ref)
     if q_ref is not None:
         rows = rows.taken(sorted(range(len(rows.q)), key=lambda k: distance(robot, rows.q[k], q_ref)))
     return branch_results(robot, rows, req, arm.mode, time.perf_counter() - t0, max_solutions, _method(arm),
                           f"no branch within the joint limits ({arm.method})", uncertified, target.homogeneous,
                           beyond="" if len(rows.q) else beyond_reach(robot, target.translation))
+
+
+def _compiled_rows(robot: Chain, target: pin.SE3, req: Request, arm: ArmClass,
+                   q_ref: np.ndarray | None) -> Rows | None:
+    """The compiled closed form's judged branches of ``target``; None where the root-by-root route must answer (no
+    certified compiled FK, roots merged, perhaps two beside a fold, or no root of the general elimination)."""
+    form = prepared_form(robot, req)
+    compiled = None if form is None else form.solve(target.homogeneous, q_ref)
+    if compiled is None or ((compiled[3] > 1) & ~compiled[4]).any():
+        return None
+    if arm.kind == GENERAL_6R and not len(compiled[0]):
+        return None  # no root: whether that is proved, the root-by-root route says
+    q, dp, dr, found, free, _ = compiled
+    return Rows(q, dp, dr, np.zeros(len(q), dtype=np.bool_), found, free)
+
+
+def _rows_root_by_root(robot: Chain, target: pin.SE3, req: Request, arm: ArmClass,
+                       q_ref: np.ndarray | None) -> tuple[Rows, str | None]:
+    """The branches of ``target`` found root by root and judged by Pinocchio, and why the set is not certified
+    ("" when it is; None where the class certifies its sets later, :func:`certificate_of`)."""
+    uncertified = None
+    if arm.kind == GENERAL_6R:
+        q, found, free, uncertified = roots_within(arm, target.homogeneous, robot.lower, robot.upper, q_ref,
+                                                   limit_slack(req.tol_rot))
+    else:
+        q, found, free = split_merged(robot_loop(robot), target.homogeneous,
+                                      *roots(robot, arm, target.homogeneous, q_ref, limit_slack(req.tol_rot)))
+        q, found, free = _inside(robot, q, found, free, limit_slack(req.tol_rot))
+    rows = Rows.of(judged_roots(robot, q, found, free, target, req), robot.n)
+    if uncertified == "" and len(rows.q) < len(q):
+        uncertified = "a root the judge does not confirm"
+    return rows, uncertified
 
 
 def _inside(robot: Chain, q: np.ndarray, found: np.ndarray, free: np.ndarray,
@@ -302,6 +317,13 @@ def certificate_of(robot: Chain, method: str, H: np.ndarray, q: np.ndarray, merg
         check = robot.derived("elimination cross-check", _elimination)
     if level == "certified" or check is None:
         return level, reason
+    return _cross_checked(robot, check, loop, H, q, reason)
+
+
+def _cross_checked(robot: Chain, check: ArmClass, loop: Loop | None, H: np.ndarray, q: np.ndarray,
+                   reason: str) -> tuple[str, str]:
+    """(complete, reason) of the set q (k, 6) [rad] of the pose H against the general elimination's certified set:
+    certified when the two are the same to 1e-6 rad and Kantorovich's test proves each branch."""
     theirs, _, _, why = roots_within(check, H, robot.lower, robot.upper, None, LIMIT_SLACK)
     if why:
         return "search", f"{reason}; the general elimination's set is not certified: {why}"

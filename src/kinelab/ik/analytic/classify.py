@@ -144,11 +144,7 @@ def general_vectors(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray
     reading whose pencil is singular is taken only when nothing else is (its sets are then never certified)."""
     failed, singular = [], []
     for mirrored in (False, True):
-        hh, oo, RR, NN = reverse(h, o, R0, N0) if mirrored else (h, o, R0, N0)
-        solver = (prepare(hh, oo, RR, NN), loop_of(hh, oo, RR, NN))
-        why, regular = usable(*solver)
-        name = "general 6R" + (" (mirrored: read from the tool)" if mirrored else "")
-        arm = ArmClass(name, GENERAL_6R, mirrored, hh, oo, RR, NN, solver)
+        arm, why, regular = _general_reading(h, o, R0, N0, mirrored)
         if not why and regular:
             return Classification(arm, "")
         if not why:
@@ -163,6 +159,23 @@ def general_vectors(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray
                           + " | ".join(failed) + f"; Pieper's decoupling: {decoupled.reason}")
 
 
+def _general_reading(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray,
+                     mirrored: bool) -> tuple[ArmClass, str, bool]:
+    """The general elimination of the chain read from the base (or, ``mirrored``, from the tool): the class, why
+    the elimination cannot take it ("" when it can) and whether its pencil is regular."""
+    hh, oo, RR, NN = reverse(h, o, R0, N0) if mirrored else (h, o, R0, N0)
+    solver = (prepare(hh, oo, RR, NN), loop_of(hh, oo, RR, NN))
+    why, regular = usable(*solver)
+    name = "general 6R" + (" (mirrored: read from the tool)" if mirrored else "")
+    return ArmClass(name, GENERAL_6R, mirrored, hh, oo, RR, NN, solver), why, regular
+
+
+def _shoulder_meets(h: np.ndarray, o: np.ndarray) -> bool:
+    """True when axes 1, 2, 3 pass through one point, no two of them parallel (class tolerances)."""
+    return (max(line_distance(o[i], h[i], o[j], h[j]) for i, j in ((0, 1), (0, 2), (1, 2))) < POINT_TOL
+            and _angle(h[0], h[1]) >= AXIS_TOL and _angle(h[1], h[2]) >= AXIS_TOL)
+
+
 def pieper_vectors(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray) -> Classification:
     """Pieper's class of the chain (h, o, R0, N0) at q = 0 (base frame, metres): axes 1, 2, 3 through one point
     (read from the base) or axes 4, 5, 6 (read from the tool), the decoupling recovering seeded configurations;
@@ -173,8 +186,7 @@ def pieper_vectors(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray)
     for mirrored in (False, True):
         hh, oo, RR, NN = reverse(h, o, R0, N0) if mirrored else (h, o, R0, N0)
         where = "read from the tool: " if mirrored else ""
-        if max(line_distance(oo[i], hh[i], oo[j], hh[j]) for i, j in ((0, 1), (0, 2), (1, 2))) >= POINT_TOL \
-                or _angle(hh[0], hh[1]) < AXIS_TOL or _angle(hh[1], hh[2]) < AXIS_TOL:
+        if not _shoulder_meets(hh, oo):
             failed.append(where + "axes 1, 2, 3 do not meet in one point")
             continue
         meets = line_distance(oo[3], hh[3], oo[4], hh[4]) < POINT_TOL and _angle(hh[3], hh[4]) >= AXIS_TOL
@@ -229,18 +241,28 @@ def classify_vectors(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarra
     failed = []
     for searched in (False, True):
         for mirrored in (False, True):
-            hh, oo, RR, NN = reverse(h, o, R0, N0) if mirrored else (h, o, R0, N0)
-            arm, misses = _first_class(hh, oo, RR, NN, searched, mirrored)
-            if arm is not None and searched and (decoupled := pieper_vectors(h, o, R0, N0)).arm is not None:
-                return Classification(with_search(decoupled.arm, arm), "")
-            if arm is not None:
-                return Classification(arm, "")
+            found = _class_read(h, o, R0, N0, searched, mirrored)
+            if isinstance(found, ArmClass):
+                return Classification(found, "")
             if not searched:
-                failed.append(("read from the tool: " if mirrored else "") + " / ".join(misses))
+                failed.append(("read from the tool: " if mirrored else "") + found)
     if h.shape[0] == 6:
         failed.append("nor a 1-D search class (two consecutive wrist axes meeting, with axes 2, 3 parallel or axes "
                       "1, 2 or 2, 3 meeting, read either way)")
     return Classification(None, " | ".join(failed))
+
+
+def _class_read(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray, searched: bool,
+                mirrored: bool) -> ArmClass | str:
+    """The chain's first closed form (or, with ``searched``, search class) read from the base (or, ``mirrored``,
+    from the tool) — a search class with Pieper's decoupling where that also takes the chain — or the tests missed,
+    in words."""
+    hh, oo, RR, NN = reverse(h, o, R0, N0) if mirrored else (h, o, R0, N0)
+    arm, misses = _first_class(hh, oo, RR, NN, searched, mirrored)
+    if arm is None:
+        return " / ".join(misses)
+    decoupled = pieper_vectors(h, o, R0, N0).arm if searched else None
+    return arm if decoupled is None else with_search(decoupled, arm)
 
 
 def _first_class(h: np.ndarray, o: np.ndarray, R0: np.ndarray, N0: np.ndarray, searched: bool,
