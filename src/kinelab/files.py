@@ -97,6 +97,19 @@ def _kind_of(mode: int) -> str:
     return "not a regular file"
 
 
+def _link_target(path: Path, what: str) -> Path:
+    """The file the link at ``path`` leads to, as :func:`output_target` takes it: only within the link's folder.
+
+    Raises:
+        KinelabError: a link out of its folder, or to what output_target refuses.
+    """
+    target = Path(os.path.realpath(path))
+    if target.parent != Path(os.path.realpath(path.parent)):
+        raise KinelabError(f"cannot write the {what} to {path}: it is a link to {target}, outside its folder; "
+                           "kinelab replaces regular files only (give the file's own path)")
+    return output_target(target, what) if target != path else target
+
+
 def output_target(path: str | Path, what: str) -> Path:
     """The file a write to ``path`` may create or replace, refusing anything else by name.
 
@@ -122,11 +135,7 @@ def output_target(path: str | Path, what: str) -> Path:
     except OSError as exc:
         raise KinelabError(f"cannot write the {what} to {path}: {exc.strerror or exc}") from None
     if info is not None and stat.S_ISLNK(info.st_mode):
-        target = Path(os.path.realpath(path))
-        if target.parent != Path(os.path.realpath(path.parent)):
-            raise KinelabError(f"cannot write the {what} to {path}: it is a link to {target}, outside its folder; "
-                               "kinelab replaces regular files only (give the file's own path)")
-        return output_target(target, what) if target != path else target
+        return _link_target(path, what)
     if info is not None and not stat.S_ISREG(info.st_mode):
         hint = f" such as {path / 'view.html'}" if stat.S_ISDIR(info.st_mode) else ""
         raise KinelabError(f"cannot write the {what} to {path}: it is {_kind_of(info.st_mode)}; kinelab writes a new "

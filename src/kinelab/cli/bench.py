@@ -115,26 +115,9 @@ def run(args: argparse.Namespace) -> int:
                         budget=args.budget_ms / 1e3, progress=progress_of(args), repeats=args.repeats,
                         start=args.start, sigma=args.sigma, schedule=args.schedule, task=args.task)
     result.update(first)
-    if args.tracking:
-        result["tracking"] = paper000_era.tracking_bench(repeats=args.repeats)
-    if args.loops:
-        result["loops"] = loops.run(args.robots, seed=args.seed, repeats=args.repeats, progress=progress_of(args))
-    if args.budgets:
-        result["budgets"] = loops.budgets_run(args.robots, seed=args.seed, n=args.n, progress=progress_of(args))
-    if args.versus:
-        result["versus"] = versus.run(args.robots, seed=args.seed, repeats=max(args.repeats, 2),
-                                      progress=progress_of(args))
-    if args.branches:
-        result["branches"] = branches.run(args.robots, seed=args.seed, repeats=max(args.repeats, 2),
-                                          progress=progress_of(args))
-    if args.completeness:
-        result["completeness"] = completeness.run(seed=args.seed, progress=progress_of(args))
-    if args.throughput:
-        result["throughput"] = throughput.run(args.robots, seed=args.seed, repeats=args.repeats,
-                                              progress=progress_of(args))
-    if args.collisions:
-        result["collisions"] = collisions.run(None, seed=args.seed, repeats=max(args.repeats, 2),
-                                              progress=progress_of(args))
+    for key, measure in _PROTOCOLS.items():  # each protocol asked for by its flag of the same name, in this order
+        if getattr(args, key):
+            result[key] = measure(args)
     if args.out:
         render.write_bench(result, args.out)
     if args.json:
@@ -144,6 +127,19 @@ def run(args: argparse.Namespace) -> int:
     if args.out:
         print(f"results written to {args.out}")
     return 0
+
+
+_PROTOCOLS: dict[str, Callable[[argparse.Namespace], Any]] = {
+    "tracking": lambda a: paper000_era.tracking_bench(repeats=a.repeats),
+    "loops": lambda a: loops.run(a.robots, seed=a.seed, repeats=a.repeats, progress=progress_of(a)),
+    "budgets": lambda a: loops.budgets_run(a.robots, seed=a.seed, n=a.n, progress=progress_of(a)),
+    "versus": lambda a: versus.run(a.robots, seed=a.seed, repeats=max(a.repeats, 2), progress=progress_of(a)),
+    "branches": lambda a: branches.run(a.robots, seed=a.seed, repeats=max(a.repeats, 2), progress=progress_of(a)),
+    "completeness": lambda a: completeness.run(seed=a.seed, progress=progress_of(a)),
+    "throughput": lambda a: throughput.run(a.robots, seed=a.seed, repeats=a.repeats, progress=progress_of(a)),
+    "collisions": lambda a: collisions.run(None, seed=a.seed, repeats=max(a.repeats, 2), progress=progress_of(a)),
+}
+"""The protocols run after the main bench, each under its flag's name (``--loops`` → ``result["loops"]``)."""
 
 
 def _router(args: argparse.Namespace) -> int:
@@ -184,28 +180,23 @@ def _before_the_peers(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def _print_tables(result: dict[str, Any]) -> None:
+    """The main bench's table, then each protocol's that ran, in _TABLES' order."""
     print(render.bench_markdown(result))
-    if "scaling" in result:
-        print(scaling.markdown(result["scaling"]))
-    if "startup" in result:
-        print(startup.markdown(result["startup"]))
-    if "tracking" in result:
-        print(paper000_era.tracking_markdown(result["tracking"]))
-    if "loops" in result:
-        print(loops.markdown(result["loops"]["throughput"], result["loops"]["tracking"], result["loops"]["budgets"]))
-    if "budgets" in result:
-        print()
-        print(loops.budget_markdown(result["budgets"]))
-    if "whole_body" in result:
-        print()
-        print(wholebody.markdown(result["whole_body"]))
-    if "versus" in result:
-        print(versus.markdown(result["versus"]))
-    if "branches" in result:
-        print(branches.markdown(result["branches"]))
-    if "throughput" in result:
-        print(throughput.markdown(result["throughput"]))
-    if "collisions" in result:
-        print(collisions.markdown(result["collisions"]))
-    if "completeness" in result:
-        print(completeness.markdown(result["completeness"]))
+    for key, table in _TABLES.items():
+        if key in result:
+            print(table(result[key]))
+
+
+_TABLES: dict[str, Callable[[Any], str]] = {
+    "scaling": lambda r: scaling.markdown(r),
+    "startup": lambda r: startup.markdown(r),
+    "tracking": lambda r: paper000_era.tracking_markdown(r),
+    "loops": lambda r: loops.markdown(r["throughput"], r["tracking"], r["budgets"]),
+    "budgets": lambda r: "\n" + loops.budget_markdown(r),
+    "whole_body": lambda r: "\n" + wholebody.markdown(r),
+    "versus": lambda r: versus.markdown(r),
+    "branches": lambda r: branches.markdown(r),
+    "throughput": lambda r: throughput.markdown(r),
+    "collisions": lambda r: collisions.markdown(r),
+    "completeness": lambda r: completeness.markdown(r),
+}

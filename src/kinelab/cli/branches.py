@@ -145,18 +145,28 @@ def _completeness_words(found: Branches) -> str:
     return PLAIN.get(found.method, found.method)
 
 
-def _print_branches(robot: Chain, args: argparse.Namespace, found: Branches, ref: Any) -> None:
-    """One line per branch: its configuration and Pinocchio's errors (nearest ``ref`` first when given)."""
-    unit = " [deg, m]" if args.deg else " [rad, m]"
-    print(f"{robot.name}: {len(found)} branch{'es' if len(found) != 1 else ''}, {_method(found)}")
-    print(f"  {_completeness(found) if args.verbose else _completeness_words(found)}")
+def _shown_q(robot: Chain, q: np.ndarray, deg: bool) -> np.ndarray:
+    """q as shown: radians and metres, or with ``deg`` the revolute joints in degrees."""
+    return np.where([j != "prismatic" for j in robot.joint_kinds], np.rad2deg(q), q) if deg else q
+
+
+def _print_notes(robot: Chain, found: Branches, ref: Any) -> None:
+    """What to know before reading the list: a redundant arm's answers sample a continuum; the order with ref."""
     if found.method == "multistart" and robot.n > 6:
         print(f"  {robot.name} has {robot.n} joints for a 6-number pose: its configurations form a continuum, of "
               "which these are samples; --redundancy K or --sew PSI lists every branch at chosen values")
     if ref is not None:
         print("  nearest --ref-q first (revolute joints compared modulo 2π)")
+
+
+def _print_branches(robot: Chain, args: argparse.Namespace, found: Branches, ref: Any) -> None:
+    """One line per branch: its configuration and Pinocchio's errors (nearest ``ref`` first when given)."""
+    unit = " [deg, m]" if args.deg else " [rad, m]"
+    print(f"{robot.name}: {len(found)} branch{'es' if len(found) != 1 else ''}, {_method(found)}")
+    print(f"  {_completeness(found) if args.verbose else _completeness_words(found)}")
+    _print_notes(robot, found, ref)
     for k, r in enumerate(found):
-        q = np.where([j != "prismatic" for j in robot.joint_kinds], np.rad2deg(r.q), r.q) if args.deg else r.q
+        q = _shown_q(robot, r.q, args.deg)
         print(f"  {k + 1:>2}  q{unit} {' '.join(f'{v:9.4f}' for v in q)}   errors {r.position_error:.1e} m, "
               f"{r.rotation_error:.1e} rad"
               + (f"  ({r.message})" if r.message else ""))
@@ -186,18 +196,21 @@ def _write_page(robot: Chain, found: Sequence[IKResult], path: str, target: Any,
     print(f"wrote {path}")
 
 
+def _gap(robot: Chain, q: np.ndarray, ref: Any, deg: bool) -> tuple[str, ...]:
+    """The distance from q to ``ref`` as the table shows it (rad, or deg with ``deg``), or nothing without ref."""
+    if ref is None:
+        return ()
+    d = limits.distance(robot, q, ref)
+    return tuple(f"{v:.4f}" for v in rounded([np.rad2deg(d) if deg else d], 4))
+
+
 def _joint_table(robot: Chain, found: Sequence[IKResult], ref: Any, deg: bool) -> Any:
     """Every branch's joints (rad and m; degrees and m with ``deg``), and with ``ref`` each one's distance to it
     (the largest joint difference, revolute joints modulo 2π), the nearest marked."""
-    angular = np.array([k != "prismatic" for k in robot.joint_kinds])
     unit = "deg" if deg else "rad"
-    header = ("#", *(f"q{i + 1} [{unit if a else 'm'}]" for i, a in enumerate(angular)),
+    header = ("#", *(f"q{i + 1} [{unit if k != 'prismatic' else 'm'}]" for i, k in enumerate(robot.joint_kinds)),
               *((f"to --ref-q [{unit}]",) if ref is not None else ()))
-    rows = []
-    for k, r in enumerate(found):
-        q = np.where(angular, np.rad2deg(r.q), r.q) if deg else r.q
-        gap = () if ref is None else (limits.distance(robot, r.q, ref),)
-        rows.append((str(k + 1), *(f"{v:.4f}" for v in rounded(q, 4)),
-                     *(f"{v:.4f}" for v in rounded([np.rad2deg(d) if deg else d for d in gap], 4))))
+    rows = [(str(k + 1), *(f"{v:.4f}" for v in rounded(_shown_q(robot, r.q, deg), 4)), *_gap(robot, r.q, ref, deg))
+            for k, r in enumerate(found)]
     names = ", ".join(f"q{i + 1} {j.name}" for i, j in enumerate(robot.joints))
     return caption.Table(header, tuple(rows), None if ref is None else 0, note=f"joints: {names}")

@@ -48,15 +48,19 @@ class Parser(argparse.ArgumentParser):
         user did not ask)."""
         found, extra = super().parse_known_args(args, namespace)
         for action in self._actions:
-            value = getattr(found, action.dest, None)
-            values = value if isinstance(value, list) else [value]
-            flat = [v for item in values for v in (item if isinstance(item, list) else [item])]
-            if any(isinstance(v, str) and not v.strip() for v in flat):
+            if _has_empty(getattr(found, action.dest, None)):
                 name = action.option_strings[-1] if action.option_strings else action.dest
                 leave = " or leave the option out" if action.option_strings else ""
                 self.error(f"argument {name}: an empty value; give {action.metavar or action.dest.upper()}{leave}")
         return found, extra
 
+
+
+def _has_empty(value: object) -> bool:
+    """True when an option's value, or one of its values (lists of lists for repeated nargs), is a blank string."""
+    values = value if isinstance(value, list) else [value]
+    flat = [v for item in values for v in (item if isinstance(item, list) else [item])]
+    return any(isinstance(v, str) and not v.strip() for v in flat)
 
 
 Subcommands: TypeAlias = "argparse._SubParsersAction[Parser]"

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import re
+from collections.abc import Callable
 from dataclasses import fields
 from typing import TYPE_CHECKING, Any
 
@@ -192,31 +193,57 @@ def _refuse_other_solvers_flags(args: argparse.Namespace) -> None:
 def _bypass_options(robot: Chain, args: argparse.Namespace) -> dict[str, Any]:
     """FRDM's bypass tables from --kick J=D, --interval J=LO:HI and --freeze J[=V] (rad, m; deg with --deg), with
     the policy :func:`kinelab.ik.frdm.options.bypass_plan` gives for --on-singular."""
-    specs = {"kicks": args.kick or [], "intervals": args.interval or [], "freeze": args.freeze or []}
-    if not any(specs.values()):
+    parsers: dict[str, tuple[list[str] | None, Callable[[Chain, str, bool], tuple[str, Any]]]] = {
+        "kicks": (args.kick, _kick), "intervals": (args.interval, _interval), "freeze": (args.freeze, _freeze)}
+    if not _bypasses_given(args, any(specs for specs, _ in parsers.values())):
+        return {}
+    out = {key: dict(parse(robot, spec, args.deg) for spec in specs)
+           for key, (specs, parse) in parsers.items() if specs}
+    return {**out, **bypass_plan(out, tuple(args.on_singular or ()))}
+
+
+def _bypasses_given(args: argparse.Namespace, given: bool) -> bool:
+    """Whether bypasses are ``given``, refusing --on-singular without them and bypasses for a solver without any.
+
+    Raises:
+        KinelabError: either.
+    """
+    if not given:
         if args.on_singular:
             raise KinelabError("--on-singular switches bypasses given by --kick, --interval or --freeze; none is")
-        return {}
+        return False
     if "kicks" not in option_fields(args.solver):
         owners = " or ".join(name for name in registry.names() if "kicks" in option_fields(name))
         raise KinelabError(f"--kick, --interval and --freeze are bypasses of --solver {owners}, not of "
                            f"--solver {args.solver}")
-    out: dict[str, Any] = {}
-    for spec in specs["kicks"]:
-        joint, value = _split_spec(spec, "--kick", "JOINT=DELTA")
-        out.setdefault("kicks", {})[joint] = _bypass_value(robot, joint, value, args.deg, "--kick")
-    for spec in specs["intervals"]:
-        joint, bounds = _split_spec(spec, "--interval", "JOINT=LOWER:UPPER")
-        lo, colon, hi = bounds.partition(":")
-        if not colon:
-            raise KinelabError(f"--interval wants JOINT=LOWER:UPPER, got {spec!r}")
-        out.setdefault("intervals", {})[joint] = (_bypass_value(robot, joint, lo, args.deg, "--interval"),
-                                                  _bypass_value(robot, joint, hi, args.deg, "--interval"))
-    for spec in specs["freeze"]:
-        joint, sep, value = spec.partition("=")
-        robot.joint_index(joint)  # an unknown joint is named with the valid ones
-        out.setdefault("freeze", {})[joint] = _bypass_value(robot, joint, value, args.deg, "--freeze") if sep else None
-    return {**out, **bypass_plan(out, tuple(args.on_singular or ()))}
+    return True
+
+
+def _kick(robot: Chain, spec: str, deg: bool) -> tuple[str, float]:
+    """--kick JOINT=DELTA: the joint and its kick (rad or m; deg with ``deg``)."""
+    joint, value = _split_spec(spec, "--kick", "JOINT=DELTA")
+    return joint, _bypass_value(robot, joint, value, deg, "--kick")
+
+
+def _freeze(robot: Chain, spec: str, deg: bool) -> tuple[str, float | None]:
+    """--freeze JOINT[=VALUE]: the joint and the value it is held at (None: where it is)."""
+    joint, sep, value = spec.partition("=")
+    robot.joint_index(joint)  # an unknown joint is named with the valid ones
+    return joint, _bypass_value(robot, joint, value, deg, "--freeze") if sep else None
+
+
+def _interval(robot: Chain, spec: str, deg: bool) -> tuple[str, tuple[float, float]]:
+    """--interval JOINT=LOWER:UPPER: the joint and its bounds (rad or m; deg with ``deg``).
+
+    Raises:
+        KinelabError: another form, an unknown joint or a bad value (named).
+    """
+    joint, bounds = _split_spec(spec, "--interval", "JOINT=LOWER:UPPER")
+    lo, colon, hi = bounds.partition(":")
+    if not colon:
+        raise KinelabError(f"--interval wants JOINT=LOWER:UPPER, got {spec!r}")
+    return joint, (_bypass_value(robot, joint, lo, deg, "--interval"),
+                   _bypass_value(robot, joint, hi, deg, "--interval"))
 
 
 def _split_spec(spec: str, flag: str, form: str) -> tuple[str, str]:
@@ -260,25 +287,42 @@ def _print_solver_notes(args: argparse.Namespace, result: IKResult) -> None:
         print(f"  model time {diag.model_time:.4g} s, final M0 = "
               + (f"{m0:+.6f}" if m0 is not None else "n/a (give --target-q for the sign of N)"))
     if registry.capabilities(args.solver).monitored:  # only a solver with the singularity monitor has events to tell
-        if args.verbose or args.kick or args.interval or args.freeze:  # the user's own bypasses: what they did
-            _print_events(result)
-        elif fired := sum(e.count or 1 for e in result.singular_events):
-            print(f"  passed near a singular configuration {plural(fired, 'time')} on the way (--verbose: what the "
-                  "solver did about it)")
+        _print_monitor(args, result)
     if result.success and result.diagnostics.clear_after is not None:
         print(f"  clear of collisions ({plural(result.diagnostics.clear_after, 'colliding answer')} found before)")
 
 
+def _print_monitor(args: argparse.Namespace, result: IKResult) -> None:
+    """The singularity monitor's account: in full with --verbose or the user's own bypasses, else one line when it
+    fired."""
+    if args.verbose or args.kick or args.interval or args.freeze:  # the user's own bypasses: what they did
+        _print_events(result)
+    elif fired := sum(e.count or 1 for e in result.singular_events):
+        print(f"  passed near a singular configuration {plural(fired, 'time')} on the way (--verbose: what the "
+              "solver did about it)")
+
+
+def _print_answer_attempt(result: IKResult) -> None:
+    """The monitor's events and the bypasses applied in the attempt that gave the answer."""
+    own, held = result.diagnostics.answer_events, result.diagnostics.answer_bypasses
+    fired = f"fired {plural(len(own), 'time')}" if own else "did not fire"
+    applied = ", ".join(f"{b.bypass} " + ("from the start" if not b.sweep else f"at sweep {b.sweep}")
+                        for b in held) or "none"
+    print(f"  the answer's attempt: monitor {fired}; bypasses: {applied}")
+
+
 def _print_events(result: IKResult) -> None:
     """What the monitor saw and which bypasses were applied: in the answer's own attempt, and over the restarts."""
-    attempts = result.restarts + 1
     looped = result.diagnostics.path != "compiled"  # the compiled multistart answers a stall by a restart
     if looped:
-        own, held = result.diagnostics.answer_events, result.diagnostics.answer_bypasses
-        fired = f"fired {plural(len(own), 'time')}" if own else "did not fire"
-        applied = ", ".join(f"{b.bypass} " + ("from the start" if not b.sweep else f"at sweep {b.sweep}")
-                            for b in held) or "none"
-        print(f"  the answer's attempt: monitor {fired}; bypasses: {applied}")
+        _print_answer_attempt(result)
+    _print_attempts(result, looped)
+
+
+def _print_attempts(result: IKResult, looped: bool) -> None:
+    """The monitor over every attempt: how often it fired and how many bypasses it switched on (the compiled
+    multistart, not ``looped``, restarts at each stall)."""
+    attempts = result.restarts + 1
     fired_all = sum(e.count or 1 for e in result.singular_events)
     monitor = f"monitor fired {plural(fired_all, 'time')}" if fired_all else "monitor did not fire"
     if not looped:

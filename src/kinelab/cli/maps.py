@@ -174,20 +174,39 @@ def _say_resumed(args: argparse.Namespace) -> None:
         print(f"kinelab: map (resumed: {done} chunks already in {args.out})", file=sys.stderr, flush=True)
 
 
+def _client(args: argparse.Namespace) -> Any:
+    """The Dask client --scheduler or --workers asks for, or None (the map runs here, in this process).
+
+    Raises:
+        KinelabError: both given, or a number of workers outside 1 to the cores here.
+    """
+    if args.scheduler and args.workers:
+        raise KinelabError("give --scheduler ADDRESS or --workers N, not both")
+    if args.workers is not None and not 1 <= args.workers <= cluster.cores():
+        raise KinelabError(f"--workers must be 1 to {cluster.cores()} (the cores here), got {args.workers}")
+    if args.scheduler is not None or args.workers:
+        return cluster.client_for(args.scheduler, args.workers)
+    return None
+
+
+def _reach_figures(result: Any, orientations: int) -> dict[str, Any]:
+    """The map's voxels, targets, voxels reached, mean reachability and mean branches per reached pose (None where
+    the solver counts none or nothing is reached)."""
+    reach, branches = result.array("reachability"), result.array("branches")
+    reached = reach > 0
+    return {"voxels": int(len(reach)), "targets": int(len(reach) * orientations), "reached_voxels": int(reached.sum()),
+            "mean_reachability": float(np.nanmean(reach)),
+            "mean_branches": None if np.isnan(branches).all() or not reached.any()
+            else float(np.mean(branches[reached]))}
+
+
 def run_reach(args: argparse.Namespace) -> int:
     """Build (or resume) the reachability map and print its summary."""
     robot = load_robot(args)
     spec = maps.MapSpec(voxel=args.voxel, orientations=args.orientations, task=args.task, restarts=args.restarts,
                         seed=args.seed, chunk_voxels=args.chunk, method=args.method,
                         collisions=common.collisions_of(args))
-    if args.scheduler and args.workers:
-        raise KinelabError("give --scheduler ADDRESS or --workers N, not both")
-
-    if args.workers is not None and not 1 <= args.workers <= cluster.cores():
-        raise KinelabError(f"--workers must be 1 to {cluster.cores()} (the cores here), got {args.workers}")
-    client = None
-    if args.scheduler is not None or args.workers:
-        client = cluster.client_for(args.scheduler, args.workers)
+    client = _client(args)
     t0 = time.perf_counter()
     shown = progress_of(args)
     if not shown:  # the bar says it where someone watches; a log file gets the one line
@@ -199,12 +218,7 @@ def run_reach(args: argparse.Namespace) -> int:
     finally:
         if client is not None:
             client.close()
-    reach, branches = result.array("reachability"), result.array("branches")
-    summary = {"robot": robot.name, "voxels": int(len(reach)), "targets": int(len(reach) * spec.orientations),
-               "reached_voxels": int((reach > 0).sum()), "mean_reachability": float(np.nanmean(reach)),
-               "solver": result.meta["solver"],
-               "mean_branches": None if np.isnan(branches).all() or not (reach > 0).any()
-               else float(np.mean(branches[reach > 0])),
+    summary = {"robot": robot.name, **_reach_figures(result, spec.orientations), "solver": result.meta["solver"],
                "seconds": time.perf_counter() - t0, "out": args.out}
     if args.json:
         print_json(summary)

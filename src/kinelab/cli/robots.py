@@ -14,7 +14,7 @@ if TYPE_CHECKING:
 
     from kinelab import collision
     from kinelab.ik.analytic import redundancy
-    from kinelab.robot import Joint
+    from kinelab.robot import Chain, Joint
 else:
     collision = lazy.module("kinelab.collision", globals())
     np = lazy.module("numpy", globals())
@@ -59,6 +59,13 @@ def _joint_row(j: Joint) -> dict[str, Any]:
     return row
 
 
+def _shown_limits(j: Joint) -> tuple[str, str]:
+    """A joint's limits as printed: metres for a prismatic joint, degrees for the others."""
+    if j.kind == "prismatic":
+        return f"{j.lower:.4f} m", f"{j.upper:.4f} m"
+    return f"{np.rad2deg(j.lower):.3f} deg", f"{np.rad2deg(j.upper):.3f} deg"
+
+
 def run_info(args: argparse.Namespace) -> int:
     """The robot's chain: base, tool, joints with their limits, the locked joints."""
     robot = load_robot(args)
@@ -69,24 +76,27 @@ def run_info(args: argparse.Namespace) -> int:
             "closed_form": redundancy.closed_form_summary(robot), "judge": str(robot.fk_certificate)}
     if args.json:
         print_json(info)
-        return 0
+    else:
+        _print_info(robot, info, args.verbose)
+    return 0
+
+
+def _print_info(robot: Chain, info: dict[str, Any], verbose: bool) -> None:
+    """``info``'s human form (as ``--json`` prints it): the chain, its joints and limits, mimics, locked joints,
+    its branches, its judge and its collision check."""
     print(f"{robot.name}: {robot.n} DOF (nq={robot.nq}, nv={robot.nv}), base {robot.base!r} -> tool {robot.tool!r}")
     print(f"{robot.source_format}: {robot.urdf_path}")
     print(f"  {'#':>2} {'joint':<22} {'type':<11} {'lower':>12} {'upper':>12}")
     for i, j in enumerate(robot.joints, start=1):
-        if j.kind == "prismatic":
-            lo, hi = f"{j.lower:.4f} m", f"{j.upper:.4f} m"
-        else:
-            lo, hi = f"{np.rad2deg(j.lower):.3f} deg", f"{np.rad2deg(j.upper):.3f} deg"
+        lo, hi = _shown_limits(j)
         print(f"  {i:>2} {j.name:<22} {j.kind:<11} {lo:>12} {hi:>12}")
     for name, m in robot.mimics.items():
         print(f"mimic: {name} follows {m.leader}")
     if robot.locked:
         print(f"locked: {', '.join(f'{k}={v:g}' for k, v in robot.locked.items())}")
-    print(f"branches: {info['closed_form'] if args.verbose else redundancy.closed_form_words(robot)}")
+    print(f"branches: {info['closed_form'] if verbose else redundancy.closed_form_words(robot)}")
     print(f"answers judged by: {info['judge']}")
     print(f"collisions: {info['collisions'] or 'not built (add --collisions: loads the meshes, counts the pairs)'}")
-    return 0
 
 
 def _collision_summary(robot: Any) -> str:

@@ -114,9 +114,10 @@ class IK:
         self.request: Request = make_request(kind.request_solver(solver), None, tol_pos, tol_rot, time_budget,
                                              max_restarts, start_outside_limits, options, task, axis, solver_options)
         self._path_request: Request | None = None
-        req = self.request  # solve_all's usual call (no options, collisions or another task): its closed form's key
-        self._usual_all = (self._given[0], req.tol_pos, req.tol_rot, req.time_budget) if not given \
-            and collisions is None and task == "pose" and axis == "z" else None
+        # solve_all's usual call (no options, collisions or another task): its closed form's key
+        usual = not given and collisions is None and (task, axis) == ("pose", "z")
+        req = self.request
+        self._usual_all = (self._given[0], req.tol_pos, req.tol_rot, req.time_budget) if usual else None
         self.collisions = collision_check(robot, collisions)
         self._nearest: NearestBranch | None = None
         self._every: EveryBranch | None | Literal[False] = False  # solve_all's usual call, once looked up
@@ -256,17 +257,22 @@ class IK:
         if drop_colliding is not False:
             flag("drop_colliding", drop_colliding)
         if self._usual_all is not None and q_ref is None and max_solutions is None and redundancy is None:
-            entry = self._every_branch(stop_below)
-            if entry is not None:  # the usual call: every branch in one compiled call
-                if seed is not None and not (type(seed) is int and seed >= 0):
-                    check_seed(seed)
-                found = entry.solve(target)
-                if found is not None:
-                    return found
+            found = self._usual_solve_all(target, seed, stop_below)
+            if found is not None:
+                return found
         found = find_all(self.robot, target, replace(self._request(seed), max_restarts=0), q_ref=q_ref,
                          max_solutions=max_solutions, stop_below=stop_below, method=self.route,
                          redundancy=redundancy)
         return clear_of(found, self.collisions, drop=bool(drop_colliding))
+
+    def _usual_solve_all(self, target: Target, seed: int | None, stop_below: float | None) -> Branches | None:
+        """solve_all's usual call: every branch in one compiled call, or None where the general route answers."""
+        entry = self._every_branch(stop_below)
+        if entry is None:
+            return None
+        if seed is not None and not (type(seed) is int and seed >= 0):
+            check_seed(seed)
+        return entry.solve(target)
 
     def _every_branch(self, stop_below: float | None) -> EveryBranch | None:
         """solve_all's one-call solver for ``stop_below`` (kept here for the default), or None."""

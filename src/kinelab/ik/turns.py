@@ -38,7 +38,14 @@ def nearest_turns(robot: Chain, result: IKResult, q0: np.ndarray | None, target:
     q = np.where(revolute, moved[0], result.q) if kept[0] else result.q
     if np.array_equal(q, result.q):
         return result
+    return _judged_again(robot, result, q, target, task, axis, (tol_pos, tol_rot))
+
+
+def _judged_again(robot: Chain, result: IKResult, q: np.ndarray, target: pin.SE3, task: str, axis: str,
+                  tolerances: tuple[float, float]) -> IKResult:
+    """The result at q when the judge confirms q meets the task's components of ``target`` within the tolerances
+    ([m], [rad]) and the limits, else the result unchanged."""
     dp, dr, within = robot.verdict(target.homogeneous, np.ascontiguousarray(q, dtype=float),
                                    "xyz".index(axis) if task == "axis" else -1)
-    met = within and (dp <= tol_pos or task == "orientation") and (dr <= tol_rot or task == "position")
+    met = within and (dp <= tolerances[0] or task == "orientation") and (dr <= tolerances[1] or task == "position")
     return replace(result, q=q, position_error=dp, rotation_error=dr) if met else result

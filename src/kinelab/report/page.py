@@ -49,23 +49,33 @@ figcaption{color:#444;font-size:13px;margin-top:.3em} .meta{color:#555;font-size
 def validate_html(report: Report, figures: dict[str, bytes]) -> str:
     """The whole page for ``report``, its figures (file name → PNG bytes) embedded."""
     verdict = "PASS" if report.passed else "FAIL"
+    parts = [f"<!doctype html><html><head><meta charset='utf-8'><title>kinelab validate: {verdict}</title>",
+             f"<style>{STYLE}</style></head><body><h1>kinelab validate</h1>",
+             f"<div class='verdict {verdict.lower()}'>{verdict}</div><p>{html.escape(_summary(report))}</p>",
+             _machine(report.provenance)]
+    return "".join(parts) + _sections(report.checks, figures) + "</body></html>"
+
+
+def _sections(checks: list[Check], figures: dict[str, bytes]) -> str:
+    """The general checks' section, then one section per SECTIONS entry that has checks, with its figures."""
+    general = [c for c in checks if not any(c.name.startswith(key) for key, _, _ in SECTIONS)]
+    parts = [_section("Models and solvers, checked against Pinocchio", general, {})]
+    for key, title, prefix in SECTIONS:
+        mine = [c for c in checks if c.name.startswith(key)]
+        if mine:
+            parts.append(_section(title, mine, {n: b for n, b in figures.items() if n.startswith(prefix)}))
+    return "".join(parts)
+
+
+def _summary(report: Report) -> str:
+    """The page's opening sentence: how many checks passed on which robots, and the failed ones named."""
     failed = [c for c in report.checks if not c.passed]
     summary = (f"{len(report.checks) - len(failed)} of {len(report.checks)} checks passed on "
                f"{', '.join(report.robots)} ({report.n} configurations for the FK checks, each other check its own "
                f"sample; shares with their 95 % Wilson interval, passing on its bound; seed {report.seed}).")
     if failed:
         summary += " Failed: " + "; ".join(f"{c.robot}: {c.name}" for c in failed) + "."
-    parts = [f"<!doctype html><html><head><meta charset='utf-8'><title>kinelab validate: {verdict}</title>",
-             f"<style>{STYLE}</style></head><body><h1>kinelab validate</h1>",
-             f"<div class='verdict {verdict.lower()}'>{verdict}</div><p>{html.escape(summary)}</p>",
-             _machine(report.provenance)]
-    general = [c for c in report.checks if not any(c.name.startswith(key) for key, _, _ in SECTIONS)]
-    parts.append(_section("Models and solvers, checked against Pinocchio", general, {}))
-    for key, title, prefix in SECTIONS:
-        checks = [c for c in report.checks if c.name.startswith(key)]
-        if checks:
-            parts.append(_section(title, checks, {n: b for n, b in figures.items() if n.startswith(prefix)}))
-    return "".join(parts) + "</body></html>"
+    return summary
 
 
 def _section(title: str, checks: list[Check], figures: dict[str, bytes]) -> str:

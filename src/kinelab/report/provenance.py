@@ -65,15 +65,19 @@ def _resolved(git: Path) -> str | None:
         ref = head.removeprefix("ref:").strip()
         common = Path((git / "commondir").read_text().strip()) if (git / "commondir").exists() else None
         roots = [git] + ([git / common] if common is not None else [])
-        for root in roots:
-            if (root / ref).is_file():
-                return (root / ref).read_text().strip()
-            if (root / "packed-refs").is_file():
-                for line in (root / "packed-refs").read_text().splitlines():
-                    if line.endswith(" " + ref):
-                        return line.split()[0]
+        return next((found for root in roots if (found := _ref_in(root, ref)) is not None), None)
     except OSError:
         return None
+
+
+def _ref_in(root: Path, ref: str) -> str | None:
+    """The commit ``ref`` (``refs/heads/main``) names in the git directory ``root``, loose or packed, or None."""
+    if (root / ref).is_file():
+        return (root / ref).read_text().strip()
+    if (root / "packed-refs").is_file():
+        for line in (root / "packed-refs").read_text().splitlines():
+            if line.endswith(" " + ref):
+                return line.split()[0]
     return None
 
 

@@ -167,6 +167,15 @@ def _write_bench_files(result: dict[str, Any], folder: Path) -> None:
         bench_figure(result, folder / "bench.png")
 
 
+def _bars(axes: tuple[Any, Any], robots: list[str], by: dict[str, dict[str, Any]], offset: float, width: float,
+          label: str) -> None:
+    """One solver's bars: success [%] on the first axes, median time [µs] on the second, a bar per robot (0 where
+    the solver has no row for it)."""
+    xs = [i + offset for i in range(len(robots))]
+    axes[0].bar(xs, [by.get(rb, {}).get("success_pct", 0) for rb in robots], width, label=label)
+    axes[1].bar(xs, [by.get(rb, {}).get("median_us", 0) for rb in robots], width, label=label)
+
+
 def bench_figure(result: dict[str, Any], path: str | Path) -> None:
     """Success rate and median time per solver and robot, as a PNG."""
     rows = result["rows"]
@@ -176,10 +185,7 @@ def bench_figure(result: dict[str, Any], path: str | Path) -> None:
     ax1, ax2 = fig.subplots(1, 2)
     width = 0.8 / max(len(solvers), 1)
     for k, s in enumerate(solvers):
-        xs = [i + k * width for i, rb in enumerate(robots)]
-        by = {r["robot"]: r for r in rows if r["solver"] == s}
-        ax1.bar(xs, [by.get(rb, {}).get("success_pct", 0) for rb in robots], width, label=s)
-        ax2.bar(xs, [by.get(rb, {}).get("median_us", 0) for rb in robots], width, label=s)
+        _bars((ax1, ax2), robots, {r["robot"]: r for r in rows if r["solver"] == s}, k * width, width, s)
     for ax, title in ((ax1, "success [%]"), (ax2, "median time [µs]")):
         ax.set_xticks([i + 0.4 - width / 2 for i in range(len(robots))], robots)
         ax.set_title(title)

@@ -29,6 +29,7 @@ from kinelab.ik.analytic.redundancy import has_swept_form, swept_arm
 from kinelab.ik.branches import SAME
 from kinelab.ik.limits import distance
 from kinelab.ik.request import check_seed, make_request
+from kinelab.ik.result import Branches
 from kinelab.report.bench.collisions import FLOOR_AND_TABLE
 from kinelab.report.bench.completeness import FOUND, own_configuration
 from kinelab.report.check import SHARE, samples_for
@@ -148,19 +149,25 @@ def analytic_checks(robot: Chain, n: int, seed: int) -> list[Check]:
     rows = [Check(robot.name, f"{form}: every branch met (Pinocchio-checked)", _worst(robot, targets, branches),
                   1e-6, "m or rad", f"{len(targets)} targets, {np.mean([len(b) for b in branches]):.2f} branches "
                   "each within the limits")]
-    for solver in ("frdm", "biquat", "dls"):
-        on_branch = nearest = solved = 0
-        for k, start, res in _solved_from_random_starts(robot, targets, solver, seed):
-            solved += 1
-            gaps = [distance(robot, res.q, b.q) for b in branches[k]]
-            on_branch += min(gaps) <= SAME  # answers met to 1e-6 lie up to ~2e-4 rad off a branch near a singularity
-            nearest += int(np.argmin(gaps)) == int(np.argmin([distance(robot, start, b.q) for b in branches[k]]))
-        detail = f"{solved} of {len(targets)} solved from random starts"
-        if solver == "frdm" and solved:
-            detail += f"; on the branch nearest its start in {100 * nearest / solved:.0f} %"
-        rows.append(Check(robot.name, f"{solver}: answers off the {form}'s branches", float(solved - on_branch), 0.0,
-                          "count", detail))
+    rows += [_on_branches(robot, solver, form, targets, branches, seed) for solver in ("frdm", "biquat", "dls")]
     return rows + completeness_checks(robot, seed)
+
+
+def _on_branches(robot: Chain, solver: str, form: str, targets: list[pin.SE3], branches: list[Branches],
+                 seed: int) -> Check:
+    """How many of ``solver``'s answers from random starts lie off the closed form's branches (FRDM's detail: the
+    share on the branch nearest its start)."""
+    on_branch = nearest = solved = 0
+    for k, start, res in _solved_from_random_starts(robot, targets, solver, seed):
+        solved += 1
+        gaps = [distance(robot, res.q, b.q) for b in branches[k]]
+        on_branch += min(gaps) <= SAME  # answers met to 1e-6 lie up to ~2e-4 rad off a branch near a singularity
+        nearest += int(np.argmin(gaps)) == int(np.argmin([distance(robot, start, b.q) for b in branches[k]]))
+    detail = f"{solved} of {len(targets)} solved from random starts"
+    if solver == "frdm" and solved:
+        detail += f"; on the branch nearest its start in {100 * nearest / solved:.0f} %"
+    return Check(robot.name, f"{solver}: answers off the {form}'s branches", float(solved - on_branch), 0.0, "count",
+                 detail)
 
 
 COMPLETENESS_POSES = 2000
@@ -372,6 +379,14 @@ PAPER_CHECKS: dict[str, list[Callable[[Chain, int, int], list[Check]]]] = {
 GENERAL_CHECKS = [model_checks, biquaternion_checks, solver_checks, analytic_checks, collision_checks]
 
 
+def _groups(robot: Chain | Robot) -> list[Any]:
+    """The check groups a robot takes: a whole robot the whole-body checks, a chain the general ones and its
+    paper's."""
+    if isinstance(robot, Robot):
+        return list(WHOLE_CHECKS)
+    return [*GENERAL_CHECKS, *PAPER_CHECKS.get(robot.name, [])]
+
+
 def run(robots: list[str] | None = None, n: int | None = None, seed: int = 0, progress: bool = False) -> Report:
     """Run every check on ``robots`` (default: stanford, era, youbot, panda, ur5, and the whole talos and baxter:
     a whole robot takes the whole-body checks, :mod:`kinelab.report.wholebody_checks`)."""
@@ -382,9 +397,7 @@ def run(robots: list[str] | None = None, n: int | None = None, seed: int = 0, pr
         raise KinelabError(f"validate needs n ≥ 1 configurations per check, got {n!r}")
     loaded = [load(name) for name in names]  # fail early, before any work, on a bad name
     report = Report(robots=names, n=n, seed=seed)
-    steps: list[tuple[Any, Any]] = [
-        (robot, fn) for robot in loaded
-        for fn in (WHOLE_CHECKS if isinstance(robot, Robot) else [*GENERAL_CHECKS, *PAPER_CHECKS.get(robot.name, [])])]
+    steps = [(robot, fn) for robot in loaded for fn in _groups(robot)]
     for robot, fn in tqdm(steps, desc="validate (check groups)", disable=not progress, unit="group"):
         report.checks.extend(fn(robot, n, seed))
     return report

@@ -165,13 +165,10 @@ def frame_id(model: pin.Model, name: str, robot: str) -> int:
     """Id of frame ``name``, preferring the link (BODY) frame where a joint shares the name."""
     if not isinstance(name, str):
         raise FrameNotFoundError(repr(name), [f.name for f in model.frames], robot)
-    body = [i for i, f in enumerate(model.frames) if f.name == name and f.type == pin.FrameType.BODY]
-    if body:
-        return body[0]
     ids = [i for i, f in enumerate(model.frames) if f.name == name]
     if not ids:
         raise FrameNotFoundError(name, [f.name for f in model.frames], robot)
-    return ids[0]
+    return next((i for i in ids if model.frames[i].type == pin.FrameType.BODY), ids[0])
 
 
 def joint_kind(joint_model: pin.JointModel) -> str | None:

@@ -104,16 +104,11 @@ class FKCertificate:
 
 def chain_arrays(robot: Chain) -> ChainArrays | str:
     """The robot's chain as arrays, or the reason it is not a plain series of 1-DoF joints."""
+    why = _not_packable(robot)
+    if why:
+        return why
     model = robot.model
-    if robot.mimics:
-        return f"joint {next(iter(robot.mimics))!r} mimics another (coupled joints)"
-    if robot.nq != robot.n + robot.joint_kinds.count("continuous"):  # a continuous joint is (cos, sin) in Pinocchio
-        return "a joint with more than one coordinate"
-    if any(model.parents[j] != j - 1 for j in range(1, model.njoints)):
-        return "the joints are not in series"
     tool = model.frames[robot.tool_frame_id]
-    if tool.parentJoint != model.njoints - 1:
-        return f"the tool frame {robot.tool!r} is not carried by the last joint"
     joints = range(1, model.njoints)
     packed = (np.array([model.jointPlacements[j].rotation for j in joints]).reshape(-1, 3, 3),
               np.array([model.jointPlacements[j].translation for j in joints]).reshape(-1, 3),
@@ -121,6 +116,20 @@ def chain_arrays(robot: Chain) -> ChainArrays | str:
               np.array([k == "prismatic" for k in robot.joint_kinds], dtype=np.int64),
               np.array(tool.placement.rotation), np.array(tool.placement.translation))
     return ChainArrays(*(np.ascontiguousarray(a) for a in packed))  # the compiled FK reads rows in C order
+
+
+def _not_packable(robot: Chain) -> str:
+    """Why the robot's chain is not a plain series of 1-DoF joints ending at the tool ("" when it is)."""
+    model = robot.model
+    if robot.mimics:
+        return f"joint {next(iter(robot.mimics))!r} mimics another (coupled joints)"
+    if robot.nq != robot.n + robot.joint_kinds.count("continuous"):  # a continuous joint is (cos, sin) in Pinocchio
+        return "a joint with more than one coordinate"
+    if any(model.parents[j] != j - 1 for j in range(1, model.njoints)):
+        return "the joints are not in series"
+    if model.frames[robot.tool_frame_id].parentJoint != model.njoints - 1:
+        return f"the tool frame {robot.tool!r} is not carried by the last joint"
+    return ""
 
 
 def certify(robot: Chain) -> FKCertificate:

@@ -44,14 +44,7 @@ def resolve(source: str) -> Description:
             command named; nothing is downloaded).
     """
     name = source[len(PREFIX):]
-    try:
-        from robot_descriptions._descriptions import DESCRIPTIONS
-    except ImportError:
-        raise DescriptionError(f"{source} needs robot_descriptions: {INSTALL_HINT}") from None
-    if name not in DESCRIPTIONS:
-        close = difflib.get_close_matches(name, list(DESCRIPTIONS), n=5) or sorted(DESCRIPTIONS)[:5]
-        raise DescriptionError(f"{source}: {name!r} is not a robot_descriptions description; close names: "
-                               + ", ".join(PREFIX + c for c in close))
+    _check_known(name, source)
     clone = _cache_path(name)
     if clone is not None and not clone.is_dir():
         raise DescriptionError(
@@ -64,6 +57,22 @@ def resolve(source: str) -> Description:
         raise DescriptionError(f"{source} names neither a URDF nor an MJCF file")
     dirs = [getattr(module, attr) for attr in ("PACKAGE_PATH", "REPOSITORY_PATH") if hasattr(module, attr)]
     return Description(name, Path(path), tuple(str(Path(d).parent) for d in dirs) + tuple(map(str, dirs)))
+
+
+def _check_known(name: str, source: str) -> None:
+    """Refuse a name robot_descriptions does not describe (close names listed), or its absence (the install hint).
+
+    Raises:
+        DescriptionError: either.
+    """
+    try:
+        from robot_descriptions._descriptions import DESCRIPTIONS
+    except ImportError:
+        raise DescriptionError(f"{source} needs robot_descriptions: {INSTALL_HINT}") from None
+    if name not in DESCRIPTIONS:
+        close = difflib.get_close_matches(name, list(DESCRIPTIONS), n=5) or sorted(DESCRIPTIONS)[:5]
+        raise DescriptionError(f"{source}: {name!r} is not a robot_descriptions description; close names: "
+                               + ", ".join(PREFIX + c for c in close))
 
 
 def _import(name: str, source: str):

@@ -89,16 +89,22 @@ def _chain(path: Path, entry: catalog.Entry | None, name: str | None, tool: str 
            trust_xacro: bool) -> Chain:
     """:func:`load`'s chain: the registered tool, base or group where the entry has them."""
     if entry is not None and not group:
-        tool, base = tool or entry.tool, base or entry.base
-        if entry.group and not (tool or base):
-            group = entry.group
-        srdf = srdf or catalog.srdf_path(entry)
+        tool, base, group, srdf = _registered(entry, tool, base, srdf)
     chain = Chain(build_file(path, tool=tool, locked=locked, name=name, base=base, package_dirs=package_dirs,
                              srdf=srdf, group=group, xacro_args=xacro_args, trust_xacro=trust_xacro))
     chain.attach(partial(whole_of, chain))
     if entry is not None and entry.display is not None and chain.n == len(entry.display):
         chain.display_pose = np.array(entry.display)
     return chain
+
+
+def _registered(entry: catalog.Entry, tool: str | None, base: str | None,
+                srdf: str | Path | None) -> tuple[str | None, str | None, str | None, str | Path | None]:
+    """(tool, base, group, srdf) with the entry's where the caller gave none (its group only when neither tool nor
+    base is given)."""
+    tool, base = tool or entry.tool, base or entry.base
+    group = entry.group if entry.group and not (tool or base) else None
+    return tool, base, group, srdf or catalog.srdf_path(entry)
 
 
 def _whole(path: Path, entry: catalog.Entry | None, name: str | None, package_dirs: list[str] | None,
@@ -150,22 +156,24 @@ def _check_load_arguments(source: Any, tool: Any, locked: Any, base: Any, packag
                           group: Any, xacro_args: Any, trust_xacro: Any) -> None:
     """Refuse an argument of the wrong type, naming it and what it takes (before any file is read)."""
     checks = (
-        ("name_or_path", source, _is_path(source), "a registered name, a file path or 'rd:NAME'"),
-        ("tool", tool, tool is None or _is_name(tool), "a frame name, or None"),
-        ("base", base, base is None or _is_name(base), "a frame name, or None"),
-        ("group", group, group is None or _is_name(group), "an SRDF group name, or None"),
-        ("srdf", srdf, srdf is None or _is_path(srdf), "a path to an SRDF file, or None"),
-        ("package_dirs", package_dirs, package_dirs is None or (isinstance(package_dirs, list | tuple)
-                                                                and all(map(_is_path, package_dirs))),
-         "a list of folder paths, or None"),
-        ("locked", locked, locked is None or _is_named_table(locked), "a dict joint name → value [rad or m], or None"),
-        ("xacro_args", xacro_args, xacro_args is None or _is_named_table(xacro_args),
-         "a dict argument name → value, or None"),
-        ("trust_xacro", trust_xacro, isinstance(trust_xacro, bool), "True or False"),
+        ("name_or_path", source, _is_path, False, "a registered name, a file path or 'rd:NAME'"),
+        ("tool", tool, _is_name, True, "a frame name, or None"),
+        ("base", base, _is_name, True, "a frame name, or None"),
+        ("group", group, _is_name, True, "an SRDF group name, or None"),
+        ("srdf", srdf, _is_path, True, "a path to an SRDF file, or None"),
+        ("package_dirs", package_dirs, _is_path_list, True, "a list of folder paths, or None"),
+        ("locked", locked, _is_named_table, True, "a dict joint name → value [rad or m], or None"),
+        ("xacro_args", xacro_args, _is_named_table, True, "a dict argument name → value, or None"),
+        ("trust_xacro", trust_xacro, lambda v: isinstance(v, bool), False, "True or False"),
     )
-    for name, value, ok, valid in checks:
-        if not ok:
+    for name, value, test, optional, valid in checks:
+        if not ((optional and value is None) or test(value)):
             raise OptionError(name, value, valid)
+
+
+def _is_path_list(value: Any) -> bool:
+    """A list or tuple of paths."""
+    return isinstance(value, list | tuple) and all(map(_is_path, value))
 
 
 def _is_path(value: Any) -> bool:

@@ -213,23 +213,34 @@ def geometry_model(chain: Chain, package_dirs: list[str] | None, kind: str) -> p
     b = chain._built
     if b.urdf_path is None or b.full is None:
         return pin.GeometryModel()  # an in-memory model brings no geometry: the viewer draws a stick figure
-    geometry_type = pin.GeometryType.COLLISION if kind == "collision" else pin.GeometryType.VISUAL
     if is_mjcf(b.urdf_path):
-        outside = meshes_outside(b.urdf_path)
-        if outside:  # Pinocchio builds all of a file's geometry or none: none, said
-            warnings.warn(f"{b.urdf_path.name}: mesh {outside[0]!r} lies outside the file's folder; kinelab "
-                          f"reads no file outside it, so {chain.name} is drawn without its {kind} geometry",
-                          stacklevel=2)
-            return pin.GeometryModel()
-        geom = pin.buildGeomFromMJCF(b.full, str(b.urdf_path), geometry_type)
+        geom = _mjcf_geometry(chain, b.urdf_path, kind)
     else:
         geom = build_visual_model(b.full, b.urdf_path, package_dirs or chain.package_dirs, kind)
-    if b.lock_ids:
+    if b.lock_ids and geom.ngeoms:
         _, geom = pin.buildReducedModel(b.full, geom, list(b.lock_ids), b.q_ref)
     if b.bMw is not None:  # re-rooted at the base frame, as the model was
-        for gid in range(geom.ngeoms):
-            obj = geom.geometryObjects[gid]
-            if obj.parentJoint == 0:
-                obj.placement = b.bMw * obj.placement
-                geom.geometryObjects[gid] = obj
+        _rerooted(geom, b.bMw)
     return geom
+
+
+def _mjcf_geometry(chain: Chain, path: Path, kind: str) -> pin.GeometryModel:
+    """The whole model's geometry of kind "visual" or "collision" from the chain's MJCF file at ``path``; empty
+    (said in a warning) when one of its meshes lies outside the file's folder."""
+    outside = meshes_outside(path)
+    if outside:  # Pinocchio builds all of a file's geometry or none: none, said
+        warnings.warn(f"{path.name}: mesh {outside[0]!r} lies outside the file's folder; kinelab "
+                      f"reads no file outside it, so {chain.name} is drawn without its {kind} geometry",
+                      stacklevel=3)
+        return pin.GeometryModel()
+    geometry_type = pin.GeometryType.COLLISION if kind == "collision" else pin.GeometryType.VISUAL
+    return pin.buildGeomFromMJCF(chain._built.full, str(path), geometry_type)
+
+
+def _rerooted(geom: pin.GeometryModel, bMw: pin.SE3) -> None:
+    """Move the objects fixed to the universe into the base frame (in place), as the model was re-rooted."""
+    for gid in range(geom.ngeoms):
+        obj = geom.geometryObjects[gid]
+        if obj.parentJoint == 0:
+            obj.placement = bMw * obj.placement
+            geom.geometryObjects[gid] = obj

@@ -83,22 +83,32 @@ def check_mjcf(path: Path) -> None:
         raise URDFError(f"malformed MJCF {path}: {exc}") from None
     bodies = list(root.iter("body"))
     check_size(path, len(bodies), "bodies")
+    _check_unread(path, root)
+    _check_classes(path, root)
+    for kind, elements in (("body", bodies), ("joint", list(root.iter("joint")))):
+        _check_unique(path, kind, [e.get("name", "") for e in elements if e.get("name")])
+    for body in bodies:
+        _check_body(path, body)
+    for joint in root.iter("joint"):
+        _check_joint(path, joint)
+
+
+def _check_unread(path: Path, root: ET.Element) -> None:
+    """Refuse what the parsers would skip without a word: an ``<include>`` (kinelab reads one file) and the UNREAD
+    elements in the world body (Pinocchio's parser drops the bodies in them)."""
     if root.find(".//include") is not None:
         raise URDFError(f"{path}: <include> is not read by kinelab; merge the included file into {path.name}")
     for tag in UNREAD:
         if root.find(f".//worldbody//{tag}") is not None:
             raise URDFError(f"{path}: <{tag}> is not read by Pinocchio's MJCF parser (the bodies in it would be "
                             f"dropped without a word); write its bodies out of it, its placement composed into theirs")
-    _check_classes(path, root)
-    for kind, elements in (("body", bodies), ("joint", list(root.iter("joint")))):
-        names = [e.get("name", "") for e in elements if e.get("name")]
-        twice = sorted({n for n in names if names.count(n) > 1})
-        if twice:
-            raise URDFError(f"{path}: two {kind} elements are named {twice[0]!r}; names must be unique")
-    for body in bodies:
-        _check_body(path, body)
-    for joint in root.iter("joint"):
-        _check_joint(path, joint)
+
+
+def _check_unique(path: Path, kind: str, names: list[str]) -> None:
+    """Refuse two elements of ``kind`` that share a name."""
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise URDFError(f"{path}: two {kind} elements are named {twice[0]!r}; names must be unique")
 
 
 def _check_classes(path: Path, root: ET.Element) -> None:
@@ -132,6 +142,11 @@ def _check_body(path: Path, body: ET.Element) -> None:
     pos = _numbers(path, body, "pos", 3)
     if pos is not None and max(abs(v) for v in pos) > MAX_OFFSET:
         raise URDFError(f"{path}: body {name!r} pos {pos} is more than {MAX_OFFSET:g} m from its parent")
+    _check_rotation(path, body, name)
+
+
+def _check_rotation(path: Path, body: ET.Element, name: str) -> None:
+    """A body's orientation, however given (quat, axisangle, euler, xyaxes, zaxis), finite and not degenerate."""
     for attribute, count, part in (("quat", 4, slice(0, 4)), ("axisangle", 4, slice(0, 3))):
         values = _numbers(path, body, attribute, count)
         if values is not None and math.hypot(*values[part]) < 1e-12:
@@ -170,6 +185,11 @@ def _check_joint(path: Path, joint: ET.Element) -> None:
     pos = _numbers(path, joint, "pos", 3)
     if pos is not None and max(map(abs, pos)) > MAX_OFFSET:
         raise URDFError(f"{path}: joint {name!r} pos {pos} lies beyond ±{MAX_OFFSET:g} m of its body")
+    _check_range(path, joint, name)
+
+
+def _check_range(path: Path, joint: ET.Element, name: str) -> None:
+    """A joint's range: two finite numbers, lower ≤ upper, within ±MAX_OFFSET."""
     span = _numbers(path, joint, "range", 2)
     if span is not None and span[0] > span[1]:
         raise URDFError(f"{path}: joint {name!r} range lower {span[0]:g} > upper {span[1]:g}")
@@ -196,20 +216,30 @@ def body_tree(model: pin.Model) -> UrdfTree:
     parents = _parent_frames(model)
     parent_of, joint_of = {}, {}
     for i in bodies:
-        up = parents[i]
-        carrier = model.frames[up].name if model.frames[up].type != pin.FrameType.BODY and up != 0 else None
-        while up != 0 and model.frames[up].type != pin.FrameType.BODY:
-            up = parents[up]
         name = model.frames[i].name
-        parent_of[name] = model.frames[up].name
-        joint_of[name] = carrier or f"{name}_fixed"
-    tops = [b for b, p in parent_of.items() if p == "universe"]
-    root = tops[0] if len(tops) == 1 else "universe"
+        parent_of[name], joint_of[name] = _parent_body(model, parents, i)
+    root = _root_body(parent_of)
     if root != "universe":
         del parent_of[root], joint_of[root]
     links = [model.frames[i].name for i in bodies] + (["universe"] if root == "universe" else [])
     leaves = [b for b in links if b not in parent_of.values() and b != root]
     return UrdfTree(root, parent_of, joint_of, {}, links, leaves)
+
+
+def _root_body(parent_of: dict[str, str]) -> str:
+    """The single body hanging from the universe, or "universe" when several do."""
+    tops = [b for b, p in parent_of.items() if p == "universe"]
+    return tops[0] if len(tops) == 1 else "universe"
+
+
+def _parent_body(model: pin.Model, parents: list[int], i: int) -> tuple[str, str]:
+    """The body above BODY frame i and the joint (or fixed joint frame) carrying it (``NAME_fixed`` when the body
+    hangs straight from another)."""
+    up = parents[i]
+    carrier = model.frames[up].name if model.frames[up].type != pin.FrameType.BODY and up != 0 else None
+    while up != 0 and model.frames[up].type != pin.FrameType.BODY:
+        up = parents[up]
+    return model.frames[up].name, carrier or f"{model.frames[i].name}_fixed"
 
 
 def _parent_frames(model: pin.Model) -> list[int]:

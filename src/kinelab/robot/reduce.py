@@ -74,6 +74,21 @@ def build_model(model: pin.Model, tool: str | None = None, locked: dict[str, flo
     return _Builder.from_model(pin.Model(model), tool, locked, name, base).built()
 
 
+def _leaf_tool(full: pin.Model, leaf: str) -> str:
+    """The one site (operational frame) on the leaf body where it has exactly one (an MJCF tip site), else the
+    leaf."""
+    ids = [i for i, f in enumerate(full.frames) if f.name == leaf and f.type == pin.FrameType.BODY]
+    if not ids:
+        return leaf
+    sites = [f.name for f in full.frames if f.type == pin.FrameType.OP_FRAME and f.parentFrame == ids[0]]
+    return sites[0] if len(sites) == 1 else leaf
+
+
+def _has_free_mimic(full: pin.Model, chain: list[int], tree: UrdfTree, locked: dict[str, float]) -> bool:
+    """True when a joint of the chain mimics another and is not locked (the model is then built with mimics)."""
+    return any(full.names[j] in tree.mimic and full.names[j] not in locked for j in chain)
+
+
 class _Builder:
     """The steps of one build; its attributes are the decisions made so far."""
 
@@ -119,21 +134,24 @@ class _Builder:
 
     def reduce(self, tool: str | None, base: str | None, locked: dict[str, float] | None) -> None:
         """The chain base → tool, its mimics and locked joints, the reduced and re-rooted model."""
-        full, tree = self._start, self.tree
+        full, tree, locked = self._start, self.tree, locked or {}
         self.base = base or tree.root
         self.tool = tool or self._default_tool(tree, full)
         chain = self._chain(full, base)
-        if any(full.names[j] in tree.mimic and full.names[j] not in (locked or {}) for j in chain):
+        if _has_free_mimic(full, chain, tree, locked):
             full, chain = self._with_mimics(full, chain, tree, base)
         self._check_chain(full, chain, tree)
         if self.urdf_path is not None:
-            tree.check_mimics(self.urdf_path, [full.names[j] for j in chain], (locked or {}))
-        reference = self.srdf.reference() if self.srdf else {}
-        held = {j: v for j, v in reference.items() if full.existJointName(j) and full.getJointId(j) not in chain}
-        self.locked = self._locked_values(full, chain, {**held, **(locked or {})})
+            tree.check_mimics(self.urdf_path, [full.names[j] for j in chain], locked)
+        self.locked = self._locked_values(full, chain, {**self._held_by_srdf(full, chain), **locked})
         self._reduce(full)
         if base is not None and base != tree.root:
             self._reroot(base)
+
+    def _held_by_srdf(self, full: pin.Model, chain: list[int]) -> dict[str, float]:
+        """The SRDF's reference values [rad or m] of the model's joints off the chain (none without an SRDF)."""
+        reference = self.srdf.reference() if self.srdf else {}
+        return {j: v for j, v in reference.items() if full.existJointName(j) and full.getJointId(j) not in chain}
 
     def built(self) -> Built:
         """The frozen result."""
@@ -171,11 +189,7 @@ class _Builder:
         if any(f.name == "tool" for f in full.frames):
             return "tool"
         if len(tree.leaves) == 1:
-            leaf = tree.leaves[0]
-            ids = [i for i, f in enumerate(full.frames) if f.name == leaf and f.type == pin.FrameType.BODY]
-            sites = [f.name for f in full.frames if f.type == pin.FrameType.OP_FRAME and ids
-                     and f.parentFrame == ids[0]]
-            return sites[0] if len(sites) == 1 else leaf
+            return _leaf_tool(full, tree.leaves[0])
         raise ChainError(
             f"the tool frame is ambiguous: {tree.root!r} branches into {len(tree.leaves)} leaf links "
             f"({', '.join(tree.leaves[:12])}{', ...' if len(tree.leaves) > 12 else ''}); pass tool=NAME"

@@ -53,13 +53,11 @@ class Space:
 def space_of(model: pin.Model) -> Space:
     """The :class:`Space` of ``model``."""
     bounded_q, bounded_v = np.zeros(model.nq, dtype=bool), np.zeros(model.nv, dtype=bool)
-    names_q, names_v = [], []
     for jid in range(1, model.njoints):
-        joint, name = model.joints[jid], model.names[jid]
+        joint = model.joints[jid]
         if joint.nq == 1 and joint.nv == 1 and joint.shortname() != "JointModelMimic":
             bounded_q[joint.idx_q], bounded_v[joint.idx_v] = True, True
-        names_q += [name] if joint.nq == 1 else [f"{name}.{k}" for k in range(joint.nq)]
-        names_v += [name] if joint.nv == 1 else [f"{name}.{k}" for k in range(joint.nv)]
+    names_q, names_v = _coordinate_names(model)
     lower = np.where(bounded_q, model.lowerPositionLimit, -np.inf)
     upper = np.where(bounded_q, model.upperPositionLimit, np.inf)
     lower[bounded_q & (lower < -UNBOUNDED)], upper[bounded_q & (upper > UNBOUNDED)] = -np.inf, np.inf
@@ -72,6 +70,17 @@ def space_of(model: pin.Model) -> Space:
         arr.flags.writeable = False
     return Space(model.nq, model.nv, lower, upper, bounded_q, bounded_v, velocity, tuple(names_q), tuple(names_v),
                  floating)
+
+
+def _coordinate_names(model: pin.Model) -> tuple[list[str], list[str]]:
+    """The names of q's and v's coordinates: a 1-coordinate joint's name, else ``name.k`` per coordinate."""
+    names_q: list[str] = []
+    names_v: list[str] = []
+    for jid in range(1, model.njoints):
+        joint, name = model.joints[jid], model.names[jid]
+        names_q += [name] if joint.nq == 1 else [f"{name}.{k}" for k in range(joint.nq)]
+        names_v += [name] if joint.nv == 1 else [f"{name}.{k}" for k in range(joint.nv)]
+    return names_q, names_v
 
 
 def check_q(space: Space, model: pin.Model, q: ArrayLike, *, limits: bool = False, what: str = "q") -> np.ndarray:

@@ -157,32 +157,57 @@ def read_srdf(path: str | Path) -> Srdf:
         root = ET.fromstring(read_text(path, "SRDF", SRDFError))
     except ET.ParseError as exc:
         raise SRDFError(f"cannot read SRDF {path}: {exc}") from None
+    _check_unique(root, path)
     out = Srdf(path)
-    for tag, elements in (("group", root.findall("group")), ("group_state", list(root.iter("group_state")))):
-        names = [e.get("name", "") for e in elements]
-        twice = sorted({n for n in names if names.count(n) > 1})
-        if twice:  # the second would be dropped (a group) or win (a configuration) without a word
-            raise SRDFError(f"{path.name}: two {tag} elements are named {twice[0]!r}; names must be unique")
     for g in root.findall("group"):  # top-level definitions (a nested <group name=.../> only refers to one)
-        chain = g.find("chain")
-        out.groups.setdefault(g.get("name", ""), Group(
-            g.get("name", ""),
-            (chain.get("base_link", ""), chain.get("tip_link", "")) if chain is not None else None,
-            tuple(j.get("name", "") for j in g.findall("joint")),
-            tuple(s.get("name", "") for s in g.findall("group"))))
+        out.groups.setdefault(g.get("name", ""), _group(g))
     virtual = [v.get("name", "") for v in root.iter("virtual_joint")]
     for st in root.iter("group_state"):
-        values = out.states[st.get("name", "")] = {}
-        for j in st.findall("joint"):
-            if len(j.get("value", "").split()) > 1:  # a floating base's pose (x y z qx qy qz qw): not a chain joint
-                virtual.append(j.get("name", ""))
-            else:
-                values[j.get("name", "")] = _number(j, path)
+        out.states[st.get("name", "")], floating = _state(st, path)
+        virtual += floating
     out.virtual_joints = tuple(dict.fromkeys(virtual))
     for ee in root.iter("end_effector"):
         out.end_effectors.setdefault(ee.get("group", ""), ee.get("parent_link", ""))
     out.disabled_collisions = tuple((d.get("link1", ""), d.get("link2", "")) for d in root.iter("disable_collisions"))
     return out
+
+
+def _check_unique(root: ET.Element, path: Path) -> None:
+    """Refuse two groups or two group states of one name (the second would be dropped, or win, without a word).
+
+    Raises:
+        SRDFError: the name given twice.
+    """
+    for tag, elements in (("group", root.findall("group")), ("group_state", list(root.iter("group_state")))):
+        names = [e.get("name", "") for e in elements]
+        twice = sorted({n for n in names if names.count(n) > 1})
+        if twice:
+            raise SRDFError(f"{path.name}: two {tag} elements are named {twice[0]!r}; names must be unique")
+
+
+def _group(g: ET.Element) -> Group:
+    """A ``<group>``: its chain (base and tip links), joints and the groups it names."""
+    chain = g.find("chain")
+    return Group(g.get("name", ""),
+                 (chain.get("base_link", ""), chain.get("tip_link", "")) if chain is not None else None,
+                 tuple(j.get("name", "") for j in g.findall("joint")),
+                 tuple(s.get("name", "") for s in g.findall("group")))
+
+
+def _state(st: ET.Element, path: Path) -> tuple[dict[str, float], list[str]]:
+    """A ``<group_state>``'s joint values, and the joints it gives a floating base's pose (x y z qx qy qz qw: not a
+    chain joint's value).
+
+    Raises:
+        SRDFError: a value that is not a finite number.
+    """
+    values, floating = {}, []
+    for j in st.findall("joint"):
+        if len(j.get("value", "").split()) > 1:
+            floating.append(j.get("name", ""))
+        else:
+            values[j.get("name", "")] = _number(j, path)
+    return values, floating
 
 
 def _number(joint: ET.Element, path: Path) -> float:

@@ -72,6 +72,40 @@ def read_tree(path: Path) -> UrdfTree:
     xml = _parse(path)
     links = [link.get("name", "") for link in xml.findall("link")]
     check_size(path, len(links), "links")
+    parent_of, joint_of, mimic = _edges(path, xml)
+    _check_links_defined(path, links, parent_of, joint_of)
+    mimic, broken = _split_mimics(mimic, {j.get("name", "?") for j in xml.findall("joint")})
+    roots = [link for link in links if link not in parent_of]
+    if len(roots) != 1:
+        raise URDFError(f"malformed URDF {path}: expected one root link, found {roots}")
+    parents = set(parent_of.values())
+    return UrdfTree(roots[0], parent_of, joint_of, mimic, links, [link for link in links if link not in parents],
+                    broken)
+
+
+def _split_mimics(mimic: dict[str, str], joints: set[str]) -> tuple[dict[str, str], dict[str, str]]:
+    """The mimic table split into the followers whose leader is a joint of the file and those whose is not."""
+    broken = {name: leader for name, leader in mimic.items() if leader not in joints}
+    return {name: leader for name, leader in mimic.items() if name not in broken}, broken
+
+
+def _check_links_defined(path: Path, links: list[str], parent_of: dict[str, str], joint_of: dict[str, str]) -> None:
+    """Refuse a joint that names a link the file does not define."""
+    known = set(links)
+    for child, parent in parent_of.items():
+        unknown = [link for link in (parent, child) if link not in known]
+        if unknown:
+            raise URDFError(f"{path}: joint {joint_of[child]!r} names link {unknown[0]!r}, "
+                            "which the file does not define")
+
+
+def _edges(path: Path, xml: ET.Element) -> tuple[dict[str, str], dict[str, str], dict[str, str]]:
+    """Each child link's parent link and joint, and each mimic joint's leader, the joints checked.
+
+    Raises:
+        URDFError: a joint that breaks a rule.
+        ChainError: a link that is the child of two joints (a closed loop).
+    """
     parent_of: dict[str, str] = {}
     joint_of: dict[str, str] = {}
     mimic: dict[str, str] = {}
@@ -87,22 +121,7 @@ def read_tree(path: Path) -> UrdfTree:
         m = joint.find("mimic")
         if m is not None:
             mimic[name] = m.get("joint", "")
-    known = set(links)
-    for child, parent in parent_of.items():
-        for link in (parent, child):
-            if link not in known:
-                raise URDFError(f"{path}: joint {joint_of[child]!r} names link {link!r}, "
-                                "which the file does not define")
-    joint_names = {j.get("name", "?") for j in xml.findall("joint")}
-    broken = {name: leader for name, leader in mimic.items() if leader not in joint_names}
-    for name in broken:
-        del mimic[name]
-    roots = [link for link in links if link not in parent_of]
-    if len(roots) != 1:
-        raise URDFError(f"malformed URDF {path}: expected one root link, found {roots}")
-    parents = set(parent_of.values())
-    return UrdfTree(roots[0], parent_of, joint_of, mimic, links, [link for link in links if link not in parents],
-                    broken)
+    return parent_of, joint_of, mimic
 
 
 def check_size(path: Path, count: int, what: str) -> None:
@@ -189,20 +208,10 @@ def _check_joint(path: Path, joint: ET.Element) -> tuple[str, str]:
     if p == c:
         raise URDFError(f"{path}: joint {name!r} connects link {p!r} to itself")
     where = f"{path}: joint {name!r}"
-    origin = joint.find("origin")
-    if origin is not None:
-        xyz = _numbers(where, "origin xyz", origin.get("xyz", "0 0 0"), 3)
-        _numbers(where, "origin rpy", origin.get("rpy", "0 0 0"), 3)
-        if max(abs(v) for v in xyz) > MAX_OFFSET:
-            raise URDFError(f"{where}: origin xyz {xyz} is more than {MAX_OFFSET:g} m from its parent")
+    _check_origin(where, joint.find("origin"))
     axis = joint.find("axis")
     if axis is not None and joint.get("type") not in ("fixed", "floating"):
-        a = _numbers(where, "axis xyz", axis.get("xyz", "1 0 0"), 3)
-        if math.hypot(*a) < 1e-12:
-            raise URDFError(f"{where}: the axis is zero; an axis must be a non-zero direction")
-        if max(map(abs, a)) > MAX_COMPONENT:  # its length overflows: Pinocchio would turn about no unit axis
-            raise URDFError(f"{where}: the axis {a} has a component beyond ±{MAX_COMPONENT:g}; give a direction "
-                            "(its length is normalised)")
+        _check_axis(where, axis)
     limit = joint.find("limit")
     if limit is not None and joint.get("type") in ("revolute", "prismatic"):
         lo = _numbers(where, "limit lower", limit.get("lower", "0"), 1)[0]
@@ -210,6 +219,26 @@ def _check_joint(path: Path, joint: ET.Element) -> tuple[str, str]:
         if lo > hi:
             raise URDFError(f"{where}: limit lower {lo:g} > upper {hi:g}")
     return p, c
+
+
+def _check_origin(where: str, origin: ET.Element | None) -> None:
+    """A joint's origin: finite xyz [m] within MAX_OFFSET of its parent, finite rpy [rad]."""
+    if origin is None:
+        return
+    xyz = _numbers(where, "origin xyz", origin.get("xyz", "0 0 0"), 3)
+    _numbers(where, "origin rpy", origin.get("rpy", "0 0 0"), 3)
+    if max(abs(v) for v in xyz) > MAX_OFFSET:
+        raise URDFError(f"{where}: origin xyz {xyz} is more than {MAX_OFFSET:g} m from its parent")
+
+
+def _check_axis(where: str, axis: ET.Element) -> None:
+    """A moving joint's axis: a finite, non-zero direction whose length a float holds."""
+    a = _numbers(where, "axis xyz", axis.get("xyz", "1 0 0"), 3)
+    if math.hypot(*a) < 1e-12:
+        raise URDFError(f"{where}: the axis is zero; an axis must be a non-zero direction")
+    if max(map(abs, a)) > MAX_COMPONENT:  # its length overflows: Pinocchio would turn about no unit axis
+        raise URDFError(f"{where}: the axis {a} has a component beyond ±{MAX_COMPONENT:g}; give a direction "
+                        "(its length is normalised)")
 
 
 def _numbers(where: str, what: str, text: str, count: int) -> list[float]:

@@ -320,13 +320,9 @@ _ARG = re.compile(r"<xacro:arg\s[^>]*name\s*=\s*[\"']([^\"']+)[\"']")
 _INCLUDE = re.compile(r"<xacro:include\s[^>]*filename\s*=\s*[\"']([^\"']+)[\"']")
 
 
-def _check_declared(path: Path, args: dict[str, str], roots: list[Path]) -> None:
-    """Refuse an argument that the file does not declare (``<xacro:arg name=...>``): xacro would ignore it
-    silently. Includes given as plain relative paths inside the roots are read too; when the file includes one
-    kinelab cannot read without expanding it (``$(find pkg)/...``), an argument may be declared there and none
-    is refused."""
-    if not args:
-        return
+def _declared(path: Path, roots: list[Path]) -> set[str] | None:
+    """The arguments the file and the plain relative includes inside the roots declare, or None when it includes one
+    only xacro can resolve (``$(find pkg)/...``)."""
     declared: set[str] = set()
     todo, seen = [path], set()
     while todo:
@@ -336,10 +332,23 @@ def _check_declared(path: Path, args: dict[str, str], roots: list[Path]) -> None
         seen.add(current)
         text = read_text(current, "xacro file", URDFError)
         declared.update(_ARG.findall(text))
-        for name in _INCLUDE.findall(text):
-            if "$" in name:
-                return  # an include only xacro can resolve: its arguments are unknown here
-            todo.append((current.parent / name).resolve())
+        includes = _INCLUDE.findall(text)
+        if any("$" in name for name in includes):
+            return None
+        todo += [(current.parent / name).resolve() for name in includes]
+    return declared
+
+
+def _check_declared(path: Path, args: dict[str, str], roots: list[Path]) -> None:
+    """Refuse an argument that the file does not declare (``<xacro:arg name=...>``): xacro would ignore it
+    silently. Includes given as plain relative paths inside the roots are read too; when the file includes one
+    kinelab cannot read without expanding it (``$(find pkg)/...``), an argument may be declared there and none
+    is refused."""
+    if not args:
+        return
+    declared = _declared(path, roots)
+    if declared is None:
+        return  # an include only xacro can resolve: its arguments are unknown here
     unknown = sorted(set(args) - declared)
     if unknown:
         listed = ", ".join(sorted(declared)) or "none"

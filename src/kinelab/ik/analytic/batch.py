@@ -133,38 +133,55 @@ def _pinocchio_batch(robot: Chain, arm: ArmClass, H: np.ndarray, req: Request, d
     in one FK batch; a root that falls short is dropped. Pose by pose (the elimination, Pieper's decoupling) the
     poses not started before ``deadline`` are left."""
     B, n = H.shape[0], arm.n
-    late, far = np.zeros(B, dtype=np.bool_), beyond_reach_rows(robot, H)
+    late = np.zeros(B, dtype=np.bool_)
     out = np.full((B, MAX_ROWS, n), np.nan)
     found, free = np.zeros((B, MAX_ROWS), dtype=np.int64), np.zeros((B, MAX_ROWS), dtype=np.bool_)
     count = np.zeros(B, dtype=np.int64)
     reasons = None
-    if arm.kind == GENERAL_6R:  # no certified compiled FK: the elimination pose by pose, Pinocchio judging
-        reasons = []
-        for b in range(B):
-            if time.perf_counter() > deadline:
-                late[b:] = True
-                reasons += [""] * (B - b)
-                break
-            if far[b]:
-                reasons.append("")
-                continue
-            q, merged, loose, why = roots_within(arm, H[b], robot.lower, robot.upper, None, limit_slack(req.tol_rot))
-            k = count[b] = len(q)
-            out[b, :k], found[b, :k], free[b, :k] = q, merged, loose
-            reasons.append(why)
-    elif arm.kind == PIEPER_6R:  # not compiled: pose by pose
-        for b in range(B):
-            if time.perf_counter() > deadline:
-                late[b:] = True
-                break
-            if far[b]:
-                continue
-            q, merged, loose = arm_roots(arm, H[b], robot.lower, robot.upper, None, limit_slack(req.tol_rot))
-            k = count[b] = len(q)
-            out[b, :k], found[b, :k], free[b, :k] = q, merged, loose
+    if arm.kind in (GENERAL_6R, PIEPER_6R):  # not compiled (no certified FK for the elimination): pose by pose
+        reasons = _pose_by_pose(robot, arm, H, req, deadline, (out, found, free, count, late))
     else:
         branches_batch(arm.kind, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, H, robot.lower, robot.upper, SAME,
                        limit_slack(req.tol_rot), out, found, free, count)
+    q, kept, f, loose, errors = _judged_rows(robot, H, req, out, found, free, count)
+    if arm.kind == GENERAL_6R:  # a root the judge refuses leaves the set uncertified
+        reasons = [why or ("" if kept[b] == count[b] else "a root the judge does not confirm")
+                   for b, why in enumerate(reasons or [])]
+    else:
+        reasons = None
+    return BranchBatch(q, kept, f, loose, errors[..., 0], errors[..., 1], _method(arm), robot.fk_certificate.judge,
+                       reasons, None if req.time_budget is None else late)
+
+
+def _pose_by_pose(robot: Chain, arm: ArmClass, H: np.ndarray, req: Request, deadline: float,
+                  arrays: tuple[np.ndarray, ...]) -> list[str]:
+    """Fill ``arrays`` (out, found, free, count, late) pose by pose with the elimination's or Pieper's roots of
+    H (B, 4, 4) within the limits, the poses past ``deadline`` marked late; returns why each pose's set is not
+    certified ("" when it is, or when the class certifies otherwise)."""
+    out, found, free, count, late = arrays
+    far, slack, reasons = beyond_reach_rows(robot, H), limit_slack(req.tol_rot), list[str]()
+    for b in range(H.shape[0]):
+        if time.perf_counter() > deadline:
+            late[b:] = True
+            return reasons + [""] * (H.shape[0] - b)
+        if far[b]:
+            reasons.append("")
+            continue
+        if arm.kind == GENERAL_6R:
+            q, merged, loose, why = roots_within(arm, H[b], robot.lower, robot.upper, None, slack)
+        else:
+            (q, merged, loose), why = arm_roots(arm, H[b], robot.lower, robot.upper, None, slack), ""
+        k = count[b] = len(q)
+        out[b, :k], found[b, :k], free[b, :k] = q, merged, loose
+        reasons.append(why)
+    return reasons
+
+
+def _judged_rows(robot: Chain, H: np.ndarray, req: Request, out: np.ndarray, found: np.ndarray, free: np.ndarray,
+                 count: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Every row judged by Pinocchio's FK in one batch, those within the tolerances moved to the front of their
+    pose: (q, kept per pose, found, free, errors (B, MAX_ROWS, 2): position [m], rotation [rad])."""
+    B = H.shape[0]
     pose, row = np.nonzero(np.arange(MAX_ROWS)[None, :] < count[:, None])
     dp, dr = pose_errors(H[pose], robot.fk_batch(out[pose, row]))
     ok = (dp <= req.tol_pos) & (dr <= req.tol_rot)
@@ -175,11 +192,7 @@ def _pinocchio_batch(robot: Chain, arm: ArmClass, H: np.ndarray, req: Request, d
     errors[pose[ok], rank, 0], errors[pose[ok], rank, 1] = dp[ok], dr[ok]
     f, loose = np.zeros_like(found), np.zeros_like(free)
     f[pose[ok], rank], loose[pose[ok], rank] = found[pose[ok], row[ok]], free[pose[ok], row[ok]]
-    if reasons is not None:  # a root the judge refuses leaves the set uncertified
-        reasons = [why or ("" if kept[b] == count[b] else "a root the judge does not confirm")
-                   for b, why in enumerate(reasons)]
-    return BranchBatch(q, kept, f, loose, errors[..., 0], errors[..., 1], _method(arm), robot.fk_certificate.judge,
-                       reasons, None if req.time_budget is None else late)
+    return q, kept, f, loose, errors
 
 
 def nearest_batch(robot: Chain, targets: Targets, q0: Configuration | None, req: Request,

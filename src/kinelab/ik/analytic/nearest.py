@@ -14,6 +14,7 @@ import pinocchio as pin
 
 from kinelab.core._analytic import ClosedForm
 from kinelab.core._joints import turn_distances
+from kinelab.ik.analytic.classify import ArmClass
 from kinelab.ik.analytic.kernel import MAX_ROWS
 from kinelab.ik.driver import solve_one
 from kinelab.ik.request import Request
@@ -143,10 +144,17 @@ def analytic_one(robot: Chain, target: pin.SE3, req: Request, q0: np.ndarray | N
                         diagnostics=Diagnostics(path="compiled", branches=q.shape[0], found=int(found[k]),
                                                 polished=1 if finished else None,
                                                 clear_after=None if model is None else 0))
+    return _none_clear(robot, target, req, q0, arm, q.shape[0], collided, model, t0)
+
+
+def _none_clear(robot: Chain, target: pin.SE3, req: Request, q0: np.ndarray | None, arm: ArmClass, branches: int,
+                collided: Any, model: CollisionModel | None, t0: float) -> IKResult:
+    """The answer when no branch was both confirmed and clear: a search class's numeric check where no branch was
+    confirmed, else the failure (``collided``: the first confirmed branch's verdict that collides, or None)."""
     contact = None if collided is None or model is None else model.contact(collided[0])
     if collided is None and arm.searched and not beyond_reach(robot, target.translation):
         return _numeric_check(robot, target, req, q0, t0)
-    return _no_branch(robot, target, req, q0, q.shape[0], (collided, contact), arm.mode, t0)
+    return _no_branch(robot, target, req, q0, branches, (collided, contact), arm.mode, t0)
 
 
 def _first_clear(robot: Chain, q: np.ndarray, order: Any, target: Any, req: Request,

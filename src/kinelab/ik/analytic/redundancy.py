@@ -228,19 +228,31 @@ def held_values(robot: Chain, redundancy: object) -> tuple[np.ndarray, str, int]
         k = check_redundancy(redundancy)
         return samples(float(robot.lower[sw.joint]), float(robot.upper[sw.joint]), k), f"swept over {k} samples", \
             sw.joint
+    index, value = _held_named(robot, redundancy)
+    names = [j.name for j in robot.joints]
+    lo, hi = float(robot.lower[index]), float(robot.upper[index])
+    if isinstance(value, bool) or not isinstance(value, int | float | np.number) or not lo <= float(value) <= hi:
+        raise OptionError("redundancy", dict(redundancy), f"{{{names[index]!r}: a value in [{lo:.6g}, {hi:.6g}] rad}}"
+                          " (any one joint, held at a value within its limits), or an integer K")
+    return np.array([float(value)]), f"held at {float(value):.6g} rad", index
+
+
+def _held_named(robot: Chain, redundancy: Mapping[object, object]) -> tuple[int, object]:
+    """The index of the one joint ``{joint name: value}`` names and its value as given (None, with the swept joint
+    or joint 0 to name in the error, when it names no joint or several).
+
+    Raises:
+        OptionError: the chain is not 7R.
+    """
     chain = _chain7(robot)
     if isinstance(chain, str):
         raise OptionError("redundancy", dict(redundancy), f"{{joint name: value}} for a 7R chain; {robot.name}'s is "
                           f"not: {chain}")
     names = [j.name for j in robot.joints]
     named = [names.index(n) for n in redundancy if n in names] if len(redundancy) == 1 else []
-    index = named[0] if named else (swept_arm(robot).joint if has_swept_form(robot) else 0)
-    value = redundancy.get(names[index]) if named else None
-    lo, hi = float(robot.lower[index]), float(robot.upper[index])
-    if isinstance(value, bool) or not isinstance(value, int | float | np.number) or not lo <= float(value) <= hi:
-        raise OptionError("redundancy", dict(redundancy), f"{{{names[index]!r}: a value in [{lo:.6g}, {hi:.6g}] rad}}"
-                          " (any one joint, held at a value within its limits), or an integer K")
-    return np.array([float(value)]), f"held at {float(value):.6g} rad", index
+    if named:
+        return named[0], redundancy.get(names[named[0]])
+    return (swept_arm(robot).joint if has_swept_form(robot) else 0), None
 
 
 def at_value(robot: Chain, target: pin.SE3, req: Request, theta: float,

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -270,15 +271,24 @@ def starts(sets: list[np.ndarray], gaps: list[np.ndarray], around: bool) -> list
             found += [*A, *B]
         if not len(A) or not len(B):
             continue
-        matched, d = _pairs(A, B, i == j)
-        for a, b in matched:
-            fa, fb = float(gaps[i][a]), float(gaps[j][b])
-            if not _crossing(fa, fb) or (d[a, b] >= MATCH and i == j):
-                continue
-            s = 0.0 if fa == fb else fa / (fa - fb)
-            found.append(A[a] + s * wrap_to_pi(B[b] - A[a]))
-            if d[a, b] >= FOLLOWED:  # a fast turn the interpolation may not follow: Newton from either end too
-                found += [A[a], B[b]]
+        found += _crossings(A, gaps[i], B, gaps[j], i == j)
+    return found
+
+
+def _crossings(A: np.ndarray, gA: np.ndarray, B: np.ndarray, gB: np.ndarray, same: bool) -> list[np.ndarray]:
+    """Newton's starts where a branch of A (m, 7) followed to B (gaps gA, gB [rad]) crosses ψ₀: the configuration
+    interpolated at the zero of the gap, and both ends where the branch turns fast; ``same``: A and B are one
+    sample's branches (two meeting at a fold)."""
+    found = []
+    matched, d = _pairs(A, B, same)
+    for a, b in matched:
+        fa, fb = float(gA[a]), float(gB[b])
+        if not _crossing(fa, fb) or (d[a, b] >= MATCH and same):
+            continue
+        s = 0.0 if fa == fb else fa / (fa - fb)
+        found.append(A[a] + s * wrap_to_pi(B[b] - A[a]))
+        if d[a, b] >= FOLLOWED:  # a fast turn the interpolation may not follow: Newton from either end too
+            found += [A[a], B[b]]
     return found
 
 
@@ -326,16 +336,25 @@ def sampled(robot: Chain, arm: Arm7, sew: SEW, H: np.ndarray, sw: SweptArm,
         if time.perf_counter() > deadline:
             return [], [], around, f"after {k} of {len(values)} samples of joint {sw.joint + 1}"
         found.append(at(float(v)))
+    if not _refine(values, found, at, deadline):
+        return [], [], around, f"while refining the {len(values)} samples of joint {sw.joint + 1}"
+    return [f[0] for f in found], [f[1] for f in found], around, ""
+
+
+def _refine(values: list[float], found: list[tuple[np.ndarray, np.ndarray]],
+            at: Callable[[float], tuple[np.ndarray, np.ndarray]], deadline: float) -> bool:
+    """Insert midpoints, REFINE times over, into every cell :func:`_refined` names (``values`` [rad] of the swept
+    joint and ``found``, the branches and gaps ``at`` gives there, grow in place); False when ``deadline`` passed."""
     for _ in range(REFINE):
         cells = [i for i in range(len(values) - 1)
                  if _refined(*found[i], *found[i + 1], values[i + 1] - values[i])]
         for i in reversed(cells):
             if time.perf_counter() > deadline:
-                return [], [], around, f"while refining the {len(values)} samples of joint {sw.joint + 1}"
+                return False
             mid = 0.5 * (values[i] + values[i + 1])
             values.insert(i + 1, mid)
             found.insert(i + 1, at(mid))
-    return [f[0] for f in found], [f[1] for f in found], around, ""
+    return True
 
 
 def distinct(q: list[np.ndarray], apart: float = 1e-6) -> np.ndarray:

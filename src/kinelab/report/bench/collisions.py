@@ -15,6 +15,7 @@ import time
 from typing import Any
 
 import numpy as np
+import pinocchio as pin
 from tqdm import tqdm
 
 from kinelab.collision import Collisions, Environment, Obstacle, collision_model
@@ -37,16 +38,22 @@ def arm(robot: Chain, n: int, seed: int, repeats: int) -> dict[str, Any]:
     calls = {"plain": lambda t, s: solve(robot, t, seed=s, time_budget=0.5),
              "collisions": lambda t, s: solve(robot, t, seed=s, time_budget=0.5, collisions=FLOOR_AND_TABLE)}
     medians = warmed_rounds(targets, calls, repeats)
-    plain = [solve(robot, t, seed=seed + k, time_budget=0.5) for k, t in enumerate(targets)]
-    aware = [solve(robot, t, seed=seed + k, time_budget=0.5, collisions=FLOOR_AND_TABLE)
-             for k, t in enumerate(targets)]
     ratio = [c / p for c, p in zip(medians["collisions"], medians["plain"], strict=True)]
     return {"robot": robot.name, "targets": len(targets), "pairs": len(model.pairs),
             "random_colliding": 1 - len(clear) / len(configurations),
             **figures(medians), "ratio": float(np.median(ratio)), "ratio_spread": (min(ratio), max(ratio)),
-            "plain_colliding": sum(r.success and model.colliding_pair(r.q) is not None for r in plain),
-            "clear_success": sum(r.success for r in aware) / len(targets),
+            **_answers(robot, model, targets, seed),
             "check_us": _check_cost(model, configurations[:1000]), "check_clear_us": _check_cost(model, clear[:1000])}
+
+
+def _answers(robot: Chain, model: Any, targets: list[pin.SE3], seed: int) -> dict[str, float]:
+    """How many plain answers collide (``plain_colliding``) and the share of targets solved clear of the floor and
+    table (``clear_success``)."""
+    plain = [solve(robot, t, seed=seed + k, time_budget=0.5) for k, t in enumerate(targets)]
+    aware = [solve(robot, t, seed=seed + k, time_budget=0.5, collisions=FLOOR_AND_TABLE)
+             for k, t in enumerate(targets)]
+    return {"plain_colliding": sum(r.success and model.colliding_pair(r.q) is not None for r in plain),
+            "clear_success": sum(r.success for r in aware) / len(targets)}
 
 
 def _check_cost(model: Any, qs: list[np.ndarray]) -> float:

@@ -118,19 +118,26 @@ def against_ssik(robot: Chain, n: int, seed: int) -> dict[str, Any] | None:
     rng = np.random.default_rng(seed + 1)
     equal, differences, t_ours, t_peer = 0, [], 0.0, 0.0
     for k in range(n):
-        H = robot.fk(robot.random_q(rng)).homogeneous
-        t0 = time.perf_counter()
-        ours = [np.asarray(a) for a in all_branches_batch(robot, H[None]).q[0] if not np.isnan(a[0])]
-        t1 = time.perf_counter()
-        theirs = [np.asarray(s.q, dtype=float) for s in peer.solve(H, respect_limits=True, enumerate_windings=False)]
-        t_ours, t_peer = t_ours + t1 - t0, t_peer + time.perf_counter() - t1
-        theirs = _distinct([t for t in theirs if max(robot.tool_error(t, pin.SE3(H))) <= 1e-6])
+        ours, theirs, times = _both_sets(robot, peer, robot.fk(robot.random_q(rng)).homogeneous)
+        t_ours, t_peer = t_ours + times[0], t_peer + times[1]
         if _same_set(ours, theirs):
             equal += 1
         else:
             differences.append({"pose": k, "kinelab": len(ours), "ssik": len(theirs)})
     return {"robot": robot.name, "poses": n, "equal": equal / n, "differences": differences,
             "kinelab_ms": 1e3 * t_ours / n, "ssik_ms": 1e3 * t_peer / n}
+
+
+def _both_sets(robot: Chain, peer: Any,
+               H: np.ndarray) -> tuple[list[np.ndarray], list[np.ndarray], tuple[float, float]]:
+    """kinelab's branches of the pose H (4 × 4, base frame) and ssik's that Pinocchio confirms to 1e-6 (distinct),
+    and the two calls' times [s]."""
+    t0 = time.perf_counter()
+    ours = [np.asarray(a) for a in all_branches_batch(robot, H[None]).q[0] if not np.isnan(a[0])]
+    t1 = time.perf_counter()
+    theirs = [np.asarray(s.q, dtype=float) for s in peer.solve(H, respect_limits=True, enumerate_windings=False)]
+    times = (t1 - t0, time.perf_counter() - t1)
+    return ours, _distinct([t for t in theirs if max(robot.tool_error(t, pin.SE3(H))) <= 1e-6]), times
 
 
 def _distinct(qs: list[np.ndarray]) -> list[np.ndarray]:
@@ -260,56 +267,95 @@ def run(robots: list[str] | None = None, n: int = 10_000, peer_n: int = 1000, ar
         if _six(robot) is None and not has_swept_form(robot):
             continue
         own.append(own_configuration(robot, n, seed))
-        if peer_n and (found := against_ssik(robot, peer_n, seed)) is not None:
-            peers.append(found)
-        if hard and name in HARD:
-            built.append(hard_poses.measure(robot, hard, seed))
-    held = [held_joint(load(name), joint, held_poses, seed) for name, joints in HELD for joint in joints
-            if held_poses and (robots is None or name in robots)]
-    angles = [sew.measure(load(name), sew_poses, seed) for name in sew.ARMS
-              if sew_poses and (robots is None or name in robots)]
+        peers += _ssik_rows(robot, peer_n, seed)
+        built += [hard_poses.measure(robot, hard, seed)] if hard and name in HARD else []
     return {"own": own, "ssik": peers, "random": random_arms(arms, arm_poses, seed),
-            "general": random_general(arms, general_poses, seed), "hard": built, "held": held, "sew": angles}
+            "general": random_general(arms, general_poses, seed), "hard": built,
+            "held": _held_rows(robots, held_poses, seed), "sew": _sew_rows(robots, sew_poses, seed)}
+
+
+def _held_rows(robots: list[str] | None, poses: int, seed: int) -> list[dict[str, Any]]:
+    """A row per joint of HELD (its arms among ``robots``, None: all), ``poses`` poses each (0: none)."""
+    return [held_joint(load(name), joint, poses, seed) for name, joints in HELD for joint in joints
+            if poses and (robots is None or name in robots)]
+
+
+def _sew_rows(robots: list[str] | None, poses: int, seed: int) -> list[dict[str, Any]]:
+    """A row per 7R arm at its SEW angle (its arms among ``robots``, None: all), ``poses`` poses each (0: none)."""
+    return [sew.measure(load(name), poses, seed) for name in sew.ARMS if poses and (robots is None or name in robots)]
+
+
+def _ssik_rows(robot: Chain, n: int, seed: int) -> list[dict[str, Any]]:
+    """The robot's row against ssik (:func:`against_ssik`), or none (n = 0, no ssik, no 6-joint class)."""
+    found = against_ssik(robot, n, seed) if n else None
+    return [] if found is None else [found]
 
 
 def markdown(result: dict[str, Any]) -> str:
     """The tables."""
-    lines = ["| arm | method | poses | own configuration found | misses (double roots) | certified complete | "
-             "branches mean / max |", "|---|---|---|---|---|---|---|"]
-    lines += [f"| {r['robot']} | {r['method']} | {r['poses']:,} | {100 * r['found']:.3f} % | {r['misses']} "
-              f"({r['near_misses']}) | {_share(r.get('certified'))} | {r['branches_mean']:.2f} / "
-              f"{r['branches_max']} |" for r in result["own"]]
-    if result["ssik"]:
-        lines += ["", "| arm | poses | branch sets equal to ssik's | differences (kinelab, ssik) | kinelab | ssik |",
-                  "|---|---|---|---|---|---|"]
-        for r in result["ssik"]:
-            shown = ", ".join("({kinelab}, {ssik})".format(**d) for d in r["differences"][:8]) or "none"
-            lines.append(f"| {r['robot']} | {r['poses']:,} | {100 * r['equal']:.2f} % | {shown} | "
-                         f"{r['kinelab_ms']:.2f} ms | {r['ssik_ms']:.1f} ms |")
-    if result["random"]:
-        lines += ["", "| random arms of the class | poses | own configuration found | misses (double roots) |",
-                  "|---|---|---|---|"]
-        lines += [f"| {r['class']} | {r['poses']:,} | {100 * r['found']:.3f} % | {r['misses']} "
-                  f"({r['near_misses']}) |" for r in result["random"]]
-    if result.get("general"):
-        g = result["general"]
-        lines += ["", "| random general 6R arms | poses | own configuration found | certified complete | refused |",
-                  "|---|---|---|---|---|",
-                  f"| {g['arms']} arms | {g['poses']:,} | {100 * g['found']:.3f} % | {100 * g['certified']:.2f} % | "
-                  f"{g['refused']} |"]
-    lines += _hard_lines(result.get("hard", []))
-    if result.get("held"):
-        lines += ["", "| 7R arm | joint held | poses | own configuration found | refused (no solver for the six) |",
-                  "|---|---|---|---|---|"]
-        lines += [f"| {r['robot']} | {r['joint']} | {r['poses']:,} | {100 * r['found']:.3f} % | {r['refused']} |"
-                  for r in result["held"]]
-    lines += sew.markdown(result.get("sew", []))
-    missed = [(r["robot"], m) for r in result["own"] for m in r.get("missed", [])]
-    if missed:
-        lines += ["", "Missed poses (arm: own configuration q, nearest branch):"]
-        lines += [f"- {name}: q = ({', '.join(f'{v:.6f}' for v in m['q'])}), {m['nearest']:.1e} rad"
-                  for name, m in missed[:50]]
+    lines = _own_lines(result["own"]) + _ssik_lines(result["ssik"]) + _random_lines(result["random"])
+    lines += _general_lines(result.get("general")) + _hard_lines(result.get("hard", []))
+    lines += _held_lines(result.get("held", [])) + sew.markdown(result.get("sew", [])) + _missed_lines(result["own"])
     return "\n".join(lines)
+
+
+def _own_lines(rows: list[dict[str, Any]]) -> list[str]:
+    """The registered arms' table: own configuration found, misses, certified share, branches."""
+    return ["| arm | method | poses | own configuration found | misses (double roots) | certified complete | "
+            "branches mean / max |", "|---|---|---|---|---|---|---|"] + [
+        f"| {r['robot']} | {r['method']} | {r['poses']:,} | {100 * r['found']:.3f} % | {r['misses']} "
+        f"({r['near_misses']}) | {_share(r.get('certified'))} | {r['branches_mean']:.2f} / {r['branches_max']} |"
+        for r in rows]
+
+
+def _ssik_lines(rows: list[dict[str, Any]]) -> list[str]:
+    """The table against ssik (none without rows)."""
+    if not rows:
+        return []
+    lines = ["", "| arm | poses | branch sets equal to ssik's | differences (kinelab, ssik) | kinelab | ssik |",
+             "|---|---|---|---|---|---|"]
+    for r in rows:
+        shown = ", ".join("({kinelab}, {ssik})".format(**d) for d in r["differences"][:8]) or "none"
+        lines.append(f"| {r['robot']} | {r['poses']:,} | {100 * r['equal']:.2f} % | {shown} | "
+                     f"{r['kinelab_ms']:.2f} ms | {r['ssik_ms']:.1f} ms |")
+    return lines
+
+
+def _random_lines(rows: list[dict[str, Any]]) -> list[str]:
+    """The random arms' table, a row per search class (none without rows)."""
+    if not rows:
+        return []
+    return ["", "| random arms of the class | poses | own configuration found | misses (double roots) |",
+            "|---|---|---|---|"] + [f"| {r['class']} | {r['poses']:,} | {100 * r['found']:.3f} % | {r['misses']} "
+                                    f"({r['near_misses']}) |" for r in rows]
+
+
+def _general_lines(g: dict[str, Any] | None) -> list[str]:
+    """The random general 6R arms' one-row table (none without them)."""
+    if not g:
+        return []
+    return ["", "| random general 6R arms | poses | own configuration found | certified complete | refused |",
+            "|---|---|---|---|---|",
+            f"| {g['arms']} arms | {g['poses']:,} | {100 * g['found']:.3f} % | {100 * g['certified']:.2f} % | "
+            f"{g['refused']} |"]
+
+
+def _held_lines(rows: list[dict[str, Any]]) -> list[str]:
+    """The 7R arms' table, a row per held joint (none without rows)."""
+    if not rows:
+        return []
+    return ["", "| 7R arm | joint held | poses | own configuration found | refused (no solver for the six) |",
+            "|---|---|---|---|---|"] + [f"| {r['robot']} | {r['joint']} | {r['poses']:,} | {100 * r['found']:.3f} % "
+                                        f"| {r['refused']} |" for r in rows]
+
+
+def _missed_lines(own: list[dict[str, Any]]) -> list[str]:
+    """The first 50 missed poses of the registered arms: each own configuration and its nearest branch [rad]."""
+    missed = [(r["robot"], m) for r in own for m in r.get("missed", [])]
+    if not missed:
+        return []
+    return ["", "Missed poses (arm: own configuration q, nearest branch):"] + [
+        f"- {name}: q = ({', '.join(f'{v:.6f}' for v in m['q'])}), {m['nearest']:.1e} rad" for name, m in missed[:50]]
 
 
 def _share(value: float | None) -> str:

@@ -25,6 +25,7 @@ import numpy as np
 
 from kinelab.geometry import wrap_to_pi
 from kinelab.ik import solve_all
+from kinelab.ik.result import Branches
 from kinelab.robot import Chain
 
 FOUND_HARD = 1e-6  # [rad] the own configuration is an answer to this on the surface (a double root: met to ~1e-8)
@@ -87,23 +88,39 @@ def measure(robot: Chain, n: int, seed: int) -> dict[str, Any]:
     failures: list[dict[str, Any]] = []
     t0 = time.perf_counter()
     for kind, q in poses(robot, n, seed):
-        found = solve_all(robot, robot.fk(q))
         row = kinds.setdefault(kind, {"poses": 0, "own": 0, "merged": 0, "neighbour": 0, "certified": 0,
                                       "uncertified": 0, "reasons": {}})
-        row["poses"] += 1
-        gaps = np.abs(wrap_to_pi(found.q - q)).max(axis=1) if len(found) else np.array([np.inf])
-        gap = float(gaps.min())
-        own = gap <= (FOUND_HARD if kind.startswith("0 rad") else FOUND_EXACT)
-        row["own"] += own
-        said = not own and gap <= FOUND_HARD and (found[int(np.argmin(gaps))].diagnostics.found or 1) > 1
-        row["merged"] += said  # answered by a root that says it stands for two (diagnostics.found)
-        row["neighbour"] += not own and gap <= FOUND_HARD and not said  # and silently
-        certified = found.complete == "certified"
-        row["certified" if certified else "uncertified"] += 1
-        if not certified:
-            reason = found.complete_reason.split(" (")[0]
-            row["reasons"][reason] = row["reasons"].get(reason, 0) + 1
-        if not own and (certified or (gap <= FOUND_HARD and not said)):
-            failures.append({"kind": kind, "q": q.tolist(), "nearest": gap, "certified": certified})
+        failed = _tally(row, kind, q, solve_all(robot, robot.fk(q)))
+        if failed is not None:
+            failures.append(failed)
     return {"robot": robot.name, "poses": n, "kinds": kinds, "failures": failures,
             "seconds": time.perf_counter() - t0}
+
+
+def _tally(row: dict[str, Any], kind: str, q: np.ndarray, found: Branches) -> dict[str, Any] | None:
+    """Count the pose of own configuration q [rad] and its branches ``found`` in its kind's row; the failure (the own
+    configuration missed by a certified set, or answered silently by a neighbouring root), or None."""
+    row["poses"] += 1
+    gap, own, said = _answered(kind, q, found)
+    row["own"] += own
+    row["merged"] += said  # answered by a root that says it stands for two (diagnostics.found)
+    silent = not own and gap <= FOUND_HARD and not said
+    row["neighbour"] += silent  # and silently
+    certified = found.complete == "certified"
+    row["certified" if certified else "uncertified"] += 1
+    if not certified:
+        reason = found.complete_reason.split(" (")[0]
+        row["reasons"][reason] = row["reasons"].get(reason, 0) + 1
+    if not own and (certified or silent):
+        return {"kind": kind, "q": q.tolist(), "nearest": gap, "certified": certified}
+    return None
+
+
+def _answered(kind: str, q: np.ndarray, found: Branches) -> tuple[float, bool, bool]:
+    """The nearest branch's distance to q [rad], whether it is q (to the kind's tolerance), and whether a
+    neighbouring root answers it saying it stands for two (``diagnostics.found``)."""
+    gaps = np.abs(wrap_to_pi(found.q - q)).max(axis=1) if len(found) else np.array([np.inf])
+    gap = float(gaps.min())
+    own = gap <= (FOUND_HARD if kind.startswith("0 rad") else FOUND_EXACT)
+    said = not own and gap <= FOUND_HARD and (found[int(np.argmin(gaps))].diagnostics.found or 1) > 1
+    return gap, own, said

@@ -76,15 +76,20 @@ class _Tally:
         best = [b for b in self.best if b is not None]
         times = np.array([b[0] for b in best]) * 1e6
         solved = [b[0] * 1e6 for b in best if b[1]]
-        failures: dict[str, int] = {}
-        for _, ok, why, _ in best:
-            if not ok:
-                key = why.split(" ")[0] if why.startswith("pose") else why
-                failures[key] = failures.get(key, 0) + 1
         n = len(best)
         return Row(self.robot.name, self.name, n, len(solved), 100.0 * len(solved) / n, float(np.median(times)),
                    float(np.percentile(times, 95)), float(np.median(solved)) if solved else float("nan"),
-                   float(np.median([b[3] for b in best])), failures)
+                   float(np.median([b[3] for b in best])), _failures(best))
+
+
+def _failures(best: list[tuple[float, bool, str, int]]) -> dict[str, int]:
+    """How many problems failed for each reason (a pose miss counted by its first word)."""
+    failures: dict[str, int] = {}
+    for _, ok, why, _ in best:
+        if not ok:
+            key = why.split(" ")[0] if why.startswith("pose") else why
+            failures[key] = failures.get(key, 0) + 1
+    return failures
 
 
 def run_robot(robot: Chain, solvers: dict[str, Prepare], problems: list[Case], budget: float, seed: int,
@@ -95,20 +100,26 @@ def run_robot(robot: Chain, solvers: dict[str, Prepare], problems: list[Case], b
     turn (the order rotating per problem and round), so each call finds the caches another library left.
     Round r gives kinelab's solvers the seeds seed + index + r·n (fresh restarts, as the peers' are)."""
     tallies = _prepared(robot, solvers, problems, budget, seed, missing)
-    count = len(problems)
     for r in range(repeats):
-        round_seed = seed + r * count
-        if schedule == "interleaved":
-            for i, case in enumerate(problems):
-                k = (r + i) % max(1, len(tallies))
-                for tally in tallies[k:] + tallies[:k]:
-                    tally.attempt(i, case, budget, round_seed)
-            continue
-        k = r % max(1, len(tallies))
-        for tally in tallies[k:] + tallies[:k]:
-            for i, case in enumerate(problems):
-                tally.attempt(i, case, budget, round_seed)
+        _round(tallies, problems, budget, seed + r * len(problems), r, schedule)
     return [t.row() for t in tallies]
+
+
+def _round(tallies: list[_Tally], problems: list[Case], budget: float, round_seed: int, r: int,
+           schedule: str) -> None:
+    """Round r of :func:`run_robot`: blocked (each solver its problems back to back, the solvers' order rotating
+    per round) or interleaved (per problem every solver in turn, the order rotating per problem and round)."""
+    turns = max(1, len(tallies))
+    if schedule == "interleaved":
+        for i, case in enumerate(problems):
+            k = (r + i) % turns
+            for tally in tallies[k:] + tallies[:k]:
+                tally.attempt(i, case, budget, round_seed)
+        return
+    k = r % turns
+    for tally in tallies[k:] + tallies[:k]:
+        for i, case in enumerate(problems):
+            tally.attempt(i, case, budget, round_seed)
 
 
 def _prepared(robot: Chain, solvers: dict[str, Prepare], problems: list[Case], budget: float, seed: int,
@@ -142,21 +153,11 @@ def run(robots: list[str] | None = None, n: int = 200, seed: int = 0, solvers: l
         sigma: float = 0.2, schedule: str = "blocked", task: str = "pose") -> dict[str, Any]:
     """Run the protocol; returns a JSON-ready dict with the rows, the machine and the versions."""
     check_seed(seed)
-    if n < 1 or repeats < 1 or not budget > 0:
-        raise KinelabError(f"bench needs n ≥ 1, repeats ≥ 1 and a positive budget (got {n}, {repeats}, {budget} s)")
-    if start not in STARTS or schedule not in SCHEDULES or not 0 < sigma < 10:
-        raise KinelabError(f"bench takes start in {STARTS}, schedule in {SCHEDULES} and 0 < sigma < 10 rad "
-                           f"(got {start!r}, {schedule!r}, {sigma})")
+    _check_protocol(n, repeats, budget, start, schedule, sigma)
     names = list(robots or DEFAULT_ROBOTS)
     loaded = [load(name, whole=False) for name in names]
     table, missing = available_solvers()
-    if solvers:
-        unknown = [s for s in solvers if s not in table]
-        if unknown:
-                raise KinelabError(f"unknown or unavailable solver {unknown[0]!r}; available: {', '.join(table)}"
-                               + (f"; not installed: {', '.join(missing)}" if missing else ""))
-        table = {k: table[k] for k in solvers}
-    table = _taking(table, task, missing)
+    table = _taking(_chosen(table, missing, solvers), task, missing)
     rows = []
     for robot in tqdm(loaded, desc="bench", disable=not progress, unit="robot"):
         problems = cases(robot, n, seed, start, sigma, task)
@@ -169,6 +170,35 @@ def run(robots: list[str] | None = None, n: int = 200, seed: int = 0, solvers: l
         "rows": [asdict(r) for r in rows],
         "not_run": missing,
     }
+
+
+def _check_protocol(n: int, repeats: int, budget: float, start: str, schedule: str, sigma: float) -> None:
+    """Refuse a protocol that cannot run, naming what is valid.
+
+    Raises:
+        KinelabError: n or repeats below 1, a budget not > 0 [s], an unknown start or schedule, or sigma outside
+            (0, 10) rad.
+    """
+    if n < 1 or repeats < 1 or not budget > 0:
+        raise KinelabError(f"bench needs n ≥ 1, repeats ≥ 1 and a positive budget (got {n}, {repeats}, {budget} s)")
+    if start not in STARTS or schedule not in SCHEDULES or not 0 < sigma < 10:
+        raise KinelabError(f"bench takes start in {STARTS}, schedule in {SCHEDULES} and 0 < sigma < 10 rad "
+                           f"(got {start!r}, {schedule!r}, {sigma})")
+
+
+def _chosen(table: dict[str, Prepare], missing: dict[str, str], solvers: list[str] | None) -> dict[str, Prepare]:
+    """The solvers the user named (all available ones when None), in the order named.
+
+    Raises:
+        KinelabError: a name that is not available (the available ones and those not installed named).
+    """
+    if not solvers:
+        return table
+    unknown = [s for s in solvers if s not in table]
+    if unknown:
+        raise KinelabError(f"unknown or unavailable solver {unknown[0]!r}; available: {', '.join(table)}"
+                           + (f"; not installed: {', '.join(missing)}" if missing else ""))
+    return {k: table[k] for k in solvers}
 
 
 def header() -> dict[str, Any]:

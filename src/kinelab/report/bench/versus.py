@@ -103,23 +103,32 @@ def compare(robot: Chain, n: int = 60, seed: int = 0, repeats: int = 4) -> list[
     for start, sigma in PROTOCOLS:
         cases = problems(robot, n, seed, start, sigma)
         result = rounds(robot, cases, contenders, repeats, seed)
-        lm = result.get("ik_LM")
+        protocol = start + (f" σ={sigma}" if start == "warm" else "")
         for name in [c for c in contenders if c != "ik_LM"]:
-            med = np.array([np.median(t) for t, _ in result[name]])
-            p95 = np.array([np.percentile(t, 95) for t, _ in result[name]])
-            row = {"robot": robot.name, "protocol": start + (f" σ={sigma}" if start == "warm" else ""),
-                   "call": name, "n": n, "repeats": repeats, "median_us": float(np.median(med) * 1e6),
-                   "p95_us": float(np.median(p95) * 1e6),
-                   "success_pct": 100.0 * float(np.mean([ok.mean() for _, ok in result[name]]))}
-            if lm is not None:
-                ratio = med / np.array([np.median(t) for t, _ in lm])
-                ratio95 = p95 / np.array([np.percentile(t, 95) for t, _ in lm])
-                row.update(lm_median_us=float(np.median([np.median(t) for t, _ in lm]) * 1e6),
-                           lm_success_pct=100.0 * float(np.mean([ok.mean() for _, ok in lm])),
-                           ratio=float(np.median(ratio)), ratio_low=float(ratio.min()), ratio_high=float(ratio.max()),
-                           ratio_p95=float(np.median(ratio95)))
+            row = {"robot": robot.name, "protocol": protocol, "call": name, "n": n, "repeats": repeats,
+                   **_figures(result[name], result.get("ik_LM"))}
             rows.append(row)
     return rows
+
+
+Rounds = list[tuple[np.ndarray, np.ndarray]]
+
+
+def _figures(mine: Rounds, lm: Rounds | None) -> dict[str, float]:
+    """A call's median and p95 [µs] and success [%] over its rounds (times [s], successes), and with ik_LM's rounds
+    the ratios to them (median of the per-round ratios, their spread, and the p95s' ratio)."""
+    med = np.array([np.median(t) for t, _ in mine])
+    p95 = np.array([np.percentile(t, 95) for t, _ in mine])
+    out = {"median_us": float(np.median(med) * 1e6), "p95_us": float(np.median(p95) * 1e6),
+           "success_pct": 100.0 * float(np.mean([ok.mean() for _, ok in mine]))}
+    if lm is None:
+        return out
+    ratio = med / np.array([np.median(t) for t, _ in lm])
+    ratio95 = p95 / np.array([np.percentile(t, 95) for t, _ in lm])
+    return {**out, "lm_median_us": float(np.median([np.median(t) for t, _ in lm]) * 1e6),
+            "lm_success_pct": 100.0 * float(np.mean([ok.mean() for _, ok in lm])),
+            "ratio": float(np.median(ratio)), "ratio_low": float(ratio.min()), "ratio_high": float(ratio.max()),
+            "ratio_p95": float(np.median(ratio95))}
 
 
 def markdown(rows: list[dict[str, Any]]) -> str:

@@ -17,6 +17,7 @@ iterated at dt = 1 s until every frame is within 1e-6 m / 1e-6 rad (at most 200 
 
 from __future__ import annotations
 
+import contextlib
 import time
 from typing import Any
 
@@ -50,26 +51,34 @@ def run_steps(name: str, steps: int = 1000, rounds: int = 3, progress: bool = Fa
     records: dict[str, dict[str, list[float]]] = {k: {"times": [], "medians": [], "violations": [], "errors": []}
                                                   for k in STEPPERS}
     for _ in tqdm(range(rounds), desc=f"whole-body {name}", disable=not progress, unit="round"):
-        steppers: dict[str, Any] = {}
-        for key, make in STEPPERS.items():
-            try:
-                steppers[key] = make(robot, scenario, q0)
-            except ImportError:  # a peer not installed (the bench extra): its rows are left out
-                continue
+        steppers = _steppers(robot, scenario, q0)
         round_times: dict[str, list[float]] = {k: [] for k in steppers}
         order = list(steppers)
         for k in range(steps):
             targets = targets_at(start, (k + 1) * DT, len(scenario.moving))
             for key in order[k % len(order):] + order[:k % len(order)]:
-                s = steppers[key]
-                t0 = time.perf_counter()
-                s.step(targets)
-                round_times[key].append(time.perf_counter() - t0)
-                _judge(robot, s, targets, frames, records[key])
+                round_times[key].append(_timed_step(steppers[key], targets))
+                _judge(robot, steppers[key], targets, frames, records[key])
         for key, times in round_times.items():
             records[key]["times"] += times
             records[key]["medians"].append(float(np.median(times)))
     return [_row(name, key, rec) for key, rec in records.items() if rec["times"]]
+
+
+def _steppers(robot: Robot, scenario: Any, q0: np.ndarray) -> dict[str, Any]:
+    """A fresh stepper per library of STEPPERS at q0 (a peer not installed, the bench extra, left out)."""
+    steppers: dict[str, Any] = {}
+    for key, make in STEPPERS.items():
+        with contextlib.suppress(ImportError):
+            steppers[key] = make(robot, scenario, q0)
+    return steppers
+
+
+def _timed_step(stepper: Any, targets: list[pin.SE3]) -> float:
+    """One step towards the targets; its time [s]."""
+    t0 = time.perf_counter()
+    stepper.step(targets)
+    return time.perf_counter() - t0
 
 
 def _judge(robot: Robot, stepper: Any, targets: list[pin.SE3], frames: tuple[str, ...], record: dict[str, Any]) -> None:
@@ -97,16 +106,16 @@ def _row(robot: str, key: str, rec: dict[str, Any]) -> dict[str, Any]:
 
 def ratios(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """kinelab's median step against each peer's, round by round: the ratio of the medians and its spread."""
-    out = []
-    for robot in sorted({r["robot"] for r in rows}):
-        mine = next((r for r in rows if r["robot"] == robot and r["library"] == "kinelab"), None)
-        for peer in (r for r in rows if r["robot"] == robot and r["library"] != "kinelab"):
-            if mine is None:
-                continue
-            per_round = np.array(mine["round_medians_us"]) / np.array(peer["round_medians_us"])
-            out.append({"robot": robot, "peer": peer["library"], "ratio": float(np.median(per_round)),
-                        "ratio_min": float(per_round.min()), "ratio_max": float(per_round.max())})
-    return out
+    mine = {r["robot"]: r for r in rows if r["library"] == "kinelab"}
+    return [_ratio(mine[peer["robot"]], peer) for peer in sorted(rows, key=lambda r: r["robot"])
+            if peer["library"] != "kinelab" and peer["robot"] in mine]
+
+
+def _ratio(mine: dict[str, Any], peer: dict[str, Any]) -> dict[str, Any]:
+    """kinelab's round medians over the peer's: the median ratio and its spread."""
+    per_round = np.array(mine["round_medians_us"]) / np.array(peer["round_medians_us"])
+    return {"robot": mine["robot"], "peer": peer["library"], "ratio": float(np.median(per_round)),
+            "ratio_min": float(per_round.min()), "ratio_max": float(per_round.max())}
 
 
 def converged(name: str, count: int = 50, seed: int = 0, progress: bool = False) -> list[dict[str, Any]]:
