@@ -137,18 +137,16 @@ def _pinocchio_batch(robot: Chain, arm: ArmClass, H: np.ndarray, req: Request, d
     out = np.full((B, MAX_ROWS, n), np.nan)
     found, free = np.zeros((B, MAX_ROWS), dtype=np.int64), np.zeros((B, MAX_ROWS), dtype=np.bool_)
     count = np.zeros(B, dtype=np.int64)
-    reasons = None
+    said: list[str] = []
     if arm.kind in (GENERAL_6R, PIEPER_6R):  # not compiled (no certified FK for the elimination): pose by pose
-        reasons = _pose_by_pose(robot, arm, H, req, deadline, (out, found, free, count, late))
+        said = _pose_by_pose(robot, arm, H, req, deadline, (out, found, free, count, late))
     else:
         branches_batch(arm.kind, arm.mirrored, arm.h, arm.o, arm.R0, arm.N0, H, robot.lower, robot.upper, SAME,
                        limit_slack(req.tol_rot), out, found, free, count)
     q, kept, f, loose, errors = _judged_rows(robot, H, req, out, found, free, count)
-    if arm.kind == GENERAL_6R:  # a root the judge refuses leaves the set uncertified
-        reasons = [why or ("" if kept[b] == count[b] else "a root the judge does not confirm")
-                   for b, why in enumerate(reasons or [])]
-    else:
-        reasons = None
+    # only the elimination's sets carry reasons; a root the judge refuses leaves its set uncertified
+    reasons = [why or ("" if kept[b] == count[b] else "a root the judge does not confirm")
+               for b, why in enumerate(said)] if arm.kind == GENERAL_6R else None
     return BranchBatch(q, kept, f, loose, errors[..., 0], errors[..., 1], _method(arm), robot.fk_certificate.judge,
                        reasons, None if req.time_budget is None else late)
 
