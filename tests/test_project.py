@@ -7,6 +7,9 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
+#: kinelab's layers, lowest first: a module imports its own layer and lower ones only.
+LAYERS = ["errors", "files", "lazy", "scratch", "progress", "geometry", "core", "robot", "collision", "dq", "typing",
+          "ik", "wholebody", "analysis", "maps", "studies", "view", "report", "cli"]
 
 
 def _commands(text: str) -> list[str]:
@@ -54,9 +57,7 @@ def test_the_package_tree_has_no_import_cycles_and_lower_layers_import_no_higher
     """Layers, lowest first; a module may import its own layer's modules and lower layers only."""
     import ast
 
-    layers = ["errors", "files", "lazy", "scratch", "progress", "geometry", "core", "robot", "collision",
-              "dq", "typing", "ik", "wholebody", "analysis", "maps", "studies", "view", "report", "cli"]
-    rank = {name: i for i, name in enumerate(layers)}
+    rank = {name: i for i, name in enumerate(LAYERS)}
     src = ROOT / "src" / "kinelab"
     for path in src.rglob("*.py"):
         parts = path.relative_to(src).with_suffix("").parts
@@ -67,6 +68,19 @@ def test_the_package_tree_has_no_import_cycles_and_lower_layers_import_no_higher
             if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("kinelab."):
                 target = node.module.split(".")[1]
                 assert rank[target] <= own, f"{path.relative_to(ROOT)} imports {node.module}"
+
+
+def test_the_architecture_page_names_the_layers_in_order_and_every_package():
+    """docs/architecture.md's layer table is the order the test above holds, and every package of src/kinelab is on
+    the page: the drawing cannot fall behind the tree unnoticed."""
+    page = (ROOT / "docs" / "architecture.md").read_text()
+    table = page.split("## Layers, lowest first", 1)[1].split("\n## ", 1)[0]
+    first_cells = [line.split("|")[1] for line in table.splitlines() if line.startswith("| `")]
+    assert [name for cell in first_cells for name in re.findall(r"`(\w+)`", cell)] == LAYERS
+    packages = sorted(p.parent.relative_to(ROOT / "src" / "kinelab").as_posix()
+                      for p in (ROOT / "src" / "kinelab").rglob("__init__.py") if p.parent.name != "kinelab")
+    missing = [name for name in packages if f"{name.split('/')[-1]}/" not in page and f"`{name}`" not in page]
+    assert not missing, f"packages not on docs/architecture.md: {missing}"
 
 
 def test_no_module_imports_itself_back():
