@@ -83,3 +83,33 @@ def test_self_motion_events_by_cumulative_sums_are_the_running_totals():
         assert len(expected) >= 2
         assert [e.sample for e in found] == [k for k, _ in expected]
         assert np.allclose([e.max_joint_step for e in found], [m for _, m in expected], rtol=1e-9, atol=0)
+
+
+def test_the_self_motion_events_made_when_read_are_the_paths_own():
+    """The self-motion check runs when a path's events are first read: the events are those of the q the path
+    returned (a change to ``res.q`` before the read does not move them), a pickle and a copy carry them, and events
+    can still be set and appended to."""
+    import copy
+    import pickle
+
+    from kinelab.ik.frdm import tracking
+    from kinelab.ik.tasks import POSE
+
+    panda = kinelab.load("panda")
+    path = cosine_path(panda, np.random.default_rng(4))
+    targets = panda.fk_batch(path)
+    res = kinelab.track(panda, targets, q0=path[0], seed=3)
+    returned_q = res.q.copy()
+    res.q[:] = path[0]  # a user's change before reading the log
+    drift = [e for e in res.events if e.trigger == "self_motion"]
+    expected = tracking.self_motion_events(panda, returned_q, path[0], targets[:, :3, 3], targets[:, :3, :3], POSE)
+    assert drift and [(e.sample, e.max_joint_step) for e in drift] == \
+        [(e.sample, e.max_joint_step) for e in expected]
+    again = kinelab.track(panda, targets, q0=path[0], seed=3)
+    for made in (pickle.loads(pickle.dumps(again)), copy.deepcopy(again)):
+        assert [e.sample for e in made.events if e.trigger == "self_motion"] == [e.sample for e in drift]
+        assert "_make_events" not in vars(made)
+    again.events.append(drift[0])
+    assert again.events[-1] is drift[0]
+    again.events = []
+    assert again.events == []

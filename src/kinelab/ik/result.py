@@ -532,6 +532,18 @@ class TrackResult:
     mode: str = "frdm (monitored)"
     contacts: list[tuple[int, Any]] = field(default_factory=list)  # (sample, Contact) with collisions=
 
+    def add_events_later(self, make: Callable[[], list[SingularEvent]]) -> None:
+        """Append what ``make()`` returns to :attr:`events`, made when the events are first read: a check of the whole
+        path whose cost only a reader of the log pays (``make`` must hold copies of what it reads)."""
+        made = self.events
+        self.__dict__.pop("events")
+        self.__dict__["_make_events"] = lambda: made + make()
+
+    def __getstate__(self) -> dict[str, Any]:
+        """The fields, events made (a pickle or a copy never carries the maker)."""
+        _ = self.events
+        return self.__dict__
+
     @property
     def joint_steps(self) -> np.ndarray:
         """|q_k − q_(k−1)| per sample and joint (first row zero) [rad or m]."""
@@ -581,6 +593,21 @@ class TrackResult:
             "median_time_per_sample_s": float(np.median(self.wall_time)),
             "mode": self.mode,
         }
+
+
+class _LaterEvents:
+    """A path's ``events`` made when first read where :meth:`TrackResult.add_events_later` left a maker in the
+    instance's dict; the list the dataclass sets shadows this otherwise (a non-data descriptor)."""
+
+    def __get__(self, obj: Any, owner: Any = None) -> Any:
+        if obj is None:
+            return self
+        made: list[SingularEvent] = obj.__dict__.pop("_make_events")()
+        obj.__dict__["events"] = made
+        return made
+
+
+TrackResult.events = _LaterEvents()  # type: ignore[assignment]
 
 
 def status_counts(codes: np.ndarray) -> dict[str, int]:

@@ -17,6 +17,7 @@ point (the ERA wrist and shoulder passages), where no monitor fires before the d
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -110,7 +111,7 @@ def run_track(robot: Chain, targets: TargetArrays, q0: np.ndarray, req: Request,
             q_prev = path.sample(k, pin.SE3(rotations[k], points[k]), q_prev)
         followed = path.result()
     mark_jumps(followed, q0, settings.jump_limit)
-    followed.events += self_motion_events(robot, followed.q, q0, points, rotations, req.task)
+    followed.add_events_later(self_motion_check(robot, followed.q, q0, points, rotations, req.task))
     return followed
 
 
@@ -136,16 +137,27 @@ def self_motion_events(robot: Chain, Q: np.ndarray, q0: np.ndarray, points: np.n
     does not ask for: Δq less its least-norm part J⁺JΔq, summed since the last event) by more than SELF_MOTION times
     the path's own largest step (the least-norm joint step J⁺Δx that each target's motion asks for) [rad or m]. Only
     on a chain with more joints than its task constrains; samples left unsolved (NaN) are skipped."""
+    return self_motion_check(robot, Q, q0, points, rotations, task)()
+
+
+def self_motion_check(robot: Chain, Q: np.ndarray, q0: np.ndarray, points: np.ndarray, rotations: np.ndarray,
+                      task: Task) -> Callable[[], list[SingularEvent]]:
+    """:func:`self_motion_events` as a maker: the path's steps taken now (copies of Q and the targets' motion), the
+    null-space drift and its events when called (a tracked path's events are made when first read)."""
     if robot.n <= task.dimension or Q.shape[0] < 2:
-        return []
+        return list
     prev = np.vstack([q0, Q[:-1]])
     dx = np.zeros((Q.shape[0], 6))
     dx[:, :3] = np.diff(np.vstack([points[:1], points]), axis=0)
     rotation_steps(np.ascontiguousarray(rotations, dtype=float), dx[:, 3:])
-    arrays = robot._judge_arrays()
-    drift, own = (null_drift(robot, prev, Q, dx, task.rows) if arrays is None
-                  else arrays.null_drift(prev, Q, dx, tuple(task.rows)))
-    return _drift_events(drift, max(float(own.max()), 1e-12))
+    Q, rows = Q.copy(), task.rows
+
+    def events() -> list[SingularEvent]:
+        arrays = robot._judge_arrays()
+        drift, own = (null_drift(robot, prev, Q, dx, rows) if arrays is None
+                      else arrays.null_drift(prev, Q, dx, tuple(rows)))
+        return _drift_events(drift, max(float(own.max()), 1e-12))
+    return events
 
 
 def null_drift(robot: Chain, prev: np.ndarray, Q: np.ndarray, dx: np.ndarray, rows: list[int]
