@@ -109,15 +109,21 @@ def joint_relations(robot: Chain, q, tol: float = RELATION_TOL) -> list[Relation
         c = next((c for c in _values(robot, index) if abs(total - c) < tol), None)
         if c is None:
             continue
-        lhs = names[index[0]] + "".join(f" {'+' if s > 0 else '−'} {names[i]}"
-                                        for i, s in zip(index[1:], sign[1:], strict=True))
-        angular = all(robot.joint_kinds[i] != "prismatic" for i in index) and c in SPECIAL_VALUES
-        if angular:  # one family for every turn: 2π is 0, −π is π
-            c = math.remainder(c, 2 * np.pi) if abs(abs(math.remainder(c, 2 * np.pi)) - np.pi) > 1e-12 else np.pi
-        out.append(Relation(index, sign, float(c), f"{lhs} = {_label(c)}", 2 * np.pi if angular else None))
+        out.append(_relation(robot, names, index, sign, c))
         if len(index) == 1:
             fixed.add(index[0])
     return out
+
+
+def _relation(robot: Chain, names: list[str], index: tuple[int, ...], sign: tuple[int, ...], c: float) -> Relation:
+    """The relation Σ sign·q[index] = c, named by its joints; an angular one at a special value is one family
+    for every turn (2π is 0, −π is π)."""
+    lhs = names[index[0]] + "".join(f" {'+' if s > 0 else '−'} {names[i]}"
+                                    for i, s in zip(index[1:], sign[1:], strict=True))
+    angular = all(robot.joint_kinds[i] != "prismatic" for i in index) and c in SPECIAL_VALUES
+    if angular:
+        c = math.remainder(c, 2 * np.pi) if abs(abs(math.remainder(c, 2 * np.pi)) - np.pi) > 1e-12 else np.pi
+    return Relation(index, sign, float(c), f"{lhs} = {_label(c)}", 2 * np.pi if angular else None)
 
 
 MOVES = 8  # configurations a relation set is tested at, away from the one it was found at
@@ -193,9 +199,7 @@ def _merge_half_turns(groups: dict[tuple, list]) -> dict[tuple, list]:
         if not verified:
             merged.setdefault(((), False), []).extend(groups[key])
             continue
-        partner = next((k for k in merged if verified and k[1] and len(rel) == len(k[0]) == 1
-                        and rel[0].period and (k[0][0].index, k[0][0].sign) == (rel[0].index, rel[0].sign)
-                        and abs(abs(k[0][0].value - rel[0].value) - np.pi) < 1e-9), None)
+        partner = next((k for k in merged if k[1] and _half_turn_apart(rel, k[0])), None)
         if partner is None:
             merged[key] = list(groups[key])
             continue
@@ -204,6 +208,13 @@ def _merge_half_turns(groups: dict[tuple, list]) -> dict[tuple, list]:
                         f"{first.text} or {_label(rel[0].value)}", np.pi)
         merged[((both,), True)] = merged.pop(partner) + list(groups[key])
     return merged
+
+
+def _half_turn_apart(a: tuple[Relation, ...], b: tuple[Relation, ...]) -> bool:
+    """True for two single periodic relations of the same joints whose values differ by π."""
+    if not (len(a) == len(b) == 1 and a[0].period):
+        return False
+    return (a[0].index, a[0].sign) == (b[0].index, b[0].sign) and abs(abs(a[0].value - b[0].value) - np.pi) < 1e-9
 
 
 @dataclass
@@ -331,6 +342,12 @@ def sweep(robot: Chain, samples: int = 5000, seed: int = 0, refine_top: int = 40
                        ratios)
 
 
+def _unexplained(qs: np.ndarray, order: list[int], known: list[tuple[Relation, ...]]) -> int | None:
+    """The first sample in ``order`` that no known family's relations hold at (within FAMILY_MARGIN), or None."""
+    return next((i for i in order if not any(all(r.residual(qs[i]) < FAMILY_MARGIN for r in rel) for rel in known)),
+                None)
+
+
 def _refine_samples(robot: Chain, qs: np.ndarray, order: list[int], lower: np.ndarray, upper: np.ndarray,
                     L: float, refine_top: int, progress: bool) -> tuple[dict, int, int]:
     """Refine the most singular samples that no family found so far explains; group the singular ones.
@@ -342,9 +359,7 @@ def _refine_samples(robot: Chain, qs: np.ndarray, order: list[int], lower: np.nd
     refined = singular_count = 0
     with bar(total=refine_top, progress=progress, desc="refine", unit="q", leave=False) as shown:
         while refined < refine_top and order:
-            known = [rel for rel, verified in groups if rel and verified]
-            pick = next((i for i in order if not any(all(r.residual(qs[i]) < FAMILY_MARGIN for r in rel)
-                                                     for rel in known)), None)
+            pick = _unexplained(qs, order, [rel for rel, verified in groups if rel and verified])
             if pick is None:
                 break
             order.remove(pick)

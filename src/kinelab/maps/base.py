@@ -84,6 +84,27 @@ def base_map(robot: Chain, grasp: pin.SE3, step: float = 0.05, restarts: int = 1
     Raises:
         KinelabError: a robot without the platform joints, or a bad step.
     """
+    _check_base_map(robot, step, restarts, seed)
+    grasp = as_target(grasp)
+    turning = load(str(robot.source), tool=robot.tool, base=robot.base, locked={j: 0.0 for j in PLATFORM[:2]})
+    xy = _platform_positions(turning, grasp, step)
+    targets = np.array([(pin.SE3(np.eye(3), np.array([-x, -y, 0.0])) * grasp).homogeneous for x, y in xy])
+    if classify(turning).arm is not None:
+        success, answers, manip = _best_branches(turning, targets)
+    else:
+        success, answers, manip = _multistart(turning, targets, seed, restarts)
+    yaw = np.where(success, answers[:, 0], np.nan)
+    q = np.where(success[:, None], answers[:, 1:], np.nan)
+    return BaseMap(np.column_stack([xy, yaw]), success, manip, q)
+
+
+def _check_base_map(robot: Chain, step: object, restarts: object, seed: object) -> None:
+    """The robot has the platform joints and a file to reload, the step is a number > 0 [m], the seed and the
+    restarts integers ≥ 0.
+
+    Raises:
+        KinelabError: naming what is wrong.
+    """
     missing = [j for j in PLATFORM if j not in robot.joint_names]
     if missing:
         raise KinelabError(f"{robot.name} has no platform joint {missing[0]!r}: a base map needs joints "
@@ -92,30 +113,36 @@ def base_map(robot: Chain, grasp: pin.SE3, step: float = 0.05, restarts: int = 1
         raise KinelabError(f"a base map needs a grid step > 0 [m], got {step!r}")
     check_seed(seed)
     check_seed(restarts, "restarts")
-    grasp = as_target(grasp)
     if robot.source is None:
         raise KinelabError(f"{robot.name} was made from an in-memory model: a base map reloads it from its file")
-    turning = load(str(robot.source), tool=robot.tool, base=robot.base, locked={j: 0.0 for j in PLATFORM[:2]})
+
+
+def _platform_positions(turning: Chain, grasp: pin.SE3, step: float) -> np.ndarray:
+    """(P, 2) the platform positions [m, world frame] on a grid of ``step`` over the disc around the grasp the arm
+    can reach it from, refused before the grid is built when over MAX_POSITIONS.
+
+    Raises:
+        KinelabError: a grid of more than MAX_POSITIONS positions.
+    """
     anchor, radius = reach_bound(turning)
     reach_xy = radius + float(np.hypot(anchor[0], anchor[1]))
-    if (2 * reach_xy / step + 1) ** 2 > MAX_POSITIONS:  # refused before the grid is built
+    if (2 * reach_xy / step + 1) ** 2 > MAX_POSITIONS:
         raise KinelabError(f"a {step:g} m step over the {reach_xy:.3g} m the arm reaches is about "
                            f"{(2 * reach_xy / step) ** 2:.3g} platform positions, over {MAX_POSITIONS}; take a "
                            "larger step")
     ticks = np.arange(-np.ceil(reach_xy / step), np.ceil(reach_xy / step) + 1) * step
-    xy = np.array([(grasp.translation[0] + a, grasp.translation[1] + b) for a in ticks for b in ticks
-                   if np.hypot(a, b) <= reach_xy])
-    targets = np.array([(pin.SE3(np.eye(3), np.array([-x, -y, 0.0])) * grasp).homogeneous for x, y in xy])
-    if classify(turning).arm is not None:
-        success, answers, manip = _best_branches(turning, targets)
-    else:
-        res = solve_batch(turning, targets, seed=seed, max_restarts=restarts)
-        success, answers, manip = res.success.copy(), res.q, np.zeros(len(xy))
-        if success.any():
-            manip[success] = _manipulability(turning, res.q[success])
-    yaw = np.where(success, answers[:, 0], np.nan)
-    q = np.where(success[:, None], answers[:, 1:], np.nan)
-    return BaseMap(np.column_stack([xy, yaw]), success, manip, q)
+    return np.array([(grasp.translation[0] + a, grasp.translation[1] + b) for a in ticks for b in ticks
+                     if np.hypot(a, b) <= reach_xy])
+
+
+def _multistart(turning: Chain, targets: np.ndarray, seed: int, restarts: int
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(reached, one answer per target (P, n), its manipulability) from the seeded multistart's batch."""
+    res = solve_batch(turning, targets, seed=seed, max_restarts=restarts)
+    success, manip = res.success.copy(), np.zeros(len(targets))
+    if success.any():
+        manip[success] = _manipulability(turning, res.q[success])
+    return success, res.q, manip
 
 
 def _manipulability(turning: Chain, q: np.ndarray) -> np.ndarray:

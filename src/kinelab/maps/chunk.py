@@ -14,6 +14,7 @@ whatever order.
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -67,16 +68,14 @@ class MapSpec:
 
     def check(self) -> None:
         """Raises KinelabError naming a bad field and what is valid."""
-        if isinstance(self.orientations, bool) or not (isinstance(self.orientations, int)
-                                                       and 1 <= self.orientations <= MAX_ORIENTATIONS):
+        if not _whole(self.orientations, 1, MAX_ORIENTATIONS):
             raise KinelabError(f"orientations must be an integer ≥ 1 and at most {MAX_ORIENTATIONS}, got "
                                f"{self.orientations!r}")
         if self.task not in ("pose", "axis"):
             raise KinelabError(f"a reachability map takes task 'pose' or 'axis', got {self.task!r}")
-        if isinstance(self.chunk_voxels, bool) or not (isinstance(self.chunk_voxels, int) and self.chunk_voxels >= 1):
+        if not _whole(self.chunk_voxels, 1):
             raise KinelabError(f"chunk_voxels must be an integer ≥ 1, got {self.chunk_voxels!r}")
-        if isinstance(self.voxel, bool) or not (isinstance(self.voxel, int | float) and np.isfinite(self.voxel)
-                                                and self.voxel > 0):
+        if not _length(self.voxel):
             raise KinelabError(f"the voxel side must be a positive length in metres, got {self.voxel!r}")
         if self.collisions is not None and not isinstance(self.collisions, Collisions):
             raise KinelabError(f"a map's collisions is a kinelab.Collisions or None, got {self.collisions!r}")
@@ -92,6 +91,16 @@ class MapSpec:
     def to_dict(self) -> dict:
         """The JSON form stored with the map (tuples as lists, as the store gives them back)."""
         return dict(json.loads(json.dumps(asdict(self), default=_plain)))
+
+
+def _whole(value: object, lo: int, hi: float = math.inf) -> bool:
+    """True for an int (not a bool) in [lo, hi]."""
+    return isinstance(value, int) and not isinstance(value, bool) and lo <= value <= hi
+
+
+def _length(value: object) -> bool:
+    """True for a finite number > 0 (not a bool)."""
+    return isinstance(value, int | float) and not isinstance(value, bool) and bool(np.isfinite(value)) and value > 0
 
 
 def _plain(value: object) -> object:

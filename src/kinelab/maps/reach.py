@@ -16,6 +16,7 @@ from kinelab.progress import bar
 from kinelab.robot import Chain
 
 if TYPE_CHECKING:
+    import numpy as np
     from distributed import Client
 
 __all__ = ["MAX_TARGETS", "MapSpec", "compute_chunk", "reachability"]
@@ -64,12 +65,38 @@ def reachability(robot: Chain, spec: MapSpec | None = None, out: str | None = No
         KinelabError: a bad spec, a map too large without ``force``, or ``out`` holding another map.
     """
     spec = spec_of(spec, fields)
+    _check_out_and_client(out, client)
+    centres = _checked_centres(robot, spec, force)
+    target = store.open_map(out, robot, spec, centres)
+    todo = [c for c in range(target.chunks) if not target.done[c]]
+    if client is not None:
+        cluster.run_chunks(client, robot, spec, centres, todo, target, progress)
+        return target
+    _run_here(robot, spec, centres, todo, target, out, progress)
+    return target
+
+
+def _check_out_and_client(out: object, client: object) -> None:
+    """``out`` is a folder path or None, ``client`` a Dask client or None.
+
+    Raises:
+        OptionError: either one otherwise.
+    """
     if out is not None and not (isinstance(out, Path) or (isinstance(out, str) and out.strip())):
         raise OptionError("out", out, "a folder path (a str or pathlib.Path), or None (in memory)")
     if client is not None and not (callable(getattr(client, "submit", None)) and hasattr(client, "scatter")):
         raise OptionError("client", client, "a dask.distributed.Client, or None (this process)")
+
+
+def _checked_centres(robot: Chain, spec: MapSpec, force: bool) -> np.ndarray:
+    """The map's voxel centres, refused where the map asks for more than MAX_TARGETS targets without ``force``: on
+    the estimate before the grid is built (a 1e-9 m voxel, say), then on the count.
+
+    Raises:
+        KinelabError: a map too large without ``force``.
+    """
     estimate = grid.estimated_voxels(robot, spec.voxel) * spec.orientations
-    if estimate > 1.2 * MAX_TARGETS and not force:  # refused before the grid is built (a 1e-9 m voxel, say)
+    if estimate > 1.2 * MAX_TARGETS and not force:
         raise KinelabError(f"this map asks for about {estimate:.3g} targets (counted before any grid is built); the "
                            f"limit is {MAX_TARGETS} without "
                            "force=True (--force): a larger voxel or fewer orientations make it smaller")
@@ -79,15 +106,15 @@ def reachability(robot: Chain, spec: MapSpec | None = None, out: str | None = No
         raise KinelabError(f"this map asks for {total} targets ({len(centres)} voxels × {spec.orientations}); the "
                            f"limit is {MAX_TARGETS} without force=True (--force): a larger voxel or fewer "
                            "orientations make it smaller")
-    target = store.open_map(out, robot, spec, centres)
-    todo = [c for c in range(target.chunks) if not target.done[c]]
-    if client is not None:
-        cluster.run_chunks(client, robot, spec, centres, todo, target, progress)
-        return target
+    return centres
+
+
+def _run_here(robot: Chain, spec: MapSpec, centres: np.ndarray, todo: list[int], target: store.ReachabilityMap,
+              out: object, progress: bool | None) -> None:
+    """The chunks left, in this process, each written as it finishes, under a bar that starts at those done."""
     resumed = target.chunks - len(todo)
     with bar(total=target.chunks, initial=resumed, progress=progress, unit="chunk",
              desc=f"map (resumed: {resumed} chunks already in {out})" if resumed else "map") as shown:
         for c in todo:
             target.write(c, compute_chunk(robot, spec, centres, c))
             shown.update()
-    return target

@@ -339,11 +339,7 @@ def side_by_side(robot: Chain, qs: list, spacing: float | None = None, viewer: m
         ConfigurationError: a q of the wrong length, non-finite, or no q at all.
         ValueError: labels of another length than qs.
     """
-    checked = [robot.check_q(q) for q in qs]
-    if not checked:
-        raise ConfigurationError("side_by_side needs at least one configuration; got none")
-    if labels is not None and len(labels) != len(checked):
-        raise ValueError(f"side_by_side: {len(labels)} labels for {len(checked)} configurations")
+    checked = _copies(robot, qs, labels)
     scene = Scene(robot, viewer=viewer)
     scene.view = "side by side"
     scene.drop_robot()
@@ -357,17 +353,38 @@ def side_by_side(robot: Chain, qs: list, spacing: float | None = None, viewer: m
         # copy 1 nearest the camera, on the left: the first row is the front one, read left to right (+y)
         row, column = divmod(k, columns)
         offset = pin.SE3(np.eye(3), np.array([(rows - 1 - row) * spacing, column * spacing, 0.0]))
-        moved = [offset.act(p) for p in points]
-        _stick_figure(scene.viewer["branches"][str(k + 1)], moved, scene.frame_length,
-                      HIGHLIGHT if k == highlight else JOINTS)
-        scene.frame(f"tool_{k + 1}", offset * robot.fk(checked[k]))
-        top = offset.translation + np.array([0.0, 0.0, max(p[2] for p in points) + 0.8 * scene.frame_length])
-        draw_number(scene.viewer["numbers"][str(k + 1)], str(k + 1), top, 0.6 * scene.frame_length, NUMBERS)
-        if target is not None:
-            _target_mark(scene.viewer["targets"][str(k + 1)], offset.act(target.translation), scene.frame_length)
-        occupied += moved + [offset.translation, top]
+        occupied += _draw_copy(scene, robot, k, checked[k], points, offset, k == highlight, target)
     _side_by_side_legend(scene, robot, labels or [f"copy {k + 1}" for k in range(len(checked))], highlight, target)
     return scene._aim(np.array(occupied), fill=SPREAD_FILL if len(checked) > 1 else FILL)
+
+
+def _copies(robot: Chain, qs: list, labels: list[str] | None) -> list[np.ndarray]:
+    """The configurations checked, at least one, and as many labels as configurations (or none).
+
+    Raises:
+        ConfigurationError: a bad q, or none.
+        ValueError: labels of another length.
+    """
+    checked = [robot.check_q(q) for q in qs]
+    if not checked:
+        raise ConfigurationError("side_by_side needs at least one configuration; got none")
+    if labels is not None and len(labels) != len(checked):
+        raise ValueError(f"side_by_side: {len(labels)} labels for {len(checked)} configurations")
+    return checked
+
+
+def _draw_copy(scene: Scene, robot: Chain, k: int, q: np.ndarray, points: list[np.ndarray], offset: pin.SE3,
+               highlighted: bool, target: pin.SE3 | None) -> list[np.ndarray]:
+    """Copy k (numbered k + 1) of the robot at q, moved by ``offset``: its stick figure, tool frame, number and
+    the target's mark; returns the points it occupies [m, scene frame]."""
+    moved = [offset.act(p) for p in points]
+    _stick_figure(scene.viewer["branches"][str(k + 1)], moved, scene.frame_length, HIGHLIGHT if highlighted else JOINTS)
+    scene.frame(f"tool_{k + 1}", offset * robot.fk(q))
+    top = offset.translation + np.array([0.0, 0.0, max(p[2] for p in points) + 0.8 * scene.frame_length])
+    draw_number(scene.viewer["numbers"][str(k + 1)], str(k + 1), top, 0.6 * scene.frame_length, NUMBERS)
+    if target is not None:
+        _target_mark(scene.viewer["targets"][str(k + 1)], offset.act(target.translation), scene.frame_length)
+    return [*moved, offset.translation, top]
 
 
 def _spacing(figures: list[list[np.ndarray]], reach: float) -> float:

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import ctypes
 import importlib.metadata
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -57,21 +57,27 @@ def _joint(model: pin.Model, jid: int) -> tuple[int, np.ndarray, float, float] |
     short = jm.shortname()
     if short == "JointModelFreeFlyer":
         return FREEFLYER, np.zeros(3), 1.0, 0.0
-    ratio, offset, mimic = 1.0, 0.0, short == "JointModelMimic"
-    if mimic:
+    if short == "JointModelMimic":
         inner = jm.extract()
         ratio, offset = float(inner.scaling), float(inner.offset)
-    elif jm.nv != 1:
+        prismatic, axis = _motion_axis(model, jm, ratio or 1.0)
+        return (MIMIC_PRISMATIC if prismatic else MIMIC_REVOLUTE), axis, ratio, offset
+    if jm.nv != 1:
         return None
+    prismatic, axis = _motion_axis(model, jm, 1.0)
+    kind = CONTINUOUS if jm.nq == 2 else PRISMATIC if prismatic else REVOLUTE
+    return kind, axis, 1.0, 0.0
+
+
+def _motion_axis(model: pin.Model, jm: pin.JointModel, scale: float) -> tuple[bool, np.ndarray]:
+    """(prismatic, unit axis in the joint's frame) of a one-velocity joint's motion subspace at the neutral q
+    (divided by ``scale``: a mimic joint's ratio). A continuous joint is a rotation."""
     data = jm.createData()
     jm.calc(data, pin.neutral(model))
-    S = np.asarray(data.S, dtype=float).ravel() / (ratio if mimic and ratio else 1.0)
-    if not mimic and jm.nq == 2:
-        return CONTINUOUS, S[3:] / np.linalg.norm(S[3:]), 1.0, 0.0
-    prismatic = np.linalg.norm(S[3:]) < 0.5 * np.linalg.norm(S)
+    S = np.asarray(data.S, dtype=float).ravel() / scale
+    prismatic = jm.nq != 2 and bool(np.linalg.norm(S[3:]) < 0.5 * np.linalg.norm(S))
     axis = S[:3] if prismatic else S[3:]
-    kind = (MIMIC_PRISMATIC if prismatic else MIMIC_REVOLUTE) if mimic else (PRISMATIC if prismatic else REVOLUTE)
-    return kind, axis / np.linalg.norm(axis), ratio, offset
+    return prismatic, axis / np.linalg.norm(axis)
 
 
 def _pose(M: pin.SE3) -> np.ndarray:
@@ -153,19 +159,48 @@ def structure(tasks: tuple[Task, ...]) -> tuple[Any, ...] | None:
 
 def pack(robot: Robot, tree: _body.Tree, tasks: tuple[Task, ...]) -> Packed:
     """The compiled problem of a task list (see :func:`structure`)."""
-    rows = _weighted_rows(robot, [t for t in tasks if isinstance(t, FrameTask | RelativeFrameTask | ComTask)])
-    post = next((t for t in tasks if isinstance(t, PostureTask)), None)
+    kinds = _Kinds.of(tasks)
+    post, couplings = kinds.posture, kinds.couplings
     post_w = np.zeros(robot.nv) if post is None else ev.posture_weight(robot, post)
-    couplings = [t for t in tasks if isinstance(t, CouplingTask)]
     post_ref = robot.neutral()
-    targets = tuple(i for i, t in enumerate(tasks) if not isinstance(t, PostureTask | CouplingTask))
-    posture = next((i for i, t in enumerate(tasks) if isinstance(t, PostureTask)), -1)
-    cslot = np.array([i for i, t in enumerate(tasks) if isinstance(t, CouplingTask)], dtype=np.intc)
-    step = _body.Step(tree, *rows, post_ref, post_w, 0.0 if post is None else post.gain,
-                      0 if post is None else post.priority, *_coupling_indices(robot, couplings),
-                      np.array([c.ratio for c in couplings]), np.array([c.offset for c in couplings]),
-                      np.array(targets, dtype=np.intc), posture, cslot)
-    return Packed(step, targets, posture, post_ref, post_w, tuple(t.label for t in tasks))
+    step = _body.Step(tree, *_weighted_rows(robot, kinds.weighted), post_ref, post_w, *_posture_terms(post),
+                      *_coupling_indices(robot, couplings), np.array([c.ratio for c in couplings]),
+                      np.array([c.offset for c in couplings]), np.array(kinds.targets, dtype=np.intc),
+                      kinds.posture_index, np.array(kinds.coupling_index, dtype=np.intc))
+    return Packed(step, kinds.targets, kinds.posture_index, post_ref, post_w, tuple(t.label for t in tasks))
+
+
+@dataclass
+class _Kinds:
+    """A task list sorted by what the compiled step does with each: the weighted tasks (frames, relative frames,
+    the CoM: their targets set per call), the posture (one at most) and the couplings, with their places in the
+    list."""
+
+    weighted: list[FrameTask | RelativeFrameTask | ComTask] = field(default_factory=list)
+    targets: tuple[int, ...] = ()
+    posture: PostureTask | None = None
+    posture_index: int = -1
+    couplings: list[CouplingTask] = field(default_factory=list)
+    coupling_index: list[int] = field(default_factory=list)
+
+    @classmethod
+    def of(cls, tasks: tuple[Task, ...]) -> _Kinds:
+        kinds = cls()
+        for i, t in enumerate(tasks):
+            if isinstance(t, PostureTask):
+                kinds.posture, kinds.posture_index = t, i
+            elif isinstance(t, CouplingTask):
+                kinds.couplings.append(t)
+                kinds.coupling_index.append(i)
+            else:
+                kinds.weighted.append(t)
+                kinds.targets += (i,)
+        return kinds
+
+
+def _posture_terms(post: PostureTask | None) -> tuple[float, int]:
+    """The posture's gain and priority for the compiled step (0, 0: no posture)."""
+    return (0.0, 0) if post is None else (post.gain, post.priority)
 
 
 Rows = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,

@@ -46,43 +46,43 @@ class Points:
 
 def task_points(robot: Robot, tasks: tuple[Task, ...], data: pin.Data, com: np.ndarray | None) -> Points:
     """Every task's points at the configuration in ``data`` (frame placements updated)."""
-    frame, p, t, w, direction, carrier, free = [], [], [], [], [], [], []
-
-    def add(fid: int, pos: np.ndarray, target: np.ndarray, weight: float, is_direction: bool, by: int = -1,
-            follows: np.ndarray | None = None) -> None:
-        free.append(np.zeros(3) if follows is None else follows)
-        frame.append(fid)
-        p.append(pos)
-        t.append(target)
-        w.append(weight)
-        direction.append(is_direction)
-        carrier.append(by)
-
+    rows: list[tuple[int, np.ndarray, np.ndarray, float, bool, int, np.ndarray]] = []
     for task in tasks:
         if isinstance(task, FrameTask | RelativeFrameTask):
-            fid = robot.frame_id(task.frame)
-            oMf = data.oMf[fid]
-            by = -1 if isinstance(task, FrameTask) else robot.frame_id(task.root)
-            target = task.target if by < 0 else data.oMf[by] * task.target
-            kind = task.task if isinstance(task, FrameTask) else "pose"
-            if kind != "orientation":
-                add(fid, oMf.translation, target.translation, task.weight, False, by)
-            axes: list[int] = list(range(3)) if kind in ("pose", "orientation") else []
-            if isinstance(task, FrameTask) and kind == "axis":
-                axes = ["xyz".index(task.axis)]
-            for k in axes:
-                add(fid, oMf.rotation[:, k], target.rotation[:, k], 0.5 * float(task.orientation_weight or 0.0), True,
-                    by)
+            rows += _frame_points(robot, task, data)
         elif isinstance(task, ComTask):
             assert com is not None
-            goal = com.copy()
-            goal[list(task.index)] = task.target[list(task.index)]  # free coordinates: their current values
-            follows = np.ones(3)
-            follows[list(task.index)] = 0.0
-            add(-1, com, goal, task.weight, False, follows=follows)
+            rows.append(_com_point(task, com))
+    frame, p, t, w, direction, carrier, free = zip(*rows, strict=True) if rows else ((),) * 7
     return Points(np.array(frame, dtype=int), np.array(p, dtype=float).reshape(-1, 3),
                   np.array(t, dtype=float).reshape(-1, 3), np.array(w, dtype=float), np.array(direction, dtype=bool),
                   np.array(carrier, dtype=int), np.array(free, dtype=float).reshape(-1, 3))
+
+
+def _frame_points(robot: Robot, task: FrameTask | RelativeFrameTask, data: pin.Data
+                  ) -> list[tuple[int, np.ndarray, np.ndarray, float, bool, int, np.ndarray]]:
+    """A frame task's points: its origin (unless only its orientation is asked for) and the axes its task
+    constrains, each with its target (a relative task's target carried by its root frame)."""
+    fid = robot.frame_id(task.frame)
+    oMf = data.oMf[fid]
+    by = -1 if isinstance(task, FrameTask) else robot.frame_id(task.root)
+    target = task.target if by < 0 else data.oMf[by] * task.target
+    kind, axis = (task.task, task.axis) if isinstance(task, FrameTask) else ("pose", "z")
+    fixed = np.zeros(3)
+    rows = [] if kind == "orientation" else [(fid, oMf.translation, target.translation, task.weight, False, by, fixed)]
+    axes = ["xyz".index(axis)] if kind == "axis" else range(3) if kind in ("pose", "orientation") else []
+    weight = 0.5 * float(task.orientation_weight or 0.0)
+    return rows + [(fid, oMf.rotation[:, k], target.rotation[:, k], weight, True, by, fixed) for k in axes]
+
+
+def _com_point(task: ComTask, com: np.ndarray) -> tuple[int, np.ndarray, np.ndarray, float, bool, int, np.ndarray]:
+    """The centre of mass as a point: its free coordinates' targets are their current values, and they follow it."""
+    index = list(task.index)
+    goal = com.copy()
+    goal[index] = task.target[index]
+    follows = np.ones(3)
+    follows[index] = 0.0
+    return -1, com, goal, task.weight, False, -1, follows
 
 
 def _rotation_angle(a: np.ndarray, b: np.ndarray, w: np.ndarray, u: np.ndarray) -> float:

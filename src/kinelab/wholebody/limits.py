@@ -45,17 +45,21 @@ class Limits:
         """
         if not isinstance(self.position, bool):
             raise OptionError("position", self.position, "True or False")
-        for name in ("velocity", "acceleration"):
-            value = getattr(self, name)
-            if value is None or isinstance(value, bool):
-                continue
-            arr = np.asarray(value, dtype=float) if _numeric(value) else None
-            if arr is None or arr.ndim > 1 or not (np.all(arr > 0) and not np.any(np.isnan(arr))):
-                raise OptionError(name, value, "True, False, None, a number > 0 or one per velocity")
+        _check_rate("velocity", self.velocity)
+        _check_rate("acceleration", self.acceleration)
         if self.acceleration is True:
             raise OptionError("acceleration", True, "None, a number > 0 or one per velocity (no file gives them)")
         if self.collisions is not None:
             raise OptionError("collisions", self.collisions, "None (distance constraints are not in this version)")
+
+
+def _check_rate(name: str, value: Any) -> None:
+    """A rate limit is True, False, None, a number > 0 or one per velocity (none NaN)."""
+    if value is None or isinstance(value, bool):
+        return
+    arr = np.asarray(value, dtype=float) if _numeric(value) else None
+    if arr is None or arr.ndim > 1 or not (np.all(arr > 0) and not np.any(np.isnan(arr))):
+        raise OptionError(name, value, "True, False, None, a number > 0 or one per velocity")
 
 
 def _numeric(value: Any) -> bool:

@@ -140,10 +140,8 @@ def _run(robot: Robot, tasks: tuple[Task, ...], start: np.ndarray, settings: Sol
     iterations, restarts = 0, 0
     q = start
     while True:
-        if settings.solver == "frdm":
-            q, used, status = frdm_solve(robot, tasks, q, settings, deadline)
-        else:
-            q, used, status = iterate(robot, ordered, q, settings, limits, deadline)
+        q, used, status = _converge(robot, tasks if settings.solver == "frdm" else ordered, q, settings, limits,
+                                    deadline)
         iterations += used
         verdicts = judge(robot, tasks, q, settings.tol_pos, settings.tol_rot)
         score = _score(verdicts)
@@ -154,12 +152,25 @@ def _run(robot: Robot, tasks: tuple[Task, ...], start: np.ndarray, settings: Sol
         restarts += 1
         q = _restart(robot, start, rng)
     _, q, status = best
+    return _result(robot, tasks, q, status, settings, iterations, restarts, time.perf_counter() - t0)
+
+
+def _converge(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, settings: SolveSettings, limits: Limits,
+              deadline: float) -> tuple[np.ndarray, int, Status]:
+    """One start run to convergence by the chosen solver: (q, iterations, status)."""
+    if settings.solver == "frdm":
+        return frdm_solve(robot, tasks, q, settings, deadline)
+    return iterate(robot, tasks, q, settings, limits, deadline)
+
+
+def _result(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, status: Status, settings: SolveSettings,
+            iterations: int, restarts: int, seconds: float) -> WholeBodyResult:
+    """The answer judged once more by Pinocchio: converged only where every task is met within the limits."""
     verdicts = judge(robot, tasks, q, settings.tol_pos, settings.tol_rot)
     met = all(v.met for v in verdicts)
     within = robot.within_limits(q)
     final = Status.CONVERGED if met and within else Status.OUTSIDE_LIMITS if met else status
-    return WholeBodyResult(q, met and within, final, verdicts, iterations, restarts, time.perf_counter() - t0,
-                           settings.solver)
+    return WholeBodyResult(q, met and within, final, verdicts, iterations, restarts, seconds, settings.solver)
 
 
 def _restart(robot: Robot, start: np.ndarray, rng: np.random.Generator) -> np.ndarray:

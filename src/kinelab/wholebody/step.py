@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 import pinocchio as pin
@@ -38,6 +38,9 @@ if TYPE_CHECKING:
     from collections.abc import Sequence
 
     from numpy.typing import ArrayLike
+
+
+T = TypeVar("T")
 
 
 @dataclass(frozen=True)
@@ -190,11 +193,10 @@ def _velocity_limits(robot: Robot, limits: Limits) -> tuple[np.ndarray, np.ndarr
     table: dict[int, tuple[Limits, np.ndarray, np.ndarray]] = robot.derived("compiled limits", _new_table)
     found = table.get(id(limits))
     if found is None or found[0] is not limits:
-        if len(table) >= MAX_PACKED:
-            table.clear()
         a = acceleration_bounds(limits, robot.space)
-        found = table[id(limits)] = (limits, np.ascontiguousarray(velocity_bounds(limits, robot.space), dtype=float),
-                                     NO_LIMIT if a is None else np.ascontiguousarray(a, dtype=float))
+        found = _kept(table, id(limits), (limits, np.ascontiguousarray(velocity_bounds(limits, robot.space),
+                                                                       dtype=float),
+                                          NO_LIMIT if a is None else np.ascontiguousarray(a, dtype=float)))
     return found[1], found[2]
 
 
@@ -202,7 +204,7 @@ def _new_table(_: Robot) -> dict[Any, Any]:
     return {}
 
 
-def _packed(robot: Robot, tasks: Any, options: StepOptions) -> Any:
+def _packed(robot: Robot, tasks: Any, options: StepOptions) -> cp.Packed | None:
     """The compiled problem of this task list with its targets set, or None (see :func:`_compiled`). The same task
     objects as a call before take that call's problem as it is (tasks are frozen: their targets are those set)."""
     if options.solver != "daqp" or not cp.daqp_linked():
@@ -218,23 +220,36 @@ def _packed(robot: Robot, tasks: Any, options: StepOptions) -> Any:
     if hit is not None and hit[1].current == ids:
         return hit[1]
     found = as_tasks(tasks)
-    tree = robot.derived("compiled tree", cp.pack_tree)
-    key = None if tree is None else cp.structure(found)
-    if tree is None or key is None:
-        return None
-    table: dict[Any, Any] = robot.derived("compiled steps", _new_table)
-    packed = table.get(key)
+    packed = _of_structure(robot, found)
     if packed is None:
-        _check_names(robot, found)
-        if len(table) >= MAX_PACKED:
-            table.clear()
-        packed = table[key] = cp.pack(robot, tree, found)
+        return None
     cp.set_targets(robot, packed, found)
-    if len(recent) >= MAX_PACKED:
-        recent.clear()
-    recent[ids] = (found, packed)  # the task objects held: their ids stay theirs
+    _kept(recent, ids, (found, packed))  # the task objects held: their ids stay theirs
     packed.current = ids
     return packed
+
+
+def _of_structure(robot: Robot, tasks: tuple[Task, ...]) -> cp.Packed | None:
+    """The compiled problem of the task list's structure, packed once per robot and structure (its names checked
+    first), or None where the compiled step does not take the tree or the list."""
+    tree = robot.derived("compiled tree", cp.pack_tree)
+    key = None if tree is None else cp.structure(tasks)
+    if tree is None or key is None:
+        return None
+    table: dict[Any, cp.Packed] = robot.derived("compiled steps", _new_table)
+    packed = table.get(key)
+    if packed is None:
+        _check_names(robot, tasks)
+        packed = _kept(table, key, cp.pack(robot, tree, tasks))
+    return packed
+
+
+def _kept(table: dict[Any, T], key: Any, value: T) -> T:
+    """``table[key] = value`` in a table of at most MAX_PACKED entries (emptied when full)."""
+    if len(table) >= MAX_PACKED:
+        table.clear()
+    table[key] = value
+    return value
 
 
 def _check_names(robot: Robot, tasks: tuple[Task, ...]) -> None:
@@ -263,16 +278,25 @@ def _step(robot: Robot, q: np.ndarray, tasks: tuple[Task, ...], dt: float, limit
     solution = _solve_level(levels[0], options, lower, upper, A_eq, b_eq)
     iterations = solution.iterations
     if solution.solved and len(levels) > 1:
-        held = np.vstack(levels[0].A) if levels[0].A else np.zeros((0, robot.nv))
-        A_eq2 = held if A_eq is None else np.vstack([A_eq, held])
-        b_eq2 = held @ solution.v if b_eq is None else np.concatenate([b_eq, held @ solution.v])
-        second = _solve_level(levels[1], options, lower, upper, A_eq2, b_eq2)
+        second = _second_level(robot, levels, solution.v, options, lower, upper, A_eq, b_eq)
         iterations += second.iterations
         solution = second if second.solved else solution
     v = solution.v if solution.solved else np.zeros(robot.nv)
     q_next = np.asarray(pin.integrate(robot.model, q, v * dt), dtype=float) if solution.solved else q.copy()
     names = tuple(robot.space.names_v[i] for i in np.flatnonzero(returning))
     return StepResult(v, q_next, solution.status, solution.solved, tuple(errors), names, iterations)
+
+
+def _second_level(robot: Robot, levels: list[ev.Rows], v_first: np.ndarray, options: StepOptions,
+                  lower: np.ndarray, upper: np.ndarray, A_eq: np.ndarray | None, b_eq: np.ndarray | None
+                  ) -> qp.Solution:
+    """The priority-2 tasks' QP, with what the first level reached held as equalities (its rows at ``v_first``)
+    beside the couplings' (``A_eq``, ``b_eq``; None: none)."""
+    held = np.vstack(levels[0].A) if levels[0].A else np.zeros((0, robot.nv))
+    if A_eq is None or b_eq is None:
+        return _solve_level(levels[1], options, lower, upper, held, held @ v_first)
+    return _solve_level(levels[1], options, lower, upper, np.vstack([A_eq, held]),
+                        np.concatenate([b_eq, held @ v_first]))
 
 
 def _levels(robot: Robot, q: np.ndarray, tasks: tuple[Task, ...], dt: float,
