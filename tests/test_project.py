@@ -8,8 +8,8 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 #: kinelab's layers, lowest first: a module imports its own layer and lower ones only.
-LAYERS = ["errors", "files", "lazy", "scratch", "progress", "geometry", "core", "robot", "collision", "dq", "typing",
-          "ik", "wholebody", "analysis", "maps", "studies", "view", "report", "cli"]
+LAYERS = ["errors", "values", "files", "lazy", "scratch", "progress", "geometry", "core", "robot", "collision", "dq",
+          "typing", "ik", "wholebody", "analysis", "maps", "studies", "view", "report", "cli"]
 
 
 def _commands(text: str) -> list[str]:

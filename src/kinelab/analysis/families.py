@@ -18,6 +18,7 @@ from kinelab.errors import KinelabError
 from kinelab.ik.request import check_seed
 from kinelab.progress import bar
 from kinelab.robot import Chain
+from kinelab.values import is_whole
 
 RELATION_TOL = 1e-3  # [rad or m] a joint relation holds within this
 SPECIAL_VALUES = (0.0, np.pi / 2, -np.pi / 2, np.pi, -np.pi, 2 * np.pi, -2 * np.pi)
@@ -276,7 +277,7 @@ def check_sweep_size(robot: Chain, samples: int, force: bool = False) -> None:
     Raises:
         KinelabError: with the estimate and how to run it anyway.
     """
-    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
+    if not is_whole(samples, 1):
         raise KinelabError(f"a sweep needs at least one sample (an integer ≥ 1), got {samples!r}")
     need = sweep_bytes(robot, samples)
     if need > MAX_SWEEP_BYTES and not force:

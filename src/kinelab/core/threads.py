@@ -7,6 +7,7 @@ from __future__ import annotations
 import os
 
 from kinelab.errors import OptionError
+from kinelab.values import is_whole
 
 _COUNT: list[int] = []
 
@@ -42,6 +43,6 @@ def set_count(threads: int | None) -> None:
         _COUNT.clear()
         return
     most = max(MAX_THREADS, available())
-    if isinstance(threads, bool) or not isinstance(threads, int) or not 1 <= threads <= most:
+    if not is_whole(threads, 1, most):
         raise OptionError("threads", threads, f"an integer from 1 to {most} (this machine has {available()} cores)")
     _COUNT[:] = [threads]

@@ -10,11 +10,10 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import math
-import numbers
 from typing import Any, TypeVar
 
 from kinelab.errors import OptionError
+from kinelab.values import is_real, is_whole
 
 T = TypeVar("T")
 
@@ -96,17 +95,14 @@ def positive(name: str, value: object, *, allow_none: bool = False, integer: boo
 
 def _in_range(value: object, integer: bool, zero: bool) -> bool:
     """A number (not a bool; an integer with ``integer``), finite and > 0 (≥ 0 with ``zero``)."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral if integer else numbers.Real):
+    if integer and not is_whole(value, hi=MAX_COUNT):
         return False
-    if integer and int(value) > MAX_COUNT:  # type: ignore[call-overload]
-        return False
-    number = float(value)
-    return math.isfinite(number) and (number > 0 or (zero and number == 0))
+    return is_real(value, 0, above=not zero)
 
 
 def finite(name: str, value: object) -> None:
     """Refuse anything but a finite real number."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(float(value)):
+    if not is_real(value):
         raise OptionError(name, value, "a finite number")
 
 

@@ -20,6 +20,7 @@ from kinelab.errors import ChainError, OptionError
 from kinelab.ik.registry import SolverOptions, solver_module
 from kinelab.ik.tasks import POSE, Task
 from kinelab.robot import Chain
+from kinelab.values import is_real
 
 START_POLICIES = ("project", "refuse")
 TOL_FLOOR = 1e-12
@@ -151,7 +152,7 @@ def _check_counts(max_restarts: Any, seed: Any, start_outside_limits: Any) -> No
 
 def _check_positive(name: str, value: Any, floor: float) -> None:
     """Refuse a value that is not a finite real > 0 and ≥ floor (a tolerance's floor: :data:`TOL_FLOOR`)."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not 0 < float(value) < math.inf:
+    if not is_real(value, 0, above=True):
         raise OptionError(name, value, "a finite number > 0" + (" or None" if name == "time_budget" else ""))
     if float(value) < floor:
         raise OptionError(name, value, f"a finite number ≥ {floor:g} (a finer error is below the rounding of "

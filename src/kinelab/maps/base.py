@@ -26,6 +26,7 @@ from kinelab.ik.api import solve_batch
 from kinelab.ik.request import check_seed
 from kinelab.ik.targets import as_target, reach_bound
 from kinelab.robot import Chain, load
+from kinelab.values import is_real, is_whole
 
 PLATFORM = ("platform_x", "platform_y", "platform_yaw")
 
@@ -66,7 +67,7 @@ def check_count(count: object) -> None:
     Raises:
         OptionError: naming the value and what is valid.
     """
-    if isinstance(count, bool) or not isinstance(count, int | np.integer) or count < 0:
+    if not is_whole(count, 0):
         raise OptionError("count", count, "an integer ≥ 0: how many of the best poses (kinelab map base --top)")
 
 
@@ -109,7 +110,7 @@ def _check_base_map(robot: Chain, step: object, restarts: object, seed: object) 
     if missing:
         raise KinelabError(f"{robot.name} has no platform joint {missing[0]!r}: a base map needs joints "
                            f"{', '.join(PLATFORM)}")
-    if isinstance(step, bool) or not (isinstance(step, int | float) and np.isfinite(step) and step > 0):
+    if not is_real(step, 0, above=True):
         raise KinelabError(f"a base map needs a grid step > 0 [m], got {step!r}")
     check_seed(seed)
     check_seed(restarts, "restarts")

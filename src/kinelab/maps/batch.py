@@ -32,6 +32,7 @@ from kinelab.maps.store import _zarr, model_sha256
 from kinelab.progress import bar
 from kinelab.robot import Chain
 from kinelab.typing import Targets
+from kinelab.values import is_real, is_whole
 
 CHUNK = 10_000  # targets per task: ~0.3 s of a panda worker, 1.3 MB of targets sent
 FIELDS = {"q": "f8", "success": "?", "status_code": "i1", "position_error": "f8", "rotation_error": "f8",
@@ -57,11 +58,11 @@ class BatchSpec:
         """
         for name, low in (("seed", 0), ("max_restarts", 0), ("chunk", 1)):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
+            if not is_whole(value, low):
                 raise OptionError(name, value, f"an integer ≥ {low}")
         for name in ("tol_pos", "tol_rot"):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int | float) or not 0 < value < np.inf:
+            if not is_real(value, 0, above=True):
                 raise OptionError(name, value, "a positive finite tolerance")
 
 

@@ -14,7 +14,6 @@ whatever order.
 from __future__ import annotations
 
 import json
-import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -28,6 +27,7 @@ from kinelab.ik.api import solve_batch
 from kinelab.ik.request import check_seed
 from kinelab.maps import grid
 from kinelab.robot import Chain
+from kinelab.values import is_real, is_whole
 
 METHODS = ("auto", "numeric")
 MAX_TARGETS = 2_000_000  # a map asking for more needs force=True (about an hour per million on one core)
@@ -68,14 +68,14 @@ class MapSpec:
 
     def check(self) -> None:
         """Raises KinelabError naming a bad field and what is valid."""
-        if not _whole(self.orientations, 1, MAX_ORIENTATIONS):
+        if not is_whole(self.orientations, 1, MAX_ORIENTATIONS):
             raise KinelabError(f"orientations must be an integer ≥ 1 and at most {MAX_ORIENTATIONS}, got "
                                f"{self.orientations!r}")
         if self.task not in ("pose", "axis"):
             raise KinelabError(f"a reachability map takes task 'pose' or 'axis', got {self.task!r}")
-        if not _whole(self.chunk_voxels, 1):
+        if not is_whole(self.chunk_voxels, 1):
             raise KinelabError(f"chunk_voxels must be an integer ≥ 1, got {self.chunk_voxels!r}")
-        if not _length(self.voxel):
+        if not is_real(self.voxel, 0, above=True):
             raise KinelabError(f"the voxel side must be a positive length in metres, got {self.voxel!r}")
         if self.collisions is not None and not isinstance(self.collisions, Collisions):
             raise KinelabError(f"a map's collisions is a kinelab.Collisions or None, got {self.collisions!r}")
@@ -91,16 +91,6 @@ class MapSpec:
     def to_dict(self) -> dict:
         """The JSON form stored with the map (tuples as lists, as the store gives them back)."""
         return dict(json.loads(json.dumps(asdict(self), default=_plain)))
-
-
-def _whole(value: object, lo: int, hi: float = math.inf) -> bool:
-    """True for an int (not a bool) in [lo, hi]."""
-    return isinstance(value, int) and not isinstance(value, bool) and lo <= value <= hi
-
-
-def _length(value: object) -> bool:
-    """True for a finite number > 0 (not a bool)."""
-    return isinstance(value, int | float) and not isinstance(value, bool) and bool(np.isfinite(value)) and value > 0
 
 
 def _plain(value: object) -> object:

@@ -13,6 +13,7 @@ import numpy as np
 from kinelab.errors import KinelabError
 from kinelab.ik.targets import reach_bound
 from kinelab.robot import Chain
+from kinelab.values import is_real
 
 PHI = np.sqrt(2.0)
 PSI = 1.533751168755204288118041  # the root of ψ⁴ = ψ + 4 the spiral uses
@@ -36,7 +37,7 @@ def voxel_centres(robot: Chain, voxel: float) -> np.ndarray:
     Raises:
         KinelabError: a voxel side that is not a positive finite number.
     """
-    if isinstance(voxel, bool) or not (isinstance(voxel, int | float) and np.isfinite(voxel) and voxel > 0):
+    if not is_real(voxel, 0, above=True):
         raise KinelabError(f"the voxel side must be a positive length in metres, got {voxel!r}")
     anchor, radius = reach_bound(robot)
     side = 2 * int(min(np.ceil(radius / voxel), 1e9)) + 1

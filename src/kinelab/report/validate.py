@@ -43,6 +43,7 @@ from kinelab.robot.tree import Robot
 from kinelab.studies import paper000_era as ep
 from kinelab.studies import paper001_stanford as seed001
 from kinelab.studies import paper003_youbot as yb
+from kinelab.values import is_whole
 
 DEFAULT_ROBOTS = ("stanford", "era", "youbot", "panda", "ur5", "talos", "baxter")  # the last two whole
 DEFAULT_N = 200
@@ -393,7 +394,7 @@ def run(robots: list[str] | None = None, n: int | None = None, seed: int = 0, pr
     check_seed(seed)
     names = list(robots or DEFAULT_ROBOTS)
     n = DEFAULT_N if n is None else n
-    if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+    if not is_whole(n, 1):
         raise KinelabError(f"validate needs n ≥ 1 configurations per check, got {n!r}")
     loaded = [load(name) for name in names]  # fail early, before any work, on a bad name
     report = Report(robots=names, n=n, seed=seed)

@@ -8,7 +8,6 @@ bounds of that joint are moved to ask for the return, never made infeasible; the
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -16,6 +15,7 @@ import numpy as np
 
 from kinelab.errors import OptionError
 from kinelab.robot.space import LIMIT_SLACK, Space
+from kinelab.values import is_real
 
 
 @dataclass(frozen=True)
@@ -149,7 +149,6 @@ def is_positive_time(dt: object) -> float:
     Raises:
         OptionError: anything else.
     """
-    if isinstance(dt, bool) or not isinstance(dt, int | float | np.number) or not math.isfinite(float(dt)) \
-            or float(dt) <= 0:
+    if not is_real(dt, 0, above=True):
         raise OptionError("dt", dt, "a finite time > 0 [s]")
     return float(dt)

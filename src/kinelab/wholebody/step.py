@@ -19,6 +19,7 @@ import pinocchio as pin
 from kinelab.errors import ChainError, OptionError
 from kinelab.robot.tree import Robot
 from kinelab.typing import Configuration
+from kinelab.values import is_real
 from kinelab.wholebody import compiled as cp
 from kinelab.wholebody import evaluate as ev
 from kinelab.wholebody import qp
@@ -61,8 +62,7 @@ class StepOptions:
         Raises:
             OptionError: a field out of what it accepts.
         """
-        if isinstance(self.damping, bool) or not isinstance(self.damping, int | float) \
-                or not math.isfinite(self.damping) or self.damping < 0:
+        if not is_real(self.damping, 0):
             raise OptionError("damping", self.damping, "a finite number ≥ 0")
         if self.solver not in qp.SOLVERS:
             raise OptionError("solver", self.solver, " or ".join(qp.SOLVERS))

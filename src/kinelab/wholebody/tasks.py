@@ -26,6 +26,7 @@ from numpy.typing import ArrayLike
 from kinelab.core._verdict import pose_defect
 from kinelab.errors import OptionError, TargetError, count_of
 from kinelab.typing import Configuration
+from kinelab.values import is_real
 
 FRAME_TASKS = ("pose", "position", "axis", "orientation")
 AXES = "xyz"
@@ -34,8 +35,7 @@ AXES = "xyz"
 def _weight(name: str, value: Any) -> float:
     if type(value) is float and 0.0 <= value < math.inf:  # the usual call, checked at once
         return value
-    if isinstance(value, bool) or not isinstance(value, int | float | np.number) or not math.isfinite(float(value)) \
-            or float(value) < 0:
+    if not is_real(value, 0):
         raise OptionError(name, value, "a finite number ≥ 0")
     return float(value)
 
@@ -339,8 +339,7 @@ class CouplingTask:
             raise OptionError("joint", (self.joint, self.leader), "two different joint names")
         for name in ("ratio", "offset"):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int | float | np.number) \
-                    or not math.isfinite(float(value)):
+            if not is_real(value):
                 raise OptionError(name, value, "a finite number")
             object.__setattr__(self, name, float(value))
 

@@ -41,6 +41,7 @@ from kinelab.ik.request import Request
 from kinelab.ik.result import Branches
 from kinelab.ik.targets import beyond_reach
 from kinelab.robot import Chain
+from kinelab.values import is_real, is_whole
 
 
 @dataclass(frozen=True, eq=False)
@@ -208,7 +209,7 @@ def check_redundancy(k: object) -> int:
     Raises:
         OptionError: K is not an integer in [1, 4096].
     """
-    if isinstance(k, bool) or not isinstance(k, int | np.integer) or not 1 <= k <= 4096:
+    if not is_whole(k, 1, 4096):
         raise OptionError("redundancy", k, "an integer in [1, 4096]: the samples of the swept joint, or "
                           "{joint name: value}, or None")
     return int(k)
@@ -231,7 +232,7 @@ def held_values(robot: Chain, redundancy: object) -> tuple[np.ndarray, str, int]
     index, value = _held_named(robot, redundancy)
     names = [j.name for j in robot.joints]
     lo, hi = float(robot.lower[index]), float(robot.upper[index])
-    if isinstance(value, bool) or not isinstance(value, int | float | np.number) or not lo <= float(value) <= hi:
+    if not is_real(value, lo, hi):
         raise OptionError("redundancy", dict(redundancy), f"{{{names[index]!r}: a value in [{lo:.6g}, {hi:.6g}] rad}}"
                           " (any one joint, held at a value within its limits), or an integer K")
     return np.array([float(value)]), f"held at {float(value):.6g} rad", index

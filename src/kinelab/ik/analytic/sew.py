@@ -41,6 +41,7 @@ from kinelab.ik.result import Branches
 from kinelab.ik.targets import beyond_reach
 from kinelab.robot import Chain
 from kinelab.typing import Configuration
+from kinelab.values import is_real, is_whole
 
 MATCH = 1.0  # rad: a branch at one sample and its nearest at the next are one branch followed when this close
 NEWTON_STEPS = 30
@@ -89,11 +90,11 @@ class SEW:
             OptionError: a field out of what it accepts (named, with what is valid).
         """
         a = self.angle
-        if isinstance(a, bool) or not isinstance(a, int | float | np.number) or not math.isfinite(float(a)):
+        if not is_real(a):
             raise OptionError("SEW.angle", a, "a finite angle [rad]")
         object.__setattr__(self, "angle", wrap_angle(float(a)))  # the same elbow plane: ψ kept in (−π, π]
         s = self.samples
-        if isinstance(s, bool) or not isinstance(s, int | np.integer) or not 8 <= s <= 4096:
+        if not is_whole(s, 8, 4096):
             raise OptionError("SEW.samples", s, "an integer in [8, 4096]")
         e_t = _unit(self.singular, "singular")
         r = _unit(self.reference, "reference")

@@ -29,6 +29,7 @@ from kinelab.ik import solve, solve_all
 from kinelab.ik.turns import nearest_turns
 from kinelab.robot import Chain
 from kinelab.typing import Configuration
+from kinelab.values import is_whole
 from kinelab.view.collisions import draw_obstacles, overlay_contacts
 from kinelab.view.scene import TARGET, Scene, on_top
 from kinelab.view.teach.recorder import RecordingWindow
@@ -161,7 +162,7 @@ class TeachSession(Session):
         Raises:
             KinelabError: a step other than the integers 1 and −1 (a float, a bool, anything else).
         """
-        if isinstance(step, bool) or not isinstance(step, int | np.integer) or step not in (1, -1):
+        if not is_whole(step) or step not in (1, -1):
             raise KinelabError(f"a branch step is the integer 1 (next) or -1 (previous), not {_short(repr(step))}")
         step = int(step)
         if self.branches is None:

@@ -21,6 +21,7 @@ from scipy.spatial import ConvexHull
 
 from kinelab.errors import KinelabError, OptionError
 from kinelab.robot.tree import Robot
+from kinelab.values import is_whole
 from kinelab.view.meshes import load_robot
 from kinelab.view.scene import AXIS_COLORS, aim_camera, on_top
 from kinelab.view.teach.recorder import RecordingWindow
@@ -261,6 +262,6 @@ def _index(index: Any, count: int) -> int:
     Raises:
         KinelabError: not an integer in [0, count).
     """
-    if isinstance(index, bool) or not isinstance(index, int | np.integer) or not 0 <= index < count:
+    if not is_whole(index, 0, count - 1):
         raise KinelabError(f"a target index is an integer from 0 to {count - 1}, not {_short(repr(index))}")
     return int(index)
