@@ -517,8 +517,8 @@ class TrackResult:
         position_error: (K,) [m]; rotation_error: (K,) [rad] (the judge's FK against each sample's target).
         status_code: (K,) int8 codes of :class:`Status` (``status`` gives the members).
         iterations: (K,) the solver's iterations per sample (FRDM sweeps); wall_time: (K,) [s] per sample.
-        events, bypasses: the monitor's log; mode: how the path was followed; contacts: (sample, Contact) pairs
-            with ``collisions=``.
+        events, bypasses: the monitor's log (a redundant arm's self-motion events are made when ``events`` is
+            first read); mode: how the path was followed; contacts: (sample, Contact) pairs with ``collisions=``.
     """
 
     q: np.ndarray
