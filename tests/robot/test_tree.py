@@ -149,3 +149,19 @@ def test_a_registered_arm_and_its_view_of_the_whole_robot_answer_alike_bit_for_b
         ours, theirs = kinelab.solve(view, arm.fk(q), seed=seed), kinelab.solve(arm, arm.fk(q), seed=seed)
         assert ours.status == theirs.status and np.array_equal(ours.q, theirs.q)
         assert ours.success and max(arm.tool_error(ours.q, arm.fk(q))) <= 1e-6
+
+
+def test_derived_data_is_built_once_per_key_even_when_it_is_none():
+    """A builder that answers None (a tree the compiled step does not take, a chain without compiled arrays) is not
+    run again on every call: its None is kept like any other value, on the whole robot and on a chain."""
+    for owner in (kinelab.load("panda"), kinelab.load("panda").robot):
+        calls = []
+
+        def build(_, calls=calls):
+            calls.append(1)
+            return None
+
+        assert owner.derived("test: nothing to build", build) is None
+        assert owner.derived("test: nothing to build", build) is None
+        assert len(calls) == 1
+        assert owner.derived("test: a value", lambda _: [3]) == owner.derived("test: a value", lambda _: [4]) == [3]

@@ -56,6 +56,9 @@ T = TypeVar("T")
 __all__ = ["LIMIT_SLACK", "Chain", "Joint", "Mimic"]
 
 
+_UNBUILT = object()  # derived(): no value kept yet under a key
+
+
 class Chain:
     """A serial chain base → tool, with Pinocchio as the kinematic reference: a model, its joint space, its
     kinematics. It is a view of the whole robot (``robot``, built on first use where the chain came from a file;
@@ -199,9 +202,10 @@ class Chain:
     def derived(self, key: str, build: Callable[[Chain], T]) -> T:
         """Data derived from this robot (a solver's chain arrays, say), built on first use and kept here,
         so it lives exactly as long as the Chain."""
-        if key not in self._derived:
-            self._derived[key] = build(self)
-        return cast(T, self._derived[key])
+        found = self._derived.get(key, _UNBUILT)
+        if found is _UNBUILT:  # a builder may answer None (nothing to build): that is kept too
+            found = self._derived[key] = build(self)
+        return found
 
     def named_q(self, name: str) -> np.ndarray:
         """The chain configuration [rad or m] of the SRDF's named configuration ``name`` (``group_state``).

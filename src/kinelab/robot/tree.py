@@ -32,6 +32,9 @@ T = TypeVar("T")
 REFERENCES = {"local": pin.LOCAL, "world": pin.WORLD, "local_world_aligned": pin.LOCAL_WORLD_ALIGNED}
 
 
+_UNBUILT = object()  # derived(): no value kept yet under a key
+
+
 class Robot:
     """A robot's whole kinematic model (see the module's docstring).
 
@@ -301,9 +304,10 @@ class Robot:
 
     def derived(self, key: str, build: Callable[[Robot], T]) -> T:
         """Data derived from this robot (a step's packed model, say), built on first use and kept here."""
-        if key not in self._derived:
-            self._derived[key] = build(self)
-        return cast(T, self._derived[key])
+        found = self._derived.get(key, _UNBUILT)
+        if found is _UNBUILT:  # a builder may answer None (nothing to build): that is kept too
+            found = self._derived[key] = build(self)
+        return found
 
     def __repr__(self) -> str:
         base = "free-flyer" if self.floating else "fixed base"

@@ -12,6 +12,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any, TypeGuard
 
+import pinocchio as pin
+
 from kinelab.errors import ChainError, OptionError
 from kinelab.ik import api as chain_api
 from kinelab.robot.chain import Chain
@@ -47,6 +49,8 @@ def solve(robot: Chain | Robot, target: Target | Sequence[Task], *positional: ob
         ChainError: a whole robot with a pose (name the frame: ``FrameTask``), or a chain with tasks. Otherwise as
             the solve taken.
     """
+    if type(target) is pin.SE3 and type(robot) is Chain:  # the usual call, told apart in two type checks
+        return chain_api.solve(robot, target, *positional, **settings)
     if is_tasks(target):
         if positional:
             chain_api.refuse_positional("solve", positional)

@@ -39,7 +39,7 @@ from kinelab.ik.chain import chain_model
 from kinelab.ik.driver import solve_one
 from kinelab.ik.limits import distance, inside_limits
 from kinelab.ik.request import Request, make_request
-from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
+from kinelab.ik.result import Branches, Diagnostics, IKResult, Method, Status
 from kinelab.ik.targets import beyond_reach
 from kinelab.robot import Chain
 from kinelab.robot.chain import _compiled_judge
@@ -172,9 +172,9 @@ def _inside(robot: Chain, q: np.ndarray, found: np.ndarray, free: np.ndarray,
     return x, found[keep], free[keep]
 
 
-def _method(arm: ArmClass) -> str:
+def _method(arm: ArmClass) -> Method:
     """The set's ``method``: "elimination" (general 6R), "search" (the 1-D search) or "closed form"."""
-    return "elimination" if arm.kind == GENERAL_6R else "search" if arm.searched else "closed form"
+    return Method.ELIMINATION if arm.kind == GENERAL_6R else Method.SEARCH if arm.searched else Method.CLOSED_FORM
 
 
 def prepared_form(robot: Chain, req: Request) -> ClosedForm | None:
