@@ -117,7 +117,7 @@ def solve(robot: Chain, target: Target, *positional: object, solver: str = "frdm
     solver = resolved(robot, solver, task, collisions, options is not None or bool(solver_options))
     key: tuple[Any, ...] = (solver, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options, task,
                              axis, collisions)
-    if solver_options:  # unpacking even an empty dict costs the usual call 0.1 µs
+    if solver_options:  # unpacking even an empty dict is not free on the usual call
         key += tuple(solver_options.items())
     ik = kept_solver(robot, key) if prefer is None else None  # solve is IK(robot, **settings).solve(target)
     if ik is not None:
