@@ -115,10 +115,8 @@ def solve(robot: Chain, target: Target, *positional: object, solver: str = "frdm
     """
     check_entry(robot, "solve", positional)
     solver = resolved(robot, solver, task, collisions, options is not None or bool(solver_options))
-    key: tuple[Any, ...] = (solver, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options, task,
-                             axis, collisions)
-    if solver_options:  # unpacking even an empty dict is not free on the usual call
-        key += tuple(solver_options.items())
+    key = (solver, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options, task, axis,
+           collisions) + (tuple(solver_options.items()) if solver_options else ())
     ik = kept_solver(robot, key) if prefer is None else None  # solve is IK(robot, **settings).solve(target)
     if ik is not None:
         engine = ik.engine
@@ -266,9 +264,8 @@ def solve_all(robot: Chain, target: Target, *positional: object, solver: str = "
     time_budget = _all_budget(time_budget, redundancy)
     if (options is not None or solver_options) and capabilities(solver).closed_form:  # said, not ignored
         refuse_options(options or solver_options)
-    key: tuple[Any, ...] = (solver, tol_pos, tol_rot, time_budget, options, task, axis, collisions)
-    if solver_options:
-        key += tuple(solver_options.items())
+    key = (solver, tol_pos, tol_rot, time_budget, options, task, axis, collisions) + (
+        tuple(solver_options.items()) if solver_options else ())
     ik = kept_solver(robot, key)  # the usual loop: the same settings again, one lookup (no settings dict built)
     if ik is None:
         ik = prepared(robot, dict(solver=solver, tol_pos=tol_pos, tol_rot=tol_rot, time_budget=time_budget,

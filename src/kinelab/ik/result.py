@@ -404,7 +404,7 @@ class Branches(Sequence[IKResult]):
 
     @classmethod
     def of_rows(cls, q: np.ndarray, position_error: np.ndarray, rotation_error: np.ndarray,
-                make_row: Callable[[Any, int], IKResult], data: Any, method: Method | str,
+                make_row: Callable[[Any, int], IKResult], data: Any, method: Method,
                 unseen: float | None) -> Branches:
         """A set of at least one branch as arrays (q: (k, n), the errors: (k,)); ``make_row(data, i)`` builds the
         i-th result when the set is first indexed or iterated (a solver's row maker, made once, and this set's
@@ -412,8 +412,7 @@ class Branches(Sequence[IKResult]):
         made = cls.__new__(cls)
         made.q, made.position_error, made.rotation_error = q, position_error, rotation_error
         made._results, made._make_row, made._data = None, make_row, data
-        made.status, made.message, made.unseen = Status.CONVERGED, "", unseen
-        made.method = method if type(method) is Method else Method(method)  # no Enum lookup per set
+        made.status, made.message, made.method, made.unseen = Status.CONVERGED, "", method, unseen
         made._certify = None
         return made
 

@@ -44,9 +44,13 @@ class Points:
     free: np.ndarray  # (n, 3): 1 where the target follows the point (a centre of mass's unconstrained coordinates)
 
 
+# one point of a task: (frame, point, target, weight, is a direction, carrier frame, follows), as Points' rows
+PointRow = tuple[int, np.ndarray, np.ndarray, float, bool, int, np.ndarray]
+
+
 def task_points(robot: Robot, tasks: tuple[Task, ...], data: pin.Data, com: np.ndarray | None) -> Points:
     """Every task's points at the configuration in ``data`` (frame placements updated)."""
-    rows: list[tuple[int, np.ndarray, np.ndarray, float, bool, int, np.ndarray]] = []
+    rows: list[PointRow] = []
     for task in tasks:
         if isinstance(task, FrameTask | RelativeFrameTask):
             rows += _frame_points(robot, task, data)
@@ -60,7 +64,7 @@ def task_points(robot: Robot, tasks: tuple[Task, ...], data: pin.Data, com: np.n
 
 
 def _frame_points(robot: Robot, task: FrameTask | RelativeFrameTask, data: pin.Data
-                  ) -> list[tuple[int, np.ndarray, np.ndarray, float, bool, int, np.ndarray]]:
+                  ) -> list[PointRow]:
     """A frame task's points: its origin (unless only its orientation is asked for) and the axes its task
     constrains, each with its target (a relative task's target carried by its root frame)."""
     fid = robot.frame_id(task.frame)
@@ -75,7 +79,7 @@ def _frame_points(robot: Robot, task: FrameTask | RelativeFrameTask, data: pin.D
     return rows + [(fid, oMf.rotation[:, k], target.rotation[:, k], weight, True, by, fixed) for k in axes]
 
 
-def _com_point(task: ComTask, com: np.ndarray) -> tuple[int, np.ndarray, np.ndarray, float, bool, int, np.ndarray]:
+def _com_point(task: ComTask, com: np.ndarray) -> PointRow:
     """The centre of mass as a point: its free coordinates' targets are their current values, and they follow it."""
     index = list(task.index)
     goal = com.copy()

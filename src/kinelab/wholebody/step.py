@@ -193,10 +193,10 @@ def _velocity_limits(robot: Robot, limits: Limits) -> tuple[np.ndarray, np.ndarr
     table: dict[int, tuple[Limits, np.ndarray, np.ndarray]] = robot.derived("compiled limits", _new_table)
     found = table.get(id(limits))
     if found is None or found[0] is not limits:
+        vmax = np.ascontiguousarray(velocity_bounds(limits, robot.space), dtype=float)
         a = acceleration_bounds(limits, robot.space)
-        found = _kept(table, id(limits), (limits, np.ascontiguousarray(velocity_bounds(limits, robot.space),
-                                                                       dtype=float),
-                                          NO_LIMIT if a is None else np.ascontiguousarray(a, dtype=float)))
+        amax = NO_LIMIT if a is None else np.ascontiguousarray(a, dtype=float)
+        found = _kept(table, id(limits), (limits, vmax, amax))
     return found[1], found[2]
 
 
