@@ -92,6 +92,8 @@ ctypedef void (*defaults_t)(DAQPSettings*) noexcept nogil
 cdef quadprog_t _quadprog = NULL
 cdef DAQPSettings _settings
 cdef double DAQP_BIG = 1e30
+cdef double MAX_COORDINATE = 1e6  # [m or rad] kinelab.robot.space.MAX_COORDINATE
+cdef int NOT_FINITE = -101  # the step's flag when its answer overflowed (nothing moved)
 
 
 def set_daqp(size_t quadprog, size_t defaults):
@@ -260,11 +262,12 @@ cdef class Tree:
                 self.vjoint[iv[j]] = j
 
     cdef int check(self, const double* q) noexcept nogil:
-        """0 when q is nq finite numbers with unit quaternions and (cos, sin) pairs (1e-6), else 1."""
+        """0 when q is nq finite numbers within MAX_COORDINATE with unit quaternions and (cos, sin) pairs (1e-6),
+        else 1."""
         cdef int j, i
         cdef double s
         for i in range(self.nq):
-            if not (q[i] - q[i] == 0.0):  # NaN or ±inf
+            if not (fabs(q[i]) <= MAX_COORDINATE):  # NaN, ±inf, or beyond what a rate of it holds
                 return 1
         for j in range(1, self.nj + 1):
             i = self.iq[j]
@@ -550,7 +553,7 @@ cdef class Step:
         """One step from q: v (v_out), q ⊕ v·dt (q_out), each task's (position, rotation) error before it in its slot
         (errors), the joints brought back into their limits (returning). ``amax`` and ``v_prev``: empty, or nv
         numbers each. Returns (DAQP's exit flag: 1 or 2 solved; −100: q is not a configuration, nothing done;
-        DAQP's iterations)."""
+        −101: the answer overflowed, nothing moved; DAQP's iterations)."""
         cdef int flag, iters = 0, level, nv = self.tree.nv
         cdef Tree tree = self.tree
         cdef const double* a = &amax[0] if amax.shape[0] == nv else NULL
@@ -573,7 +576,9 @@ cdef class Step:
             if flag == 1 or flag == 2:
                 memcpy(&v_out[0], &self.x[0], nv * sizeof(double))
                 tree.integrate(&q[0], &self.x[0], dt, &q_out[0])
-            else:
+                if not (_finite(&v_out[0], nv) and _finite(&q_out[0], tree.nq)):
+                    flag = NOT_FINITE
+            if not (flag == 1 or flag == 2):
                 memset(&v_out[0], 0, nv * sizeof(double))
                 memcpy(&q_out[0], &q[0], tree.nq * sizeof(double))
         return flag, iters
@@ -744,6 +749,14 @@ cdef class Step:
         for j in range(nv):  # its bounds hold to its tolerance: exactly here
             self.x[j] = min(max(self.x[j], lower[j]), upper[j])
         return result.exitflag
+
+
+cdef inline bint _finite(const double* x, int n) noexcept nogil:
+    cdef int i
+    for i in range(n):
+        if not (x[i] - x[i] == 0.0):  # NaN or ±inf
+            return False
+    return True
 
 
 cdef inline int _task_rows(int kind, int axis) noexcept nogil:

@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike
 from kinelab.errors import ConfigurationError, JointLimitError, OptionError, count_of
 
 LIMIT_SLACK = 1e-9  # joint values this far past a limit still count as within it (rad or m)
+MAX_COORDINATE = 1e6  # [m or rad] a coordinate beyond it is no configuration (a base 1000 km away, say)
 SAMPLE_TURNS = 4  # random configurations keep unbounded revolute joints within ±4 turns
 UNBOUNDED = 1e300  # a limit beyond this is no limit (Pinocchio writes ±DBL_MAX for a free-flyer's)
 MAX_SAMPLE_BYTES = 8 * 2**30  # the most memory one random_qs call fills
@@ -102,9 +103,10 @@ def check_q(space: Space, model: pin.Model, q: ArrayLike, *, limits: bool = Fals
                                  f"{', '.join(space.names_q[:8])}{', ...' if space.nq > 8 else ''}), "
                                  f"got {raw.shape[0] if raw.ndim == 1 else 'shape ' + str(raw.shape)}")
     arr = np.ascontiguousarray(raw, dtype=float)
-    bad = np.flatnonzero(~np.isfinite(arr))
+    bad = np.flatnonzero(~(np.abs(arr) <= MAX_COORDINATE))
     if bad.size:
-        raise ConfigurationError(f"{what}[{bad[0]}] ({space.names_q[bad[0]]}) is {arr[bad[0]]}: values must be finite")
+        raise ConfigurationError(f"{what}[{bad[0]}] ({space.names_q[bad[0]]}) is {arr[bad[0]]}: values must be finite "
+                                 f"and within ±{MAX_COORDINATE:g} (m or rad)")
     if not pin.isNormalized(model, arr, 1e-6):
         raise ConfigurationError(f"{what}: a quaternion (a free-flyer's or a spherical joint's) or a continuous "
                                  "joint's (cos, sin) is not of unit norm (within 1e-6)")

@@ -57,6 +57,10 @@ def solve(robot: Chain | Robot, target: Target | Sequence[Task], *positional: ob
         if isinstance(robot, Chain):
             raise ChainError(f"tasks are solved on a whole robot: {robot.name}'s is robot.robot (kinelab.solve("
                              "robot.robot, tasks))")
+        extra = [k for k in settings if k not in SOLVE_SETTINGS]
+        if extra:
+            raise OptionError(extra[0], settings[extra[0]], "a setting of a whole-body solve: "
+                              f"{', '.join(SOLVE_SETTINGS)}")
         return wholebody.solve(robot, target, **settings)
     if isinstance(robot, Robot):
         raise ChainError(f"{robot.name} is a whole robot: ask for a frame with a task (kinelab.solve(robot, "
@@ -64,6 +68,8 @@ def solve(robot: Chain | Robot, target: Target | Sequence[Task], *positional: ob
     return chain_api.solve(robot, target, *positional, **settings)
 
 
+SOLVE_SETTINGS = ("q0", "solver", "seed", "tol_pos", "tol_rot", "max_iterations", "max_restarts", "time_budget",
+                  "limits")  # kinelab.wholebody.solve.solve's keywords
 FOLLOWERS = ("frdm", "step")
 STEP_SETTINGS = ("q0", "seed", "tol_pos", "tol_rot", "time_budget", "task", "axis", "jump_limit")
 

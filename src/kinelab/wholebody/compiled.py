@@ -251,7 +251,7 @@ def set_targets(robot: Robot, packed: Packed, tasks: tuple[Task, ...]) -> None:
     if packed.posture >= 0:
         posture = tasks[packed.posture]
         assert isinstance(posture, PostureTask)
-        packed.post_ref[:] = robot.neutral() if posture.q_ref is None else posture.q_ref
+        packed.post_ref[:] = ev.checked_ref(robot, posture)
         if isinstance(posture.weight, np.ndarray):
             packed.post_w[:] = ev.posture_weight(robot, posture)
 

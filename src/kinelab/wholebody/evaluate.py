@@ -124,10 +124,13 @@ def checked_ref(robot: Robot, task: PostureTask) -> np.ndarray:
     Raises:
         ConfigurationError: a q_ref that is not a configuration of the robot.
     """
-    q_ref = robot.neutral() if task.q_ref is None else task.q_ref
+    if task.q_ref is None:
+        return robot.neutral()
+    q_ref = task.q_ref
     if q_ref.shape != (robot.nq,):
         raise ConfigurationError(f"PostureTask.q_ref must have nq = {robot.nq} numbers for {robot.name}, got "
                                  f"{q_ref.shape[0]}")
+    robot.check_q(q_ref, what="PostureTask.q_ref")  # its quaternions unit, its coordinates within reason
     return q_ref
 
 

@@ -54,20 +54,22 @@ class Limits:
 
 
 def _check_rate(name: str, value: Any) -> None:
-    """A rate limit is True, False, None, a number > 0 or one per velocity (none NaN)."""
+    """A rate limit is True, False, None, a number > 0 or one per velocity (real numbers: no NaN, no booleans, no
+    complex numbers)."""
     if value is None or isinstance(value, bool):
         return
-    arr = np.asarray(value, dtype=float) if _numeric(value) else None
+    arr = _real(value)
     if arr is None or arr.ndim > 1 or not (np.all(arr > 0) and not np.any(np.isnan(arr))):
-        raise OptionError(name, value, "True, False, None, a number > 0 or one per velocity")
+        raise OptionError(name, value, "True, False, None, a number > 0 or one per velocity (real numbers)")
 
 
-def _numeric(value: Any) -> bool:
+def _real(value: Any) -> np.ndarray | None:
+    """``value`` as a float array when it is real numbers (integers or floats), else None."""
     try:
-        np.asarray(value, dtype=float)
+        arr = np.asarray(value)
     except (TypeError, ValueError):
-        return False
-    return True
+        return None
+    return arr.astype(float) if arr.dtype.kind in "iuf" else None
 
 
 def velocity_bounds(limits: Limits, space: Space) -> np.ndarray:
@@ -143,12 +145,27 @@ def bounds(space: Space, q: np.ndarray, dt: float, vmax: np.ndarray, position: b
     return lo, hi, returning
 
 
+MIN_DT = 1e-9  # [s] a shorter step asks for rates (error / dt) past any joint's and toward what a double holds
+
+
 def is_positive_time(dt: object) -> float:
-    """``dt`` [s] as a float > 0.
+    """``dt`` [s] as a float ≥ MIN_DT.
 
     Raises:
         OptionError: anything else.
     """
-    if not is_real(dt, 0, above=True):
-        raise OptionError("dt", dt, "a finite time > 0 [s]")
+    if not is_real(dt, MIN_DT):
+        raise OptionError("dt", dt, f"a finite time ≥ {MIN_DT:g} s")
     return float(dt)
+
+
+def checked_v_prev(v_prev: object, nv: int) -> np.ndarray:
+    """The velocity before a step as nv finite floats [rad/s or m/s].
+
+    Raises:
+        OptionError: another shape, NaN/inf, or not real numbers (named).
+    """
+    arr = _real(v_prev)
+    if arr is None or arr.shape != (nv,) or not np.isfinite(arr).all():
+        raise OptionError("v_prev", v_prev, f"the velocity before the step: nv = {nv} finite numbers")
+    return np.ascontiguousarray(arr)

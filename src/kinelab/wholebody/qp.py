@@ -34,16 +34,28 @@ class Solution:
     iterations: int
 
 
+MAX_ITERATIONS = 10_000  # each solver's iteration bound: the step's QPs take tens, a call never runs unbounded
+NOT_FINITE = "not finite"  # the status of an answer that overflowed (nothing moved)
+
+
 def solve(H: np.ndarray, f: np.ndarray, lower: np.ndarray, upper: np.ndarray, A_eq: np.ndarray | None,
-          b_eq: np.ndarray | None, solver: str = "daqp") -> Solution:
-    """Solve the step's QP (see the module's docstring).
+          b_eq: np.ndarray | None, solver: str = "daqp", dt: float = 1.0) -> Solution:
+    """Solve the step's QP (see the module's docstring) for v, as the problem in x = v·dt: the same minimiser
+    (the objective times dt²), its numbers of the size of the motion whatever dt, so that the solver's absolute
+    tolerances and iterations do not depend on dt.
 
     Raises:
         KinelabError: the solver is not installed (with the install hint).
     """
-    if solver == "proxsuite":
-        return _proxsuite(H, f, lower, upper, A_eq, b_eq)
-    return _daqp(H, f, lower, upper, A_eq, b_eq)
+    fx, lo, up = f * dt, lower * dt, upper * dt
+    bx = None if b_eq is None else b_eq * dt
+    found = (_proxsuite if solver == "proxsuite" else _daqp)(H, fx, lo, up, A_eq, bx)
+    if not found.solved:
+        return found
+    v = found.v / dt
+    if not np.isfinite(v).all():
+        return Solution(np.full(v.shape, np.nan), NOT_FINITE, False, found.iterations)
+    return Solution(np.clip(v, lower, upper), found.status, True, found.iterations)
 
 
 def _daqp(H: np.ndarray, f: np.ndarray, lower: np.ndarray, upper: np.ndarray, A_eq: np.ndarray | None,
@@ -56,7 +68,7 @@ def _daqp(H: np.ndarray, f: np.ndarray, lower: np.ndarray, upper: np.ndarray, A_
     lo = np.concatenate([np.maximum(lower, -BIG), [] if b_eq is None else b_eq])
     sense = np.zeros(n + m, dtype=c_int)
     sense[n:] = EQUALITY
-    x, _, flag, info = daqp.solve(H, f, A, up, lo, sense)
+    x, _, flag, info = daqp.solve(H, f, A, up, lo, sense)  # its own iteration limit (1,000 by default) bounds it
     solved = flag in (1, 2)
     x = np.clip(np.asarray(x, dtype=float), lower, upper)  # its bounds hold to its tolerance (1e-7): exactly here
     return Solution(x if solved else np.full(n, np.nan), DAQP_STATUS.get(flag, str(flag)), solved,
@@ -70,6 +82,8 @@ def _proxsuite(H: np.ndarray, f: np.ndarray, lower: np.ndarray, upper: np.ndarra
     m = 0 if A_eq is None else A_eq.shape[0]
     qp = proxsuite.proxqp.dense.QP(n, m, 0, True)
     qp.settings.eps_abs = 1e-10
+    qp.settings.max_iter = MAX_ITERATIONS
+    qp.settings.max_iter_in = MAX_ITERATIONS
     qp.settings.verbose = False
     qp.init(H, f, A_eq, b_eq, None, None, None, np.maximum(lower, -BIG), np.minimum(upper, BIG))
     qp.solve()

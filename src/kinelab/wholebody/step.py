@@ -10,6 +10,7 @@ q ⊕ v·dt through ``pin.integrate``.
 from __future__ import annotations
 
 import math
+import operator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeVar
 
@@ -23,7 +24,14 @@ from kinelab.values import is_real
 from kinelab.wholebody import compiled as cp
 from kinelab.wholebody import evaluate as ev
 from kinelab.wholebody import qp
-from kinelab.wholebody.limits import Limits, acceleration_bounds, bounds, is_positive_time, velocity_bounds
+from kinelab.wholebody.limits import (
+    Limits,
+    acceleration_bounds,
+    bounds,
+    checked_v_prev,
+    is_positive_time,
+    velocity_bounds,
+)
 from kinelab.wholebody.tasks import (
     TASK_TYPES,
     ComTask,
@@ -151,11 +159,11 @@ def step(robot: Robot, q: Configuration, tasks: Task | Sequence[Task], dt: float
     if not isinstance(options, StepOptions):
         raise OptionError("options", options, "a kinelab.StepOptions(...)")
     dt = is_positive_time(dt)
-    fast = _compiled(robot, q, tasks, dt, limits, options, v_prev)
+    prev = None if v_prev is None else checked_v_prev(v_prev, robot.nv)
+    fast = _compiled(robot, q, tasks, dt, limits, options, prev)
     if fast is not None:
         return fast
     q, found = robot.check_q(q), as_tasks(tasks)
-    prev = None if v_prev is None else np.asarray(v_prev, dtype=float)
     return _step(robot, q, found, dt, limits, options, prev)
 
 
@@ -164,7 +172,7 @@ NO_LIMIT = np.empty(0)
 
 
 def _compiled(robot: Robot, q: Any, tasks: Any, dt: float, limits: Limits, options: StepOptions,
-              v_prev: Any) -> StepResult | None:
+              v_prev: np.ndarray | None) -> StepResult | None:
     """The step in one compiled call (:mod:`kinelab.wholebody.compiled`), or None where that path does not serve (a
     q or task list to check and name, another QP solver, a tree it does not take): the readable step then answers,
     alike."""
@@ -175,8 +183,8 @@ def _compiled(robot: Robot, q: Any, tasks: Any, dt: float, limits: Limits, optio
     if arr is None or arr.shape != (robot.nq,):
         return None
     vmax, amax = _velocity_limits(robot, limits)
-    prev = NO_LIMIT if v_prev is None else np.ascontiguousarray(v_prev, dtype=float)
-    if amax.size and prev.shape != (robot.nv,):
+    prev = NO_LIMIT if v_prev is None else v_prev
+    if amax.size and v_prev is None:
         return None
     q_out, v_out, errors = np.empty(robot.nq), np.empty(robot.nv), np.empty((len(packed.labels), 2))
     returning = np.empty(robot.nv, dtype=np.uint8)
@@ -184,8 +192,11 @@ def _compiled(robot: Robot, q: Any, tasks: Any, dt: float, limits: Limits, optio
                                         errors, returning)
     if flag == -100:  # not a configuration: the readable path names what is wrong
         return None
-    return StepResult(v_out, q_out, "solved" if flag in (1, 2) else qp.DAQP_STATUS.get(flag, str(flag)),
+    return StepResult(v_out, q_out, "solved" if flag in (1, 2) else STATUS.get(flag, str(flag)),
                       flag in (1, 2), errors, returning.view(bool), iterations, packed.labels, robot.space.names_v)
+
+
+STATUS = {**qp.DAQP_STATUS, -101: qp.NOT_FINITE}  # the compiled step's flags in words
 
 
 def _velocity_limits(robot: Robot, limits: Limits) -> tuple[np.ndarray, np.ndarray]:
@@ -205,28 +216,41 @@ def _new_table(_: Robot) -> dict[Any, Any]:
 
 
 def _packed(robot: Robot, tasks: Any, options: StepOptions) -> cp.Packed | None:
-    """The compiled problem of this task list with its targets set, or None (see :func:`_compiled`). The same task
-    objects as a call before take that call's problem as it is (tasks are frozen: their targets are those set)."""
+    """The compiled problem of this task list with its targets set, or None (see :func:`_compiled`). The very task
+    objects of a recent call take that call's problem as it is: tasks are values (their targets copied and
+    read-only, :mod:`kinelab.wholebody.tasks`), so the same objects hold the same targets."""
     if options.solver != "daqp" or not cp.daqp_linked():
         return None
     if isinstance(tasks, TASK_TYPES):
         tasks = (tasks,)
-    try:
-        ids = tuple(map(id, tasks))
-    except TypeError:
-        return None
-    recent: dict[tuple[int, ...], Any] = robot.derived("compiled recent", _new_table)
-    hit = recent.get(ids)
-    if hit is not None and hit[1].current == ids:
-        return hit[1]
+    recent: list[tuple[tuple[Task, ...], cp.Packed]] = robot.derived("compiled recent", _new_list)
+    for held, packed in recent:
+        if packed.current is held and _same_objects(held, tasks):
+            return packed
     found = as_tasks(tasks)
-    packed = _of_structure(robot, found)
-    if packed is None:
+    made = _of_structure(robot, found)
+    if made is None:
         return None
-    cp.set_targets(robot, packed, found)
-    _kept(recent, ids, (found, packed))  # the task objects held: their ids stay theirs
-    packed.current = ids
-    return packed
+    cp.set_targets(robot, made, found)
+    made.current = found
+    recent.insert(0, (found, made))
+    del recent[RECENT:]
+    return made
+
+
+RECENT = 4  # task lists whose problems are looked up by the objects themselves (a loop alternating a few lists)
+
+
+def _same_objects(held: tuple[Task, ...], tasks: Any) -> bool:
+    """Whether ``tasks`` is a sequence of exactly the objects ``held`` (not equal ones: the same)."""
+    try:
+        return len(held) == len(tasks) and all(map(operator.is_, held, tasks))
+    except TypeError:
+        return False
+
+
+def _new_list(_: Robot) -> list[Any]:
+    return []
 
 
 def _of_structure(robot: Robot, tasks: tuple[Task, ...]) -> cp.Packed | None:
@@ -275,28 +299,31 @@ def _step(robot: Robot, q: np.ndarray, tasks: tuple[Task, ...], dt: float, limit
     lower, upper, returning = bounds(robot.space, q, dt, vmax, limits.position,
                                      acceleration_bounds(limits, robot.space), v_prev)
     A_eq, b_eq = (np.array([a for a, _ in eq]), np.array([c for _, c in eq])) if eq else (None, None)
-    solution = _solve_level(levels[0], options, lower, upper, A_eq, b_eq)
+    solution = _solve_level(levels[0], options, lower, upper, A_eq, b_eq, dt)
     iterations = solution.iterations
     if solution.solved and len(levels) > 1:
-        second = _second_level(robot, levels, solution.v, options, lower, upper, A_eq, b_eq)
+        second = _second_level(robot, levels, solution.v, options, lower, upper, A_eq, b_eq, dt)
         iterations += second.iterations
         solution = second if second.solved else solution
     v = solution.v if solution.solved else np.zeros(robot.nv)
     q_next = np.asarray(pin.integrate(robot.model, q, v * dt), dtype=float) if solution.solved else q.copy()
+    status, solved = solution.status, solution.solved
+    if solved and not (np.isfinite(v).all() and np.isfinite(q_next).all()):
+        status, solved, v, q_next = qp.NOT_FINITE, False, np.zeros(robot.nv), q.copy()
     names = tuple(robot.space.names_v[i] for i in np.flatnonzero(returning))
-    return StepResult(v, q_next, solution.status, solution.solved, tuple(errors), names, iterations)
+    return StepResult(v, q_next, status, solved, tuple(errors), names, iterations)
 
 
 def _second_level(robot: Robot, levels: list[ev.Rows], v_first: np.ndarray, options: StepOptions,
-                  lower: np.ndarray, upper: np.ndarray, A_eq: np.ndarray | None, b_eq: np.ndarray | None
+                  lower: np.ndarray, upper: np.ndarray, A_eq: np.ndarray | None, b_eq: np.ndarray | None, dt: float
                   ) -> qp.Solution:
     """The priority-2 tasks' QP, with what the first level reached held as equalities (its rows at ``v_first``)
     beside the couplings' (``A_eq``, ``b_eq``; None: none)."""
     held = np.vstack(levels[0].A) if levels[0].A else np.zeros((0, robot.nv))
     if A_eq is None or b_eq is None:
-        return _solve_level(levels[1], options, lower, upper, held, held @ v_first)
+        return _solve_level(levels[1], options, lower, upper, held, held @ v_first, dt)
     return _solve_level(levels[1], options, lower, upper, np.vstack([A_eq, held]),
-                        np.concatenate([b_eq, held @ v_first]))
+                        np.concatenate([b_eq, held @ v_first]), dt)
 
 
 def _levels(robot: Robot, q: np.ndarray, tasks: tuple[Task, ...], dt: float,
@@ -346,8 +373,8 @@ def _error(task: Task, e: np.ndarray, gap: np.ndarray | None) -> TaskError:
 
 
 def _solve_level(rows: ev.Rows, options: StepOptions, lower: np.ndarray, upper: np.ndarray,
-                 A_eq: np.ndarray | None, b_eq: np.ndarray | None) -> qp.Solution:
-    """One level's QP: H = Σ Aᵀ W A + diag + λI, f = −Σ Aᵀ W b − target."""
+                 A_eq: np.ndarray | None, b_eq: np.ndarray | None, dt: float) -> qp.Solution:
+    """One level's QP: H = Σ Aᵀ W A + diag + λI, f = −Σ Aᵀ W b − target (solved for v·dt, :func:`qp.solve`)."""
     nv = lower.shape[0]
     H = np.diag(rows.diag + options.damping)
     f = -rows.target.copy()
@@ -358,4 +385,4 @@ def _solve_level(rows: ev.Rows, options: StepOptions, lower: np.ndarray, upper: 
         f -= WA.T @ b
     elif not rows.diag.any():
         H += np.eye(nv) * max(options.damping, 1e-12)
-    return qp.solve(H, f, lower, upper, A_eq, b_eq, options.solver)
+    return qp.solve(H, f, lower, upper, A_eq, b_eq, options.solver, dt)

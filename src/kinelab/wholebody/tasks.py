@@ -15,7 +15,6 @@ root frame).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -32,11 +31,21 @@ FRAME_TASKS = ("pose", "position", "axis", "orientation")
 AXES = "xyz"
 
 
+MAX_WEIGHT = 1e12  # a larger weight squares past what the QP's matrix holds with the rest in it
+
+
 def _weight(name: str, value: Any) -> float:
-    if type(value) is float and 0.0 <= value < math.inf:  # the usual call, checked at once
+    if type(value) is float and 0.0 <= value <= MAX_WEIGHT:  # the usual call, checked at once
         return value
-    if not is_real(value, 0):
-        raise OptionError(name, value, "a finite number ≥ 0")
+    if not is_real(value, 0, MAX_WEIGHT):
+        raise OptionError(name, value, f"a number from 0 to {MAX_WEIGHT:g}")
+    return float(value)
+
+
+def _gain(value: Any) -> float:
+    """A task's gain: the share of its error a step asks to close, 0 to 1 (more would overshoot the target)."""
+    if not is_real(value, 0, 1):
+        raise OptionError("gain", value, "a number from 0 to 1 (the share of the error a step closes)")
     return float(value)
 
 
@@ -47,8 +56,9 @@ def _weights(value: Any) -> float | np.ndarray:
             arr = np.array(value, dtype=float)
         except (TypeError, ValueError):
             arr = np.array([np.nan])
-        if arr.ndim != 1 or not np.all(np.isfinite(arr)) or np.any(arr < 0):
-            raise OptionError("weight", value, "a finite number ≥ 0, or one per velocity (nv numbers ≥ 0)")
+        if arr.ndim != 1 or not np.all(np.isfinite(arr)) or np.any(arr < 0) or np.any(arr > MAX_WEIGHT):
+            raise OptionError("weight", value, f"a number from 0 to {MAX_WEIGHT:g}, or one per velocity (nv such "
+                              "numbers)")
         arr.flags.writeable = False
         return arr
     return _weight("weight", value)
@@ -60,8 +70,69 @@ def _priority(value: Any) -> int:
     return int(value)
 
 
-def _pose(value: Any, what: str) -> pin.SE3:
-    """A target pose: an SE3 or a 4 × 4 homogeneous matrix, finite, its rotation a rotation.
+FROZEN = ("a task's target is a value, copied when the task is made: make the task anew (or task.moved(target)) "
+          "for another target")
+
+
+class FixedPose(pin.SE3):
+    """A task's target pose: a ``pin.SE3`` that cannot change. Its rotation and translation are read-only views
+    and its setters refuse, so that what a step answers for is what its task was given (a caller's SE3 is copied,
+    never kept)."""
+
+    __slots__ = ()
+
+    @property
+    def translation(self) -> np.ndarray:
+        """The position [m], read-only."""
+        view = pin.SE3.translation.fget(self)
+        view.flags.writeable = False
+        return view
+
+    @translation.setter
+    def translation(self, value: Any) -> None:
+        raise TargetError(FROZEN)
+
+    @property
+    def rotation(self) -> np.ndarray:
+        """The rotation matrix, read-only."""
+        view = pin.SE3.rotation.fget(self)
+        view.flags.writeable = False
+        return view
+
+    @rotation.setter
+    def rotation(self, value: Any) -> None:
+        raise TargetError(FROZEN)
+
+    @property
+    def homogeneous(self) -> np.ndarray:
+        """The 4 × 4 matrix (a copy)."""
+        return pin.SE3.homogeneous.fget(self)
+
+    @homogeneous.setter
+    def homogeneous(self, value: Any) -> None:
+        raise TargetError(FROZEN)
+
+    def setIdentity(self) -> FixedPose:
+        """Refused: a target is a value."""
+        raise TargetError(FROZEN)
+
+    def setRandom(self) -> FixedPose:
+        """Refused: a target is a value."""
+        raise TargetError(FROZEN)
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return FixedPose, (pin.SE3.homogeneous.fget(self),)
+
+    def __copy__(self) -> FixedPose:
+        return self  # a value: a copy would be the same
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> FixedPose:
+        return self
+
+
+def _pose(value: Any, what: str) -> FixedPose:
+    """A target pose: an SE3 or a 4 × 4 homogeneous matrix, finite, its rotation a rotation; a copy that cannot
+    change.
 
     Raises:
         TargetError: anything else (named).
@@ -69,23 +140,40 @@ def _pose(value: Any, what: str) -> pin.SE3:
     if isinstance(value, pin.SE3):
         H = value.homogeneous
     else:
+        H = _real_array(value, f"{what} must be a pin.SE3 or a 4 × 4 homogeneous matrix")
         try:
-            H = np.asarray(value, dtype=float).reshape(4, 4)
-        except (TypeError, ValueError):
+            H = H.reshape(4, 4)
+        except ValueError:
             raise TargetError(f"{what} must be a pin.SE3 or a 4 × 4 homogeneous matrix, got {value!r}") from None
-    if pose_defect(H):  # compiled: finite, orthonormal within 1e-6 with det +1, last row 0 0 0 1
+    if pose_defect(H) or np.abs(H[:3, 3]).max() > MAX_COORDINATE:
         raise TargetError(f"{what} is not a finite pose with a proper rotation (orthonormal within 1e-6, det +1, "
-                          "last row 0, 0, 0, 1)")
-    return pin.SE3(H)
+                          f"last row 0, 0, 0, 1) and a position within {MAX_COORDINATE:g} m")
+    return FixedPose(np.ascontiguousarray(H))
+
+
+MAX_COORDINATE = 1e6  # [m] a target farther than this from the world's origin is a mistake (and overflows rates)
+
+
+def _real_array(value: Any, what: str) -> np.ndarray:
+    """``value`` as a new float array; booleans, complex numbers, strings and objects refused (``what`` says what
+    was expected)."""
+    try:
+        arr = np.array(value)
+    except (TypeError, ValueError):
+        raise TargetError(f"{what}, got {value!r}") from None
+    if arr.dtype.kind not in "iuf":  # booleans, complex numbers, text and objects are not coordinates
+        raise TargetError(f"{what} (real numbers, not {arr.dtype.name}), got {value!r}")
+    return arr.astype(float)
 
 
 def _vector(value: Any, size: int, what: str) -> np.ndarray:
-    try:
-        arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise TargetError(f"{what} must be {size} numbers, got {value!r}") from None
+    """``size`` finite numbers within MAX_COORDINATE, as a new read-only array."""
+    arr = _real_array(value, f"{what} must be {size} numbers")
     if arr.shape != (size,) or not np.isfinite(arr).all():
         raise TargetError(f"{what} must be {size} finite numbers, got {count_of(arr.shape)}")
+    if np.abs(arr).max() > MAX_COORDINATE:
+        raise TargetError(f"{what} must lie within {MAX_COORDINATE:g} m of the world's origin, got {arr.tolist()}")
+    arr.flags.writeable = False
     return arr
 
 
@@ -124,7 +212,7 @@ class FrameTask:
             raise OptionError("frame", self.frame, "a frame name")
         if self.task not in FRAME_TASKS:
             raise OptionError("task", self.task, ", ".join(FRAME_TASKS))
-        if not isinstance(self.axis, str) or self.axis not in AXES:
+        if self.axis not in ("x", "y", "z"):
             raise OptionError("axis", self.axis, "'x', 'y' or 'z'")
         target = self.target
         if self.task == "position" and not isinstance(target, pin.SE3) and np.size(target) == 3:
@@ -133,7 +221,7 @@ class FrameTask:
         object.__setattr__(self, "weight", _weight("weight", self.weight))
         ow = self.weight if self.orientation_weight is None else self.orientation_weight
         object.__setattr__(self, "orientation_weight", _weight("orientation_weight", ow))
-        object.__setattr__(self, "gain", _weight("gain", self.gain))
+        object.__setattr__(self, "gain", _gain(self.gain))
         object.__setattr__(self, "priority", _priority(self.priority))
 
     @property
@@ -198,7 +286,7 @@ class RelativeFrameTask:
         object.__setattr__(self, "weight", _weight("weight", self.weight))
         ow = self.weight if self.orientation_weight is None else self.orientation_weight
         object.__setattr__(self, "orientation_weight", _weight("orientation_weight", ow))
-        object.__setattr__(self, "gain", _weight("gain", self.gain))
+        object.__setattr__(self, "gain", _gain(self.gain))
         object.__setattr__(self, "priority", _priority(self.priority))
 
     rows = 6
@@ -242,7 +330,7 @@ class ComTask:
             raise OptionError("axes", self.axes, "'xyz' or a part of it ('xy', 'z', ...)")
         object.__setattr__(self, "index", tuple(AXES.index(a) for a in self.axes))
         object.__setattr__(self, "weight", _weight("weight", self.weight))
-        object.__setattr__(self, "gain", _weight("gain", self.gain))
+        object.__setattr__(self, "gain", _gain(self.gain))
         object.__setattr__(self, "priority", _priority(self.priority))
 
     @property
@@ -286,15 +374,17 @@ class PostureTask:
         """
         if self.q_ref is not None:
             try:
-                arr = np.array(self.q_ref, dtype=float)
-            except (TypeError, ValueError):
-                raise OptionError("q_ref", self.q_ref, "nq numbers (Pinocchio's q), or None") from None
+                arr = _real_array(self.q_ref, "")
+            except TargetError:
+                arr = np.array([np.nan])
+            if arr.ndim != 1 or not np.isfinite(arr).all():
+                raise OptionError("q_ref", self.q_ref, "nq finite real numbers (Pinocchio's q), or None")
             arr.flags.writeable = False
             object.__setattr__(self, "q_ref", arr)
         object.__setattr__(self, "weight", _weights(self.weight))
         if not isinstance(self.base, bool):
             raise OptionError("base", self.base, "True or False")
-        object.__setattr__(self, "gain", _weight("gain", self.gain))
+        object.__setattr__(self, "gain", _gain(self.gain))
         object.__setattr__(self, "priority", _priority(self.priority))
 
     label = "posture"
