@@ -147,3 +147,13 @@ def test_counts_beyond_what_a_c_int_holds_are_refused_or_served(ur5, call, big):
         assert "integer" in str(err) or "at most" in str(err) or "too" in str(err)
     else:
         assert result is not None
+
+
+@pytest.mark.parametrize("seed", [np.uint64(2**64 - 1), np.uint64(2**63), 2**64 - 1, 2**70])
+def test_a_numpy_seed_past_2_63_is_taken_by_the_table_start(ur5, seed):
+    """#67 item 9 as written: a raw OverflowError from the batch's seed states (a regression)."""
+    k, r = kinelab, ur5
+    res = k.solve_batch(r, [r.fk(r.random_q(0))], q0="table", seed=seed)
+    assert res.success[0] and max(r.tool_error(res.q[0], r.fk(r.random_q(0)))) <= 1e-6
+    again = k.solve_batch(r, [r.fk(r.random_q(0))], q0="table", seed=int(seed))
+    assert np.array_equal(again.q, res.q)  # a NumPy seed and the same Python int start alike

@@ -22,7 +22,7 @@ def seed_state(seed: int | None) -> np.ndarray:
 def seed_states(seed: int, count: int) -> np.ndarray:
     """(count, 1) generator states, row b's equal to ``seed_state(seed + b)`` (splitmix64, vectorised)."""
     with np.errstate(over="ignore"):
-        x = np.arange(count, dtype=np.uint64) + np.uint64(seed % (1 << 64))
+        x = np.arange(count, dtype=np.uint64) + np.uint64(int(seed) % (1 << 64))  # int: a NumPy seed may be 2**64 - 1
         x = x + np.uint64(0x9E3779B97F4A7C15)
         x = (x ^ (x >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
         x = (x ^ (x >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
