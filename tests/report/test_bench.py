@@ -271,3 +271,71 @@ def test_the_collision_free_batch_has_no_colliding_success_by_pinocchio():
 
     clear = throughput.collision_free(kinelab.load("panda"), rounds=1, seed=0)
     assert clear["colliding"] == 0 and clear["success"][0] >= 0.99 and clear["pairs"] > 50
+
+
+def _breaks(robot, budget):
+    raise AttributeError("module 'roboticstoolbox' has no attribute 'Chain'")  # #67 item 4: the renamed adapter
+
+
+def _raises_on_every_solve(robot, budget):
+    def run(case, seed):
+        raise AttributeError("the peer's solve broke")
+
+    return run
+
+
+def _declines(robot, budget):
+    from kinelab.report.bench.peers import PeerDeclinedError
+
+    raise PeerDeclinedError("sees 5 joints, kinelab 6")
+
+
+@pytest.mark.parametrize("adapter, needle", [(_breaks, "no attribute 'Chain'"),
+                                             (_raises_on_every_solve, "raised on every problem")])
+def test_an_installed_peer_that_fails_stops_the_bench_by_name(monkeypatch, adapter, needle):
+    """#67 item 4: 'Not run: rtb-ik_LM on ur5 (AttributeError ...)' dropped the peer from every figure; an installed
+    peer that breaks is now an error of the bench, its last line named, and the command exits 1."""
+    from kinelab.cli import main
+    from kinelab.report.bench import peers
+
+    pytest.importorskip("pink")
+    monkeypatch.setitem(peers.ADAPTERS, "pink", adapter)
+    with pytest.raises(peers.PeerFailedError, match=f"pink.*{needle}"):
+        runner.run(robots=["ur5"], n=2, repeats=1, solvers=["frdm", "pink"])
+    assert main(["bench", "--robots", "ur5", "--n", "2", "--repeats", "1", "--solvers", "frdm", "pink"]) == 1
+
+
+def test_a_peer_that_does_not_take_the_robot_is_said_not_run(monkeypatch):
+    from kinelab.report.bench import peers
+
+    pytest.importorskip("pink")
+    monkeypatch.setitem(peers.ADAPTERS, "pink", _declines)
+    result = runner.run(robots=["ur5"], n=2, repeats=1, solvers=["frdm", "pink"])
+    assert result["not_run"] == {"pink on ur5": "sees 5 joints, kinelab 6"}
+    assert [r["solver"] for r in result["rows"]] == ["frdm"]
+
+
+def test_the_rtb_adapter_loads_its_robot_where_roboticstoolbox_is_installed(ur5):
+    """The adapter's own call, run wherever the bench extra is (CI's bench job): it was rtb.Chain.URDF."""
+    pytest.importorskip("roboticstoolbox")
+    from kinelab.report.bench import peers
+
+    ets = peers.rtb_ets(ur5)
+    q = ur5.random_q(0)
+    assert np.abs(np.asarray(ets.fkine(q).A) - ur5.fk(q).homogeneous).max() <= 1e-9
+
+
+def test_a_broken_whole_body_peer_stops_that_bench_by_name(monkeypatch):
+    from kinelab.report.bench import peers, steppers
+    from kinelab.report.bench import wholebody as wb
+
+    pytest.importorskip("pink")
+
+    class Broken:
+        def __init__(self, *args):
+            raise ImportError("cannot import name 'FrameTask' from 'pink.tasks'")
+
+    monkeypatch.setitem(steppers.STEPPERS, "pink", Broken)
+    monkeypatch.setattr(wb, "STEPPERS", steppers.STEPPERS)
+    with pytest.raises(peers.PeerFailedError, match="pink failed on panda: ImportError"):
+        wb.run(["panda"], steps=5, rounds=1, solves=0)

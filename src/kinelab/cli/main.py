@@ -83,7 +83,7 @@ def main(argv: list[str] | None = None) -> int:
         return code
     except KinelabError as exc:
         print(f"kinelab: error: {one_line(str(exc))}", file=sys.stderr)
-        return 2
+        return getattr(exc, "exit_code", 2)  # 2: the user's input; a failure of the tool's own says otherwise
     except KeyboardInterrupt as stop:
         note = getattr(stop, "note", "")
         print(f"kinelab: interrupted{'; ' + note if note else ''}", file=sys.stderr)

@@ -72,7 +72,7 @@ def throughput(robot: Chain, n: int = 2000, seed: int = 0, start: str = "warm", 
         return res.q, time.perf_counter() - t0
 
     runners: dict[str, Runner] = {"frdm solve() loop": loop, "frdm solve_batch": batch}
-    with contextlib.suppress(ImportError, ValueError):
+    with contextlib.suppress(ImportError, peers.PeerDeclinedError):
         ets = peers.rtb_ets(robot)
 
         def lm_loop() -> tuple[np.ndarray, float]:
@@ -104,7 +104,7 @@ def tracking(robot: Chain, seed: int = 0, paths: int = 20, samples: int = 200,
     target_sets = [[robot.fk(q) for q in Q] for Q in Q_paths]
     runners: dict[str, Callable[[np.ndarray, list[pin.SE3]], np.ndarray]] = {
         "frdm track": lambda Q, targets: track(robot, targets, q0=Q[0], seed=seed).q}
-    with contextlib.suppress(ImportError, ValueError):
+    with contextlib.suppress(ImportError, peers.PeerDeclinedError):
         ets = peers.rtb_ets(robot)
 
         def lm_loop(Q: np.ndarray, targets: list[pin.SE3]) -> np.ndarray:

@@ -30,6 +30,22 @@ from kinelab.scratch import scratch_dir
 PEERS = {"rtb-ik_LM": "roboticstoolbox", "trac-ik": "pytracik", "ikpy": "ikpy", "pink": "pink"}
 
 
+class PeerDeclinedError(KinelabError):
+    """A peer does not take this robot or task (its model of the chain differs, say): a "Not run" line, said."""
+
+
+class PeerFailedError(KinelabError):
+    """An installed peer failed where it should run (its adapter or the peer broke): the bench stops, exit 1,
+    rather than print figures without it."""
+
+    exit_code = 1
+
+
+def last_line(exc: BaseException) -> str:
+    """An exception as its traceback's last line says it (one line, at most 300 characters)."""
+    return " ".join(f"{type(exc).__name__}: {exc}".split())[:300]
+
+
 def kinematic_urdf(robot: Chain) -> Path:
     """A copy of the robot's URDF without visual, collision, inertial, gazebo or transmission elements."""
     if robot.urdf_path is None:
@@ -57,15 +73,15 @@ def rtb_ets(robot: Chain) -> Any:
     """roboticstoolbox's ETS of the robot's base → tool chain (its URDF import), checked for the joint count.
 
     Raises:
-        ImportError: roboticstoolbox is not installed; ValueError: it sees another number of joints.
+        ImportError: roboticstoolbox is not installed; PeerDeclinedError: it sees another number of joints.
     """
     import roboticstoolbox as rtb
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        ets = rtb.Chain.URDF(str(kinematic_urdf(robot))).ets(end=tool_link(robot))
+        ets = rtb.Robot.URDF(str(kinematic_urdf(robot))).ets(end=tool_link(robot))
     if ets.n != robot.n:
-        raise ValueError(f"roboticstoolbox sees {ets.n} joints, kinelab {robot.n}")
+        raise PeerDeclinedError(f"roboticstoolbox sees {ets.n} joints, kinelab {robot.n}")
     return ets
 
 
@@ -75,7 +91,7 @@ def rtb_chain_ets(robot: Chain) -> Any:
     (or tz(q)) · SE3(Aᵀ), A a rotation taking z onto the joint axis. Checked against Pinocchio's FK.
 
     Raises:
-        ImportError: roboticstoolbox is not installed; ValueError: its FK disagrees with Pinocchio's.
+        ImportError: roboticstoolbox is not installed; PeerDeclinedError: its FK disagrees with Pinocchio's.
     """
     from roboticstoolbox import ET, ETS
 
@@ -92,7 +108,7 @@ def rtb_chain_ets(robot: Chain) -> Any:
     ets = ETS([*parts, ET.SE3(tool)])  # type: ignore[operator, unused-ignore]  # one list: * renumbered joints
     q = robot.random_q(0)
     if not np.allclose(np.asarray(ets.fkine(q).A), robot.fk(q).homogeneous, atol=1e-9):
-        raise ValueError("the ETS built from the chain disagrees with Pinocchio's FK")
+        raise PeerDeclinedError("the ETS built from the chain disagrees with Pinocchio's FK")
     return ets
 
 
@@ -129,7 +145,7 @@ def _tracik(robot: Chain, budget: float) -> SolveFn:
 
     solver = TracIK(robot.base, tool_link(robot), str(kinematic_urdf(robot)), timeout=budget, epsilon=5e-7)
     if solver.dof != robot.n:
-        raise ValueError(f"TRAC-IK sees {solver.dof} joints, kinelab {robot.n}")
+        raise PeerDeclinedError(f"TRAC-IK sees {solver.dof} joints, kinelab {robot.n}")
     solver.joint_limits = (list(robot.lower), list(robot.upper))
 
     def run(case: Case, seed: int):
@@ -149,7 +165,7 @@ def _ikpy(robot: Chain, budget: float) -> SolveFn:
     names = [link.name for link in chain.links]
     active = [names.index(j) for j in robot.joint_names if j in names]
     if len(active) != robot.n:
-        raise ValueError(f"ikpy's chain lacks some of {robot.joint_names}")
+        raise PeerDeclinedError(f"ikpy's chain lacks some of {robot.joint_names}")
     mask = [i in active for i in range(len(names))]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -59,13 +59,17 @@ class _Tally:
     def __init__(self, robot: Chain, name: str, solve_fn: SolveFn, n: int):
         self.robot, self.name, self.solve_fn = robot, name, solve_fn
         self.best: list[tuple[float, bool, str, int] | None] = [None] * n
+        self.raised: Exception | None = None  # the last exception of a solve, kept to name a peer that always fails
+        self.calls = self.raising = 0
 
     def attempt(self, k: int, case: Case, budget: float, seed: int) -> None:
         t0 = time.perf_counter()
+        self.calls += 1
         try:
             q, it = self.solve_fn(case, seed + case.index)
-        except Exception:  # noqa: BLE001 - a solver that raises on a problem has failed that problem
+        except Exception as exc:  # noqa: BLE001 - a solver that raises on a problem has failed that problem
             q, it = None, -1
+            self.raised, self.raising = exc, self.raising + 1
         elapsed = time.perf_counter() - t0
         ok, why = check_solution(self.robot, q, case.oMtarget, elapsed, budget, task=case.task)
         kept = self.best[k]
@@ -73,6 +77,14 @@ class _Tally:
             self.best[k] = (elapsed, ok, why, it)
 
     def row(self) -> Row:
+        """The pair's figures.
+
+        Raises:
+            PeerFailedError: every solve raised (a broken adapter or peer, never figures without it).
+        """
+        if self.calls and self.raising == self.calls and self.raised is not None:
+            raise peers.PeerFailedError(f"{self.name} on {self.robot.name} raised on every problem: "
+                                   f"{peers.last_line(self.raised)}")
         best = [b for b in self.best if b is not None]
         times = np.array([b[0] for b in best]) * 1e6
         solved = [b[0] * 1e6 for b in best if b[1]]
@@ -132,9 +144,11 @@ def _prepared(robot: Chain, solvers: dict[str, Prepare], problems: list[Case], b
             for case in problems[:3]:  # warm-up: compilation, caches (an error here shows in the timed loop)
                 with contextlib.suppress(Exception):
                     solve_fn(case, seed)
-        except Exception as exc:  # noqa: BLE001 - a peer that cannot load this robot is reported, not fatal
-            missing[f"{name} on {robot.name}"] = f"{type(exc).__name__}: {exc}"[:200]
+        except peers.PeerDeclinedError as exc:  # a peer that does not take this robot is reported, not fatal
+            missing[f"{name} on {robot.name}"] = str(exc)[:200]
             continue
+        except Exception as exc:  # noqa: BLE001 - an installed peer that breaks stops the bench, named
+            raise peers.PeerFailedError(f"{name} failed on {robot.name}: {peers.last_line(exc)}") from exc
         tallies.append(_Tally(robot, name, solve_fn, len(problems)))
     return tallies
 

@@ -247,3 +247,4 @@ class Maps:
 
 
 STEPPERS = {"kinelab": KinelabStepper, "pink": PinkStepper, "mink": MinkStepper}
+PEER_MODULES = {"pink": ("pink",), "mink": ("mink", "mujoco")}  # what each peer needs installed (the bench extra)

@@ -62,7 +62,7 @@ def solvers(robot: Chain) -> dict[str, Solver]:
         out["solve analytic"] = lambda t, q0, seed: solve(robot, t, solver="analytic", q0=q0).q
     try:
         ets = peers.rtb_ets(robot)
-    except (ImportError, ValueError, peers.KinelabError):
+    except (ImportError, peers.PeerDeclinedError):  # not installed, or it does not take this chain
         return out
     out["ik_LM"] = lambda t, q0, seed: np.asarray(ets.ik_LM(t.homogeneous, q0=q0, tol=5e-13, joint_limits=True).q,
                                                    dtype=float)

@@ -17,7 +17,7 @@ iterated at dt = 1 s until every frame is within 1e-6 m / 1e-6 rad (at most 200 
 
 from __future__ import annotations
 
-import contextlib
+import importlib.util
 import time
 from typing import Any
 
@@ -26,8 +26,10 @@ import pinocchio as pin
 from tqdm import tqdm
 
 from kinelab.errors import KinelabError
+from kinelab.report.bench.peers import PeerFailedError, last_line
 from kinelab.report.bench.steppers import (
     DT,
+    PEER_MODULES,
     PERIOD,
     RADIUS,
     SCENARIOS,
@@ -66,12 +68,29 @@ def run_steps(name: str, steps: int = 1000, rounds: int = 3, progress: bool = Fa
 
 
 def _steppers(robot: Robot, scenario: Any, q0: np.ndarray) -> dict[str, Any]:
-    """A fresh stepper per library of STEPPERS at q0 (a peer not installed, the bench extra, left out)."""
+    """A fresh stepper per library of STEPPERS at q0 (a peer not installed, the bench extra, left out).
+
+    Raises:
+        PeerFailedError: an installed peer that fails to set up (its last line named).
+    """
     steppers: dict[str, Any] = {}
     for key, make in STEPPERS.items():
-        with contextlib.suppress(ImportError):
+        if key in not_installed():
+            continue
+        try:
             steppers[key] = make(robot, scenario, q0)
+        except Exception as exc:  # noqa: BLE001 - an installed peer that breaks stops the bench, named
+            if key == "kinelab":
+                raise
+            raise PeerFailedError(f"{key} failed on {robot.name}: {last_line(exc)}") from exc
     return steppers
+
+
+def not_installed() -> dict[str, str]:
+    """The peers of the whole-body bench that are not installed, each with the install hint."""
+    return {key: f"not installed ({', '.join(m for m in mods if importlib.util.find_spec(m) is None)}): "
+                 "pip install -e '.[bench]'"
+            for key, mods in PEER_MODULES.items() if any(importlib.util.find_spec(m) is None for m in mods)}
 
 
 def _timed_step(stepper: Any, targets: list[pin.SE3]) -> float:
@@ -198,7 +217,7 @@ def run(robots: list[str] | None = None, steps: int = 1000, rounds: int = 3, sol
         rows += run_steps(name, steps, rounds, progress)
         if solves:
             solved += converged(name, solves, seed, progress)
-    return {"steps": rows, "ratios": ratios(rows), "solves": solved,
+    return {"steps": rows, "ratios": ratios(rows), "solves": solved, "not_run": not_installed(),
             "protocol": {"dt_s": DT, "steps": steps, "rounds": rounds, "radius_m": RADIUS, "period_s": PERIOD}}
 
 
@@ -217,4 +236,6 @@ def markdown(result: dict[str, Any]) -> str:
         for r in result["solves"]:
             lines.append(f"| {r['robot']} | {r['solver']} | {r['success_pct']:.1f} % of {r['targets']} | "
                          f"{r['median_ms']:.2f} ms |")
+    if result.get("not_run"):
+        lines += ["", "Not run: " + "; ".join(f"{k} ({why})" for k, why in result["not_run"].items())]
     return "\n".join(lines)
