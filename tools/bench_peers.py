@@ -10,8 +10,9 @@ failed (exit ≠ 0) with its reason; "Not run" is only for a peer that does not 
 import json
 import subprocess
 import sys
-import tomllib
 from pathlib import Path
+
+import tomllib
 
 ROOT = Path(__file__).resolve().parents[1]
 ARM_PEERS = ("rtb-ik_LM", "trac-ik", "ikpy", "pink")
