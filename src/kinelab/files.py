@@ -17,10 +17,49 @@ from kinelab.errors import KinelabError
 
 if TYPE_CHECKING:
     import tempfile
+    from collections.abc import Iterator
 else:
     tempfile = lazy.module("tempfile", globals())
 
 MAX_BYTES = 64 * 2**20  # [bytes] the largest robot, SRDF, obstacle or metadata file read (URDFs are kilobytes)
+_interrupted = [False]  # a Ctrl-C seen within held_interrupts(): no output is replaced after it
+
+
+@contextlib.contextmanager
+def held_interrupts() -> Iterator[None]:
+    """Within the block, remember Ctrl-C (SIGINT) even where a library catches the KeyboardInterrupt it raises (some
+    guard their optional imports with ``except BaseException``): once seen, :func:`write_output` and
+    :func:`stop_if_interrupted` refuse to go on. The command line runs in such a block; the handler before it is
+    put back after. Off the main thread (where no handler can be set) the block changes nothing."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def on_interrupt(signum: int, frame: object) -> None:
+        _interrupted[0] = True
+        raise KeyboardInterrupt
+
+    _interrupted[0] = False
+    previous = signal.signal(signal.SIGINT, on_interrupt)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+        _interrupted[0] = False
+
+
+def interrupted() -> bool:
+    """Whether a Ctrl-C was seen within :func:`held_interrupts`."""
+    return _interrupted[0]
+
+
+def stop_if_interrupted(what: str) -> None:
+    """Raise KeyboardInterrupt when a Ctrl-C was seen (``what``: what is left as it was, for the message)."""
+    if _interrupted[0]:
+        raise KeyboardInterrupt(f"{what} left as it was")
 
 
 def as_path(value: object, what: str, error: type[KinelabError]) -> Path:
@@ -201,10 +240,13 @@ def write_output(path: str | Path, data: str | bytes, what: str = "file") -> Pat
         with os.fdopen(fd, "wb") as f:
             f.write(raw)
         os.chmod(tmp, mode)
+        stop_if_interrupted(str(target))
         os.replace(tmp, target)
+        tmp = None
     except OSError as exc:
-        if tmp is not None:
+        raise KinelabError(f"cannot write the {what} to {path}: {exc.strerror or exc}") from None
+    finally:
+        if tmp is not None:  # not renamed into place (a failure, or Ctrl-C): nothing of it is left
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
-        raise KinelabError(f"cannot write the {what} to {path}: {exc.strerror or exc}") from None
     return target

@@ -586,3 +586,48 @@ def test_a_page_command_says_what_it_is_doing_before_each_slow_step(capsys, monk
     assert code == 0 and said and "kinelab: drawing the map" in said[0][1]
     monkeypatch.undo()
     assert cli.main(["view", "ur5", "--html", page]) == 0 and capsys.readouterr().err == ""  # not a terminal
+
+
+SWALLOWED = """
+import os, signal, sys
+import kinelab.cli.view as view
+real = view.load_robot
+
+def load_and_lose_a_ctrl_c(*args, **kwargs):
+    try:  # what a library that guards its imports with `except BaseException` does to a Ctrl-C
+        os.kill(os.getpid(), signal.SIGINT)
+        for _ in range(10_000_000):
+            pass
+    except BaseException:
+        pass
+    return real(*args, **kwargs)
+
+view.load_robot = load_and_lose_a_ctrl_c
+from kinelab.cli.main import main
+sys.exit(main(sys.argv[1:]))
+"""
+
+
+def test_a_ctrl_c_a_library_swallows_still_stops_the_command_and_keeps_the_old_page(tmp_path):
+    """#67 item 5: an interrupt during start-up that a library caught let `view --html` finish, replace the old page
+    and exit 0. The Ctrl-C is remembered: the old page stays whole, no temporary file is left, the exit is 130."""
+    page = tmp_path / "view.html"
+    page.write_text("the old page")
+    proc = subprocess.run([sys.executable, "-c", SWALLOWED, "view", "ur5", "--html", str(page)], capture_output=True,
+                          text=True, timeout=300, env={**os.environ, "PYTHONWARNINGS": "ignore"})
+    assert proc.returncode == 130, proc.stderr[-1000:]
+    assert proc.stderr.strip().splitlines()[-1].startswith("kinelab: interrupted")
+    assert page.read_text() == "the old page"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["view.html"]
+
+
+def test_the_cli_puts_the_callers_ctrl_c_handler_back(tmp_path):
+    """main() holds interrupts only while it runs: in a program (or a test suite) that calls it, the handler before
+    it is back after it, and a later write is not refused."""
+    from kinelab.cli import main
+    from kinelab.files import interrupted, write_output
+
+    before = signal.getsignal(signal.SIGINT)
+    assert main(["fk", "ur5", "0", "0", "0", "0", "0", "0"]) == 0
+    assert signal.getsignal(signal.SIGINT) is before and not interrupted()
+    assert write_output(tmp_path / "a.txt", "x").read_text() == "x"

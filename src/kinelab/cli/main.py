@@ -20,7 +20,7 @@ from typing import Any
 import kinelab
 from kinelab.cli.common import Parser
 from kinelab.errors import KinelabError
-from kinelab.files import output_target
+from kinelab.files import held_interrupts, output_target, stop_if_interrupted
 
 # each command → the module with its parser and handler, in the order ``kinelab --help`` lists them
 COMMANDS = {"robots": "robots", "info": "robots", "fk": "fk", "ik": "ik", "branches": "branches",
@@ -71,15 +71,22 @@ def one_line(message: str) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run one command; a user error prints one line and returns 2, Ctrl-C returns 130."""
+    """Run one command; a user error prints one line and returns 2, Ctrl-C returns 130 (and replaces no output,
+    even where a library swallowed the interrupt)."""
+    with held_interrupts():  # before the commands' imports: a Ctrl-C a library swallows is still remembered
+        return _run(argv)
+
+
+def _run(argv: list[str] | None) -> int:
     warnings.formatwarning = _one_line
-    words = list(sys.argv[1:] if argv is None else argv)
-    args = build_parser(words).parse_args(words)
-    args.command_line = words  # what resumes an interrupted command
     try:
+        words = list(sys.argv[1:] if argv is None else argv)
+        args = build_parser(words).parse_args(words)
+        args.command_line = words  # what resumes an interrupted command
         if getattr(args, "html", None):  # a page that could not be written is refused before the work it shows
             output_target(args.html, "page")
         code: int = args.func(args)
+        stop_if_interrupted("the output")  # a Ctrl-C swallowed on the way: the command did not finish
         return code
     except KinelabError as exc:
         print(f"kinelab: error: {one_line(str(exc))}", file=sys.stderr)

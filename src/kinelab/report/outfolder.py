@@ -16,7 +16,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from kinelab.errors import KinelabError
-from kinelab.files import output_folder, umask
+from kinelab.files import interrupted, output_folder, stop_if_interrupted, umask
 
 MARKER = ".kinelab-report"
 FIGURES = ("era_elbow.png", "era_wrist.png", "era_shoulder.png", "seed001_convergence.png")  # validate's figures
@@ -84,6 +84,9 @@ def atomic_folder(out: str | Path, kind: str) -> Iterator[Path]:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     tmp.chmod(0o777 & ~umask())
+    if interrupted():  # a Ctrl-C a library swallowed: the old report stays
+        shutil.rmtree(tmp, ignore_errors=True)
+        stop_if_interrupted(str(final))
     old = final.with_name(f".{final.name}.old-{os.getpid()}") if final.exists() else None
     if old is not None:
         final.rename(old)
