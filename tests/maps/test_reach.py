@@ -274,3 +274,62 @@ def test_a_map_with_a_table_differs_from_one_without_exactly_where_the_exact_che
     assert (walled["reachability"] <= free["reachability"]).all()
     assert (walled["reachability"] < free["reachability"]).any()  # the table and floor take poses away
     assert spec.to_dict()["collisions"]["environment"]["obstacles"][1]["name"] == "table"
+
+
+def _full_disk(*args, **kwargs):
+    import errno
+
+    raise OSError(errno.ENOSPC, "No space left on device")
+
+
+@pytest.mark.parametrize("where", ["creating the store", "writing a chunk"])
+def test_a_full_disk_gives_one_line_and_leaves_no_store_that_blocks_the_rerun(tmp_path, capsys, monkeypatch, where):
+    """#67 item 7: `map reach --out` on a full disk printed a traceback and left a partial store that blocked the
+    rerun. The disk's refusal is simulated (ENOSPC from the store); the command prints one line and exits 2, and the
+    same command once there is room writes the whole map, equal to a map made in one go."""
+    zarr = pytest.importorskip("zarr")
+    from kinelab import cli
+
+    out = tmp_path / "m.zarr"
+    argv = ["map", "reach", "ur5", "--voxel", "0.4", "--orientations", "2", "--restarts", "2", "--chunk", "8",
+            "--out", str(out), "--json"]
+    with monkeypatch.context() as m:
+        if where == "creating the store":
+            m.setattr(zarr.hierarchy.Group, "create_dataset", _full_disk)
+        else:
+            real = zarr.core.Array.__setitem__
+
+            def second_chunk_fails(self, key, value):  # the disk fills up as the second chunk's values go in
+                if self.name.endswith("manipulability") and isinstance(key, slice) and key.start == 8:
+                    _full_disk()
+                real(self, key, value)
+
+            m.setattr(zarr.core.Array, "__setitem__", second_chunk_fails)
+        assert cli.main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("kinelab: error: cannot write") and "No space left" in err[0]
+    if where == "creating the store":
+        assert not out.exists()
+    else:
+        assert "1 chunk(s) done are kept" in err[0] and maps.load(out).finished() == (1, maps.load(out).chunks)
+    assert cli.main(argv) == 0
+    capsys.readouterr()
+    whole = maps.reachability(kinelab.load("ur5"), reach.MapSpec(voxel=0.4, orientations=2, restarts=2,
+                                                                 chunk_voxels=8))
+    np.testing.assert_array_equal(maps.load(out).array("reachability"), whole.array("reachability"))
+
+
+def test_map_view_says_an_interrupted_map_is_unfinished(ur5, tmp_path, capsys):
+    """#67 item 7: `map view` drew an interrupted map without saying so."""
+    pytest.importorskip("zarr")
+    from kinelab import cli
+
+    spec = reach.MapSpec(voxel=0.4, orientations=2, chunk_voxels=8, restarts=2)
+    centres = grid.voxel_centres(ur5, spec.voxel)
+    partial = store.open_map(tmp_path / "m.zarr", ur5, spec, centres)
+    partial.write(0, reach.compute_chunk(ur5, spec, centres, 0))
+    page = tmp_path / "map.html"
+    assert cli.main(["map", "view", str(tmp_path / "m.zarr"), "--html", str(page)]) == 0
+    said = capsys.readouterr().out
+    assert f"unfinished: 1 of {partial.chunks} chunks" in said
+    assert f"unfinished: 1 of {partial.chunks} chunks" in page.read_text()

@@ -251,6 +251,9 @@ def run_view(args: argparse.Namespace) -> int:
     step(f"drawing the map of {robot.name} and its slices")
     page = maps_module.map_page(robot, rmap)
     write_output(args.html, page, "page")
+    done, chunks = rmap.finished()
+    unfinished = f"; unfinished: {done} of {chunks} chunks (run the same map reach again to resume)" \
+        if done < chunks else ""
     print(f"wrote {args.html}: {robot.name}, {int((rmap.array('reachability') > 0).sum())} reached voxels of "
-          f"{meta['voxels']}, {meta['spec']['voxel']:g} m")
+          f"{meta['voxels']}, {meta['spec']['voxel']:g} m{unfinished}")
     return 0

@@ -9,6 +9,7 @@ file, the spec, the voxel count and the kinelab version. Zarr is the optional ex
 from __future__ import annotations
 
 import hashlib
+import shutil
 import warnings
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -136,13 +137,27 @@ class ReachabilityMap:
         return len(self.done)
 
     def write(self, index: int, values: dict[str, np.ndarray]) -> None:
-        """Store chunk ``index``'s values, then mark it done."""
+        """Store chunk ``index``'s values, then mark it done.
+
+        Raises:
+            KinelabError: the disk refused (full, say): the chunks done before it are kept, and the same call
+                resumes the map once there is room.
+        """
         size = self.meta["spec"]["chunk_voxels"]
-        for name in VALUES:
-            self.values[name][index * size:index * size + len(values[name])] = values[name]
-        if self.checksums is not None:
-            self.checksums[index] = self._digest(index)
-        self.done[index] = True
+        try:
+            for name in VALUES:
+                self.values[name][index * size:index * size + len(values[name])] = values[name]
+            if self.checksums is not None:
+                self.checksums[index] = self._digest(index)
+            self.done[index] = True
+        except OSError as err:
+            raise KinelabError(f"cannot write chunk {index} of the map to {self.path}: {err.strerror or err}; the "
+                               f"{self.finished()[0]} chunk(s) done are kept: run the same map again to resume"
+                               ) from None
+
+    def finished(self) -> tuple[int, int]:
+        """(chunks done, chunks in all): a map whose run was interrupted has fewer done."""
+        return int(np.count_nonzero(_read(self.done, slice(None), "done", self.path))), self.chunks
 
     def _digest(self, index: int) -> np.ndarray:
         """SHA-256 of chunk ``index``'s stored values, as 32 bytes."""
@@ -196,15 +211,17 @@ def open_map(out: str | Path | None, robot: Chain, spec: MapSpec, centres: np.nd
         return found
     try:
         group = zarr.open_group(str(path), mode="w")
+        group.attrs.update({**meta, "centres_sha256": centres_sha256(centres)})
+        group.create_dataset("centres", data=centres, chunks=(spec.chunk_voxels, 3))
+        for name in VALUES:
+            group.create_dataset(name, shape=(len(centres),), chunks=(spec.chunk_voxels,), dtype="f8",
+                                 fill_value=np.nan)
+        group.create_dataset("checksums", shape=(chunks, 32), chunks=(1, 32), dtype="u1", fill_value=0)
+        group.create_dataset("done", shape=(chunks,), chunks=(1,), dtype=bool, fill_value=False)
     except (KeyError, OSError) as err:  # zarr's directory store says KeyError for a file it cannot create
+        shutil.rmtree(path, ignore_errors=True)  # it was new: half a store would block the next run
         why = getattr(err, "strerror", None) or "not a writable folder"
-        raise KinelabError(f"cannot write the map to {path}: {why}; give --out a folder you can write") from None
-    group.attrs.update({**meta, "centres_sha256": centres_sha256(centres)})
-    group.create_dataset("centres", data=centres, chunks=(spec.chunk_voxels, 3))
-    for name in VALUES:
-        group.create_dataset(name, shape=(len(centres),), chunks=(spec.chunk_voxels,), dtype="f8", fill_value=np.nan)
-    group.create_dataset("checksums", shape=(chunks, 32), chunks=(1, 32), dtype="u1", fill_value=0)
-    group.create_dataset("done", shape=(chunks,), chunks=(1,), dtype=bool, fill_value=False)
+        raise KinelabError(f"cannot write the map to {path}: {why}; nothing was left there") from None
     return ReachabilityMap(meta, {k: group[k] for k in ("centres", "done", "checksums", *VALUES)}, path)
 
 

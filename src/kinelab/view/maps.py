@@ -89,8 +89,10 @@ def map_page(robot: Chain, rmap: ReachabilityMap) -> str:
 
     scene = reachability_cloud(robot, rmap, meshes=False)
     spec = rmap.meta["spec"]
+    done, chunks = rmap.finished()
     scene.title = (f"{robot.name}: reachability map, {rmap.meta['voxels']} voxels of {spec['voxel']:g} m, "
-                   f"{spec['orientations']} orientations each ({rmap.meta['solver']})")
+                   f"{spec['orientations']} orientations each ({rmap.meta['solver']})"
+                   + (f" — unfinished: {done} of {chunks} chunks" if done < chunks else ""))
     scene.legend["slices"] = ("right: the reachability index on the voxel layers through the map's centre, across z, "
                               "y and x (dark red: no orientation reached)")
     try:
