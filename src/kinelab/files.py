@@ -56,6 +56,11 @@ def interrupted() -> bool:
     return _interrupted[0]
 
 
+def interrupt_taken() -> None:
+    """A command took the Ctrl-C as its normal end (a server stopping): it stops nothing more."""
+    _interrupted[0] = False
+
+
 def stop_if_interrupted(what: str) -> None:
     """Raise KeyboardInterrupt when a Ctrl-C was seen (``what``: what is left as it was, for the message)."""
     if _interrupted[0]:

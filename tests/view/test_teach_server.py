@@ -10,6 +10,7 @@ import urllib.request
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import kinelab
@@ -120,3 +121,98 @@ def test_a_burst_of_a_thousand_requests_from_a_hundred_threads_is_all_answered(p
     with ThreadPoolExecutor(100) as pool:
         codes = list(pool.map(get, range(1000)))
     assert codes.count(200) == 1000
+
+
+@pytest.fixture(scope="module")
+def talos_page():
+    with teach(kinelab.load("talos")) as served:
+        yield served
+
+
+def _strict(text):
+    def refuse(name):
+        raise ValueError(f"not JSON: {name}")
+
+    return json.loads(text, parse_constant=refuse)
+
+
+def raw(port, method, path, body=b"", headers=()):
+    """A request with exactly these header lines (repeats allowed): its status and its body as text."""
+    lines = [f"{method} {path} HTTP/1.0", *headers, f"Content-Length: {len(body)}", "", ""]
+    with socket.create_connection(("127.0.0.1", port), timeout=30) as s:
+        s.sendall("\r\n".join(lines).encode() + body)
+        data = b""
+        while chunk := s.recv(1 << 16):
+            data += chunk
+    status, _, payload = data.partition(b"\r\n\r\n")
+    return int(status.split()[1]), payload.decode()
+
+
+@pytest.mark.parametrize("x", [1e308, 1e7, float("nan")])
+def test_a_base_far_away_is_refused_by_name_and_every_reply_is_strict_json(talos_page, x):
+    """#67 item 8: TALOS's page took a base at x = 1e308; its replies then carried `Infinity` (not JSON) and every
+    target was refused ("q[0] is nan") until a sane q was posted."""
+    port = talos_page.server.port
+    q = talos_page.session.q.tolist()
+    far = [x, *q[1:]]
+    body = json.dumps({"q": far}, allow_nan=True).encode()
+    head = [f"Host: 127.0.0.1:{port}", "Content-Type: application/json"]
+    code, text = raw(port, "POST", "/q", body, head)
+    reply = _strict(text)
+    assert code == 400 and "q[0]" in reply["error"] and np.array_equal(talos_page.session.q, q)
+    code, text = raw(port, "GET", "/state?since=0", headers=head)
+    assert code == 200 and _strict(text)["readout"]
+    code, text = raw(port, "POST", "/q", json.dumps({"q": q}).encode(), head)
+    assert code == 200 and "error" not in _strict(text)
+
+
+def test_two_host_headers_are_refused(page):
+    port = page.server.port
+    for hosts in ([f"127.0.0.1:{port}", "evil.example"], ["evil.example", f"127.0.0.1:{port}"],
+                  [f"127.0.0.1:{port}", f"127.0.0.1:{port}"]):
+        code, text = raw(port, "GET", "/state?since=0", headers=[f"Host: {h}" for h in hosts])
+        assert code == 400 and "one Host" in _strict(text)["error"]
+
+
+def test_the_page_is_answered_while_150_half_open_connections_wait(page):
+    """#67 item 8: 150 connections that send half a request delayed the page 18 s (each held one of 64 threads for
+    the 10 s timeout). They now fit beside it, each closed after the 2 s timeout: the page is answered at once
+    (well inside the old 10 s), and every half-open connection is closed by the server."""
+    port = page.server.port
+    half = []
+    for _ in range(150):
+        s = socket.create_connection(("127.0.0.1", port), timeout=30)
+        s.sendall(b"GET /state HTTP/1.1\r\nHost: 127.0.0.1\r\n")
+        half.append(s)
+    t0 = time.monotonic()
+    code, _ = send(port, "GET", "/")
+    waited = time.monotonic() - t0
+    assert code == 200 and waited < teach_server.DEADLINE
+    for s in half:
+        s.settimeout(30)
+        while s.recv(1 << 16):
+            pass
+        s.close()
+
+
+def test_a_connection_that_trickles_is_closed_at_its_deadline(monkeypatch):
+    """A byte every second never trips the per-read timeout; the per-connection deadline ends it."""
+    with teach(kinelab.load("ur5"), q=START) as served:
+        monkeypatch.setattr(teach_server, "DEADLINE", 1.5)
+        s = socket.create_connection(("127.0.0.1", served.server.port), timeout=30)
+        closed = False
+        for byte in b"GET /state HTTP/1.1\r\nHost: 127.0.0.1\r\n":
+            try:
+                s.sendall(bytes([byte]))
+            except OSError:
+                closed = True
+                break
+            s.settimeout(0.5)
+            try:
+                if s.recv(1 << 16) == b"":
+                    closed = True
+                    break
+            except TimeoutError:
+                pass
+        assert closed
+        s.close()

@@ -17,6 +17,7 @@ from kinelab.cli.common import (
     robot_arguments,
 )
 from kinelab.errors import KinelabError
+from kinelab.files import interrupt_taken
 from kinelab.progress import step
 from kinelab.robot import catalog
 
@@ -67,7 +68,8 @@ def run_teach(args: argparse.Namespace) -> int:
         webbrowser.open(server.url)
     try:
         server.serve_forever()
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # Ctrl-C is how a server is stopped: its normal end
+        interrupt_taken()
         return 0
     finally:
         server.close()

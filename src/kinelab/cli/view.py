@@ -19,6 +19,7 @@ from kinelab.cli.common import (
     robot_arguments,
 )
 from kinelab.errors import KinelabError
+from kinelab.files import interrupt_taken
 from kinelab.progress import step
 
 if TYPE_CHECKING:
@@ -131,7 +132,8 @@ def _serve(scene: Any) -> int:
     try:
         while True:
             time.sleep(1.0)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # Ctrl-C is how a server is stopped: its normal end
+        interrupt_taken()
         return 0
     finally:
         scene.close()

@@ -5,8 +5,9 @@ Requests: ``GET /`` the page; ``GET /state?since=N`` the scene commands after N 
 ``{"q": [...]}``, ``/target`` ``{"matrix": [16 numbers, rows first]}``, ``/branch`` ``{"step": ±1}``, ``/snap``,
 ``/collisions`` ``{"on": bool}``. Each answers ``{"seq", "commands" (base64 msgpack), "readout"}`` and, when the
 request was refused, ``"error"`` naming why in at most 200 characters (HTTP 400; 403 for a request that is not the
-page's own: another Host or Origin; 415 for a POST that is not JSON). The session is never left broken by a request.
-A connection gets 10 s to send its request.
+page's own: another Host or Origin, or two Host headers; 415 for a POST that is not JSON). Replies are strict JSON
+(a non-finite reading is null). The session is never left broken by a request. A connection that sends nothing for
+2 s is closed, and every connection within 10 s.
 """
 
 from __future__ import annotations
@@ -15,8 +16,11 @@ import base64
 import contextlib
 import html
 import json
+import math
+import socket
 import sys
 import threading
+import time
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from importlib import resources
 from pathlib import Path
@@ -36,9 +40,10 @@ if TYPE_CHECKING:
 
 LOOPBACK = "127.0.0.1"
 MAX_BODY = 1 << 16  # [bytes] an action's JSON is a few hundred
-TIMEOUT = 10.0  # [s] a connection that sends nothing (or half a request) for this long is closed
-BACKLOG = 256  # connections the system queues while the server is busy: a browser's bursts fit
-MAX_CONNECTIONS = 64  # connections served at once (a thread each); more wait in the backlog
+TIMEOUT = 2.0  # [s] a connection that sends nothing (or half a request) for this long is closed
+DEADLINE = 10.0  # [s] a connection's whole life: one trickling a byte at a time is closed all the same
+BACKLOG = 512  # connections the system queues while the server is busy: a browser's bursts fit
+MAX_CONNECTIONS = 256  # connections served at once (a thread each); more wait in the backlog
 MAX_REASON = 200  # [characters] of a refusal's reason
 
 
@@ -51,8 +56,37 @@ class _Quiet(ThreadingHTTPServer):
     request_queue_size = BACKLOG
 
     def __init__(self, address: tuple[str, int], handler: type[BaseHTTPRequestHandler]):
+        self.closing = threading.Event()  # before the bind: a port in use calls server_close at once
         super().__init__(address, handler)
         self.slots = threading.BoundedSemaphore(MAX_CONNECTIONS)
+        self.deadlines: dict[Any, float] = {}  # each open connection → when it is closed whatever it does
+        self.watched = threading.Lock()
+        threading.Thread(target=self._reap, name="teach deadlines", daemon=True).start()
+
+    def watch(self, connection: Any) -> None:
+        """Close ``connection`` at its deadline (:data:`DEADLINE` from now) unless it is forgotten first."""
+        with self.watched:
+            self.deadlines[connection] = time.monotonic() + DEADLINE
+
+    def forget(self, connection: Any) -> None:
+        """The connection ended on its own."""
+        with self.watched:
+            self.deadlines.pop(connection, None)
+
+    def _reap(self) -> None:
+        """One thread for every connection's deadline (a timer each would double the threads)."""
+        while not self.closing.wait(0.25):
+            now = time.monotonic()
+            with self.watched:
+                late = [c for c, t in self.deadlines.items() if t <= now]
+                for c in late:
+                    del self.deadlines[c]
+            for c in late:
+                _close(c)
+
+    def server_close(self) -> None:
+        self.closing.set()
+        super().server_close()
 
     def process_request(self, request: Any, client_address: Any) -> None:
         if not self.slots.acquire(timeout=TIMEOUT):  # every slot held by connections that will time out
@@ -134,8 +168,11 @@ class TeachServer:
         """Refuse a request that is not the page's own.
 
         Raises:
-            RequestError: 403 for a Host other than 127.0.0.1 or localhost with this port, or another Origin.
+            RequestError: 403 for a Host other than 127.0.0.1 or localhost with this port, or another Origin; 400 for
+                two Host headers.
         """
+        if len(headers.get_all("Host") or ()) > 1:  # which one a proxy or the browser meant is not ours to guess
+            raise RequestError(400, "a request names one Host")
         host, origin = headers.get("Host"), headers.get("Origin")
         if host not in self.hosts:
             raise RequestError(403, f"this server answers its own page only (Host {host!r} is not {self.url})")
@@ -213,6 +250,14 @@ def _handler(server: TeachServer) -> type[BaseHTTPRequestHandler]:
     class Handler(BaseHTTPRequestHandler):
         timeout = TIMEOUT  # a half-sent request holds its thread this long, not for ever
 
+        def setup(self) -> None:
+            super().setup()
+            server.httpd.watch(self.connection)
+
+        def finish(self) -> None:
+            server.httpd.forget(self.connection)
+            super().finish()
+
         def log_message(self, format: str, *args: Any) -> None:  # quiet: the terminal shows the address only
             return
 
@@ -252,7 +297,7 @@ def _handler(server: TeachServer) -> type[BaseHTTPRequestHandler]:
             self._send_json(code, reply)
 
         def _send_json(self, code: int, value: dict[str, Any]) -> None:
-            self._send(code, json.dumps(value).encode("utf-8"), "application/json")
+            self._send(code, json.dumps(strict(value), allow_nan=False).encode("utf-8"), "application/json")
 
         def _send(self, code: int, data: bytes, kind: str) -> None:
             self.send_response(code)
@@ -264,6 +309,23 @@ def _handler(server: TeachServer) -> type[BaseHTTPRequestHandler]:
             self.wfile.write(data)
 
     return Handler
+
+
+def _close(connection: Any) -> None:
+    """End a connection past its deadline (its thread's blocked read then returns)."""
+    with contextlib.suppress(OSError):
+        connection.shutdown(socket.SHUT_RDWR)
+
+
+def strict(value: Any) -> Any:
+    """``value`` with every NaN or infinity as None: JSON has no such numbers (Python's ``Infinity`` is not JSON)."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: strict(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [strict(v) for v in value]
+    return value
 
 
 def _int(text: Any) -> int:
