@@ -10,18 +10,24 @@ with ``follower="step"`` by the whole-body step (:func:`kinelab.wholebody.follow
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any, TypeGuard
+from typing import TYPE_CHECKING, Any, TypeGuard
 
 import pinocchio as pin
 
+from kinelab import lazy
 from kinelab.errors import ChainError, OptionError
 from kinelab.ik import api as chain_api
 from kinelab.robot.chain import Chain
 from kinelab.robot.tree import Robot
 from kinelab.typing import Target, Targets
-from kinelab.wholebody import follow
-from kinelab.wholebody import solve as wholebody
 from kinelab.wholebody.tasks import TASK_TYPES, Task
+
+if TYPE_CHECKING:
+    from kinelab.wholebody import follow
+    from kinelab.wholebody import solve as wholebody
+else:  # a chain's solve does not load the whole-body step (its QP, its compiled problem)
+    follow = lazy.module("kinelab.wholebody.follow", globals())
+    wholebody = lazy.module("kinelab.wholebody.solve", globals())
 
 
 def is_tasks(target: object) -> TypeGuard[Task | Sequence[Task]]:

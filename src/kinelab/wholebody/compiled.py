@@ -10,8 +10,6 @@ installed module (its version checked); another version, or none, leaves the rea
 
 from __future__ import annotations
 
-import ctypes
-import importlib.metadata
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -35,6 +33,9 @@ def daqp_linked() -> bool:
     """True once DAQP's C functions are taken from the installed module (a supported version), else False."""
     if _body.daqp_ready():
         return True
+    import ctypes
+    import importlib.metadata  # 20 ms: read when the step is first taken, not when a chain's solve loads
+
     try:
         import daqp
 
