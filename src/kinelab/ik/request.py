@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -193,3 +194,25 @@ def verdict_reserve(budget: float) -> float:
     the result, which after milliseconds of kernel work run with cold caches (≈ 0.1–0.2 ms on the development
     machine, against ≈ 15 µs warm). 4 % of the budget, at most 0.2 ms: the bench's allowance is 5 % + 0.1 ms."""
     return min(2e-4, 0.04 * budget)
+
+
+class Deadline:
+    """A budget's end for a loop of uneven steps: :meth:`near` says whether the next step, as slow as the slowest
+    one so far, would end past it, so that a loop stops before a step that overruns rather than after it.
+
+    Args:
+        start: ``time.perf_counter()`` when the budget began [s].
+        budget: the budget [s] (None: none; the deadline never comes).
+    """
+
+    __slots__ = ("end", "slowest", "last")
+
+    def __init__(self, start: float, budget: float | None):
+        self.end = math.inf if budget is None else start + budget - verdict_reserve(budget)
+        self.slowest, self.last = 0.0, start
+
+    def near(self) -> bool:
+        """Call before each step: True when the step after the one just finished would pass the end."""
+        now = time.perf_counter()
+        self.slowest, self.last = max(self.slowest, now - self.last), now
+        return now + self.slowest > self.end

@@ -10,6 +10,7 @@ finished by a warm-started solve from it; one that still misses is dropped.
 
 from __future__ import annotations
 
+import math
 import time
 from functools import partial
 from types import SimpleNamespace
@@ -229,32 +230,32 @@ class Rows(NamedTuple):
 
 
 def judged_roots(robot: Chain, q: np.ndarray, found: np.ndarray, free: np.ndarray, target: pin.SE3,
-                 req: Request, held: dict[str, float] | None = None) -> list[Answer]:
+                 req: Request, held: dict[str, float] | None = None, end: float = math.inf) -> list[Answer]:
     """The roots q (m × n) the judge confirms, in their order: each as (q, position error [m], rotation error [rad],
     finished, roots merged, one of a continuum). Where the robot's compiled FK is certified, every root is judged in
     one compiled pass; a root short of the tolerances but near them is finished by :func:`judged` (FRDM, the
-    joints of ``held`` frozen)."""
+    joints of ``held`` frozen, within what is left before ``end``: ``time.perf_counter``'s clock [s])."""
     judge = robot.derived("compiled judge", _compiled_judge)
     m = q.shape[0]
     if judge is None or m == 0:
-        return _judged_each(robot, q, found, free, target, req, held)
+        return _judged_each(robot, q, found, free, target, req, held, end)
     dp, dr, inside = np.empty(m), np.empty(m), np.empty(m, dtype=np.uint8)
     lower, upper = robot.check_bounds
     judge.verdicts(target.homogeneous, q, lower, upper, dp, dr, inside)
     answers = []
     for k, (p, r, within) in enumerate(zip(dp.tolist(), dr.tolist(), inside.tolist(), strict=True)):
         v = (q[k], p, r, False) if within and p <= req.tol_pos and r <= req.tol_rot else \
-            judged(robot, q[k], target, req, held) if near_enough(p, r, req) else None
+            judged(robot, q[k], target, req, held, end) if near_enough(p, r, req) else None
         if v is not None:
             answers.append((*v, int(found[k]), bool(free[k])))
     return answers
 
 
 def _judged_each(robot: Chain, q: np.ndarray, found: np.ndarray, free: np.ndarray, target: Any, req: Request,
-                 held: dict[str, float] | None) -> list[Answer]:
+                 held: dict[str, float] | None, end: float) -> list[Answer]:
     """:func:`judged_roots` root by root with Pinocchio's FK (a robot whose compiled FK is not its judge)."""
     return [(*v, int(found[k]), bool(free[k])) for k in range(q.shape[0])
-            if (v := judged(robot, q[k], target, req, held)) is not None]
+            if (v := judged(robot, q[k], target, req, held, end)) is not None]
 
 
 def branch_results(robot: Chain, rows: Rows, req: Request, mode: str, elapsed: float, max_solutions: int | None,
@@ -413,19 +414,22 @@ def near_enough(dp: float, dr: float, req: Request) -> bool:
     return dp <= 1e3 * req.tol_pos + 1e-6 and dr <= 1e3 * req.tol_rot + 1e-6
 
 
-def judged(robot: Chain, q: np.ndarray, target: Target, req: Request,
-           held: dict[str, float] | None = None) -> tuple[np.ndarray, float, float, bool] | None:
+def judged(robot: Chain, q: np.ndarray, target: Target, req: Request, held: dict[str, float] | None = None,
+           end: float = math.inf) -> tuple[np.ndarray, float, float, bool] | None:
     """(q, position error, rotation error, finished) when Pinocchio's FK of q meets the tolerances, after a
-    warm-started finish (``finished``; the joints of ``held`` frozen at their values [rad]) if the closed form
-    fell short; None when it still does not."""
+    warm-started finish (``finished``; the joints of ``held`` frozen at their values [rad]; within what is left
+    before ``end``, ``time.perf_counter``'s clock [s]) if the closed form fell short; None when it still does not."""
     dp, dr = robot.tool_error(q, target)
     if dp <= req.tol_pos and dr <= req.tol_rot:
         return q, dp, dr, False
     if not near_enough(dp, dr, req):
         return None  # not this pose's root (a 5R arm's candidate for the other shoulder side, say)
     frozen = {} if held is None else {"freeze": held, "active": ("freeze",)}
+    left = end - time.perf_counter()
+    if left <= 0.0:
+        return None  # the budget is spent: a root not finished is not an answer
     finish = make_request("frdm", seed=0, tol_pos=req.tol_pos, tol_rot=req.tol_rot, max_restarts=0,
-                          solver_options=frozen)
+                          solver_options=frozen, time_budget=1.0 if left == math.inf else min(left, 1.0))
     done = solve_one(robot, target, q, finish)
     return (done.q, done.position_error, done.rotation_error, True) if done.success else None
 

@@ -136,7 +136,7 @@ def held_rows(robot: Chain, H: np.ndarray, starts: np.ndarray | None, req: Reque
                           f"({six.fk_certificate.reason})")
     B, keep = len(H), np.arange(7) != sw.joint
     values, q, tried = held_values(robot, starts, B), np.full((B, 7), np.nan), np.zeros(B, dtype=np.int64)
-    left = np.arange(B)
+    left, slowest, began = np.arange(B), 0.0, time.perf_counter()
     for k in range(values.shape[1]):
         theta = values[left, k]
         q6, errors = np.full((len(left), 6), np.nan), np.full((len(left), 2), np.nan)
@@ -149,7 +149,9 @@ def held_rows(robot: Chain, H: np.ndarray, starts: np.ndarray | None, req: Reque
         left = left[~found]
         if not left.size:
             break
-        if time.perf_counter() > deadline:
+        now = time.perf_counter()
+        slowest, began = max(slowest, now - began), now
+        if now + slowest > deadline:  # the next value, as slow as the slowest so far, would end past it
             return q, tried, True
     return q, tried, False
 

@@ -37,7 +37,7 @@ from kinelab.ik.analytic.classify import (
 from kinelab.ik.analytic.kernel import GENERAL_6R
 from kinelab.ik.chain import PRISMATIC, chain_model
 from kinelab.ik.limits import distance
-from kinelab.ik.request import Request
+from kinelab.ik.request import Deadline, Request
 from kinelab.ik.result import Branches
 from kinelab.ik.targets import beyond_reach
 from kinelab.robot import Chain
@@ -257,10 +257,10 @@ def _held_named(robot: Chain, redundancy: Mapping[object, object]) -> tuple[int,
 
 
 def at_value(robot: Chain, target: pin.SE3, req: Request, theta: float,
-             q_ref: np.ndarray | None = None, joint: int | None = None) -> list[Answer]:
+             q_ref: np.ndarray | None = None, joint: int | None = None, end: float = math.inf) -> list[Answer]:
     """Every branch of ``target`` with joint ``joint`` (None: the swept one) held at ``theta`` [rad] that Pinocchio
-    confirms within the limits: (q, position error [m], rotation error [rad], finished by FRDM, roots merged, one
-    of a continuum).
+    confirms within the limits: (q, position error [m], rotation error [rad], finished by FRDM before ``end``
+    (``time.perf_counter``'s clock [s]), roots merged, one of a continuum).
 
     Raises:
         OptionError: the chain cannot be swept (``joint`` None), or the six left are solved by nothing here.
@@ -278,7 +278,7 @@ def at_value(robot: Chain, target: pin.SE3, req: Request, theta: float,
     ref = None if q_ref is None else q_ref[keep]
     q6, found_, free = arm_roots(arm, H, robot.lower[keep], robot.upper[keep], ref, limit_slack(req.tol_rot))
     q = np.ascontiguousarray(np.insert(q6, joint, theta, axis=1))
-    return judged_roots(robot, q, found_, free, target, req, {robot.joints[joint].name: theta})
+    return judged_roots(robot, q, found_, free, target, req, {robot.joints[joint].name: theta}, end)
 
 
 def _is_swept(robot: Chain, joint: int) -> bool:
@@ -311,15 +311,15 @@ def redundant_all(robot: Chain, target: pin.SE3, req: Request, redundancy: objec
     if req.task.name != "pose":
         raise OptionError("task", req.task_label, "'pose' with redundancy= (other tasks: solver='frdm')")
     values, how, joint = held_values(robot, redundancy)
-    deadline = np.inf if req.time_budget is None else t0 + req.time_budget
+    deadline = Deadline(t0, req.time_budget)
     answers: list[Answer] = []
     late = ""
     beyond = beyond_reach(robot, target.translation)
     for k, theta in enumerate(values if not beyond else ()):
-        if time.perf_counter() > deadline:
+        if deadline.near():
             late = f"after {k} of {len(values)} values of joint {joint + 1}"
             break
-        answers += at_value(robot, target, req, float(theta), q_ref, joint)
+        answers += at_value(robot, target, req, float(theta), q_ref, joint, deadline.end)
     if q_ref is not None:
         answers.sort(key=lambda a: distance(robot, a[0], q_ref))
     arm = swept_arm(robot).arm if _is_swept(robot, joint) else arm_holding(robot, joint, float(values[0]))

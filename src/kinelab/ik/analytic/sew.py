@@ -36,7 +36,7 @@ from kinelab.ik.analytic.branches import Answer, Rows, arm_roots, branch_results
 from kinelab.ik.analytic.certify import Loop, equations, loop_of
 from kinelab.ik.analytic.redundancy import SweptArm, chain7_vectors, samples, swept_arm
 from kinelab.ik.limits import distance, nearest_inside
-from kinelab.ik.request import Request
+from kinelab.ik.request import Deadline, Request
 from kinelab.ik.result import Branches
 from kinelab.ik.targets import beyond_reach
 from kinelab.robot import Chain
@@ -313,11 +313,11 @@ def _refined(A: np.ndarray, gA: np.ndarray, B: np.ndarray, gB: np.ndarray, width
 
 
 def sampled(robot: Chain, arm: Arm7, sew: SEW, H: np.ndarray, sw: SweptArm,
-            deadline: float = math.inf) -> tuple[list[np.ndarray], list[np.ndarray], bool, str]:
+            deadline: Deadline | None = None) -> tuple[list[np.ndarray], list[np.ndarray], bool, str]:
     """The branches (m, 7) at the samples of the swept joint, in order, each a root of the loop equations to ROOT
     with every joint but the swept one unbounded (a branch is followed past the limits it crosses; the limits judge
     the answers), their ψ − ψ₀ [rad], whether the swept joint's range is a whole turn, and how far it got when
-    ``deadline`` (``time.perf_counter``'s clock [s]) passed ("" when it did not): ``sew.samples`` values spread
+    ``deadline`` came (a :class:`Deadline`; "" when it did not): ``sew.samples`` values spread
     over its range (its ends included unless it is a whole turn), and midpoints added, REFINE times over, in every
     cell :func:`_refined` names."""
     lo, hi = float(robot.lower[sw.joint]), float(robot.upper[sw.joint])
@@ -333,8 +333,9 @@ def sampled(robot: Chain, arm: Arm7, sew: SEW, H: np.ndarray, sw: SweptArm,
         return q, np.array([wrap_angle(sew.of(*arm.points(x)) - sew.angle) for x in q])
 
     found = []
+    deadline = deadline or Deadline(0.0, None)
     for k, v in enumerate(values):
-        if time.perf_counter() > deadline:
+        if deadline.near():
             return [], [], around, f"after {k} of {len(values)} samples of joint {sw.joint + 1}"
         found.append(at(float(v)))
     if not _refine(values, found, at, deadline):
@@ -343,14 +344,14 @@ def sampled(robot: Chain, arm: Arm7, sew: SEW, H: np.ndarray, sw: SweptArm,
 
 
 def _refine(values: list[float], found: list[tuple[np.ndarray, np.ndarray]],
-            at: Callable[[float], tuple[np.ndarray, np.ndarray]], deadline: float) -> bool:
+            at: Callable[[float], tuple[np.ndarray, np.ndarray]], deadline: Deadline) -> bool:
     """Insert midpoints, REFINE times over, into every cell :func:`_refined` names (``values`` [rad] of the swept
-    joint and ``found``, the branches and gaps ``at`` gives there, grow in place); False when ``deadline`` passed."""
+    joint and ``found``, the branches and gaps ``at`` gives there, grow in place); False when ``deadline`` came."""
     for _ in range(REFINE):
         cells = [i for i in range(len(values) - 1)
                  if _refined(*found[i], *found[i + 1], values[i + 1] - values[i])]
         for i in reversed(cells):
-            if time.perf_counter() > deadline:
+            if deadline.near():
                 return False
             mid = 0.5 * (values[i] + values[i + 1])
             values.insert(i + 1, mid)
@@ -381,12 +382,12 @@ def sew_all(robot: Chain, target: pin.SE3, req: Request, sew: SEW, q_ref: np.nda
     sw = swept_arm(robot, sew)  # built once per robot, before the clock starts
     arm, H = arm7(robot), target.homogeneous
     t0 = time.perf_counter()
-    deadline = math.inf if req.time_budget is None else t0 + req.time_budget
+    deadline = Deadline(t0, req.time_budget)
     beyond = beyond_reach(robot, target.translation)
     sets, gaps, around, late = ([], [], False, "") if beyond else sampled(robot, arm, sew, H, sw, deadline)
     roots = []
     for x in starts(sets, gaps, around):
-        if time.perf_counter() > deadline:
+        if deadline.near():
             late = late or "while finishing the roots found"
             break
         if (r := finish(arm, sew, x, H)) is not None:

@@ -11,7 +11,6 @@ from typing import Any, NamedTuple
 
 import numpy as np
 import pinocchio as pin
-from scipy.integrate import solve_ivp
 
 from kinelab.errors import KinelabError
 from kinelab.ik.biquat import laws
@@ -158,6 +157,8 @@ def _step(system: System, q_pin: np.ndarray, T: np.ndarray, qd: np.ndarray, Td: 
 
 def adaptive(system: System, q_pin: np.ndarray, stop: Stop, traj: Trajectory | None) -> tuple:
     """scipy's RK45 on tangent coordinates δ (q = q0 ⊕ δ), stopped by an event when M* is within tolerance."""
+    from scipy.integrate import solve_ivp  # 30-300 ms to import: only where the adaptive integrator is asked for
+
     model, nv = system.model, system.robot.nv
     eps_rot, eps_dual = stop.eps_rot, stop.eps_dual
     q_base = q_pin.copy()

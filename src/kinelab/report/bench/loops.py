@@ -141,32 +141,58 @@ def tracking(robot: Chain, seed: int = 0, paths: int = 20, samples: int = 200,
 
 def budgets(robot: Chain, budget: float = 0.005, n: int = 200, seed: int = 0,
             solvers: tuple[str, ...] = ("frdm", "biquat", "dls")) -> list[dict[str, Any]]:
-    """How well every path keeps ``time_budget`` [s]: n calls that cannot succeed (tolerances of 1e-300) from
-    random starts, paths interleaved per problem; the wall time of each call, outside kinelab. The paths: each
-    solver's ``solve``, the prepared ``IK.solve``, FRDM's ``solve_batch`` of 64 targets, ``solve_all``,
-    ``solve(prefer=)``, ``solve(collisions="self")`` (arms with collision geometry) and ``track`` of 50 samples."""
-    problems = cases(robot, n, seed)
-    paths = _budget_paths(robot, budget, solvers)
-    times: dict[str, list[float]] = {name: [] for name in paths}
-    for call in paths.values():  # warm-up: compilation
-        call(problems[0], seed, 1e-6)
-    names = list(paths)
-    with unmeetable_tolerances():
-        for k, case in enumerate(problems):
-            for name in names[k % len(names):] + names[:k % len(names)]:
-                t0 = time.perf_counter()
-                paths[name](case, seed + k, 1e-300)
-                times[name].append(time.perf_counter() - t0)
+    """How well every path keeps ``time_budget`` [s] the way a program meets it: each path in a fresh process
+    (:func:`path_times`), its first call included, n calls that cannot succeed (tolerances of 1e-300) from random
+    starts; the wall time of each call, outside kinelab. The paths: each solver's ``solve``, the prepared
+    ``IK.solve``, FRDM's ``solve_batch`` of 64 targets, ``solve_all``, ``solve(prefer=)``,
+    ``solve(collisions="self")`` (arms with collision geometry), ``track`` of 50 samples and the closed form's."""
+    rows = []
     allowed, loose = budget * 1.05 + 1e-4, budget * 1.10 + 2e-3
-    return [{"robot": robot.name, "solver": name, "budget_ms": budget * 1e3,
-             "p50_ms": float(np.percentile(t, 50) * 1e3), "p99_ms": float(np.percentile(t, 99) * 1e3),
-             "max_ms": float(np.max(t) * 1e3), "kept": bool(np.percentile(t, 99) <= allowed),
-             "kept_loose": bool(np.percentile(t, 99) <= loose)}
-            for name, t in times.items()]
+    for name in _budget_paths(robot, budget, solvers):
+        t = np.array(_fresh(robot.name, name, budget, n, seed, solvers))
+        rows.append({"robot": robot.name, "solver": name, "budget_ms": budget * 1e3,
+                     "first_ms": float(t[0] * 1e3), "p50_ms": float(np.percentile(t, 50) * 1e3),
+                     "p99_ms": float(np.percentile(t, 99) * 1e3), "max_ms": float(np.max(t) * 1e3),
+                     "kept": bool(np.percentile(t, 99) <= allowed), "kept_loose": bool(np.percentile(t, 99) <= loose)})
+    return rows
 
 
-def _budget_paths(robot: Chain, budget: float, solvers: tuple[str, ...]) -> dict[str, Callable[..., Any]]:
-    """One call per path, (case, seed, tolerance) → anything, each with ``budget``."""
+def _fresh(robot: str, path: str, budget: float, n: int, seed: int, solvers: tuple[str, ...]) -> list[float]:
+    """:func:`path_times` in a process of its own (a fresh interpreter: nothing imported, prepared or cached)."""
+    import json
+    import subprocess
+    import sys
+
+    args = json.dumps([robot, path, budget, n, seed, list(solvers)])
+    out = subprocess.run([sys.executable, "-c", "import sys, json; from kinelab.report.bench.loops import "
+                          "path_times; print(json.dumps(path_times(*json.loads(sys.argv[1]))))", args],
+                         capture_output=True, text=True, timeout=3600, check=False)
+    if out.returncode != 0:
+        raise KinelabError(f"the budget of {path!r} on {robot} could not be measured: "
+                           f"{' '.join(out.stderr.strip().splitlines()[-1:])}")
+    times: list[float] = json.loads(out.stdout)
+    return times
+
+
+def path_times(robot_name: str, path: str, budget: float, n: int, seed: int, solvers: list[str]) -> list[float]:
+    """The wall time [s] of each of n calls of one budget path on a robot loaded here, the first call of the
+    process first (nothing run before it but the robot's load)."""
+    robot = load(robot_name)
+    call = _budget_paths(robot, budget, tuple(solvers), probe=False)[path]
+    times = []
+    with unmeetable_tolerances():
+        for k, case in enumerate(cases(robot, n, seed)):
+            t0 = time.perf_counter()
+            call(case, seed + k, 1e-300)
+            times.append(time.perf_counter() - t0)
+    return times
+
+
+def _budget_paths(robot: Chain, budget: float, solvers: tuple[str, ...],
+                  probe: bool = True) -> dict[str, Callable[..., Any]]:
+    """One call per path, (case, seed, tolerance) → anything, each with ``budget`` (``probe``: the closed form's
+    paths where :func:`_analytic_paths` finds them by preparing one; else where the robot's class says so, nothing
+    prepared before the first call)."""
     def single(name: str) -> Callable[..., Any]:
         return lambda case, seed, tol: solve(robot, case.oMtarget, solver=name, q0=case.q_start, seed=seed,
                                              tol_pos=tol, tol_rot=tol, time_budget=budget)
@@ -192,30 +218,32 @@ def _budget_paths(robot: Chain, budget: float, solvers: tuple[str, ...]) -> dict
             collisions="self")
     paths["frdm track of 50"] = lambda case, seed, tol: track(
         robot, [case.oMtarget] * 50, q0=case.q_start, tol_pos=tol, tol_rot=tol, time_budget=budget)
-    paths.update(_analytic_paths(robot, budget))
+    paths.update(_analytic_paths(robot, budget, probe))
     return paths
 
 
-def _analytic_paths(robot: Chain, budget: float) -> dict[str, Callable[..., Any]]:
+def _analytic_paths(robot: Chain, budget: float, probe: bool = True) -> dict[str, Callable[..., Any]]:
     """The closed form's paths where the robot has one: ``solve`` and a batch of 100 with solver "analytic",
     ``solve_all_batch`` of 1,000 (a 6R chain in a class), and ``solve_all`` with ``redundancy=`` 64 samples and a
-    SEW angle (a 7R arm with a swept form)."""
-    try:
-        IK(robot, solver="analytic")
-    except KinelabError:
-        return {}
+    SEW angle (a 7R arm with a swept form). ``probe`` False: every path named, nothing prepared (a child process
+    measuring its first call, told the path by a parent that probed)."""
+    if probe:
+        try:
+            IK(robot, solver="analytic")
+        except KinelabError:
+            return {}
     paths: dict[str, Callable[..., Any]] = {
         "analytic solve": lambda case, seed, tol: solve(robot, case.oMtarget, solver="analytic", q0=case.q_start,
                                                         tol_pos=tol, tol_rot=tol, time_budget=budget),
         "analytic batch of 100": lambda case, seed, tol: solve_batch(
             robot, [case.oMtarget] * 100, solver="analytic", q0=case.q_start, tol_pos=tol, tol_rot=tol,
             time_budget=budget)}
-    if robot.n == 7 and has_swept_form(robot):
+    if robot.n == 7 and (not probe or has_swept_form(robot)):
         paths["solve_all K=64"] = lambda case, seed, tol: solve_all(robot, case.oMtarget, redundancy=64,
                                                                     tol_pos=tol, tol_rot=tol, time_budget=budget)
         paths["solve_all SEW"] = lambda case, seed, tol: solve_all(
             robot, case.oMtarget, redundancy=SEW(0.3), tol_pos=tol, tol_rot=tol, time_budget=budget)
-    else:
+    if robot.n != 7 or not probe:
         paths["solve_all_batch of 1000"] = lambda case, seed, tol: solve_all_batch(
             robot, [case.oMtarget] * 1000, tol_pos=tol, tol_rot=tol, time_budget=budget)
     return paths
@@ -259,13 +287,14 @@ def run(robots: list[str] | None, seed: int = 0, repeats: int = 3, n: int = 2000
 def budget_markdown(rows: list[dict[str, Any]]) -> str:
     """The budget table: per robot and entry point, p50, p99 and the largest wall time of a call that cannot
     succeed, against two bars."""
-    lines = ["| robot | entry point | budget | p50 | p99 | max | p99 ≤ budget + 5 % + 0.1 ms | ≤ + 10 % + 2 ms |",
-             "|---|---|---:|---:|---:|---:|---|---|"]
+    lines = ["| robot | entry point | budget | first call | p50 | p99 | max | p99 ≤ budget + 5 % + 0.1 ms | "
+             "≤ + 10 % + 2 ms |", "|---|---|---:|---:|---:|---:|---:|---|---|"]
     for r in rows:
-        lines.append(f"| {r['robot']} | {r['solver']} | {r['budget_ms']:.1f} ms | {r['p50_ms']:.2f} ms | "
-                     f"{r['p99_ms']:.2f} ms | {r['max_ms']:.2f} ms | {'yes' if r['kept'] else 'NO'} | "
-                     f"{'yes' if r.get('kept_loose', r['kept']) else 'NO'} |")
-    return "\n".join(lines)
+        lines.append(f"| {r['robot']} | {r['solver']} | {r['budget_ms']:.1f} ms | {r['first_ms']:.2f} ms | "
+                     f"{r['p50_ms']:.2f} ms | {r['p99_ms']:.2f} ms | {r['max_ms']:.2f} ms | "
+                     f"{'yes' if r['kept'] else 'NO'} | {'yes' if r.get('kept_loose', r['kept']) else 'NO'} |")
+    return "\n".join(lines) + ("\n\nEach entry point in a fresh process, its first call included in the "
+                               "percentiles (nothing before it but the robot's load).")
 
 
 def markdown(throughput_rows: list[dict[str, Any]], tracking_rows: list[dict[str, Any]],
