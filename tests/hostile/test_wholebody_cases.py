@@ -217,3 +217,25 @@ def test_gains_in_range_are_taken(talos, gain):
     q = talos.neutral()
     res = kinelab.step(talos, q, [FrameTask(HAND, hand_target(talos, q), gain=gain)], .01)
     assert res.solved and np.isfinite(res.v).all()
+
+
+def test_an_edit_of_the_models_limits_is_refused_not_silently_ignored(talos):
+    """Item 3: edits of robot.model's limits were silently ignored (the step holds the limits read at load). The
+    model a robot holds cannot change its limits: in place is numpy's read-only refusal, assignment is refused by
+    name with the way to a robot with other limits; that way gives a robot whose step holds them."""
+    with pytest.raises(ValueError, match="read-only"):
+        talos.model.upperPositionLimit[10] = 0.1
+    with pytest.raises(kinelab.KinelabError, match="from_model"):
+        talos.model.velocityLimit = np.zeros(talos.nv)
+    panda = kinelab.load("panda")
+    with pytest.raises(ValueError, match="read-only"):
+        panda.model.lowerPositionLimit[0] = 0.0
+    model = pin.Model(talos.model)
+    j = talos.model.joints[talos.model.getJointId("arm_left_4_joint")]
+    model.upperPositionLimit[j.idx_q] = model.lowerPositionLimit[j.idx_q] + 0.01
+    tight = kinelab.Robot.from_model(model)
+    q = tight.neutral()
+    q[j.idx_q] = model.lowerPositionLimit[j.idx_q]
+    target = pin.SE3(np.eye(3), tight.frame_placement(q, HAND).translation + np.array([0.0, 0.0, 0.3]))
+    res = kinelab.step(tight, q, [FrameTask(HAND, target, task="position")], 0.5)
+    assert res.solved and res.q[j.idx_q] <= model.upperPositionLimit[j.idx_q] + 1e-9

@@ -43,7 +43,7 @@ from kinelab.robot.mjcf import is_mjcf
 from kinelab.robot.poses import NEAR_SINGULAR as NEAR_SINGULAR  # the threshold, defined here before
 from kinelab.robot.poses import best_conditioned, reference_of
 from kinelab.robot.reduce import build_model
-from kinelab.robot.space import LIMIT_SLACK, MAX_SAMPLE_BYTES, SAMPLE_TURNS, generator, uniform
+from kinelab.robot.space import LIMIT_SLACK, MAX_SAMPLE_BYTES, SAMPLE_TURNS, fixed_limits, generator, uniform
 from kinelab.scratch import own
 
 if TYPE_CHECKING:
@@ -78,7 +78,7 @@ class Chain:
             built: the frozen result of :mod:`kinelab.robot.build`.
         """
         self.name, self.source, self.urdf_path = built.name, built.source, built.urdf_path
-        self.model, self.tool, self.base = built.model, built.tool, built.base
+        self.model, self.tool, self.base = fixed_limits(built.model), built.tool, built.base
         self.joints, self.mimics, self.locked = list(built.joints), built.mimics, built.locked
         self.srdf, self.package_dirs = built.srdf, built.package_dirs
         self.xacro_args, self.trust_xacro = built.xacro_args, built.trust_xacro

@@ -15,7 +15,7 @@ import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from kinelab.errors import ConfigurationError, JointLimitError, OptionError, count_of
+from kinelab.errors import ConfigurationError, DescriptionError, JointLimitError, OptionError, count_of
 
 LIMIT_SLACK = 1e-9  # joint values this far past a limit still count as within it (rad or m)
 MAX_COORDINATE = 1e6  # [m or rad] a coordinate beyond it is no configuration (a base 1000 km away, say)
@@ -49,6 +49,42 @@ class Space:
     names_q: tuple[str, ...]
     names_v: tuple[str, ...]
     floating: bool
+
+
+LOCKED = ("a robot's joint limits are read when it is built: edit a copy (model = pinocchio.Model(robot.model)) and "
+          "build the robot from it (kinelab.Robot.from_model(model), or kinelab.Chain.from_model(model, tool=...))")
+
+
+def _read_only(name: str) -> property:
+    """A property of :class:`FixedLimitsModel` serving pin.Model's ``name`` read-only and refusing assignment."""
+    vector = getattr(pin.Model, name)
+
+    def get(self: pin.Model) -> np.ndarray:
+        view = vector.fget(self)
+        view.flags.writeable = False
+        return view
+
+    def refuse(self: pin.Model, value: object) -> None:
+        raise DescriptionError(LOCKED)
+
+    return property(get, refuse, doc=f"pin.Model's {name}, read-only (the robot's limits are fixed when it is built)")
+
+
+class FixedLimitsModel(pin.Model):
+    """The Pinocchio model a robot holds: a ``pin.Model`` (every Pinocchio function takes it) whose joint limits
+    cannot change, so that no step or solve answers within limits other than the model's (an edit of them was
+    silently ignored: kinelab reads them once, when the robot is built)."""
+
+    __slots__ = ()
+    lowerPositionLimit = _read_only("lowerPositionLimit")
+    upperPositionLimit = _read_only("upperPositionLimit")
+    velocityLimit = _read_only("velocityLimit")
+    effortLimit = _read_only("effortLimit")
+
+
+def fixed_limits(model: pin.Model) -> FixedLimitsModel:
+    """A copy of ``model`` whose joint limits cannot change (the model itself if it is one already)."""
+    return model if isinstance(model, FixedLimitsModel) else FixedLimitsModel(model)
 
 
 def space_of(model: pin.Model) -> Space:

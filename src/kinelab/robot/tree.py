@@ -54,13 +54,14 @@ class Robot:
         """A Robot over a Pinocchio model (:func:`kinelab.load` and :meth:`from_model` make one).
 
         Args:
-            model: the whole model (kept as given: copy it first if you will change yours).
+            model: the whole model (kept as a copy whose joint limits cannot change: ``robot.model``).
             name: the robot's name (default: the model's).
             source: the file it was read from, or None.
             srdf: its SRDF, or None.
             chain_source: how :meth:`chain` builds a view (the loader's; None: from the model).
             geometry: how :meth:`visual_model` builds the geometry (None: none, a stick figure).
         """
+        model = sp.fixed_limits(model)  # the limits the space reads now are the model's for as long as it lives
         self.model, self.name, self.source, self.srdf = model, name or model.name or "robot", source, srdf
         self.data = model.createData()
         self.space = sp.space_of(model)
