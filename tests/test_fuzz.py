@@ -602,3 +602,62 @@ def test_the_public_api_counts_no_raw_error_hang_or_nonsense_accepted():
             tally.run(functools.partial(call, value), nonsense=True)
         assert tally.run(functools.partial(call, good)) is not None or name in ("solve.options",), name
     assert _faults(tally) == ""
+
+
+WB_BAD = [float("nan"), float("inf"), -1.0, 1e308, 1e-320, 0.0, 2.0, True, 1 + 2j, "x", None, [1.0, 2.0], -0.0]
+WB_FIELDS = {  # a field of the step's inputs → whether a value is one it accepts (anything else is nonsense)
+    "gain": lambda v: _real(v) and 0 <= v <= 1, "weight": lambda v: _real(v) and 0 <= v <= 1e12,
+    "dt": lambda v: _real(v) and v >= 1e-9, "axis": lambda v: v in ("x", "y", "z"),
+    "target_x": lambda v: _real(v) and abs(v) <= 1e6, "com_z": lambda v: _real(v) and abs(v) <= 1e6,
+    "base_x": lambda v: _real(v) and abs(v) <= 1e6, "v_prev": lambda v: _real(v) and math.isfinite(v),
+    "acceleration": lambda v: v is None or (isinstance(v, float) and v > 0),  # inf: no limit
+    "posture": lambda v: False,  # [v] * nq is no configuration of a floating robot (its quaternion is not unit)
+
+}
+
+
+def _real(v) -> bool:
+    return isinstance(v, numbers.Real) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _whole_body_call(robot, q, hand, field, value):
+    """One step with ``field`` set to ``value``, the other inputs sane (plain Python lists, as a user writes them)."""
+    target = robot.frame_placement(q, hand).homogeneous.tolist()
+    com, q = robot.com(q).tolist(), q.tolist()
+    args = {"gain": 1.0, "weight": 1.0, "dt": 0.01, "axis": "z", "acceleration": None}
+    if field == "target_x":
+        target[0][3] = value
+    elif field == "com_z":
+        com[2] = value
+    elif field == "base_x":
+        q[0] = value
+    elif field in args:
+        args[field] = value
+    tasks = [kinelab.FrameTask(hand, target, task="axis", axis=args["axis"], gain=args["gain"], weight=args["weight"]),
+             kinelab.ComTask(com, axes="xy")]
+    if field == "posture":
+        tasks.append(kinelab.PostureTask([value] * robot.nq))
+    v_prev = [value] * robot.nv if field == "v_prev" else None
+    limits = kinelab.Limits(acceleration=5.0 if field == "v_prev" else args["acceleration"])
+    return kinelab.step(robot, q, tasks, args["dt"], limits=limits, v_prev=v_prev)
+
+
+@pytest.mark.parametrize("robot_name, hand", [("talos", "arm_left_7_link"), ("talos", "gripper_right_base_link")])
+def test_the_whole_body_step_counts_no_raw_error_hang_nonsense_or_solved_nan(robot_name, hand):
+    """#67: a step's inputs one at a time set to values it does not accept (NaN, inf, 1e308, subnormal, booleans,
+    complex numbers, text): a KinelabError, or an answer that is honest — solved only with a finite v and a q that
+    is a configuration within the limits."""
+    robot = kinelab.load(robot_name)
+    rng = random.Random(f"whole-body-{robot_name}")
+    tally = Tally(f"wholebody.step.{robot_name}")
+    for _ in range(max(20, CASES // 2)):
+        field, value = rng.choice(sorted(WB_FIELDS)), rng.choice(WB_BAD)
+        q = robot.random_q(rng.randrange(1000))
+        out = tally.run(functools.partial(_whole_body_call, robot, q, hand, field, value),
+                        nonsense=not WB_FIELDS[field](value))
+        if out is not None and out.solved:
+            assert np.isfinite(out.v).all() and np.isfinite(out.q).all(), (field, value)
+            assert robot.within_limits(out.q), (field, value)
+    counts = tally.close()
+    assert counts["raw"] == 0 and counts["hangs"] == 0 and counts["nonsense_accepted"] == 0, (counts, tally.raw[:5])
+    assert counts["clean"] > 0

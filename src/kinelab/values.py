@@ -21,3 +21,18 @@ def is_real(value: object, lo: float = -math.inf, hi: float = math.inf, *, above
 def is_whole(value: object, lo: float = -math.inf, hi: float = math.inf) -> TypeGuard[int]:
     """True for an integer (a Python or NumPy int, not a bool) with lo ≤ value ≤ hi."""
     return isinstance(value, numbers.Integral) and not isinstance(value, bool) and lo <= int(value) <= hi
+
+
+def mixes_non_reals(value: object) -> bool:
+    """True for a list or tuple (nested or not) holding a bool, a complex number or anything else that is not a
+    real number: NumPy would turn ``[0.1, True]`` into floats without a word. Arrays are judged by their dtype
+    instead (this looks at Python sequences only)."""
+    if not isinstance(value, list | tuple):
+        return False
+    import numpy as np  # here: this lowest layer is read by start-up paths that load no NumPy
+
+    try:
+        items = np.array(value, dtype=object).ravel()
+    except ValueError:  # ragged: not numbers in a shape
+        return True
+    return any(isinstance(x, bool | np.bool_) or not isinstance(x, numbers.Real) for x in items)

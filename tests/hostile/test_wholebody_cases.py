@@ -239,3 +239,20 @@ def test_an_edit_of_the_models_limits_is_refused_not_silently_ignored(talos):
     target = pin.SE3(np.eye(3), tight.frame_placement(q, HAND).translation + np.array([0.0, 0.0, 0.3]))
     res = kinelab.step(tight, q, [FrameTask(HAND, target, task="position")], 0.5)
     assert res.solved and res.q[j.idx_q] <= model.upperPositionLimit[j.idx_q] + 1e-9
+
+
+def test_a_position_limit_wins_over_the_acceleration_limit_on_both_paths(talos):
+    """Found by the whole-body fuzz: with every joint moving at -1 rad/s before the step and a·dt = 0.05, a joint
+    0.005 rad above its lower limit was sent 0.0095 rad past it (both steps let the acceleration band win where it
+    lay wholly beyond the position bound). The position limit holds; the acceleration yields."""
+    q = talos.neutral()
+    j = talos.model.joints[talos.model.getJointId("arm_left_4_joint")]
+    q[j.idx_q] = talos.model.lowerPositionLimit[j.idx_q] + 0.005
+    tasks = [ComTask(talos.com(q), axes="xy")]
+    lim = Limits(acceleration=5.0)
+    v_prev = np.full(talos.nv, -1.0)
+    for res in (kinelab.step(talos, q, tasks, .01, limits=lim, v_prev=v_prev),
+                readable(talos, q, tasks, .01, limits=lim, v_prev=v_prev)):
+        assert res.solved and talos.within_limits(res.q)
+        assert res.q[j.idx_q] >= talos.model.lowerPositionLimit[j.idx_q] - 1e-12
+        assert res.v[j.idx_v] == pytest.approx(-0.5, abs=1e-9)  # as near the band as the position allows

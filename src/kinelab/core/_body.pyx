@@ -286,7 +286,7 @@ cdef class Tree:
         |v − v_prev| ≤ amax·dt); a joint outside its limits only comes back, at most at its velocity limit
         (``returning``): :func:`kinelab.wholebody.limits.bounds`, compiled."""
         cdef int j, i, v
-        cdef double pl, pu
+        cdef double pl, pu, a_lo, a_hi
         for v in range(self.nv):
             lo[v], hi[v], returning[v] = -vmax[v], vmax[v], 0
         if position:
@@ -302,10 +302,14 @@ cdef class Tree:
                 else:
                     lo[v], hi[v] = max(pl, -vmax[v]), min(pu, vmax[v])
         if amax != NULL and v_prev != NULL:
-            for v in range(self.nv):
-                lo[v], hi[v] = max(lo[v], v_prev[v] - amax[v] * dt), min(hi[v], v_prev[v] + amax[v] * dt)
-                if lo[v] > hi[v]:
+            for v in range(self.nv):  # the acceleration yields where it cannot keep within the others
+                a_lo, a_hi = v_prev[v] - amax[v] * dt, v_prev[v] + amax[v] * dt
+                if a_hi < lo[v]:
+                    hi[v] = lo[v]
+                elif a_lo > hi[v]:
                     lo[v] = hi[v]
+                else:
+                    lo[v], hi[v] = max(lo[v], a_lo), min(hi[v], a_hi)
 
     cdef void forward(self, const double* q) noexcept nogil:
         """Every joint's world placement at q."""

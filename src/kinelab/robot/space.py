@@ -16,6 +16,7 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from kinelab.errors import ConfigurationError, DescriptionError, JointLimitError, OptionError, count_of
+from kinelab.values import mixes_non_reals
 
 LIMIT_SLACK = 1e-9  # joint values this far past a limit still count as within it (rad or m)
 MAX_COORDINATE = 1e6  # [m or rad] a coordinate beyond it is no configuration (a base 1000 km away, say)
@@ -130,7 +131,7 @@ def check_q(space: Space, model: pin.Model, q: ArrayLike, *, limits: bool = Fals
     """
     try:
         raw = np.asarray(q)
-        if raw.dtype.kind not in "fiu":
+        if raw.dtype.kind not in "fiu" or mixes_non_reals(q):
             raise TypeError
     except (TypeError, ValueError):
         raise ConfigurationError(f"{what} must be {space.nq} numbers (Pinocchio's q), got {q!r}") from None

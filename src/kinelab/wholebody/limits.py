@@ -15,7 +15,7 @@ import numpy as np
 
 from kinelab.errors import OptionError
 from kinelab.robot.space import LIMIT_SLACK, Space
-from kinelab.values import is_real
+from kinelab.values import is_real, mixes_non_reals
 
 
 @dataclass(frozen=True)
@@ -69,7 +69,7 @@ def _real(value: Any) -> np.ndarray | None:
         arr = np.asarray(value)
     except (TypeError, ValueError):
         return None
-    return arr.astype(float) if arr.dtype.kind in "iuf" else None
+    return arr.astype(float) if arr.dtype.kind in "iuf" and not mixes_non_reals(value) else None
 
 
 def velocity_bounds(limits: Limits, space: Space) -> np.ndarray:
@@ -138,10 +138,11 @@ def bounds(space: Space, q: np.ndarray, dt: float, vmax: np.ndarray, position: b
         new_hi = np.where(above, np.maximum(pu, vl), np.minimum(pu, vu))
         lo[idx], hi[idx] = new_lo, new_hi
         returning[idx] = below | above
-    if amax is not None and v_prev is not None:
-        lo, hi = np.maximum(lo, v_prev - amax * dt), np.minimum(hi, v_prev + amax * dt)
-        crossed = lo > hi  # the acceleration cannot keep within the others: the position's bound wins
-        lo[crossed] = hi[crossed]
+    if amax is not None and v_prev is not None:  # the acceleration yields where it cannot keep within the others
+        a_lo, a_hi = v_prev - amax * dt, v_prev + amax * dt
+        below, above = a_hi < lo, a_lo > hi  # its whole band beyond what the positions and velocities allow
+        lo, hi = (np.where(below, lo, np.where(above, hi, np.maximum(lo, a_lo))),
+                  np.where(below, lo, np.where(above, hi, np.minimum(hi, a_hi))))
     return lo, hi, returning
 
 

@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike
 from kinelab.core._verdict import pose_defect
 from kinelab.errors import OptionError, TargetError, count_of
 from kinelab.typing import Configuration
-from kinelab.values import is_real
+from kinelab.values import is_real, mixes_non_reals
 
 FRAME_TASKS = ("pose", "position", "axis", "orientation")
 AXES = "xyz"
@@ -161,6 +161,8 @@ def _real_array(value: Any, what: str) -> np.ndarray:
         arr = np.array(value)
     except (TypeError, ValueError):
         raise TargetError(f"{what}, got {value!r}") from None
+    if mixes_non_reals(value):
+        raise TargetError(f"{what} (real numbers only: a bool or a complex number among them), got {value!r}")
     if arr.dtype.kind not in "iuf":  # booleans, complex numbers, text and objects are not coordinates
         raise TargetError(f"{what} (real numbers, not {arr.dtype.name}), got {value!r}")
     return arr.astype(float)
