@@ -68,7 +68,7 @@ def _daqp(H: np.ndarray, f: np.ndarray, lower: np.ndarray, upper: np.ndarray, A_
     lo = np.concatenate([np.maximum(lower, -BIG), [] if b_eq is None else b_eq])
     sense = np.zeros(n + m, dtype=c_int)
     sense[n:] = EQUALITY
-    x, _, flag, info = daqp.solve(H, f, A, up, lo, sense)  # its own iteration limit (1,000 by default) bounds it
+    x, _, flag, info = daqp.solve(H, f, A, up, lo, sense, iter_limit=MAX_ITERATIONS)
     solved = flag in (1, 2)
     x = np.clip(np.asarray(x, dtype=float), lower, upper)  # its bounds hold to its tolerance (1e-7): exactly here
     return Solution(x if solved else np.full(n, np.nan), DAQP_STATUS.get(flag, str(flag)), solved,
