@@ -39,7 +39,8 @@ _LAZY = {
     "RelativeFrameTask": ("kinelab.wholebody.tasks", "RelativeFrameTask"),
     "ComTask": ("kinelab.wholebody.tasks", "ComTask"),
     "PostureTask": ("kinelab.wholebody.tasks", "PostureTask"),
-    "CouplingTask": ("kinelab.wholebody.tasks", "CouplingTask"),
+    "CouplingTask": ("kinelab.wholebody.constraints", "CouplingTask"),
+    "DampingTask": ("kinelab.wholebody.tasks", "DampingTask"),
     "Limits": ("kinelab.wholebody.limits", "Limits"),
     "StepOptions": ("kinelab.wholebody.step", "StepOptions"),
     "StepResult": ("kinelab.wholebody.step", "StepResult"),
@@ -101,16 +102,18 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
     from kinelab.robot.loading import load
     from kinelab.robot.tree import Robot
     from kinelab.wholebody.api import solve, track
+    from kinelab.wholebody.constraints import CouplingTask
     from kinelab.wholebody.limits import Limits
     from kinelab.wholebody.solve import WholeBodyResult
     from kinelab.wholebody.step import StepOptions, StepResult, step
-    from kinelab.wholebody.tasks import ComTask, CouplingTask, FrameTask, PostureTask, RelativeFrameTask
+    from kinelab.wholebody.tasks import ComTask, DampingTask, FrameTask, PostureTask, RelativeFrameTask
 
 
 __all__ = [
     "BatchIKResult",
     "ComTask",
     "CouplingTask",
+    "DampingTask",
     "FrameTask",
     "Limits",
     "PostureTask",

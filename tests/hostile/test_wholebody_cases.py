@@ -244,7 +244,8 @@ def test_an_edit_of_the_models_limits_is_refused_not_silently_ignored(talos):
 def test_a_position_limit_wins_over_the_acceleration_limit_on_both_paths(talos):
     """Found by the whole-body fuzz: with every joint moving at -1 rad/s before the step and a·dt = 0.05, a joint
     0.005 rad above its lower limit was sent 0.0095 rad past it (both steps let the acceleration band win where it
-    lay wholly beyond the position bound). The position limit holds; the acceleration yields."""
+    lay wholly beyond the position bound). The position limit holds; the acceleration yields, and the joint moves
+    no faster than it can still stop before the limit braking at a: v·dt + v²/(2a) ≤ d (docs/wholebody.md)."""
     q = talos.neutral()
     j = talos.model.joints[talos.model.getJointId("arm_left_4_joint")]
     q[j.idx_q] = talos.model.lowerPositionLimit[j.idx_q] + 0.005
@@ -255,4 +256,23 @@ def test_a_position_limit_wins_over_the_acceleration_limit_on_both_paths(talos):
                 readable(talos, q, tasks, .01, limits=lim, v_prev=v_prev)):
         assert res.solved and talos.within_limits(res.q)
         assert res.q[j.idx_q] >= talos.model.lowerPositionLimit[j.idx_q] - 1e-12
-        assert res.v[j.idx_v] == pytest.approx(-0.5, abs=1e-9)  # as near the band as the position allows
+        a, dt, d = 5.0, 0.01, 0.005
+        assert res.v[j.idx_v] == pytest.approx(a * dt - np.sqrt((a * dt) ** 2 + 2 * a * d), abs=1e-9)
+
+
+def test_acceleration_and_position_limits_hold_together_from_a_consistent_start(talos):
+    """A joint driven at its limit with an acceleration limit: it brakes in time (the braking bound), so that no
+    step breaks either limit, on both paths."""
+    j = talos.model.joints[talos.model.getJointId("arm_left_1_joint")]
+    lim, dt, a = Limits(acceleration=3.0), 0.01, 3.0
+    for path in (kinelab.step, lambda r, q, t, d, limits, v_prev: readable(r, q, t, d, limits, v_prev)):
+        q, v = talos.neutral(), np.zeros(talos.nv)
+        target = talos.frame_placement(q, HAND).translation + np.array([0.0, 2.0, 0.0])  # out of reach: pushes on
+        tasks = [FrameTask(HAND, pin.SE3(np.eye(3), target), task="position")]
+        for _ in range(150):
+            res = path(talos, q, tasks, dt, limits=lim, v_prev=v)
+            assert res.solved and talos.within_limits(res.q)
+            assert np.abs(res.v - v).max() <= a * dt * (1 + 1e-9) + 1e-12
+            q, v = res.q, res.v
+        lo, hi = talos.model.lowerPositionLimit[j.idx_q], talos.model.upperPositionLimit[j.idx_q]
+        assert min(q[j.idx_q] - lo, hi - q[j.idx_q]) < 0.05  # it reached its limit, braking

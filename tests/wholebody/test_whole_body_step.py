@@ -229,3 +229,55 @@ def test_the_limit_check_fails_when_a_bound_is_dropped(monkeypatch, dropped):
     monkeypatch.setattr(step_module, "_compiled", lambda *args: None)  # the readable step, whose bounds are patched
     monkeypatch.setattr(step_module, "bounds", without)
     assert limits_check(baxter, 10, 0)[0].value > 0
+
+
+@pytest.mark.parametrize("name", ["panda", "talos"])
+def test_a_damping_task_is_the_same_step_compiled_and_readable(name):
+    """#68: DampingTask (pink's and mink's) is one class, in both steps: each task's rate and error agree between
+    the compiled and the readable step, at priority 1 and 2, one weight or one per velocity."""
+    import importlib
+
+    from kinelab import DampingTask
+    from kinelab.wholebody import evaluate as ev
+
+    readable = importlib.import_module("kinelab.wholebody.step")._step
+    robot = robot_of(name)
+    rng = np.random.default_rng(23)
+    frames = FRAMES[name]
+    for k in range(8):
+        q, qt = robot.random_q(rng), robot.random_q(rng)
+        tasks = [FrameTask(f, T, task="position") for f, T in zip(frames, robot.frame_placements(qt, frames),
+                                                                     strict=True)]
+        weight = 0.5 if k % 2 else rng.uniform(0.0, 1.0, robot.nv)
+        tasks += [DampingTask(weight, priority=1 + (k // 2) % 2), ComTask(robot.com(qt), axes="xy", priority=2)]
+        fast = step(robot, q, tasks, 0.05)
+        slow = readable(robot, q, tuple(tasks), 0.05, Limits(), StepOptions(), None)
+        assert fast.solved and slow.solved
+        assert np.abs(fast.v - slow.v).max() <= 1e-6 * max(1.0, np.abs(slow.v).max())
+        ev.forward(robot, q, com=True)
+        for a, b in zip(fast.errors, slow.errors, strict=True):
+            assert a.label == b.label and abs(a.position - b.position) <= 1e-12 and abs(a.rotation - b.rotation) <= 1e-9
+
+
+def test_a_damping_task_is_ridge_regression_by_numpy():
+    """Unbounded, one position task and DampingTask(w): v = (AᵀA + (w + λ) I)⁻¹ Aᵀ b, b = −e/dt, by NumPy."""
+    from kinelab import DampingTask
+
+    robot = robot_of("panda")
+    rng = np.random.default_rng(4)
+    q = robot.random_q(rng)
+    frame = FRAMES["panda"][0]
+    target = robot.frame_placement(q, frame).translation + np.array([0.05, -0.02, 0.03])
+    dt, w, lam = 0.1, 0.3, 1e-6
+    res = step(robot, q, [FrameTask(frame, target, task="position"), DampingTask(w)], dt,
+               limits=Limits(position=False, velocity=None))
+    pin.computeJointJacobians(robot.model, robot.data, q)
+    pin.updateFramePlacements(robot.model, robot.data)
+    fid = robot.model.getFrameId(frame)
+    A = pin.getFrameJacobian(robot.model, robot.data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)[:3]
+    b = -(robot.data.oMf[fid].translation - target) / dt
+    expected = np.linalg.solve(A.T @ A + (w + lam) * np.eye(robot.nv), A.T @ b)
+    assert res.solved and np.abs(res.v - expected).max() <= 1e-8 * max(1.0, np.abs(expected).max())
+    plain = step(robot, q, [FrameTask(frame, target, task="position")], dt, limits=Limits(position=False,
+                                                                                         velocity=None))
+    assert np.linalg.norm(res.v) < np.linalg.norm(plain.v)  # the damping slows what the task leaves free

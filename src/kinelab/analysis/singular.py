@@ -22,6 +22,7 @@ import numpy as np
 from kinelab.errors import OptionError
 from kinelab.robot import Chain
 from kinelab.robot.poses import NEAR_SINGULAR as NEAR_SINGULAR  # σ_min/σ_max below: near-singular (one threshold)
+from kinelab.typing import Configuration
 
 
 def sigma_words(ratio: float) -> str:
@@ -154,7 +155,7 @@ def checked_length(length: object) -> float:
     return float(length)  # type: ignore[arg-type]
 
 
-def analyze(robot: Chain, q, length: float | None = None) -> Analysis:
+def analyze(robot: Chain, q: Configuration, length: float | None = None) -> Analysis:
     """SVD of the scaled tool Jacobian at q: rank, σ, manipulability, condition, lost and null directions.
 
     Args:

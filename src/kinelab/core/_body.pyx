@@ -12,7 +12,7 @@ certifies the two equal on each robot before this path serves it.
 
 import numpy as np
 
-from libc.math cimport acos, asin, atan2, cos, fabs, sin, sqrt, M_PI
+from libc.math cimport INFINITY, acos, asin, atan2, cos, fabs, sin, sqrt, M_PI
 from libc.string cimport memcpy, memset
 
 from kinelab.core._blas cimport dgemm, ready
@@ -301,6 +301,9 @@ cdef class Tree:
                     lo[v], hi[v], returning[v] = max(pl, -vmax[v]), max(pu, -vmax[v]), 1
                 else:
                     lo[v], hi[v] = max(pl, -vmax[v]), min(pu, vmax[v])
+                    if amax != NULL and amax[v] < INFINITY:  # no faster than it can still stop before the limit
+                        hi[v] = min(hi[v], _braking(pu * dt, amax[v], dt))
+                        lo[v] = max(lo[v], -_braking(-pl * dt, amax[v], dt))
         if amax != NULL and v_prev != NULL:
             for v in range(self.nv):  # the acceleration yields where it cannot keep within the others
                 a_lo, a_hi = v_prev[v] - amax[v] * dt, v_prev[v] + amax[v] * dt
@@ -486,9 +489,10 @@ cdef class Step:
     cdef int[::1] kind, joint, root, axis, priority, rows
     cdef double[:, ::1] place, root_place, target
     cdef double[::1] wp, wo, gain
-    cdef double[::1] post_ref, post_w
+    cdef double[::1] post_ref, post_w, damping1, damping2
     cdef double post_gain
     cdef int post_priority
+    cdef bint level2
     cdef int[::1] cq, cv, lq, lv, slot, cslot
     cdef int post_slot
     cdef double[::1] cratio, coffset
@@ -497,19 +501,24 @@ cdef class Step:
     cdef double[::1] b1, b2, w1, w2, f, lower, upper, bl, bu, x, x1, lam, c
     cdef int[::1] sense, warm
 
-    def __init__(self, Tree tree, int[::1] kind, int[::1] joint, int[::1] root, int[::1] axis, int[::1] priority,
-                 double[:, ::1] place, double[:, ::1] root_place, double[::1] wp, double[::1] wo, double[::1] gain,
-                 double[::1] post_ref, double[::1] post_w, double post_gain, int post_priority, int[::1] cq,
-                 int[::1] cv, int[::1] lq, int[::1] lv, double[::1] cratio, double[::1] coffset, int[::1] slot,
-                 int post_slot, int[::1] cslot):
+    def __init__(self, Tree tree, problem):
+        """The step of ``problem`` (:class:`kinelab.wholebody.compiled.StepProblem`: the tasks' blocks, the
+        posture, the dampings and the couplings, as named arrays) on ``tree``."""
         cdef int t, n
-        self.slot, self.post_slot, self.cslot = slot, post_slot, cslot
+        cdef int[::1] kind = problem.kind
+        cdef int[::1] axis = problem.axis
+        cdef int[::1] priority = problem.priority
         ready()  # BLAS from SciPy, once per process
+        self.slot, self.post_slot, self.cslot = problem.slot, problem.post_slot, problem.cslot
         self.tree, self.ntasks = tree, kind.shape[0]
-        self.kind, self.joint, self.root, self.axis, self.priority = kind, joint, root, axis, priority
-        self.place, self.root_place, self.wp, self.wo, self.gain = place, root_place, wp, wo, gain
-        self.post_ref, self.post_w, self.post_gain, self.post_priority = post_ref, post_w, post_gain, post_priority
-        self.cq, self.cv, self.lq, self.lv, self.cratio, self.coffset = cq, cv, lq, lv, cratio, coffset
+        self.kind, self.joint, self.root, self.axis, self.priority = kind, problem.joint, problem.root, axis, priority
+        self.place, self.root_place = problem.place, problem.root_place
+        self.wp, self.wo, self.gain = problem.wp, problem.wo, problem.gain
+        self.post_ref, self.post_w = problem.post_ref, problem.post_w
+        self.post_gain, self.post_priority = problem.post_gain, problem.post_priority
+        self.damping1, self.damping2 = problem.damping1, problem.damping2
+        self.cq, self.cv, self.lq, self.lv = problem.cq, problem.cv, problem.lq, problem.lv
+        self.cratio, self.coffset = problem.cratio, problem.coffset
         self.target = np.zeros((self.ntasks, 12))
         self.rows = np.zeros(self.ntasks, dtype=np.intc)
         self.m1 = self.m2 = 0
@@ -521,7 +530,8 @@ cdef class Step:
             else:
                 self.m2 += n
         n = tree.nv
-        self.neq = cq.shape[0]
+        self.neq = self.cq.shape[0]
+        self.level2 = self.m2 > 0 or self.post_priority == 2 or np.any(problem.damping2)
         self.A1 = np.zeros((max(self.m1, 1), n))
         self.A2 = np.zeros((max(self.m2, 1), n))
         self.b1, self.w1 = np.zeros(max(self.m1, 1)), np.zeros(max(self.m1, 1))
@@ -572,7 +582,7 @@ cdef class Step:
             self._rows(&q[0], dt, &errors[0, 0])
             self._other_errors(&q[0], &errors[0, 0])
             flag = self._solve(1, &self.lower[0], &self.upper[0], damping, &q[0], dt, &iters)
-            if (flag == 1 or flag == 2) and self.m2 + (1 if self.post_priority == 2 else 0) > 0:
+            if (flag == 1 or flag == 2) and self.level2:
                 memcpy(&self.x1[0], &self.x[0], nv * sizeof(double))
                 level = self._solve(2, &self.lower[0], &self.upper[0], damping, &q[0], dt, &iters)
                 if not (level == 1 or level == 2):
@@ -714,7 +724,7 @@ cdef class Step:
         if m > 0:
             dgemm(&nt, &tr, &nv, &nv, &m, &alpha, A, &nv, A, &nv, &beta, &self.H[0, 0], &nv)
         for j in range(nv):
-            self.H[j, j] += damping
+            self.H[j, j] += damping + (self.damping1[j] if level == 1 else self.damping2[j])
         if self.post_priority == level:
             for j in range(nv):
                 if self.post_w[j] != 0.0:
@@ -753,6 +763,12 @@ cdef class Step:
         for j in range(nv):  # its bounds hold to its tolerance: exactly here
             self.x[j] = min(max(self.x[j], lower[j]), upper[j])
         return result.exitflag
+
+
+cdef inline double _braking(double distance, double amax, double dt) noexcept nogil:
+    """:func:`kinelab.wholebody.limits.braking`, for one joint with a finite amax."""
+    cdef double ad = amax * dt
+    return -ad + sqrt(ad * ad + 2.0 * amax * max(distance, 0.0))
 
 
 cdef inline bint _finite(const double* x, int n) noexcept nogil:

@@ -20,7 +20,7 @@ from kinelab.ik import api as chain_api
 from kinelab.robot.chain import Chain
 from kinelab.robot.tree import Robot
 from kinelab.typing import Target, Targets
-from kinelab.wholebody.tasks import TASK_TYPES, Task
+from kinelab.wholebody.tasks import Task
 
 if TYPE_CHECKING:
     from kinelab.wholebody import follow
@@ -32,9 +32,9 @@ else:  # a chain's solve does not load the whole-body step (its QP, its compiled
 
 def is_tasks(target: object) -> TypeGuard[Task | Sequence[Task]]:
     """True for a task or a non-empty list or tuple of tasks."""
-    if isinstance(target, TASK_TYPES):
+    if isinstance(target, Task):
         return True
-    return isinstance(target, list | tuple) and bool(target) and all(isinstance(t, TASK_TYPES) for t in target)
+    return isinstance(target, list | tuple) and bool(target) and all(isinstance(t, Task) for t in target)
 
 
 def solve(robot: Chain | Robot, target: Target | Sequence[Task], *positional: object, **settings: Any) -> Any:

@@ -10,7 +10,7 @@ installed module (its version checked); another version, or none, leaves the rea
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -18,14 +18,11 @@ import pinocchio as pin
 
 from kinelab.core import _body
 from kinelab.robot.tree import Robot
-from kinelab.wholebody import evaluate as ev
-from kinelab.wholebody.tasks import ComTask, CouplingTask, FrameTask, PostureTask, RelativeFrameTask, Task
+from kinelab.wholebody.tasks import Task
 
 CERTIFY_SAMPLES = 20
 CERTIFY_TOL = 1e-10  # [m, rad] compiled against Pinocchio
 DAQP_VERSIONS = ("0.11.",)  # the C interface's layout these declarations match
-KINDS = {"pose": 0, "position": 1, "orientation": 2, "axis": 3}
-T_RELATIVE, T_COM = 4, 5
 REVOLUTE, PRISMATIC, CONTINUOUS, FREEFLYER, MIMIC_REVOLUTE, MIMIC_PRISMATIC = range(6)
 
 
@@ -134,133 +131,147 @@ def certified(robot: Robot, tree: _body.Tree) -> bool:
     return True
 
 
+@dataclass(frozen=True)
+class StepProblem:
+    """A task list as the compiled step takes it, one record of named arrays (``_body.Step(tree, problem)``): per
+    weighted task (frames, relative frames, the centre of mass) its kind code, joint, root joint, axis (a centre
+    of mass's coordinates as bits), priority, placements [R row-major, t], weights and gain; the posture's
+    reference, weights, gain and priority (0: none); each level's damping per velocity; the couplings' q and v
+    indices, ratios and offsets; and each one's slot in the list (for its error)."""
+
+    kind: np.ndarray
+    joint: np.ndarray
+    root: np.ndarray
+    axis: np.ndarray
+    priority: np.ndarray
+    place: np.ndarray
+    root_place: np.ndarray
+    wp: np.ndarray
+    wo: np.ndarray
+    gain: np.ndarray
+    slot: np.ndarray
+    post_ref: np.ndarray
+    post_w: np.ndarray
+    post_gain: float
+    post_priority: int
+    post_slot: int
+    damping1: np.ndarray
+    damping2: np.ndarray
+    cq: np.ndarray
+    cv: np.ndarray
+    lq: np.ndarray
+    lv: np.ndarray
+    cratio: np.ndarray
+    coffset: np.ndarray
+    cslot: np.ndarray
+
+
+class Packer:
+    """What each task's :meth:`~kinelab.wholebody.tasks.Task.pack` hands over, collected into a
+    :class:`StepProblem`. A list the compiled step does not take (two postures, a posture on the free-flyer) is
+    ``refused`` with the reason, and the readable step answers it."""
+
+    def __init__(self, robot: Robot):
+        self.robot, self.index, self.refused = robot, 0, ""
+        self.blocks: list[tuple[Any, ...]] = []  # per weighted task: kind, joint, root, axis, priority, ...
+        self.slots: list[int] = []  # the list index of each weighted task
+        self.post: tuple[np.ndarray, float, int, int] | None = None  # weights, gain, priority, slot
+        self.diagonal = [np.zeros(robot.nv), np.zeros(robot.nv)]  # each level's damping per velocity
+        self.couplings: list[tuple[int, int, int, int, float, float, int]] = []
+
+    def weighted(self, task: Any, kind: int, joint: int, placement: pin.SE3 | None, axis: int, root: int = 0,
+                 root_placement: pin.SE3 | None = None) -> None:
+        """A weighted task's block: its kind code, the joint carrying its frame (and the root's), the frame's
+        placement on it, its axis code."""
+        place = np.zeros(12) if placement is None else _pose(placement)
+        other = np.zeros(12) if root_placement is None else _pose(root_placement)
+        self.blocks.append((kind, joint, root, axis, task.priority, place, other, task.weight,
+                            float(getattr(task, "orientation_weight", 0.0) or 0.0), task.gain))
+        self.slots.append(self.index)
+
+    def posture(self, task: Any, weights: np.ndarray) -> None:
+        """The one posture (its reference set per call)."""
+        if self.post is not None or task.base:
+            self.refused = "a second posture, or a posture on the free-flyer"
+        self.post = (weights, task.gain, task.priority, self.index)
+
+    def damping(self, task: Any, weights: np.ndarray) -> None:
+        """A damping's diagonal, at its level."""
+        self.diagonal[task.priority - 1] += weights
+
+    def coupling(self, task: Any, qj: int, vj: int, ql: int, vl: int) -> None:
+        """A coupling's indices, ratio and offset."""
+        self.couplings.append((qj, vj, ql, vl, task.ratio, task.offset, self.index))
+
+    def decline(self, reason: str) -> None:
+        """A task the compiled step has no block for (a user's own): the readable step answers the list."""
+        self.refused = reason
+
+    def problem(self) -> StepProblem:
+        """The record the compiled step is built from."""
+        b = list(zip(*self.blocks, strict=True)) if self.blocks else [()] * 10
+        ints = lambda values: np.array(values, dtype=np.intc)  # noqa: E731
+        c = list(zip(*self.couplings, strict=True)) if self.couplings else [()] * 7
+        weights, post_gain, post_priority, post_slot = self.post or (np.zeros(self.robot.nv), 0.0, 0, -1)
+        return StepProblem(ints(b[0]), ints(b[1]), ints(b[2]), ints(b[3]), ints(b[4]),
+                           np.array(b[5], dtype=float).reshape(-1, 12), np.array(b[6], dtype=float).reshape(-1, 12),
+                           np.array(b[7], dtype=float), np.array(b[8], dtype=float), np.array(b[9], dtype=float),
+                           ints(self.slots), self.robot.neutral(), np.array(weights, dtype=float), post_gain,
+                           post_priority, post_slot, self.diagonal[0], self.diagonal[1], ints(c[0]), ints(c[1]),
+                           ints(c[2]), ints(c[3]), np.array(c[4], dtype=float), np.array(c[5], dtype=float),
+                           ints(c[6]))
+
+
 @dataclass
 class Packed:
-    """A task list's compiled problem: the Step and, per task, what to copy into it each call."""
+    """A task list's compiled problem: the Step, its record, and the slots each task's target is written to per
+    call (:meth:`~kinelab.wholebody.tasks.Task.refresh` calls :meth:`set_pose`, :meth:`set_point`,
+    :meth:`set_posture`)."""
 
     step: _body.Step
-    targets: tuple[int, ...]  # indices of the tasks whose target is set per call (frames, relative, CoM)
-    posture: int  # index of the posture task, or -1
-    post_ref: np.ndarray  # the posture's reference, which the Step reads (written per call)
-    post_w: np.ndarray  # the posture's weight per velocity, which the Step reads (written per call)
+    problem: StepProblem
+    slots: tuple[int, ...]  # per task of the list: its weighted slot, or -1
     labels: tuple[str, ...]  # each task's label, in order
-    current: Any = None  # the ids of the task objects whose targets the Step holds
+    current: Any = None  # the task objects whose targets the Step holds
+
+    def set_pose(self, slot: int, H: np.ndarray) -> None:
+        """A weighted task's target pose (4 × 4)."""
+        self.step.set_pose(slot, H)
+
+    def set_point(self, slot: int, p: np.ndarray) -> None:
+        """A weighted task's target point [m]."""
+        self.step.set_point(slot, p)
+
+    def set_posture(self, q_ref: np.ndarray, weights: np.ndarray | None) -> None:
+        """The posture's reference (and per-velocity weights when they are set per call)."""
+        self.problem.post_ref[:] = q_ref
+        if weights is not None:
+            self.problem.post_w[:] = weights
 
 
-def structure(tasks: tuple[Task, ...]) -> tuple[Any, ...] | None:
-    """The key of a task list's compiled problem (everything but the targets and the posture's reference: each
-    task's :meth:`shape`), or None where the compiled step does not take it (more than one posture, a posture on
-    the free-flyer)."""
-    key = tuple(t.shape() for t in tasks)
-    postures = [k for k in key if k[0] == "p"]
-    if len(postures) > 1 or any(k[-1] for k in postures):
+def structure(tasks: tuple[Task, ...]) -> tuple[Any, ...]:
+    """The key of a task list's compiled problem: each task's :meth:`~kinelab.wholebody.tasks.Task.shape`
+    (everything but the targets and the posture's reference)."""
+    return tuple(t.shape() for t in tasks)
+
+
+def pack(robot: Robot, tree: _body.Tree, tasks: tuple[Task, ...]) -> Packed | None:
+    """The compiled problem of a task list, each task packing its own block; None where the compiled step does not
+    take the list (the readable step answers it)."""
+    packer = Packer(robot)
+    for i, task in enumerate(tasks):
+        packer.index = i
+        task.pack(packer, robot)
+    if packer.refused:
         return None
-    return key
-
-
-def pack(robot: Robot, tree: _body.Tree, tasks: tuple[Task, ...]) -> Packed:
-    """The compiled problem of a task list (see :func:`structure`)."""
-    kinds = _Kinds.of(tasks)
-    post, couplings = kinds.posture, kinds.couplings
-    post_w = np.zeros(robot.nv) if post is None else ev.posture_weight(robot, post)
-    post_ref = robot.neutral()
-    step = _body.Step(tree, *_weighted_rows(robot, kinds.weighted), post_ref, post_w, *_posture_terms(post),
-                      *_coupling_indices(robot, couplings), np.array([c.ratio for c in couplings]),
-                      np.array([c.offset for c in couplings]), np.array(kinds.targets, dtype=np.intc),
-                      kinds.posture_index, np.array(kinds.coupling_index, dtype=np.intc))
-    return Packed(step, kinds.targets, kinds.posture_index, post_ref, post_w, tuple(t.label for t in tasks))
-
-
-@dataclass
-class _Kinds:
-    """A task list sorted by what the compiled step does with each: the weighted tasks (frames, relative frames,
-    the CoM: their targets set per call), the posture (one at most) and the couplings, with their places in the
-    list."""
-
-    weighted: list[FrameTask | RelativeFrameTask | ComTask] = field(default_factory=list)
-    targets: tuple[int, ...] = ()
-    posture: PostureTask | None = None
-    posture_index: int = -1
-    couplings: list[CouplingTask] = field(default_factory=list)
-    coupling_index: list[int] = field(default_factory=list)
-
-    @classmethod
-    def of(cls, tasks: tuple[Task, ...]) -> _Kinds:
-        kinds = cls()
-        for i, t in enumerate(tasks):
-            if isinstance(t, PostureTask):
-                kinds.posture, kinds.posture_index = t, i
-            elif isinstance(t, CouplingTask):
-                kinds.couplings.append(t)
-                kinds.coupling_index.append(i)
-            else:
-                kinds.weighted.append(t)
-                kinds.targets += (i,)
-        return kinds
-
-
-def _posture_terms(post: PostureTask | None) -> tuple[float, int]:
-    """The posture's gain and priority for the compiled step (0, 0: no posture)."""
-    return (0.0, 0) if post is None else (post.gain, post.priority)
-
-
-Rows = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
-             np.ndarray, np.ndarray]
-
-
-def _weighted_rows(robot: Robot, weighted: list[FrameTask | RelativeFrameTask | ComTask]) -> Rows:
-    """The compiled step's arrays of the weighted tasks (frames and the CoM), one entry per task: kind, joint,
-    root joint, axis (or the CoM's component bits), priority, placement, root placement, position weight,
-    orientation weight, gain."""
-    n = len(weighted)
-    kind, joint, root = np.zeros(n, dtype=np.intc), np.zeros(n, dtype=np.intc), np.zeros(n, dtype=np.intc)
-    axis, priority = np.zeros(n, dtype=np.intc), np.ones(n, dtype=np.intc)
-    place, root_place = np.zeros((n, 12)), np.zeros((n, 12))
-    wp, wo, gain = np.zeros(n), np.zeros(n), np.zeros(n)
-    for k, t in enumerate(weighted):
-        priority[k], gain[k], wp[k] = t.priority, t.gain, t.weight
-        if isinstance(t, ComTask):
-            kind[k], axis[k] = T_COM, sum(1 << i for i in t.index)
-            continue
-        frame = robot.model.frames[robot.frame_id(t.frame)]
-        joint[k], place[k], wo[k] = frame.parentJoint, _pose(frame.placement), float(t.orientation_weight or 0.0)
-        if isinstance(t, RelativeFrameTask):
-            other = robot.model.frames[robot.frame_id(t.root)]
-            kind[k], root[k], root_place[k] = T_RELATIVE, other.parentJoint, _pose(other.placement)
-        else:
-            kind[k], axis[k] = KINDS[t.task], "xyz".index(t.axis)
-    return kind, joint, root, axis, priority, place, root_place, wp, wo, gain
-
-
-def _coupling_indices(robot: Robot,
-                      couplings: list[CouplingTask]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Each coupled joint's and its leader's q and velocity indices: (joint q, joint v, leader q, leader v)."""
-    ids = [[robot.model.joints[robot.model.getJointId(n)] for n in (c.joint, c.leader)] for c in couplings]
-    return (np.array([a.idx_q for a, _ in ids], dtype=np.intc), np.array([a.idx_v for a, _ in ids], dtype=np.intc),
-            np.array([b.idx_q for _, b in ids], dtype=np.intc), np.array([b.idx_v for _, b in ids], dtype=np.intc))
+    problem = packer.problem()
+    slots = [-1] * len(tasks)
+    for k, i in enumerate(packer.slots):
+        slots[i] = k
+    return Packed(_body.Step(tree, problem), problem, tuple(slots), tuple(t.label for t in tasks))
 
 
 def set_targets(robot: Robot, packed: Packed, tasks: tuple[Task, ...]) -> None:
-    """Copy each task's target (and the posture's reference) into the packed problem."""
-    step = packed.step
-    for k, i in enumerate(packed.targets):
-        task = tasks[i]
-        if isinstance(task, ComTask):
-            step.set_point(k, task.target)
-        else:
-            step.set_pose(k, task.target.homogeneous)  # type: ignore[union-attr]
-    if packed.posture >= 0:
-        posture = tasks[packed.posture]
-        assert isinstance(posture, PostureTask)
-        packed.post_ref[:] = ev.checked_ref(robot, posture)
-        if isinstance(posture.weight, np.ndarray):
-            packed.post_w[:] = ev.posture_weight(robot, posture)
-
-
-def target_of(task: Task) -> np.ndarray:
-    """A task's target as the compiled step reads it: 12 numbers (R row-major, t), a CoM's in the last three."""
-    if isinstance(task, ComTask):
-        out = np.zeros(12)
-        out[9:] = task.target
-        return out
-    return _pose(task.target)  # type: ignore[union-attr]
+    """Each task's target (and the posture's reference) written into the packed problem."""
+    for task, slot in zip(tasks, packed.slots, strict=True):
+        task.refresh(packed, robot, slot)

@@ -1,4 +1,6 @@
-"""Each task's error and rate matrix at a configuration, from one Pinocchio pass (``computeJointJacobians``).
+"""What the readable step's tasks share: Pinocchio's pass at a configuration (``computeJointJacobians``), the rows
+of each priority level the tasks add themselves to (:meth:`kinelab.wholebody.tasks.Task.add_to`), and the shapes
+of their answers.
 
 A task gives ``(A, e)``: its error e (m, rad) and A with ``de/dt = A v`` to first order (v: nv velocities). A frame's
 pose error is its position's and its rotation's, apart: the frame origin's offset from the target's in world axes
@@ -9,28 +11,87 @@ in the root frame's axes.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 import pinocchio as pin
 
-from kinelab.errors import ConfigurationError, JointNotFoundError, OptionError
-from kinelab.robot.tree import Robot
-from kinelab.wholebody.tasks import ComTask, CouplingTask, FrameTask, PostureTask, RelativeFrameTask, Task
+if TYPE_CHECKING:
+    from kinelab.robot.tree import Robot
 
 LOCAL = pin.ReferenceFrame.LOCAL
+Rowset = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]  # A, e, the rows' weights, a pose's gap
+# one FRDM point of a task: (frame, point, target, weight, is a direction, carrier frame, follows)
+PointRow = tuple[int, np.ndarray, np.ndarray, float, bool, int, np.ndarray]
+
+
+class Packing(Protocol):
+    """What a task hands its block of the compiled problem to (:class:`kinelab.wholebody.compiled.Packer`)."""
+
+    def weighted(self, task: Any, kind: int, joint: int, placement: pin.SE3 | None, axis: int, root: int = 0,
+                 root_placement: pin.SE3 | None = None) -> None:
+        """A weighted task's block."""
+
+    def posture(self, task: Any, weights: np.ndarray) -> None:
+        """The posture."""
+
+    def damping(self, task: Any, weights: np.ndarray) -> None:
+        """A damping's diagonal."""
+
+    def coupling(self, task: Any, qj: int, vj: int, ql: int, vl: int) -> None:
+        """A coupling's indices."""
+
+    def decline(self, reason: str) -> None:
+        """A block the compiled step has no code for: the readable step answers the list (``reason`` says why)."""
+
+
+class TargetSlots(Protocol):
+    """Where a task writes its target per call (:class:`kinelab.wholebody.compiled.Packed`)."""
+
+    def set_pose(self, slot: int, H: np.ndarray) -> None:
+        """A target pose."""
+
+    def set_point(self, slot: int, p: np.ndarray) -> None:
+        """A target point."""
+
+    def set_posture(self, q_ref: np.ndarray, weights: np.ndarray | None) -> None:
+        """The posture's reference."""
 
 
 @dataclass
 class Rows:
     """The weighted rows of one priority level: ``A v ≈ b`` with b = −gain·e/dt, each row's weight ``w``, and the
-    posture's diagonal part (``diag``: the weight per velocity, ``target``: its b)."""
+    diagonal part (``diag``: a weight per velocity — a posture's, a damping's — and ``target``: its pull)."""
 
     A: list[np.ndarray]
     b: list[np.ndarray]
     w: list[np.ndarray]
     diag: np.ndarray
     target: np.ndarray
+
+    def add(self, A: np.ndarray, b: np.ndarray, w: np.ndarray) -> None:
+        """Rows ``A v ≈ b``, weighted row by row by ``w``."""
+        self.A.append(A)
+        self.b.append(b)
+        self.w.append(w)
+
+
+@dataclass
+class StepRows:
+    """What the tasks of one readable step put in: two priority levels and the equalities ``a · v = c``."""
+
+    nv: int
+    levels: list[Rows] = field(init=False)
+    equalities: list[tuple[np.ndarray, float]] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.levels = [Rows([], [], [], np.zeros(self.nv), np.zeros(self.nv)) for _ in range(2)]
+
+    def used(self) -> list[Rows]:
+        """The levels a task asked something of (the first alone when none did)."""
+        used = [lv for lv in self.levels if lv.A or lv.diag.any()]
+        return used or self.levels[:1]
 
 
 def skew(a: np.ndarray) -> np.ndarray:
@@ -47,128 +108,20 @@ def forward(robot: Robot, q: np.ndarray, com: bool) -> None:
         pin.jacobianCenterOfMass(robot.model, robot.data, False)
 
 
-Rowset = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]  # A, e, the rows' weights, a pose's gap
+def task_rows(robot: Robot, task: Any) -> Rowset:
+    """(A, e, per-row weight, a pose's translation gap) of a frame, relative frame or centre-of-mass task at
+    ``robot.data``'s configuration (the task's own :meth:`rows`)."""
+    rows: Rowset = task.rows(robot)
+    return rows
 
 
-def frame_rows(robot: Robot, task: FrameTask) -> Rowset:
-    """(A, e, per-row weight, the translation gap of a pose [m]) of a frame task at ``robot.data``'s configuration."""
-    fid = robot.frame_id(task.frame)
-    oMf = robot.data.oMf[fid]
-    J = pin.getFrameJacobian(robot.model, robot.data, fid, LOCAL)
-    wp, wo = task.weight, task.orientation_weight
-    if task.task == "pose":
-        E_R = oMf.rotation.T @ task.target.rotation
-        A = np.vstack([oMf.rotation @ J[:3], -pin.Jlog3(E_R.T) @ J[3:]])
-        e = np.concatenate([oMf.translation - task.target.translation, pin.log3(E_R)])
-        return A, e, np.array([wp, wp, wp, wo, wo, wo]), None
-    if task.task == "position":
-        return oMf.rotation @ J[:3], oMf.translation - task.target.translation, np.full(3, wp), None
-    if task.task == "orientation":
-        E_R = oMf.rotation.T @ task.target.rotation
-        return -pin.Jlog3(E_R.T) @ J[3:], pin.log3(E_R), np.full(3, wo), None
-    k = "xyz".index(task.axis)
-    a, t = oMf.rotation[:, k], task.target.rotation[:, k]
-    A = np.vstack([oMf.rotation @ J[:3], -skew(a) @ oMf.rotation @ J[3:]])
-    e = np.concatenate([oMf.translation - task.target.translation, a - t])
-    return A, e, np.array([wp, wp, wp, wo, wo, wo]), None
+def posture_error(robot: Robot, task: Any, q: np.ndarray) -> np.ndarray:
+    """A posture's q ⊖ q_ref (nv) [rad or m] (its own :meth:`error_at`)."""
+    error: np.ndarray = task.error_at(robot, q)
+    return error
 
 
-def relative_rows(robot: Robot, task: RelativeFrameTask) -> Rowset:
-    """(A, e, per-row weight) of a relative frame task: the frame's body velocity less the root's, in the frame."""
-    fid, rid = robot.frame_id(task.frame), robot.frame_id(task.root)
-    oMf, oMr = robot.data.oMf[fid], robot.data.oMf[rid]
-    Jf = pin.getFrameJacobian(robot.model, robot.data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
-    Jr = pin.getFrameJacobian(robot.model, robot.data, rid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
-    Rr, Rf = oMr.rotation, oMf.rotation
-    gap = oMf.translation - oMr.translation
-    E_R = Rf.T @ Rr @ task.target.rotation
-    A = np.vstack([Rr.T @ (Jf[:3] - Jr[:3] + skew(gap) @ Jr[3:]), -pin.Jlog3(E_R.T) @ Rf.T @ (Jf[3:] - Jr[3:])])
-    e = np.concatenate([Rr.T @ gap - task.target.translation, pin.log3(E_R)])
-    wp, wo = task.weight, task.orientation_weight
-    return A, e, np.array([wp, wp, wp, wo, wo, wo]), None
-
-
-def com_rows(robot: Robot, task: ComTask) -> Rowset:
-    """(A, e, per-row weight, None) of the centre-of-mass task (``forward`` ran with com=True)."""
-    index = list(task.index)
-    return robot.data.Jcom[index], (robot.data.com[0] - task.target)[index], np.full(len(index), task.weight), None
-
-
-def posture_mask(robot: Robot, task: PostureTask) -> np.ndarray:
-    """(nv,) the velocities a posture task pulls (all but a free-flyer's six unless ``base``)."""
-    mask = np.ones(robot.nv, dtype=bool)
-    if robot.floating and not task.base:
-        mask[:6] = False
+def posture_mask(robot: Robot, task: Any) -> np.ndarray:
+    """(nv,) the velocities a posture pulls (its own :meth:`mask`)."""
+    mask: np.ndarray = task.mask(robot)
     return mask
-
-
-def posture_weight(robot: Robot, task: PostureTask) -> np.ndarray:
-    """(nv,) the posture's weight per velocity (zero where it does not pull: a free-flyer's six unless ``base``).
-
-    Raises:
-        OptionError: per-velocity weights of another length than nv.
-    """
-    if isinstance(task.weight, np.ndarray):
-        if task.weight.shape != (robot.nv,):
-            raise OptionError("weight", task.weight, f"a number, or nv = {robot.nv} numbers for {robot.name}")
-        weight = task.weight.copy()
-    else:
-        weight = np.full(robot.nv, float(task.weight))
-    weight[~posture_mask(robot, task)] = 0.0
-    return weight
-
-
-def checked_ref(robot: Robot, task: PostureTask) -> np.ndarray:
-    """A posture's reference q (the robot's neutral one for None).
-
-    Raises:
-        ConfigurationError: a q_ref that is not a configuration of the robot.
-    """
-    if task.q_ref is None:
-        return robot.neutral()
-    q_ref = task.q_ref
-    if q_ref.shape != (robot.nq,):
-        raise ConfigurationError(f"PostureTask.q_ref must have nq = {robot.nq} numbers for {robot.name}, got "
-                                 f"{q_ref.shape[0]}")
-    robot.check_q(q_ref, what="PostureTask.q_ref")  # its quaternions unit, its coordinates within reason
-    return q_ref
-
-
-def posture_error(robot: Robot, task: PostureTask, q: np.ndarray) -> np.ndarray:
-    """q ⊖ q_ref (nv) [rad or m].
-
-    Raises:
-        ConfigurationError: a q_ref that is not a configuration of the robot.
-    """
-    return np.asarray(pin.difference(robot.model, checked_ref(robot, task), q), dtype=float)
-
-
-def coupling_row(robot: Robot, task: CouplingTask, q: np.ndarray, dt: float) -> tuple[np.ndarray, float]:
-    """(a, c): the equality a·v = c that keeps ``joint = ratio · leader + offset`` after the step (and brings it
-    back when it is off).
-
-    Raises:
-        JointNotFoundError: an unknown joint. OptionError: a joint with more than one coordinate.
-    """
-    a = np.zeros(robot.nv)
-    idx = []
-    for name in (task.joint, task.leader):
-        if not robot.model.existJointName(name):
-            raise JointNotFoundError(name, robot.joint_names)
-        joint = robot.model.joints[robot.model.getJointId(name)]
-        if joint.nq != 1 or joint.nv != 1:
-            raise OptionError("CouplingTask", name, "a joint with one coordinate (revolute or prismatic)")
-        idx.append((joint.idx_q, joint.idx_v))
-    (qj, vj), (ql, vl) = idx
-    a[vj], a[vl] = 1.0, -task.ratio
-    return a, -(q[qj] - task.ratio * q[ql] - task.offset) / dt
-
-
-def task_rows(robot: Robot, task: Task) -> Rowset:
-    """(A, e, per-row weight, a pose's translation gap) of a frame, relative frame or centre-of-mass task."""
-    if isinstance(task, FrameTask):
-        return frame_rows(robot, task)
-    if isinstance(task, RelativeFrameTask):
-        return relative_rows(robot, task)
-    assert isinstance(task, ComTask)
-    return com_rows(robot, task)

@@ -22,9 +22,10 @@ import pinocchio as pin
 
 from kinelab.ik.result import Status
 from kinelab.robot.tree import Robot
+from kinelab.wholebody.evaluate import PointRow
 from kinelab.wholebody.iterate import SolveSettings, iterate, posture_second
 from kinelab.wholebody.limits import Limits
-from kinelab.wholebody.tasks import ComTask, CouplingTask, FrameTask, PostureTask, RelativeFrameTask, Task
+from kinelab.wholebody.tasks import Task
 
 FALL = 0.2  # a sweep that takes off less than this share of the weighted error ends the sweeps
 HANDOVER = 1e-2  # [m or rad] below this error the Gauss–Newton finish takes over
@@ -44,49 +45,14 @@ class Points:
     free: np.ndarray  # (n, 3): 1 where the target follows the point (a centre of mass's unconstrained coordinates)
 
 
-# one point of a task: (frame, point, target, weight, is a direction, carrier frame, follows), as Points' rows
-PointRow = tuple[int, np.ndarray, np.ndarray, float, bool, int, np.ndarray]
-
-
 def task_points(robot: Robot, tasks: tuple[Task, ...], data: pin.Data, com: np.ndarray | None) -> Points:
-    """Every task's points at the configuration in ``data`` (frame placements updated)."""
-    rows: list[PointRow] = []
-    for task in tasks:
-        if isinstance(task, FrameTask | RelativeFrameTask):
-            rows += _frame_points(robot, task, data)
-        elif isinstance(task, ComTask):
-            assert com is not None
-            rows.append(_com_point(task, com))
+    """Every task's points (:meth:`~kinelab.wholebody.tasks.Task.points`) at the configuration in ``data`` (frame
+    placements updated)."""
+    rows: list[PointRow] = [row for task in tasks for row in task.points(robot, data, com)]
     frame, p, t, w, direction, carrier, free = zip(*rows, strict=True) if rows else ((),) * 7
     return Points(np.array(frame, dtype=int), np.array(p, dtype=float).reshape(-1, 3),
                   np.array(t, dtype=float).reshape(-1, 3), np.array(w, dtype=float), np.array(direction, dtype=bool),
                   np.array(carrier, dtype=int), np.array(free, dtype=float).reshape(-1, 3))
-
-
-def _frame_points(robot: Robot, task: FrameTask | RelativeFrameTask, data: pin.Data
-                  ) -> list[PointRow]:
-    """A frame task's points: its origin (unless only its orientation is asked for) and the axes its task
-    constrains, each with its target (a relative task's target carried by its root frame)."""
-    fid = robot.frame_id(task.frame)
-    oMf = data.oMf[fid]
-    by = -1 if isinstance(task, FrameTask) else robot.frame_id(task.root)
-    target = task.target if by < 0 else data.oMf[by] * task.target
-    kind, axis = (task.task, task.axis) if isinstance(task, FrameTask) else ("pose", "z")
-    fixed = np.zeros(3)
-    rows = [] if kind == "orientation" else [(fid, oMf.translation, target.translation, task.weight, False, by, fixed)]
-    axes = ["xyz".index(axis)] if kind == "axis" else range(3) if kind in ("pose", "orientation") else []
-    weight = 0.5 * float(task.orientation_weight or 0.0)
-    return rows + [(fid, oMf.rotation[:, k], target.rotation[:, k], weight, True, by, fixed) for k in axes]
-
-
-def _com_point(task: ComTask, com: np.ndarray) -> PointRow:
-    """The centre of mass as a point: its free coordinates' targets are their current values, and they follow it."""
-    index = list(task.index)
-    goal = com.copy()
-    goal[index] = task.target[index]
-    follows = np.ones(3)
-    follows[index] = 0.0
-    return -1, com, goal, task.weight, False, -1, follows
 
 
 def _rotation_angle(a: np.ndarray, b: np.ndarray, w: np.ndarray, u: np.ndarray) -> float:
@@ -146,7 +112,7 @@ def sweep(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, joints: list[Tre
     sweep_joints(robot, tasks, q, joints, data)
     if robot.floating:
         pin.framesForwardKinematics(robot.model, data, q)
-        has_com = any(isinstance(t, ComTask) for t in tasks)
+        has_com = any(t.uses_com for t in tasks)
         com = pin.centerOfMass(robot.model, data, q) if has_com else None
         _move_base(robot, q, task_points(robot, tasks, data, com))
     _couple(robot, tasks, q)
@@ -163,7 +129,7 @@ def sweep_joints(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, joints: l
         The task points at the new q (as Pinocchio's FK there gives them).
     """
     model = robot.model
-    has_com = any(isinstance(t, ComTask) for t in tasks)
+    has_com = any(t.uses_com for t in tasks)
     pin.framesForwardKinematics(model, data, q)
     com = pin.centerOfMass(model, data, q) if has_com else None
     points = task_points(robot, tasks, data, com)
@@ -293,18 +259,15 @@ def _move_base(robot: Robot, q: np.ndarray, points: Points) -> None:
 
 
 def _couple(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray) -> None:
-    """Each coupling held by setting its joint from its leader."""
+    """Each task that can be met outright (a coupling) met, q changed in place."""
     for task in tasks:
-        if isinstance(task, CouplingTask):
-            jq = robot.model.joints[robot.model.getJointId(task.joint)].idx_q
-            lq = robot.model.joints[robot.model.getJointId(task.leader)].idx_q
-            q[jq] = task.ratio * q[lq] + task.offset
+        task.project(robot, q)
 
 
 def weighted_error(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, data: pin.Data) -> tuple[float, float]:
     """(Σ w‖p − t‖², the largest point or direction gap [m or ≈ rad]) at q."""
     pin.framesForwardKinematics(robot.model, data, q)
-    com = pin.centerOfMass(robot.model, data, q) if any(isinstance(t, ComTask) for t in tasks) else None
+    com = pin.centerOfMass(robot.model, data, q) if any(t.uses_com for t in tasks) else None
     pts = task_points(robot, tasks, data, com)
     gaps = np.linalg.norm(pts.p - pts.t, axis=1)
     return float(pts.w @ gaps**2), float(gaps.max(initial=0.0))
@@ -321,7 +284,7 @@ def frdm_solve(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, settings: S
     q = np.array(q, dtype=float)
     data = robot.model.createData()
     joints = robot.derived("frdm tree joints", tree_joints)
-    frdm_tasks = tuple(t for t in tasks if not isinstance(t, PostureTask))
+    frdm_tasks = tuple(t for t in tasks if not t.preference)  # a preference has no points: left to the finish
     error, _ = weighted_error(robot, frdm_tasks, q, data)
     used = 0
     for used in range(1, settings.max_iterations + 1):

@@ -16,8 +16,8 @@ from kinelab.ik import options as opt
 from kinelab.ik.result import Status
 from kinelab.robot.tree import Robot
 from kinelab.wholebody.limits import Limits
-from kinelab.wholebody.step import StepOptions, TaskError, _step
-from kinelab.wholebody.tasks import PostureTask, Task
+from kinelab.wholebody.step import StepOptions, _step
+from kinelab.wholebody.tasks import Task, TaskError
 
 SOLVERS = ("step", "frdm")
 STALL = 1e-3  # a step that takes off less than this share of the error, ten times running, is a stall
@@ -52,8 +52,9 @@ class SolveSettings:
 
 
 def posture_second(tasks: tuple[Task, ...]) -> tuple[Task, ...]:
-    """The tasks with every posture asked for second (priority 2): a converged solve meets the others exactly."""
-    return tuple(replace(t, priority=2) if isinstance(t, PostureTask) else t for t in tasks)
+    """The tasks as a converged solve asks for them (:meth:`~kinelab.wholebody.tasks.Task.second`: every posture
+    second, priority 2), so that it meets the others exactly."""
+    return tuple(t.second() for t in tasks)
 
 
 def iterate(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, settings: SolveSettings, limits: Limits,
@@ -98,5 +99,5 @@ def _toward(robot: Robot, q: np.ndarray, q_full: np.ndarray, share: float) -> np
 def _size(errors: tuple[TaskError, ...], tasks: tuple[Task, ...], settings: SolveSettings) -> tuple[float, float]:
     """(the largest error, the sum of the errors squared), each in units of its tolerance, a posture left out."""
     scaled = [(e.position / settings.tol_pos, e.rotation / settings.tol_rot)
-              for e, t in zip(errors, tasks, strict=True) if not isinstance(t, PostureTask)]
+              for e, t in zip(errors, tasks, strict=True) if not t.preference]
     return max((max(p, r) for p, r in scaled), default=0.0), sum(p * p + r * r for p, r in scaled)

@@ -136,6 +136,11 @@ def bounds(space: Space, q: np.ndarray, dt: float, vmax: np.ndarray, position: b
         below, above = pl > slack, pu < -slack  # outside its limits: only a return is allowed, at most at the limit
         new_lo = np.where(below, np.minimum(pl, vu), np.maximum(pl, vl))
         new_hi = np.where(above, np.maximum(pu, vl), np.minimum(pu, vu))
+        if amax is not None:  # no faster than it can still stop before the limit, braking at amax
+            a = amax[idx]
+            inside = ~(below | above)
+            new_hi = np.where(inside, np.minimum(new_hi, braking(pu * dt, a, dt)), new_hi)
+            new_lo = np.where(inside, np.maximum(new_lo, -braking(-pl * dt, a, dt)), new_lo)
         lo[idx], hi[idx] = new_lo, new_hi
         returning[idx] = below | above
     if amax is not None and v_prev is not None:  # the acceleration yields where it cannot keep within the others
@@ -147,6 +152,17 @@ def bounds(space: Space, q: np.ndarray, dt: float, vmax: np.ndarray, position: b
 
 
 MIN_DT = 1e-9  # [s] a shorter step asks for rates (error / dt) past any joint's and toward what a double holds
+
+
+def braking(distance: np.ndarray, amax: np.ndarray, dt: float) -> np.ndarray:
+    """The largest speed [rad/s or m/s] toward a limit ``distance`` away [rad or m] from which steps of ``dt``
+    braking at ``amax`` still stop before it: v·dt + v²/(2a) ≤ d (inf where there is no acceleration limit). At
+    that speed the next step's bound, and the position's (d − v·dt)/dt, are both at least v − a·dt: the
+    acceleration and position limits can hold together at every later step."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        ad = amax * dt
+        speed = -ad + np.sqrt(ad * ad + 2.0 * amax * np.maximum(distance, 0.0))
+    return np.where(np.isfinite(amax), speed, np.inf)
 
 
 def is_positive_time(dt: object) -> float:

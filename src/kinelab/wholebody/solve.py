@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
@@ -24,19 +24,10 @@ from kinelab.ik.result import Status
 from kinelab.robot.space import generator
 from kinelab.robot.tree import Robot
 from kinelab.typing import Configuration
-from kinelab.wholebody import evaluate as ev
 from kinelab.wholebody.frdm import frdm_solve
 from kinelab.wholebody.iterate import SolveSettings, iterate, posture_second
 from kinelab.wholebody.limits import Limits
-from kinelab.wholebody.tasks import (
-    ComTask,
-    CouplingTask,
-    FrameTask,
-    PostureTask,
-    RelativeFrameTask,
-    Task,
-    as_tasks,
-)
+from kinelab.wholebody.tasks import Task, as_tasks
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -116,17 +107,8 @@ def solve(robot: Robot, tasks: Task | Sequence[Task], *, q0: Configuration | Non
         raise OptionError("limits", limits, "a kinelab.Limits(...), or None")
     start = robot.neutral() if q0 is None else robot.check_q(q0, what="q0")
     for t in found:  # a bad frame or joint named before any work
-        _check_names(robot, t)
+        t.check(robot)
     return _run(robot, found, start, settings, limits, seed)
-
-
-def _check_names(robot: Robot, task: Task) -> None:
-    if isinstance(task, FrameTask):
-        robot.frame_id(task.frame)
-    elif isinstance(task, RelativeFrameTask):
-        robot.frame_id(task.frame), robot.frame_id(task.root)
-    elif isinstance(task, CouplingTask):
-        ev.coupling_row(robot, task, robot.neutral(), 1.0)
 
 
 def _run(robot: Robot, tasks: tuple[Task, ...], start: np.ndarray, settings: SolveSettings, limits: Limits,
@@ -188,42 +170,12 @@ def _score(verdicts: tuple[TaskVerdict, ...]) -> float:
 def judge(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, tol_pos: float, tol_rot: float,
           ) -> tuple[TaskVerdict, ...]:
     """Each task's errors at q by Pinocchio's own FK (``framesForwardKinematics``) and centre of mass
-    (``centerOfMass``), and whether they are within tolerance (a posture is never judged: met)."""
+    (``centerOfMass``), and whether they are within tolerance (a preference — a posture — is never judged: met)."""
     model, data = robot.model, robot.model.createData()
     pin.framesForwardKinematics(model, data, q)
-    com = pin.centerOfMass(model, data, q) if any(isinstance(t, ComTask) for t in tasks) else None
+    com = pin.centerOfMass(model, data, q) if any(t.uses_com for t in tasks) else None
     out = []
     for task in tasks:
-        dp, dr = _judged_errors(robot, data, task, q, com)
-        met = isinstance(task, PostureTask) or (dp <= tol_pos and dr <= tol_rot)
-        out.append(TaskVerdict(task.label, dp, dr, met))
+        dp, dr = task.judged(robot, data, q, com)
+        out.append(TaskVerdict(task.label, dp, dr, task.preference or (dp <= tol_pos and dr <= tol_rot)))
     return tuple(out)
-
-
-def _judged_errors(robot: Robot, data: Any, task: Task, q: np.ndarray, com: np.ndarray | None,
-                   ) -> tuple[float, float]:
-    """(position [m], rotation [rad]) error of one task from Pinocchio's placements."""
-    if isinstance(task, FrameTask):
-        oMf = data.oMf[robot.frame_id(task.frame)]
-        return _frame_gap(oMf, task.target, task.task, "xyz".index(task.axis))
-    if isinstance(task, RelativeFrameTask):
-        rMf = data.oMf[robot.frame_id(task.root)].actInv(data.oMf[robot.frame_id(task.frame)])
-        return _frame_gap(rMf, task.target, "pose", 0)
-    if isinstance(task, ComTask):
-        assert com is not None
-        return float(np.linalg.norm((com - task.target)[list(task.index)])), 0.0
-    if isinstance(task, PostureTask):
-        return float(np.abs(ev.posture_error(robot, task, q)[ev.posture_mask(robot, task)]).max(initial=0.0)), 0.0
-    a, c = ev.coupling_row(robot, task, q, 1.0)
-    return abs(c), 0.0
-
-
-def _frame_gap(M: pin.SE3, target: pin.SE3, kind: str, axis: int) -> tuple[float, float]:
-    """(position, rotation) error of pose M against target for a frame task of ``kind``."""
-    dp = 0.0 if kind == "orientation" else float(np.linalg.norm(M.translation - target.translation))
-    if kind == "position":
-        return dp, 0.0
-    if kind == "axis":
-        u, v = M.rotation[:, axis], target.rotation[:, axis]
-        return dp, float(math.atan2(np.linalg.norm(np.cross(u, v)), float(u @ v)))
-    return dp, float(np.linalg.norm(pin.log3(M.rotation.T @ target.rotation)))

@@ -9,7 +9,6 @@ q ⊕ v·dt through ``pin.integrate``.
 
 from __future__ import annotations
 
-import math
 import operator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeVar
@@ -32,16 +31,7 @@ from kinelab.wholebody.limits import (
     is_positive_time,
     velocity_bounds,
 )
-from kinelab.wholebody.tasks import (
-    TASK_TYPES,
-    ComTask,
-    CouplingTask,
-    FrameTask,
-    PostureTask,
-    RelativeFrameTask,
-    Task,
-    as_tasks,
-)
+from kinelab.wholebody.tasks import Task, TaskError, as_tasks
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -74,16 +64,6 @@ class StepOptions:
             raise OptionError("damping", self.damping, "a finite number ≥ 0")
         if self.solver not in qp.SOLVERS:
             raise OptionError("solver", self.solver, " or ".join(qp.SOLVERS))
-
-
-@dataclass(frozen=True)
-class TaskError:
-    """One task's error at a configuration: position [m] and rotation [rad] (0 where the task has none; a posture's
-    and a coupling's in ``position``, their largest joint gap [rad or m])."""
-
-    label: str
-    position: float
-    rotation: float
 
 
 class StepResult:
@@ -186,7 +166,7 @@ def _compiled(robot: Robot, q: Any, tasks: Any, dt: float, limits: Limits, optio
     prev = NO_LIMIT if v_prev is None else v_prev
     if amax.size and v_prev is None:
         return None
-    q_out, v_out, errors = np.empty(robot.nq), np.empty(robot.nv), np.empty((len(packed.labels), 2))
+    q_out, v_out, errors = np.empty(robot.nq), np.empty(robot.nv), np.zeros((len(packed.labels), 2))
     returning = np.empty(robot.nv, dtype=np.uint8)
     flag, iterations = packed.step.step(arr, dt, vmax, limits.position, amax, prev, options.damping, q_out, v_out,
                                         errors, returning)
@@ -221,7 +201,7 @@ def _packed(robot: Robot, tasks: Any, options: StepOptions) -> cp.Packed | None:
     read-only, :mod:`kinelab.wholebody.tasks`), so the same objects hold the same targets."""
     if options.solver != "daqp" or not cp.daqp_linked():
         return None
-    if isinstance(tasks, TASK_TYPES):
+    if isinstance(tasks, Task):
         tasks = (tasks,)
     recent: list[tuple[tuple[Task, ...], cp.Packed]] = robot.derived("compiled recent", _new_list)
     for held, packed in recent:
@@ -255,17 +235,17 @@ def _new_list(_: Robot) -> list[Any]:
 
 def _of_structure(robot: Robot, tasks: tuple[Task, ...]) -> cp.Packed | None:
     """The compiled problem of the task list's structure, packed once per robot and structure (its names checked
-    first), or None where the compiled step does not take the tree or the list."""
+    first), or None where the compiled step does not take the tree or the list (kept as such)."""
     tree = robot.derived("compiled tree", cp.pack_tree)
-    key = None if tree is None else cp.structure(tasks)
-    if tree is None or key is None:
+    if tree is None:
         return None
-    table: dict[Any, cp.Packed] = robot.derived("compiled steps", _new_table)
-    packed = table.get(key)
-    if packed is None:
-        _check_names(robot, tasks)
-        packed = _kept(table, key, cp.pack(robot, tree, tasks))
-    return packed
+    key = cp.structure(tasks)
+    table: dict[Any, cp.Packed | None] = robot.derived("compiled steps", _new_table)
+    if key not in table:
+        for t in tasks:
+            t.check(robot)
+        _kept(table, key, cp.pack(robot, tree, tasks))
+    return table[key]
 
 
 def _kept(table: dict[Any, T], key: Any, value: T) -> T:
@@ -276,25 +256,13 @@ def _kept(table: dict[Any, T], key: Any, value: T) -> T:
     return value
 
 
-def _check_names(robot: Robot, tasks: tuple[Task, ...]) -> None:
-    """Name a bad frame or joint before a task list is packed."""
-    for t in tasks:
-        if isinstance(t, CouplingTask):
-            ev.coupling_row(robot, t, robot.neutral(), 1.0)
-        elif isinstance(t, FrameTask | RelativeFrameTask):
-            robot.frame_id(t.frame)
-            if isinstance(t, RelativeFrameTask):
-                robot.frame_id(t.root)
-        elif isinstance(t, PostureTask):
-            ev.checked_ref(robot, t)
-            ev.posture_weight(robot, t)
-
-
 def _step(robot: Robot, q: np.ndarray, tasks: tuple[Task, ...], dt: float, limits: Limits, options: StepOptions,
           v_prev: np.ndarray | None) -> StepResult:
     """:func:`step` once its arguments are checked."""
-    ev.forward(robot, q, com=any(isinstance(t, ComTask) for t in tasks))
-    levels, errors, eq = _levels(robot, q, tasks, dt)
+    ev.forward(robot, q, com=any(t.uses_com for t in tasks))
+    rows = ev.StepRows(robot.nv)
+    errors = [task.add_to(rows, robot, q, dt) for task in tasks]
+    levels, eq = rows.used(), rows.equalities
     vmax = velocity_bounds(limits, robot.space)
     lower, upper, returning = bounds(robot.space, q, dt, vmax, limits.position,
                                      acceleration_bounds(limits, robot.space), v_prev)
@@ -324,52 +292,6 @@ def _second_level(robot: Robot, levels: list[ev.Rows], v_first: np.ndarray, opti
         return _solve_level(levels[1], options, lower, upper, held, held @ v_first, dt)
     return _solve_level(levels[1], options, lower, upper, np.vstack([A_eq, held]),
                         np.concatenate([b_eq, held @ v_first]), dt)
-
-
-def _levels(robot: Robot, q: np.ndarray, tasks: tuple[Task, ...], dt: float,
-            ) -> tuple[list[ev.Rows], list[TaskError], list[tuple[np.ndarray, float]]]:
-    """The rows of each priority level, each task's error, and the couplings' equalities."""
-    levels = [ev.Rows([], [], [], np.zeros(robot.nv), np.zeros(robot.nv)) for _ in range(2)]
-    errors: list[TaskError] = []
-    eq: list[tuple[np.ndarray, float]] = []
-    for task in tasks:
-        if isinstance(task, CouplingTask):
-            a, c = ev.coupling_row(robot, task, q, dt)
-            eq.append((a, c))
-            errors.append(TaskError(task.label, abs(c * dt), 0.0))  # |joint − ratio · leader − offset|
-            continue
-        rows = levels[task.priority - 1]
-        if isinstance(task, PostureTask):
-            e = ev.posture_error(robot, task, q)
-            weight = ev.posture_weight(robot, task)
-            rows.diag += weight
-            rows.target += weight * (-task.gain * e / dt)
-            errors.append(TaskError(task.label, float(np.abs(e[weight > 0]).max(initial=0.0)), 0.0))  # what it pulls
-            continue
-        A, e, w, gap = ev.task_rows(robot, task)
-        rows.A.append(A)
-        rows.b.append(-task.gain * e / dt)
-        rows.w.append(w)
-        errors.append(_error(task, e, gap))
-    used = [lv for lv in levels if lv.A or lv.diag.any()]
-    return used or levels[:1], errors, eq
-
-
-def _error(task: Task, e: np.ndarray, gap: np.ndarray | None) -> TaskError:
-    """A task's error in m and rad from its error vector: a pose's rotation is its log's angular part and its
-    position the gap's length (``gap``: the frame-to-target translation, the error's linear part elsewhere); an
-    axis's angle from the two unit axes' difference."""
-    lin = e[:3] if gap is None else gap
-    dp = math.hypot(*lin) if getattr(task, "task", "pose") != "orientation" else 0.0
-    if isinstance(task, ComTask):
-        return TaskError(task.label, math.hypot(*e), 0.0)
-    kind = getattr(task, "task", "pose")
-    if kind == "position":
-        return TaskError(task.label, dp, 0.0)
-    if kind == "axis":
-        return TaskError(task.label, dp, 2.0 * math.asin(min(1.0, math.hypot(*e[3:]) / 2.0)))
-    rot = e[3:] if kind == "pose" else e
-    return TaskError(task.label, dp, math.hypot(*rot))
 
 
 def _solve_level(rows: ev.Rows, options: StepOptions, lower: np.ndarray, upper: np.ndarray,

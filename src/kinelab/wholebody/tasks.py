@@ -1,4 +1,4 @@
-"""Tasks of whole-body kinematics: frozen values, each asking one thing of the robot's configuration.
+"""Tasks of whole-body kinematics: values, each asking one thing of the robot's configuration and answering for it.
 
 Every task gives, at a configuration, its error ``e`` and a matrix ``A`` such that a velocity v [nv] changes the
 error at the rate ``A v`` (first order): the step asks ``A v = −gain · e / dt`` of every task, weighted, and the
@@ -6,192 +6,162 @@ converged solve drives every ``e`` to zero. Units: errors in m and rad (posture:
 unit velocity. Frames are Pinocchio's; a target pose is ``oM*`` in the world frame (a RelativeFrameTask's in its
 root frame).
 
+What a task is, is decided here and nowhere else: each kind is a :class:`Task` and answers, through its own
+methods, for what every part of kinelab asks of it — its rows of the readable step (:meth:`Task.add_to`), its block
+of the compiled step (:meth:`Task.pack`, :meth:`Task.refresh`), its points for FRDM on the tree
+(:meth:`Task.points`) and its errors for the converged solve's verdict (:meth:`Task.judged`). A new task is one
+class (docs/extending.md).
+
 - :class:`FrameTask`: a frame's pose, position, one axis (and the position), or orientation.
 - :class:`RelativeFrameTask`: a frame's pose in another frame (one hand in the other's).
 - :class:`ComTask`: the centre of mass (all three coordinates, or some: "xy" over the feet).
 - :class:`PostureTask`: a reference configuration (the joints not asked for elsewhere).
-- :class:`CouplingTask`: one joint a linear function of another (mimic joints, gears), held exactly.
+- :class:`DampingTask`: small velocities (a weight on ‖v‖², per velocity if wanted).
+- :class:`~kinelab.wholebody.constraints.CouplingTask`: one joint a linear function of another, held exactly.
 """
 
 from __future__ import annotations
 
+import math
+from abc import ABC, abstractmethod
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 import pinocchio as pin
 from numpy.typing import ArrayLike
 
-from kinelab.core._verdict import pose_defect
-from kinelab.errors import OptionError, TargetError, count_of
+from kinelab.errors import OptionError
 from kinelab.typing import Configuration
-from kinelab.values import is_real, mixes_non_reals
+from kinelab.wholebody import targets as tg
+from kinelab.wholebody.evaluate import LOCAL, Packing, PointRow, Rowset, StepRows, TargetSlots, skew
+from kinelab.wholebody.targets import FixedPose
+
+if TYPE_CHECKING:
+    from kinelab.robot.tree import Robot
 
 FRAME_TASKS = ("pose", "position", "axis", "orientation")
 AXES = "xyz"
-
-
-MAX_WEIGHT = 1e12  # a larger weight squares past what the QP's matrix holds with the rest in it
-
-
-def _weight(name: str, value: Any) -> float:
-    if type(value) is float and 0.0 <= value <= MAX_WEIGHT:  # the usual call, checked at once
-        return value
-    if not is_real(value, 0, MAX_WEIGHT):
-        raise OptionError(name, value, f"a number from 0 to {MAX_WEIGHT:g}")
-    return float(value)
-
-
-def _gain(value: Any) -> float:
-    """A task's gain: the share of its error a step asks to close, 0 to 1 (more would overshoot the target)."""
-    if not is_real(value, 0, 1):
-        raise OptionError("gain", value, "a number from 0 to 1 (the share of the error a step closes)")
-    return float(value)
-
-
-def _weights(value: Any) -> float | np.ndarray:
-    """A posture's weight: one number, or one per velocity (a read-only array), each finite and ≥ 0."""
-    if isinstance(value, list | tuple | np.ndarray):
-        try:
-            arr = np.array(value, dtype=float)
-        except (TypeError, ValueError):
-            arr = np.array([np.nan])
-        if arr.ndim != 1 or not np.all(np.isfinite(arr)) or np.any(arr < 0) or np.any(arr > MAX_WEIGHT):
-            raise OptionError("weight", value, f"a number from 0 to {MAX_WEIGHT:g}, or one per velocity (nv such "
-                              "numbers)")
-        arr.flags.writeable = False
-        return arr
-    return _weight("weight", value)
-
-
-def _priority(value: Any) -> int:
-    if value not in (1, 2) or isinstance(value, bool):
-        raise OptionError("priority", value, "1 (first) or 2 (in the first's null space)")
-    return int(value)
-
-
-FROZEN = ("a task's target is a value, copied when the task is made: make the task anew (or task.moved(target)) "
-          "for another target")
-
-
-class FixedPose(pin.SE3):
-    """A task's target pose: a ``pin.SE3`` that cannot change. Its rotation and translation are read-only views
-    and its setters refuse, so that what a step answers for is what its task was given (a caller's SE3 is copied,
-    never kept)."""
-
-    __slots__ = ()
-
-    @property
-    def translation(self) -> np.ndarray:
-        """The position [m], read-only."""
-        view = pin.SE3.translation.fget(self)
-        view.flags.writeable = False
-        return view
-
-    @translation.setter
-    def translation(self, value: Any) -> None:
-        raise TargetError(FROZEN)
-
-    @property
-    def rotation(self) -> np.ndarray:
-        """The rotation matrix, read-only."""
-        view = pin.SE3.rotation.fget(self)
-        view.flags.writeable = False
-        return view
-
-    @rotation.setter
-    def rotation(self, value: Any) -> None:
-        raise TargetError(FROZEN)
-
-    @property
-    def homogeneous(self) -> np.ndarray:
-        """The 4 × 4 matrix (a copy)."""
-        return pin.SE3.homogeneous.fget(self)
-
-    @homogeneous.setter
-    def homogeneous(self, value: Any) -> None:
-        raise TargetError(FROZEN)
-
-    def setIdentity(self) -> FixedPose:
-        """Refused: a target is a value."""
-        raise TargetError(FROZEN)
-
-    def setRandom(self) -> FixedPose:
-        """Refused: a target is a value."""
-        raise TargetError(FROZEN)
-
-    def __reduce__(self) -> tuple[Any, ...]:
-        return FixedPose, (pin.SE3.homogeneous.fget(self),)
-
-    def __copy__(self) -> FixedPose:
-        return self  # a value: a copy would be the same
-
-    def __deepcopy__(self, memo: dict[int, Any]) -> FixedPose:
-        return self
-
-
-def _pose(value: Any, what: str) -> FixedPose:
-    """A target pose: an SE3 or a 4 × 4 homogeneous matrix, finite, its rotation a rotation; a copy that cannot
-    change.
-
-    Raises:
-        TargetError: anything else (named).
-    """
-    if isinstance(value, pin.SE3):
-        H = value.homogeneous
-    else:
-        H = _real_array(value, f"{what} must be a pin.SE3 or a 4 × 4 homogeneous matrix")
-        try:
-            H = H.reshape(4, 4)
-        except ValueError:
-            raise TargetError(f"{what} must be a pin.SE3 or a 4 × 4 homogeneous matrix, got {value!r}") from None
-    if pose_defect(H) or np.abs(H[:3, 3]).max() > MAX_COORDINATE:
-        raise TargetError(f"{what} is not a finite pose with a proper rotation (orthonormal within 1e-6, det +1, "
-                          f"last row 0, 0, 0, 1) and a position within {MAX_COORDINATE:g} m")
-    return FixedPose(np.ascontiguousarray(H))
-
-
-MAX_COORDINATE = 1e6  # [m] a target farther than this from the world's origin is a mistake (and overflows rates)
-
-
-def _real_array(value: Any, what: str) -> np.ndarray:
-    """``value`` as a new float array; booleans, complex numbers, strings and objects refused (``what`` says what
-    was expected)."""
-    try:
-        arr = np.array(value)
-    except (TypeError, ValueError):
-        raise TargetError(f"{what}, got {value!r}") from None
-    if mixes_non_reals(value):
-        raise TargetError(f"{what} (real numbers only: a bool or a complex number among them), got {value!r}")
-    if arr.dtype.kind not in "iuf":  # booleans, complex numbers, text and objects are not coordinates
-        raise TargetError(f"{what} (real numbers, not {arr.dtype.name}), got {value!r}")
-    return arr.astype(float)
-
-
-def _vector(value: Any, size: int, what: str) -> np.ndarray:
-    """``size`` finite numbers within MAX_COORDINATE, as a new read-only array."""
-    arr = _real_array(value, f"{what} must be {size} numbers")
-    if arr.shape != (size,) or not np.isfinite(arr).all():
-        raise TargetError(f"{what} must be {size} finite numbers, got {count_of(arr.shape)}")
-    if np.abs(arr).max() > MAX_COORDINATE:
-        raise TargetError(f"{what} must lie within {MAX_COORDINATE:g} m of the world's origin, got {arr.tolist()}")
-    arr.flags.writeable = False
-    return arr
+KINDS = {"pose": 0, "position": 1, "orientation": 2, "axis": 3}  # the compiled step's codes of a frame task
+T_RELATIVE, T_COM = 4, 5
 
 
 @dataclass(frozen=True)
-class FrameTask:
+class TaskError:
+    """One task's error at a configuration: position [m] and rotation [rad] (0 where the task has none; a posture's
+    and a coupling's in ``position``, their largest joint gap [rad or m])."""
+
+    label: str
+    position: float
+    rotation: float
+
+
+class Task(ABC):
+    """What every task answers for (see the module's docstring). A subclass is a frozen dataclass with a
+    ``priority`` (1, or 2 in the first's null space; 0: held exactly) and a :attr:`label`."""
+
+    priority: int
+    uses_com: ClassVar[bool] = False  # the readable step computes the centre of mass and its Jacobian for it
+    preference: ClassVar[bool] = False  # never judged, left out of the converged solve's merit (a posture)
+
+    @property
+    @abstractmethod
+    def label(self) -> str:
+        """The task in words (results and messages)."""
+
+    def check(self, robot: Robot) -> None:
+        """Name a frame or joint the robot does not have (before any work).
+
+        Raises:
+            FrameNotFoundError, JointNotFoundError, OptionError, ConfigurationError: named.
+        """
+        return None  # a task that names nothing has nothing to check
+
+    @abstractmethod
+    def add_to(self, rows: StepRows, robot: Robot, q: np.ndarray, dt: float) -> TaskError:
+        """Put the task's terms into the readable step's rows at q (``robot.data`` holds Pinocchio's pass there),
+        and return its error there."""
+
+    @abstractmethod
+    def pack(self, packer: Packing, robot: Robot) -> None:
+        """Put the task's block into the compiled problem being packed (its target set by :meth:`refresh`)."""
+
+    def refresh(self, packed: TargetSlots, robot: Robot, slot: int) -> None:
+        """Write this task's target into the compiled problem's ``slot`` (per call: what the task holds now)."""
+        return None  # a task with no target (a damping) writes nothing
+
+    @abstractmethod
+    def shape(self) -> tuple[Any, ...]:
+        """Everything but the target: what a compiled problem is packed for."""
+
+    def points(self, robot: Robot, data: pin.Data, com: np.ndarray | None) -> list[PointRow]:
+        """The task's points for FRDM on the tree, at the configuration in ``data`` (none: left to the finish)."""
+        return []
+
+    @abstractmethod
+    def judged(self, robot: Robot, data: pin.Data, q: np.ndarray, com: np.ndarray | None) -> tuple[float, float]:
+        """(position [m], rotation [rad]) error at q from Pinocchio's placements in ``data`` (and ``com``)."""
+
+    def project(self, robot: Robot, q: np.ndarray) -> None:
+        """Make q meet the task exactly where it can be set outright (a coupling; q changed in place)."""
+        return None  # a task met only by moving toward it: nothing to set
+
+    def second(self) -> Task:
+        """The task as the converged solve asks for it (a posture: second, so that it never holds a task off)."""
+        return self
+
+
+class _Frame(Task):
+    """A task on frames: its rows from Pinocchio's Jacobians, its error split into position and rotation."""
+
+    frame: str
+    target: FixedPose
+    weight: float
+    orientation_weight: float | None
+    gain: float
+
+    @abstractmethod
+    def rows(self, robot: Robot) -> Rowset:
+        """(A, e, per-row weight, a pose's translation gap) at ``robot.data``'s configuration."""
+
+    def add_to(self, rows: StepRows, robot: Robot, q: np.ndarray, dt: float) -> TaskError:
+        """The weighted rows ``A v ≈ −gain · e / dt`` at the task's level."""
+        A, e, w, gap = self.rows(robot)
+        rows.levels[self.priority - 1].add(A, -self.gain * e / dt, w)
+        return self.error_of(e, gap)
+
+    def error_of(self, e: np.ndarray, gap: np.ndarray | None) -> TaskError:
+        """The error in m and rad of an error vector: the position the gap's length (or e's linear part), the
+        rotation its log's angular part."""
+        rot = e[3:]
+        return TaskError(self.label, math.hypot(*(e[:3] if gap is None else gap)), math.hypot(*rot))
+
+    def check(self, robot: Robot) -> None:
+        """Name an unknown frame.
+
+        Raises:
+            FrameNotFoundError: named.
+        """
+        robot.frame_id(self.frame)
+
+    def refresh(self, packed: TargetSlots, robot: Robot, slot: int) -> None:
+        """The target pose, per call."""
+        packed.set_pose(slot, self.target.homogeneous)
+
+
+@dataclass(frozen=True)
+class FrameTask(_Frame):
     """A frame's pose (or part of it) at a target, in the world frame.
 
     Attributes:
         frame: the frame's name.
-        target: oM* (``pin.SE3`` or 4 × 4); for task "position" three numbers [m] may stand for it.
+        target: oM* (``pin.SE3`` or 4 × 4, copied); for task "position" three numbers [m] may stand for it.
         task: "pose", "position", "axis" (the position and one axis of the frame along the target's same axis,
             free to turn about it) or "orientation".
         axis: the frame axis of task "axis": "x", "y" or "z".
         weight: the weight of the position error [1/m]; orientation_weight: of the rotation error [1/rad] (None:
             the same number).
-        gain: the share of the error the step asks to close in ``dt`` (1: all of it).
+        gain: the share of the error the step asks to close in ``dt``, 0 to 1 (1: all of it).
         priority: 1, or 2 (in the null space of the priority-1 tasks).
     """
 
@@ -216,28 +186,26 @@ class FrameTask:
             raise OptionError("task", self.task, ", ".join(FRAME_TASKS))
         if self.axis not in ("x", "y", "z"):
             raise OptionError("axis", self.axis, "'x', 'y' or 'z'")
-        target = self.target
-        if self.task == "position" and not isinstance(target, pin.SE3) and np.size(target) == 3:
-            target = pin.SE3(np.eye(3), _vector(target, 3, f"target of {self.frame!r}"))
-        object.__setattr__(self, "target", _pose(target, f"the target of frame {self.frame!r}"))
-        object.__setattr__(self, "weight", _weight("weight", self.weight))
+        object.__setattr__(self, "target", self._target(self.target))
+        object.__setattr__(self, "weight", tg.weight("weight", self.weight))
         ow = self.weight if self.orientation_weight is None else self.orientation_weight
-        object.__setattr__(self, "orientation_weight", _weight("orientation_weight", ow))
-        object.__setattr__(self, "gain", _gain(self.gain))
-        object.__setattr__(self, "priority", _priority(self.priority))
+        object.__setattr__(self, "orientation_weight", tg.weight("orientation_weight", ow))
+        object.__setattr__(self, "gain", tg.gain(self.gain))
+        object.__setattr__(self, "priority", tg.priority(self.priority))
+
+    def _target(self, target: Any) -> FixedPose:
+        if self.task == "position" and not isinstance(target, pin.SE3) and np.size(target) == 3:
+            target = pin.SE3(np.eye(3), tg.vector(target, 3, f"target of {self.frame!r}"))
+        return tg.pose(target, f"the target of frame {self.frame!r}")
 
     @property
-    def rows(self) -> int:
+    def rows_count(self) -> int:
         """How many rows the task adds to the step's least squares."""
         return {"pose": 6, "position": 3, "axis": 6, "orientation": 3}[self.task]
 
     def shape(self) -> tuple[Any, ...]:
-        """Everything but the target: what a compiled step is packed for (kept on the task)."""
-        found = self.__dict__.get("_shape")
-        if found is None:
-            found = self.__dict__["_shape"] = ("f", self.frame, self.task, self.axis, self.weight,
-                                               self.orientation_weight, self.gain, self.priority)
-        return found
+        """Everything but the target: what a compiled step is packed for."""
+        return ("f", self.frame, self.task, self.axis, self.weight, self.orientation_weight, self.gain, self.priority)
 
     def moved(self, target: pin.SE3 | ArrayLike) -> FrameTask:
         """The same task at another target (checked), its other settings taken as they are: a path's samples.
@@ -247,9 +215,7 @@ class FrameTask:
         """
         made = object.__new__(FrameTask)
         made.__dict__.update(self.__dict__)
-        if self.task == "position" and not isinstance(target, pin.SE3) and np.size(target) == 3:
-            target = pin.SE3(np.eye(3), _vector(target, 3, f"target of {self.frame!r}"))
-        made.__dict__["target"] = _pose(target, f"the target of frame {self.frame!r}")
+        made.__dict__["target"] = self._target(target)
         return made
 
     @property
@@ -257,14 +223,58 @@ class FrameTask:
         """The task in words (results and messages)."""
         return f"{self.task} of {self.frame}" + (f" ({self.axis} axis)" if self.task == "axis" else "")
 
+    def rows(self, robot: Robot) -> Rowset:
+        """(A, e, per-row weight, None) at ``robot.data``'s configuration: the position's rows in world axes, the
+        rotation's ``−Jlog3(E_Rᵀ)`` times the frame's angular Jacobian, an axis's the two unit axes' difference."""
+        fid = robot.frame_id(self.frame)
+        oMf = robot.data.oMf[fid]
+        J = pin.getFrameJacobian(robot.model, robot.data, fid, LOCAL)
+        wp, wo = self.weight, float(self.orientation_weight or 0.0)
+        R, t = oMf.rotation, oMf.translation - self.target.translation
+        if self.task == "position":
+            return R @ J[:3], t, np.full(3, wp), None
+        if self.task == "axis":
+            k = AXES.index(self.axis)
+            a = R[:, k]
+            A = np.vstack([R @ J[:3], -skew(a) @ R @ J[3:]])
+            return A, np.concatenate([t, a - self.target.rotation[:, k]]), np.array([wp] * 3 + [wo] * 3), None
+        E_R = R.T @ self.target.rotation
+        rot_A, rot_e = -pin.Jlog3(E_R.T) @ J[3:], pin.log3(E_R)
+        if self.task == "orientation":
+            return rot_A, rot_e, np.full(3, wo), None
+        return np.vstack([R @ J[:3], rot_A]), np.concatenate([t, rot_e]), np.array([wp] * 3 + [wo] * 3), None
+
+    def error_of(self, e: np.ndarray, gap: np.ndarray | None) -> TaskError:
+        """The error in m and rad (an axis's angle from the two unit axes' difference)."""
+        if self.task == "position":
+            return TaskError(self.label, math.hypot(*e), 0.0)
+        if self.task == "orientation":
+            return TaskError(self.label, 0.0, math.hypot(*e))
+        if self.task == "axis":
+            return TaskError(self.label, math.hypot(*e[:3]), 2.0 * math.asin(min(1.0, math.hypot(*e[3:]) / 2.0)))
+        return super().error_of(e, gap)
+
+    def pack(self, packer: Packing, robot: Robot) -> None:
+        """A frame block: the frame's joint and placement, the task's code and axis."""
+        frame = robot.model.frames[robot.frame_id(self.frame)]
+        packer.weighted(self, KINDS[self.task], frame.parentJoint, frame.placement, AXES.index(self.axis))
+
+    def points(self, robot: Robot, data: pin.Data, com: np.ndarray | None) -> list[PointRow]:
+        """The origin (unless only the orientation is asked for) and the axes the task constrains."""
+        return frame_points(robot, self, data, self.target, -1, self.task, self.axis)
+
+    def judged(self, robot: Robot, data: pin.Data, q: np.ndarray, com: np.ndarray | None) -> tuple[float, float]:
+        """The frame's errors by Pinocchio's placement."""
+        return frame_gap(data.oMf[robot.frame_id(self.frame)], self.target, self.task, AXES.index(self.axis))
+
 
 @dataclass(frozen=True)
-class RelativeFrameTask:
+class RelativeFrameTask(_Frame):
     """A frame's pose in another frame (``root``) at a target: one hand held in the other's frame.
 
     Attributes:
         frame: the moving frame; root: the frame the target is in.
-        target: rootM* (``pin.SE3`` or 4 × 4).
+        target: rootM* (``pin.SE3`` or 4 × 4, copied).
         weight, orientation_weight, gain, priority: as :class:`FrameTask`'s.
     """
 
@@ -284,14 +294,14 @@ class RelativeFrameTask:
         """
         if not isinstance(self.frame, str) or not isinstance(self.root, str):
             raise OptionError("frame", (self.frame, self.root), "two frame names")
-        object.__setattr__(self, "target", _pose(self.target, f"the target of {self.frame!r} in {self.root!r}"))
-        object.__setattr__(self, "weight", _weight("weight", self.weight))
+        object.__setattr__(self, "target", tg.pose(self.target, f"the target of {self.frame!r} in {self.root!r}"))
+        object.__setattr__(self, "weight", tg.weight("weight", self.weight))
         ow = self.weight if self.orientation_weight is None else self.orientation_weight
-        object.__setattr__(self, "orientation_weight", _weight("orientation_weight", ow))
-        object.__setattr__(self, "gain", _gain(self.gain))
-        object.__setattr__(self, "priority", _priority(self.priority))
+        object.__setattr__(self, "orientation_weight", tg.weight("orientation_weight", ow))
+        object.__setattr__(self, "gain", tg.gain(self.gain))
+        object.__setattr__(self, "priority", tg.priority(self.priority))
 
-    rows = 6
+    rows_count = 6
 
     @property
     def label(self) -> str:
@@ -302,13 +312,75 @@ class RelativeFrameTask:
         """Everything but the target: what a compiled step is packed for."""
         return ("r", self.frame, self.root, self.weight, self.orientation_weight, self.gain, self.priority)
 
+    def check(self, robot: Robot) -> None:
+        """Name an unknown frame.
+
+        Raises:
+            FrameNotFoundError: named.
+        """
+        robot.frame_id(self.frame), robot.frame_id(self.root)
+
+    def rows(self, robot: Robot) -> Rowset:
+        """(A, e, per-row weight, None): the frame's body velocity less the root's, in the root frame."""
+        fid, rid = robot.frame_id(self.frame), robot.frame_id(self.root)
+        oMf, oMr = robot.data.oMf[fid], robot.data.oMf[rid]
+        Jf = pin.getFrameJacobian(robot.model, robot.data, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+        Jr = pin.getFrameJacobian(robot.model, robot.data, rid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+        Rr, Rf = oMr.rotation, oMf.rotation
+        gap = oMf.translation - oMr.translation
+        E_R = Rf.T @ Rr @ self.target.rotation
+        A = np.vstack([Rr.T @ (Jf[:3] - Jr[:3] + skew(gap) @ Jr[3:]), -pin.Jlog3(E_R.T) @ Rf.T @ (Jf[3:] - Jr[3:])])
+        e = np.concatenate([Rr.T @ gap - self.target.translation, pin.log3(E_R)])
+        wp, wo = self.weight, float(self.orientation_weight or 0.0)
+        return A, e, np.array([wp, wp, wp, wo, wo, wo]), None
+
+    def pack(self, packer: Packing, robot: Robot) -> None:
+        """A relative block: both frames' joints and placements."""
+        frame = robot.model.frames[robot.frame_id(self.frame)]
+        other = robot.model.frames[robot.frame_id(self.root)]
+        packer.weighted(self, T_RELATIVE, frame.parentJoint, frame.placement, 0, other.parentJoint, other.placement)
+
+    def points(self, robot: Robot, data: pin.Data, com: np.ndarray | None) -> list[PointRow]:
+        """The frame's origin and axes, their targets carried by the root frame."""
+        by = robot.frame_id(self.root)
+        return frame_points(robot, self, data, data.oMf[by] * self.target, by, "pose", "z")
+
+    def judged(self, robot: Robot, data: pin.Data, q: np.ndarray, com: np.ndarray | None) -> tuple[float, float]:
+        """The pose's errors in the root frame, by Pinocchio's placements."""
+        rMf = data.oMf[robot.frame_id(self.root)].actInv(data.oMf[robot.frame_id(self.frame)])
+        return frame_gap(rMf, self.target, "pose", 0)
+
+
+def frame_points(robot: Robot, task: _Frame, data: pin.Data, target: pin.SE3, by: int, kind: str,
+                 axis: str) -> list[PointRow]:
+    """A frame task's FRDM points: its origin (unless only its orientation is asked for) and the axes its ``kind``
+    constrains, each with its target (``by``: the frame carrying the target, or -1)."""
+    fid = robot.frame_id(task.frame)
+    oMf = data.oMf[fid]
+    fixed = np.zeros(3)
+    rows = [] if kind == "orientation" else [(fid, oMf.translation, target.translation, task.weight, False, by, fixed)]
+    axes = [AXES.index(axis)] if kind == "axis" else range(3) if kind in ("pose", "orientation") else []
+    weight = 0.5 * float(task.orientation_weight or 0.0)  # Σ‖R eₖ − R* eₖ‖² ≈ 2θ²: θ² counted once
+    return rows + [(fid, oMf.rotation[:, k], target.rotation[:, k], weight, True, by, fixed) for k in axes]
+
+
+def frame_gap(M: pin.SE3, target: pin.SE3, kind: str, axis: int) -> tuple[float, float]:
+    """(position, rotation) error of pose M against target for a frame task of ``kind``."""
+    dp = 0.0 if kind == "orientation" else float(np.linalg.norm(M.translation - target.translation))
+    if kind == "position":
+        return dp, 0.0
+    if kind == "axis":
+        u, v = M.rotation[:, axis], target.rotation[:, axis]
+        return dp, float(math.atan2(np.linalg.norm(np.cross(u, v)), float(u @ v)))
+    return dp, float(np.linalg.norm(pin.log3(M.rotation.T @ target.rotation)))
+
 
 @dataclass(frozen=True)
-class ComTask:
+class ComTask(Task):
     """The centre of mass at a target [m], world frame: all three coordinates, or those ``axes`` names.
 
     Attributes:
-        target: three numbers [m] (the coordinates not in ``axes`` are read but not asked for).
+        target: three numbers [m] (copied; the coordinates not in ``axes`` are read but not asked for).
         axes: "xyz", or a part such as "xy" (the CoM over a point of the floor).
         weight [1/m], gain, priority: as :class:`FrameTask`'s.
     """
@@ -319,6 +391,7 @@ class ComTask:
     gain: float = 1.0
     priority: int = 1
     index: tuple[int, ...] = field(init=False, repr=False, compare=False)
+    uses_com: ClassVar[bool] = True
 
     def __post_init__(self) -> None:
         """Check every field.
@@ -326,17 +399,17 @@ class ComTask:
         Raises:
             OptionError, TargetError: a field out of what it accepts (named).
         """
-        object.__setattr__(self, "target", _vector(self.target, 3, "the centre of mass's target"))
+        object.__setattr__(self, "target", tg.vector(self.target, 3, "the centre of mass's target"))
         if not isinstance(self.axes, str) or not self.axes or any(a not in AXES for a in self.axes) \
                 or len(set(self.axes)) != len(self.axes):
             raise OptionError("axes", self.axes, "'xyz' or a part of it ('xy', 'z', ...)")
         object.__setattr__(self, "index", tuple(AXES.index(a) for a in self.axes))
-        object.__setattr__(self, "weight", _weight("weight", self.weight))
-        object.__setattr__(self, "gain", _gain(self.gain))
-        object.__setattr__(self, "priority", _priority(self.priority))
+        object.__setattr__(self, "weight", tg.weight("weight", self.weight))
+        object.__setattr__(self, "gain", tg.gain(self.gain))
+        object.__setattr__(self, "priority", tg.priority(self.priority))
 
     @property
-    def rows(self) -> int:
+    def rows_count(self) -> int:
         """How many rows the task adds."""
         return len(self.index)
 
@@ -349,13 +422,47 @@ class ComTask:
         """Everything but the target: what a compiled step is packed for."""
         return ("c", self.axes, self.weight, self.gain, self.priority)
 
+    def rows(self, robot: Robot) -> Rowset:
+        """(A, e, per-row weight, None) from Pinocchio's centre of mass and its Jacobian."""
+        index = list(self.index)
+        return robot.data.Jcom[index], (robot.data.com[0] - self.target)[index], np.full(len(index), self.weight), None
+
+    def add_to(self, rows: StepRows, robot: Robot, q: np.ndarray, dt: float) -> TaskError:
+        """The weighted rows of the coordinates asked for."""
+        A, e, w, _ = self.rows(robot)
+        rows.levels[self.priority - 1].add(A, -self.gain * e / dt, w)
+        return TaskError(self.label, math.hypot(*e), 0.0)
+
+    def pack(self, packer: Packing, robot: Robot) -> None:
+        """A centre-of-mass block (its coordinates as bits)."""
+        packer.weighted(self, T_COM, 0, None, sum(1 << i for i in self.index))
+
+    def refresh(self, packed: TargetSlots, robot: Robot, slot: int) -> None:
+        """The target point, per call."""
+        packed.set_point(slot, self.target)
+
+    def points(self, robot: Robot, data: pin.Data, com: np.ndarray | None) -> list[PointRow]:
+        """The centre of mass as a point: its free coordinates' targets are their current values, and follow it."""
+        assert com is not None
+        index = list(self.index)
+        goal = com.copy()
+        goal[index] = self.target[index]
+        follows = np.ones(3)
+        follows[index] = 0.0
+        return [(-1, com, goal, self.weight, False, -1, follows)]
+
+    def judged(self, robot: Robot, data: pin.Data, q: np.ndarray, com: np.ndarray | None) -> tuple[float, float]:
+        """The distance of the coordinates asked for, by Pinocchio's centre of mass."""
+        assert com is not None
+        return float(np.linalg.norm((com - self.target)[list(self.index)])), 0.0
+
 
 @dataclass(frozen=True)
-class PostureTask:
+class PostureTask(Task):
     """A reference configuration: every joint pulled toward ``q_ref`` (Pinocchio's q, nq numbers).
 
     Attributes:
-        q_ref: the reference (None: the robot's neutral configuration, within its limits).
+        q_ref: the reference (copied; None: the robot's neutral configuration, within its limits).
         weight: [1/rad or 1/m] every joint's, or one per velocity (nv numbers ≥ 0; a free-flyer's six are read
             only with ``base``); base: include the free-flyer's six velocities (default: not, the base is placed by
             the other tasks).
@@ -367,6 +474,7 @@ class PostureTask:
     base: bool = False
     gain: float = 1.0
     priority: int = 1
+    preference: ClassVar[bool] = True
 
     def __post_init__(self) -> None:
         """Check every field.
@@ -376,18 +484,18 @@ class PostureTask:
         """
         if self.q_ref is not None:
             try:
-                arr = _real_array(self.q_ref, "")
-            except TargetError:
+                arr = tg.real_array(self.q_ref, "")
+            except Exception:  # noqa: BLE001 - any refusal of the numbers is the field's
                 arr = np.array([np.nan])
             if arr.ndim != 1 or not np.isfinite(arr).all():
                 raise OptionError("q_ref", self.q_ref, "nq finite real numbers (Pinocchio's q), or None")
             arr.flags.writeable = False
             object.__setattr__(self, "q_ref", arr)
-        object.__setattr__(self, "weight", _weights(self.weight))
+        object.__setattr__(self, "weight", tg.weights(self.weight))
         if not isinstance(self.base, bool):
             raise OptionError("base", self.base, "True or False")
-        object.__setattr__(self, "gain", _gain(self.gain))
-        object.__setattr__(self, "priority", _priority(self.priority))
+        object.__setattr__(self, "gain", tg.gain(self.gain))
+        object.__setattr__(self, "priority", tg.priority(self.priority))
 
     label = "posture"
 
@@ -406,20 +514,96 @@ class PostureTask:
         """
         return replace(self, q_ref=q_ref, weight=self.weight if weight is None else weight)
 
+    def check(self, robot: Robot) -> None:
+        """Name a reference or weights that do not fit the robot.
+
+        Raises:
+            ConfigurationError, OptionError: named.
+        """
+        self.reference(robot)
+        self.weights(robot)
+
+    def mask(self, robot: Robot) -> np.ndarray:
+        """(nv,) the velocities the posture pulls (all but a free-flyer's six unless ``base``)."""
+        mask = np.ones(robot.nv, dtype=bool)
+        if robot.floating and not self.base:
+            mask[:6] = False
+        return mask
+
+    def weights(self, robot: Robot) -> np.ndarray:
+        """(nv,) the weight per velocity (zero where it does not pull).
+
+        Raises:
+            OptionError: per-velocity weights of another length than nv.
+        """
+        return _per_velocity(robot, self.weight) * self.mask(robot)
+
+    def reference(self, robot: Robot) -> np.ndarray:
+        """The reference q (the robot's neutral one for None).
+
+        Raises:
+            ConfigurationError: a q_ref that is not a configuration of the robot.
+        """
+        if self.q_ref is None:
+            return robot.neutral()
+        return robot.check_q(self.q_ref, what="PostureTask.q_ref")  # its shape, quaternions, coordinates
+
+    def error_at(self, robot: Robot, q: np.ndarray) -> np.ndarray:
+        """q ⊖ q_ref (nv) [rad or m]."""
+        return np.asarray(pin.difference(robot.model, self.reference(robot), q), dtype=float)
+
+    def add_to(self, rows: StepRows, robot: Robot, q: np.ndarray, dt: float) -> TaskError:
+        """The diagonal pull ``weight · ‖v + gain · (q ⊖ q_ref) / dt‖²``; its error the largest gap it pulls."""
+        e, weight = self.error_at(robot, q), self.weights(robot)
+        level = rows.levels[self.priority - 1]
+        level.diag += weight
+        level.target += weight * (-self.gain * e / dt)
+        return TaskError(self.label, float(np.abs(e[weight > 0]).max(initial=0.0)), 0.0)
+
+    def pack(self, packer: Packing, robot: Robot) -> None:
+        """The compiled problem's one posture (its reference and weights written per call)."""
+        packer.posture(self, self.weights(robot))
+
+    def refresh(self, packed: TargetSlots, robot: Robot, slot: int) -> None:
+        """The reference (and per-velocity weights), per call."""
+        packed.set_posture(self.reference(robot), self.weights(robot) if isinstance(self.weight, np.ndarray)
+                           else None)
+
+    def judged(self, robot: Robot, data: pin.Data, q: np.ndarray, com: np.ndarray | None) -> tuple[float, float]:
+        """The largest gap it pulls (never a verdict: a posture is a preference)."""
+        return float(np.abs(self.error_at(robot, q)[self.mask(robot)]).max(initial=0.0)), 0.0
+
+    def second(self) -> PostureTask:
+        """Asked for second, in what the other tasks leave free."""
+        return replace(self, priority=2)
+
+
+def _per_velocity(robot: Robot, weight: float | np.ndarray) -> np.ndarray:
+    """A weight as nv numbers.
+
+    Raises:
+        OptionError: per-velocity weights of another length than nv.
+    """
+    if isinstance(weight, np.ndarray):
+        if weight.shape != (robot.nv,):
+            raise OptionError("weight", weight, f"a number, or nv = {robot.nv} numbers for {robot.name}")
+        return weight.copy()
+    return np.full(robot.nv, float(weight))
+
 
 @dataclass(frozen=True)
-class CouplingTask:
-    """Joint ``joint`` held at ``ratio · leader + offset`` [rad or m], exactly (an equality of the step): a mimic
-    joint or a gear that the file does not declare.
+class DampingTask(Task):
+    """Small velocities: ``weight · ‖v‖²`` in the step's objective (pink's and mink's damping task): the motion
+    the other tasks leave free is kept slow. Every velocity, a free-flyer's too (per-velocity weights choose).
 
     Attributes:
-        joint, leader: 1-DoF joints' names; ratio: the factor; offset: [rad or m].
+        weight: [1/(rad/s)² or 1/(m/s)²] one number, or one per velocity (nv numbers ≥ 0).
+        priority: the level whose objective it joins (1, or 2).
     """
 
-    joint: str
-    leader: str
-    ratio: float = 1.0
-    offset: float = 0.0
+    weight: Any = 1e-3
+    priority: int = 1
+    preference: ClassVar[bool] = True
 
     def __post_init__(self) -> None:
         """Check every field.
@@ -427,29 +611,36 @@ class CouplingTask:
         Raises:
             OptionError: a field out of what it accepts (named).
         """
-        if not isinstance(self.joint, str) or not isinstance(self.leader, str) or self.joint == self.leader:
-            raise OptionError("joint", (self.joint, self.leader), "two different joint names")
-        for name in ("ratio", "offset"):
-            value = getattr(self, name)
-            if not is_real(value):
-                raise OptionError(name, value, "a finite number")
-            object.__setattr__(self, name, float(value))
+        object.__setattr__(self, "weight", tg.weights(self.weight))
+        object.__setattr__(self, "priority", tg.priority(self.priority))
 
-    priority = 0  # held exactly, above every weighted task
-    rows = 1
-
-    @property
-    def label(self) -> str:
-        """The task in words."""
-        return f"{self.joint} = {self.ratio:g} × {self.leader} + {self.offset:g}"
+    label = "damping"
 
     def shape(self) -> tuple[Any, ...]:
-        """What a compiled step is packed for (the whole coupling)."""
-        return ("k", self.joint, self.leader, self.ratio, self.offset, False)
+        """Its weights and level: all of it (nothing is set per call)."""
+        weight = tuple(self.weight.tolist()) if isinstance(self.weight, np.ndarray) else self.weight
+        return ("d", weight, self.priority)
 
+    def check(self, robot: Robot) -> None:
+        """Name weights of another length than nv.
 
-Task = FrameTask | RelativeFrameTask | ComTask | PostureTask | CouplingTask
-TASK_TYPES = (FrameTask, RelativeFrameTask, ComTask, PostureTask, CouplingTask)
+        Raises:
+            OptionError: named.
+        """
+        _per_velocity(robot, self.weight)
+
+    def add_to(self, rows: StepRows, robot: Robot, q: np.ndarray, dt: float) -> TaskError:
+        """The diagonal ``weight · ‖v‖²`` at its level; no error to speak of."""
+        rows.levels[self.priority - 1].diag += _per_velocity(robot, self.weight)
+        return TaskError(self.label, 0.0, 0.0)
+
+    def pack(self, packer: Packing, robot: Robot) -> None:
+        """Its diagonal, at its level."""
+        packer.damping(self, _per_velocity(robot, self.weight))
+
+    def judged(self, robot: Robot, data: pin.Data, q: np.ndarray, com: np.ndarray | None) -> tuple[float, float]:
+        """Nothing to judge: a damping asks for no place."""
+        return 0.0, 0.0
 
 
 def as_tasks(tasks: object) -> tuple[Task, ...]:
@@ -458,14 +649,15 @@ def as_tasks(tasks: object) -> tuple[Task, ...]:
     Raises:
         OptionError: anything else (named), or no task at all.
     """
-    items: Any = (tasks,) if isinstance(tasks, TASK_TYPES) else tasks
+    items: Any = (tasks,) if isinstance(tasks, Task) else tasks
     try:
         found = tuple(items)
     except TypeError:
-        raise OptionError("tasks", tasks, "a task (FrameTask, RelativeFrameTask, ComTask, PostureTask, CouplingTask) "
-                          "or a list of them") from None
-    bad = [t for t in found if not isinstance(t, TASK_TYPES)]
+        raise OptionError("tasks", tasks, f"a task ({', '.join(NAMES)}) or a list of them") from None
+    bad = [t for t in found if not isinstance(t, Task)]
     if bad or not found:
-        raise OptionError("tasks", bad[0] if bad else tasks, "FrameTask, RelativeFrameTask, ComTask, PostureTask or "
-                          "CouplingTask values (at least one)")
+        raise OptionError("tasks", bad[0] if bad else tasks, f"{', '.join(NAMES)} values (at least one)")
     return found
+
+
+NAMES = ("FrameTask", "RelativeFrameTask", "ComTask", "PostureTask", "DampingTask", "CouplingTask")
