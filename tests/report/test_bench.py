@@ -311,7 +311,8 @@ def test_a_peer_that_does_not_take_the_robot_is_said_not_run(monkeypatch):
     pytest.importorskip("pink")
     monkeypatch.setitem(peers.ADAPTERS, "pink", _declines)
     result = runner.run(robots=["ur5"], n=2, repeats=1, solvers=["frdm", "pink"])
-    assert result["not_run"] == {"pink on ur5": "sees 5 joints, kinelab 6"}
+    assert result["not_run"]["pink on ur5"] == "sees 5 joints, kinelab 6"
+    assert all(k == "pink on ur5" or "not installed" in why for k, why in result["not_run"].items())
     assert [r["solver"] for r in result["rows"]] == ["frdm"]
 
 
