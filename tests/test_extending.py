@@ -18,6 +18,7 @@ def test_the_pages_toy_task_is_stepped_and_solved_by_its_own_methods(monkeypatch
     namespace: dict = {}
     exec(compile(block, "extending.md", "exec"), namespace)  # noqa: S102 - the page's own example
     talos, q, solved = namespace["talos"], namespace["q"], namespace["solved"]
+    assert not namespace["problem"].compiled  # a task with no compiled block: the readable step answered
     model, data = talos.model, talos.model.createData()
     j = model.joints[model.getJointId("arm_left_4_joint")]
     assert abs(q[j.idx_q] + 1.2) <= 1e-3

@@ -34,7 +34,8 @@ _LAZY = {
     "Joint": ("kinelab.robot.joints", "Joint"),
     "robots": ("kinelab.robot.catalog", "names"),
     "solve": ("kinelab.wholebody.api", "solve"),
-    "step": ("kinelab.wholebody.step", "step"),
+    "step": ("kinelab.wholebody.problem", "step"),
+    "WholeBody": ("kinelab.wholebody.problem", "WholeBody"),
     "FrameTask": ("kinelab.wholebody.tasks", "FrameTask"),
     "RelativeFrameTask": ("kinelab.wholebody.tasks", "RelativeFrameTask"),
     "ComTask": ("kinelab.wholebody.tasks", "ComTask"),
@@ -104,8 +105,9 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
     from kinelab.wholebody.api import solve, track
     from kinelab.wholebody.constraints import CouplingTask
     from kinelab.wholebody.limits import Limits
+    from kinelab.wholebody.problem import WholeBody, step
     from kinelab.wholebody.solve import WholeBodyResult
-    from kinelab.wholebody.step import StepOptions, StepResult, step
+    from kinelab.wholebody.step import StepOptions, StepResult
     from kinelab.wholebody.tasks import ComTask, DampingTask, FrameTask, PostureTask, RelativeFrameTask
 
 
@@ -120,6 +122,7 @@ __all__ = [
     "RelativeFrameTask",
     "StepOptions",
     "StepResult",
+    "WholeBody",
     "WholeBodyResult",
     "step",
     "BatchSpec",

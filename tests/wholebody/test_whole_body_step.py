@@ -226,7 +226,9 @@ def test_the_limit_check_fails_when_a_bound_is_dropped(monkeypatch, dropped):
             vmax = np.full_like(vmax, np.inf)
         return original(space, q, dt, vmax, position and dropped != "position", amax, v_prev)
 
-    monkeypatch.setattr(step_module, "_compiled", lambda *args: None)  # the readable step, whose bounds are patched
+    problem_module = importlib.import_module("kinelab.wholebody.problem")
+    monkeypatch.setattr(problem_module.WholeBody, "_compiled_step", lambda *args: None)  # the readable step, whose
+    # bounds are patched
     monkeypatch.setattr(step_module, "bounds", without)
     assert limits_check(baxter, 10, 0)[0].value > 0
 

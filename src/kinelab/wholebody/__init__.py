@@ -7,13 +7,15 @@ limits held exactly, one differential step (a QP), and the converged solve.
 - :mod:`~kinelab.wholebody.limits`: what the step holds (positions, velocities, accelerations).
 - :mod:`~kinelab.wholebody.evaluate`: each task's error and rate matrix from one Pinocchio pass.
 - :mod:`~kinelab.wholebody.qp`: the QP (DAQP, or ProxQP).
-- :mod:`~kinelab.wholebody.step`: :func:`step`.
+- :mod:`~kinelab.wholebody.step`: the step's QP (the readable step, its options and result).
+- :mod:`~kinelab.wholebody.problem`: :class:`WholeBody`, a problem prepared once, and :func:`step`.
 """
 
 from kinelab.wholebody.constraints import CouplingTask
 from kinelab.wholebody.limits import Limits
-from kinelab.wholebody.step import StepOptions, StepResult, step
+from kinelab.wholebody.problem import WholeBody, step
+from kinelab.wholebody.step import StepOptions, StepResult
 from kinelab.wholebody.tasks import ComTask, DampingTask, FrameTask, PostureTask, RelativeFrameTask, Task, TaskError
 
 __all__ = ["ComTask", "CouplingTask", "DampingTask", "FrameTask", "Limits", "PostureTask", "RelativeFrameTask",
-           "StepOptions", "StepResult", "Task", "TaskError", "step"]
+           "StepOptions", "StepResult", "Task", "TaskError", "WholeBody", "step"]

@@ -38,7 +38,8 @@ from kinelab.robot.chain import Chain
 from kinelab.robot.tree import Robot
 from kinelab.typing import Configuration, Targets
 from kinelab.wholebody.limits import Limits
-from kinelab.wholebody.step import StepOptions, step
+from kinelab.wholebody.problem import step
+from kinelab.wholebody.step import StepOptions
 from kinelab.wholebody.tasks import FrameTask, PostureTask
 
 FLOOR = 1e-4  # [rad or m] room beyond the task's least step: the corrections of a path at rest

@@ -110,6 +110,25 @@ class Task(ABC):
         """The task as the converged solve asks for it (a posture: second, so that it never holds a task off)."""
         return self
 
+    def moved(self, target: Any) -> Task:
+        """The same task at another target (checked), its other settings taken as they are.
+
+        Raises:
+            OptionError: a task with no target (a damping, a coupling). TargetError: a target that is not one.
+        """
+        raise OptionError("target", target, f"a task with a target ({self.label} has none to move)")
+
+    def _target(self, target: Any) -> Any:
+        """``target`` checked and copied as this task holds it."""
+        return target
+
+    def _with_target(self, target: Any) -> Any:
+        """A copy of this task holding ``target`` (checked), made without checking the other fields again."""
+        made = object.__new__(type(self))
+        made.__dict__.update(self.__dict__)
+        made.__dict__["target"] = self._target(target)
+        return made
+
 
 class _Frame(Task):
     """A task on frames: its rows from Pinocchio's Jacobians, its error split into position and rotation."""
@@ -213,9 +232,7 @@ class FrameTask(_Frame):
         Raises:
             TargetError: a target that is not a pose (named).
         """
-        made = object.__new__(FrameTask)
-        made.__dict__.update(self.__dict__)
-        made.__dict__["target"] = self._target(target)
+        made: FrameTask = self._with_target(target)
         return made
 
     @property
@@ -294,7 +311,7 @@ class RelativeFrameTask(_Frame):
         """
         if not isinstance(self.frame, str) or not isinstance(self.root, str):
             raise OptionError("frame", (self.frame, self.root), "two frame names")
-        object.__setattr__(self, "target", tg.pose(self.target, f"the target of {self.frame!r} in {self.root!r}"))
+        object.__setattr__(self, "target", self._target(self.target))
         object.__setattr__(self, "weight", tg.weight("weight", self.weight))
         ow = self.weight if self.orientation_weight is None else self.orientation_weight
         object.__setattr__(self, "orientation_weight", tg.weight("orientation_weight", ow))
@@ -302,6 +319,18 @@ class RelativeFrameTask(_Frame):
         object.__setattr__(self, "priority", tg.priority(self.priority))
 
     rows_count = 6
+
+    def _target(self, target: Any) -> FixedPose:
+        return tg.pose(target, f"the target of {self.frame!r} in {self.root!r}")
+
+    def moved(self, target: pin.SE3 | ArrayLike) -> RelativeFrameTask:
+        """The same task at another target (rootM*, checked).
+
+        Raises:
+            TargetError: a target that is not a pose (named).
+        """
+        made: RelativeFrameTask = self._with_target(target)
+        return made
 
     @property
     def label(self) -> str:
@@ -399,7 +428,7 @@ class ComTask(Task):
         Raises:
             OptionError, TargetError: a field out of what it accepts (named).
         """
-        object.__setattr__(self, "target", tg.vector(self.target, 3, "the centre of mass's target"))
+        object.__setattr__(self, "target", self._target(self.target))
         if not isinstance(self.axes, str) or not self.axes or any(a not in AXES for a in self.axes) \
                 or len(set(self.axes)) != len(self.axes):
             raise OptionError("axes", self.axes, "'xyz' or a part of it ('xy', 'z', ...)")
@@ -412,6 +441,18 @@ class ComTask(Task):
     def rows_count(self) -> int:
         """How many rows the task adds."""
         return len(self.index)
+
+    def _target(self, target: Any) -> np.ndarray:
+        return tg.vector(target, 3, "the centre of mass's target")
+
+    def moved(self, target: ArrayLike) -> ComTask:
+        """The same task at another target [m] (checked).
+
+        Raises:
+            TargetError: a target that is not three finite numbers (named).
+        """
+        made: ComTask = self._with_target(target)
+        return made
 
     @property
     def label(self) -> str:
