@@ -33,7 +33,6 @@ if TYPE_CHECKING:
     pass
 
 
-T = TypeVar("T")
 
 
 @dataclass(frozen=True)
