@@ -10,7 +10,7 @@ q ⊕ v·dt through ``pin.integrate``.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, TypeVar
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
