@@ -2,7 +2,7 @@ from typing import Any, TypeVar
 
 from kinelab.core._chain import Judge
 from kinelab.core._frdm import Packed
-from kinelab.ik.spec import BiquatSpec, EngineSpec, FRDMSpec
+from kinelab.core.spec import BiquatSpec, EngineSpec, FRDMSpec
 
 R = TypeVar("R")
 

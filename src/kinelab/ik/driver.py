@@ -17,11 +17,11 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import numpy as np
 import pinocchio as pin
 
+from kinelab.core.spec import EngineSpec
 from kinelab.ik.limits import turned_verdict, wrap_q
 from kinelab.ik.registry import SolverOptions
 from kinelab.ik.request import Request, verdict_reserve
 from kinelab.ik.result import Attempt, BypassRecord, IKResult, SingularEvent, Status
-from kinelab.ik.spec import EngineSpec
 from kinelab.ik.targets import as_target, out_of_reach, reach_bound
 from kinelab.ik.tasks import COMPONENTS, POSE, Task
 from kinelab.robot import Chain
@@ -237,7 +237,7 @@ def engine_spec(robot: Chain, req: Request, cm: ChainModel,
         attempt_of: (the kernel's code, q, statistics, deadline [s]) → the :class:`Attempt` the general route builds.
         mode: the converged result's ``mode``.
         diagnostics: statistics → the result's diagnostics (called when they are first read).
-        spec_type: the engine's spec (:class:`kinelab.ik.spec.FRDMSpec`, :class:`~kinelab.ik.spec.BiquatSpec`).
+        spec_type: the engine's spec (:class:`kinelab.core.spec.FRDMSpec`, :class:`~kinelab.core.spec.BiquatSpec`).
         kernel: the engine's own settings (its kernel's arrays and constants: the spec type's own fields, and
             ``pstar``, ``Rstar``, ``wrap_continuous``).
     """

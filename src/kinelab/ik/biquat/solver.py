@@ -18,6 +18,7 @@ from numpy.typing import ArrayLike
 
 from kinelab.core._engine import BiquatEngine
 from kinelab.core._frdm import pack_chain
+from kinelab.core.spec import BiquatSpec
 from kinelab.dq import kinematics as biquat_kinematics
 from kinelab.dq.algebra import DualQuat, same_pose
 from kinelab.errors import BiquaternionError, KinelabError
@@ -32,7 +33,6 @@ from kinelab.ik.limits import wrap_q
 from kinelab.ik.multistart import clock_chunk
 from kinelab.ik.request import Request
 from kinelab.ik.result import Attempt, BiquatDiagnostics, Status
-from kinelab.ik.spec import BiquatSpec
 from kinelab.robot import Chain
 
 Options = BiquatOptions

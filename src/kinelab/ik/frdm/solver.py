@@ -17,6 +17,7 @@ import pinocchio as pin
 
 from kinelab.core import _frdm
 from kinelab.core._engine import FRDMEngine
+from kinelab.core.spec import FRDMSpec
 from kinelab.ik import dls
 from kinelab.ik import multistart as restarts
 from kinelab.ik.chain import CONTINUOUS, ChainModel, chain_model
@@ -28,7 +29,6 @@ from kinelab.ik.frdm.options import ORDERS, FRDMOptions
 from kinelab.ik.multistart import clock_chunk
 from kinelab.ik.request import Request
 from kinelab.ik.result import Attempt, FRDMDiagnostics, SingularEvent, Status
-from kinelab.ik.spec import FRDMSpec
 from kinelab.robot import Chain
 
 Options = FRDMOptions
