@@ -10,7 +10,7 @@ with ``follower="step"`` by the whole-body step (:func:`kinelab.wholebody.follow
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any, TypeGuard
+from typing import TYPE_CHECKING, Any, TypeGuard, overload
 
 import pinocchio as pin
 
@@ -23,8 +23,13 @@ from kinelab.typing import Target, Targets
 from kinelab.wholebody.tasks import Task
 
 if TYPE_CHECKING:
+    from kinelab.ik.registry import SolverOptions
+    from kinelab.ik.result import IKResult, TrackResult
+    from kinelab.typing import CollisionSpec, Configuration
     from kinelab.wholebody import follow
     from kinelab.wholebody import solve as wholebody
+    from kinelab.wholebody.limits import Limits
+    from kinelab.wholebody.solve import WholeBodyResult
 else:  # a chain's solve does not load the whole-body step (its QP, its compiled problem)
     follow = lazy.module("kinelab.wholebody.follow", globals())
     wholebody = lazy.module("kinelab.wholebody.solve", globals())
@@ -37,7 +42,23 @@ def is_tasks(target: object) -> TypeGuard[Task | Sequence[Task]]:
     return isinstance(target, list | tuple) and bool(target) and all(isinstance(t, Task) for t in target)
 
 
-def solve(robot: Chain | Robot, target: Target | Sequence[Task], *positional: object, **settings: Any) -> Any:
+@overload
+def solve(robot: Chain, target: Target, *, solver: str = "frdm", q0: Configuration | None = None,
+          seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float = 1.0,
+          max_restarts: int = 1000, start_outside_limits: str = "project", options: SolverOptions = None,
+          task: str = "pose", axis: str = "z", prefer: Configuration | None = None, collisions: CollisionSpec = None,
+          **solver_options: object) -> IKResult: ...
+
+
+@overload
+def solve(robot: Robot, target: Task | Sequence[Task], *, q0: Configuration | None = None, solver: str = "step",
+          seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6, max_iterations: int = 100,
+          max_restarts: int = 200, time_budget: float | None = 1.0, limits: Limits | None = None
+          ) -> WholeBodyResult: ...
+
+
+def solve(robot: Chain | Robot, target: Target | Task | Sequence[Task], *positional: object,
+          **settings: Any) -> IKResult | WholeBodyResult:
     """Inverse kinematics: a chain's tool at ``target`` (an ``IKResult``), or a whole robot's tasks (a
     ``WholeBodyResult``).
 
@@ -80,7 +101,8 @@ FOLLOWERS = ("frdm", "step")
 STEP_SETTINGS = ("q0", "seed", "tol_pos", "tol_rot", "time_budget", "task", "axis", "jump_limit")
 
 
-def track(robot: Chain, targets: Targets, *positional: object, follower: str = "frdm", **settings: Any) -> Any:
+def track(robot: Chain, targets: Targets, *positional: object, follower: str = "frdm",
+          **settings: Any) -> TrackResult:
     """Follow a path: each target in turn, from the answer before.
 
     Args:
