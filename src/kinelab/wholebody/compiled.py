@@ -232,7 +232,6 @@ class Packed:
     problem: StepProblem
     slots: tuple[int, ...]  # per task of the list: its weighted slot, or -1
     labels: tuple[str, ...]  # each task's label, in order
-    current: Any = None  # the task objects whose targets the Step holds
 
     def set_pose(self, slot: int, H: np.ndarray) -> None:
         """A weighted task's target pose (4 × 4)."""

@@ -153,7 +153,6 @@ class WholeBody:
         self._tasks[i] = moved
         if self._packed is not None:
             moved.refresh(self._packed, self.robot, self._packed.slots[i])
-            self._packed.current = None
         return moved
 
     def _index(self, task: Task | int) -> int:
@@ -175,13 +174,21 @@ class WholeBody:
         if cp.structure(found) != cp.structure(tuple(self._tasks)):
             raise OptionError("tasks", tasks, "tasks of the same kinds, frames and settings as the problem's (a new "
                               "kinelab.WholeBody for others)")
-        self._tasks = list(found)
-        self._refresh_all()
+        self._take(found)
+
+    def _take(self, found: tuple[Task, ...]) -> None:
+        """Tasks of this structure in place of the problem's: only those that are other objects write their
+        targets (a task is a value: the same object holds the same target)."""
+        packed = self._packed
+        for i, (held, task) in enumerate(zip(self._tasks, found, strict=True)):
+            if task is not held:
+                self._tasks[i] = task
+                if packed is not None:
+                    task.refresh(packed, self.robot, packed.slots[i])
 
     def _refresh_all(self) -> None:
         if self._packed is not None:
             cp.set_targets(self.robot, self._packed, tuple(self._tasks))
-            self._packed.current = None
 
     def solve(self, q0: Configuration | None = None, **settings: Any) -> WholeBodyResult:
         """The converged solve of these tasks (:func:`kinelab.wholebody.solve.solve`; the limits' positions held,
@@ -262,7 +269,7 @@ def kept(robot: Robot, tasks: Any, limits: Limits, options: StepOptions) -> Whol
     key = cp.structure(found)
     problem = table.get(key)
     if problem is not None and problem.options == options:
-        problem.retarget(found)
+        problem._take(found)  # the same structure: the key says so
         problem.use(limits)
     else:
         if len(table) >= KEPT:

@@ -151,10 +151,10 @@ def pose(value: Any, what: str) -> FixedPose:
             H = H.reshape(4, 4)
         except ValueError:
             raise TargetError(f"{what} must be a pin.SE3 or a 4 × 4 homogeneous matrix, got {value!r}") from None
-    if pose_defect(H) or np.abs(H[:3, 3]).max() > MAX_COORDINATE:
+    if pose_defect(H) or H[0, 3] * H[0, 3] + H[1, 3] * H[1, 3] + H[2, 3] * H[2, 3] > MAX_COORDINATE * MAX_COORDINATE:
         raise TargetError(f"{what} is not a finite pose with a proper rotation (orthonormal within 1e-6, det +1, "
                           f"last row 0, 0, 0, 1) and a position within {MAX_COORDINATE:g} m")
-    return FixedPose(np.ascontiguousarray(H))
+    return FixedPose(H)
 
 
 MAX_COORDINATE = 1e6  # [m] a target farther than this from the world's origin is a mistake (and overflows rates)
