@@ -97,3 +97,12 @@ def test_bad_problems_are_refused_by_name(talos):
     problem = WholeBody(talos, [ComTask([0, 0, 0.8])])
     with pytest.raises(kinelab.KinelabError, match="same kinds"):
         problem.retarget([ComTask([0, 0, 0.8], axes="xy")])
+
+
+def test_a_problem_says_which_step_answers_and_why(talos):
+    from kinelab import StepOptions
+
+    assert WholeBody(talos, [ComTask([0, 0, 0.8])]).route.startswith("compiled")
+    assert "proxsuite" in WholeBody(talos, [ComTask([0, 0, 0.8])], options=StepOptions(solver="proxsuite")).route
+    two = WholeBody(talos, [PostureTask(), PostureTask(weight=1e-2)])
+    assert not two.compiled and "two postures" in two.route

@@ -94,8 +94,22 @@ class WholeBody:
 
     @property
     def compiled(self) -> bool:
-        """Whether each step is one compiled call (else the readable step answers, alike)."""
+        """Whether each step is one compiled call (else the readable step answers, alike: :attr:`route` says
+        why)."""
         return self._packed is not None
+
+    @property
+    def route(self) -> str:
+        """Which step answers, and why, in words."""
+        if self._packed is not None:
+            return "compiled: the tree certified against Pinocchio, DAQP's C interface linked, every task packed"
+        if self.options.solver != "daqp":
+            return f"readable: the QP solver is {self.options.solver!r} (the compiled step runs DAQP)"
+        if not cp.daqp_linked():
+            return "readable: DAQP's C interface is not linked (an installed daqp other than 0.11.x, or none)"
+        if self.robot.derived("compiled tree", cp.pack_tree) is None:
+            return "readable: the robot's tree has a joint the compiled step has no code for, or failed its certificate"
+        return "readable: a task the compiled step has no block for (or two postures, or a posture on the base)"
 
     def step(self, q: Configuration, dt: float, v_prev: ArrayLike | None = None) -> StepResult:
         """One differential step from q (:func:`kinelab.step`'s answer for these tasks, limits and options).
