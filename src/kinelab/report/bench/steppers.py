@@ -13,7 +13,7 @@ import pinocchio as pin
 
 from kinelab.robot import Chain, load
 from kinelab.robot.tree import Robot
-from kinelab.wholebody import ComTask, FrameTask, Limits, PostureTask, StepOptions, step
+from kinelab.wholebody import ComTask, FrameTask, Limits, PostureTask, StepOptions, WholeBody
 
 DT = 0.005  # [s]
 RADIUS, PERIOD = 0.05, 2.0  # [m], [s] each hand's circle
@@ -84,14 +84,17 @@ class KinelabStepper:
         self.frames = [FrameTask(f, M) for f, M in zip(frames, placed, strict=True)]
         self.extra = ([ComTask(robot.com(q0))] if scenario.com else []) + \
             [PostureTask(q0, weight=POSTURE_COST**2)]
-        self.options = StepOptions(damping=DAMPING)
-        self.limits = Limits()
+        self.moving = len(scenario.moving)
+        self.problem = WholeBody(robot, [*self.frames, *self.extra], limits=Limits(),
+                                 options=StepOptions(damping=DAMPING))
         self.v = np.zeros(robot.nv)
 
     def step(self, targets: list[pin.SE3]) -> None:
-        """One step toward the frames' targets (base frame), integrated."""
-        tasks = [t.moved(M) for t, M in zip(self.frames, targets, strict=True)] + self.extra
-        result = step(self.robot, self.q, tasks, DT, limits=self.limits, options=self.options)
+        """One step toward the frames' targets (base frame), integrated: the moving frames' targets set, as pink's
+        and mink's tasks are given theirs."""
+        for i in range(self.moving):
+            self.problem.set_target(i, targets[i])
+        result = self.problem.step(self.q, DT)
         self.q, self.v = result.q, result.v
 
     def pinocchio_q(self) -> np.ndarray:
