@@ -129,17 +129,7 @@ def check_q(space: Space, model: pin.Model, q: ArrayLike, *, limits: bool = Fals
         ConfigurationError: another shape, a non-real type, NaN/inf, a quaternion not of unit norm (1e-6).
         JointLimitError: with ``limits``, a bounded joint outside its limits (named).
     """
-    try:
-        raw = np.asarray(q)
-        if raw.dtype.kind not in "fiu" or mixes_non_reals(q):
-            raise TypeError
-    except (TypeError, ValueError):
-        raise ConfigurationError(f"{what} must be {space.nq} numbers (Pinocchio's q), got {q!r}") from None
-    if raw.shape != (space.nq,):
-        raise ConfigurationError(f"{what} must have nq = {space.nq} numbers (Pinocchio's q: "
-                                 f"{', '.join(space.names_q[:8])}{', ...' if space.nq > 8 else ''}), "
-                                 f"got {raw.shape[0] if raw.ndim == 1 else 'shape ' + str(raw.shape)}")
-    arr = np.ascontiguousarray(raw, dtype=float)
+    arr = _q_numbers(space, q, what)
     bad = np.flatnonzero(~(np.abs(arr) <= MAX_COORDINATE))
     if bad.size:
         raise ConfigurationError(f"{what}[{bad[0]}] ({space.names_q[bad[0]]}) is {arr[bad[0]]}: values must be finite "
@@ -153,6 +143,25 @@ def check_q(space: Space, model: pin.Model, q: ArrayLike, *, limits: bool = Fals
             i = int(outside[0])
             raise JointLimitError(space.names_q[i], float(arr[i]), float(space.lower[i]), float(space.upper[i]))
     return arr
+
+
+def _q_numbers(space: Space, q: ArrayLike, what: str) -> np.ndarray:
+    """``q`` as nq contiguous floats (real numbers only: no bool, complex or text, in arrays or lists).
+
+    Raises:
+        ConfigurationError: anything else, or another shape (named).
+    """
+    try:
+        raw = np.asarray(q)
+        if raw.dtype.kind not in "fiu" or mixes_non_reals(q):
+            raise TypeError
+    except (TypeError, ValueError):
+        raise ConfigurationError(f"{what} must be {space.nq} numbers (Pinocchio's q), got {q!r}") from None
+    if raw.shape != (space.nq,):
+        raise ConfigurationError(f"{what} must have nq = {space.nq} numbers (Pinocchio's q: "
+                                 f"{', '.join(space.names_q[:8])}{', ...' if space.nq > 8 else ''}), "
+                                 f"got {raw.shape[0] if raw.ndim == 1 else 'shape ' + str(raw.shape)}")
+    return np.ascontiguousarray(raw, dtype=float)
 
 
 def check_v(space: Space, v: ArrayLike, what: str = "v") -> np.ndarray:

@@ -135,11 +135,8 @@ class WholeBody:
     def _compiled_step(self, q: Any, dt: float, prev: np.ndarray | None) -> StepResult | None:
         """The step in one compiled call, or None where it does not serve (a q to check and name first, an
         acceleration limit without the velocity before)."""
-        packed, robot = self._packed, self.robot
-        if packed is None or (self._amax.size and prev is None):
-            return None
-        arr = q if type(q) is np.ndarray and q.dtype == np.float64 and q.flags.c_contiguous else None
-        if arr is None or arr.shape != (robot.nq,):
+        packed, robot, arr = self._packed, self.robot, _plain(q, self.robot.nq)
+        if packed is None or arr is None or (self._amax.size and prev is None):
             return None
         q_out, v_out, errors = np.empty(robot.nq), np.empty(robot.nv), np.zeros((len(packed.labels), 2))
         returning = np.empty(robot.nv, dtype=np.uint8)
@@ -224,6 +221,14 @@ class WholeBody:
     def __repr__(self) -> str:
         return (f"WholeBody({self.robot.name}, {len(self._tasks)} tasks, "
                 f"{'compiled' if self.compiled else 'readable'} step)")
+
+
+def _plain(q: Any, nq: int) -> np.ndarray | None:
+    """q when it is nq contiguous float64 numbers, as the compiled step takes it (else None: the readable step
+    checks and names it)."""
+    if type(q) is np.ndarray and q.dtype == np.float64 and q.flags.c_contiguous and q.shape == (nq,):
+        return q
+    return None
 
 
 def _packed(robot: Robot, tasks: tuple[Task, ...], options: StepOptions) -> cp.Packed | None:

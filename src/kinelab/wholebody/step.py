@@ -122,13 +122,20 @@ def _step(robot: Robot, q: np.ndarray, tasks: tuple[Task, ...], dt: float, limit
         second = _second_level(robot, levels, solution.v, options, lower, upper, A_eq, b_eq, dt)
         iterations += second.iterations
         solution = second if second.solved else solution
-    v = solution.v if solution.solved else np.zeros(robot.nv)
-    q_next = np.asarray(pin.integrate(robot.model, q, v * dt), dtype=float) if solution.solved else q.copy()
+    names = tuple(robot.space.names_v[i] for i in np.flatnonzero(returning))
+    return _result(robot, q, dt, solution, tuple(errors), names, iterations)
+
+
+def _result(robot: Robot, q: np.ndarray, dt: float, solution: qp.Solution, errors: tuple[TaskError, ...],
+            returning: tuple[str, ...], iterations: int) -> StepResult:
+    """The step's answer: q ⊕ v·dt where the QP solved and its answer is finite, else v zero and q unmoved (status
+    ``not finite`` for an answer that overflowed)."""
     status, solved = solution.status, solution.solved
+    v = solution.v if solved else np.zeros(robot.nv)
+    q_next = np.asarray(pin.integrate(robot.model, q, v * dt), dtype=float) if solved else q.copy()
     if solved and not (np.isfinite(v).all() and np.isfinite(q_next).all()):
         status, solved, v, q_next = qp.NOT_FINITE, False, np.zeros(robot.nv), q.copy()
-    names = tuple(robot.space.names_v[i] for i in np.flatnonzero(returning))
-    return StepResult(v, q_next, status, solved, tuple(errors), names, iterations)
+    return StepResult(v, q_next, status, solved, errors, returning, iterations)
 
 
 def _second_level(robot: Robot, levels: list[ev.Rows], v_first: np.ndarray, options: StepOptions,

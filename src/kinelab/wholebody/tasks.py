@@ -143,6 +143,18 @@ class _Frame(Task):
     def rows(self, robot: Robot) -> Rowset:
         """(A, e, per-row weight, a pose's translation gap) at ``robot.data``'s configuration."""
 
+    def _check_weights(self) -> None:
+        """The weights, the gain and the priority checked (the orientation weight the position's where None).
+
+        Raises:
+            OptionError: a field out of what it accepts (named).
+        """
+        object.__setattr__(self, "weight", tg.weight("weight", self.weight))
+        ow = self.weight if self.orientation_weight is None else self.orientation_weight
+        object.__setattr__(self, "orientation_weight", tg.weight("orientation_weight", ow))
+        object.__setattr__(self, "gain", tg.gain(self.gain))
+        object.__setattr__(self, "priority", tg.priority(self.priority))
+
     def add_to(self, rows: StepRows, robot: Robot, q: np.ndarray, dt: float) -> TaskError:
         """The weighted rows ``A v ≈ −gain · e / dt`` at the task's level."""
         A, e, w, gap = self.rows(robot)
@@ -206,11 +218,7 @@ class FrameTask(_Frame):
         if self.axis not in ("x", "y", "z"):
             raise OptionError("axis", self.axis, "'x', 'y' or 'z'")
         object.__setattr__(self, "target", self._target(self.target))
-        object.__setattr__(self, "weight", tg.weight("weight", self.weight))
-        ow = self.weight if self.orientation_weight is None else self.orientation_weight
-        object.__setattr__(self, "orientation_weight", tg.weight("orientation_weight", ow))
-        object.__setattr__(self, "gain", tg.gain(self.gain))
-        object.__setattr__(self, "priority", tg.priority(self.priority))
+        self._check_weights()
 
     def _target(self, target: Any) -> FixedPose:
         if self.task == "position" and not isinstance(target, pin.SE3) and np.size(target) == 3:
@@ -312,11 +320,7 @@ class RelativeFrameTask(_Frame):
         if not isinstance(self.frame, str) or not isinstance(self.root, str):
             raise OptionError("frame", (self.frame, self.root), "two frame names")
         object.__setattr__(self, "target", self._target(self.target))
-        object.__setattr__(self, "weight", tg.weight("weight", self.weight))
-        ow = self.weight if self.orientation_weight is None else self.orientation_weight
-        object.__setattr__(self, "orientation_weight", tg.weight("orientation_weight", ow))
-        object.__setattr__(self, "gain", tg.gain(self.gain))
-        object.__setattr__(self, "priority", tg.priority(self.priority))
+        self._check_weights()
 
     rows_count = 6
 

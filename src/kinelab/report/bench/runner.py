@@ -82,9 +82,7 @@ class _Tally:
         Raises:
             PeerFailedError: every solve raised (a broken adapter or peer, never figures without it).
         """
-        if self.calls and self.raising == self.calls and self.raised is not None:
-            raise peers.PeerFailedError(f"{self.name} on {self.robot.name} raised on every problem: "
-                                   f"{peers.last_line(self.raised)}")
+        _tally_check(self)
         best = [b for b in self.best if b is not None]
         times = np.array([b[0] for b in best]) * 1e6
         solved = [b[0] * 1e6 for b in best if b[1]]
@@ -92,6 +90,17 @@ class _Tally:
         return Row(self.robot.name, self.name, n, len(solved), 100.0 * len(solved) / n, float(np.median(times)),
                    float(np.percentile(times, 95)), float(np.median(solved)) if solved else float("nan"),
                    float(np.median([b[3] for b in best])), _failures(best))
+
+
+def _tally_check(tally: _Tally) -> None:
+    """Raise when every solve of the tally raised (a broken adapter or peer).
+
+    Raises:
+        PeerFailedError: named with the last exception's line.
+    """
+    if tally.calls and tally.raising == tally.calls and tally.raised is not None:
+        raise peers.PeerFailedError(f"{tally.name} on {tally.robot.name} raised on every problem: "
+                                    f"{peers.last_line(tally.raised)}")
 
 
 def _failures(best: list[tuple[float, bool, str, int]]) -> dict[str, int]:
