@@ -1,6 +1,8 @@
 """#59: the converged multi-frame solve, both solvers: every frame's target from one random configuration of the whole
 robot, met within 1e-6 m / 1e-6 rad per frame inside the limits, judged here again by Pinocchio's own FK and centre
-of mass; a target set no configuration meets is reported per task, never as a success."""
+of mass; a target set no configuration meets is reported per task, never as a success. The solves are bounded by a
+count of restarts, not by a clock: the outcome is the same on a loaded machine (G1's third target with FRDM takes 39
+restarts, 3-7 s)."""
 
 import numpy as np
 import pinocchio as pin
@@ -46,7 +48,7 @@ def test_reachable_targets_are_met_and_judged(name, solver):
         q_true, tasks = reachable_tasks(robot, rng)
         start = robot.neutral()
         start[:7] = q_true[:7] if robot.floating else start[:7]
-        res = kinelab.solve(robot, tasks, q0=start, solver=solver, seed=k, time_budget=5.0)
+        res = kinelab.solve(robot, tasks, q0=start, solver=solver, seed=k, time_budget=None, max_restarts=100)
         assert res.success and res.status == "converged", (k, res.message)
         assert all(v.met for v in res.tasks) and res.judge == "Pinocchio FK"
         assert_met_by_pinocchio(robot, tasks, res.q)
@@ -59,7 +61,7 @@ def test_baxter_holds_a_box_with_both_grippers():
     right_in_left = (box * pin.SE3(pin.rpy.rpyToMatrix(-np.pi / 2, 0, 0), np.array([0, -0.18, 0]))).inverse() * left
     tasks = [FrameTask("left_gripper", left), RelativeFrameTask("left_gripper", "right_gripper", right_in_left),
              PostureTask()]
-    res = kinelab.solve(baxter, tasks, seed=0, time_budget=5.0)
+    res = kinelab.solve(baxter, tasks, seed=0, time_budget=None, max_restarts=100)
     assert res.success, res.message
     data = baxter.model.createData()
     pin.framesForwardKinematics(baxter.model, data, res.q)
