@@ -8,6 +8,7 @@ errors every call raises on bad input (all :class:`KinelabError`).
 from typing import TYPE_CHECKING
 
 from kinelab.errors import (
+    AssemblyError,
     BiquaternionError,
     ChainError,
     ConfigurationError,
@@ -41,6 +42,7 @@ _LAZY = {
     "ComTask": ("kinelab.wholebody.tasks", "ComTask"),
     "PostureTask": ("kinelab.wholebody.tasks", "PostureTask"),
     "CouplingTask": ("kinelab.wholebody.constraints", "CouplingTask"),
+    "Closure": ("kinelab.robot.closures", "Closure"),
     "DampingTask": ("kinelab.wholebody.tasks", "DampingTask"),
     "Limits": ("kinelab.wholebody.limits", "Limits"),
     "StepOptions": ("kinelab.wholebody.step", "StepOptions"),
@@ -99,6 +101,7 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
     from kinelab.maps.batch import BatchSpec, solve_batch_on_cluster
     from kinelab.robot.catalog import names as robots
     from kinelab.robot.chain import Chain
+    from kinelab.robot.closures import Closure
     from kinelab.robot.joints import Joint
     from kinelab.robot.loading import load
     from kinelab.robot.tree import Robot
@@ -112,7 +115,9 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
 
 
 __all__ = [
+    "AssemblyError",
     "BatchIKResult",
+    "Closure",
     "ComTask",
     "CouplingTask",
     "DampingTask",

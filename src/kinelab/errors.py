@@ -115,6 +115,15 @@ class TargetError(KinelabError):
     """A target that is not a valid pose (shape, NaN/inf, not a rotation, not a unit quaternion)."""
 
 
+class AssemblyError(KinelabError):
+    """No configuration of a robot's passive joints closes every loop with its actuated joints held (within the
+    limits); ``residual`` is the smallest closure error reached [m, rad]."""
+
+    def __init__(self, message: str, residual: float):
+        self.residual = residual
+        super().__init__(message)
+
+
 class BiquaternionError(KinelabError):
     """A biquaternion that is not what an operation needs (non-finite, not unit, wrong shape)."""
 

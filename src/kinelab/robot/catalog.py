@@ -32,6 +32,7 @@ class Entry:
     floating: bool = False  # the whole robot's base floats (a free-flyer at its root)
     hands: tuple[str, ...] = ()  # a whole robot's frames a user moves first (teach's targets, the notebook's)
     feet: tuple[str, ...] = ()  # a whole robot's frames that stand on the floor (held where they are)
+    closures: str | None = None  # its closures declaration, below the same directory as relpath
 
     @property
     def chain(self) -> str:
@@ -64,6 +65,12 @@ BUNDLED = (
           "UR10e with a factory-size calibration (axes off parallel by mrad): a general 6R, no closed form"),
     Entry("general6r", "kinelab", "general6r.urdf", "flange",
           "kinelab's own general 6R arm: no two axes parallel or meeting (every branch by the elimination)"),
+)
+
+CLOSED = (  # bundled robots that close loops (kinelab.robot.closures): whole robots, their loops declared beside
+    Entry("fourbar", "kinelab", "fourbar.urdf", None,
+          "planar crank-rocker four-bar, one loop (closed at the coupler's end), the crank driven",
+          whole=True, closures="fourbar.closures.yaml", hands=("coupler_tip",)),
 )
 
 ERD_ARMS = (
@@ -137,7 +144,7 @@ ERD_WHOLE = (
            paws=("lf_foot", "rf_foot", "lh_foot", "rh_foot")),
 )
 
-ENTRIES = {e.name: e for e in BUNDLED + ERD_ARMS + ERD_WHOLE}
+ENTRIES = {e.name: e for e in BUNDLED + ERD_ARMS + ERD_WHOLE + CLOSED}
 
 
 def bundled_urdf_dir() -> Path:
@@ -184,6 +191,14 @@ def package_dirs() -> list[str]:
     if share:
         dirs += [str(share), str(share / "example-robot-data" / "robots")]
     return dirs
+
+
+def closures_path(entry: Entry) -> Path | None:
+    """The entry's closures declaration (YAML), or None."""
+    if entry.closures is None:
+        return None
+    root = bundled_urdf_dir() if entry.source == "kinelab" else erd_robots_dir()
+    return None if root is None else root / entry.closures
 
 
 def srdf_path(entry: Entry) -> Path | None:

@@ -8,6 +8,7 @@ whole robot. Every decision of a build is :mod:`kinelab.robot.build`'s.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from functools import partial
 from pathlib import Path
 from typing import Any
@@ -19,6 +20,7 @@ from kinelab.errors import OptionError
 from kinelab.robot import catalog, descriptions
 from kinelab.robot.build import Built, whole_model
 from kinelab.robot.chain import Chain
+from kinelab.robot.closures import Closure, read_closures
 from kinelab.robot.meshes import build_visual_model, mesh_package_dirs
 from kinelab.robot.mjcf import is_mjcf
 from kinelab.robot.reduce import build_file
@@ -30,7 +32,8 @@ __all__ = ["load", "whole_of"]
 def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, float] | None = None,
          base: str | None = None, package_dirs: list[str] | None = None, srdf: str | Path | None = None,
          group: str | None = None, xacro_args: dict[str, str] | None = None, *,
-         trust_xacro: bool = False, whole: bool | None = None, floating: bool | None = None) -> Any:
+         trust_xacro: bool = False, whole: bool | None = None, floating: bool | None = None,
+         closures: Sequence[Closure] | str | Path | None = None, actuated: Sequence[str] | None = None) -> Any:
     """Load a registered robot (``kinelab.robots()``) or a model file: a :class:`~kinelab.robot.chain.Chain`
     (an arm) or the whole :class:`~kinelab.robot.tree.Robot` (see the module's docstring).
 
@@ -57,6 +60,10 @@ def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, fl
         whole: True: the whole robot (no chain is cut); None (default): whole for a registered whole robot.
         floating: the whole robot with a free-flyer at its root (implies ``whole``); None: the registered
             robot's own choice (a humanoid's or quadruped's base floats), else fixed.
+        closures: the loops the robot closes (implies ``whole``): a list of :class:`~kinelab.Closure`, or a
+            closures declaration file (YAML, :mod:`~kinelab.robot.closures`); None: a registered robot's own.
+        actuated: the joints a controller drives (the others move with the loops); a declaration file's
+            ``actuated`` where None.
 
     Returns:
         A Chain, or the whole Robot.
@@ -77,9 +84,13 @@ def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, fl
     else:
         path, entry = catalog.resolve(name_or_path)
         name = entry.name if entry else None
-    if whole or floating or (whole is None and entry is not None and entry.whole):
-        return _whole(path, entry, name, package_dirs, srdf, xacro_args, trust_xacro, floating,
-                      (tool, base, locked, group))
+    if whole or floating or closures is not None or (whole is None and entry is not None and entry.whole):
+        robot = _whole(path, entry, name, package_dirs, srdf, xacro_args, trust_xacro, floating,
+                       (tool, base, locked, group))
+        _declare(robot, entry, closures, actuated)
+        return robot
+    if actuated is not None:
+        raise OptionError("actuated", actuated, "None without closures (a whole robot's loops: closures=...)")
     return _chain(path, entry, name, tool, locked, base, package_dirs, srdf, group, xacro_args, trust_xacro)
 
 
@@ -127,6 +138,23 @@ def _whole(path: Path, entry: catalog.Entry | None, name: str | None, package_di
     if entry is not None:
         robot.hands, robot.feet = entry.hands, entry.feet
     return robot
+
+
+def _declare(robot: Robot, entry: catalog.Entry | None, closures: Sequence[Closure] | str | Path | None,
+             actuated: Sequence[str] | None) -> None:
+    """The robot's loops declared: those given (a list, or a declaration file the user named), else the registered
+    robot's."""
+    if closures is None and entry is not None:
+        closures = catalog.closures_path(entry)
+    if closures is None:
+        if actuated is not None:
+            raise OptionError("actuated", actuated, "None without closures (a whole robot's loops: closures=...)")
+        return
+    if isinstance(closures, str | Path):
+        loops, declared = read_closures(closures)
+        robot.declare_closures(loops, declared if actuated is None else actuated)
+    else:
+        robot.declare_closures(closures, () if actuated is None else actuated)
 
 
 def _geometry(model: Any, urdf_path: Path, package_dirs: list[str], kind: str) -> Any:

@@ -20,8 +20,10 @@ import pinocchio as pin
 from numpy.typing import ArrayLike
 
 from kinelab.errors import ChainError, FrameNotFoundError, OptionError, SRDFError
+from kinelab.robot import assembly
 from kinelab.robot import space as sp
 from kinelab.robot.chain import Chain
+from kinelab.robot.closures import Closure, check_closures
 from kinelab.robot.reduce import build_model
 
 if TYPE_CHECKING:
@@ -72,6 +74,8 @@ class Robot:
         self._derived: dict[str, Any] = {}
         self.hands: tuple[str, ...] = ()  # the frames a user moves first (a registered robot's; teach's targets)
         self.feet: tuple[str, ...] = ()  # the frames standing on the floor (held where they are by teach)
+        self.closures: tuple[Closure, ...] = ()  # the loops the robot closes (:meth:`declare_closures`)
+        self.actuated: tuple[str, ...] = ()  # the joints a controller drives; the others move with the loops
 
     @overload
     @classmethod
@@ -261,6 +265,45 @@ class Robot:
         return np.array(pin.jacobianCenterOfMass(self.model, self.data, self.check_q(q)), dtype=float)
 
     # -- views and the rest ---------------------------------------------------------------------
+    # -- closed loops -------------------------------------------------------------------------------
+    def declare_closures(self, closures: Sequence[Closure], actuated: Sequence[str] = ()) -> None:
+        """Declare the loops the robot closes and its actuated joints (:mod:`kinelab.robot.closures`).
+
+        Raises:
+            OptionError: not a list of Closure, or of one-coordinate joints' names.
+            FrameNotFoundError, JointNotFoundError: named.
+        """
+        self.closures, self.actuated = check_closures(self.model, closures, actuated)
+        self._derived.clear()
+
+    def closure_error(self, q: ArrayLike) -> np.ndarray:
+        """Every closure's held error components at q, stacked in declaration order [m, rad] (frame_a's axes)."""
+        return assembly.loop_state(self.model, self.data, self.check_q(q), self.closures, jacobian=False)[0]
+
+    def closure_jacobian(self, q: ArrayLike) -> np.ndarray:
+        """The closures' Jacobian at q: d(:meth:`closure_error`)/dv, rows × nv."""
+        J = assembly.loop_state(self.model, self.data, self.check_q(q), self.closures)[1]
+        assert J is not None
+        return J
+
+    def assemble(self, q: ArrayLike, *, actuated: Sequence[str] | None = None) -> np.ndarray:
+        """q with the passive joints moved so that every loop closes to 1e-10 [m, rad], the actuated joints (and a
+        free-flyer) held where q has them; the assembly nearest q, else one from seeded restarts.
+
+        Args:
+            q: a configuration (nq numbers) within the limits.
+            actuated: the joints held (default: the declared ``robot.actuated``).
+
+        Raises:
+            ConfigurationError, JointLimitError: a bad q. OptionError: no closures declared, or unknown actuated
+                joints. AssemblyError: no assembly within the limits (the residual reached named).
+        """
+        arr = self.check_q(q, limits=True)
+        if not self.closures:
+            raise OptionError("closures", (), "declared loops (load(..., closures=...) or robot.declare_closures)")
+        held = self.actuated if actuated is None else check_closures(self.model, self.closures, actuated)[1]
+        return assembly.assemble(self, arr, held)
+
     def chain(self, base: str | None, tool: str, *, locked: dict[str, float] | None = None) -> Chain:
         """The chain from frame ``base`` (None: the root) to frame ``tool``: a view of this robot with its own
         one-number-per-joint q (:class:`~kinelab.robot.chain.Chain`), everything kinelab does on an arm.

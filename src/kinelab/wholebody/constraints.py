@@ -5,17 +5,20 @@ Equalities are tasks of the same protocol (:class:`kinelab.wholebody.tasks.Task`
 step's bounds (:class:`kinelab.wholebody.limits.Limits`).
 
 - :class:`CouplingTask`: one joint a linear function of another (mimic joints, gears), held exactly.
+- :class:`ClosureTask`: a robot's loop held closed (:mod:`kinelab.robot.closures`), one per declared closure.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 import pinocchio as pin
 
 from kinelab.errors import JointNotFoundError, OptionError
+from kinelab.robot.assembly import closure_error, closure_jacobian, newton, passive_indices
+from kinelab.robot.closures import ASSEMBLY_TOL, Closure, check_closures
 from kinelab.values import is_real
 from kinelab.wholebody.evaluate import Packing, StepRows
 from kinelab.wholebody.tasks import Task, TaskError
@@ -115,3 +118,87 @@ class CouplingTask(Task):
         """The joint set from its leader."""
         (qj, _), (ql, _) = self.indices(robot)
         q[qj] = self.ratio * q[ql] + self.offset
+
+
+@dataclass(frozen=True)
+class ClosureTask(Task):
+    """A robot's loop held closed (an equality of the step: its error driven to zero each step, drift corrected);
+    added by the step and the solve for every closure the robot declares (:mod:`kinelab.robot.closures`).
+
+    Attributes:
+        closure: the loop.
+    """
+
+    closure: Closure
+
+    def __post_init__(self) -> None:
+        """Check the closure.
+
+        Raises:
+            OptionError: not a kinelab.Closure.
+        """
+        if not isinstance(self.closure, Closure):
+            raise OptionError("closure", self.closure, "a kinelab.Closure")
+
+    priority = 0  # held exactly, above every weighted task
+    settled: ClassVar[bool] = True  # the rows hold the loop to first order; the rest is projected out each step
+    tolerance: ClassVar[float] = ASSEMBLY_TOL  # a solve meets its tasks with every loop closed to this
+
+    @property
+    def rows_count(self) -> int:
+        """One row per held component."""
+        return len(self.closure.rows)
+
+    @property
+    def label(self) -> str:
+        """The loop in words."""
+        return self.closure.label
+
+    def shape(self) -> tuple[Any, ...]:
+        """What a compiled step is packed for (the whole closure)."""
+        return ("c", self.closure)
+
+    def check(self, robot: Robot) -> None:
+        """Name a frame the robot does not have.
+
+        Raises:
+            FrameNotFoundError: named.
+        """
+        check_closures(robot.model, [self.closure], ())
+
+    def _frames(self, robot: Robot) -> tuple[int, int]:
+        return robot.frame_id(self.closure.frame_a), robot.frame_id(self.closure.frame_b)
+
+    def add_to(self, rows: StepRows, robot: Robot, q: np.ndarray, dt: float) -> TaskError:
+        """Its equalities ``J v = −e / dt``; its error (position [m], rotation [rad]) at q."""
+        frames = self._frames(robot)
+        e = closure_error(robot.model, robot.data, self.closure, frames)
+        J = closure_jacobian(robot.model, robot.data, self.closure, frames)
+        for a, c in zip(J, -e / dt, strict=True):
+            rows.equalities.append((a, float(c)))
+        return TaskError(self.label, *self._split(e))
+
+    def _split(self, e: np.ndarray) -> tuple[float, float]:
+        """(largest position component [m], largest rotation component [rad]) of an error."""
+        linear = self.closure.rows < 3
+        return (float(np.max(np.abs(e[linear]), initial=0.0)), float(np.max(np.abs(e[~linear]), initial=0.0)))
+
+    def pack(self, packer: Packing, robot: Robot) -> None:
+        """No compiled block yet: the readable step answers a robot with loops."""
+        packer.decline("a loop closure (the compiled step has no block for one yet)")
+
+    def judged(self, robot: Robot, data: pin.Data, q: np.ndarray, com: np.ndarray | None) -> tuple[float, float]:
+        """The loop's error at q from Pinocchio's placements in ``data``."""
+        return self._split(closure_error(robot.model, data, self.closure, self._frames(robot)))
+
+    def project(self, robot: Robot, q: np.ndarray) -> None:
+        """The passive joints moved to close the loops (Gauss–Newton, the actuated joints held; q changed in place
+        where it closes them)."""
+        closed, residual = newton(robot, q, passive_indices(robot, robot.actuated), ASSEMBLY_TOL)
+        if residual <= ASSEMBLY_TOL:
+            q[:] = closed
+
+
+def loops(robot: Robot) -> tuple[Task, ...]:
+    """The robot's loops as the equalities every step and solve holds (none: ``()``)."""
+    return tuple(ClosureTask(c) for c in robot.closures)

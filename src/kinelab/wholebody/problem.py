@@ -19,6 +19,7 @@ import numpy as np
 from kinelab.errors import ChainError, OptionError
 from kinelab.robot.tree import Robot
 from kinelab.wholebody import compiled as cp
+from kinelab.wholebody.constraints import loops
 from kinelab.wholebody.limits import Limits, acceleration_bounds, checked_v_prev, is_positive_time, velocity_bounds
 from kinelab.wholebody.step import DEFAULT_LIMITS, DEFAULT_OPTIONS, STATUS, StepOptions, StepResult, _step
 from kinelab.wholebody.tasks import Task, as_tasks
@@ -60,12 +61,13 @@ class WholeBody:
             raise OptionError("options", options, "a kinelab.StepOptions(...)")
         self.robot, self.limits, self.options = robot, limits, options
         self._tasks = list(as_tasks(tasks))
+        self.loops = loops(robot)  # the robot's closures, held as equalities of every step
         for task in self._tasks:
             task.check(robot)
         self._vmax = np.ascontiguousarray(velocity_bounds(limits, robot.space), dtype=float)
         amax = acceleration_bounds(limits, robot.space)
         self._amax = NO_LIMIT if amax is None else np.ascontiguousarray(amax, dtype=float)
-        self._packed = _packed(robot, tuple(self._tasks), options)
+        self._packed = _packed(robot, tuple(self._tasks) + self.loops, options)
         self._refresh_all()
 
     def use(self, limits: Limits) -> None:
@@ -109,6 +111,8 @@ class WholeBody:
             return "readable: DAQP's C interface is not linked (an installed daqp other than 0.11.x, or none)"
         if self.robot.derived("compiled tree", cp.pack_tree) is None:
             return "readable: the robot's tree has a joint the compiled step has no code for, or failed its certificate"
+        if self.loops:
+            return "readable: the robot closes loops (the compiled step has no block for a closure yet)"
         return "readable: a task the compiled step has no block for (or two postures, or a posture on the base)"
 
     def step(self, q: Configuration, dt: float, v_prev: ArrayLike | None = None) -> StepResult:
@@ -130,7 +134,8 @@ class WholeBody:
         fast = self._compiled_step(q, dt, prev)
         if fast is not None:
             return fast
-        return _step(self.robot, self.robot.check_q(q), tuple(self._tasks), dt, self.limits, self.options, prev)
+        return _step(self.robot, self.robot.check_q(q), tuple(self._tasks) + self.loops, dt, self.limits,
+                     self.options, prev)
 
     def _compiled_step(self, q: Any, dt: float, prev: np.ndarray | None) -> StepResult | None:
         """The step in one compiled call, or None where it does not serve (a q to check and name first, an

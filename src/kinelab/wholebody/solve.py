@@ -24,6 +24,7 @@ from kinelab.ik.result import Status
 from kinelab.robot.space import generator
 from kinelab.robot.tree import Robot
 from kinelab.typing import Configuration
+from kinelab.wholebody.constraints import loops
 from kinelab.wholebody.frdm import frdm_solve
 from kinelab.wholebody.iterate import SolveSettings, iterate, posture_second
 from kinelab.wholebody.limits import Limits
@@ -100,7 +101,7 @@ def solve(robot: Robot, tasks: Task | Sequence[Task], *, q0: Configuration | Non
     """
     if not isinstance(robot, Robot):
         raise ChainError(f"a whole-body solve takes a whole robot (kinelab.load('talos')), got {type(robot).__name__}")
-    found = as_tasks(tasks)
+    found = as_tasks(tasks) + loops(robot)  # a robot's closures held with its tasks
     settings = SolveSettings(solver, tol_pos, tol_rot, max_iterations, max_restarts, time_budget)
     limits = Limits(velocity=None) if limits is None else limits
     if not isinstance(limits, Limits):
@@ -177,5 +178,6 @@ def judge(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, tol_pos: float, 
     out = []
     for task in tasks:
         dp, dr = task.judged(robot, data, q, com)
-        out.append(TaskVerdict(task.label, dp, dr, task.preference or (dp <= tol_pos and dr <= tol_rot)))
+        tp, tr = (min(tol_pos, task.tolerance), min(tol_rot, task.tolerance)) if task.tolerance else (tol_pos, tol_rot)
+        out.append(TaskVerdict(task.label, dp, dr, task.preference or (dp <= tp and dr <= tr)))
     return tuple(out)

@@ -123,7 +123,19 @@ def _step(robot: Robot, q: np.ndarray, tasks: tuple[Task, ...], dt: float, limit
         iterations += second.iterations
         solution = second if second.solved else solution
     names = tuple(robot.space.names_v[i] for i in np.flatnonzero(returning))
-    return _result(robot, q, dt, solution, tuple(errors), names, iterations)
+    result = _result(robot, q, dt, solution, tuple(errors), names, iterations)
+    return _settled(robot, q, dt, tasks, result) if result.solved and any(t.settled for t in tasks) else result
+
+
+def _settled(robot: Robot, q: np.ndarray, dt: float, tasks: tuple[Task, ...], result: StepResult) -> StepResult:
+    """The step's q projected onto the equalities the QP holds to first order only (a loop's), v = (q_next ⊖ q)/dt
+    again: the drift a step leaves (O(|v dt|²)) removed where it is made, not carried to the next step."""
+    q_next = result.q.copy()
+    for task in tasks:
+        if task.settled:
+            task.project(robot, q_next)
+    v = np.asarray(pin.difference(robot.model, q, q_next), dtype=float) / dt
+    return StepResult(v, q_next, result.status, result.solved, result.errors, result.returning, result.iterations)
 
 
 def _result(robot: Robot, q: np.ndarray, dt: float, solution: qp.Solution, errors: tuple[TaskError, ...],

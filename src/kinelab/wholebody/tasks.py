@@ -63,6 +63,8 @@ class Task(ABC):
     priority: int
     uses_com: ClassVar[bool] = False  # the readable step computes the centre of mass and its Jacobian for it
     preference: ClassVar[bool] = False  # never judged, left out of the converged solve's merit (a posture)
+    settled: ClassVar[bool] = False  # projected onto after each step (a nonlinear equality's second-order drift)
+    tolerance: ClassVar[float] = 0.0  # a tighter tolerance [m, rad] its verdict holds it to (0: the solve's)
 
     @property
     @abstractmethod
