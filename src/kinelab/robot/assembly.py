@@ -105,7 +105,7 @@ def passive_indices(robot: Robot, actuated: Sequence[str]) -> np.ndarray:
 
 def assemble(robot: Robot, q: np.ndarray, actuated: Sequence[str], tol: float = ASSEMBLY_TOL) -> np.ndarray:
     """q with its passive joints moved so that every loop closes (≤ ``tol``), the actuated joints and a free-flyer
-    held: Gauss–Newton from q (the assembly nearest the start), then from seeded random passive values.
+    held: Levenberg–Marquardt from q (usually the assembly nearest the start), then from seeded random passive values.
 
     Raises:
         AssemblyError: no assembly within the joint limits was found; the smallest residual reached is named.

@@ -71,6 +71,9 @@ CLOSED = (  # bundled robots that close loops (kinelab.robot.closures): whole ro
     Entry("fourbar", "kinelab", "fourbar.urdf", None,
           "planar crank-rocker four-bar, one loop (closed at the coupler's end), the crank driven",
           whole=True, closures="fourbar.closures.yaml", hands=("coupler_tip",)),
+    Entry("delta", "kinelab", "delta.urdf", None,
+          "delta robot in Clavel's geometry: three motors, forearms on ball joints, the platform kept parallel",
+          whole=True, closures="delta.closures.yaml", hands=("platform_centre",)),
 )
 
 ERD_ARMS = (

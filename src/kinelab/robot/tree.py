@@ -288,7 +288,7 @@ class Robot:
 
     def assemble(self, q: ArrayLike, *, actuated: Sequence[str] | None = None) -> np.ndarray:
         """q with the passive joints moved so that every loop closes to 1e-10 [m, rad], the actuated joints (and a
-        free-flyer) held where q has them; the assembly nearest q, else one from seeded restarts.
+        free-flyer) held where q has them; usually the assembly nearest q, else one from seeded restarts.
 
         Args:
             q: a configuration (nq numbers) within the limits.
