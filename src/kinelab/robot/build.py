@@ -78,6 +78,8 @@ class Whole:
         model: the whole Pinocchio model (a free-flyer at its root when asked for; mimic joints as Pinocchio's).
         name: the robot's name; source: the file the user named; urdf_path: the file Pinocchio read.
         srdf: the SRDF read, or None.
+        mimics: mimic joints Pinocchio could not build, folded: plain joints of the model that every whole-body
+            step and solve holds at ``multiplier · leader + offset``.
     """
 
     model: pin.Model
@@ -85,6 +87,7 @@ class Whole:
     source: Path
     urdf_path: Path
     srdf: Srdf | None
+    mimics: tuple[Mimic, ...] = ()
 
 
 def whole_model(path: str | Path, *, floating: bool = False, name: str | None = None,
@@ -117,7 +120,22 @@ def whole_model(path: str | Path, *, floating: bool = False, name: str | None = 
     check_names(model, urdf_path)
     check_data_size(model, name or model.name or urdf_path.stem)
     found = srdf_of(srdf, tree)
-    return Whole(model, name or model.name or urdf_path.stem, source, urdf_path, found)
+    return Whole(model, name or model.name or urdf_path.stem, source, urdf_path, found, _folded(model, tree))
+
+
+def _folded(model: pin.Model, tree: UrdfTree) -> tuple[Mimic, ...]:
+    """The file's mimic joints that are plain joints of the model (Pinocchio could not build them), with one
+    coordinate each and their factors read: held as couplings by the whole-body step."""
+    folded = []
+    for name, leader in tree.mimic.items():
+        if name not in tree.mimic_factors or not (model.existJointName(name) and model.existJointName(leader)):
+            continue
+        joint, lead = model.joints[model.getJointId(name)], model.joints[model.getJointId(leader)]
+        if joint.nq == joint.nv == lead.nq == lead.nv == 1:  # a plain joint of its own (not Pinocchio's mimic)
+            multiplier, offset = tree.mimic_factors[name]
+            folded.append(Mimic(name, leader, multiplier, offset, float(model.lowerPositionLimit[joint.idx_q]),
+                                float(model.upperPositionLimit[joint.idx_q])))
+    return tuple(folded)
 
 
 def _whole_urdf(path: Path, mimic: bool, root: pin.JointModel | None) -> pin.Model:
@@ -127,7 +145,8 @@ def _whole_urdf(path: Path, mimic: bool, root: pin.JointModel | None) -> pin.Mod
             return build_full_model(path, mimic=True, root=root)
         except URDFError as refused:
             warnings.warn(f"{path.name}: Pinocchio cannot build its mimic joints ({refused}); they are plain joints "
-                          "(hold them with a CouplingTask)", stacklevel=3)
+                          "of the model, held as couplings by every whole-body step and solve (robot.mimics)",
+                          stacklevel=3)
     return build_full_model(path, root=root)
 
 

@@ -135,6 +135,7 @@ def _whole(path: Path, entry: catalog.Entry | None, name: str | None, package_di
     robot = Robot(made.model, name=made.name, source=made.source, srdf=made.srdf,
                   chain_source=lambda tool, base, locked: chains(tool, locked, base),
                   geometry=partial(_geometry, made.model, made.urdf_path, mesh_package_dirs(package_dirs)))
+    robot.mimics = made.mimics
     if entry is not None:
         robot.hands, robot.feet = entry.hands, entry.feet
     return robot

@@ -24,6 +24,7 @@ from kinelab.robot import assembly
 from kinelab.robot import space as sp
 from kinelab.robot.chain import Chain
 from kinelab.robot.closures import Closure, check_closures
+from kinelab.robot.joints import Mimic
 from kinelab.robot.reduce import build_model
 
 if TYPE_CHECKING:
@@ -76,6 +77,7 @@ class Robot:
         self.feet: tuple[str, ...] = ()  # the frames standing on the floor (held where they are by teach)
         self.closures: tuple[Closure, ...] = ()  # the loops the robot closes (:meth:`declare_closures`)
         self.actuated: tuple[str, ...] = ()  # the joints a controller drives; the others move with the loops
+        self.mimics: tuple[Mimic, ...] = ()  # mimic joints Pinocchio could not build: plain joints, held as couplings
 
     @overload
     @classmethod

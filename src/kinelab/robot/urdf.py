@@ -45,6 +45,7 @@ class UrdfTree:
     links: list[str]
     leaves: list[str]
     broken_mimic: dict[str, str] = field(default_factory=dict)  # joint -> a leader the file lacks
+    mimic_factors: dict[str, tuple[float, float]] = field(default_factory=dict)  # joint -> (multiplier, offset)
 
     def check_mimics(self, path: Path, chain: list[str], locked: Iterable[str]) -> None:
         """A mimic joint whose leader is missing: refused on the chain (unless locked), locked with one warning
@@ -80,7 +81,24 @@ def read_tree(path: Path) -> UrdfTree:
         raise URDFError(f"malformed URDF {path}: expected one root link, found {roots}")
     parents = set(parent_of.values())
     return UrdfTree(roots[0], parent_of, joint_of, mimic, links, [link for link in links if link not in parents],
-                    broken)
+                    broken, _mimic_factors(xml))
+
+
+def _mimic_factors(xml: ET.Element) -> dict[str, tuple[float, float]]:
+    """Each mimic joint's (multiplier, offset) as the file gives them (URDF's defaults 1 and 0); a joint whose
+    numbers are not finite numbers is left out (never folded as a coupling)."""
+    factors = {}
+    for joint in xml.findall("joint"):
+        m = joint.find("mimic")
+        if m is None:
+            continue
+        try:
+            values = (float(m.get("multiplier", "1")), float(m.get("offset", "0")))
+        except ValueError:
+            continue
+        if all(map(math.isfinite, values)):
+            factors[joint.get("name", "?")] = values
+    return factors
 
 
 def _split_mimics(mimic: dict[str, str], joints: set[str]) -> tuple[dict[str, str], dict[str, str]]:

@@ -200,5 +200,7 @@ class ClosureTask(Task):
 
 
 def loops(robot: Robot) -> tuple[Task, ...]:
-    """The robot's loops as the equalities every step and solve holds (none: ``()``)."""
-    return tuple(ClosureTask(c) for c in robot.closures)
+    """What the robot itself holds, as the equalities every step and solve adds to its tasks: its folded mimic
+    joints (couplings) and its loops (none: ``()``)."""
+    couplings = tuple(CouplingTask(m.name, m.leader, m.multiplier, m.offset) for m in robot.mimics)
+    return couplings + tuple(ClosureTask(c) for c in robot.closures)

@@ -119,7 +119,8 @@ class WholeBody:
         """One differential step from q (:func:`kinelab.step`'s answer for these tasks, limits and options).
 
         Args:
-            q: the configuration (Pinocchio's q, nq numbers); it may lie outside the limits (brought back).
+            q: the configuration (Pinocchio's q, nq numbers); it may lie outside the limits (brought back), and
+                off the robot's own loops and folded mimic joints (brought onto them first: the step starts there).
             dt: the step [s], at least 1e-9.
             v_prev: the velocity before the step (nv), for acceleration limits.
 
@@ -131,11 +132,21 @@ class WholeBody:
         """
         dt = is_positive_time(dt)
         prev = None if v_prev is None else checked_v_prev(v_prev, self.robot.nv)
+        if self.loops:
+            q = self._onto_loops(q)
         fast = self._compiled_step(q, dt, prev)
         if fast is not None:
             return fast
         return _step(self.robot, self.robot.check_q(q), tuple(self._tasks) + self.loops, dt, self.limits,
                      self.options, prev)
+
+    def _onto_loops(self, q: Any) -> np.ndarray:
+        """A copy of q brought onto what the robot itself holds (its loops closed, its folded mimic joints set from
+        their leaders), as the mechanism is: a start off them is a model's, not a motion the step must make."""
+        arr = np.array(self.robot.check_q(q), dtype=float)
+        for task in self.loops:
+            task.project(self.robot, arr)
+        return arr
 
     def _compiled_step(self, q: Any, dt: float, prev: np.ndarray | None) -> StepResult | None:
         """The step in one compiled call, or None where it does not serve (a q to check and name first, an
@@ -204,7 +215,7 @@ class WholeBody:
 
     def _refresh_all(self) -> None:
         if self._packed is not None:
-            cp.set_targets(self.robot, self._packed, tuple(self._tasks))
+            cp.set_targets(self.robot, self._packed, tuple(self._tasks) + self.loops)
 
     def solve(self, q0: Configuration | None = None, **settings: Any) -> WholeBodyResult:
         """The converged solve of these tasks (:func:`kinelab.wholebody.solve.solve`; the limits' positions held,
