@@ -22,9 +22,10 @@ from kinelab.errors import (
 )
 from kinelab.files import checked_file
 from kinelab.robot import xacro
+from kinelab.robot.closures import Closure
 from kinelab.robot.joints import Joint, Mimic
 from kinelab.robot.meshes import c_stderr_captured
-from kinelab.robot.mjcf import is_mjcf, read_mjcf
+from kinelab.robot.mjcf import equalities, is_mjcf, read_mjcf
 from kinelab.robot.srdf import Srdf, read_srdf
 from kinelab.robot.urdf import UrdfTree, read_tree
 
@@ -78,6 +79,7 @@ class Whole:
         model: the whole Pinocchio model (a free-flyer at its root when asked for; mimic joints as Pinocchio's).
         name: the robot's name; source: the file the user named; urdf_path: the file Pinocchio read.
         srdf: the SRDF read, or None.
+        closures, actuated: an MJCF file's equality constraints as loops, and its actuators' joints.
         mimics: mimic joints Pinocchio could not build, folded: plain joints of the model that every whole-body
             step and solve holds at ``multiplier · leader + offset``.
     """
@@ -88,6 +90,8 @@ class Whole:
     urdf_path: Path
     srdf: Srdf | None
     mimics: tuple[Mimic, ...] = ()
+    closures: tuple[Closure, ...] = ()  # an MJCF's <equality> connects and welds
+    actuated: tuple[str, ...] = ()  # an MJCF's actuated joints
 
 
 def whole_model(path: str | Path, *, floating: bool = False, name: str | None = None,
@@ -112,15 +116,17 @@ def whole_model(path: str | Path, *, floating: bool = False, name: str | None = 
     urdf_path = xacro.expand(source, xacro_args, trusted=trust_xacro, package_dirs=package_dirs) \
         if xacro.is_xacro(source) else source
     root = pin.JointModelFreeFlyer() if floating else None
+    loops: tuple[tuple[Closure, ...], tuple[str, ...]] = ((), ())
     if is_mjcf(urdf_path):
         model, tree = read_mjcf(urdf_path, root)
+        loops = equalities(urdf_path, model, root)
     else:
         tree = read_tree(urdf_path)
         model = _whole_urdf(urdf_path, bool(tree.mimic), root)
     check_names(model, urdf_path)
     check_data_size(model, name or model.name or urdf_path.stem)
     found = srdf_of(srdf, tree)
-    return Whole(model, name or model.name or urdf_path.stem, source, urdf_path, found, _folded(model, tree))
+    return Whole(model, name or model.name or urdf_path.stem, source, urdf_path, found, _folded(model, tree), *loops)
 
 
 def _folded(model: pin.Model, tree: UrdfTree) -> tuple[Mimic, ...]:

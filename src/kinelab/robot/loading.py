@@ -136,6 +136,8 @@ def _whole(path: Path, entry: catalog.Entry | None, name: str | None, package_di
                   chain_source=lambda tool, base, locked: chains(tool, locked, base),
                   geometry=partial(_geometry, made.model, made.urdf_path, mesh_package_dirs(package_dirs)))
     robot.mimics = made.mimics
+    if made.closures:
+        robot.declare_closures(made.closures, made.actuated)
     if entry is not None:
         robot.hands, robot.feet = entry.hands, entry.feet
     return robot
@@ -147,6 +149,8 @@ def _declare(robot: Robot, entry: catalog.Entry | None, closures: Sequence[Closu
     robot's."""
     if closures is None and entry is not None:
         closures = catalog.closures_path(entry)
+    if closures is None and robot.closures:  # an MJCF's own <equality> loops, declared by _whole
+        closures, actuated = robot.closures, robot.actuated if actuated is None else actuated
     if closures is None:
         if actuated is not None:
             raise OptionError("actuated", actuated, "None without closures (a whole robot's loops: closures=...)")

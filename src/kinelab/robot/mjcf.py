@@ -9,6 +9,7 @@ angles are in degrees (MuJoCo's default): the parser converts every range to rad
 from __future__ import annotations
 
 import math
+import warnings
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -16,6 +17,7 @@ import pinocchio as pin
 
 from kinelab.errors import URDFError
 from kinelab.files import read_text
+from kinelab.robot.closures import Closure
 from kinelab.robot.urdf import MAX_COMPONENT, MAX_OFFSET, UrdfTree, check_size
 
 UNREAD = ("frame", "replicate", "attach")  # MuJoCo 3 elements Pinocchio's parser skips, with their bodies
@@ -272,3 +274,41 @@ def _reaches_root(parents: list[int], i: int, reaches: list[bool]) -> bool:
         seen.add(up)
         up = parents[up]
     return True
+
+
+def equalities(path: Path, model: pin.Model, root: pin.JointModel | None = None) -> tuple[tuple[Closure, ...],
+                                                                                          tuple[str, ...]]:
+    """The MJCF file's ``<equality>`` connects and welds as closures, and its actuated joints (the ``joint`` of each
+    ``<actuator>`` element that names one), read by Pinocchio 4's ``buildModelAndConstraintsFromMJCF``.
+
+    Each constraint's two anchors become frames of ``model`` (changed in place): ``NAME_a`` on the first body's
+    joint and ``NAME_b`` on the second's (NAME: the equality's name, else ``equality_K``; MuJoCo places the second
+    anchor where the first is in the file's reference configuration, qpos0); a connect is a point
+    closure, a weld a frame closure. A file with no ``<equality>`` gives none; one whose equalities Pinocchio
+    cannot read gives none, with a warning naming why.
+    """
+    tree = ET.fromstring(read_text(path, "MJCF file", URDFError))
+    actuated = tuple(dict.fromkeys(a.get("joint", "") for section in tree.iter("actuator") for a in section
+                                   if model.existJointName(a.get("joint", ""))))
+    if tree.find("equality") is None:
+        return (), actuated
+    try:
+        built = (pin.buildModelAndConstraintsFromMJCF(str(path)) if root is None else
+                 pin.buildModelAndConstraintsFromMJCF(str(path), root))
+    except Exception as exc:  # noqa: BLE001 - the parser raises RuntimeError, ValueError, IndexError, ...
+        warnings.warn(f"{path.name}: Pinocchio cannot read its <equality> constraints ({type(exc).__name__}: {exc}); "
+                      "the robot is loaded without loops", stacklevel=3)
+        return (), actuated
+    closures: list[Closure] = []
+    for kind, tag, constraints in (("point", "connect", built[1]), ("frame", "weld", built[2])):
+        elements = [e for section in tree.iter("equality") for e in section.iter(tag)]
+        matched = len(elements) == len(constraints)  # Pinocchio's list in the file's order
+        for k, constraint in enumerate(constraints):
+            if matched and elements[k].get("active", "true") == "false":
+                continue  # MuJoCo's inactive equality: not a loop until the user turns it on
+            name = (elements[k].get("name") if matched else None) or f"equality_{len(closures)}"
+            for end, joint, placement in (("a", constraint.joint1_id, constraint.joint1_placement),
+                                          ("b", constraint.joint2_id, constraint.joint2_placement)):
+                model.addFrame(pin.Frame(f"{name}_{end}", joint, placement, pin.FrameType.OP_FRAME))
+            closures.append(Closure(f"{name}_a", f"{name}_b", kind))
+    return tuple(closures), actuated
