@@ -72,7 +72,19 @@ def test_a_whole_robot_takes_the_whole_body_checks(capsys):
     assert code == 0 and report["passed"] and all(n.startswith("whole body: ") for n in names)
     assert {"whole body: limit violations over the steps", "whole body: false successes (frdm)",
             "whole body: task Jacobians vs differences of Pinocchio's FK"} <= set(names)
-    assert validate.DEFAULT_ROBOTS[-2:] == ("talos", "baxter")
+    assert validate.DEFAULT_ROBOTS[-4:-2] == ("talos", "baxter")
+
+
+def test_a_robot_with_loops_takes_the_loop_checks(capsys):
+    """#69: validate's closed-chain section on the four-bar: every closure against Pinocchio's constraint models,
+    the assemblies against the closed form, the loops after every step, the solve's targets; all pass."""
+    code = cli.main(["validate", "--robots", "fourbar", "--n", "20", "--json"])
+    report = json.loads(capsys.readouterr().out)
+    names = [c["name"] for c in report["checks"]]
+    assert code == 0 and report["passed"] and all(n.startswith("loops: ") for n in names)
+    assert {"loops: closure errors vs Pinocchio's constraint models", "loops: assemblies against the closed form",
+            "loops: closure error after every step", "loops: false successes (step)"} <= set(names)
+    assert validate.DEFAULT_ROBOTS[-2:] == ("fourbar", "delta")
 
 
 def _report_with_one_failure():

@@ -36,6 +36,7 @@ from kinelab.report.check import SHARE, samples_for
 from kinelab.report.check import Z95 as Z95  # re-exported: where the reports and their tests read them
 from kinelab.report.check import Check as Check
 from kinelab.report.check import wilson as wilson
+from kinelab.report.closed_checks import CLOSED_CHECKS
 from kinelab.report.provenance import provenance
 from kinelab.report.wholebody_checks import WHOLE_CHECKS
 from kinelab.robot import Chain, load
@@ -45,7 +46,8 @@ from kinelab.studies import paper001_stanford as seed001
 from kinelab.studies import paper003_youbot as yb
 from kinelab.values import is_whole
 
-DEFAULT_ROBOTS = ("stanford", "era", "youbot", "panda", "ur5", "talos", "baxter")  # the last two whole
+DEFAULT_ROBOTS = ("stanford", "era", "youbot", "panda", "ur5", "talos", "baxter", "fourbar", "delta")  # whole: the
+# last four, the last two closing loops
 DEFAULT_N = 200
 
 
@@ -384,13 +386,14 @@ def _groups(robot: Chain | Robot) -> list[Any]:
     """The check groups a robot takes: a whole robot the whole-body checks, a chain the general ones and its
     paper's."""
     if isinstance(robot, Robot):
-        return list(WHOLE_CHECKS)
+        return list(CLOSED_CHECKS if robot.closures else WHOLE_CHECKS)
     return [*GENERAL_CHECKS, *PAPER_CHECKS.get(robot.name, [])]
 
 
 def run(robots: list[str] | None = None, n: int | None = None, seed: int = 0, progress: bool = False) -> Report:
-    """Run every check on ``robots`` (default: stanford, era, youbot, panda, ur5, and the whole talos and baxter:
-    a whole robot takes the whole-body checks, :mod:`kinelab.report.wholebody_checks`)."""
+    """Run every check on ``robots`` (default: stanford, era, youbot, panda, ur5, the whole talos and baxter, and
+    fourbar and delta, which close loops: a whole robot takes the whole-body checks,
+    :mod:`kinelab.report.wholebody_checks`, one with loops :mod:`kinelab.report.closed_checks`)."""
     check_seed(seed)
     names = list(robots or DEFAULT_ROBOTS)
     n = DEFAULT_N if n is None else n

@@ -134,6 +134,9 @@ def _run(robot: Robot, tasks: tuple[Task, ...], start: np.ndarray, settings: Sol
             break
         restarts += 1
         q = _restart(robot, start, rng)
+        for task in tasks:
+            if task.settled:  # a restart starts on the robot's loops, as the mechanism would
+                task.project(robot, q)
     _, q, status = best
     return _result(robot, tasks, q, status, settings, iterations, restarts, time.perf_counter() - t0)
 
