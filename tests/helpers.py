@@ -8,6 +8,9 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+import kinelab
+from kinelab import Closure
+
 BUNDLED = ("stanford", "era", "youbot")
 ERD_ARMS = ("panda", "ur5", "kinova", "xarm7")
 
@@ -190,3 +193,24 @@ def joint_line(robot, rng, samples=400, step=0.025):
     d = qb - qa
     d *= min(1.0, step * (samples - 1) / np.abs(d).max())
     return qa + np.linspace(0, 1, samples)[:, None] * d
+
+
+def planar_fourbar(a: float, b: float, c: float, d: float) -> kinelab.Robot:
+    """A four-bar of any lengths built here in memory (crank at the origin, rocker pivot at (d, 0, 0)), its loop
+    declared at C: a model independent of the bundled file."""
+    model = pin.Model()
+    z = pin.JointModelRZ()
+    crank = model.addJoint(0, z, pin.SE3.Identity(), "crank_joint")
+    coupler = model.addJoint(crank, z, pin.SE3(np.eye(3), np.array([a, 0.0, 0.0])), "coupler_joint")
+    rocker = model.addJoint(0, z, pin.SE3(np.eye(3), np.array([d, 0.0, 0.0])), "rocker_joint")
+    for joint in (crank, coupler, rocker):
+        model.appendBodyToJoint(joint, pin.Inertia.FromSphere(0.1, 0.01), pin.SE3.Identity())
+    model.lowerPositionLimit[:] = -2 * np.pi
+    model.upperPositionLimit[:] = 2 * np.pi
+    model.addFrame(pin.Frame("coupler_tip", coupler, pin.SE3(np.eye(3), np.array([b, 0.0, 0.0])),
+                             pin.FrameType.OP_FRAME))
+    model.addFrame(pin.Frame("rocker_tip", rocker, pin.SE3(np.eye(3), np.array([c, 0.0, 0.0])),
+                             pin.FrameType.OP_FRAME))
+    robot = kinelab.Robot.from_model(model, name="fourbar_built")
+    robot.declare_closures([Closure("coupler_tip", "rocker_tip", (1, 1, 0, 0, 0, 0))], ["crank_joint"])
+    return robot

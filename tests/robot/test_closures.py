@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 import pytest
+from helpers import planar_fourbar
 
 import kinelab
 from kinelab import AssemblyError, Closure, FrameNotFoundError, JointNotFoundError, OptionError, URDFError
@@ -15,27 +16,6 @@ from kinelab.robot.closures import read_closures
 
 A, B, C, D = 0.10, 0.28, 0.22, 0.30  # urdf/fourbar.urdf's crank, coupler, rocker and ground [m]
 SEEDS = range(20)
-
-
-def planar_fourbar(a: float, b: float, c: float, d: float) -> kinelab.Robot:
-    """A four-bar of any lengths built here in memory (crank at the origin, rocker pivot at (d, 0, 0)), its loop
-    declared at C: a model independent of the bundled file."""
-    model = pin.Model()
-    z = pin.JointModelRZ()
-    crank = model.addJoint(0, z, pin.SE3.Identity(), "crank_joint")
-    coupler = model.addJoint(crank, z, pin.SE3(np.eye(3), np.array([a, 0.0, 0.0])), "coupler_joint")
-    rocker = model.addJoint(0, z, pin.SE3(np.eye(3), np.array([d, 0.0, 0.0])), "rocker_joint")
-    for joint in (crank, coupler, rocker):
-        model.appendBodyToJoint(joint, pin.Inertia.FromSphere(0.1, 0.01), pin.SE3.Identity())
-    model.lowerPositionLimit[:] = -2 * np.pi
-    model.upperPositionLimit[:] = 2 * np.pi
-    model.addFrame(pin.Frame("coupler_tip", coupler, pin.SE3(np.eye(3), np.array([b, 0.0, 0.0])),
-                             pin.FrameType.OP_FRAME))
-    model.addFrame(pin.Frame("rocker_tip", rocker, pin.SE3(np.eye(3), np.array([c, 0.0, 0.0])),
-                             pin.FrameType.OP_FRAME))
-    robot = kinelab.Robot.from_model(model, name="fourbar_built")
-    robot.declare_closures([Closure("coupler_tip", "rocker_tip", (1, 1, 0, 0, 0, 0))], ["crank_joint"])
-    return robot
 
 
 def closed_form_c(theta: float, a: float, b: float, c: float, d: float) -> list[np.ndarray]:

@@ -103,11 +103,11 @@ def q_from_cli(robot: Chain, values: list[str], deg: bool, what: str = "q") -> n
     Raises:
         ConfigurationError: a value that is not a number, or the wrong count.
     """
-    if len(values) == 1 and not _is_number(values[0]):
+    if len(values) == 1 and not is_number(values[0]):
         return robot.named_q(values[0])
     numbers = []
     for v in values:
-        if not _is_number(v):
+        if not is_number(v):
             raise ConfigurationError(f"{what}: {v!r} is not a number (give {robot.n} numbers, or one SRDF "
                                      "configuration name with --srdf)")
         numbers.append(float(v))
@@ -123,7 +123,8 @@ def q_from_cli(robot: Chain, values: list[str], deg: bool, what: str = "q") -> n
     return q
 
 
-def _is_number(text: str) -> bool:
+def is_number(text: str) -> bool:
+    """Whether a command-line word reads as a number."""
     try:
         float(text)
     except ValueError:
@@ -154,7 +155,7 @@ def _locked(items: list[str] | None) -> dict[str, float] | None:
     found = pairs(items, "--lock")
     if found is None:
         return None
-    bad = [f"{name}={value}" for name, value in found.items() if not _is_number(value)]
+    bad = [f"{name}={value}" for name, value in found.items() if not is_number(value)]
     if bad:
         raise KinelabError(f"--lock {bad[0]}: the value is not a number (rad or m)")
     return {name: float(value) for name, value in found.items()}

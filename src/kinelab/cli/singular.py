@@ -6,7 +6,7 @@ import argparse
 from typing import TYPE_CHECKING, Any
 
 from kinelab import lazy
-from kinelab.cli import common
+from kinelab.cli import closed, common
 from kinelab.cli.common import Subcommands
 from kinelab.errors import KinelabError
 
@@ -30,13 +30,20 @@ def add(sub: Subcommands) -> None:
     s.add_argument("--sweep", type=int, help="sample N configurations within the limits and report families")
     s.add_argument("--grid", action="store_true", help="sweep a stratified grid instead of uniform samples")
     s.add_argument("--force", action="store_true", help="run a sweep even when its memory estimate is over the limit")
+    s.add_argument("--closures", metavar="FILE", help="a closures declaration (YAML): the robot closes loops, Q gives "
+                                                        "its motors (registered robots with loops take theirs)")
+    s.add_argument("--output", metavar="FRAME", help="a robot with loops: the frame whose position is the output "
+                                                     "(default: its first hand)")
     common.seed_argument(s)
     common.json_flag(s)
     s.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    """The analysis at one q, or the sweep's families."""
+    """The analysis at one q, or the sweep's families (a robot with loops: its two types, :mod:`kinelab.cli.closed`)."""
+    looped = closed.closed_robot(args)
+    if looped is not None:
+        return closed.run(looped, args)
     robot = common.load_robot(args)
     if args.sweep is not None:
         if args.q:
