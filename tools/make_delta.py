@@ -94,7 +94,10 @@ def leg(i: int) -> str:
 
 def platform() -> str:
     """The platform's centre frame (leg 1's wrist sits at its first joint) and its joints for legs 2 and 3."""
-    text = fixed("platform_centre_fixed", "platform", "platform_centre", f"{-RP} 0 0")
+    text = (f'  <link name="platform_centre">\n    <visual><geometry><cylinder radius="{RP + 0.01}" length="0.008"/>'
+            f'</geometry>\n      <material name="platform_m"><color rgba="0.9 0.6 0.1 1"/></material></visual>\n'
+            f'  </link>\n  <joint name="platform_centre_fixed" type="fixed"><parent link="platform"/>'
+            f'<child link="platform_centre"/><origin xyz="{-RP} 0 0" rpy="0 0 0"/></joint>\n')
     for i in (1, 2):
         phi = PHI[i]
         text += fixed(f"platform_joint_{i + 1}_fixed", "platform_centre", f"platform_joint_{i + 1}",

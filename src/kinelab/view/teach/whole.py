@@ -33,7 +33,7 @@ if TYPE_CHECKING:
     from kinelab.typing import Configuration
 
 SOLE = (0.20, 0.10)  # [m] the sole drawn under each foot frame for the support polygon: length (x), width (y)
-GOLD, COM, INSIDE, OUTSIDE = 0xF2B01E, 0xD62728, 0x2CA02C, 0xD62728
+GOLD, COM, INSIDE, OUTSIDE, LOOP = 0xF2B01E, 0xD62728, 0x2CA02C, 0xD62728, 0x17BECF
 
 
 class WholeTeachSession(Session):
@@ -57,6 +57,8 @@ class WholeTeachSession(Session):
         for name in self.hands + self.feet:
             robot.frame_id(name)
         self.q, self.start = standing(robot, self.feet) if q is None else (robot.check_q(q, limits=True), "given")
+        if robot.closures:  # a robot with loops starts with them closed
+            self.q, self.start = robot.assemble(self.q), f"{self.start}, its loops closed"
         self.rest = self.q.copy()
         self.targets = list(robot.frame_placements(self.q, self.hands))
         self.pins = robot.frame_placements(self.q, self.feet)
@@ -121,8 +123,16 @@ class WholeTeachSession(Session):
                 for h in hands]
         rows.append(["centre of mass", ", ".join(f"{x:.4f}" for x in com) + " m"
                      + ("" if inside is None else (" — over the feet" if inside else " — NOT over the feet"))])
+        loops = [{"loop": c.label, "error": float(np.abs(e).max(initial=0.0))}
+                 for c, e in zip(self.robot.closures, self._loop_errors(), strict=True)]
+        rows += [[c["loop"], f"{c['error']:.2e} m, rad"] for c in loops]
         return {"robot": self.robot.name, "q": self.q.tolist(), "hands": hands, "com_m": com.tolist(),
-                "com_over_support": inside, "rows": rows, "status": self.status}
+                "com_over_support": inside, "loops": loops, "rows": rows, "status": self.status}
+
+    def _loop_errors(self) -> list[np.ndarray]:
+        """Each closure's held error components at q [m, rad]."""
+        sizes = np.cumsum([len(c.rows) for c in self.robot.closures])[:-1]
+        return np.split(self.robot.closure_error(self.q), sizes) if self.robot.closures else []
 
     def page_config(self) -> dict[str, Any]:
         """What the page is built from: the sliders (bounded one-coordinate joints, their index in q), the targets,
@@ -141,6 +151,8 @@ class WholeTeachSession(Session):
                      f"{SOLE[0]:g} × {SOLE[1]:g} m sole under each. " if self.feet else "")
                   + ("Red ball: the centre of mass (held over the floor at its start); its shadow green over the "
                      "polygon, red off it. " if self.com_target is not None else "")
+                  + (f"Cyan balls: the two ends of each of its {len(self.robot.closures)} loops (one ball where a "
+                     "loop is closed); the readout gives each loop's error. " if self.robot.closures else "")
                   + f"Start: {self.start}.")
         return {"q": self.q.tolist(), "joints": joints, "targets": [f"target_{k}" for k in range(len(self.hands))],
                 "heading": f"kinelab teach — {self.robot.name} (whole robot)", "legend": legend, "whole": True}
@@ -148,7 +160,9 @@ class WholeTeachSession(Session):
     # -- internals ------------------------------------------------------------------------------
     def tasks(self) -> list[Any]:
         """Every hand at its target, every foot where it stands, the centre of mass over its start, a posture."""
-        tasks: list[Any] = [FrameTask(h, T) for h, T in zip(self.hands, self.targets, strict=True)]
+        task = "position" if self.robot.closures else "pose"  # a loop decides how a closed chain's hand turns
+        tasks: list[Any] = [FrameTask(h, T.translation if task == "position" else T, task=task)
+                            for h, T in zip(self.hands, self.targets, strict=True)]
         tasks += [FrameTask(f, M) for f, M in zip(self.feet, self.pins, strict=True)]
         if self.com_target is not None:
             tasks.append(ComTask(self.com_target, axes="xy"))
@@ -185,6 +199,10 @@ class WholeTeachSession(Session):
             self.viewer["support"].set_object(g.Line(g.PointsGeometry(points), _over(INSIDE)))
         if self.com_target is not None:
             self.viewer["com"].set_object(g.Sphere(0.12 * self.frame_length), on_top(COM, 0.9))
+        for k in range(len(self.robot.closures)):
+            for tip in ("a", "b"):
+                self.viewer["loops"][f"loop_{k}"][tip].set_object(g.Sphere(0.06 * self.frame_length),
+                                                                  on_top(LOOP, 0.8))
         self.viz.display(self.q)
         aim_camera(self.viewer, self._points(), 0.1 * self.robot.characteristic_length(), floor_z=self.floor)
 
@@ -201,17 +219,32 @@ class WholeTeachSession(Session):
         """The floor's height [m]: the lowest foot's (0 without feet)."""
         return min((M.translation[2] for M in self.pins), default=0.0)
 
+    def _draw_loops(self) -> None:
+        """Each loop's two ends, and a line between them where the loop is open."""
+        for k, (a, b) in enumerate(_loop_ends(self.robot, self.q)):
+            node = self.viewer["loops"][f"loop_{k}"]
+            node["a"].set_transform(pin.SE3(np.eye(3), a).homogeneous)
+            node["b"].set_transform(pin.SE3(np.eye(3), b).homogeneous)
+            node["gap"].set_object(g.Line(g.PointsGeometry(np.array([a, b]).T), _over(OUTSIDE)))
+
     def _draw(self) -> None:
         self.viz.display(self.q)
         for k, (M, T) in enumerate(zip(self.robot.frame_placements(self.q, self.hands), self.targets, strict=True)):
             self.viewer["frames"][f"hand_{k}"].set_transform(M.homogeneous)
             self.viewer["frames"][f"target_{k}"].set_transform(T.homogeneous)
+        self._draw_loops()
         if self.com_target is not None:
             com = self.robot.com(self.q)
             self.viewer["com"].set_transform(pin.SE3(np.eye(3), com).homogeneous)
             over = self.support is not None and inside_polygon(com[:2], self.support)
             shadow = np.array([[com[0], com[0]], [com[1], com[1]], [com[2], self.floor]])
             self.viewer["com_shadow"].set_object(g.Line(g.PointsGeometry(shadow), _over(INSIDE if over else OUTSIDE)))
+
+
+def _loop_ends(robot: Robot, q: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Each closure's two frames' origins at q [m]."""
+    return [(robot.frame_placement(q, c.frame_a).translation, robot.frame_placement(q, c.frame_b).translation)
+            for c in robot.closures]
 
 
 def _over(color: int) -> Any:
