@@ -96,9 +96,8 @@ def main() -> int:
     scale = 10 if args.quick else 1
     for name in ("fourbar", "delta"):
         robot = kinelab.load(name)
-        for line in (assemblies(robot, 10_000 // scale, 1), held(robot, 100_000 // scale, 2),
-                     solves(robot, 10_000 // scale, 3)):
-            print(f"{name}: {line}", flush=True)
+        for figure, count, seed in ((assemblies, 10_000, 1), (held, 100_000, 2), (solves, 10_000, 3)):
+            print(f"{name}: {figure(robot, count // scale, seed)}", flush=True)
     return 0
 
 
