@@ -74,6 +74,9 @@ CLOSED = (  # bundled robots that close loops (kinelab.robot.closures): whole ro
     Entry("delta", "kinelab", "delta.urdf", None,
           "delta robot in Clavel's geometry: three motors, forearms on ball joints, the platform kept parallel",
           whole=True, closures="delta.closures.yaml", hands=("platform_centre",)),
+    Entry("ankle", "kinelab", "ankle.urdf", None,
+          "two-rod parallel ankle: pitch and roll of the foot driven by two motors on the shin through two rods",
+          whole=True, closures="ankle.closures.yaml", hands=("sole",)),
 )
 
 ERD_ARMS = (
