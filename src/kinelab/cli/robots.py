@@ -6,6 +6,7 @@ import argparse
 from typing import TYPE_CHECKING, Any
 
 from kinelab import lazy
+from kinelab.cli import whole_info
 from kinelab.cli.common import Subcommands, json_flag, load_robot, print_json, robot_arguments, verbose_flag
 from kinelab.robot import catalog
 
@@ -26,8 +27,11 @@ def add(sub: Subcommands) -> None:
     s = sub.add_parser("robots", help="list the registered robots")
     json_flag(s)
     s.set_defaults(func=run_robots)
-    s = sub.add_parser("info", help="joints, types, limits, DOF and tool frame of a robot")
+    s = sub.add_parser("info", help="joints, types, limits, DOF and tool frame of a robot (a whole robot: its tree)")
     robot_arguments(s, limits=False)
+    s.add_argument("--whole", action="store_true",
+                   help="describe the whole robot (its tree, hands, feet, loops, the whole-body step it takes); a "
+                        "registered whole robot such as talos is described whole unless a chain is named")
     s.add_argument("--collisions", action="store_true",
                    help="also build the self-collision model (loads the collision meshes) and say what it checks")
     json_flag(s)
@@ -67,7 +71,10 @@ def _shown_limits(j: Joint) -> tuple[str, str]:
 
 
 def run_info(args: argparse.Namespace) -> int:
-    """The robot's chain: base, tool, joints with their limits, the locked joints."""
+    """The robot's chain: base, tool, joints with their limits, the locked joints (a whole robot:
+    :mod:`kinelab.cli.whole_info`)."""
+    if whole_info.whole_wanted(args):
+        return whole_info.run(args)
     robot = load_robot(args)
     info = {"robot": robot.name, "urdf": str(robot.urdf_path), "base": robot.base, "tool": robot.tool,
             "dof": robot.n, "nq": robot.nq, "nv": robot.nv, "joints": [_joint_row(j) for j in robot.joints],
