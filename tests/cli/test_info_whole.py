@@ -41,3 +41,30 @@ def test_a_file_is_described_whole_when_asked_and_a_chain_when_a_tool_is_named(
 def test_romeo_s_folded_mimics_are_listed(capsys: pytest.CaptureFixture[str]) -> None:
     out = info(capsys, "romeo")
     assert len(out["mimics"]) == 22 and out["mimics"]["LFinger12"] == "1 × LHand + 0"
+
+
+def test_a_whole_robot_asked_for_a_chain_names_the_option_and_its_hands(capsys: pytest.CaptureFixture[str]) -> None:
+    """#72 item 2: `kinelab fk talos` names --tool (not Python syntax) and the robot's hands."""
+    assert main(["fk", "talos"]) == 2
+    err = capsys.readouterr().err
+    assert "--tool on the command line" in err and "gripper_left_base_link, gripper_right_base_link" in err
+    assert "pass tool=NAME" not in err
+
+
+def test_an_ambiguous_file_names_three_likely_tools(tmp_path) -> None:
+    """A tree with no registered tool: the error names --tool and the leaves named like a tool, deepest first."""
+    from helpers import write_urdf
+
+    body = "".join(f'<link name="{n}"/>' for n in ("base", "a", "b", "left_gripper", "camera", "right_hand"))
+    for parent, child in (("base", "a"), ("a", "left_gripper"), ("base", "b"), ("b", "right_hand"),
+                          ("base", "camera")):
+        body += (f'<joint name="{child}_j" type="revolute"><parent link="{parent}"/><child link="{child}"/>'
+                 '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>')
+    with pytest.raises(kinelab.ChainError, match="--tool on the command line.*likely left_gripper, right_hand, camera"):
+        kinelab.load(write_urdf(tmp_path, body))
+
+
+def test_the_robot_list_calls_a_whole_robot_whole(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["robots"]) == 0
+    out = capsys.readouterr().out
+    assert "talos_reduced.urdf; the whole robot, free-flyer base" in out and "; chain the whole" not in out

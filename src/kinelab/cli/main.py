@@ -45,7 +45,8 @@ def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
             is imported and its parser built (a command starts without the others' imports); otherwise (None,
             ``--help``, a mistyped command) every command's, so that help and errors list them all.
     """
-    p = Parser(prog="kinelab", description="Kinematics of serial arms, checked against Pinocchio.")
+    p = Parser(prog="kinelab",
+               description="Kinematics of serial arms, whole robots and closed chains, checked against Pinocchio.")
     p.add_argument("--version", action=_Version, nargs=0, help="show kinelab's version and exit")
     sub = p.add_subparsers(dest="command", required=True, parser_class=Parser)
     named = COMMANDS.get(argv[0]) if argv else None

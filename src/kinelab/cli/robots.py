@@ -52,7 +52,8 @@ def run_robots(args: argparse.Namespace) -> int:
     width = max(len(e.name) for e in catalog.ENTRIES.values()) + 2
     for r in rows:
         print(f"{r['name']:<{width}}{r['description']}")
-        print(f"{'':<{width}}{r['source']}: {r['file']}; chain {r['chain']}")
+        kind = "" if catalog.ENTRIES[str(r["name"])].whole else "chain "  # a whole robot's "chain" says it is one
+        print(f"{'':<{width}}{r['source']}: {r['file']}; {kind}{r['chain']}")
     return 0
 
 

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from kinelab.errors import OptionError
+from kinelab.errors import ChainError, OptionError
 from kinelab.robot import catalog, descriptions
 from kinelab.robot.build import Built, whole_model
 from kinelab.robot.chain import Chain
@@ -99,6 +99,10 @@ def _chain(path: Path, entry: catalog.Entry | None, name: str | None, tool: str 
            srdf: str | Path | None, group: str | None, xacro_args: dict[str, str] | None,
            trust_xacro: bool) -> Chain:
     """:func:`load`'s chain: the registered tool, base or group where the entry has them."""
+    if entry is not None and entry.whole and not (tool or base or group):
+        raise ChainError(f"{entry.name} is a whole robot: name the chain's tool (--tool on the command line, tool= "
+                         f"in Python), such as {', '.join((entry.hands + entry.feet)[:3]) or 'one of its leaf links'}, "
+                         "or take the whole robot (kinelab.load(name); --whole where a command takes it)")
     if entry is not None and not group:
         tool, base, group, srdf = _registered(entry, tool, base, srdf)
     chain = Chain(build_file(path, tool=tool, locked=locked, name=name, base=base, package_dirs=package_dirs,

@@ -192,7 +192,9 @@ class _Builder:
             return _leaf_tool(full, tree.leaves[0])
         raise ChainError(
             f"the tool frame is ambiguous: {tree.root!r} branches into {len(tree.leaves)} leaf links "
-            f"({', '.join(tree.leaves[:12])}{', ...' if len(tree.leaves) > 12 else ''}); pass tool=NAME"
+            f"({', '.join(tree.leaves[:12])}{', ...' if len(tree.leaves) > 12 else ''}); name one (--tool on the "
+            f"command line, tool= in Python), likely {', '.join(likely_tools(tree))}; or take the whole robot "
+            "(--whole, whole=True)"
         )
 
     @staticmethod
@@ -328,3 +330,21 @@ def _locked_value(full: pin.Model, jid: int, value: object) -> float:
         if not lo - LIMIT_SLACK <= number <= hi + LIMIT_SLACK:
             raise JointLimitError(name, number, lo, hi)
     return number
+
+
+TOOL_WORDS = ("gripper", "hand", "tool", "tcp", "ee", "flange", "wrist", "finger", "foot", "sole")
+
+
+def likely_tools(tree: UrdfTree, count: int = 3) -> list[str]:
+    """The leaves most likely meant as a tool: those named like one (gripper, hand, tool, ...) first, the deepest
+    (most links from the root) first among equals."""
+    def depth(link: str) -> int:
+        n = 0
+        while link in tree.parent_of:
+            link, n = tree.parent_of[link], n + 1
+        return n
+
+    def named(link: str) -> int:
+        return next((k for k, word in enumerate(TOOL_WORDS) if word in link.lower()), len(TOOL_WORDS))
+
+    return sorted(tree.leaves, key=lambda link: (named(link), -depth(link), link))[:count]
