@@ -51,7 +51,7 @@ def solve(robot: Chain, target: Target, *, solver: str = "frdm", q0: Configurati
 
 
 @overload
-def solve(robot: Robot, target: Task | Sequence[Task], *, q0: Configuration | None = None, solver: str = "step",
+def solve(robot: Robot | Chain, target: Task | Sequence[Task], *, q0: Configuration | None = None, solver: str = "step",
           seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6, max_iterations: int = 100,
           max_restarts: int = 200, time_budget: float | None = 1.0, limits: Limits | None = None
           ) -> WholeBodyResult: ...
@@ -73,7 +73,7 @@ def solve(robot: Chain | Robot, target: Target | Task | Sequence[Task], *positio
         An :class:`~kinelab.ik.result.IKResult` or a :class:`~kinelab.wholebody.solve.WholeBodyResult`.
 
     Raises:
-        ChainError: a whole robot with a pose (name the frame: ``FrameTask``), or a chain with tasks. Otherwise as
+        ChainError: a whole robot with a pose (name the frame: ``FrameTask``). Otherwise as
             the solve taken.
     """
     if type(target) is pin.SE3 and type(robot) is Chain:  # the usual call, told apart in two type checks
@@ -81,9 +81,6 @@ def solve(robot: Chain | Robot, target: Target | Task | Sequence[Task], *positio
     if is_tasks(target):
         if positional:
             chain_api.refuse_positional("solve", positional)
-        if isinstance(robot, Chain):
-            raise ChainError(f"tasks are solved on a whole robot: {robot.name}'s is robot.robot (kinelab.solve("
-                             "robot.robot, tasks))")
         extra = [k for k in settings if k not in SOLVE_SETTINGS]
         if extra:
             raise OptionError(extra[0], settings[extra[0]], "a setting of a whole-body solve: "

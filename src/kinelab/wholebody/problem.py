@@ -16,12 +16,14 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from kinelab.errors import ChainError, OptionError
+from kinelab.errors import OptionError
+from kinelab.robot.chain import Chain
 from kinelab.robot.tree import Robot
 from kinelab.wholebody import compiled as cp
 from kinelab.wholebody.constraints import loops
 from kinelab.wholebody.limits import Limits, acceleration_bounds, checked_v_prev, is_positive_time, velocity_bounds
 from kinelab.wholebody.step import DEFAULT_LIMITS, DEFAULT_OPTIONS, STATUS, StepOptions, StepResult, _step
+from kinelab.wholebody.subject import as_robot
 from kinelab.wholebody.tasks import Task, as_tasks
 
 if TYPE_CHECKING:
@@ -40,7 +42,7 @@ class WholeBody:
     """A robot's tasks, limits and step options, checked and packed once (see the module's docstring).
 
     Args:
-        robot: the whole robot (:func:`kinelab.load`).
+        robot: the whole robot (:func:`kinelab.load`), or a chain (its own joints; :mod:`~kinelab.wholebody.subject`).
         tasks: a task or a list of them (:mod:`kinelab.wholebody.tasks`, and any :class:`~kinelab.wholebody.Task`).
         limits: what every step holds (:class:`~kinelab.wholebody.Limits`).
         options: the QP's damping and solver (:class:`~kinelab.wholebody.StepOptions`).
@@ -50,11 +52,9 @@ class WholeBody:
         FrameNotFoundError, JointNotFoundError, ConfigurationError: a task naming what the robot lacks.
     """
 
-    def __init__(self, robot: Robot, tasks: Task | Sequence[Task], *, limits: Limits = DEFAULT_LIMITS,
+    def __init__(self, robot: Robot | Chain, tasks: Task | Sequence[Task], *, limits: Limits = DEFAULT_LIMITS,
                  options: StepOptions = DEFAULT_OPTIONS):
-        if not isinstance(robot, Robot):
-            raise ChainError(f"a whole-body problem takes a whole robot (kinelab.load('talos'), or load(path, "
-                             f"whole=True)), got {type(robot).__name__}")
+        robot = as_robot(robot)
         if not isinstance(limits, Limits):
             raise OptionError("limits", limits, "a kinelab.Limits(...)")
         if not isinstance(options, StepOptions):
@@ -256,13 +256,14 @@ def _packed(robot: Robot, tasks: tuple[Task, ...], options: StepOptions) -> cp.P
     return None if tree is None else cp.pack(robot, tree, tasks)
 
 
-def step(robot: Robot, q: Configuration, tasks: Task | Sequence[Task], dt: float, *, limits: Limits = DEFAULT_LIMITS,
-         options: StepOptions = DEFAULT_OPTIONS, v_prev: ArrayLike | None = None) -> StepResult:
+def step(robot: Robot | Chain, q: Configuration, tasks: Task | Sequence[Task], dt: float, *,
+         limits: Limits = DEFAULT_LIMITS, options: StepOptions = DEFAULT_OPTIONS,
+         v_prev: ArrayLike | None = None) -> StepResult:
     """One differential step of whole-body kinematics (:mod:`kinelab.wholebody.step`), through a kept
     :class:`WholeBody` for this robot and task structure (:func:`kept`).
 
     Args:
-        robot: the whole robot (:func:`kinelab.load`).
+        robot: the whole robot (:func:`kinelab.load`), or a chain (its own joints; :mod:`~kinelab.wholebody.subject`).
         q: the configuration (Pinocchio's q, nq numbers); it may lie outside the limits (brought back).
         tasks: a task or a list of them (:mod:`kinelab.wholebody.tasks`).
         dt: the step [s], at least 1e-9.
@@ -277,10 +278,7 @@ def step(robot: Robot, q: Configuration, tasks: Task | Sequence[Task], dt: float
         ChainError: not a whole robot. ConfigurationError: a bad q. OptionError, TargetError: a bad task, limit or
             option, named. FrameNotFoundError, JointNotFoundError: an unknown frame or joint.
     """
-    if not isinstance(robot, Robot):
-        raise ChainError(f"step takes a whole robot (kinelab.load('talos'), or load(path, whole=True)), got "
-                         f"{type(robot).__name__}")
-    return kept(robot, tasks, limits, options).step(q, dt, v_prev)
+    return kept(as_robot(robot, "step"), tasks, limits, options).step(q, dt, v_prev)
 
 
 KEPT = 32  # problems kept per robot for kinelab.step (a caller sweeping weights: the memory stays bounded)

@@ -19,8 +19,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
-from kinelab.errors import ChainError, OptionError
+from kinelab.errors import OptionError
 from kinelab.ik.result import Status
+from kinelab.robot.chain import Chain
 from kinelab.robot.space import generator
 from kinelab.robot.tree import Robot
 from kinelab.typing import Configuration
@@ -28,6 +29,7 @@ from kinelab.wholebody.constraints import loops
 from kinelab.wholebody.frdm import frdm_solve
 from kinelab.wholebody.iterate import SolveSettings, iterate, posture_second
 from kinelab.wholebody.limits import Limits
+from kinelab.wholebody.subject import as_robot
 from kinelab.wholebody.tasks import Task, as_tasks
 
 if TYPE_CHECKING:
@@ -73,14 +75,15 @@ class WholeBodyResult:
                          if not t.met)
 
 
-def solve(robot: Robot, tasks: Task | Sequence[Task], *, q0: Configuration | None = None, solver: str = "step",
+def solve(robot: Robot | Chain, tasks: Task | Sequence[Task], *, q0: Configuration | None = None, solver: str = "step",
           seed: int | None = None,
           tol_pos: float = 1e-6, tol_rot: float = 1e-6, max_iterations: int = 100, max_restarts: int = 200,
           time_budget: float | None = 1.0, limits: Limits | None = None) -> WholeBodyResult:
     """A configuration that meets every task (see the module's docstring).
 
     Args:
-        robot: the whole robot.
+        robot: the whole robot, or a chain (its own joints: Pinocchio's q of its model;
+            :mod:`~kinelab.wholebody.subject`).
         tasks: a task or a list of them.
         q0: the start (Pinocchio's q; None: the robot's neutral configuration).
         solver: "step" (the iterated differential step) or "frdm" (FRDM on the tree).
@@ -99,8 +102,7 @@ def solve(robot: Robot, tasks: Task | Sequence[Task], *, q0: Configuration | Non
         ChainError: not a whole robot. OptionError, TargetError, ConfigurationError, FrameNotFoundError,
             JointNotFoundError: bad input, named.
     """
-    if not isinstance(robot, Robot):
-        raise ChainError(f"a whole-body solve takes a whole robot (kinelab.load('talos')), got {type(robot).__name__}")
+    robot = as_robot(robot, "a whole-body solve")
     found = as_tasks(tasks) + loops(robot)  # a robot's closures held with its tasks
     settings = SolveSettings(solver, tol_pos, tol_rot, max_iterations, max_restarts, time_budget)
     limits = Limits(velocity=None) if limits is None else limits
