@@ -31,7 +31,7 @@ import numpy as np
 import pinocchio as pin
 
 import kinelab
-from kinelab.view.teach.whole import inside_polygon, standing, support_polygon
+from kinelab.view.teach.whole import inside_polygon, support_polygon
 from kinelab.wholebody import ComTask, FrameTask, Limits, PostureTask, RelativeFrameTask
 
 talos = kinelab.load("talos")
@@ -47,7 +47,7 @@ print("hands:", talos.hands, " feet:", talos.feet)
 # toward the start at the second priority (it acts only in what the other tasks leave free).
 
 # %%
-q0, how = standing(talos, talos.feet)
+q0 = kinelab.standing(talos)  # the SRDF's half_sitting, the soles on the floor
 feet = talos.frame_placements(q0, talos.feet)
 hands = talos.frame_placements(q0, talos.hands)
 turn = pin.SE3(pin.rpy.rpyToMatrix(0.0, 0.0, np.deg2rad(20.0)), np.zeros(3))
@@ -56,7 +56,7 @@ com0 = talos.com(q0)
 tasks = ([FrameTask(h, G) for h, G in zip(talos.hands, goals, strict=True)]
          + [FrameTask(f, M) for f, M in zip(talos.feet, feet, strict=True)]
          + [ComTask(com0, axes="xy"), PostureTask(q0, priority=2)])
-print(f"start: {how}; {len(tasks)} tasks")
+print(f"start: half_sitting on the floor; {len(tasks)} tasks")
 
 results = {solver: kinelab.solve(talos, tasks, q0=q0, solver=solver, seed=0, time_budget=5.0)
            for solver in ("step", "frdm")}

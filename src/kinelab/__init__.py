@@ -43,6 +43,7 @@ _LAZY = {
     "PostureTask": ("kinelab.wholebody.tasks", "PostureTask"),
     "CouplingTask": ("kinelab.wholebody.constraints", "CouplingTask"),
     "Closure": ("kinelab.robot.closures", "Closure"),
+    "standing": ("kinelab.robot.standing", "standing"),
     "DampingTask": ("kinelab.wholebody.tasks", "DampingTask"),
     "Limits": ("kinelab.wholebody.limits", "Limits"),
     "StepOptions": ("kinelab.wholebody.step", "StepOptions"),
@@ -104,6 +105,7 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
     from kinelab.robot.closures import Closure
     from kinelab.robot.joints import Joint
     from kinelab.robot.loading import load
+    from kinelab.robot.standing import standing
     from kinelab.robot.tree import Robot
     from kinelab.wholebody.api import solve, track
     from kinelab.wholebody.constraints import CouplingTask
@@ -171,6 +173,7 @@ __all__ = [
     "solve_all_batch",
     "solve_batch",
     "solve_batch_on_cluster",
+    "standing",
     "target_from_xyz_quat_wxyz",
     "target_from_xyz_rpy",
     "track",

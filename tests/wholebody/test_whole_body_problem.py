@@ -106,3 +106,16 @@ def test_a_problem_says_which_step_answers_and_why(talos):
     assert "proxsuite" in WholeBody(talos, [ComTask([0, 0, 0.8])], options=StepOptions(solver="proxsuite")).route
     two = WholeBody(talos, [PostureTask(), PostureTask(weight=1e-2)])
     assert not two.compiled and "two postures" in two.route
+
+
+def test_a_robot_stands_on_its_feet_and_its_named_poses_too(talos):
+    """#72 item 4: kinelab.standing(talos) is the SRDF's half_sitting with the soles on the floor (z = 0, 1e-12),
+    as is named_q("half_sitting"); a robot with loops stands with them closed; a chain is refused by name."""
+    q = kinelab.standing(talos)
+    assert np.allclose(q, talos.named_q("half_sitting"))
+    soles = [M.translation[2] for M in talos.frame_placements(q, talos.feet)]
+    assert min(soles) == pytest.approx(0.0, abs=1e-12) and q[2] > 0.9
+    delta = kinelab.load("delta")
+    assert np.abs(delta.closure_error(kinelab.standing(delta))).max() <= 1e-10
+    with pytest.raises(kinelab.ChainError, match="whole robot"):
+        kinelab.standing(kinelab.load("panda"))

@@ -209,7 +209,8 @@ class Robot:
         return np.asarray(pin.difference(self.model, self.check_q(q0), self.check_q(q1, what="q1")), dtype=float)
 
     def named_q(self, name: str) -> np.ndarray:
-        """The whole q of the SRDF's named configuration ``name``: its joints at their values, the others neutral.
+        """The whole q of the SRDF's named configuration ``name``: its joints at their values, the others neutral;
+        a free-flyer robot with feet stands on them (its base raised until the lowest foot is at z = 0).
 
         Raises:
             SRDFError: no SRDF, or an unknown name (the names listed).
@@ -220,6 +221,21 @@ class Robot:
         for joint, value in self.srdf.state(name).items():
             if self.model.existJointName(joint) and self.model.joints[self.model.getJointId(joint)].nq == 1:
                 q[self.model.joints[self.model.getJointId(joint)].idx_q] = value
+        return self._on_its_feet(q)
+
+    def standing(self) -> np.ndarray:
+        """Where the robot stands: its SRDF's "half_sitting" (else its neutral configuration), its loops closed,
+        and a free-flyer robot with feet on them (the lowest foot at z = 0) [m, rad]."""
+        try:
+            q = self.named_q("half_sitting")
+        except SRDFError:
+            q = self._on_its_feet(self.neutral())
+        return self.assemble(q) if self.closures else q
+
+    def _on_its_feet(self, q: np.ndarray) -> np.ndarray:
+        """q with a free-flyer's height set so that the lowest of the robot's feet is on the floor (z = 0)."""
+        if self.floating and self.feet:
+            q[2] -= min(M.translation[2] for M in self.frame_placements(q, self.feet))
         return q
 
     # -- kinematics -----------------------------------------------------------------------------

@@ -259,14 +259,11 @@ def standing(robot: Robot, feet: tuple[str, ...]) -> tuple[np.ndarray, str]:
     Returns:
         (q, how it was chosen, in words).
     """
-    try:
-        q, how = robot.named_q("half_sitting"), "the SRDF's half_sitting"
-    except KinelabError:
-        q, how = robot.neutral(), "the neutral configuration"
-    q = robot.check_q(q)
-    if robot.floating and feet:
+    named = robot.srdf is not None and "half_sitting" in robot.srdf.states
+    q = robot.standing()
+    if robot.floating and feet and feet != robot.feet:  # other feet than the robot's own: those on the floor
         q[2] -= min(M.translation[2] for M in robot.frame_placements(q, feet))
-    return q, how
+    return q, "the SRDF's half_sitting" if named else "the neutral configuration"
 
 
 def support_polygon(feet: list[pin.SE3]) -> np.ndarray | None:
