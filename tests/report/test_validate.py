@@ -334,3 +334,13 @@ def test_every_joint_of_the_era_passage_figures_can_be_seen(tmp_path):
     for panel, columns in (("without bypass", slice(0, half)), ("with bypass", slice(half, None))):
         for joint, mask in hues.items():
             assert mask[:, columns].sum() >= 400, (panel, joint, int(mask[:, columns].sum()))  # a legend swatch: < 100
+
+
+def test_a_log_gets_a_line_per_check_group_as_it_ends(capsys, tmp_path):
+    """#72 item 1: with its output in a file or a pipe (as under pytest), validate says each group as it ends, on
+    stderr (the table stays on stdout)."""
+    assert cli.main(["validate", "--robots", "fourbar", "--n", "5", "--out", str(tmp_path / "r")]) == 0
+    err = capsys.readouterr().err.splitlines()
+    groups = [line for line in err if line.startswith("validate ")]
+    assert len(groups) == 4 and groups[0].startswith("validate 1/4: fourbar, closure model check:")
+    assert all(" failed (" in line for line in groups)

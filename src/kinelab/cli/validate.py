@@ -37,7 +37,8 @@ def run(args: argparse.Namespace) -> int:
     out = args.out or (None if args.json else "kinelab-report")  # --json alone writes no folder
     if out:
         check_output_folder(out, "validate")  # before the work, not after it
-    report = validate.run(robots=args.robots, n=args.n, seed=args.seed, progress=progress_of(args))
+    report = validate.run(robots=args.robots, n=args.n, seed=args.seed, progress=progress_of(args),
+                          lines=not args.json and not progress_of(args))
     if out:
         render.write_validate_report(report, out)
     if args.json:

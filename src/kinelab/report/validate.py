@@ -6,6 +6,8 @@ is a list of :class:`Check` rows, printed as a table, written as Markdown/HTML/J
 
 from __future__ import annotations
 
+import sys
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from typing import Any
@@ -390,7 +392,8 @@ def _groups(robot: Chain | Robot) -> list[Any]:
     return [*GENERAL_CHECKS, *PAPER_CHECKS.get(robot.name, [])]
 
 
-def run(robots: list[str] | None = None, n: int | None = None, seed: int = 0, progress: bool = False) -> Report:
+def run(robots: list[str] | None = None, n: int | None = None, seed: int = 0, progress: bool = False,
+        lines: bool = False) -> Report:
     """Run every check on ``robots`` (default: stanford, era, youbot, panda, ur5, the whole talos and baxter, and
     fourbar and delta, which close loops: a whole robot takes the whole-body checks,
     :mod:`kinelab.report.wholebody_checks`, one with loops :mod:`kinelab.report.closed_checks`)."""
@@ -402,6 +405,12 @@ def run(robots: list[str] | None = None, n: int | None = None, seed: int = 0, pr
     loaded = [load(name) for name in names]  # fail early, before any work, on a bad name
     report = Report(robots=names, n=n, seed=seed)
     steps = [(robot, fn) for robot in loaded for fn in _groups(robot)]
-    for robot, fn in tqdm(steps, desc="validate (check groups)", disable=not progress, unit="group"):
-        report.checks.extend(fn(robot, n, seed))
+    for k, (robot, fn) in enumerate(tqdm(steps, desc="validate (check groups)", disable=not progress, unit="group")):
+        started = time.perf_counter()
+        found = fn(robot, n, seed)
+        report.checks.extend(found)
+        if lines:  # a log or a pipe: one line per group as it ends, never silent for a whole run
+            failed = sum(not c.passed for c in found)
+            print(f"validate {k + 1}/{len(steps)}: {robot.name}, {fn.__name__.replace('_', ' ')}: {len(found)} "
+                  f"checks, {failed} failed ({time.perf_counter() - started:.1f} s)", file=sys.stderr, flush=True)
     return report
