@@ -46,11 +46,12 @@ def test_each_task_is_solved_and_judged_on_its_components_only(name, task, solve
     targets = task_targets(robot, task, 12, seed=10 * ARMS.index(name) + TASKS.index(task))
     solved = 0
     for k, target in enumerate(targets):
-        res = kinelab.solve(robot, target, solver=solver, task=task, seed=k, time_budget=0.3)
+        res = kinelab.solve(robot, target, solver=solver, task=task, seed=k, time_budget=None, max_restarts=60)
         assert res.success == judged_here(robot, res.q, target, task), (k, res.status, res.message)
         assert res.task == ("axis z" if task == "axis" else task)
         solved += res.success
-    assert solved >= 11  # measured: FRDM and DLS miss 2 of 40 axis targets on so101 (FRDM on panda too)
+    assert solved >= 11  # measured: FRDM and DLS miss 2 of 40 axis targets on so101 (FRDM on panda too); bounded
+    # by a count of restarts, not a clock: with 0.3 s a solve, a busy machine (two test runs side by side) missed 3
 
 
 def test_a_position_task_ignores_an_unreachable_orientation_that_the_pose_task_cannot_meet():
