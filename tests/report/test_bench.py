@@ -340,3 +340,13 @@ def test_a_broken_whole_body_peer_stops_that_bench_by_name(monkeypatch):
     monkeypatch.setattr(wb, "STEPPERS", steppers.STEPPERS)
     with pytest.raises(peers.PeerFailedError, match="pink failed on panda: ImportError"):
         wb.run(["panda"], steps=5, rounds=1, solves=0)
+
+
+def test_pink_declines_a_chain_whose_tool_name_is_two_frames():
+    """z1's tool name 'gripperStator' names two frames (a body and its joint): pink, which finds a frame by name
+    only, raised on every problem and stopped the bench; it now declines the robot, said as a 'Not run' line."""
+    pytest.importorskip("pink")
+    from kinelab.report.bench import peers
+
+    with pytest.raises(peers.PeerDeclinedError, match="'gripperStator' names 2 frames"):
+        peers._pink(kinelab.load("z1"), 0.005)

@@ -186,6 +186,9 @@ def _pink(robot: Chain, budget: float) -> SolveFn:
     from pink.tasks import FrameTask
 
     task = FrameTask(robot.tool, position_cost=1.0, orientation_cost=1.0)
+    if sum(f.name == robot.tool for f in robot.model.frames) > 1:  # pink finds a frame by its name alone
+        raise PeerDeclinedError(f"pink names frames by name only, and {robot.tool!r} names "
+                                f"{sum(f.name == robot.tool for f in robot.model.frames)} frames of this chain")
 
     def run(case: Case, seed: int):
         deadline = time.perf_counter() + budget
