@@ -28,14 +28,14 @@ class Limits:
             limit [rad/s or m/s] on every joint but a free-flyer's; (nv,) numbers: one per velocity.
         acceleration: None (none), a number or (nv,) numbers [rad/s² or m/s²]: |v − v_prev| ≤ a·dt, where the
             step is given the velocity before it.
-        collisions: None (no distance constraint). (Collision avoidance as a constraint of the step is not in this
-            version: the converged solve checks answers with ``collisions=`` instead.)
+
+    Collision avoidance is not a constraint of the step in this version (the converged solve of a chain checks its
+    answers with ``collisions=``).
     """
 
     position: bool = True
     velocity: Any = True
     acceleration: Any = None
-    collisions: Any = None
 
     def __post_init__(self) -> None:
         """Check every field.
@@ -49,8 +49,6 @@ class Limits:
         _check_rate("acceleration", self.acceleration)
         if self.acceleration is True:
             raise OptionError("acceleration", True, "None, a number > 0 or one per velocity (no file gives them)")
-        if self.collisions is not None:
-            raise OptionError("collisions", self.collisions, "None (distance constraints are not in this version)")
 
 
 def _check_rate(name: str, value: Any) -> None:

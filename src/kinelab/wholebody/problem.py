@@ -321,8 +321,7 @@ def _equal_limits(a: object, b: Limits) -> bool:
         return False
     return all(np.array_equal(np.asarray(x, dtype=object), np.asarray(y, dtype=object))
                if isinstance(x, np.ndarray | list | tuple) or isinstance(y, np.ndarray | list | tuple) else x == y
-               for x, y in ((a.position, b.position), (a.velocity, b.velocity), (a.acceleration, b.acceleration),
-                            (a.collisions, b.collisions)))
+               for x, y in ((a.position, b.position), (a.velocity, b.velocity), (a.acceleration, b.acceleration)))
 
 
 def _same_objects(held: list[Task], tasks: Any) -> bool:
