@@ -76,14 +76,7 @@ def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, fl
     _check_load_arguments(name_or_path, tool, locked, base, package_dirs, srdf, group, xacro_args, trust_xacro)
     _check_flag("whole", whole)
     _check_flag("floating", floating)
-    name: str | None
-    if str(name_or_path).startswith(descriptions.PREFIX):
-        found = descriptions.resolve(str(name_or_path))
-        name, path, entry = found.name, found.path, None
-        package_dirs = [*(package_dirs or []), *found.package_dirs]
-    else:
-        path, entry = catalog.resolve(name_or_path)
-        name = entry.name if entry else None
+    path, entry, name, package_dirs = _source(name_or_path, package_dirs)
     if whole or floating or closures is not None or (whole is None and entry is not None and entry.whole):
         robot = _whole(path, entry, name, package_dirs, srdf, xacro_args, trust_xacro, floating,
                        (tool, base, locked, group))
@@ -92,6 +85,17 @@ def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, fl
     if actuated is not None:
         raise OptionError("actuated", actuated, "None without closures (a whole robot's loops: closures=...)")
     return _chain(path, entry, name, tool, locked, base, package_dirs, srdf, group, xacro_args, trust_xacro)
+
+
+def _source(name_or_path: str | Path, package_dirs: list[str] | None
+            ) -> tuple[Path, catalog.Entry | None, str | None, list[str] | None]:
+    """(file, registered entry, name, package folders) of what :func:`load` was given: a description of
+    robot_descriptions (its packages added), a registered name or a path."""
+    if str(name_or_path).startswith(descriptions.PREFIX):
+        found = descriptions.resolve(str(name_or_path))
+        return found.path, None, found.name, [*(package_dirs or []), *found.package_dirs]
+    path, entry = catalog.resolve(name_or_path)
+    return path, entry, entry.name if entry else None, package_dirs
 
 
 def _chain(path: Path, entry: catalog.Entry | None, name: str | None, tool: str | None,

@@ -246,69 +246,74 @@ def read_json(rfile: BufferedIOBase, length_header: str | None) -> dict[str, Any
     return body
 
 
-def _handler(server: TeachServer) -> type[BaseHTTPRequestHandler]:
-    class Handler(BaseHTTPRequestHandler):
-        timeout = TIMEOUT  # a half-sent request holds its thread this long, not for ever
+class _Handler(BaseHTTPRequestHandler):
+    """The teach page's requests, answered for ``server_of`` (a subclass per server sets it)."""
 
-        def setup(self) -> None:
-            super().setup()
-            server.httpd.watch(self.connection)
+    server_of: TeachServer
+    timeout = TIMEOUT  # a half-sent request holds its thread this long, not for ever
 
-        def finish(self) -> None:
-            server.httpd.forget(self.connection)
-            super().finish()
+    def setup(self) -> None:
+        super().setup()
+        self.server_of.httpd.watch(self.connection)
 
-        def log_message(self, format: str, *args: Any) -> None:  # quiet: the terminal shows the address only
+    def finish(self) -> None:
+        self.server_of.httpd.forget(self.connection)
+        super().finish()
+
+    def log_message(self, format: str, *args: Any) -> None:  # quiet: the terminal shows the address only
+        return
+
+    def do_GET(self) -> None:  # noqa: N802 (http.server's name)
+        url = urlparse(self.path)
+        try:
+            self.server_of.check_origin(self.headers)
+        except RequestError as exc:
+            self._send_json(exc.code, {"error": str(exc)})
             return
+        if url.path == "/state":
+            since = _int(parse_qs(url.query).get("since", ["0"])[0])
+            with self.server_of.lock:
+                self._send_json(200, self.server_of.reply(since))
+        elif url.path in self.server_of.files:
+            kind = "text/html; charset=utf-8" if url.path == "/" else "text/javascript; charset=utf-8"
+            self._send(200, self.server_of.files[url.path], kind)
+        else:
+            self._send(404, b"not found", "text/plain")
 
-        def do_GET(self) -> None:  # noqa: N802 (http.server's name)
-            url = urlparse(self.path)
+    def do_POST(self) -> None:  # noqa: N802
+        try:
+            self.server_of.check_origin(self.headers)
+            if self.headers.get_content_type() != "application/json":
+                raise RequestError(415, "the actions take JSON (Content-Type: application/json)")
+            body = read_json(self.rfile, self.headers.get("Content-Length"))
+        except RequestError as exc:
+            self._send_json(exc.code, {"error": str(exc)})
+            return
+        with self.server_of.lock:
+            code, error = 200, ""
             try:
-                server.check_origin(self.headers)
-            except RequestError as exc:
-                self._send_json(exc.code, {"error": str(exc)})
-                return
-            if url.path == "/state":
-                since = _int(parse_qs(url.query).get("since", ["0"])[0])
-                with server.lock:
-                    self._send_json(200, server.reply(since))
-            elif url.path in server.files:
-                kind = "text/html; charset=utf-8" if url.path == "/" else "text/javascript; charset=utf-8"
-                self._send(200, server.files[url.path], kind)
-            else:
-                self._send(404, b"not found", "text/plain")
+                self.server_of.act(urlparse(self.path).path.strip("/"), body)
+            except KinelabError as exc:
+                code, error = 400, short(str(exc))
+            reply = self.server_of.reply(_int(body.get("since", 0)), error)
+        self._send_json(code, reply)
 
-        def do_POST(self) -> None:  # noqa: N802
-            try:
-                server.check_origin(self.headers)
-                if self.headers.get_content_type() != "application/json":
-                    raise RequestError(415, "the actions take JSON (Content-Type: application/json)")
-                body = read_json(self.rfile, self.headers.get("Content-Length"))
-            except RequestError as exc:
-                self._send_json(exc.code, {"error": str(exc)})
-                return
-            with server.lock:
-                code, error = 200, ""
-                try:
-                    server.act(urlparse(self.path).path.strip("/"), body)
-                except KinelabError as exc:
-                    code, error = 400, short(str(exc))
-                reply = server.reply(_int(body.get("since", 0)), error)
-            self._send_json(code, reply)
+    def _send_json(self, code: int, value: dict[str, Any]) -> None:
+        self._send(code, json.dumps(strict(value), allow_nan=False).encode("utf-8"), "application/json")
 
-        def _send_json(self, code: int, value: dict[str, Any]) -> None:
-            self._send(code, json.dumps(strict(value), allow_nan=False).encode("utf-8"), "application/json")
+    def _send(self, code: int, data: bytes, kind: str) -> None:
+        self.send_response(code)
+        self.send_header("Content-Type", kind)
+        self.send_header("Content-Length", str(len(data)))
+        self.send_header("Cache-Control", "no-store")
+        self.send_header("X-Content-Type-Options", "nosniff")
+        self.end_headers()
+        self.wfile.write(data)
 
-        def _send(self, code: int, data: bytes, kind: str) -> None:
-            self.send_response(code)
-            self.send_header("Content-Type", kind)
-            self.send_header("Content-Length", str(len(data)))
-            self.send_header("Cache-Control", "no-store")
-            self.send_header("X-Content-Type-Options", "nosniff")
-            self.end_headers()
-            self.wfile.write(data)
 
-    return Handler
+def _handler(server: TeachServer) -> type[BaseHTTPRequestHandler]:
+    """The request handler class of one teach server."""
+    return type("Handler", (_Handler,), {"server_of": server})
 
 
 def _close(connection: Any) -> None:
