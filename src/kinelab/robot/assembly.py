@@ -130,6 +130,9 @@ def newton(robot: Robot, q: np.ndarray, passive: np.ndarray, tol: float) -> tupl
     convergence near a closed loop, steady steps far from one), a halving line search: (q reached, its largest
     error)."""
     model, data = robot.model, robot.data
+    e, _ = loop_state(model, data, q, robot.closures, jacobian=False)
+    if np.max(np.abs(e), initial=0.0) <= tol * 1e-2:  # closed already (every step's start): no Jacobian to build
+        return q, float(np.max(np.abs(e), initial=0.0))
     e, J = loop_state(model, data, q, robot.closures)
     norm, slow = float(np.linalg.norm(e)), 0
     for _ in range(NEWTON_ITERATIONS):
