@@ -52,7 +52,7 @@ def run(robot: Robot, args: argparse.Namespace) -> int:
     if bad:
         raise KinelabError(f"{bad[0]!r} is not a number (give {len(robot.actuated)} motor values, rad or deg)")
     motors = np.array([float(v) for v in args.q]) * (math.pi / 180 if args.deg else 1.0)
-    q = _assembled(robot, motors)
+    q = _assembled(robot, robot.assemble(robot.neutral()), motors)
     s = closed_singular.analyze(robot, q, output)
     if args.json:
         common.print_json({"robot": robot.name, "output": output, "q": q.tolist(), "sigma_serial": s.sigma_serial,
@@ -65,9 +65,9 @@ def run(robot: Robot, args: argparse.Namespace) -> int:
     return 0
 
 
-def _assembled(robot: Robot, motors: np.ndarray) -> np.ndarray:
-    """The home pose with the motors at ``motors``, assembled."""
-    q = robot.assemble(robot.neutral())
+def _assembled(robot: Robot, home: np.ndarray, motors: np.ndarray) -> np.ndarray:
+    """The home pose (assembled) with the motors at ``motors``, assembled."""
+    q = home.copy()
     for name, value in zip(robot.actuated, motors, strict=True):
         q[robot.model.joints[robot.model.getJointId(name)].idx_q] = value
     return robot.assemble(q)
@@ -79,11 +79,12 @@ def _sweep(robot: Robot, output: str, args: argparse.Namespace) -> int:
         raise KinelabError(f"--sweep takes a number of samples ≥ 1, got {args.sweep}")
     rng = np.random.default_rng(args.seed)
     index = [robot.model.joints[robot.model.getJointId(a)].idx_q for a in robot.actuated]
+    home = robot.assemble(robot.neutral())  # once: every sample starts from it
     rows: list[tuple[float, float, np.ndarray]] = []
     refused = 0
     for _ in range(args.sweep):
         try:
-            q = _assembled(robot, robot.random_q(rng)[index])
+            q = _assembled(robot, home, robot.random_q(rng)[index])
         except AssemblyError:
             refused += 1
             continue
