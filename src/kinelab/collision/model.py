@@ -29,7 +29,7 @@ from kinelab.collision.obstacles import Environment, Obstacle
 from kinelab.collision.spheres import PLANE, Frames
 from kinelab.collision.spheres import candidates as sphere_candidates
 from kinelab.errors import KinelabError
-from kinelab.robot import Chain
+from kinelab.robot import Chain, Robot
 from kinelab.robot.meshes import mesh_package_dirs, missing_meshes
 from kinelab.robot.mjcf import is_mjcf
 
@@ -48,17 +48,27 @@ class Collisions:
         self_collisions: the robot against itself.
         environment: the obstacles (base frame), or None.
         margin: a clearance every pair must keep [m] (≥ 0).
+        detection: the whole-body step only: a pair enters the step's QP once it is nearer than margin + detection
+            [m] (> 0); farther pairs cost nothing.
+        gain: the whole-body step only: ξ of the velocity damper ḋ ≥ −ξ (d − margin)/dt, in (0, 1] (the share of
+            the remaining clearance a step may close).
     """
 
     self_collisions: bool = True
     environment: Environment | None = None
     margin: float = 0.0
+    detection: float = 0.05
+    gain: float = 0.5
 
     def __post_init__(self) -> None:
         if not isinstance(self.self_collisions, bool | np.bool_):
             raise CollisionError(f"self_collisions is True or False, got {self.self_collisions!r}")
         if not _is_clearance(self.margin):
             raise CollisionError(f"the collision margin is a clearance ≥ 0 m, got {self.margin!r}")
+        if not _is_clearance(self.detection) or self.detection == 0:
+            raise CollisionError(f"the detection distance is a distance > 0 m, got {self.detection!r}")
+        if not _is_clearance(self.gain) or not 0 < self.gain <= 1:
+            raise CollisionError(f"the collision gain is a number in (0, 1], got {self.gain!r}")
         if self.environment is not None and not isinstance(self.environment, Environment):
             raise CollisionError(f"environment must be a kinelab.Environment, got {type(self.environment).__name__}")
         if not self.self_collisions and self.environment is None:
@@ -84,7 +94,7 @@ def as_collisions(value: object) -> Collisions | None:
     if isinstance(value, Environment):
         return Collisions(environment=value)
     raise CollisionError(f"collisions={value!r} is not valid: None, 'self', a kinelab.Environment or a "
-                         "kinelab.Collisions(self_collisions=, environment=, margin=)")
+                         "kinelab.Collisions(self_collisions=, environment=, margin=, detection=, gain=)")
 
 
 @dataclass(frozen=True)
@@ -317,7 +327,7 @@ def _check_srdf_links(robot: Chain) -> None:
                       f"{robot.name}'s model does not have; those pairs are ignored", stacklevel=4)
 
 
-def _self_pairs(robot: Chain, objects: list[Any], own: int) -> tuple[list[tuple[int, int]], tuple[int, int]]:
+def _self_pairs(robot: Chain | Robot, objects: list[Any], own: int) -> tuple[list[tuple[int, int]], tuple[int, int]]:
     """The robot's own pairs worth checking, and how many were left out as adjacent and as SRDF-disabled."""
     parents = robot.model.parents
     link = [robot.model.frames[o.parentFrame].name for o in objects[:own]]

@@ -28,14 +28,15 @@ class Limits:
             limit [rad/s or m/s] on every joint but a free-flyer's; (nv,) numbers: one per velocity.
         acceleration: None (none), a number or (nv,) numbers [rad/s² or m/s²]: |v − v_prev| ≤ a·dt, where the
             step is given the velocity before it.
-
-    Collision avoidance is not a constraint of the step in this version (the converged solve of a chain checks its
-    answers with ``collisions=``).
+        collisions: None (none), or what :class:`kinelab.Collisions` takes — ``"self"``, an ``Environment`` or a
+            ``Collisions(self_collisions=, environment=, margin=, detection=, gain=)``: every pair nearer than
+            margin + detection held apart by one row of the QP (:mod:`kinelab.wholebody.clearance`).
     """
 
     position: bool = True
     velocity: Any = True
     acceleration: Any = None
+    collisions: Any = None
 
     def __post_init__(self) -> None:
         """Check every field.
@@ -49,6 +50,10 @@ class Limits:
         _check_rate("acceleration", self.acceleration)
         if self.acceleration is True:
             raise OptionError("acceleration", True, "None, a number > 0 or one per velocity (no file gives them)")
+        if self.collisions is not None:  # the collision module (coal's geometry) loaded only when asked for
+            from kinelab.collision.model import as_collisions
+
+            object.__setattr__(self, "collisions", as_collisions(self.collisions))
 
 
 def _check_rate(name: str, value: Any) -> None:

@@ -1,4 +1,5 @@
-"""The step's quadratic program: minimize ½ vᵀHv + fᵀv subject to lower ≤ v ≤ upper and A_eq v = b_eq.
+"""The step's quadratic program: minimize ½ vᵀHv + fᵀv subject to lower ≤ v ≤ upper, A_eq v = b_eq and
+A_in v ≥ b_in (the collision rows, :mod:`kinelab.wholebody.clearance`).
 
 DAQP (a dual active-set solver for small dense problems) by default: on the step's problems — tens of variables,
 box bounds and a few equalities — it answers in microseconds and exactly at the bounds it makes active, which the
@@ -38,8 +39,17 @@ MAX_ITERATIONS = 10_000  # each solver's iteration bound: the step's QPs take te
 NOT_FINITE = "not finite"  # the status of an answer that overflowed (nothing moved)
 
 
+@dataclass(frozen=True)
+class Inequalities:
+    """Rows A v ≥ b of the step's QP (A: (m, nv); b: (m,))."""
+
+    A: np.ndarray
+    b: np.ndarray
+
+
 def solve(H: np.ndarray, f: np.ndarray, lower: np.ndarray, upper: np.ndarray, A_eq: np.ndarray | None,
-          b_eq: np.ndarray | None, solver: str = "daqp", dt: float = 1.0) -> Solution:
+          b_eq: np.ndarray | None, solver: str = "daqp", dt: float = 1.0,
+          inequalities: Inequalities | None = None) -> Solution:
     """Solve the step's QP (see the module's docstring) for v. ProxQP is given the problem in x = v·dt (the same
     minimiser, the objective times dt²): its absolute tolerances then meet numbers the size of the motion whatever
     dt (in v it ran to its iteration bound below dt ≈ 1e-8). DAQP takes v as it is: its active set is exact at the
@@ -50,10 +60,11 @@ def solve(H: np.ndarray, f: np.ndarray, lower: np.ndarray, upper: np.ndarray, A_
         KinelabError: the solver is not installed (with the install hint).
     """
     if solver != "proxsuite":
-        found = _daqp(H, f, lower, upper, A_eq, b_eq)
+        found = _daqp(H, f, lower, upper, A_eq, b_eq, inequalities)
         v = found.v
     else:
-        found = _proxsuite(H, f * dt, lower * dt, upper * dt, A_eq, None if b_eq is None else b_eq * dt)
+        scaled = None if inequalities is None else Inequalities(inequalities.A, inequalities.b * dt)
+        found = _proxsuite(H, f * dt, lower * dt, upper * dt, A_eq, None if b_eq is None else b_eq * dt, scaled)
         v = found.v / dt
     if not found.solved:
         return found
@@ -63,15 +74,19 @@ def solve(H: np.ndarray, f: np.ndarray, lower: np.ndarray, upper: np.ndarray, A_
 
 
 def _daqp(H: np.ndarray, f: np.ndarray, lower: np.ndarray, upper: np.ndarray, A_eq: np.ndarray | None,
-          b_eq: np.ndarray | None) -> Solution:
+          b_eq: np.ndarray | None, inequalities: Inequalities | None = None) -> Solution:
     daqp = _import("daqp")
     n = H.shape[0]
     m = 0 if A_eq is None else A_eq.shape[0]
     A = np.zeros((0, n)) if A_eq is None else A_eq
     up = np.concatenate([np.minimum(upper, BIG), [] if b_eq is None else b_eq])
     lo = np.concatenate([np.maximum(lower, -BIG), [] if b_eq is None else b_eq])
-    sense = np.zeros(n + m, dtype=c_int)
-    sense[n:] = EQUALITY
+    if inequalities is not None:
+        A = np.vstack([A, inequalities.A])
+        up = np.concatenate([up, np.full(inequalities.b.shape[0], BIG)])
+        lo = np.concatenate([lo, inequalities.b])
+    sense = np.zeros(A.shape[0] + n, dtype=c_int)
+    sense[n:n + m] = EQUALITY
     x, _, flag, info = daqp.solve(H, f, A, up, lo, sense, iter_limit=MAX_ITERATIONS)
     solved = flag in (1, 2)
     x = np.clip(np.asarray(x, dtype=float), lower, upper)  # its bounds hold to its tolerance (1e-7): exactly here
@@ -80,16 +95,19 @@ def _daqp(H: np.ndarray, f: np.ndarray, lower: np.ndarray, upper: np.ndarray, A_
 
 
 def _proxsuite(H: np.ndarray, f: np.ndarray, lower: np.ndarray, upper: np.ndarray, A_eq: np.ndarray | None,
-               b_eq: np.ndarray | None) -> Solution:
+               b_eq: np.ndarray | None, inequalities: Inequalities | None = None) -> Solution:
     proxsuite = _import("proxsuite")
     n = H.shape[0]
     m = 0 if A_eq is None else A_eq.shape[0]
-    qp = proxsuite.proxqp.dense.QP(n, m, 0, True)
+    k = 0 if inequalities is None else inequalities.b.shape[0]
+    qp = proxsuite.proxqp.dense.QP(n, m, k, True)
     qp.settings.eps_abs = 1e-10
     qp.settings.max_iter = MAX_ITERATIONS
     qp.settings.max_iter_in = MAX_ITERATIONS
     qp.settings.verbose = False
-    qp.init(H, f, A_eq, b_eq, None, None, None, np.maximum(lower, -BIG), np.minimum(upper, BIG))
+    C, low, high = (None, None, None) if inequalities is None else (
+        inequalities.A, inequalities.b, np.full(k, BIG))
+    qp.init(H, f, A_eq, b_eq, C, low, high, np.maximum(lower, -BIG), np.minimum(upper, BIG))
     qp.solve()
     status = str(qp.results.info.status).rsplit(".", 1)[-1].lower()
     solved = "solved" in status

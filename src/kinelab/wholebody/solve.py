@@ -13,18 +13,20 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
 
+from kinelab.collision.model import Collisions, Contact
 from kinelab.errors import OptionError
 from kinelab.ik.result import Status
 from kinelab.robot.chain import Chain
 from kinelab.robot.space import generator
 from kinelab.robot.tree import Robot
 from kinelab.typing import Configuration
+from kinelab.wholebody.clearance import step_collisions
 from kinelab.wholebody.constraints import loops
 from kinelab.wholebody.frdm import frdm_solve
 from kinelab.wholebody.iterate import SolveSettings, iterate, posture_second
@@ -56,6 +58,8 @@ class WholeBodyResult:
         tasks: each task's verdict (Pinocchio's FK and centre of mass), in the order given.
         iterations: steps (or FRDM sweeps) in all; restarts: random restarts after the first start.
         wall_time [s]; solver: "step" or "frdm"; judge: whose FK judged.
+        closest: with ``limits.collisions``, the nearest pair at q over every monitored pair (names, distance [m]);
+            an answer nearer than the margin is no success (status ``collision``).
     """
 
     q: np.ndarray
@@ -67,6 +71,7 @@ class WholeBodyResult:
     wall_time: float
     solver: str
     judge: str = "Pinocchio FK"
+    closest: Contact | None = None
 
     @property
     def message(self) -> str:
@@ -121,7 +126,7 @@ def _run(robot: Robot, tasks: tuple[Task, ...], start: np.ndarray, settings: Sol
     deadline = math.inf if settings.time_budget is None else t0 + settings.time_budget
     rng = generator(seed)
     ordered = posture_second(tasks)
-    best: tuple[float, np.ndarray, Status] | None = None
+    best: tuple[tuple[float, float], np.ndarray, Status] | None = None
     iterations, restarts = 0, 0
     q = start
     while True:
@@ -129,18 +134,19 @@ def _run(robot: Robot, tasks: tuple[Task, ...], start: np.ndarray, settings: Sol
                                     deadline)
         iterations += used
         verdicts = judge(robot, tasks, q, settings.tol_pos, settings.tol_rot)
-        score = _score(verdicts)
+        score = (_penetration(robot, q, limits), _score(verdicts))  # a clear answer before any in collision
         if best is None or score < best[0]:
             best = (score, q, status)
-        if all(v.met for v in verdicts) or restarts >= settings.max_restarts or time.perf_counter() > deadline:
+        if score == (0.0, 0.0) or restarts >= settings.max_restarts or time.perf_counter() > deadline:
             break
         restarts += 1
-        q = _restart(robot, start, rng)
+        q = _restart(robot, start, rng, limits)
         for task in tasks:
             if task.settled:  # a restart starts on the robot's loops, as the mechanism would
                 task.project(robot, q)
     _, q, status = best
-    return _result(robot, tasks, q, status, settings, iterations, restarts, time.perf_counter() - t0)
+    result = _result(robot, tasks, q, status, settings, iterations, restarts, time.perf_counter() - t0)
+    return result if limits.collisions is None else _clear(robot, result, limits.collisions)
 
 
 def _converge(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, settings: SolveSettings, limits: Limits,
@@ -161,12 +167,36 @@ def _result(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, status: Status
     return WholeBodyResult(q, met and within, final, verdicts, iterations, restarts, seconds, settings.solver)
 
 
-def _restart(robot: Robot, start: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """A random configuration with the start's free-flyer (the base stays where the tasks put it)."""
-    q = robot.random_q(rng)
-    if robot.floating:
-        q[:7] = start[:7]
+def _penetration(robot: Robot, q: np.ndarray, limits: Limits) -> float:
+    """How far the nearest pair at q is inside the margin [m] (0: clear, or no collisions asked)."""
+    if limits.collisions is None:
+        return 0.0
+    return max(0.0, -step_collisions(robot, limits.collisions).closest(q)[1])
+
+
+def _clear(robot: Robot, result: WholeBodyResult, collisions: Collisions) -> WholeBodyResult:
+    """The result with its nearest pair (coal's distance on every monitored pair) and, nearer than the margin, no
+    success (status ``collision``)."""
+    contact, slack = step_collisions(robot, collisions).closest(result.q)
+    if slack >= 0.0:
+        return replace(result, closest=contact)
+    return replace(result, closest=contact, success=False,
+                   status=Status.COLLISION if result.success else result.status)
+
+
+def _restart(robot: Robot, start: np.ndarray, rng: np.random.Generator, limits: Limits) -> np.ndarray:
+    """A random configuration with the start's free-flyer (the base stays where the tasks put it); with collisions
+    held, the first of up to RESTART_DRAWS clear of every pair (else the last drawn: the step brings it out)."""
+    for _ in range(RESTART_DRAWS):
+        q = robot.random_q(rng)
+        if robot.floating:
+            q[:7] = start[:7]
+        if _penetration(robot, q, limits) == 0.0:
+            break
     return q
+
+
+RESTART_DRAWS = 20
 
 
 def _score(verdicts: tuple[TaskVerdict, ...]) -> float:

@@ -9,17 +9,17 @@ q ⊕ v·dt through ``pin.integrate``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pinocchio as pin
 
+from kinelab.collision.model import Contact
 from kinelab.errors import OptionError
 from kinelab.robot.tree import Robot
 from kinelab.values import is_real
+from kinelab.wholebody import clearance, qp
 from kinelab.wholebody import evaluate as ev
-from kinelab.wholebody import qp
 from kinelab.wholebody.limits import (
     Limits,
     acceleration_bounds,
@@ -27,12 +27,6 @@ from kinelab.wholebody.limits import (
     velocity_bounds,
 )
 from kinelab.wholebody.tasks import Task, TaskError
-
-if TYPE_CHECKING:
-
-    pass
-
-
 
 
 @dataclass(frozen=True)
@@ -68,9 +62,12 @@ class StepResult:
         errors: each task's error at the start of the step, in the order given (:class:`TaskError`).
         returning: the joints outside their limits at the start, brought back at the velocity limit.
         iterations: the QP's iterations (both levels).
+        closest: with collisions held, the nearest pair within margin + detection at the start (names and distance
+            [m]), else None.
     """
 
-    __slots__ = ("v", "q", "status", "solved", "iterations", "_errors", "_labels", "_returning", "_names")
+    __slots__ = ("v", "q", "status", "solved", "iterations", "closest", "_errors", "_labels", "_returning",
+                 "_names")
 
     def __init__(self, v: np.ndarray, q: np.ndarray, status: str, solved: bool,
                  errors: tuple[TaskError, ...] | np.ndarray, returning: tuple[str, ...] | np.ndarray = (),
@@ -79,6 +76,7 @@ class StepResult:
         """A step's answer (``errors``: TaskErrors, or an (ntasks, 2) array with ``labels``; ``returning``: joint
         names, or a bool mask over the velocities with ``names``)."""
         self.v, self.q, self.status, self.solved, self.iterations = v, q, status, solved, iterations
+        self.closest: Contact | None = None
         self._errors, self._labels, self._returning, self._names = errors, labels, returning, names
 
     @property
@@ -105,6 +103,10 @@ DEFAULT_OPTIONS = StepOptions()
 STATUS = {**qp.DAQP_STATUS, -101: qp.NOT_FINITE}  # the compiled step's flags in words
 
 
+SEPARATE = 1e4  # the weight of a pair in collision's separation, where its row cannot be held with the others
+REFINE = 3  # re-solves of a step whose answer brings a pair nearer than the margin (clearance.overshoot)
+
+
 def _step(robot: Robot, q: np.ndarray, tasks: tuple[Task, ...], dt: float, limits: Limits, options: StepOptions,
           v_prev: np.ndarray | None) -> StepResult:
     """:func:`step` once its arguments are checked."""
@@ -116,15 +118,90 @@ def _step(robot: Robot, q: np.ndarray, tasks: tuple[Task, ...], dt: float, limit
     lower, upper, returning = bounds(robot.space, q, dt, vmax, limits.position,
                                      acceleration_bounds(limits, robot.space), v_prev)
     A_eq, b_eq = (np.array([a for a, _ in eq]), np.array([c for _, c in eq])) if eq else (None, None)
-    solution = _solve_level(levels[0], options, lower, upper, A_eq, b_eq, dt)
-    iterations = solution.iterations
-    if solution.solved and len(levels) > 1:
-        second = _second_level(robot, levels, solution.v, options, lower, upper, A_eq, b_eq, dt)
-        iterations += second.iterations
-        solution = second if second.solved else solution
+    problem = _Levels(levels, options, lower, upper, (A_eq, b_eq), dt)
+    if limits.collisions is None:
+        solution = problem.solve(robot, None)
+        closest = None
+    else:
+        solution, closest = _apart(robot, q, dt, limits, problem)
     names = tuple(robot.space.names_v[i] for i in np.flatnonzero(returning))
-    result = _result(robot, q, dt, solution, tuple(errors), names, iterations)
+    result = _result(robot, q, dt, solution, tuple(errors), names, solution.iterations)
+    result.closest = closest
     return _settled(robot, q, dt, tasks, result) if result.solved and any(t.settled for t in tasks) else result
+
+
+@dataclass(frozen=True)
+class _Levels:
+    """A step's QP levels with their bounds and equalities, solved with given collision rows."""
+
+    levels: list[ev.Rows]
+    options: StepOptions
+    lower: np.ndarray
+    upper: np.ndarray
+    eq: tuple[np.ndarray | None, np.ndarray | None]
+    dt: float
+
+    def pulled(self, A: np.ndarray, b: np.ndarray) -> _Levels:
+        """These levels with rows ``A v ≈ b`` asked first, at the weight SEPARATE (pairs in collision brought out)."""
+        first = self.levels[0]
+        pulled = ev.Rows([*first.A, A], [*first.b, b], [*first.w, np.full(b.shape, SEPARATE)], first.diag,
+                         first.target)
+        return replace(self, levels=[pulled, *self.levels[1:]])
+
+    def solve(self, robot: Robot, apart: qp.Inequalities | None) -> qp.Solution:
+        """Both levels (the second where there are tasks of priority 2); iterations summed."""
+        A_eq, b_eq = self.eq
+        solution = _solve_level(self.levels[0], self.options, self.lower, self.upper, A_eq, b_eq, self.dt, apart)
+        if not solution.solved or len(self.levels) < 2:
+            return solution
+        second = _second_level(robot, self.levels, solution.v, self.options, self.lower, self.upper, self.eq,
+                               self.dt, apart)
+        best = second if second.solved else solution
+        return qp.Solution(best.v, best.status, True, solution.iterations + second.iterations)
+
+
+def _apart(robot: Robot, q: np.ndarray, dt: float, limits: Limits, problem: _Levels
+           ) -> tuple[qp.Solution, Contact | None]:
+    """The step with the collision rows (:mod:`~kinelab.wholebody.clearance`), solved again with the pairs its
+    answer brought too near held as more rows (up to REFINE times); an answer that still does is shortened."""
+    found = clearance.step_collisions(robot, limits.collisions)
+    start = clearance.rows(found, robot, dt)
+    A, b = start.A, clearance.feasible(start.A, start.b, problem.lower, problem.upper)
+    solution = problem.solve(robot, qp.Inequalities(A, b) if b.size else None)
+    if not solution.solved and (b > 0).any():  # pairs in collision that cannot all be held apart at once
+        inside = b > 0
+        problem = problem.pulled(A[inside], b[inside])
+        A, b = A[~inside], b[~inside]
+        solution = problem.solve(robot, qp.Inequalities(A, b) if b.size else None)
+    if not solution.solved or start.near.size == 0:
+        return solution, start.closest
+    for _ in range(REFINE):
+        more = clearance.overshoot(found, robot, start, _moved(robot, q, solution.v, dt), dt)
+        if more is None:
+            return solution, start.closest
+        A = np.vstack([A, more[0]])
+        b = np.concatenate([b, clearance.feasible(more[0], more[1], problem.lower, problem.upper)])
+        again = problem.solve(robot, qp.Inequalities(A, b))
+        if not again.solved:
+            break
+        solution = again
+    return _shortened(robot, q, dt, found, start, solution), start.closest
+
+
+def _moved(robot: Robot, q: np.ndarray, v: np.ndarray, dt: float) -> np.ndarray:
+    return np.asarray(pin.integrate(robot.model, q, v * dt), dtype=float)
+
+
+def _shortened(robot: Robot, q: np.ndarray, dt: float, found: clearance.StepCollisions, start: clearance.Rows,
+               solution: qp.Solution) -> qp.Solution:
+    """The answer, halved until no pair ends nearer than it may (none moved at all after 10 halvings): where the
+    rows cannot say how a pair's nearest points move within the step, the step is made shorter."""
+    v = solution.v
+    for _ in range(10):
+        if not clearance.too_near(found, robot, start, _moved(robot, q, v, dt))[2]:
+            return qp.Solution(v, solution.status, True, solution.iterations)
+        v = 0.5 * v
+    return qp.Solution(np.zeros_like(v), solution.status, True, solution.iterations)
 
 
 def _settled(robot: Robot, q: np.ndarray, dt: float, tasks: tuple[Task, ...], result: StepResult) -> StepResult:
@@ -135,7 +212,9 @@ def _settled(robot: Robot, q: np.ndarray, dt: float, tasks: tuple[Task, ...], re
         if task.settled:
             task.project(robot, q_next)
     v = np.asarray(pin.difference(robot.model, q, q_next), dtype=float) / dt
-    return StepResult(v, q_next, result.status, result.solved, result.errors, result.returning, result.iterations)
+    settled = StepResult(v, q_next, result.status, result.solved, result.errors, result.returning, result.iterations)
+    settled.closest = result.closest
+    return settled
 
 
 def _result(robot: Robot, q: np.ndarray, dt: float, solution: qp.Solution, errors: tuple[TaskError, ...],
@@ -151,19 +230,21 @@ def _result(robot: Robot, q: np.ndarray, dt: float, solution: qp.Solution, error
 
 
 def _second_level(robot: Robot, levels: list[ev.Rows], v_first: np.ndarray, options: StepOptions,
-                  lower: np.ndarray, upper: np.ndarray, A_eq: np.ndarray | None, b_eq: np.ndarray | None, dt: float
-                  ) -> qp.Solution:
+                  lower: np.ndarray, upper: np.ndarray, eq: tuple[np.ndarray | None, np.ndarray | None], dt: float,
+                  apart: qp.Inequalities | None) -> qp.Solution:
     """The priority-2 tasks' QP, with what the first level reached held as equalities (its rows at ``v_first``)
-    beside the couplings' (``A_eq``, ``b_eq``; None: none)."""
+    beside the couplings' (``eq``: A_eq, b_eq; None: none) and the collision rows ``apart``."""
+    A_eq, b_eq = eq
     held = np.vstack(levels[0].A) if levels[0].A else np.zeros((0, robot.nv))
     if A_eq is None or b_eq is None:
-        return _solve_level(levels[1], options, lower, upper, held, held @ v_first, dt)
+        return _solve_level(levels[1], options, lower, upper, held, held @ v_first, dt, apart)
     return _solve_level(levels[1], options, lower, upper, np.vstack([A_eq, held]),
-                        np.concatenate([b_eq, held @ v_first]), dt)
+                        np.concatenate([b_eq, held @ v_first]), dt, apart)
 
 
 def _solve_level(rows: ev.Rows, options: StepOptions, lower: np.ndarray, upper: np.ndarray,
-                 A_eq: np.ndarray | None, b_eq: np.ndarray | None, dt: float) -> qp.Solution:
+                 A_eq: np.ndarray | None, b_eq: np.ndarray | None, dt: float,
+                 apart: qp.Inequalities | None = None) -> qp.Solution:
     """One level's QP: H = Σ Aᵀ W A + diag + λI, f = −Σ Aᵀ W b − target (solved for v·dt, :func:`qp.solve`)."""
     nv = lower.shape[0]
     H = np.diag(rows.diag + options.damping)
@@ -175,4 +256,4 @@ def _solve_level(rows: ev.Rows, options: StepOptions, lower: np.ndarray, upper: 
         f -= WA.T @ b
     elif not rows.diag.any():
         H += np.eye(nv) * max(options.damping, 1e-12)
-    return qp.solve(H, f, lower, upper, A_eq, b_eq, options.solver, dt)
+    return qp.solve(H, f, lower, upper, A_eq, b_eq, options.solver, dt, apart)

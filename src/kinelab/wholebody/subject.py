@@ -27,6 +27,7 @@ def as_robot(robot: Any, what: str = "a whole-body problem") -> Robot:
 
 
 def _chain_robot(chain: Chain) -> Robot:
-    robot = Robot(chain.model, name=chain.name)
+    robot = Robot(chain.model, name=chain.name, srdf=chain.srdf,
+                  geometry=lambda kind: chain.visual_model(kind=kind))
     robot.hands = (chain.tool,)
     return robot
