@@ -196,44 +196,54 @@ def rows(found: StepCollisions, robot: Robot, dt: float) -> Rows:
     return Rows(A, -spec.gain * (d - hold) / dt, near, d, found.contact(near[k], d[k]))
 
 
-def overshoot(found: StepCollisions, robot: Robot, start: Rows, q_next: np.ndarray, dt: float
+def overshoot(found: StepCollisions, robot: Robot, start: Rows, v: np.ndarray, q_next: np.ndarray, dt: float
               ) -> tuple[np.ndarray, np.ndarray] | None:
-    """Rows for the pairs a step's answer brings nearer than it may (None: none; :func:`too_near`): the damper is
-    first-order on the nearest points at the start, but a pair's nearest points can change within a step (another
-    corner of a hull comes nearest), so the points found at ``q_next`` are carried back to the start on their
-    objects and held there as one more row each, at ``robot.data``'s placements and Jacobians.
+    """Rows for the pairs a step's answer brings nearer than it may (None: none; :func:`too_near`). The damper is
+    first-order on the nearest points at the start, and a step can leave it two ways: a pair's nearest points
+    change within the step (another corner of a hull comes nearest), and the distance curves (a rotation's second
+    order). So the points found at ``q_next`` are carried back to the start on their objects and held there as one
+    more row each, asking in addition for what the first order missed: the new row's linear prediction of the
+    distance at ``q_next`` less the distance found there.
 
     Args:
         found: the step geometry.
-        robot: its robot.
+        robot: its robot (``robot.data``: the start's placements and Jacobians).
         start: the rows at the start (:func:`rows`).
-        q_next: the step's answer.
+        v: the step's answer [nv].
+        q_next: where it goes, q ⊕ v·dt.
         dt: the step [s].
 
     Returns:
         (A, b) of the new rows, or None.
     """
-    after, results, low = too_near(found, robot, start, q_next)
-    if not low:
+    after, pairs, results = too_near(found, robot, start, q_next)
+    if not pairs.size:
         return None
-    data, hold, pairs = robot.data, found.spec.margin + SETTLE, start.near[low]
-    p1, p2, n = _witnesses([results[i] for i in low])
+    data, hold = robot.data, found.spec.margin + SETTLE
+    p1, p2, n = _witnesses(results)
     joints = found.joints[found.pairs[pairs]]
     p1 = np.array([_carried(data, after, j, p) for j, p in zip(joints[:, 0], p1, strict=True)])
     p2 = np.array([_carried(data, after, j, p) for j, p in zip(joints[:, 1], p2, strict=True)])
     A = _rates(found, data, pairs, p1, p2, n)
-    return A, -found.spec.gain * (np.einsum("ij,ij->i", n, p2 - p1) - hold) / dt
+    d = np.einsum("ij,ij->i", n, p2 - p1)
+    missed = np.maximum(d + (A @ v) * dt - np.array([r.min_distance for r in results]), 0.0)
+    return A, (-found.spec.gain * (d - hold) + missed) / dt
 
 
 def too_near(found: StepCollisions, robot: Robot, start: Rows, q_next: np.ndarray
-             ) -> tuple[pin.Data, list[pin.DistanceResult], list[int]]:
-    """The placements at ``q_next``, the near pairs' distances there, and which of them end nearer than they may:
-    nearer than the margin, or (a pair that started nearer) than it started."""
+             ) -> tuple[pin.Data, np.ndarray, list[pin.DistanceResult]]:
+    """The placements at ``q_next``, and the pairs that end nearer than they may there with their distances:
+    nearer than the margin, or (a pair that started nearer) than it started. Every pair is looked at — the near
+    ones at the start, and any whose spheres are within the margin at ``q_next`` (a fast step can bring a far pair
+    from beyond the detection distance)."""
     after = robot.model.createData()
     pin.forwardKinematics(robot.model, after, q_next)
-    results = found.distances(after, start.near)
-    allowed = np.minimum(found.spec.margin, start.distances) - 1e-9
-    return after, results, [i for i, r in enumerate(results) if r.min_distance < allowed[i]]
+    pairs = np.union1d(start.near, found.near(after, found.spec.margin))
+    results = found.distances(after, pairs)
+    started = dict(zip(start.near.tolist(), start.distances.tolist(), strict=True))
+    low = [i for i, (k, r) in enumerate(zip(pairs.tolist(), results, strict=True))
+           if r.min_distance < min(found.spec.margin, started.get(k, np.inf)) - 1e-9]
+    return after, pairs[low], [results[i] for i in low]
 
 
 def _witnesses(results: list[pin.DistanceResult]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -173,10 +173,10 @@ def _apart(robot: Robot, q: np.ndarray, dt: float, limits: Limits, problem: _Lev
         problem = problem.pulled(A[inside], b[inside])
         A, b = A[~inside], b[~inside]
         solution = problem.solve(robot, qp.Inequalities(A, b) if b.size else None)
-    if not solution.solved or start.near.size == 0:
+    if not solution.solved:
         return solution, start.closest
     for _ in range(REFINE):
-        more = clearance.overshoot(found, robot, start, _moved(robot, q, solution.v, dt), dt)
+        more = clearance.overshoot(found, robot, start, solution.v, _moved(robot, q, solution.v, dt), dt)
         if more is None:
             return solution, start.closest
         A = np.vstack([A, more[0]])
@@ -198,7 +198,7 @@ def _shortened(robot: Robot, q: np.ndarray, dt: float, found: clearance.StepColl
     rows cannot say how a pair's nearest points move within the step, the step is made shorter."""
     v = solution.v
     for _ in range(10):
-        if not clearance.too_near(found, robot, start, _moved(robot, q, v, dt))[2]:
+        if not clearance.too_near(found, robot, start, _moved(robot, q, v, dt))[1].size:
             return qp.Solution(v, solution.status, True, solution.iterations)
         v = 0.5 * v
     return qp.Solution(np.zeros_like(v), solution.status, True, solution.iterations)
