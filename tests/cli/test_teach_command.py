@@ -78,7 +78,7 @@ def test_a_whole_robot_s_page_is_served_with_a_target_per_hand():
 
 
 def test_a_whole_robot_s_page_refuses_a_chain_s_flags_by_name(capsys):
-    for argv, words in ((["talos", "--collisions"], "checks no collisions"),
+    for argv, words in ((["talos", "0.1"], "drop Q"),
                         (["talos", "--hands", "no_such_frame"], "no_such_frame"),
                         (["ur5", "--hands", "tool0", "--tool", "tool0"], "drop --tool")):
         code = cli.main(["teach", *argv])

@@ -47,8 +47,8 @@ def test_what_a_whole_robot_s_page_does_not_do_is_said(talos_page):
     s = talos_page.session
     with pytest.raises(KinelabError, match="no branches"):
         s.step_branch(1)
-    with pytest.raises(KinelabError, match="collisions are not checked"):
-        s.set_collisions(True)
+    with pytest.raises(KinelabError, match="true or false"):
+        s.set_collisions("yes")
     with pytest.raises(KinelabError, match="from 0 to 1"):
         s.set_target(s.targets[0], 2)
     with pytest.raises(OptionError, match="hands"):

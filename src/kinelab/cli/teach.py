@@ -102,22 +102,21 @@ def _check_whole_arguments(args: argparse.Namespace) -> None:
     """Refuse a chain's options on a whole robot's page.
 
     Raises:
-        KinelabError: Q, --collisions, --obstacles, --tool, --base, --group or --lock given.
+        KinelabError: Q, --tool, --base, --group or --lock given.
     """
-    if args.q or args.collisions or args.obstacles is not None:
-        raise KinelabError("a whole robot's page starts standing and checks no collisions: drop Q, --collisions "
-                           "and --obstacles (or name a chain with --tool)")
+    if args.q:
+        raise KinelabError("a whole robot's page starts standing: drop Q (or name a chain with --tool)")
     if args.tool or args.base or args.group or args.lock:
         raise KinelabError("--hands and --feet are a whole robot's: drop --tool, --base, --group and --lock")
 
 
 def _whole_session(args: argparse.Namespace) -> Any:
-    """A whole robot's page: a target per hand, the feet held."""
+    """A whole robot's page: a target per hand, the feet held; with the collision flags, every pair kept apart."""
     _check_whole_arguments(args)
     robot = robot_module.load(args.robot, whole=True, srdf=args.srdf, package_dirs=args.package_dir,
                               xacro_args=pairs(args.xacro_arg, "--xacro-arg"), trust_xacro=args.trust_xacro)
     step(f"drawing {robot.name} (its meshes load)")
-    options = teach.TeachOptions(time_budget=args.time_budget or 0.5)
+    options = teach.TeachOptions(time_budget=args.time_budget or 0.5, collisions=collisions_of(args))
     hands = None if args.hands is None else tuple(args.hands)
     feet = None if args.feet is None else tuple(args.feet)
     return teach.WholeTeachSession(robot, None, options, hands, feet)

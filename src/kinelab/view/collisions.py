@@ -39,11 +39,18 @@ def draw_collisions(scene: Scene, model: CollisionModel, q: Configuration) -> li
 def draw_obstacles(scene: Scene, environment: Environment) -> Scene:
     """Draw the obstacles (translucent, each its own colour, named with it in the caption; a plane as a 4 m
     square) in ``scene``; returns the scene."""
-    obstacles = environment.obstacles
+    named = draw_obstacle_nodes(scene.viewer, environment)
+    if named:
+        scene.legend["obstacles"] = f"{len(named)} obstacle(s), translucent: " + "; ".join(named)
+    return scene
+
+
+def draw_obstacle_nodes(viewer: Any, environment: Environment) -> list[str]:
+    """Draw the obstacles under ``viewer["obstacles"]``; returns each one's colour and name, for a legend."""
     named = []
-    for k, obstacle in enumerate(obstacles):
+    for k, obstacle in enumerate(environment.obstacles):
         colour, word = OBSTACLE_COLOURS[k % len(OBSTACLE_COLOURS)]
-        node = scene.viewer["obstacles"][f"{k}"]
+        node = viewer["obstacles"][f"{k}"]
         # faint enough that a red link seen through an obstacle still reads red; no depth writes, so that one
         # translucent surface never hides another (or the robot) behind it
         opacity = 0.15 if obstacle.shape == "plane" else 0.35
@@ -51,9 +58,7 @@ def draw_obstacles(scene: Scene, environment: Environment) -> Scene:
                                                                 depthWrite=False))
         node.set_transform(_placement(obstacle).homogeneous)
         named.append(f"{word}: {obstacle.name or 'obstacle ' + str(k + 1)} ({obstacle.shape})")
-    if obstacles:
-        scene.legend["obstacles"] = f"{len(obstacles)} obstacle(s), translucent: " + "; ".join(named)
-    return scene
+    return named
 
 
 def overlay_contacts(scene: Scene, model: CollisionModel, names: set[str]) -> None:

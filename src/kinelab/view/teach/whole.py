@@ -1,6 +1,9 @@
 """The teach page of a whole robot: a target per hand to drag, the feet held where they stand, the centre of mass
 held over them and drawn with its support polygon; every drag is met by the whole-body solve from where the robot
 stands (:func:`kinelab.wholebody.solve.solve`, no restart: the robot moves, it does not jump to another posture).
+With collisions (``TeachOptions(collisions=...)``, or the switch), every step of that solve keeps each pair apart by
+the margin (:mod:`kinelab.wholebody.clearance`): a hand dragged into an obstacle or the robot's own body stops at
+the margin, and the readout names the nearest pair and its distance.
 
 The support polygon is the convex hull of a ``SOLE`` rectangle under each foot frame (its x along the foot), on the
 floor; the centre of mass is held at its start's horizontal place (``ComTask`` on x and y), drawn as a red ball with
@@ -19,6 +22,7 @@ import pinocchio as pin
 from pinocchio.visualize import MeshcatVisualizer
 from scipy.spatial import ConvexHull
 
+from kinelab.collision.model import Collisions, Contact, as_collisions
 from kinelab.errors import KinelabError, OptionError
 from kinelab.robot.tree import Robot
 from kinelab.values import is_whole
@@ -26,12 +30,16 @@ from kinelab.view.meshes import load_robot
 from kinelab.view.scene import AXIS_COLORS, aim_camera, on_top
 from kinelab.view.teach.recorder import RecordingWindow
 from kinelab.view.teach.session import Session, TeachOptions, _checked_pose, _locked, _pose, _short
+from kinelab.view.collisions import draw_obstacle_nodes
+from kinelab.wholebody.clearance import step_collisions
+from kinelab.wholebody.limits import Limits
 from kinelab.wholebody.solve import solve
 from kinelab.wholebody.tasks import ComTask, FrameTask, PostureTask
 
 if TYPE_CHECKING:
     from kinelab.typing import Configuration
 
+HELD_AT = 1e-3  # [m] an answer short of its target whose nearest pair is this near the margin was held off by it
 SOLE = (0.20, 0.10)  # [m] the sole drawn under each foot frame for the support polygon: length (x), width (y)
 GOLD, COM, INSIDE, OUTSIDE, LOOP = 0xF2B01E, 0xD62728, 0x2CA02C, 0xD62728, 0x17BECF
 
@@ -60,6 +68,8 @@ class WholeTeachSession(Session):
         if robot.closures:  # a robot with loops starts with them closed
             self.q, self.start = robot.assemble(self.q), f"{self.start}, its loops closed"
         self.rest = self.q.copy()
+        self.collisions: Collisions | None = as_collisions(self.options.collisions)
+        self.closest: Contact | None = self._nearest()
         self.targets = list(robot.frame_placements(self.q, self.hands))
         self.pins = robot.frame_placements(self.q, self.feet)
         self.com_target = robot.com(self.q) if robot.floating and self.feet else None
@@ -99,13 +109,19 @@ class WholeTeachSession(Session):
         """
         raise KinelabError("a whole robot's page has no branches: drag a hand's gold ball")
 
+    @_locked
     def set_collisions(self, on: object) -> None:
-        """Collisions are not checked on a whole robot's page.
+        """Switch collisions on (the options' value, else the robot with itself) or off.
 
         Raises:
-            KinelabError: always.
+            KinelabError: ``on`` not true or false. CollisionError: the robot has no collision geometry.
         """
-        raise KinelabError("collisions are not checked on a whole robot's page in this version")
+        if not isinstance(on, bool):
+            raise KinelabError(f"collisions are switched by on: true or false, not {_short(repr(on))}")
+        self.collisions = (as_collisions(self.options.collisions) or Collisions()) if on else None
+        self.closest = self._nearest()
+        self.status = "collisions on" if on else "collisions off"
+        self._draw()
 
     # -- what the page shows --------------------------------------------------------------------
     @_locked
@@ -126,8 +142,18 @@ class WholeTeachSession(Session):
         loops = [{"loop": c.label, "error": float(np.abs(e).max(initial=0.0))}
                  for c, e in zip(self.robot.closures, self._loop_errors(), strict=True)]
         rows += [[c["loop"], f"{c['error']:.2e} m, rad"] for c in loops]
+        nearest = None if self.closest is None else {"first": self.closest.first, "second": self.closest.second,
+                                                     "distance_m": self.closest.distance}
+        if nearest is not None and self.collisions is not None:
+            rows.append(["nearest pair", f"{self.closest} (margin {self.collisions.margin * 1e3:g} mm)"])
         return {"robot": self.robot.name, "q": self.q.tolist(), "hands": hands, "com_m": com.tolist(),
-                "com_over_support": inside, "loops": loops, "rows": rows, "status": self.status}
+                "com_over_support": inside, "loops": loops, "nearest": nearest, "rows": rows, "status": self.status}
+
+    def _nearest(self) -> Contact | None:
+        """The nearest pair at q with collisions on (None: off)."""
+        if self.collisions is None:
+            return None
+        return step_collisions(self.robot, self.collisions).closest(self.q)[0]
 
     def _loop_errors(self) -> list[np.ndarray]:
         """Each closure's held error components at q [m, rad]."""
@@ -153,6 +179,9 @@ class WholeTeachSession(Session):
                      "polygon, red off it. " if self.com_target is not None else "")
                   + (f"Cyan balls: the two ends of each of its {len(self.robot.closures)} loops (one ball where a "
                      "loop is closed); the readout gives each loop's error. " if self.robot.closures else "")
+                  + (f"Obstacles, translucent: {'; '.join(self._obstacles)}. " if self._obstacles else "")
+                  + ("Collisions held: every pair at least the margin apart (the readout names the nearest). "
+                     if self.collisions is not None else "")
                   + f"Start: {self.start}.")
         return {"q": self.q.tolist(), "joints": joints, "targets": [f"target_{k}" for k in range(len(self.hands))],
                 "heading": f"kinelab teach — {self.robot.name} (whole robot)", "legend": legend, "whole": True}
@@ -171,13 +200,28 @@ class WholeTeachSession(Session):
     def _follow(self) -> None:
         o = self.options
         res = solve(self.robot, self.tasks(), q0=self.q, seed=0, tol_pos=o.tol_pos, tol_rot=o.tol_rot,
-                    max_restarts=0, time_budget=o.time_budget)
+                    max_restarts=0, time_budget=o.time_budget,
+                    limits=Limits(velocity=None, collisions=self.collisions))
+        missed = [v.label for v in res.tasks if not v.met]
         if res.success:
             self.q = np.array(res.q)
             self.status = f"following: every task met within {o.tol_pos:g} m, {o.tol_rot:g} rad"
+        elif self._held_off(res):
+            self.q = np.array(res.q)
+            self.status = f"held off by {res.closest}: {_short(', '.join(missed), 120)} not met"
         else:
-            missed = [v.label for v in res.tasks if not v.met]
             self.status = f"not reached ({res.status}): {_short(', '.join(missed), 120)}; q kept"
+        self.closest = res.closest if self.collisions is not None else None
+
+    def _held_off(self, res: Any) -> bool:
+        """Whether an answer short of its targets is where the collisions stop the robot: its nearest pair at the
+        margin (within HELD_AT), within the limits, every foot and loop held — the robot goes as far as it can."""
+        if self.collisions is None or res.closest is None:
+            return False
+        if not 0.0 <= res.closest.distance - self.collisions.margin <= HELD_AT:
+            return False
+        held = res.tasks[len(self.hands):]  # the feet, the centre of mass, the loops (the hands' come first)
+        return self.robot.within_limits(res.q) and all(v.met for v in held)
 
     def _draw_robot(self) -> None:
         self.viz = MeshcatVisualizer(self.robot.model, pin.GeometryModel(), self.robot.visual_model())
@@ -203,6 +247,9 @@ class WholeTeachSession(Session):
             for tip in ("a", "b"):
                 self.viewer["loops"][f"loop_{k}"][tip].set_object(g.Sphere(0.06 * self.frame_length),
                                                                   on_top(LOOP, 0.8))
+        given = as_collisions(self.options.collisions)
+        environment = None if given is None else given.environment
+        self._obstacles = [] if environment is None else draw_obstacle_nodes(self.viewer, environment)
         self.viz.display(self.q)
         aim_camera(self.viewer, self._points(), 0.1 * self.robot.characteristic_length(), floor_z=self.floor)
 
