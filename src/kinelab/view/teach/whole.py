@@ -26,11 +26,11 @@ from kinelab.collision.model import Collisions, Contact, as_collisions
 from kinelab.errors import KinelabError, OptionError
 from kinelab.robot.tree import Robot
 from kinelab.values import is_whole
+from kinelab.view.collisions import draw_obstacle_nodes
 from kinelab.view.meshes import load_robot
 from kinelab.view.scene import AXIS_COLORS, aim_camera, on_top
 from kinelab.view.teach.recorder import RecordingWindow
 from kinelab.view.teach.session import Session, TeachOptions, _checked_pose, _locked, _pose, _short
-from kinelab.view.collisions import draw_obstacle_nodes
 from kinelab.wholebody.clearance import step_collisions
 from kinelab.wholebody.limits import Limits
 from kinelab.wholebody.solve import solve
