@@ -95,7 +95,7 @@ def solve(robot: Chain | Robot, target: Target | Task | Sequence[Task], *positio
 SOLVE_SETTINGS = ("q0", "solver", "seed", "tol_pos", "tol_rot", "max_iterations", "max_restarts", "time_budget",
                   "limits")  # kinelab.wholebody.solve.solve's keywords
 FOLLOWERS = ("frdm", "step")
-STEP_SETTINGS = ("q0", "seed", "tol_pos", "tol_rot", "time_budget", "task", "axis", "jump_limit")
+STEP_SETTINGS = ("q0", "seed", "tol_pos", "tol_rot", "time_budget", "task", "axis", "jump_limit", "collisions")
 
 
 def track(robot: Chain, targets: Targets, *positional: object, follower: str = "frdm",

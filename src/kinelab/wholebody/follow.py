@@ -15,7 +15,9 @@ task's own least step (the first level alone, solved first) plus ``FLOOR``, the 
 joint within twice that step plus ``FLOOR`` of the sample before, and never beyond ``jump_limit``. A sample that
 cannot be met within that box is left unmet (an honest miss, the path goes on), never met by a jump. Corrections
 (the task alone, at most ``CORRECTIONS`` steps) meet each sample to its tolerance; the chain's judge judges every
-sample.
+sample. With ``collisions=``, every step keeps each pair apart by the margin (:mod:`kinelab.wholebody.clearance`):
+a sample the obstacles keep the tool from is left unmet where they stop it, and a row nearer than the margin is no
+success (status ``collision``).
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from kinelab.collision.model import Collisions, as_collisions
 from kinelab.errors import OptionError
 from kinelab.ik import api as chain_api
 from kinelab.ik import options as opt
@@ -36,10 +39,12 @@ from kinelab.ik.result import Status, TrackResult
 from kinelab.ik.targets import as_target_arrays
 from kinelab.robot.chain import Chain
 from kinelab.robot.tree import Robot
-from kinelab.typing import Configuration, Targets
+from kinelab.typing import CollisionSpec, Configuration, Targets
+from kinelab.wholebody.clearance import step_collisions
 from kinelab.wholebody.limits import Limits
 from kinelab.wholebody.problem import step
 from kinelab.wholebody.step import StepOptions
+from kinelab.wholebody.subject import as_robot
 from kinelab.wholebody.tasks import FrameTask, PostureTask
 
 FLOOR = 1e-4  # [rad or m] room beyond the task's least step: the corrections of a path at rest
@@ -59,6 +64,11 @@ class Follower:
     posture: PostureTask
     req: Request
     jump_limit: float
+    collisions: Collisions | None = None
+
+    def limits(self, velocity: Any) -> Limits:
+        """The step's limits: positions, ``velocity`` (None: none), the path's collisions."""
+        return Limits(velocity=velocity, collisions=self.collisions)
 
     def sample(self, oMtarget: pin.SE3, q_prev: np.ndarray, v_prev: np.ndarray) -> tuple[np.ndarray, int]:
         """One sample: the task's least step, the step with the posture in a box about q_prev, the corrections.
@@ -67,30 +77,24 @@ class Follower:
             (q, the steps taken).
         """
         frame = self.frame.moved(oMtarget)
-        alone = step(self.robot, q_prev, frame, 1.0, limits=Limits(velocity=None), options=OPTIONS)
+        alone = step(self.robot, q_prev, frame, 1.0, limits=self.limits(None), options=OPTIONS)
         need = float(np.abs(alone.v).max())
         cap = min(2.0 * need + FLOOR, self.jump_limit)  # the box about q_prev, corrections included
         posture = self.posture.moved(*preferred(self.robot, q_prev, v_prev))
-        moved = step(self.robot, q_prev, [frame, posture], 1.0, limits=Limits(velocity=min(need + FLOOR, cap)),
+        moved = step(self.robot, q_prev, [frame, posture], 1.0, limits=self.limits(min(need + FLOOR, cap)),
                      options=OPTIONS)
         q = moved.q if moved.solved else q_prev
         for used in range(CORRECTIONS):
             room = cap - np.abs(pin.difference(self.robot.model, q_prev, q))  # what is left of the box
-            fixed = step(self.robot, q, frame, 1.0, limits=Limits(velocity=np.maximum(room, 1e-12)),
-                         options=OPTIONS)
+            fixed = step(self.robot, q, frame, 1.0, limits=self.limits(np.maximum(room, 1e-12)), options=OPTIONS)
             if _met(fixed.errors[0], self.req, frame.task) or not fixed.solved:
                 return q, used + 2
             q = fixed.q
         return q, CORRECTIONS + 2
 
 
-def chain_robot(chain: Chain) -> Robot:
-    """The chain's own model as a whole robot (base frame = the chain's base), built once per chain."""
-    return chain.derived("whole-body view", lambda c: Robot.from_model(c.model, name=c.name))
-
-
 def follow_by_step(chain: Chain, points: np.ndarray, rotations: np.ndarray, q0: np.ndarray, req: Request,
-                   jump_limit: float | None, t_start: float) -> TrackResult:
+                   jump_limit: float | None, t_start: float, collisions: Collisions | None = None) -> TrackResult:
     """Every sample of a path by the step (see the module's docstring).
 
     Args:
@@ -102,11 +106,12 @@ def follow_by_step(chain: Chain, points: np.ndarray, rotations: np.ndarray, q0: 
         jump_limit: the largest joint change between two samples [rad or m] (None: the task's least step alone
             bounds it).
         t_start: the ``time.perf_counter()`` value the budget counts from.
+        collisions: what every step keeps apart (None: nothing).
 
     Returns:
         The :class:`TrackResult`, mode "whole-body step (posture, limits)", every sample judged.
     """
-    robot = chain_robot(chain)
+    robot = as_robot(chain)
     count = points.shape[0]
     Q = np.full((count, chain.n), np.nan)
     iterations = np.zeros(count, dtype=np.int64)
@@ -116,7 +121,7 @@ def follow_by_step(chain: Chain, points: np.ndarray, rotations: np.ndarray, q0: 
     follower = Follower(chain, robot, FrameTask(chain.tool, pin.SE3(rotations[0], points[0]), task=req.task.name,
                                                 axis=axis),
                         PostureTask(q, weight=np.ones(robot.nv), priority=2), req,
-                        np.inf if jump_limit is None else float(jump_limit))
+                        np.inf if jump_limit is None else float(jump_limit), collisions)
     v = np.zeros(robot.nv)
     t0 = time.perf_counter()
     for k in range(count):
@@ -126,16 +131,23 @@ def follow_by_step(chain: Chain, points: np.ndarray, rotations: np.ndarray, q0: 
         v = np.asarray(pin.difference(robot.model, q, q_next), dtype=float)
         q = q_next
         Q[k] = chain.from_pin_q(q)
-    return _judged(chain, Q, points, rotations, req, iterations, (time.perf_counter() - t0) / max(count, 1))
+    per_sample = (time.perf_counter() - t0) / max(count, 1)
+    return _judged(chain, Q, points, rotations, req, iterations, per_sample, collisions)
 
 
 def _judged(chain: Chain, Q: np.ndarray, points: np.ndarray, rotations: np.ndarray, req: Request,
-            iterations: np.ndarray, per_sample: float) -> TrackResult:
-    """The path's result, every started sample judged (the others: status ``time_budget``)."""
+            iterations: np.ndarray, per_sample: float, collisions: Collisions | None) -> TrackResult:
+    """The path's result, every started sample judged (the others: status ``time_budget``; a met sample nearer
+    than the margin: ``collision``)."""
     dp, dr, ok = judged_path(chain, Q, points, rotations, req.task, req.tol_pos, req.tol_rot)
     started = np.isfinite(Q).all(axis=1)
     codes = np.where(ok, Status.CONVERGED.code, np.where(started, Status.MAX_ITERATIONS.code,
                                                           Status.TIME_BUDGET.code)).astype(np.int8)
+    if collisions is not None:
+        found = step_collisions(as_robot(chain), collisions)
+        for k in np.flatnonzero(ok):
+            if found.closest(chain.to_pin_q(Q[k]))[1] < 0.0:
+                codes[k] = Status.COLLISION.code
     return TrackResult(Q, dp, dr, codes, iterations, np.full(Q.shape[0], per_sample), mode=MODE)
 
 
@@ -174,7 +186,7 @@ def preferred(robot: Robot, q: np.ndarray, v_prev: np.ndarray) -> tuple[np.ndarr
 def track(chain: Chain, targets: Targets, *, q0: Configuration | None = None, seed: int | None = None,
           tol_pos: float = 1e-6,
           tol_rot: float = 1e-6, time_budget: float | None = None, task: str = "pose", axis: str = "z",
-          jump_limit: float | None = 0.2) -> TrackResult:
+          jump_limit: float | None = 0.2, collisions: CollisionSpec = None) -> TrackResult:
     """Follow a path by the step (see the module's docstring): ``kinelab.track(chain, targets, follower="step")``.
 
     Args:
@@ -192,6 +204,8 @@ def track(chain: Chain, targets: Targets, *, q0: Configuration | None = None, se
         jump_limit: no joint moves more than this between two rows [rad or m] (None: the task's least step alone
             bounds the motion). The rows are one continuous motion, missed samples included (a missed sample's row
             is where the arm went, within the box): no row is ever reached by a jump.
+        collisions: None, "self", an ``Environment`` or a ``Collisions``: every step keeps each pair apart by the
+            margin (the start must be clear).
 
     Returns:
         One row of q per sample, the judge's errors, statuses (:class:`TrackResult`).
@@ -211,4 +225,4 @@ def track(chain: Chain, targets: Targets, *, q0: Configuration | None = None, se
                                   f"({first.status.value}: {first.message})")
         q0 = first.q
     start = chain.check_q(q0, limits=True, what="q0")
-    return follow_by_step(chain, points, rotations, start, req, jump_limit, t_start)
+    return follow_by_step(chain, points, rotations, start, req, jump_limit, t_start, as_collisions(collisions))
