@@ -15,6 +15,7 @@ if TYPE_CHECKING:
     from kinelab.report import render
     from kinelab.report.bench import (
         branches,
+        collision_step,
         collisions,
         completeness,
         loops,
@@ -41,6 +42,7 @@ else:
     throughput = lazy.module("kinelab.report.bench.throughput", globals())
     versus = lazy.module("kinelab.report.bench.versus", globals())
     wholebody = lazy.module("kinelab.report.bench.wholebody", globals())
+    collision_step = lazy.module("kinelab.report.bench.collision_step", globals())
 
 
 def add(sub: Subcommands) -> None:
@@ -94,6 +96,10 @@ def add(sub: Subcommands) -> None:
                    help="instead of the arm protocol: the whole-body step side by side with pink and mink (--robots "
                         "among panda, baxter, talos, g1; default all four), --repeats rounds, and the converged "
                         "solve against pink iterated (--n targets per robot)")
+    s.add_argument("--collisions-step", action="store_true",
+                   help="instead of the arm protocol: the whole-body step holding collisions side by side with mink's "
+                        "CollisionAvoidanceLimit and pink's self-collision barrier (--robots among panda, talos; "
+                        "default both), --repeats rounds of 1,000 steps: time, penetrations, least distance")
     s.add_argument("--router", action="store_true",
                    help="instead of the arm protocol: kinelab.IK(...).solve_batch, .solve_all and .track against "
                         "the module functions (--robots; default ur5 panda kinova crx10ia era), --repeats rounds")
@@ -108,6 +114,9 @@ def run(args: argparse.Namespace) -> int:
     """Run the protocols asked for, print their tables (or JSON), write the files with --out."""
     if args.out:
         check_output_folder(args.out, "bench")
+    if args.collisions_step:
+        return _alone(args, "collisions_step", lambda: collision_step.run(
+            args.robots, rounds=args.repeats, progress=progress_of(args)), collision_step.markdown)
     if args.whole_body or args.router:  # a protocol run alone
         return _whole_body(args) if args.whole_body else _router(args)
     first = _before_the_peers(args)

@@ -169,7 +169,7 @@ class MinkStepper:
         import mink
 
         self.mink, self.robot = mink, robot
-        self.model = mujoco_model(robot)
+        self.model = self.make_model(robot)
         self.maps = Maps(robot, self.model)
         self.configuration = mink.Configuration(self.model)
         self.configuration.update(self.maps.to_mujoco(q0))
@@ -190,6 +190,10 @@ class MinkStepper:
             and np.isfinite(robot.velocity_limit[robot.model.joints[robot.model.getJointId(
                 self.model.joint(i).name)].idx_v])}
         self.limits = [mink.ConfigurationLimit(self.model), mink.VelocityLimit(self.model, velocities)]
+
+    def make_model(self, robot: Robot) -> Any:
+        """MuJoCo's model the stepper runs on (:func:`mujoco_model`)."""
+        return mujoco_model(robot)
 
     def step(self, targets: list[pin.SE3]) -> None:
         """One step toward the frames' targets (base frame), integrated."""
