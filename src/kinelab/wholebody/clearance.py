@@ -62,9 +62,11 @@ class StepCollisions:
     spec: Collisions
     summary: str
     gdata: pin.GeometryData = field(init=False)
+    after: pin.Data = field(init=False)
 
     def __post_init__(self) -> None:
         self.gdata = pin.GeometryData(self.geom)
+        self.after = self.robot.model.createData()  # the scratch of the placements at a step's answer
         for request in self.gdata.distanceRequests:
             request.gjk_tolerance = GJK_TOLERANCE
 
@@ -236,7 +238,7 @@ def too_near(found: StepCollisions, robot: Robot, start: Rows, q_next: np.ndarra
     nearer than the margin, or (a pair that started nearer) than it started. Every pair is looked at — the near
     ones at the start, and any whose spheres are within the margin at ``q_next`` (a fast step can bring a far pair
     from beyond the detection distance)."""
-    after = robot.model.createData()
+    after = found.after
     pin.forwardKinematics(robot.model, after, q_next)
     pairs = np.union1d(start.near, found.near(after, found.spec.margin))
     results = found.distances(after, pairs)
