@@ -10,6 +10,7 @@ from helpers import pinocchio_tool
 import kinelab
 
 ROUTES = {"ur5": "analytic", "kinova": "analytic", "panda": "analytic", "era": "analytic", "crx10ia": "frdm"}
+SINGLE = {**ROUTES, "panda": "frdm", "era": "frdm"}  # a single call without a start on a 7R arm: FRDM's
 
 
 @pytest.mark.parametrize("name", list(ROUTES))
@@ -27,7 +28,10 @@ def test_auto_takes_the_stated_route_and_every_answer_meets_its_pose(name):
     prepared = kinelab.IK(robot, solver="auto").solve_batch(targets, seed=0)
     assert prepared.mode.split(" ")[0] == res.mode.split(" ")[0]
     one = kinelab.solve(robot, pin.SE3(targets[0]), solver="auto", seed=0)
-    assert one.success and one.solver == ROUTES[name]
+    assert one.success and one.solver == SINGLE[name]
+    started = kinelab.solve(robot, pin.SE3(targets[0]), solver="auto", q0=qs[1], seed=0)
+    assert started.success and started.solver == ROUTES[name]  # a start: the branch nearest it
+    assert kinelab.IK(robot, solver="auto").solve(pin.SE3(targets[0]), seed=0).solver == SINGLE[name]
 
 
 def test_auto_leaves_the_closed_form_where_it_cannot_answer():

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 from kinelab import lazy
 from kinelab.errors import OptionError
-from kinelab.ik.auto import resolved
+from kinelab.ik.auto import single
 from kinelab.ik.batch import BatchIKResult
 from kinelab.ik.branches import UNSEEN
 from kinelab.ik.prepared import kept_solver, prepared
@@ -114,7 +114,8 @@ def solve(robot: Chain, target: Target, *positional: object, solver: str = "frdm
         SolverNotFoundError, OptionError, TargetError, ConfigurationError: bad input, named.
     """
     check_entry(robot, "solve", positional)
-    solver = resolved(robot, solver, task, collisions, options is not None or bool(solver_options))
+    solver = single(robot, solver, task, collisions, options is not None or bool(solver_options),
+                    q0 is not None or prefer is not None)
     key = (solver, tol_pos, tol_rot, time_budget, max_restarts, start_outside_limits, options, task, axis,
            collisions) + (tuple(solver_options.items()) if solver_options else ())
     ik = kept_solver(robot, key) if prefer is None else None  # solve is IK(robot, **settings).solve(target)

@@ -19,9 +19,11 @@ from kinelab.robot.chain import Chain
 from kinelab.typing import CollisionSpec
 
 if TYPE_CHECKING:
+    from kinelab.ik import registry
     from kinelab.ik.analytic import classify as classify_module
     from kinelab.ik.analytic import held, kernel
 else:
+    registry = lazy.module("kinelab.ik.registry", globals())
     classify_module = lazy.module("kinelab.ik.analytic.classify", globals())
     held = lazy.module("kinelab.ik.analytic.held", globals())
     kernel = lazy.module("kinelab.ik.analytic.kernel", globals())
@@ -36,6 +38,20 @@ def resolved(robot: Chain, solver: str, task: str, collisions: CollisionSpec, ha
     if task != "pose" or collisions is not None or has_options:
         return "frdm"
     return "analytic" if closed_form_serves(robot) else "frdm"
+
+
+def single(robot: Chain, solver: str, task: str, collisions: CollisionSpec, has_options: bool,
+           start_given: bool) -> str:
+    """The solver a single call (``solve``) takes for ``solver``: what :func:`resolved` says, except "auto" on a 7R
+    arm without a start — its held joint's closed form serves a batch and a start's nearest branch, but from no
+    start it searches the held joint for a branch within the limits, about 20× FRDM's one compiled call
+    (docs/route.md): FRDM answers."""
+    route = resolved(robot, solver, task, collisions, has_options)
+    kind = registry.capabilities(solver)
+    if kind.picks and registry.capabilities(route).closed_form and not start_given \
+            and robot.derived("auto: held", held.applies):
+        return kind.request_solver(solver)  # what the picking solver runs: FRDM
+    return route
 
 
 def closed_form_serves(robot: Chain) -> bool:

@@ -125,6 +125,8 @@ class IK:
         self._prepare()
         # the usual call's one compiled call (kinelab.core._engine), where the solver has one
         self.engine: Engine | None = None if self.collisions is not None or self.analytic else self._engine()
+        # "auto" on a 7R arm: a single call without a start is FRDM's (kinelab.ik.auto.single), built on its first
+        self._single: IK | None | Literal[False] = None if capabilities(self._given[0]).picks and self.held else False
 
     def _prepare(self) -> None:
         """Everything a call would otherwise build first: the closed form's class (a chain without one refused
@@ -177,6 +179,8 @@ class IK:
         """
         if prefer is not None:
             return self._preferring(target, q0, seed, prefer)
+        if self._single is not False and q0 is None:
+            return self._frdm_single().solve(target, seed=seed)
         if self.engine is not None:  # the usual call, in one compiled call (an int: why it declines)
             res = self.engine.solve(target, q0, seed)
             if type(res) is not int:
@@ -184,6 +188,15 @@ class IK:
         elif self.analytic:
             return self._nearest_branch(target, q0)
         return solve_clear_of(self.robot, target, q0, self._request(seed), self.collisions)
+
+    def _frdm_single(self) -> IK:
+        """The FRDM solver with these settings, for "auto"'s single calls without a start on a 7R arm."""
+        if not isinstance(self._single, IK):
+            req = self.request
+            self._single = IK(self.robot, solver="frdm", tol_pos=req.tol_pos, tol_rot=req.tol_rot,
+                              time_budget=req.time_budget, max_restarts=req.max_restarts,
+                              start_outside_limits=req.start_outside_limits)
+        return self._single
 
     def _preferring(self, target: Any, q0: Any, seed: int | None, prefer: Any) -> IKResult:
         """``solve(prefer=)``: the closed form's branch nearest ``prefer`` for solver "analytic", else the (clear)
