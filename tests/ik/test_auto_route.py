@@ -59,3 +59,29 @@ def test_the_issues_2000_targets_auto_takes_the_closed_form_every_answer_at_1e_6
         M = pinocchio_tool(robot, q)
         assert np.linalg.norm(M.translation - H[:3, 3]) <= 1e-6
         assert np.linalg.norm(pin.log3(M.rotation.T @ H[:3, :3])) <= 1e-6
+
+
+def test_the_closed_form_route_checks_its_input_as_the_others_do():
+    """Found making "auto" the default (#71): the closed form's route took a bad seed, a start outside the limits
+    and a start mode it had no use for without a word, where FRDM's refuses them by name."""
+    ur5, panda = kinelab.load("ur5"), kinelab.load("panda")
+    target = ur5.fk(ur5.random_q(1))
+    for call in (lambda: kinelab.solve(ur5, target, solver="auto", seed=-3),
+                 lambda: kinelab.IK(ur5, solver="analytic").solve(target, seed=-3),
+                 lambda: kinelab.solve_batch(ur5, [target], solver="auto", seed=-3)):
+        with pytest.raises(kinelab.OptionError, match="an integer ≥ 0"):
+            call()
+    Q = ur5.random_qs(4, 2)
+    starts = Q.copy()
+    starts[1, 2] = 99.0
+    with pytest.raises(kinelab.JointLimitError, match="elbow_joint"):
+        kinelab.solve_batch(ur5, ur5.fk_batch(Q), solver="auto", q0=starts)
+    with pytest.raises(kinelab.JointLimitError, match="elbow_joint"):
+        kinelab.solve(ur5, target, solver="auto", q0=starts[1], start_outside_limits="refuse")
+    with pytest.warns(UserWarning, match="projected"):
+        res = kinelab.solve(ur5, ur5.fk(Q[1]), solver="auto", q0=starts[1])
+    assert res.success and res.solver == "analytic"
+    targets = panda.fk_batch(panda.random_qs(3, 1))
+    with pytest.raises(kinelab.ConfigurationError, match="'random', 'table'"):
+        kinelab.solve_batch(panda, targets, solver="auto", q0="tables")
+    assert kinelab.solve_batch(panda, targets, solver="auto", q0="table").success.all()

@@ -177,6 +177,8 @@ class IK:
         Raises:
             TargetError, ConfigurationError, JointLimitError, OptionError: a bad target, start or seed.
         """
+        if seed is not None:
+            check_seed(seed)  # every route refuses a bad seed, the closed form's too (it draws nothing)
         if prefer is not None:
             return self._preferring(target, q0, seed, prefer)
         if self._single is not False and q0 is None:
@@ -214,8 +216,10 @@ class IK:
                          Route.EITHER if closed else Route.MULTISTART)
 
     def _nearest_branch(self, target: Any, q0: Any) -> IKResult:
-        """Solver "analytic": the branch nearest q0 in one compiled call where that serves, else root by root."""
-        ref = None if q0 is None else self.robot.check_q(q0, what="q0")
+        """Solver "analytic": the branch nearest q0 in one compiled call where that serves, else root by root (a q0
+        outside the limits refused or projected, as ``start_outside_limits`` says)."""
+        ref = None if q0 is None else analytic_batch.within_limits(
+            self.robot, self.robot.check_q(q0, what="q0")[None, :], self.request.start_outside_limits)[0]
         if self.held:
             return held.nearest_held_one(self.robot, as_target(target, self.request.task.name), ref, self.request)
         found = None if self._nearest is None else self._nearest.solve(target, ref)

@@ -4,6 +4,7 @@ compiled call over the poses where the class allows, each answer judged within t
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
@@ -203,24 +204,46 @@ def nearest_batch(robot: Chain, targets: Targets, q0: Configuration | None, req:
     """
     t0 = time.perf_counter()
     H = stack_homogeneous(*as_target_arrays(targets))
-    starts = batch_starts(robot, q0, len(H))
+    starts = batch_starts(robot, q0, len(H), req)
     form = prepared_form(robot, req) if model is None else None
     if form is not None:
         return _compiled_nearest(robot, form, np.ascontiguousarray(H), starts, req, t0)
     return _nearest_rows(robot, H, starts, req, model, t0)
 
 
-def batch_starts(robot: Chain, q0: Configuration | None, count: int) -> np.ndarray | None:
-    """A batch's starts as (count, n) [rad or m] (None: none given; one start serves every row).
+def batch_starts(robot: Chain, q0: Configuration | str | None, count: int, req: Request) -> np.ndarray | None:
+    """A batch's references as (count, n) [rad or m] (None: none given; one serves every row). The start modes of
+    the iterative solvers, "random" and "table" (task "pose"), mean no reference here; a row outside the limits is
+    refused (``start_outside_limits`` "refuse", a batch's default) or projected into them with a warning.
 
     Raises:
-        ConfigurationError: q0 of another shape, not finite or outside the limits (its row named).
+        ConfigurationError: q0 of another shape, not finite, or a string of no start mode (its row named).
+        JointLimitError: a row outside the limits, refused (its row named).
     """
+    if isinstance(q0, str):
+        if q0 not in ("random", "table") or (q0 == "table" and req.task.name != "pose"):
+            raise ConfigurationError(f"q0 must be None, 'random', 'table' (task 'pose'), {robot.n} numbers or "
+                                     f"(B, {robot.n}), got {q0!r} for task {req.task.name!r}")
+        return None
     starts = None if q0 is None else robot.check_qs(np.atleast_2d(q0), what="q0")
-    if starts is not None and starts.shape[0] not in (1, count):
+    if starts is None:
+        return None
+    if starts.shape[0] not in (1, count):
         raise ConfigurationError(f"q0 must be None, {robot.n} numbers or ({count}, {robot.n}) for {count} targets of "
                                  f"{robot.name}, got {count_of(np.asarray(q0).shape)}")
-    return None if starts is None else np.broadcast_to(starts, (count, robot.n))
+    return np.broadcast_to(within_limits(robot, starts, req.start_outside_limits), (count, robot.n))
+
+
+def within_limits(robot: Chain, refs: np.ndarray, policy: str) -> np.ndarray:
+    """(k, n) references within the limits: rows outside refused (policy "refuse", JointLimitError naming the row)
+    or projected into them with a warning ("project"), as the iterative solvers treat their starts."""
+    outside = [b for b in range(refs.shape[0]) if not robot.within_limits(refs[b])]
+    if not outside:
+        return refs
+    if policy == "refuse":
+        robot.check_q(refs[outside[0]], limits=True, what=f"q0[{outside[0]}]" if refs.shape[0] > 1 else "q0")
+    warnings.warn(f"q0 is outside the joint limits of {robot.name}; projected into them", stacklevel=4)
+    return np.clip(refs, robot.lower, robot.upper)
 
 
 def _compiled_nearest(robot: Chain, form: ClosedForm, H: np.ndarray, starts: np.ndarray | None, req: Request,

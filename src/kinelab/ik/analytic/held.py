@@ -170,7 +170,7 @@ def nearest_held(robot: Chain, targets: Targets, q0: Configuration | None, req: 
     points, rotations = as_target_arrays(targets)
     H = stack_homogeneous(points, rotations)
     arm_of(held_robot(robot), req)  # the task is "pose" (named otherwise)
-    starts = batch_starts(robot, q0, len(H))
+    starts = batch_starts(robot, q0, len(H), req)
     deadline = np.inf if req.time_budget is None else t0 + req.time_budget - verdict_reserve(req.time_budget)
     q, tried, late = held_rows(robot, H, starts, req, deadline)
     held = ~np.isnan(q[:, 0])
