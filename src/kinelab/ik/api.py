@@ -136,7 +136,9 @@ def solve_batch(robot: Chain, targets: Targets, *positional: object, solver: str
                 options: SolverOptions = None, task: str = "pose", axis: str = "z", collisions: CollisionSpec = None,
                 **solver_options: object) -> BatchIKResult:
     """Solve IK for every target of a batch: row b is what :func:`solve` gives for ``targets[b]`` alone with
-    ``seed = seed + b`` and start ``q0[b]``, when neither runs out of time.
+    ``seed = seed + b`` and start ``q0[b]``, when neither runs out of time — except ``solver="auto"`` on a 7R arm
+    without starts, where the batch takes the held joint's closed form and a single call FRDM (each the faster for
+    its entry point, docs/route.md; both answers judged alike).
 
     FRDM with compiled options runs the rows in parallel inside one kernel (every core; the answers do not
     depend on the thread count); the other solvers and FRDM's monitored options run the rows one by one.
