@@ -213,3 +213,28 @@ def test_the_step_follower_keeps_a_path_clear_of_the_table() -> None:
     slack = [found.closest(panda.to_pin_q(q))[1] for q in held.q]
     assert min(slack) >= -1e-6
     assert held.success[:20].all() and not held.success[-15:].any()
+
+
+# Baxter's grippers pressed together, step 8,473 of tools/collision_goals.py's scene: 60 collision rows of rank 12
+PRESSED = [0.0, -0.029572588528, -0.283964000852, -1.416580480619, 1.767622993822, 2.639727850732, 0.211576595271,
+           -0.414357219397, 0.020832999818, 0.172972306665, -0.594919875579, 1.023020405017, 1.465835931966,
+           -2.352980127259, -0.477888542426, -1.581505499064, 1.46e-10]
+
+
+def test_many_degenerate_rows_still_give_a_step():
+    """With the grippers pressed together the rows are many and nearly the same (DAQP's active set cycled there on
+    this project's machine; ProxQP then answers): the step is solved and every pair stays clear of the margin."""
+    pytest.importorskip("proxsuite")
+    baxter = kinelab.load("baxter")
+    found = clearance.step_collisions(baxter, Collisions(margin=0.01))
+    home = baxter.neutral()
+    left, right = baxter.hands
+    a, b = baxter.frame_placement(home, left).translation, baxter.frame_placement(home, right).translation
+    s = 0.5 - 0.5 * np.cos(2 * np.pi * 8473 * DT / 8.0)
+    tasks = [FrameTask(left, a + s * (b - a), task="position"), FrameTask(right, b + s * (a - b), task="position")]
+    q = np.array(PRESSED)
+    for _ in range(20):
+        result = kinelab.step(baxter, q, tasks, DT, limits=Limits(collisions=Collisions(margin=0.01)))
+        assert result.solved, result.status
+        q = result.q
+        assert found.closest(q)[1] >= -1e-4

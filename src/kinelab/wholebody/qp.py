@@ -4,12 +4,13 @@ A_in v ≥ b_in (the collision rows, :mod:`kinelab.wholebody.clearance`).
 DAQP (a dual active-set solver for small dense problems) by default: on the step's problems — tens of variables,
 box bounds and a few equalities — it answers in microseconds and exactly at the bounds it makes active, which the
 limits need (docs/wholebody.md, the solver measured against ProxQP). ProxQP (proxsuite, Pinocchio's family) is the
-other choice.
+other choice, and answers where DAQP's active set cycles (many nearly equal rows) when it is installed.
 """
 
 from __future__ import annotations
 
 import importlib
+import importlib.util
 from ctypes import c_int
 from dataclasses import dataclass
 from typing import Any
@@ -35,6 +36,8 @@ class Solution:
     iterations: int
 
 
+CYCLING = DAQP_STATUS[-2]  # DAQP's active set cycles on many degenerate rows (two grippers pressed together:
+# 60 collision rows of rank 12): ProxQP, where installed, answers those
 MAX_ITERATIONS = 10_000  # each solver's iteration bound: the step's QPs take tens, a call never runs unbounded
 NOT_FINITE = "not finite"  # the status of an answer that overflowed (nothing moved)
 
@@ -62,6 +65,8 @@ def solve(H: np.ndarray, f: np.ndarray, lower: np.ndarray, upper: np.ndarray, A_
     if solver != "proxsuite":
         found = _daqp(H, f, lower, upper, A_eq, b_eq, inequalities)
         v = found.v
+        if found.status == CYCLING and importlib.util.find_spec("proxsuite") is not None:
+            return solve(H, f, lower, upper, A_eq, b_eq, "proxsuite", dt, inequalities)  # degenerate rows
     else:
         scaled = None if inequalities is None else Inequalities(inequalities.A, inequalities.b * dt)
         found = _proxsuite(H, f * dt, lower * dt, upper * dt, A_eq, None if b_eq is None else b_eq * dt, scaled)
