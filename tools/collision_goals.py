@@ -157,11 +157,13 @@ def main() -> int:
     parser.add_argument("--steps", type=int, default=100_000)
     parser.add_argument("--solves", type=int, default=10_000)
     parser.add_argument("--scenes", default=",".join(SCENES))
+    parser.add_argument("--solve-on", default="panda", help="the scenes whose robots' converged solves are counted")
     args = parser.parse_args()
-    for name in args.scenes.split(","):
-        print(run_scene(SCENES[name], args.steps), flush=True)
-    for name in args.scenes.split(","):
-        if name == "panda" and args.solves > 0:
+    if args.steps > 0:
+        for name in args.scenes.split(","):
+            print(run_scene(SCENES[name], args.steps), flush=True)
+    for name in args.solve_on.split(","):
+        if args.solves > 0:
             print(solves(name, args.solves, 3), flush=True)
     return 0
 
