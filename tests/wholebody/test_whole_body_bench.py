@@ -42,3 +42,15 @@ def test_a_robot_without_a_scenario_is_named_with_the_valid_ones(capsys):
     code = cli.main(["bench", "--whole-body", "--robots", "ur5"])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and "'ur5'" in err[0] and "talos" in err[0]
+
+
+def test_n_0_skips_the_converged_solves_and_other_protocols_refuse_it(capsys):
+    """#72 item 8: ``--whole-body --n 0`` runs the steps alone; an arm protocol refuses 0 targets in one line."""
+    import json
+
+    assert cli.main(["bench", "--whole-body", "--robots", "panda", "--repeats", "1", "--n", "0", "--json"]) == 0
+    found = json.loads(capsys.readouterr().out)["whole_body"]
+    assert found["solves"] == [] and {r["library"] for r in found["steps"]} >= {"kinelab"}
+    code = cli.main(["bench", "--n", "0"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "--whole-body" in err[0]

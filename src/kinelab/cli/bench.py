@@ -7,7 +7,16 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from kinelab import lazy
-from kinelab.cli.common import Subcommands, count, positive_number, print_json, progress_of, seed_argument
+from kinelab.cli.common import (
+    Subcommands,
+    count,
+    count_or_zero,
+    positive_number,
+    print_json,
+    progress_of,
+    seed_argument,
+)
+from kinelab.errors import KinelabError
 from kinelab.ik.words import TASKS
 from kinelab.report.outfolder import check_output_folder
 
@@ -50,7 +59,8 @@ def add(sub: Subcommands) -> None:
     s = sub.add_parser("bench", help="the IK benchmark: kinelab's solvers and the installed peers")
     s.add_argument("--robots", nargs="+", default=None,
                    help="robots (default: panda ur5 stanford era xarm7 z1 kinova ur10 so101 youbot)")
-    s.add_argument("--n", type=count, default=200, help="targets per robot (default 200)")
+    s.add_argument("--n", type=count_or_zero, default=200,
+                   help="targets per robot (default 200; 0 with --whole-body: its converged solves skipped)")
     seed_argument(s)
     s.add_argument("--solvers", nargs="+", default=None, help="solvers to run (default: all available)")
     s.add_argument("--budget-ms", type=positive_number, default=5.0, help="time budget per solve [ms] (default 5)")
@@ -114,6 +124,9 @@ def run(args: argparse.Namespace) -> int:
     """Run the protocols asked for, print their tables (or JSON), write the files with --out."""
     if args.out:
         check_output_folder(args.out, "bench")
+    if args.n == 0 and not args.whole_body:
+        raise KinelabError("--n 0 skips the converged solves of --whole-body; the other protocols need --n ≥ 1 "
+                           "targets per robot")
     if args.collisions_step:
         return _alone(args, "collisions_step", lambda: collision_step.run(
             args.robots, rounds=args.repeats, progress=progress_of(args)), collision_step.markdown)

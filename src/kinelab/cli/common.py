@@ -82,8 +82,8 @@ def positive_number(text: str) -> float:
     return value
 
 
-def count(text: str) -> int:
-    """An argparse type: a whole number ≥ 1 that a C int holds (a count of targets, rounds, samples).
+def count(text: str, least: int = 1) -> int:
+    """An argparse type: a whole number ≥ 1 (≥ ``least``) that a C int holds (a count of targets, rounds, samples).
 
     Raises:
         argparse.ArgumentTypeError: anything else (argparse names the option).
@@ -92,9 +92,18 @@ def count(text: str) -> int:
         value = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
-    if not 1 <= value <= 2**31 - 1:
-        raise argparse.ArgumentTypeError(f"{text} is not a whole number in [1, {2**31 - 1}]")
+    if not least <= value <= 2**31 - 1:
+        raise argparse.ArgumentTypeError(f"{text} is not a whole number in [{least}, {2**31 - 1}]")
     return value
+
+
+def count_or_zero(text: str) -> int:
+    """An argparse type: a whole number ≥ 0 that a C int holds (0: a part of a protocol skipped).
+
+    Raises:
+        argparse.ArgumentTypeError: anything else (argparse names the option).
+    """
+    return count(text, least=0)
 
 
 def q_from_cli(robot: Chain, values: list[str], deg: bool, what: str = "q") -> np.ndarray:
