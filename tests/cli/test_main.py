@@ -111,7 +111,8 @@ def test_ik_says_what_its_time_measured_and_prints_frdm_s_monitor_for_frdm_alone
     q = ["0.3", "-1.2", "1.0", "-0.5", "0.8", "0.2"]
     code, out, _ = run(capsys, "ik", "ur5", "--target-q", *q, "--solver", "analytic")
     assert code == 0 and "ms (one call, first-call costs included" in out and "monitor" not in out
-    code, out, _ = run(capsys, "ik", "ur5", "--target-q", *q, "--seed", "0", "--start-q", "random", "--verbose")
+    code, out, _ = run(capsys, "ik", "ur5", "--target-q", *q, "--seed", "0", "--start-q", "random", "--verbose",
+                       "--solver", "frdm")
     assert code == 0 and "ms (one call, first-call costs included" in out and "monitor did not fire" in out
     assert "method frdm" in out
 
@@ -483,9 +484,9 @@ def test_kinelab_ik_and_branches_print_the_api_s_answers(capsys, name):
         q_target = robot.random_q(rng)
         words = [repr(v) for v in q_target.tolist()]
         code, out, _ = run(capsys, "ik", name, "--target-q", *words, "--seed", str(seed), "--json",
-                           "--start-q", "random")
+                           "--start-q", "random", "--solver", "frdm")
         printed = json.loads(out)
-        res = kinelab.solve(robot, robot.fk(q_target), seed=seed)
+        res = kinelab.solve(robot, robot.fk(q_target), seed=seed, solver="frdm")
         assert code == (0 if res.success else 1)
         assert printed["q"] == res.q.tolist() and printed["status"] == res.status.value
         assert (printed["iterations"], printed["restarts"]) == (res.iterations, res.restarts)

@@ -103,7 +103,7 @@ def test_prefer_labels_the_task_as_solve_does(ur5):
 
 
 def test_results_carry_typed_diagnostics(ur5):
-    res = kinelab.solve(ur5, _target(ur5), seed=0)
+    res = kinelab.solve(ur5, _target(ur5), solver="frdm", seed=0)
     assert isinstance(res.diagnostics, Diagnostics) and res.diagnostics.path == "compiled"
     assert res.diagnostics.sweeps == res.iterations and res.diagnostics.attempts == res.restarts + 1
     loop = kinelab.solve(ur5, _target(ur5), seed=0, policy=("auto_kick",))

@@ -21,11 +21,11 @@ def problems(robot, count, seed, sigma=None):
 def test_every_row_is_the_single_solve_with_seed_plus_row(name, sigma):
     robot = load(name)
     _, targets, starts = problems(robot, 40, 1, sigma)
-    batch = kinelab.solve_batch(robot, targets, q0=starts, seed=11)
+    batch = kinelab.solve_batch(robot, targets, q0=starts, seed=11, solver="frdm")
     assert batch.mode.startswith("frdm+newton (compiled batch")
     for b in range(40):
         one = kinelab.solve(robot, targets[b], q0=None if starts is None else starts[b], seed=11 + b,
-                            time_budget=60.0)
+                            time_budget=60.0, solver="frdm")
         np.testing.assert_array_equal(batch.q[b], one.q)
         assert batch.success[b] == one.success and batch.status[b] == one.status.value
         assert batch.position_error[b] == pytest.approx(one.position_error, abs=1e-15)
@@ -38,9 +38,9 @@ def test_the_batch_does_not_depend_on_the_thread_count():
     _, targets, _ = problems(robot, 600, 2)
     try:
         threads.set_count(1)
-        one = kinelab.solve_batch(robot, targets, seed=5)
+        one = kinelab.solve_batch(robot, targets, seed=5, solver="frdm")
         threads.set_count(4)  # more threads than this machine's two cores: rows interleave differently
-        many = kinelab.solve_batch(robot, targets, seed=5)
+        many = kinelab.solve_batch(robot, targets, seed=5, solver="frdm")
     finally:
         threads.set_count(None)
     assert "1 threads" in one.mode and "4 threads" in many.mode

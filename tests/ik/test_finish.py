@@ -62,8 +62,9 @@ def test_the_finish_converges_from_warm_starts_in_fewer_iterations_and_reports_i
         q = robot.random_q(rng)
         target = robot.fk(q)
         q0 = np.clip(q + rng.normal(0, 0.02, q.size), robot.lower, robot.upper)
-        fast = kinelab.solve(robot, target, q0=q0, seed=0, max_restarts=0, time_budget=None)
-        pure = kinelab.solve(robot, target, q0=q0, seed=0, max_restarts=0, time_budget=None, finish="none")
+        fast = kinelab.solve(robot, target, q0=q0, seed=0, max_restarts=0, time_budget=None, solver="frdm")
+        pure = kinelab.solve(robot, target, q0=q0, seed=0, max_restarts=0, time_budget=None, finish="none",
+                             solver="frdm")
         dp, dr = robot.tool_error(fast.q, target)  # the oracle's own check, beside the result's
         assert fast.success and dp <= 1e-6 and dr <= 1e-6 and robot.within_limits(fast.q)
         assert fast.mode == "frdm+newton" and pure.mode == "frdm" and pure.diagnostics.newton_steps == 0

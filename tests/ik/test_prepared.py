@@ -45,7 +45,7 @@ def _same(a: kinelab.IKResult, b: kinelab.IKResult) -> None:
 @pytest.mark.parametrize("task", ["pose", "position", "axis"])
 def test_the_one_call_equals_the_general_route_and_kinelab_solve(name, task):
     robot = kinelab.load(name)
-    settings = dict(task=task, time_budget=None, max_restarts=30)
+    settings = dict(task=task, time_budget=None, max_restarts=30, solver="frdm")
     ik = kinelab.IK(robot, **settings)
     assert ik.engine is not None  # the usual call is served by the engine (pose-like targets, float starts)
     rng = np.random.default_rng(3)
@@ -111,7 +111,7 @@ def test_a_start_given_as_a_list_or_another_real_dtype_takes_the_one_call(ur5, m
     general route's named error."""
     from kinelab.ik import prepared
 
-    ik = kinelab.IK(ur5, time_budget=None, max_restarts=5)
+    ik = kinelab.IK(ur5, solver="frdm", time_budget=None, max_restarts=5)
     rng = np.random.default_rng(6)
     q = ur5.random_q(rng)
     target = ur5.fk(q)
@@ -141,7 +141,7 @@ def test_the_engine_says_why_it_declines_and_the_general_route_then_answers():
     from kinelab.ik.spec import Decline
 
     robot = kinelab.load("ur5")
-    ik = kinelab.IK(robot, time_budget=None)
+    ik = kinelab.IK(robot, solver="frdm", time_budget=None)
     q = np.array([0.3, -1.2, 1.4, -0.5, 0.9, 0.2])
     target = robot.fk(q)
     far = pin.SE3(np.eye(3), np.array([5.0, 0.0, 0.0]))

@@ -70,7 +70,7 @@ def test_each_solver_s_diagnostics_are_its_own_record():
     robot = load("ur5")
     q = robot.random_q(2)
     target = robot.fk(q)
-    frdm = kinelab.solve(robot, target, seed=1, time_budget=None).diagnostics
+    frdm = kinelab.solve(robot, target, solver="frdm", seed=1, time_budget=None).diagnostics
     biquat = kinelab.solve(robot, target, solver="biquat", seed=1, time_budget=None).diagnostics
     branch = kinelab.solve_all(robot, target)[0].diagnostics
     assert type(frdm) is kinelab.FRDMDiagnostics and frdm.sweeps >= 1 and not hasattr(frdm, "model_time")

@@ -13,15 +13,15 @@ FIELDS = ("sweeps", "attempts", "stalls", "polished", "newton_steps", "accelerat
 @pytest.mark.parametrize("name", ["ur5", "panda", "youbot", "kinova"])
 def test_solve_the_prepared_solver_and_a_batch_row_take_the_same_route(name):
     robot = kinelab.load(name)
-    ik = kinelab.IK(robot, time_budget=None)
+    ik = kinelab.IK(robot, solver="frdm", time_budget=None)
     rng = np.random.default_rng(17)
     for k in range(12):
         q = robot.random_q(rng)
         target = robot.fk(q)
         q0 = np.clip(q + rng.normal(0, 0.2, q.size), robot.lower, robot.upper) if k % 2 else None
-        plain = kinelab.solve(robot, target, q0=q0, seed=k, time_budget=None)
+        plain = kinelab.solve(robot, target, q0=q0, seed=k, time_budget=None, solver="frdm")
         prepared = ik.solve(target, q0=q0, seed=k)
-        row = kinelab.solve_batch(robot, [target], q0=None if q0 is None else [q0], seed=k)
+        row = kinelab.solve_batch(robot, [target], q0=None if q0 is None else [q0], seed=k, solver="frdm")
         np.testing.assert_array_equal(plain.q, prepared.q)
         np.testing.assert_array_equal(plain.q, row.q[0])
         assert plain.status == prepared.status and plain.status.value == row.status[0]
@@ -37,9 +37,9 @@ def test_a_batch_row_is_the_single_solve_with_seed_plus_its_index():
     robot = kinelab.load("panda")
     rng = np.random.default_rng(3)
     targets = [robot.fk(robot.random_q(rng)) for _ in range(20)]
-    batch = kinelab.solve_batch(robot, targets, seed=100)
+    batch = kinelab.solve_batch(robot, targets, seed=100, solver="frdm")
     for b, target in enumerate(targets):
-        one = kinelab.solve(robot, target, seed=100 + b, time_budget=None)
+        one = kinelab.solve(robot, target, seed=100 + b, time_budget=None, solver="frdm")
         np.testing.assert_array_equal(one.q, batch.q[b])
         assert one.iterations == batch.iterations[b] and one.restarts == batch.restarts[b]
 
@@ -104,7 +104,7 @@ def test_a_result_s_diagnostics_are_built_only_when_read(monkeypatch):
     from kinelab.ik.frdm.solver import _Context
 
     robot = kinelab.load("panda")
-    ik = kinelab.IK(robot, time_budget=None)
+    ik = kinelab.IK(robot, solver="frdm", time_budget=None)
     built, made_by = [], _Context.diagnostics
     monkeypatch.setattr(_Context, "diagnostics", lambda ctx, st: built.append(1) or made_by(ctx, st))
     q = robot.random_q(3)

@@ -64,9 +64,11 @@ def test_solve_batch_is_the_kept_prepared_solvers_call(spy, name, solver, extra)
 def test_solve_is_the_kept_prepared_solvers_call(spy):
     robot = kinelab.load("ur5")
     target = robot.fk(np.array([0.3, -1.2, 1.4, -0.5, 0.9, 0.2]))
-    results = [kinelab.solve(robot, target, seed=s) for s in range(3)]
+    results = [kinelab.solve(robot, target, solver="frdm", seed=s) for s in range(3)]
     assert spy["built"] == 1 and spy["solve"] == 1  # later calls: the kept solver's compiled engine directly
     assert all(r.success for r in results)
+    closed = [kinelab.solve(robot, target, solver="auto", seed=s) for s in range(3)]  # the closed form
+    assert spy["built"] == 2 and all(r.success and r.solver == "analytic" for r in closed)
 
 
 def _path(robot, q, count=30, step=0.01):

@@ -36,15 +36,15 @@ def test_the_look_up_is_the_brute_force_nearest_and_a_stored_pose_finds_itself()
 def test_a_batch_from_the_table_is_each_single_solve_from_its_start(name):
     robot = load(name)
     targets = robot.fk_batch(robot.random_qs(40, 9))
-    batch = kinelab.solve_batch(robot, targets, q0="table", seed=5)
+    batch = kinelab.solve_batch(robot, targets, q0="table", seed=5, solver="frdm")
     assert "first starts from the start table" in batch.mode and batch.success.all()
     starts = start_table(robot).nearest(targets)
     for b in range(0, 40, 7):
-        one = kinelab.solve(robot, pin.SE3(targets[b]), q0=starts[b], seed=5 + b, time_budget=60.0)
+        one = kinelab.solve(robot, pin.SE3(targets[b]), q0=starts[b], seed=5 + b, time_budget=60.0, solver="frdm")
         np.testing.assert_array_equal(batch.q[b], one.q)
-    random = kinelab.solve_batch(robot, targets, q0="random", seed=5)
+    random = kinelab.solve_batch(robot, targets, q0="random", seed=5, solver="frdm")
     assert "start table" not in random.mode and random.success.all()
-    np.testing.assert_array_equal(random.q, kinelab.solve_batch(robot, targets, seed=5).q)
+    np.testing.assert_array_equal(random.q, kinelab.solve_batch(robot, targets, seed=5, solver="frdm").q)
 
 
 def test_a_start_mode_that_is_not_one_is_refused_by_name():

@@ -268,7 +268,8 @@ def _print_answer(robot: Chain, args: argparse.Namespace, result: IKResult) -> N
     """Status, q (degrees with --deg), the errors on the task's components and the effort."""
     q_show = np.where([k != "prismatic" for k in robot.joint_kinds], np.rad2deg(result.q), result.q) \
         if args.deg else result.q
-    print(f"{robot.name} {args.solver}, task {result.task}: {result.status.value} (success: {result.success})")
+    route = result.solver if result.solver == args.solver else f"{result.solver} (--solver {args.solver})"
+    print(f"{robot.name} {route}, task {result.task}: {result.status.value} (success: {result.success})")
     print(f"  q{' [deg, m]' if args.deg else ' [rad, m]'}  {shown(q_show)}")
     free = {"position": (False, True), "orientation": (True, False)}.get(args.task, (False, False))
     print(f"  position error {result.position_error:.3e} m{' (free)' if free[0] else ''}, "
@@ -286,7 +287,7 @@ def _print_solver_notes(args: argparse.Namespace, result: IKResult) -> None:
         m0 = diag.M0
         print(f"  model time {diag.model_time:.4g} s, final M0 = "
               + (f"{m0:+.6f}" if m0 is not None else "n/a (give --target-q for the sign of N)"))
-    if registry.capabilities(args.solver).monitored:  # only a solver with the singularity monitor has events to tell
+    if registry.capabilities(result.solver).monitored:  # only the route with the singularity monitor has events
         _print_monitor(args, result)
     if result.success and result.diagnostics.clear_after is not None:
         print(f"  clear of collisions ({plural(result.diagnostics.clear_after, 'colliding answer')} found before)")
