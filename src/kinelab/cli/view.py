@@ -13,7 +13,9 @@ from kinelab.cli.common import (
     Subcommands,
     collision_arguments,
     collisions_of,
+    is_number,
     load_robot,
+    pairs,
     plural,
     q_from_cli,
     robot_arguments,
@@ -21,6 +23,7 @@ from kinelab.cli.common import (
 from kinelab.errors import KinelabError
 from kinelab.files import interrupt_taken
 from kinelab.progress import step
+from kinelab.robot import catalog
 
 if TYPE_CHECKING:
     import signal
@@ -28,9 +31,10 @@ if TYPE_CHECKING:
     from kinelab import collision
     from kinelab import robot as robot_module
     from kinelab.studies import paper000_era
-    from kinelab.view import collisions
+    from kinelab.view import collisions, whole_scene
     from kinelab.view import scene as viz
 else:
+    whole_scene = lazy.module("kinelab.view.whole_scene", globals())
     collision = lazy.module("kinelab.collision", globals())
     collisions = lazy.module("kinelab.view.collisions", globals())
     paper000_era = lazy.module("kinelab.studies.paper000_era", globals())
@@ -47,6 +51,9 @@ def add(sub: Subcommands) -> None:
     robot_arguments(s, "configuration (default: the robot's display pose)")
     s.add_argument("--singular", action="store_true", help="draw the lost directions and σ_min at q")
     collision_arguments(s)
+    s.add_argument("--whole", action="store_true",
+                   help="the whole robot (a registered whole robot, such as talos or delta, is whole without it): "
+                        "standing on the floor, its loops closed; Q its Pinocchio q or an SRDF configuration's name")
     s.add_argument("--html", help="write a self-contained HTML page instead of serving")
     s.set_defaults(func=run_view)
     s = sub.add_parser("animate", help="animate a solver run in meshcat (the ERA passages)")
@@ -58,7 +65,9 @@ def add(sub: Subcommands) -> None:
 
 
 def run_view(args: argparse.Namespace) -> int:
-    """Draw the robot at q (any finite q; joints outside their limits are noted)."""
+    """Draw the robot at q (any finite q; joints outside their limits are noted); a whole robot standing."""
+    if _wants_whole(args):
+        return _publish(_whole_scene(args), args.html)
     robot = load_robot(args)
     q = robot.check_q(q_from_cli(robot, args.q, args.deg) if args.q else robot.display_q())
     if not args.ignore_limits:
@@ -73,6 +82,48 @@ def run_view(args: argparse.Namespace) -> int:
         contacts = collisions.draw_collisions(scene, collision.collision_model(robot, spec), q)
         print(f"{len(contacts)} contact(s)" + "".join(f"\n  {c}" for c in contacts))
     return _publish(scene, args.html)
+
+
+def _wants_whole(args: argparse.Namespace) -> bool:
+    """The whole robot: --whole, or a registered whole robot named without a chain's flags."""
+    if args.whole:
+        return True
+    entry = catalog.ENTRIES.get(args.robot)
+    return bool(entry is not None and entry.whole and not (args.tool or args.base or args.group or args.lock))
+
+
+def _whole_scene(args: argparse.Namespace) -> Any:
+    """The whole robot's scene (standing, or at Q: its Pinocchio q or an SRDF configuration's name).
+
+    Raises:
+        KinelabError: a chain's flag given with it (named).
+    """
+    given = [flag for flag, on in (("--singular", args.singular), ("--collisions", args.collisions),
+                                   ("--obstacles", args.obstacles is not None), ("--tool", args.tool),
+                                   ("--base", args.base), ("--group", args.group), ("--lock", args.lock)) if on]
+    if given:
+        raise KinelabError(f"{given[0]} is a chain's: a whole robot's view draws it standing (name a chain with "
+                           "--tool for the others)")
+    robot = robot_module.load(args.robot, whole=True, srdf=args.srdf, package_dirs=args.package_dir,
+                              xacro_args=pairs(args.xacro_arg, "--xacro-arg"), trust_xacro=args.trust_xacro)
+    q = None
+    if args.q:
+        q = robot.named_q(args.q[0]) if len(args.q) == 1 and not is_number(args.q[0]) else \
+            robot.check_q([float(v) for v in _numbers(args.q)])
+    step(f"drawing {robot.name} (its meshes load)")
+    return whole_scene.WholeScene(robot, q)
+
+
+def _numbers(values: list[str]) -> list[str]:
+    """The Q words, refused by name where one is not a number.
+
+    Raises:
+        KinelabError: a word that is not a number.
+    """
+    bad = [v for v in values if not is_number(v)]
+    if bad:
+        raise KinelabError(f"Q: {bad[0]!r} is not a number (a whole robot's Q is its Pinocchio q, or one SRDF name)")
+    return values
 
 
 def run_animate(args: argparse.Namespace) -> int:
