@@ -15,7 +15,7 @@ collide, so the exact test runs only on the others. A plane's test is the sphere
 from __future__ import annotations
 
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -243,21 +243,46 @@ def _build(robot: Chain, collisions: Collisions) -> CollisionModel:
     if geom.ngeoms == 0:
         raise CollisionError(f"{robot.name} has no collision geometry (no <collision> element in its file, or a "
                              "model built in memory): collisions cannot be checked")
+    found = paired(robot, geom, collisions)
+    summary = (f"{found.own} collision object(s) of {robot.name}, {len(found.obstacles)} obstacle(s); "
+               f"{len(found.pairs)} pairs checked ({found.left_out[0]} on adjacent links and {found.left_out[1]} "
+               f"disabled by the SRDF left out), margin {collisions.margin:g} m")
+    return CollisionModel(robot, geom, np.array(found.pairs, dtype=np.int64).reshape(-1, 2), *found.spheres,
+                          found.joints, float(collisions.margin), summary, collisions, _frames(robot))
+
+
+@dataclass(frozen=True)
+class Paired:
+    """A geometry's objects (the robot's ``own`` first, then the obstacles), their joints, the pairs added to it and
+    how many self pairs were left out (adjacent, by the SRDF, by the caller's filter); ``spheres``: the first
+    test's centres, radii and normals."""
+
+    objects: list[Any]
+    joints: np.ndarray
+    own: int
+    obstacles: tuple[Obstacle, ...]
+    pairs: list[tuple[int, int]]
+    left_out: tuple[int, int, int]
+    spheres: tuple[np.ndarray, np.ndarray, np.ndarray]
+
+
+def paired(robot: Chain | Robot, geom: pin.GeometryModel, collisions: Collisions,
+           keep: Callable[[list[tuple[int, int]]], list[tuple[int, int]]] | None = None) -> Paired:
+    """Append the obstacles to ``geom`` and add every pair worth checking (see the module's docstring): the
+    robot's own pairs (those ``keep`` keeps, when given) and every moving object against every obstacle."""
     own = geom.ngeoms
-    obstacles = collisions.environment.obstacles if collisions.environment is not None else ()
+    obstacles = tuple(collisions.environment.obstacles) if collisions.environment is not None else ()
     _add_obstacles(geom, obstacles)
     objects = list(geom.geometryObjects)
-    joints = np.array([o.parentJoint for o in objects], dtype=int)
-    pairs, left_out = _self_pairs(robot, objects, own) if collisions.self_collisions else ([], (0, 0))
-    pairs += [(i, own + k) for i in range(own) if joints[i] != 0 for k in range(len(obstacles))]
-    for i, j in pairs:
+    joints = np.array([o.parentJoint for o in objects], dtype=np.int64)
+    pairs, (adjacent, by_srdf) = _self_pairs(robot, objects, own) if collisions.self_collisions else ([], (0, 0))
+    kept = pairs if keep is None else keep(pairs)
+    filtered = len(pairs) - len(kept)
+    kept = kept + [(i, own + k) for i in range(own) if joints[i] != 0 for k in range(len(obstacles))]
+    for i, j in kept:
         geom.addCollisionPair(pin.CollisionPair(int(i), int(j)))
-    centres, radii, normals = _spheres(objects, own, obstacles)
-    summary = (f"{own} collision object(s) of {robot.name}, {len(obstacles)} obstacle(s); {len(pairs)} pairs "
-               f"checked ({left_out[0]} on adjacent links and {left_out[1]} disabled by the SRDF left out), "
-               f"margin {collisions.margin:g} m")
-    return CollisionModel(robot, geom, np.array(pairs, dtype=np.int64).reshape(-1, 2), centres, radii, normals,
-                          joints.astype(np.int64), float(collisions.margin), summary, collisions, _frames(robot))
+    return Paired(objects, joints, own, obstacles, kept, (adjacent, by_srdf, filtered),
+                  _spheres(objects, own, obstacles))
 
 
 def _add_obstacles(geom: pin.GeometryModel, obstacles: Sequence[Obstacle]) -> None:
@@ -347,7 +372,7 @@ def _self_pairs(robot: Chain | Robot, objects: list[Any], own: int) -> tuple[lis
     return pairs, (adjacent, by_srdf)
 
 
-def _spheres(objects: list[Any], own: int, obstacles: tuple[Any, ...]) -> tuple[np.ndarray, ...]:
+def _spheres(objects: list[Any], own: int, obstacles: tuple[Any, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per object: the centre (its joint's frame) and radius of the sphere around its box, and a plane's normal."""
     G = len(objects)
     centres, radii, normals = np.zeros((G, 3)), np.zeros(G), np.zeros((G, 3))

@@ -93,11 +93,7 @@ class WholeScene:
 
     def points(self) -> np.ndarray:
         """(k, 3) where the robot is at q: its joints' origins and its visuals' [m]."""
-        model, data = self.robot.model, self.robot.model.createData()
-        pin.forwardKinematics(model, data, self.q)
-        gdata = pin.GeometryData(self.pinviz.visual_model)
-        pin.updateGeometryPlacements(model, data, self.pinviz.visual_model, gdata)
-        return np.array([*(M.translation for M in data.oMi[1:]), *(M.translation for M in gdata.oMg)])
+        return robot_points(self.robot.model, self.pinviz.visual_model, self.q)
 
     def _draw_loops(self) -> list[float]:
         """Each loop's two ends (and a line between them where it is open); returns each loop's largest held error
@@ -137,6 +133,15 @@ class WholeScene:
         """Stop the server this scene started."""
         if self.server is not None:
             self.server.stop()
+
+
+def robot_points(model: pin.Model, visual_model: pin.GeometryModel, q: np.ndarray) -> np.ndarray:
+    """(k, 3) where a robot is at q: its joints' origins and its visuals' [m] (what a camera frames)."""
+    data = model.createData()
+    pin.forwardKinematics(model, data, q)
+    gdata = pin.GeometryData(visual_model)
+    pin.updateGeometryPlacements(model, data, visual_model, gdata)
+    return np.array([*(M.translation for M in data.oMi[1:]), *(M.translation for M in gdata.oMg)])
 
 
 def start(robot: Robot) -> np.ndarray:

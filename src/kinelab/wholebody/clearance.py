@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
-from kinelab.collision.model import CollisionError, Collisions, Contact, _add_obstacles, _hulls, _self_pairs, _spheres
+from kinelab.collision.model import CollisionError, Collisions, Contact, _hulls, paired
 from kinelab.collision.spheres import PLANE
 from kinelab.robot.tree import Robot
 
@@ -126,25 +126,14 @@ def _build(robot: Robot, collisions: Collisions) -> StepCollisions:
         raise CollisionError(f"{robot.name} has no collision geometry (no <collision> element in its file, or a "
                              "model built in memory): the step cannot keep its links apart")
     geom = _hulls(own_geom)
-    own = geom.ngeoms
-    obstacles = collisions.environment.obstacles if collisions.environment is not None else ()
-    _add_obstacles(geom, obstacles)
-    objects = list(geom.geometryObjects)
-    joints = np.array([o.parentJoint for o in objects], dtype=np.int64)
-    pairs, left_out = _self_pairs(robot, objects, own) if collisions.self_collisions else ([], (0, 0))
-    before = len(pairs)
-    pairs = _apart_at_neutral(robot, geom, pairs, collisions.margin + TOUCHING)
-    touching = before - len(pairs)
-    pairs += [(i, own + k) for i in range(own) if joints[i] != 0 for k in range(len(obstacles))]
-    for i, j in pairs:
-        geom.addCollisionPair(pin.CollisionPair(int(i), int(j)))
-    centres, radii, normals = _spheres(objects, own, obstacles)
-    summary = (f"{own} collision object(s) of {robot.name} (convex hulls), {len(obstacles)} obstacle(s); "
-               f"{len(pairs)} pairs ({left_out[0]} adjacent, {left_out[1]} disabled by the SRDF and "
-               f"{touching} within the margin at the neutral configuration left out), "
-               f"margin {collisions.margin:g} m")
-    return StepCollisions(robot, geom, np.array(pairs, dtype=np.int64).reshape(-1, 2), joints, centres, radii,
-                          normals, collisions, summary)
+    found = paired(robot, geom, collisions,
+                   keep=lambda pairs: _apart_at_neutral(robot, geom, pairs, collisions.margin + TOUCHING))
+    adjacent, by_srdf, near = found.left_out
+    summary = (f"{found.own} collision object(s) of {robot.name} (convex hulls), {len(found.obstacles)} obstacle(s); "
+               f"{len(found.pairs)} pairs ({adjacent} adjacent, {by_srdf} disabled by the SRDF and {near} within the "
+               f"margin at the neutral configuration left out), margin {collisions.margin:g} m")
+    return StepCollisions(robot, geom, np.array(found.pairs, dtype=np.int64).reshape(-1, 2), found.joints,
+                          *found.spheres, collisions, summary)
 
 
 def _apart_at_neutral(robot: Robot, geom: pin.GeometryModel, pairs: list[tuple[int, int]], apart: float

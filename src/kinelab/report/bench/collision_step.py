@@ -41,6 +41,7 @@ from kinelab.report.bench.steppers import (
     MinkStepper,
     PinkStepper,
     start_of,
+    targets_at,
     whole,
 )
 from kinelab.robot.tree import Robot
@@ -79,19 +80,6 @@ def obstacles(scene: Scene, robot: Robot, q0: np.ndarray) -> Environment:
             centre = M.translation + M.rotation @ np.array([0.0, RADIUS * (np.cos(a) - 1.0), RADIUS * np.sin(a)])
             out.append(Obstacle("sphere", (0.03,), xyz=tuple(centre), name=f"ball {k}.{j}"))
     return Environment(tuple(out))
-
-
-def targets_at(start: list[pin.SE3], t: float, moving: int) -> list[pin.SE3]:
-    """The frames' targets at t [s]: the first ``moving`` on RADIUS circles in their frame's y-z plane."""
-    out = []
-    for k, M in enumerate(start):
-        if k < moving:
-            a = 2 * np.pi * t / PERIOD + k * np.pi / 2
-            offset = M.rotation @ np.array([0.0, RADIUS * (np.cos(a) - 1.0), RADIUS * np.sin(a)])
-            out.append(pin.SE3(M.rotation, M.translation + offset))
-        else:
-            out.append(M)
-    return out
 
 
 class KinelabCollisionStepper(KinelabStepper):
@@ -230,7 +218,7 @@ def run_scene(name: str, steps: int, rounds: int, progress: bool = False) -> lis
         round_times: dict[str, list[float]] = {k: [] for k in steppers}
         order = list(steppers)
         for k in range(steps):
-            targets = targets_at(start, (k + 1) * DT, len(scenario.moving))
+            targets = targets_at(start, (k + 1) * DT, len(scenario.moving), RADIUS)
             for key in order[k % len(order):] + order[:k % len(order)]:
                 t0 = time.perf_counter()
                 steppers[key].step(targets)

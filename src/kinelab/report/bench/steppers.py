@@ -59,13 +59,14 @@ def start_of(robot: Robot) -> np.ndarray:
     return q
 
 
-def targets_at(start: list[pin.SE3], t: float, moving: int) -> list[pin.SE3]:
-    """The frames' targets at time t [s]: the first ``moving`` turning on circles in their frame's y-z plane."""
+def targets_at(start: list[pin.SE3], t: float, moving: int, radius: float = RADIUS) -> list[pin.SE3]:
+    """The frames' targets at time t [s]: the first ``moving`` turning on circles of ``radius`` [m] in their frame's
+    y-z plane."""
     out = []
     for k, M in enumerate(start):
         if k < moving:
             a = 2 * np.pi * t / PERIOD + k * np.pi / 2
-            offset = M.rotation @ np.array([0.0, RADIUS * (np.cos(a) - 1.0), RADIUS * np.sin(a)])
+            offset = M.rotation @ np.array([0.0, radius * (np.cos(a) - 1.0), radius * np.sin(a)])
             out.append(pin.SE3(M.rotation, M.translation + offset))
         else:
             out.append(M)

@@ -31,6 +31,7 @@ from kinelab.view.meshes import load_robot
 from kinelab.view.scene import AXIS_COLORS, aim_camera, on_top
 from kinelab.view.teach.recorder import RecordingWindow
 from kinelab.view.teach.session import Session, TeachOptions, _checked_pose, _locked, _pose, _short
+from kinelab.view.whole_scene import robot_points
 from kinelab.wholebody.clearance import step_collisions
 from kinelab.wholebody.limits import Limits
 from kinelab.wholebody.solve import solve
@@ -255,11 +256,7 @@ class WholeTeachSession(Session):
 
     def _points(self) -> np.ndarray:
         """Where the robot is at q: its joints' origins and its visuals' [m], for the camera."""
-        model, data = self.robot.model, self.robot.model.createData()
-        pin.forwardKinematics(model, data, self.q)
-        gdata = pin.GeometryData(self.viz.visual_model)
-        pin.updateGeometryPlacements(model, data, self.viz.visual_model, gdata)
-        return np.array([*(M.translation for M in data.oMi[1:]), *(M.translation for M in gdata.oMg)])
+        return robot_points(self.robot.model, self.viz.visual_model, self.q)
 
     @property
     def floor(self) -> float:
