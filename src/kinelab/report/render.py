@@ -160,6 +160,10 @@ def _write_bench_files(result: dict[str, Any], folder: Path) -> None:
         sections.append(loops.budget_markdown(result["budgets"]))
     if "whole_body" in result:
         sections.append(wholebody.markdown(result["whole_body"]))
+    if "collisions_step" in result:
+        from kinelab.report.bench import collision_step  # the collision bench's module only where it ran
+
+        sections.append(collision_step.markdown(result["collisions_step"]))
     if "versus" in result:
         sections.append(versus.markdown(result["versus"]))
     write_output(folder / "bench.md", "\n\n".join(sections) + "\n")
