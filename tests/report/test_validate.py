@@ -71,7 +71,8 @@ def test_a_whole_robot_takes_the_whole_body_checks(capsys):
     names = [c["name"] for c in report["checks"]]
     assert code == 0 and report["passed"] and all(n.startswith("whole body: ") for n in names)
     assert {"whole body: limit violations over the steps", "whole body: false successes (frdm)",
-            "whole body: task Jacobians vs differences of Pinocchio's FK"} <= set(names)
+            "whole body: task Jacobians vs differences of Pinocchio's FK",
+            "whole body: collision rows: rate against coal's central difference"} <= set(names)
     assert validate.DEFAULT_ROBOTS[-4:-2] == ("talos", "baxter")
 
 

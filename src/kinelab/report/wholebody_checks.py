@@ -13,6 +13,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.report.check import SHARE, Check, samples_for
+from kinelab.report.collision_step_checks import collision_step_check
 from kinelab.robot.tree import Robot
 from kinelab.wholebody import compiled
 from kinelab.wholebody import evaluate as ev
@@ -152,4 +153,4 @@ def _met_by_pinocchio(robot: Robot, tasks: list[Any], q: np.ndarray) -> bool:
     return bool(robot.within_limits(q))
 
 
-WHOLE_CHECKS = [compiled_tree_check, task_jacobian_check, limits_check, solve_checks]
+WHOLE_CHECKS = [compiled_tree_check, task_jacobian_check, limits_check, solve_checks, collision_step_check]
