@@ -126,7 +126,7 @@ def test_the_search_stops_by_its_rule_with_every_closed_form_branch():
     for k in range(20):
         target = ur5.fk(ur5.random_q(rng))
         analytic = [q for q in ur_inverse(BASE @ target.homogeneous, *UR_DH["ur5"]) if ur5.within_limits(q)]
-        found = kinelab.solve_all(ur5, target, solver="frdm", seed=k, time_budget=60.0)  # the rule ends it, not the clock
+        found = kinelab.solve_all(ur5, target, solver="frdm", seed=k, time_budget=60.0)  # the rule ends it first
         d = found[0].diagnostics
         stopped += d.unseen < 0.01
         complete += all(min(distance(ur5, s.q, q) for s in found) < 1e-2 for q in analytic)
