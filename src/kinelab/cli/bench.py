@@ -24,6 +24,7 @@ if TYPE_CHECKING:
     from kinelab.report import render
     from kinelab.report.bench import (
         branches,
+        closed_step,
         collision_step,
         collisions,
         completeness,
@@ -52,6 +53,7 @@ else:
     versus = lazy.module("kinelab.report.bench.versus", globals())
     wholebody = lazy.module("kinelab.report.bench.wholebody", globals())
     collision_step = lazy.module("kinelab.report.bench.collision_step", globals())
+    closed_step = lazy.module("kinelab.report.bench.closed_step", globals())
 
 
 def add(sub: Subcommands) -> None:
@@ -106,6 +108,9 @@ def add(sub: Subcommands) -> None:
                    help="instead of the arm protocol: the whole-body step side by side with pink and mink (--robots "
                         "among panda, baxter, talos, g1; default all four), --repeats rounds, and the converged "
                         "solve against pink iterated (--n targets per robot)")
+    s.add_argument("--closed", action="store_true",
+                   help="instead of the arm protocol: the step on robots that close loops (fourbar, ankle) side by "
+                        "side with mink's EqualityConstraintTask, --repeats rounds of 1,000 steps: time, loop error")
     s.add_argument("--collisions-step", action="store_true",
                    help="instead of the arm protocol: the whole-body step holding collisions side by side with mink's "
                         "CollisionAvoidanceLimit and pink's self-collision barrier (--robots among panda, talos; "
@@ -127,6 +132,8 @@ def run(args: argparse.Namespace) -> int:
     if args.n == 0 and not args.whole_body:
         raise KinelabError("--n 0 skips the converged solves of --whole-body; the other protocols need --n ≥ 1 "
                            "targets per robot")
+    if args.closed:
+        return _alone(args, "closed", lambda: closed_step.run(args.robots, rounds=args.repeats), closed_step.markdown)
     if args.collisions_step:
         return _alone(args, "collisions_step", lambda: collision_step.run(
             args.robots, rounds=args.repeats, progress=progress_of(args)), collision_step.markdown)

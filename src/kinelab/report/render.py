@@ -160,6 +160,10 @@ def _write_bench_files(result: dict[str, Any], folder: Path) -> None:
         sections.append(loops.budget_markdown(result["budgets"]))
     if "whole_body" in result:
         sections.append(wholebody.markdown(result["whole_body"]))
+    if "closed" in result:
+        from kinelab.report.bench import closed_step  # the loop bench's module only where it ran
+
+        sections.append(closed_step.markdown(result["closed"]))
     if "collisions_step" in result:
         from kinelab.report.bench import collision_step  # the collision bench's module only where it ran
 

@@ -148,6 +148,11 @@ class PinkStepper:
 def mujoco_model(robot: Robot) -> Any:
     """MuJoCo's model of the robot's URDF, meshes left out, fixed links kept as bodies, a free joint at the root of
     a floating robot."""
+    return mujoco_spec(robot).compile()
+
+
+def mujoco_spec(robot: Robot) -> Any:
+    """MuJoCo's spec of :func:`mujoco_model`, to add to before compiling."""
     import mujoco
 
     assert robot.source is not None
@@ -158,7 +163,7 @@ def mujoco_model(robot: Robot) -> Any:
     spec = mujoco.MjSpec.from_string(text)
     if robot.floating:
         spec.worldbody.first_body().add_freejoint()
-    return spec.compile()
+    return spec
 
 
 class MinkStepper:

@@ -1,0 +1,49 @@
+"""#69: ``kinelab bench --closed``. MuJoCo's model must hold the same loops: at assemblies of the four-bar and the
+ankle, its connect equalities' two sites coincide (1e-9 m), so that mink is asked what kinelab is; kinelab's steps
+on the bench's path keep the loops closed. Times are the bench's business, not a test's."""
+
+import numpy as np
+import pytest
+
+import kinelab
+from kinelab import cli
+from kinelab.report.bench import closed_step
+from kinelab.report.bench.steppers import Maps
+
+
+@pytest.mark.parametrize("name", ["fourbar", "ankle"])
+def test_mujoco_s_loop_sites_meet_at_kinelab_s_assemblies(name):
+    mujoco = pytest.importorskip("mujoco")
+    robot = kinelab.load(name)
+    model = closed_step.loop_model(robot)
+    maps, data = Maps(robot, model), mujoco.MjData(model)
+    home = robot.assemble(robot.neutral())
+    motors = [robot.model.joints[robot.model.getJointId(a)].idx_q for a in robot.actuated]
+    rng = np.random.default_rng(2)
+    met = 0
+    for _ in range(10):
+        q = home.copy()
+        q[motors] += rng.uniform(-0.3, 0.3, len(motors))
+        try:
+            q = robot.assemble(q)
+        except kinelab.AssemblyError:
+            continue
+        data.qpos[:] = maps.to_mujoco(q)
+        mujoco.mj_kinematics(model, data)
+        for k in range(len(robot.closures)):
+            a, b = data.site(f"loop{k}a").xpos, data.site(f"loop{k}b").xpos
+            assert np.linalg.norm(a - b) <= 1e-9
+        met += 1
+    assert met >= 5
+
+
+def test_kinelab_keeps_the_loops_on_the_bench_path():
+    rows = closed_step.run_robot("fourbar", steps=60, rounds=1)
+    mine = next(r for r in rows if r["library"] == "kinelab")
+    assert mine["steps"] == 60 and mine["max_loop_error"] <= 1e-9
+
+
+def test_the_delta_is_named_as_the_robot_the_bench_cannot_pose(capsys):
+    code = cli.main(["bench", "--closed", "--robots", "delta"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "orientation loop" in err[0]
