@@ -238,3 +238,27 @@ def test_many_degenerate_rows_still_give_a_step():
         assert result.solved, result.status
         q = result.q
         assert found.closest(q)[1] >= -1e-4
+
+
+def test_a_mesh_obstacle_is_kept_at_the_margin(tmp_path):
+    """A mesh obstacle (an example-robot-data STL, scaled 2×, in the hand's way; coal's distance from a hull to the
+    mesh's triangles): the hand sent into it stops with every pair clear of the margin, the mesh named nearest."""
+    import json
+    import shutil
+
+    panda = kinelab.load("panda")
+    shutil.copy(panda.robot.source.parents[1] / "meshes" / "collision" / "link0.stl", tmp_path / "block.stl")
+    (tmp_path / "scene.json").write_text(json.dumps({"obstacles": [
+        {"shape": "mesh", "mesh": "block.stl", "size": [2.0], "xyz": [0.5, 0.0, 0.1], "name": "block"}]}))
+    spec = Collisions(environment=Environment.from_file(tmp_path / "scene.json"), margin=0.01)
+    robot = as_robot(panda)
+    found = clearance.step_collisions(robot, spec)
+    problem = WholeBody(panda, [FrameTask(robot.hands[0], np.array([0.5, 0.0, 0.1]), task="position")],
+                        limits=Limits(collisions=spec))
+    q, worst = robot.neutral(), np.inf
+    for _ in range(300):
+        result = problem.step(q, DT)
+        q = result.q
+        worst = min(worst, found.closest(q)[1])
+    assert worst >= -1e-4 and result.closest is not None and result.closest.second == "block"
+    assert abs(result.closest.distance - 0.01) <= 1e-3
