@@ -48,14 +48,14 @@ BUNDLED = (
     # display poses: the paper's target (stanford), an arm bent at every joint (era), the youBot's arm bent
     # forward on its platform at the origin; σ_min/σ_max of the scaled Jacobian 0.11, 0.12 and 0.045
     Entry("stanford", "kinelab", "stanford.urdf", "tool",
-          "Stanford arm RRPRRR, frames of Lomovtseva & Chelnokov (seed 001)",
+          "Stanford arm RRPRRR, in the frames of Lomovtseva & Chelnokov's biquaternion paper",
           display=(0.34906585, 0.6981317, 0.3, -0.61086524, 1.04719755, -0.78539816)),
     Entry("era", "kinelab", "era.urdf", "tool",
-          "European Robotic Arm, 7R symmetric, approximate geometry (seed 000)",
+          "European Robotic Arm, 7R symmetric, approximate geometry (Danilov et al.'s FRDM paper)",
           display=(0.3, 0.5, -0.6, -1.3, 0.6, 0.4, 0.2)),
     Entry("youbot", "kinelab", "youbot.urdf", "tool",
-          "KUKA youBot arm on its planar base: platform_x, platform_y, platform_yaw, arm_joint_1..5 (the paper's "
-          "X_C, Y_C, theta, theta1..theta5; seed 003)",
+          "KUKA youBot arm on its planar base: platform_x, platform_y, platform_yaw, arm_joint_1..5 (Kapustina's "
+          "X_C, Y_C, theta, theta1..theta5)",
           display=(0.0, 0.0, 0.0, 0.3, 0.5, 0.9, 0.7, 0.0)),
     Entry("xarm6", "kinelab", "xarm6.urdf", "link_eef",
           "UFACTORY xArm6, 6R without three axes meeting, from the maker's DH table"),
