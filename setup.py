@@ -37,6 +37,6 @@ setup(
     ext_modules=cythonize(extensions, language_level=3, include_path=[str(ROOT / "src")]),
     package_dir={"": "src", "kinelab.urdf": "urdf"},
     packages=[*find_packages("src"), "kinelab.urdf"],
-    package_data={"kinelab.urdf": ["*.urdf", "*.yaml"], "kinelab.core": ["*.pyx", "*.pxd", "*.pxi", "*.pyi"],
+    package_data={"kinelab.urdf": ["*.urdf", "*.yaml", "*.xml"], "kinelab.core": ["*.pyx", "*.pxd", "*.pxi", "*.pyi"],
                   "kinelab.view.teach": ["*.html", "*.js"]},
 )

@@ -147,3 +147,29 @@ def test_a_class_that_no_default_defines_is_refused_by_name(tmp_path):
         load(path)
     path.write_text(text.replace('<body name="base"', '<body name="base" childclass="arm"', 1))
     assert load(path).joint_names == ["j1", "j2", "j3"]
+
+
+@pytest.mark.parametrize("degrees", [False, True])
+def test_a_hinge_with_a_ref_keeps_the_files_range(tmp_path, degrees):
+    """Pinocchio's parser shifts a hinge's range by its ``ref`` while the angle stays MuJoCo's qpos; kinelab puts
+    the file's range back (j1's range (-2, 2) rad with ref 0.5: the limits stay (-2, 2), and the placement at
+    q = ref is the one written in the file, as in MuJoCo)."""
+    path = write_mjcf(tmp_path, degrees=degrees)
+    ref = "28.647890" if degrees else "0.5"
+    path.write_text(path.read_text().replace('name="j1" type="hinge"', f'name="j1" type="hinge" ref="{ref}"'))
+    robot = load(path, whole=True)
+    i = robot.model.joints[robot.model.getJointId("j1")].idx_q
+    assert robot.model.lowerPositionLimit[i] == pytest.approx(-2.0, abs=1e-6)
+    assert robot.model.upperPositionLimit[i] == pytest.approx(2.0, abs=1e-6)
+    q = robot.neutral()
+    q[i] = 0.5
+    assert robot.frame_placement(q, "l2").translation == pytest.approx([0.0, 0.1, 0.5], abs=1e-6)
+
+
+def test_floating_puts_a_free_flyer_under_an_mjcf_once(tmp_path):
+    """``floating=True`` on a file without a free joint adds one (nq 3 + 7); on a file whose root body carries its
+    own ``<freejoint>`` none is added twice."""
+    fixed = load(write_mjcf(tmp_path), floating=True)
+    assert fixed.floating and fixed.nq == 10 and fixed.model.joints[1].shortname() == "JointModelFreeFlyer"
+    own = load(write_mjcf(tmp_path, free=True, name="free.xml"), floating=True)
+    assert own.floating and own.nq == 10 and own.model.njoints == 5

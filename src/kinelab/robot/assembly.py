@@ -134,28 +134,52 @@ def newton(robot: Robot, q: np.ndarray, passive: np.ndarray, tol: float) -> tupl
     if np.max(np.abs(e), initial=0.0) <= tol * 1e-2:  # closed already (every step's start): no Jacobian to build
         return q, float(np.max(np.abs(e), initial=0.0))
     e, J = loop_state(model, data, q, robot.closures)
-    norm, slow = float(np.linalg.norm(e)), 0
+    norm, slow, free = float(np.linalg.norm(e)), 0, passive
+    bounds = _scalar_bounds(model, passive)
     for _ in range(NEWTON_ITERATIONS):
-        if np.max(np.abs(e), initial=0.0) <= tol * 1e-2 or J is None:
+        if np.max(np.abs(e), initial=0.0) <= tol * 1e-2 or J is None or free.size == 0:
             break
-        Jp = J[:, passive]
-        dx = np.linalg.solve(Jp.T @ Jp + (norm * norm + 1e-14) * np.eye(passive.size), -Jp.T @ e)
+        Jp = J[:, free]
+        dx = np.linalg.solve(Jp.T @ Jp + (norm * norm + 1e-14) * np.eye(free.size), -Jp.T @ e)
         dv = np.zeros(model.nv)
         for alpha in (1.0, 0.5, 0.25, 0.125, 0.0625, 0.03125):
-            dv[passive] = alpha * dx
-            trial = pin.integrate(model, q, dv)
+            dv[free] = alpha * dx
+            trial, clamped = _clamped(bounds, pin.integrate(model, q, dv))
             e_trial, _ = loop_state(model, data, trial, robot.closures, jacobian=False)
             if np.linalg.norm(e_trial) < norm:
                 break
         else:
             break
-        q = trial
+        q, free = trial, np.setdiff1d(free, clamped)
         e, J = loop_state(model, data, q, robot.closures)
         slow = slow + 1 if np.linalg.norm(e) > 0.99 * norm else 0
         norm = float(np.linalg.norm(e))
         if slow >= 3:  # a gap that no longer shrinks: a local least-squares minimum, not a closing loop
             break
     return q, float(np.max(np.abs(e), initial=0.0))
+
+
+def _scalar_bounds(model: pin.Model, passive: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The passive joints with one coordinate and finite limits: (their v indices, q indices, lower, upper)."""
+    pairs = [(model.joints[j].idx_v, model.joints[j].idx_q) for j in range(1, model.njoints)
+             if model.joints[j].nq == model.joints[j].nv == 1 and model.joints[j].idx_v in set(passive.tolist())
+             and np.isfinite(model.lowerPositionLimit[model.joints[j].idx_q])
+             and np.isfinite(model.upperPositionLimit[model.joints[j].idx_q])]
+    iv = np.array([p[0] for p in pairs], dtype=int)
+    iq = np.array([p[1] for p in pairs], dtype=int)
+    return iv, iq, model.lowerPositionLimit[iq], model.upperPositionLimit[iq]
+
+
+def _clamped(bounds: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+             q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """q with its bounded passive coordinates put back into their limits, and the v indices that were put back
+    (held at their limit from there on: the other passive joints close the loop, as the real mechanism's stop)."""
+    iv, iq, lower, upper = bounds
+    clipped = np.clip(q[iq], lower, upper)
+    moved = clipped != q[iq]
+    q = q.copy()
+    q[iq] = clipped
+    return q, iv[moved]
 
 
 def _random_passive(robot: Robot, q: np.ndarray, passive: np.ndarray, rng: np.random.Generator) -> np.ndarray:

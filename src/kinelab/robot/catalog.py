@@ -77,6 +77,10 @@ CLOSED = (  # bundled robots that close loops (kinelab.robot.closures): whole ro
     Entry("ankle", "kinelab", "ankle.urdf", None,
           "two-rod parallel ankle: pitch and roll of the foot driven by two motors on the shin through two rods",
           whole=True, closures="ankle.closures.yaml", hands=("sole",)),
+    Entry("cassie", "kinelab", "cassie.xml", None,
+          "Agility Robotics Cassie, both legs (MuJoCo Menagerie's MJCF, reduced): five motors a leg, the achilles "
+          "and plantar rods closing two loops a leg (MJCF <connect> equalities), the springs passive",
+          whole=True, floating=True, hands=("left-foot",), feet=("right-foot",)),
 )
 
 ERD_ARMS = (

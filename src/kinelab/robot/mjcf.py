@@ -41,12 +41,24 @@ def read_mjcf(path: Path, root: pin.JointModel | None = None) -> tuple[pin.Model
         URDFError: a file Pinocchio cannot read (the file and Pinocchio's reason named).
     """
     check_mjcf(path)
+    root = None if floats(path) else root
     try:
-        model = pin.buildModelFromMJCF(str(path)) if root is None else pin.buildModelFromMJCF(str(path), root)
+        model = pin.buildModelFromMJCF(str(path)) if root is None else \
+            pin.buildModelAndConstraintsFromMJCF(str(path), root, "root_joint")[0]  # the unambiguous overload
     except Exception as exc:  # noqa: BLE001 - the parser raises RuntimeError, ValueError, IndexError, ...
         raise URDFError(f"Pinocchio cannot read the MJCF {path}: {type(exc).__name__}: {exc}") from None
     _restore_slide_ranges(model, ET.fromstring(read_text(path, "MJCF file", URDFError)))
     return model, body_tree(model)
+
+
+def floats(path: Path) -> bool:
+    """True when the file's root body carries its own free joint (``<freejoint>``, or a ``<joint type="free">``):
+    the robot floats as written, and a free-flyer asked for on top of it is not added twice."""
+    world = ET.fromstring(read_text(path, "MJCF file", URDFError)).find("worldbody")
+    for body in [] if world is None else world.findall("body"):
+        if body.find("freejoint") is not None or any(j.get("type") == "free" for j in body.findall("joint")):
+            return True
+    return False
 
 
 def meshes_outside(path: Path) -> list[str]:
@@ -200,15 +212,22 @@ def _check_range(path: Path, joint: ET.Element, name: str) -> None:
 
 
 def _restore_slide_ranges(model: pin.Model, root: ET.Element) -> None:
+    """Put back the file's ranges the parser changes: a slide joint's (converted to radians with the angles, when
+    they are in degrees) and a hinge's with a ``ref`` (shifted by ``ref``, while its angle is MuJoCo's qpos: the
+    placements agree with MuJoCo's at the same q, the ranges then do not)."""
     compiler = root.find("compiler")
-    if compiler is not None and compiler.get("angle", "degree") == "radian":
-        return
+    degrees = compiler is None or compiler.get("angle", "degree") != "radian"
     for joint in root.iter("joint"):
-        name, rng = joint.get("name"), joint.get("range")
-        if joint.get("type") == "slide" and name and rng and model.existJointName(name):
-            lo, hi = (float(v) for v in rng.split()[:2])
-            iq = model.idx_qs[model.getJointId(name)]
-            model.lowerPositionLimit[iq], model.upperPositionLimit[iq] = lo, hi
+        name, rng, kind = joint.get("name"), joint.get("range"), joint.get("type", "hinge")
+        if not (name and rng and model.existJointName(name)):
+            continue
+        lo, hi = (float(v) for v in rng.split()[:2])
+        if kind == "hinge" and joint.get("ref") is not None:
+            lo, hi = (math.radians(lo), math.radians(hi)) if degrees else (lo, hi)
+        elif not (kind == "slide" and degrees):
+            continue
+        iq = model.idx_qs[model.getJointId(name)]
+        model.lowerPositionLimit[iq], model.upperPositionLimit[iq] = lo, hi
 
 
 def body_tree(model: pin.Model) -> UrdfTree:
@@ -293,8 +312,8 @@ def equalities(path: Path, model: pin.Model, root: pin.JointModel | None = None)
     if tree.find("equality") is None:
         return (), actuated
     try:
-        built = (pin.buildModelAndConstraintsFromMJCF(str(path)) if root is None else
-                 pin.buildModelAndConstraintsFromMJCF(str(path), root))
+        built = (pin.buildModelAndConstraintsFromMJCF(str(path)) if root is None or floats(path) else
+                 pin.buildModelAndConstraintsFromMJCF(str(path), root, "root_joint"))
     except Exception as exc:  # noqa: BLE001 - the parser raises RuntimeError, ValueError, IndexError, ...
         warnings.warn(f"{path.name}: Pinocchio cannot read its <equality> constraints ({type(exc).__name__}: {exc}); "
                       "the robot is loaded without loops", stacklevel=3)

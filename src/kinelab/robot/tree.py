@@ -224,13 +224,25 @@ class Robot:
         return self._on_its_feet(q)
 
     def standing(self) -> np.ndarray:
-        """Where the robot stands: its SRDF's "half_sitting" (else its neutral configuration), its loops closed,
-        and a free-flyer robot with feet on them (the lowest foot at z = 0) [m, rad]."""
+        """Where the robot stands: its SRDF's "half_sitting", else an MJCF file's keyframe (``home``, else its
+        first), else its neutral configuration with a free-flyer robot's feet on the floor (the lowest foot at
+        z = 0); its loops closed [m, rad]."""
         try:
             q = self.named_q("half_sitting")
         except SRDFError:
-            q = self._on_its_feet(self.neutral())
+            keyframe = self._keyframe()
+            q = self._on_its_feet(self.neutral()) if keyframe is None else keyframe
         return self.assemble(q) if self.closures else q
+
+    def _keyframe(self) -> np.ndarray | None:
+        """The file's keyframe ``home`` (else its first one) as Pinocchio's parser read it, clipped into the
+        limits; None for a file without keyframes."""
+        entries = [(e.key(), np.array(e.data(), dtype=float)) for e in self.model.referenceConfigurations]
+        frames = {name: q for name, q in entries if name != "qpos0" and q.shape == (self.nq,)}
+        if not frames:
+            return None
+        q = frames.get("home", next(iter(frames.values())))
+        return np.clip(q, self.space.lower, self.space.upper)
 
     def _on_its_feet(self, q: np.ndarray) -> np.ndarray:
         """q with a free-flyer's height set so that the lowest of the robot's feet is on the floor (z = 0)."""
