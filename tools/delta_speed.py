@@ -46,7 +46,7 @@ def main() -> int:
     parser.add_argument("--n", type=int, default=300)
     args = parser.parse_args()
     robot = kinelab.load("delta")
-    hand, home = robot.hands[0], robot.assemble(robot.neutral())
+    hand, home = robot.hands[0], robot.standing()
     index = [robot.model.joints[robot.model.getJointId(a)].idx_q for a in robot.actuated]
     rng = np.random.default_rng(5)
     general, formula, met_general, met_formula = [], [], 0, 0

@@ -61,7 +61,7 @@ def regular_ranks(robot: Robot, output: str) -> tuple[int, int]:
 
 def _ranks(robot: Robot, output: str) -> tuple[int, int]:
     rng = np.random.default_rng(0)
-    home = robot.assemble(robot.neutral())
+    home = robot.standing()
     actuated = _actuated(robot)
     ranks = (0, 0)
     for _ in range(RANK_SAMPLES):

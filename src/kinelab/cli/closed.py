@@ -52,7 +52,7 @@ def run(robot: Robot, args: argparse.Namespace) -> int:
     if bad:
         raise KinelabError(f"{bad[0]!r} is not a number (give {len(robot.actuated)} motor values, rad or deg)")
     motors = np.array([float(v) for v in args.q]) * (math.pi / 180 if args.deg else 1.0)
-    q = _assembled(robot, robot.assemble(robot.neutral()), motors)
+    q = _assembled(robot, robot.standing(), motors)
     s = closed_singular.analyze(robot, q, output)
     if args.json:
         common.print_json({"robot": robot.name, "output": output, "q": q.tolist(), "sigma_serial": s.sigma_serial,
@@ -79,7 +79,7 @@ def _sweep(robot: Robot, output: str, args: argparse.Namespace) -> int:
         raise KinelabError(f"--sweep takes a number of samples ≥ 1, got {args.sweep}")
     rng = np.random.default_rng(args.seed)
     index = [robot.model.joints[robot.model.getJointId(a)].idx_q for a in robot.actuated]
-    home = robot.assemble(robot.neutral())  # once: every sample starts from it
+    home = robot.standing()  # once: every sample starts from it
     rows: list[tuple[float, float, np.ndarray]] = []
     refused = 0
     for _ in range(args.sweep):

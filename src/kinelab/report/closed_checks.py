@@ -77,7 +77,7 @@ def assembly_check(robot: Robot, n: int, seed: int) -> list[Check]:
     delta) the claims and refusals are its, the place its point."""
     rng = np.random.default_rng(seed + 11)
     data = robot.model.createData()
-    home = robot.assemble(robot.neutral())
+    home = robot.standing()
     actuated = [robot.model.joints[robot.model.getJointId(a)].idx_q for a in robot.actuated]
     reference = CLOSED_FORMS.get(robot.name)
     false = disagree = claimed = 0
@@ -147,7 +147,7 @@ def held_loops_check(robot: Robot, n: int, seed: int) -> list[Check]:
     rng = np.random.default_rng(seed + 12)
     data = robot.model.createData()
     hand = robot.hands[0]
-    q = robot.assemble(robot.neutral())
+    q = robot.standing()
     worst, failed = 0.0, 0
     problem = WholeBody(robot, [FrameTask(hand, robot.frame_placement(q, hand).translation, task="position")])
     for k in range(STEPS):
@@ -183,7 +183,7 @@ def solve_check(robot: Robot, n: int, seed: int) -> list[Check]:
 
     rng = np.random.default_rng(seed + 13)
     data = robot.model.createData()
-    hand, home = robot.hands[0], robot.assemble(robot.neutral())
+    hand, home = robot.hands[0], robot.standing()
     met = false = 0
     for k in range(TARGETS):
         target = robot.frame_placement(_random_assembly(robot, home, rng), hand).translation

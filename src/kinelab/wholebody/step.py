@@ -16,6 +16,7 @@ import pinocchio as pin
 
 from kinelab.collision.model import Contact
 from kinelab.errors import OptionError
+from kinelab.robot.closures import ASSEMBLY_TOL
 from kinelab.robot.tree import Robot
 from kinelab.values import is_real
 from kinelab.wholebody import clearance, qp
@@ -206,15 +207,31 @@ def _shortened(robot: Robot, q: np.ndarray, dt: float, found: clearance.StepColl
 
 def _settled(robot: Robot, q: np.ndarray, dt: float, tasks: tuple[Task, ...], result: StepResult) -> StepResult:
     """The step's q projected onto the equalities the QP holds to first order only (a loop's), v = (q_next ⊖ q)/dt
-    again: the drift a step leaves (O(|v dt|²)) removed where it is made, not carried to the next step."""
-    q_next = result.q.copy()
-    for task in tasks:
-        if task.settled:
-            task.project(robot, q_next)
+    again: the drift a step leaves (O(|v dt|²)) removed where it is made, not carried to the next step. A step too
+    long for the projection to close the loops from (a passive joint at its stop on the way) is halved until it
+    can (at most 8 times; else the whole step, as the QP gave it)."""
+    q_next, step = _projected(robot, q, result.q, tasks), result.v * dt
+    for _ in range(8 if robot.closures else 0):
+        if np.max(np.abs(robot.closure_error(q_next)), initial=0.0) <= ASSEMBLY_TOL:
+            break
+        step = 0.5 * step
+        shorter = _projected(robot, q, np.asarray(pin.integrate(robot.model, q, step), dtype=float), tasks)
+        if np.max(np.abs(robot.closure_error(shorter)), initial=0.0) <= ASSEMBLY_TOL:
+            q_next = shorter
+            break
     v = np.asarray(pin.difference(robot.model, q, q_next), dtype=float) / dt
     settled = StepResult(v, q_next, result.status, result.solved, result.errors, result.returning, result.iterations)
     settled.closest = result.closest
     return settled
+
+
+def _projected(robot: Robot, q: np.ndarray, q_next: np.ndarray, tasks: tuple[Task, ...]) -> np.ndarray:
+    """q_next with every settled task's projection applied (a copy)."""
+    q_next = q_next.copy()
+    for task in tasks:
+        if task.settled:
+            task.project(robot, q_next)
+    return q_next
 
 
 def _result(robot: Robot, q: np.ndarray, dt: float, solution: qp.Solution, errors: tuple[TaskError, ...],

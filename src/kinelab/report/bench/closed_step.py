@@ -36,7 +36,7 @@ POSTURE = 1e-3
 def targets(robot: Robot, steps: int) -> tuple[np.ndarray, list[np.ndarray]]:
     """The assembled start and the tool's place at each step: the motors swept by sines (0.3 rad, periods of 2-3 s)
     about the start, each sample assembled from the one before."""
-    home = robot.assemble(robot.neutral())
+    home = robot.standing()
     motors = [robot.model.joints[robot.model.getJointId(a)].idx_q for a in robot.actuated]
     q, out = home.copy(), []
     for k in range(steps):
