@@ -6,7 +6,6 @@ loops held over a long run of steps, converged solves on reachable targets. Corr
 from __future__ import annotations
 
 import argparse
-import contextlib
 import sys
 import time
 
@@ -128,7 +127,7 @@ def solves(robot: kinelab.Robot, n: int, seed: int) -> str:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true", help="a tenth of every count")
-    parser.add_argument("--robots", default="fourbar,delta,ankle", help="robots with loops (default: fourbar, delta, ankle; cassie too)")
+    parser.add_argument("--robots", default="fourbar,delta,ankle", help="robots with loops (or cassie)")
     parser.add_argument("--figures", default="assemblies,held,solves", help="which figures (default: all three)")
     args = parser.parse_args()
     scale = 10 if args.quick else 1
