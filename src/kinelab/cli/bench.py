@@ -109,8 +109,9 @@ def add(sub: Subcommands) -> None:
                         "among panda, baxter, talos, g1; default all four), --repeats rounds, and the converged "
                         "solve against pink iterated (--n targets per robot)")
     s.add_argument("--closed", action="store_true",
-                   help="instead of the arm protocol: the step on robots that close loops (fourbar, ankle) side by "
-                        "side with mink's EqualityConstraintTask, --repeats rounds of 1,000 steps: time, loop error")
+                   help="instead of the arm protocol: the step on robots that close loops (fourbar, ankle, cassie) "
+                        "side by side with mink's EqualityConstraintTask, --repeats rounds of 1,000 steps: time, "
+                        "loop error")
     s.add_argument("--collisions-step", action="store_true",
                    help="instead of the arm protocol: the whole-body step holding collisions side by side with mink's "
                         "CollisionAvoidanceLimit and pink's self-collision barrier (--robots among panda, talos; "

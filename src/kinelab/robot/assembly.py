@@ -29,6 +29,9 @@ class Robot(Protocol):
     def within_limits(self, q: Any) -> bool:
         """Whether q is within the joint limits."""
 
+    def derived(self, key: str, build: Any) -> Any:
+        """Data derived from the robot, built on first use and kept."""
+
     def random_q(self, rng: np.random.Generator) -> np.ndarray:
         """A configuration drawn within the limits."""
 
@@ -52,6 +55,8 @@ def closure_error(model: pin.Model, data: pin.Data, closure: Closure, frames: tu
         The error [m, rad], one number per held component.
     """
     aMb = data.oMf[frames[0]].actInv(data.oMf[frames[1]])
+    if closure.rows[-1] < 3:  # a point loop: its rotation is not held
+        return aMb.translation[closure.rows]
     return np.concatenate([aMb.translation, pin.log3(aMb.rotation)])[closure.rows]
 
 
@@ -64,11 +69,13 @@ def closure_jacobian(model: pin.Model, data: pin.Data, closure: Closure, frames:
     oMa, oMb = data.oMf[frames[0]], data.oMf[frames[1]]
     Ja = pin.getFrameJacobian(model, data, frames[0], pin.LOCAL_WORLD_ALIGNED)
     Jb = pin.getFrameJacobian(model, data, frames[1], pin.LOCAL_WORLD_ALIGNED)
-    J = np.empty((6, model.nv))
+    J = np.zeros((6, model.nv))
+    rows = closure.rows
     J[:3] = oMa.rotation.T @ (Jb[:3] - Ja[:3] + pin.skew(oMb.translation - oMa.translation) @ Ja[3:])
-    R_ab = oMa.rotation.T @ oMb.rotation
-    J[3:] = pin.Jlog3(R_ab) @ oMb.rotation.T @ (Jb[3:] - Ja[3:])
-    return J[closure.rows]
+    if rows[-1] >= 3:  # a loop that holds a rotation (a point loop's rows are all linear)
+        R_ab = oMa.rotation.T @ oMb.rotation
+        J[3:] = pin.Jlog3(R_ab) @ oMb.rotation.T @ (Jb[3:] - Ja[3:])
+    return J[rows]
 
 
 def frame_ids(model: pin.Model, closures: Sequence[Closure]) -> list[tuple[int, int]]:
@@ -135,7 +142,7 @@ def newton(robot: Robot, q: np.ndarray, passive: np.ndarray, tol: float) -> tupl
         return q, float(np.max(np.abs(e), initial=0.0))
     e, J = loop_state(model, data, q, robot.closures)
     norm, slow, free = float(np.linalg.norm(e)), 0, passive
-    bounds = _scalar_bounds(model, passive)
+    bounds = robot.derived(f"passive bounds {passive.tobytes().hex()}", lambda r: _scalar_bounds(r.model, passive))
     for _ in range(NEWTON_ITERATIONS):
         if np.max(np.abs(e), initial=0.0) <= tol * 1e-2 or J is None or free.size == 0:
             break

@@ -20,6 +20,7 @@ list of closures and the independent, here ``actuated``, joints)::
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -68,7 +69,7 @@ class Closure:
         """Which of [x, y, z, rx, ry, rz] the loop holds."""
         return KINDS[self.kind] if isinstance(self.kind, str) else self.kind
 
-    @property
+    @functools.cached_property
     def rows(self) -> np.ndarray:
         """The indices of the held components."""
         return np.flatnonzero(self.mask)

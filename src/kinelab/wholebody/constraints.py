@@ -193,8 +193,12 @@ class ClosureTask(Task):
 
     def project(self, robot: Robot, q: np.ndarray) -> None:
         """The passive joints moved to close the loops (Gauss–Newton, the actuated joints held; q changed in place
-        where it closes them)."""
-        closed, residual = newton(robot, q, passive_indices(robot, robot.actuated), ASSEMBLY_TOL)
+        where it closes them). Every loop of the robot at once: the task of its first loop does it, the others'
+        find them closed."""
+        if robot.closures and self.closure in robot.closures[1:]:
+            return
+        passive = robot.derived("loops' passive joints", lambda r: passive_indices(r, r.actuated))
+        closed, residual = newton(robot, q, passive, ASSEMBLY_TOL)
         if residual <= ASSEMBLY_TOL:
             q[:] = closed
 

@@ -3,10 +3,12 @@
 
 Robots: the four-bar (its coupler tip) and the parallel ankle (its sole), whose loops are point closures that MuJoCo
 writes as ``connect`` equalities between two sites (the delta's third loop holds an orientation alone, which
-MuJoCo's equalities cannot say: it is left out). MuJoCo's model is compiled from the same URDF (the whole-body
-bench's, :func:`kinelab.report.bench.steppers.mujoco_spec`) with a site at each closure frame and a connect
-between each loop's two sites. The targets: the tool's place along the robot's own motion (its motors swept by
-sines, each sample assembled), one per step of 5 ms, from the assembled start. kinelab holds each loop as an
+MuJoCo's equalities cannot say: it is left out), and Cassie (both feet and the pelvis as poses, its four loops).
+MuJoCo's model of a URDF is compiled from the same file (the whole-body bench's,
+:func:`kinelab.report.bench.steppers.mujoco_spec`) with a site at each closure frame and a connect between each
+loop's two sites; an MJCF robot (Cassie) is the file itself, whose connects are the loops kinelab read. The
+targets: the tasks' frames along the robot's own motion (its motors swept by sines, each sample assembled), one
+per step of 5 ms, from the assembled start. kinelab holds each loop as an
 equality of its QP; mink asks it as a task of cost 1e3 (its equalities are soft). Position limits only, DAQP for
 both, a posture of weight 1e-3. Per step: the library's step and integration time, the loops' largest error by
 Pinocchio at its configuration (mink's mapped by joint name), and the tool's distance to its target. The two are
@@ -24,27 +26,45 @@ import numpy as np
 from kinelab.errors import KinelabError
 from kinelab.report.bench.steppers import Maps, mujoco_spec
 from kinelab.robot import load
+from kinelab.robot.mjcf import is_mjcf
 from kinelab.robot.tree import Robot
 from kinelab.wholebody import FrameTask, Limits, PostureTask, StepOptions, WholeBody
 
 DT = 0.005
-ROBOTS = ("fourbar", "ankle")
+ROBOTS = ("fourbar", "ankle", "cassie")
 EQUALITY_COST = 1e3  # mink's loops, asked far above its tool's cost 1
 POSTURE = 1e-3
+POSES = {"cassie": ("left-foot", "right-foot", "cassie-pelvis")}  # frames held as whole poses (else: the tool's place)
 
 
-def targets(robot: Robot, steps: int) -> tuple[np.ndarray, list[np.ndarray]]:
-    """The assembled start and the tool's place at each step: the motors swept by sines (0.3 rad, periods of 2-3 s)
-    about the start, each sample assembled from the one before."""
+def frames(robot: Robot) -> list[tuple[str, str]]:
+    """The bench's tasks: (frame, "pose" or "position")."""
+    return [(f, "pose") for f in POSES[robot.name]] if robot.name in POSES else [(robot.hands[0], "position")]
+
+
+def targets(robot: Robot, steps: int) -> tuple[np.ndarray, list[list[Any]]]:
+    """The assembled start and each task's target at each step (an SE3 for a pose, a point for a position): the
+    motors swept by sines (0.3 rad, periods of 2-3 s, within their limits) about the start, each sample assembled
+    from the one before."""
     home = robot.standing()
     motors = [robot.model.joints[robot.model.getJointId(a)].idx_q for a in robot.actuated]
+    lower, upper = robot.model.lowerPositionLimit[motors], robot.model.upperPositionLimit[motors]
+    periods = 2.0 + np.arange(len(motors)) / max(len(motors) - 1, 1)
     q, out = home.copy(), []
     for k in range(steps):
         q = q.copy()
-        q[motors] = home[motors] + 0.3 * np.sin(2 * np.pi * k * DT / (2.0 + np.arange(len(motors))))
+        q[motors] = np.clip(home[motors] + 0.3 * np.sin(2 * np.pi * k * DT / periods), lower, upper)
         q = robot.assemble(q)
-        out.append(robot.frame_placement(q, robot.hands[0]).translation)
+        out.append([robot.frame_placement(q, f) if kind == "pose" else robot.frame_placement(q, f).translation
+                    for f, kind in frames(robot)])
     return home, out
+
+
+def tool_error(robot: Robot, q: np.ndarray, goal: list[Any]) -> float:
+    """The largest distance of a task's frame from its target's place [m]."""
+    return max(float(np.linalg.norm(robot.frame_placement(q, f).translation
+                                    - (g.translation if kind == "pose" else g)))
+               for (f, kind), g in zip(frames(robot), goal, strict=True))
 
 
 class KinelabLoops:
@@ -54,14 +74,16 @@ class KinelabLoops:
 
     def __init__(self, robot: Robot, home: np.ndarray):
         self.robot, self.q = robot, home.copy()
-        self.problem = WholeBody(robot, [FrameTask(robot.hands[0], robot.frame_placement(home, robot.hands[0])
-                                                   .translation, task="position"),
-                                         PostureTask(home, weight=POSTURE)],
-                                 limits=Limits(velocity=None), options=StepOptions(damping=1e-12))
+        tasks: list[Any] = [FrameTask(f, robot.frame_placement(home, f) if kind == "pose"
+                                      else robot.frame_placement(home, f).translation, task=kind)
+                            for f, kind in frames(robot)]
+        self.problem = WholeBody(robot, [*tasks, PostureTask(home, weight=POSTURE)], limits=Limits(velocity=None),
+                                 options=StepOptions(damping=1e-12))
 
-    def step(self, target: np.ndarray) -> None:
-        """One step toward the tool's target, integrated."""
-        self.problem.set_target(0, target)
+    def step(self, goal: list[Any]) -> None:
+        """One step toward the tasks' targets, integrated."""
+        for i, target in enumerate(goal):
+            self.problem.set_target(i, target)
         self.q = self.problem.step(self.q, DT).q
 
     def pinocchio_q(self) -> np.ndarray:
@@ -70,7 +92,7 @@ class KinelabLoops:
 
 
 class MinkLoops:
-    """mink's step, the loops an ``EqualityConstraintTask`` on MuJoCo's connect equalities."""
+    """mink's step, the loops an ``EqualityConstraintTask`` on MuJoCo's connect equalities (an MJCF robot's own)."""
 
     name = "mink"
 
@@ -82,15 +104,21 @@ class MinkLoops:
         self.maps = Maps(robot, self.model)
         self.configuration = mink.Configuration(self.model)
         self.configuration.update(self.maps.to_mujoco(home))
-        self.tool = mink.FrameTask(robot.hands[0], "body", position_cost=1.0, orientation_cost=0.0)
+        self.frames = [mink.FrameTask(f, "body", position_cost=1.0, orientation_cost=1.0 if kind == "pose" else 0.0)
+                       for f, kind in frames(robot)]
         posture = mink.PostureTask(self.model, cost=np.sqrt(POSTURE))
         posture.set_target_from_configuration(self.configuration)
-        self.tasks = [self.tool, posture, mink.EqualityConstraintTask(self.model, cost=EQUALITY_COST)]
+        self.tasks = [*self.frames, posture, mink.EqualityConstraintTask(self.model, cost=EQUALITY_COST)]
         self.limits = [mink.ConfigurationLimit(self.model)]
 
-    def step(self, target: np.ndarray) -> None:
-        """One step toward the tool's target, integrated."""
-        self.tool.set_target(self.mink.SE3.from_translation(np.asarray(target, dtype=float)))
+    def step(self, goal: list[Any]) -> None:
+        """One step toward the tasks' targets, integrated."""
+        for task, target in zip(self.frames, goal, strict=True):
+            if isinstance(target, np.ndarray):
+                task.set_target(self.mink.SE3.from_translation(np.asarray(target, dtype=float)))
+            else:
+                task.set_target(self.mink.SE3.from_rotation_and_translation(
+                    self.mink.SO3.from_matrix(target.rotation), target.translation))
         qvel = self.mink.solve_ik(self.configuration, self.tasks, DT, "daqp", damping=1e-12, limits=self.limits)
         self.configuration.integrate_inplace(qvel, DT)
 
@@ -108,6 +136,8 @@ def loop_model(robot: Robot) -> Any:
     """
     import mujoco
 
+    if robot.source is not None and is_mjcf(robot.source):
+        return mujoco.MjModel.from_xml_path(str(robot.source))  # the file's own equalities, the loops kinelab read
     if any(tuple(c.mask) != (1, 1, 1, 0, 0, 0) and tuple(c.mask) != (1, 1, 0, 0, 0, 0) for c in robot.closures):
         raise KinelabError(f"{robot.name} holds a loop that is not a point closure: MuJoCo's connect cannot say it")
     spec = mujoco_spec(robot)
@@ -143,8 +173,7 @@ def run_robot(name: str, steps: int, rounds: int) -> list[dict[str, Any]]:
                 times[s.name].append(time.perf_counter() - t0)
                 q = s.pinocchio_q()
                 rec[s.name]["loop"].append(float(np.abs(robot.closure_error(q)).max()))
-                rec[s.name]["tool"].append(float(np.linalg.norm(robot.frame_placement(q, robot.hands[0])
-                                                                .translation - target)))
+                rec[s.name]["tool"].append(tool_error(robot, q, target))
         for key, t in times.items():
             rec[key]["t"] += t
             rec[key]["medians"].append(float(np.median(t)))
@@ -154,7 +183,8 @@ def run_robot(name: str, steps: int, rounds: int) -> list[dict[str, Any]]:
 
 
 def run(robots: list[str] | None = None, steps: int = 1000, rounds: int = 3) -> dict[str, Any]:
-    """The protocol on each robot (default: the four-bar and the ankle), kinelab's median over mink's per round.
+    """The protocol on each robot (default: the four-bar, the ankle and Cassie), kinelab's median over mink's per
+    round.
 
     Raises:
         KinelabError: a robot without a loop bench (the valid names listed).

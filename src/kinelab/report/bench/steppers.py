@@ -215,21 +215,28 @@ class MinkStepper:
 
 
 class Maps:
-    """Pinocchio's q and v ↔ MuJoCo's qpos and qvel, joint by joint by name (a free joint's quaternion reordered:
-    x y z w ↔ w x y z; its velocity, world-linear in MuJoCo, is left out of :meth:`velocity`: its limits are
-    infinite)."""
+    """Pinocchio's q and v ↔ MuJoCo's qpos and qvel, joint by joint by name (a free joint's and a ball joint's
+    quaternion reordered: x y z w ↔ w x y z; a free joint's velocity, world-linear in MuJoCo, is left out of
+    :meth:`velocity`: its limits are infinite)."""
 
     def __init__(self, robot: Robot, model: Any):
         self.robot, self.nq = robot, int(model.nq)
         self.free: int | None = None
         self.pairs: list[tuple[int, int, int, int]] = []  # (pinocchio idx_q, idx_v, MuJoCo qpos, qvel address)
+        self.balls: list[tuple[int, int]] = []  # (pinocchio idx_q, MuJoCo qpos address) of each ball joint
         for i in range(model.njnt):
             name = model.joint(i).name
             if model.jnt_type[i] == 0:
                 self.free = int(model.jnt_qposadr[i])
             elif robot.model.existJointName(name):
                 joint = robot.model.joints[robot.model.getJointId(name)]
-                self.pairs.append((joint.idx_q, joint.idx_v, int(model.jnt_qposadr[i]), int(model.jnt_dofadr[i])))
+                if model.jnt_type[i] == 1:
+                    self.balls.append((joint.idx_q, int(model.jnt_qposadr[i])))
+                    self.pairs += [(joint.idx_v + k, joint.idx_v + k, -1, int(model.jnt_dofadr[i]) + k)
+                                   for k in range(3)]
+                else:
+                    self.pairs.append((joint.idx_q, joint.idx_v, int(model.jnt_qposadr[i]),
+                                       int(model.jnt_dofadr[i])))
 
     def to_mujoco(self, q: np.ndarray) -> np.ndarray:
         """MuJoCo's qpos of Pinocchio's q."""
@@ -238,7 +245,10 @@ class Maps:
             a = self.free
             out[a:a + 3], out[a + 3], out[a + 4:a + 7] = q[:3], q[6], q[3:6]
         for iq, _, adr, _ in self.pairs:
-            out[adr] = q[iq]
+            if adr >= 0:
+                out[adr] = q[iq]
+        for iq, adr in self.balls:
+            out[adr], out[adr + 1:adr + 4] = q[iq + 3], q[iq:iq + 3]
         return out
 
     def from_mujoco(self, qpos: np.ndarray) -> np.ndarray:
@@ -248,7 +258,10 @@ class Maps:
             a = self.free
             out[:3], out[3:6], out[6] = qpos[a:a + 3], qpos[a + 4:a + 7], qpos[a + 3]
         for iq, _, adr, _ in self.pairs:
-            out[iq] = qpos[adr]
+            if adr >= 0:
+                out[iq] = qpos[adr]
+        for iq, adr in self.balls:
+            out[iq:iq + 3], out[iq + 3] = qpos[adr + 1:adr + 4], qpos[adr]
         return out
 
     def velocity(self, qvel: np.ndarray) -> np.ndarray:
