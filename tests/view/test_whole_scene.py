@@ -28,7 +28,7 @@ def test_a_humanoid_stands_on_the_floor_and_every_part_is_above_it():
         scene.close()
 
 
-@pytest.mark.parametrize("name", ["delta", "fourbar"])
+@pytest.mark.parametrize("name", ["delta", "fourbar", "cassie"])
 def test_a_robot_with_loops_is_drawn_with_every_loop_closed_and_its_ends_drawn(name):
     robot = kinelab.load(name)
     scene = WholeScene(robot)
@@ -43,6 +43,20 @@ def test_a_robot_with_loops_is_drawn_with_every_loop_closed_and_its_ends_drawn(n
         for k in range(len(robot.closures)):
             assert {f"/meshcat/loops/loop_{k}/a", f"/meshcat/loops/loop_{k}/b"} <= paths
         assert not any(p.endswith("/gap") for p in paths)  # no loop drawn open
+    finally:
+        scene.close()
+
+
+def test_a_file_without_visual_geometry_is_drawn_with_its_collision_geometry():
+    """kinelab's Cassie has capsules for collision and no visual geometry: the scene draws its 23 capsules and
+    spheres instead of nothing."""
+    robot = kinelab.load("cassie")
+    assert robot.visual_model().ngeoms == 0 and robot.visual_model("collision").ngeoms == 23
+    scene = WholeScene(robot)
+    try:
+        assert scene.pinviz.visual_model.ngeoms == 23
+        paths = browser.scene_paths(scene.static_html())
+        assert sum(p.startswith("/meshcat/cassie/") for p in paths) >= 23
     finally:
         scene.close()
 

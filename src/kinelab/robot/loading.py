@@ -14,14 +14,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pinocchio as pin
 
 from kinelab.errors import ChainError, OptionError
 from kinelab.robot import catalog, descriptions
 from kinelab.robot.build import Built, whole_model
 from kinelab.robot.chain import Chain
 from kinelab.robot.closures import Closure, read_closures
-from kinelab.robot.meshes import build_visual_model, mesh_package_dirs
+from kinelab.robot.meshes import build_visual_model, mesh_package_dirs, mjcf_geometry
 from kinelab.robot.mjcf import is_mjcf
 from kinelab.robot.reduce import build_file
 from kinelab.robot.tree import Robot
@@ -173,7 +172,7 @@ def _declare(robot: Robot, entry: catalog.Entry | None, closures: Sequence[Closu
 def _geometry(model: Any, urdf_path: Path, package_dirs: list[str], kind: str) -> Any:
     """The whole robot's geometry of ``kind`` ("visual" or "collision")."""
     if is_mjcf(urdf_path):
-        return pin.GeometryModel()  # Pinocchio builds an MJCF's geometry for its own model only (the chain's view)
+        return mjcf_geometry(model, urdf_path, kind)
     return build_visual_model(model, urdf_path, package_dirs, kind)
 
 

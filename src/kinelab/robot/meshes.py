@@ -225,16 +225,27 @@ def geometry_model(chain: Chain, package_dirs: list[str] | None, kind: str) -> p
 
 
 def _mjcf_geometry(chain: Chain, path: Path, kind: str) -> pin.GeometryModel:
-    """The whole model's geometry of kind "visual" or "collision" from the chain's MJCF file at ``path``; empty
-    (said in a warning) when one of its meshes lies outside the file's folder."""
+    """The whole model's geometry of kind "visual" or "collision" from the chain's MJCF file at ``path``."""
+    assert chain._built.full is not None  # a chain read from a file keeps the file's whole model
+    return mjcf_geometry(chain._built.full, path, kind)
+
+
+def mjcf_geometry(model: pin.Model, path: Path, kind: str) -> pin.GeometryModel:
+    """The geometry of kind "visual" or "collision" an MJCF file at ``path`` gives its whole ``model``; empty (said
+    in a warning) when one of its meshes lies outside the file's folder or Pinocchio cannot build it."""
     outside = meshes_outside(path)
     if outside:  # Pinocchio builds all of a file's geometry or none: none, said
         warnings.warn(f"{path.name}: mesh {outside[0]!r} lies outside the file's folder; kinelab "
-                      f"reads no file outside it, so {chain.name} is drawn without its {kind} geometry",
+                      f"reads no file outside it, so {model.name or path.stem} is drawn without its {kind} geometry",
                       stacklevel=3)
         return pin.GeometryModel()
     geometry_type = pin.GeometryType.COLLISION if kind == "collision" else pin.GeometryType.VISUAL
-    return pin.buildGeomFromMJCF(chain._built.full, str(path), geometry_type)
+    try:
+        return pin.buildGeomFromMJCF(model, str(path), geometry_type)
+    except Exception as exc:  # noqa: BLE001 - the parser raises RuntimeError, ValueError, ...
+        warnings.warn(f"{path.name}: Pinocchio cannot build its {kind} geometry ({type(exc).__name__}: {exc}); it is "
+                      "drawn without it", stacklevel=3)
+        return pin.GeometryModel()
 
 
 def _rerooted(geom: pin.GeometryModel, bMw: pin.SE3) -> None:

@@ -50,7 +50,7 @@ class WholeScene:
                 self.server = Server(tab_title(robot.name, "live view"))
                 viewer = meshcat.Visualizer(zmq_url=self.server.zmq_url)
             self.viewer = viewer
-        self.pinviz = MeshcatVisualizer(robot.model, pin.GeometryModel(), robot.visual_model())
+        self.pinviz = MeshcatVisualizer(robot.model, pin.GeometryModel(), drawn_geometry(robot))
         self.pinviz.initViewer(viewer=self.viewer)
         self.root = robot.name  # the robot's node in the viewer
         load_robot(self.pinviz, self.root)
@@ -133,6 +133,13 @@ class WholeScene:
         """Stop the server this scene started."""
         if self.server is not None:
             self.server.stop()
+
+
+def drawn_geometry(robot: Robot) -> pin.GeometryModel:
+    """What draws the robot: its visual geometry, else (a file that has none, as kinelab's reduced Cassie) its
+    collision geometry."""
+    visual = robot.visual_model()
+    return visual if visual.ngeoms else robot.visual_model("collision")
 
 
 def robot_points(model: pin.Model, visual_model: pin.GeometryModel, q: np.ndarray) -> np.ndarray:
