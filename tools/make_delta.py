@@ -17,7 +17,7 @@ ROOT = Path(__file__).resolve().parents[1]
 R, LA, LB, RP = 0.10, 0.20, 0.45, 0.04  # base radius, upper arm, forearm, platform radius [m]
 PHI = (0.0, 2 * np.pi / 3, 4 * np.pi / 3)
 MOTOR = (-0.6, 1.4)  # [rad] the motors' range (0: the upper arm horizontal, positive: down)
-PASSIVE = 3.141592653589793
+PASSIVE = 6.283185307179586  # ±2π: an ideal ball joint has no stop, and one at ±π cuts off branches across it
 
 HEADER = f"""<?xml version="1.0"?>
 <!--
@@ -29,7 +29,7 @@ HEADER = f"""<?xml version="1.0"?>
   delta.closures.yaml, 15 joints, 9 closure equations, the 3 motors driven, 3 idle spins. The
   platform's position has a closed form (three spheres' intersection, docs/closures.md), the reference of
   tests/robot/test_delta.py. Motors {MOTOR[0]}..{MOTOR[1]} rad (0: arm horizontal, positive: down); passive joints
-  +-pi. Links 0.05-0.2 kg. Written by tools/make_delta.py.
+  +-2 pi (ball joints have no stop; a stop at +-pi would cut off the assemblies across it). Links 0.05-0.2 kg. Written by tools/make_delta.py.
 -->
 <robot name="delta">
   <link name="base_link">
