@@ -14,7 +14,7 @@
 # ---
 
 # %% [markdown]
-# # 08 · Closed loops: a four-bar and a delta robot
+# # 08 · Closed loops: a four-bar, a delta robot and Cassie
 #
 # A URDF describes a tree, so a robot whose links close loops is written as one — every loop cut at a joint — and
 # the cuts are declared as **closures**, two frames that must meet (docs/closures.md). kinelab assembles such a
@@ -181,4 +181,43 @@ plt.gca().set_aspect("equal")
 plt.xlabel("x [m]")
 plt.ylabel("y [m]")
 plt.title("the platform's path")
+plt.show()
+
+# %% [markdown]
+# ## Cassie: a biped whose legs close four loops
+#
+# `cassie` is MuJoCo Menagerie's model of Agility Robotics' Cassie reduced to its kinematics (urdf/cassie.xml): an
+# MJCF file whose four `<connect>` equalities — each leg's achilles rod to its heel spring, its plantar rod to its
+# foot — are its loops, read through Pinocchio 4's loader, and whose motors are its actuated joints (five a leg).
+# The pelvis floats. Here the left foot goes where the left hip pitched 0.35 rad and the knee bent 0.45 rad further
+# put it (assembled: 17 cm forward, 5 cm up) while the right foot and the pelvis hold their poses; every step
+# holds the four loops.
+
+# %%
+cassie = kinelab.load("cassie")
+q = cassie.standing()  # the file's "home" keyframe, its loops closed
+print(f"{cassie.name}: nq = {cassie.nq}, nv = {cassie.nv}, {len(cassie.closures)} loops, "
+      f"actuated: {', '.join(cassie.actuated)}")
+lifted = q.copy()
+for joint, turn in (("left-hip-pitch", 0.35), ("left-knee", -0.45)):
+    lifted[cassie.model.joints[cassie.model.getJointId(joint)].idx_q] += turn
+goal = cassie.frame_placement(cassie.assemble(lifted), "left-foot")
+start = cassie.frame_placement(q, "left-foot").translation
+print(f"the left foot's goal: {100 * (goal.translation - start).round(3)} cm from where it stands")
+walker = kinelab.WholeBody(cassie, [FrameTask("left-foot", goal),
+                                    FrameTask("right-foot", cassie.frame_placement(q, "right-foot")),
+                                    FrameTask("cassie-pelvis", cassie.frame_placement(q, "cassie-pelvis"))])
+path, loops = [], 0.0
+for _ in range(150):
+    q = walker.step(q, 0.01).q
+    loops = max(loops, np.abs(cassie.closure_error(q)).max())
+    path.append(cassie.frame_placement(q, "left-foot").translation)
+path = np.array(path)
+print(f"150 steps: largest loop error {loops:.1e}; the left foot {np.linalg.norm(path[-1] - goal.translation):.1e} m "
+      "from its goal")
+plt.figure(figsize=(5, 3))
+plt.plot(path[:, 0], path[:, 2])
+plt.xlabel("x [m] (forward)")
+plt.ylabel("z [m]")
+plt.title("Cassie's left foot, seen from the side")
 plt.show()
