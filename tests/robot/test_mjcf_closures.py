@@ -130,3 +130,62 @@ def test_a_file_without_equalities_declares_nothing(tmp_path: Path) -> None:
     path.write_text(FOURBAR.split("  <equality>")[0] + "</mujoco>\n")
     robot = kinelab.load(path, whole=True)
     assert robot.closures == () and robot.actuated == ()
+
+
+GRIPPER = """<mujoco model="mjcf_gripper">
+  <compiler angle="degree"/>
+  <worldbody>
+    <body name="palm">
+      <body name="left" pos="0 0.02 0">
+        <joint name="left_finger" type="hinge" axis="0 0 1" range="-60 60" ref="10"/>
+        <geom type="capsule" fromto="0 0 0 0.05 0 0" size="0.005" mass="0.01"/>
+      </body>
+      <body name="right" pos="0 -0.02 0">
+        <joint name="right_finger" type="hinge" axis="0 0 1" range="-60 60" ref="-5"/>
+        <geom type="capsule" fromto="0 0 0 0.05 0 0" size="0.005" mass="0.01"/>
+      </body>
+      <body name="slider" pos="0 0 0.05">
+        <joint name="slide" type="slide" axis="1 0 0" range="0 0.04"/>
+        <geom type="sphere" size="0.01" mass="0.01"/>
+      </body>
+    </body>
+  </worldbody>
+  <equality>
+    <joint name="mirror" joint1="right_finger" joint2="left_finger" polycoef="0.1 -1 0 0 0"/>
+    <joint name="drive" joint1="slide" joint2="left_finger" polycoef="0.01 0.02 0 0 0"/>
+    <joint name="bent" joint1="slide" joint2="right_finger" polycoef="0 0.01 0.3 0 0" active="false"/>
+  </equality>
+  <actuator><motor joint="left_finger"/></actuator>
+</mujoco>
+"""
+
+
+def test_an_mjcf_joint_equality_is_a_coupling_with_mujocos_meaning(tmp_path: Path) -> None:
+    """A mimic gripper written with MJCF joint equalities (refs, a slide driven by a hinge): each linear one is a
+    coupling whose residual equals MuJoCo's own equality residual at 20 seeded qpos (1e-12), the inactive one is
+    left out; the step holds them while the leader moves."""
+    mujoco = pytest.importorskip("mujoco")
+    path = tmp_path / "gripper.xml"
+    path.write_text(GRIPPER)
+    robot = kinelab.load(path, whole=True)
+    assert [(m.name, m.leader) for m in robot.mimics] == [("right_finger", "left_finger"), ("slide", "left_finger")]
+    m = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(m)
+    rng = np.random.default_rng(692)
+    index = {j.name: robot.model.joints[robot.model.getJointId(j.name)].idx_q for j in robot.mimics}
+    index["left_finger"] = robot.model.joints[robot.model.getJointId("left_finger")].idx_q
+    for _ in range(20):
+        d.qpos[:] = rng.uniform(-1.0, 1.0, m.nq)
+        mujoco.mj_forward(m, d)
+        residual = [d.qpos[m.joint(c.name).qposadr[0]] - c.multiplier * d.qpos[m.joint(c.leader).qposadr[0]]
+                    - c.offset for c in robot.mimics]
+        mj = d.efc_pos[:d.nefc][d.efc_type[:d.nefc] == int(mujoco.mjtConstraint.mjCNSTR_EQUALITY)]
+        assert np.abs(np.array(residual) - mj).max() <= 1e-12
+    q = robot.neutral()
+    problem = kinelab.WholeBody(robot, [kinelab.PostureTask(q)])
+    for k in range(50):
+        q = q.copy()
+        q[index["left_finger"]] = 0.5 * np.sin(0.05 * k)
+        q = problem.step(q, 0.01).q
+        for c in robot.mimics:
+            assert abs(q[index[c.name]] - c.multiplier * q[index[c.leader]] - c.offset) <= 1e-9

@@ -25,7 +25,7 @@ from kinelab.robot import xacro
 from kinelab.robot.closures import Closure
 from kinelab.robot.joints import Joint, Mimic
 from kinelab.robot.meshes import c_stderr_captured
-from kinelab.robot.mjcf import equalities, is_mjcf, read_mjcf
+from kinelab.robot.mjcf import equalities, is_mjcf, joint_couplings, read_mjcf
 from kinelab.robot.srdf import Srdf, read_srdf
 from kinelab.robot.urdf import UrdfTree, read_tree
 
@@ -126,7 +126,8 @@ def whole_model(path: str | Path, *, floating: bool = False, name: str | None = 
     check_names(model, urdf_path)
     check_data_size(model, name or model.name or urdf_path.stem)
     found = srdf_of(srdf, tree)
-    return Whole(model, name or model.name or urdf_path.stem, source, urdf_path, found, _folded(model, tree), *loops)
+    couplings = joint_couplings(urdf_path, model) if is_mjcf(urdf_path) else _folded(model, tree)
+    return Whole(model, name or model.name or urdf_path.stem, source, urdf_path, found, couplings, *loops)
 
 
 def _folded(model: pin.Model, tree: UrdfTree) -> tuple[Mimic, ...]:

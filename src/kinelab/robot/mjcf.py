@@ -18,6 +18,7 @@ import pinocchio as pin
 from kinelab.errors import URDFError
 from kinelab.files import read_text
 from kinelab.robot.closures import Closure
+from kinelab.robot.joints import Mimic
 from kinelab.robot.urdf import MAX_COMPONENT, MAX_OFFSET, UrdfTree, check_size
 
 UNREAD = ("frame", "replicate", "attach")  # MuJoCo 3 elements Pinocchio's parser skips, with their bodies
@@ -331,3 +332,34 @@ def equalities(path: Path, model: pin.Model, root: pin.JointModel | None = None)
                 model.addFrame(pin.Frame(f"{name}_{end}", joint, placement, pin.FrameType.OP_FRAME))
             closures.append(Closure(f"{name}_a", f"{name}_b", kind))
     return tuple(closures), actuated
+
+
+def joint_couplings(path: Path, model: pin.Model) -> tuple[Mimic, ...]:
+    """The file's active ``<equality><joint joint1=... joint2=... polycoef=...>`` elements whose polynomial is linear,
+    as couplings: ``joint1 = multiplier · joint2 + offset`` in MuJoCo's meaning (``y − y0 = a0 + a1 (x − x0)``, with
+    y0, x0 the joints' ``ref``), held by every whole-body step and solve (``robot.mimics``). One whose polynomial
+    bends (a2, a3 or a4 not zero), or that holds a joint alone, is left out with a warning naming it."""
+    tree = ET.fromstring(read_text(path, "MJCF file", URDFError))
+    compiler = tree.find("compiler")
+    degrees = compiler is None or compiler.get("angle", "degree") != "radian"
+    refs = {j.get("name"): _ref(j, degrees) for j in tree.iter("joint") if j.get("name")}
+    out = []
+    for element in (e for section in tree.iter("equality") for e in section.iter("joint")):
+        follower, leader = element.get("joint1", ""), element.get("joint2")
+        coef = [float(v) for v in element.get("polycoef", "0 1 0 0 0").split()] + [0.0] * 5
+        if element.get("active", "true") == "false" or not model.existJointName(follower):
+            continue
+        if leader is None or not model.existJointName(leader) or any(coef[2:5]):
+            warnings.warn(f"{path.name}: the joint equality on {follower!r} is not read (kinelab holds a joint "
+                          "equal to a linear function of another joint)", stacklevel=3)
+            continue
+        iq = model.idx_qs[model.getJointId(follower)]
+        out.append(Mimic(follower, leader, coef[1], refs.get(follower, 0.0) + coef[0] - coef[1] * refs.get(leader, 0.0),
+                         float(model.lowerPositionLimit[iq]), float(model.upperPositionLimit[iq])))
+    return tuple(out)
+
+
+def _ref(joint: ET.Element, degrees: bool) -> float:
+    """A hinge's or slide's ``ref`` (its qpos0) in radians or metres."""
+    ref = float(joint.get("ref", "0"))
+    return math.radians(ref) if degrees and joint.get("type", "hinge") == "hinge" else ref
