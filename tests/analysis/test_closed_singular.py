@@ -149,3 +149,20 @@ def test_the_command_reads_both_types(capsys: pytest.CaptureFixture[str]) -> Non
     assert sweep["samples"] == 20 and sweep["no_assembly"] == 0 and sweep["smallest_parallel"]["sigma"] > 1e-3
     assert main(["singular", "fourbar", "1", "2"]) == 2
     assert "one value per motor, 1 in all (crank_joint)" in capsys.readouterr().err
+
+
+def test_the_singularity_map_of_a_robot_with_loops_finds_the_dead_points(capsys: pytest.CaptureFixture[str]) -> None:
+    """``kinelab map singular fourbar`` maps a robot with loops by both types over random motor configurations (the
+    sweep's engine): 400 draws find the four-bar's type I near a closed-form dead point (the smallest σ_I's crank
+    angle within 0.02 rad of one) and no type II; ``--grid`` is refused in one line, exit 2."""
+    import json
+
+    from kinelab.cli.main import main
+
+    assert main(["map", "singular", "fourbar", "--samples", "400", "--seed", "5", "--json"]) == 0
+    mapped = json.loads(capsys.readouterr().out)
+    assert mapped["samples"] == 400 and mapped["no_assembly"] == 0 and mapped["near_parallel"] == 0
+    crank = mapped["smallest_serial"]["motors"][0]
+    assert min(abs(np.angle(np.exp(1j * (crank - d)))) for d in dead_points()) <= 0.02
+    assert main(["map", "singular", "fourbar", "--grid"]) == 2
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1

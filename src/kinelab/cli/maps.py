@@ -131,7 +131,21 @@ def run_base(args: argparse.Namespace) -> int:
 
 
 def run_singular(args: argparse.Namespace) -> int:
-    """σ_min/σ_max over samples: how many near-singular, how many rank-deficient."""
+    """σ_min/σ_max over samples: how many near-singular, how many rank-deficient; for a robot that closes loops,
+    its type I and type II singularities over random motor configurations (``kinelab singular ROBOT --sweep N``).
+
+    Raises:
+        KinelabError: ``--grid`` for a robot with loops (its motors are drawn at random, each draw assembled).
+    """
+    from kinelab.cli import closed
+
+    whole = closed.closed_robot(argparse.Namespace(robot=args.robot, closures=None))
+    if whole is not None:
+        if args.grid:
+            raise KinelabError(f"{whole.name} closes loops: its map draws random motor configurations and assembles "
+                               "each; --grid is for chains (leave it out)")
+        return closed.run(whole, argparse.Namespace(sweep=args.samples, output=None, seed=args.seed, json=args.json,
+                                                    q=[], deg=False))
     robot = load_robot(args)
     result = maps.singularity(robot, samples=args.samples, seed=args.seed, method="grid" if args.grid else "random",
                               progress=progress_of(args))
