@@ -214,3 +214,21 @@ def planar_fourbar(a: float, b: float, c: float, d: float) -> kinelab.Robot:
     robot = kinelab.Robot.from_model(model, name="fourbar_built")
     robot.declare_closures([Closure("coupler_tip", "rocker_tip", (1, 1, 0, 0, 0, 0))], ["crank_joint"])
     return robot
+
+
+def lowest_part(robot: kinelab.Chain, q: np.ndarray) -> float:
+    """The lowest z [m], in the base frame, of any frame's origin and any collision or visual object's placement
+    that the joints move (the base's own shapes, fixed to it, may reach below its plane: a youBot's wheels)."""
+    import pinocchio as pin
+
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, robot.to_pin_q(q))
+    low = min(M.translation[2] for f, M in zip(robot.model.frames, data.oMf, strict=True) if f.parentJoint > 0)
+    for kind in ("visual", "collision"):
+        geometry = robot.visual_model(kind=kind)
+        if geometry.ngeoms:
+            gdata = pin.GeometryData(geometry)
+            pin.updateGeometryPlacements(robot.model, data, geometry, gdata)
+            low = min([low] + [M.translation[2] for g, M in zip(geometry.geometryObjects, gdata.oMg, strict=True)
+                               if g.parentJoint > 0])
+    return float(low)

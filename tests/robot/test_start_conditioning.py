@@ -4,6 +4,7 @@ crx10ia and kinova at rank 3); the threshold is the one `kinelab singular` calls
 
 import numpy as np
 import pytest
+from helpers import lowest_part
 
 import kinelab
 from kinelab.analysis.singular import NEAR_SINGULAR, analyze
@@ -44,3 +45,17 @@ def test_the_sphere_s_colour_and_words_agree_with_kinelab_singular():
     for ratio in (0.0101, 0.0122, 0.3):
         r, g, _ = rgb(sigma_colour(ratio))
         assert g >= 0xC0 and r < g and sigma_words(ratio) == "away from a singular configuration"
+
+
+FLOOR_STANDING = ["stanford", "era", "xarm6", "crx10ia", "ur10e_calibrated", "general6r", "panda", "ur3", "ur5",
+                  "ur10", "kinova", "xarm7", "z1", "so101"]  # arms whose base plane is the floor (not the youBot:
+# its base frame is at the wheels' axles, the floor 3.4 cm below)
+
+
+@pytest.mark.parametrize("name", FLOOR_STANDING)
+def test_every_floor_standing_arm_starts_and_shows_above_its_floor(name):
+    """#72 item 3: the start (teach, ``kinelab ik``) and the display pose (``kinelab view``) put no frame and no link's
+    mesh origin below the base plane by Pinocchio's placements (UR5's start had its wrist at z = −0.176 m)."""
+    robot = kinelab.load(name)
+    for q in (robot.reference_q()[0], robot.display_q()):
+        assert lowest_part(robot, q) >= -1e-9

@@ -9,7 +9,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 from devtools import open_page
-from helpers import pinocchio_tool
+from helpers import lowest_part, pinocchio_tool
 
 import kinelab
 from kinelab.view.teach import teach
@@ -150,3 +150,16 @@ def test_without_a_start_the_page_opens_at_a_well_conditioned_pose_and_says_so()
         shown = p.eval("document.getElementById('kinelab-readout').textContent")
         assert "singular" not in shown
         assert "well-conditioned" in p.eval("document.getElementById('kinelab-legend').textContent")
+
+
+def test_the_ur5_page_starts_with_every_link_above_the_floor():
+    """#72 item 3: teach without a start. The page's robot (its readout's q, drawn: its tool where Pinocchio puts
+    it) has every moving frame and link shape on or above the floor plane by Pinocchio's placements; on f5b077e its
+    wrist was at z = −0.176 m, through the floor grid."""
+    robot = kinelab.load("ur5")
+    with teach(robot) as served, open_page(served.url) as p:
+        p.wait_for("window.kinelab && window.kinelab.ready", 90)
+        settle(p)
+        q = assert_drawn_tool_is_pinocchio_fk(p, robot)
+        assert np.array_equal(served.session.q, q)
+        assert lowest_part(robot, q) >= -1e-9
