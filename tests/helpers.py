@@ -219,8 +219,6 @@ def planar_fourbar(a: float, b: float, c: float, d: float) -> kinelab.Robot:
 def lowest_part(robot: kinelab.Chain, q: np.ndarray) -> float:
     """The lowest z [m], in the base frame, of any frame's origin and any collision or visual object's placement
     that the joints move (the base's own shapes, fixed to it, may reach below its plane: a youBot's wheels)."""
-    import pinocchio as pin
-
     data = robot.model.createData()
     pin.framesForwardKinematics(robot.model, data, robot.to_pin_q(q))
     low = min(M.translation[2] for f, M in zip(robot.model.frames, data.oMf, strict=True) if f.parentJoint > 0)
