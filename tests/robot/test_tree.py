@@ -165,3 +165,16 @@ def test_derived_data_is_built_once_per_key_even_when_it_is_none():
         assert owner.derived("test: nothing to build", build) is None
         assert len(calls) == 1
         assert owner.derived("test: a value", lambda _: [3]) == owner.derived("test: a value", lambda _: [4]) == [3]
+
+
+def test_whole_floats_a_robot_whose_srdf_declares_a_floating_virtual_joint():
+    """#72 item 6: ``load(urdf, whole=True, srdf=...)`` of a quadruped whose SRDF declares ``<virtual_joint
+    type="floating">`` (go2) gives it a free-flyer (nq 12 + 7); without the SRDF, or with ``floating=False``, the
+    base is fixed; a registered arm's SRDF without one leaves it fixed."""
+    urdf, srdf = ERD / "go2_description/urdf/go2.urdf", ERD / "go2_description/srdf/go2.srdf"
+    walker = kinelab.load(urdf, whole=True, srdf=srdf)
+    assert walker.floating and walker.nq == 19 and walker.model.joints[1].shortname() == "JointModelFreeFlyer"
+    assert not kinelab.load(urdf, whole=True).floating
+    assert not kinelab.load(urdf, whole=True, srdf=srdf, floating=False).floating
+    panda = ERD / "panda_description"
+    assert not kinelab.load(panda / "urdf/panda.urdf", whole=True, srdf=panda / "srdf/panda.srdf").floating

@@ -23,6 +23,7 @@ from kinelab.robot.closures import Closure, read_closures
 from kinelab.robot.meshes import build_visual_model, mesh_package_dirs, mjcf_geometry
 from kinelab.robot.mjcf import is_mjcf
 from kinelab.robot.reduce import build_file
+from kinelab.robot.srdf import read_srdf
 from kinelab.robot.tree import Robot
 
 __all__ = ["load", "whole_of"]
@@ -58,7 +59,8 @@ def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, fl
             ``load_yaml``); without it those are refused with their line (:mod:`~kinelab.robot.xacro`).
         whole: True: the whole robot (no chain is cut); None (default): whole for a registered whole robot.
         floating: the whole robot with a free-flyer at its root (implies ``whole``); None: the registered
-            robot's own choice (a humanoid's or quadruped's base floats), else fixed.
+            robot's own choice (a humanoid's or quadruped's base floats), else free when its SRDF declares a
+            ``<virtual_joint type="floating">`` (a walker's), else fixed.
         closures: the loops the robot closes (implies ``whole``): a list of :class:`~kinelab.Closure`, or a
             closures declaration file (YAML, :mod:`~kinelab.robot.closures`); None: a registered robot's own.
         actuated: the joints a controller drives (the others move with the loops); a declaration file's
@@ -132,9 +134,9 @@ def _whole(path: Path, entry: catalog.Entry | None, name: str | None, package_di
     for key, value in zip(("tool", "base", "locked", "group"), chain_settings, strict=True):
         if value is not None:
             raise OptionError(key, value, "None with the whole robot (a chain of it: robot.chain(base, tool))")
-    if floating is None:
-        floating = bool(entry is not None and entry.floating)
     srdf = srdf or (catalog.srdf_path(entry) if entry is not None else None)
+    if floating is None:  # the catalogue says, else the SRDF's floating virtual joint (a walker's: anymal, go2, a1)
+        floating = entry.floating if entry is not None else bool(srdf is not None and read_srdf(srdf).floats)
     made = whole_model(path, floating=floating, name=name, package_dirs=package_dirs, srdf=srdf,
                        xacro_args=xacro_args, trust_xacro=trust_xacro)
     chains = partial(_chain, path, None, made.name, package_dirs=package_dirs, srdf=srdf, group=None,

@@ -34,6 +34,7 @@ class Srdf:
     states: dict[str, dict[str, float]] = field(default_factory=dict)
     end_effectors: dict[str, str] = field(default_factory=dict)  # group → parent link
     virtual_joints: tuple[str, ...] = ()  # a floating base's joint (declared, or given a pose): skipped
+    floats: bool = False  # a <virtual_joint type="floating">: the robot walks or flies, its base free
     disabled_collisions: tuple[tuple[str, str], ...] = ()  # link pairs never checked against each other
 
     def group(self, name: str) -> Group:
@@ -166,6 +167,7 @@ def read_srdf(path: str | Path) -> Srdf:
         out.states[st.get("name", "")], floating = _state(st, path)
         virtual += floating
     out.virtual_joints = tuple(dict.fromkeys(virtual))
+    out.floats = any(v.get("type") == "floating" for v in root.iter("virtual_joint"))
     for ee in root.iter("end_effector"):
         out.end_effectors.setdefault(ee.get("group", ""), ee.get("parent_link", ""))
     out.disabled_collisions = tuple((d.get("link1", ""), d.get("link2", "")) for d in root.iter("disable_collisions"))
