@@ -68,3 +68,15 @@ def test_every_loaded_chain_agrees_with_yourdfpy_and_finite_differences(path):
     fk = fk_vs_yourdfpy(robot, count=100)
     assert fk.max_position <= 1e-9 and fk.max_rotation <= 1e-9
     assert jacobians_vs_fd(robot, count=20).max_rotation <= 1e-6
+
+
+@pytest.mark.skipif(not CORPUS, reason="example-robot-data not installed")
+def test_the_corpus_refusals_say_why_in_one_line():
+    """#72 item 6: ANYmal C and B1 (a link and a joint, or a link and its fixed joint, of one name) load now, and
+    agree with yourdfpy above; ur3.urdf (an empty <robot>) is refused naming what is missing."""
+    names = {p.relative_to(ERD).as_posix(): p for p in CORPUS}
+    for loads in ("anymal_c_simple_description/urdf/anymal.urdf", "b1_description/urdf/b1-z1.urdf"):
+        robot, err = load_corpus(names[loads])
+        assert robot is not None, err
+    _, err = load_corpus(names["ur_description/urdf/ur3.urdf"])
+    assert err is not None and "no <link> element" in str(err) and "\n" not in str(err)

@@ -21,6 +21,7 @@ import pinocchio as pin
 
 from kinelab.errors import OptionError, URDFError
 from kinelab.robot import catalog
+from kinelab.robot.folding import reduced
 from kinelab.robot.mjcf import is_mjcf, meshes_outside
 
 if TYPE_CHECKING:
@@ -218,7 +219,7 @@ def geometry_model(chain: Chain, package_dirs: list[str] | None, kind: str) -> p
     else:
         geom = build_visual_model(b.full, b.urdf_path, package_dirs or chain.package_dirs, kind)
     if b.lock_ids and geom.ngeoms:
-        _, geom = pin.buildReducedModel(b.full, geom, list(b.lock_ids), b.q_ref)
+        _, geom = reduced(b.full, list(b.lock_ids), pin.neutral(b.full) if b.q_ref is None else b.q_ref, geom)
     if b.bMw is not None:  # re-rooted at the base frame, as the model was
         _rerooted(geom, b.bMw)
     return geom

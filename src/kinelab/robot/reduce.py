@@ -33,6 +33,7 @@ from kinelab.robot.build import (
     one_to_pin,
     srdf_of,
 )
+from kinelab.robot.folding import reduced
 from kinelab.robot.joints import Joint, Mimic
 from kinelab.robot.meshes import mesh_package_dirs
 from kinelab.robot.mjcf import body_tree, is_mjcf, read_mjcf
@@ -172,8 +173,8 @@ class _Builder:
         lock_ids = [full.getJointId(j) for j in self.locked]
         self._full, self._lock_ids, self._q_ref = full, lock_ids, q_ref
         try:
-            self.model = pin.buildReducedModel(full, lock_ids, q_ref) if lock_ids else full
-        except ValueError as exc:  # Pinocchio cannot fold a locked joint whose name a link also bears
+            self.model = reduced(full, lock_ids, q_ref) if lock_ids else full
+        except ValueError as exc:  # what Pinocchio still cannot fold, said
             raise ChainError(f"{self.name}: Pinocchio cannot lock the joints off the chain ({exc}); give "
                              "another tool= or base=") from None
         check_data_size(self.model, self.name)
@@ -348,3 +349,4 @@ def likely_tools(tree: UrdfTree, count: int = 3) -> list[str]:
         return next((k for k, word in enumerate(TOOL_WORDS) if word in link.lower()), len(TOOL_WORDS))
 
     return sorted(tree.leaves, key=lambda link: (named(link), -depth(link), link))[:count]
+

@@ -77,8 +77,12 @@ def read_tree(path: Path) -> UrdfTree:
     _check_links_defined(path, links, parent_of, joint_of)
     mimic, broken = _split_mimics(mimic, {j.get("name", "?") for j in xml.findall("joint")})
     roots = [link for link in links if link not in parent_of]
+    if not links:
+        raise URDFError(f"malformed URDF {path}: it has no <link> element (a robot is at least one link; a file "
+                        "written from a xacro that expanded to nothing looks like this)")
     if len(roots) != 1:
-        raise URDFError(f"malformed URDF {path}: expected one root link, found {roots}")
+        raise URDFError(f"malformed URDF {path}: {len(roots)} links have no parent ({', '.join(roots[:5])}); a URDF "
+                        "tree has one root (join the others to it with fixed joints)")
     parents = set(parent_of.values())
     return UrdfTree(roots[0], parent_of, joint_of, mimic, links, [link for link in links if link not in parents],
                     broken, _mimic_factors(xml))
