@@ -230,3 +230,20 @@ def lowest_part(robot: kinelab.Chain, q: np.ndarray) -> float:
             low = min([low] + [M.translation[2] for g, M in zip(geometry.geometryObjects, gdata.oMg, strict=True)
                                if g.parentJoint > 0])
     return float(low)
+
+
+def assembled_draws(robot: kinelab.Robot, count: int, rng: np.random.Generator, spread: float | None = None):
+    """``count`` motor draws from the robot's standing pose, each assembled (a draw with no assembly yields None):
+    the motors uniform within their limits, or moved by up to ``spread`` rad about the standing pose."""
+    home = robot.standing()
+    motors = [robot.model.joints[robot.model.getJointId(a)].idx_q for a in robot.actuated]
+    for _ in range(count):
+        q = home.copy()
+        if spread is None:
+            q[motors] = robot.random_q(rng)[motors]
+        else:
+            q[motors] += rng.uniform(-spread, spread, len(motors))
+        try:
+            yield q, robot.assemble(q)
+        except kinelab.AssemblyError:
+            yield q, None

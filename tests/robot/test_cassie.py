@@ -7,6 +7,7 @@ places both feet and the pelvis with every loop closed (judged by Pinocchio's FK
 import numpy as np
 import pinocchio as pin
 import pytest
+from helpers import assembled_draws
 
 import kinelab
 from kinelab import AssemblyError, FrameTask
@@ -105,16 +106,10 @@ def test_the_assembly_closes_the_loops_within_the_limits_with_the_motors_held(ca
     to 1e-10, every joint within its limits and the motors exactly where they were put; a refusal leaves no
     assembly found from 21 starts. At least 50 are claimed (a shin spring at its stop, the tarsus and the heel
     spring take up the rest)."""
-    home = cassie.standing()
     index = motors(cassie)
-    rng = np.random.default_rng(69)
     claimed = 0
-    for _ in range(60):
-        q = home.copy()
-        q[index] = cassie.random_q(rng)[index]
-        try:
-            found = cassie.assemble(q)
-        except AssemblyError:
+    for q, found in assembled_draws(cassie, 60, np.random.default_rng(69)):
+        if found is None:
             continue
         claimed += 1
         assert np.abs(cassie.closure_error(found)).max() <= 1e-10

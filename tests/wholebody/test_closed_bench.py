@@ -5,6 +5,7 @@ on the bench's path keep the loops closed. Times are the bench's business, not a
 
 import numpy as np
 import pytest
+from helpers import assembled_draws
 
 import kinelab
 from kinelab import cli
@@ -18,16 +19,9 @@ def test_mujoco_s_loop_sites_meet_at_kinelab_s_assemblies(name):
     robot = kinelab.load(name)
     model = closed_step.loop_model(robot)
     maps, data = Maps(robot, model), mujoco.MjData(model)
-    home = robot.assemble(robot.neutral())
-    motors = [robot.model.joints[robot.model.getJointId(a)].idx_q for a in robot.actuated]
-    rng = np.random.default_rng(2)
     met = 0
-    for _ in range(10):
-        q = home.copy()
-        q[motors] += rng.uniform(-0.3, 0.3, len(motors))
-        try:
-            q = robot.assemble(q)
-        except kinelab.AssemblyError:
+    for _, q in assembled_draws(robot, 10, np.random.default_rng(2), spread=0.3):
+        if q is None:
             continue
         data.qpos[:] = maps.to_mujoco(q)
         mujoco.mj_kinematics(model, data)
@@ -46,15 +40,9 @@ def test_cassie_s_own_connects_are_closed_at_kinelab_s_assemblies():
     robot = kinelab.load("cassie")
     model = closed_step.loop_model(robot)
     maps, data = Maps(robot, model), mujoco.MjData(model)
-    home, motors = robot.standing(), [robot.model.joints[robot.model.getJointId(a)].idx_q for a in robot.actuated]
-    rng = np.random.default_rng(3)
     met = 0
-    for _ in range(12):
-        q = home.copy()
-        q[motors] = robot.random_q(rng)[motors]
-        try:
-            q = robot.assemble(q)
-        except kinelab.AssemblyError:
+    for _, q in assembled_draws(robot, 12, np.random.default_rng(3)):
+        if q is None:
             continue
         data.qpos[:] = maps.to_mujoco(q)
         mujoco.mj_forward(model, data)
