@@ -4,6 +4,7 @@ of mass kept over them, judged again by Pinocchio; what the page cannot do on a 
 import numpy as np
 import pinocchio as pin
 import pytest
+from helpers import assembled_draws
 
 import kinelab
 from kinelab.errors import KinelabError, OptionError
@@ -72,3 +73,29 @@ def test_the_support_polygon_holds_both_soles_and_the_test_of_inside_is_right():
     assert np.allclose(sorted(hull[:, 0]), [-0.1, -0.1, 0.1, 0.1]) and np.allclose(sorted(hull[:, 1]),
                                                                                     [-0.15, -0.15, 0.15, 0.15])
     assert inside_polygon(np.array([0.05, 0.0]), hull) and not inside_polygon(np.array([0.15, 0.0]), hull)
+
+
+def test_a_robot_with_loops_has_a_slider_per_motor_and_stays_on_its_loops():
+    """#69: the four-bar's and the delta's teach pages slide their motors only; a motor set from the page moves the
+    passive joints to close every loop (1e-10), the motor where it was put; motor values with no assembly (a seeded
+    draw of Cassie's) leave the robot where it was and say so."""
+    for name in ("fourbar", "delta"):
+        robot = kinelab.load(name)
+        with teach(robot) as served:
+            session = served.session
+            assert [j["name"] for j in session.page_config()["joints"]] == list(robot.actuated)
+            motor = robot.model.joints[robot.model.getJointId(robot.actuated[0])].idx_q
+            q = session.q.copy()
+            q[motor] += 0.2
+            session.set_q(q)
+            assert session.q[motor] == pytest.approx(q[motor], abs=1e-15)
+            assert np.abs(robot.closure_error(session.q)).max() <= 1e-10
+            assert "loops closed" in session.status
+    cassie = kinelab.load("cassie")
+    draws = list(assembled_draws(cassie, 6, np.random.default_rng(7)))
+    stuck = draws[5][0]  # motors at which Cassie's loops cannot close within its limits
+    assert draws[5][1] is None
+    with teach(cassie) as served:
+        before = served.session.q.copy()
+        served.session.set_q(stuck)
+        assert np.array_equal(served.session.q, before) and "no assembly" in served.session.status

@@ -23,7 +23,7 @@ from pinocchio.visualize import MeshcatVisualizer
 from scipy.spatial import ConvexHull
 
 from kinelab.collision.model import Collisions, Contact, as_collisions
-from kinelab.errors import KinelabError, OptionError
+from kinelab.errors import AssemblyError, KinelabError, OptionError
 from kinelab.robot.tree import Robot
 from kinelab.values import is_whole
 from kinelab.view.collisions import draw_obstacle_nodes
@@ -83,6 +83,26 @@ class WholeTeachSession(Session):
         self._draw()
 
     # -- actions --------------------------------------------------------------------------------
+    @_locked
+    def set_q(self, q: Configuration) -> None:
+        """Put the robot at q (within the limits, rad or m); the targets stay. A robot with loops keeps its motors
+        where q has them and moves its passive joints to close the loops (its sliders are its motors'); where they
+        cannot close, the robot stays and the status says so.
+
+        Raises:
+            ConfigurationError: q of the wrong length, not finite or outside the limits (named).
+        """
+        checked = self.robot.check_q(q, limits=True)
+        if self.robot.closures:
+            try:
+                checked = self.robot.assemble(checked)
+            except AssemblyError as exc:
+                self.status = f"no assembly at these motor values (the loops stay {exc.residual:.2g} open): not moved"
+                self._draw()
+                return
+        self.q, self.status = checked, "joints set" + (", the loops closed" if self.robot.closures else "")
+        self._draw()
+
     @_locked
     def set_target(self, oMtarget: pin.SE3, index: int = 0) -> None:
         """Move hand ``index``'s target (base frame) and meet every task from where the robot stands; q stays where
@@ -162,12 +182,15 @@ class WholeTeachSession(Session):
         return np.split(self.robot.closure_error(self.q), sizes) if self.robot.closures else []
 
     def page_config(self) -> dict[str, Any]:
-        """What the page is built from: the sliders (bounded one-coordinate joints, their index in q), the targets,
-        the heading and the legend."""
+        """What the page is built from: the sliders (bounded one-coordinate joints, their index in q; a robot with
+        loops: its motors), the targets, the heading and the legend."""
         model, space = self.robot.model, self.robot.space
         joints = []
+        moved = set(self.robot.actuated) if self.robot.closures else None  # a robot with loops: its motors
         for jid in range(1, model.njoints):
             joint = model.joints[jid]
+            if moved is not None and model.names[jid] not in moved:
+                continue
             if joint.nq == 1 and np.isfinite(space.lower[joint.idx_q]) and np.isfinite(space.upper[joint.idx_q]):
                 kind = "prismatic" if "JointModelP" in joint.shortname() else "revolute"
                 joints.append({"name": model.names[jid], "kind": kind, "iq": joint.idx_q,
