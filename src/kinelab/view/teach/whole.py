@@ -233,9 +233,24 @@ class WholeTeachSession(Session):
         elif self._held_off(res):
             self.q = np.array(res.q)
             self.status = f"held off by {res.closest}: {_short(', '.join(missed), 120)} not met"
+        elif self._as_near(res):
+            self.q = np.array(res.q)
+            off = max(v.position_error for v in res.tasks[:len(self.hands)])
+            self.status = f"as near as its loops let it: {off * 1e3:.1f} mm from the target"
         else:
             self.status = f"not reached ({res.status}): {_short(', '.join(missed), 120)}; q kept"
         self.closest = res.closest if self.collisions is not None else None
+
+    def _as_near(self, res: Any) -> bool:
+        """Whether an answer short of its targets is as near as a robot with loops gets (a four-bar's hand moves on
+        a curve): the loops and every foot held, within the limits, the hands nearer their targets than before."""
+        if not self.robot.closures or not self.robot.within_limits(res.q):
+            return False
+        if not all(v.met for v in res.tasks[len(self.hands):]):
+            return False
+        before = [np.linalg.norm(M.translation - T.translation)
+                  for M, T in zip(self.robot.frame_placements(self.q, self.hands), self.targets, strict=True)]
+        return sum(v.position_error for v in res.tasks[:len(self.hands)]) < sum(before)
 
     def _held_off(self, res: Any) -> bool:
         """Whether an answer short of its targets is where the collisions stop the robot: its nearest pair at the
