@@ -6,9 +6,11 @@ is a list of :class:`Check` rows, printed as a table, written as Markdown/HTML/J
 
 from __future__ import annotations
 
+import contextlib
 import sys
+import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -392,6 +394,31 @@ def _groups(robot: Chain | Robot) -> list[Any]:
     return [*GENERAL_CHECKS, *PAPER_CHECKS.get(robot.name, [])]
 
 
+HEARTBEAT = 10.0  # [s] a log hears from a running check group at least this often
+
+
+@contextlib.contextmanager
+def heartbeat(label: str | None) -> Iterator[None]:
+    """While the block runs, a line on stderr every HEARTBEAT seconds saying what still runs (``label``; None:
+    silent): a log or a pipe never waits long on a slow group without a word."""
+    if label is None:
+        yield
+        return
+    done, started = threading.Event(), time.perf_counter()
+
+    def beat() -> None:
+        while not done.wait(HEARTBEAT):
+            print(f"{label}: still running ({time.perf_counter() - started:.0f} s)", file=sys.stderr, flush=True)
+
+    thread = threading.Thread(target=beat, daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        done.set()
+        thread.join()
+
+
 def run(robots: list[str] | None = None, n: int | None = None, seed: int = 0, progress: bool = False,
         lines: bool = False) -> Report:
     """Run every check on ``robots`` (default: stanford, era, youbot, panda, ur5, the whole talos and baxter, and
@@ -407,10 +434,12 @@ def run(robots: list[str] | None = None, n: int | None = None, seed: int = 0, pr
     steps = [(robot, fn) for robot in loaded for fn in _groups(robot)]
     for k, (robot, fn) in enumerate(tqdm(steps, desc="validate (check groups)", disable=not progress, unit="group")):
         started = time.perf_counter()
-        found = fn(robot, n, seed)
+        label = f"validate {k + 1}/{len(steps)}: {robot.name}, {fn.__name__.replace('_', ' ')}"
+        with heartbeat(label if lines else None):
+            found = fn(robot, n, seed)
         report.checks.extend(found)
         if lines:  # a log or a pipe: one line per group as it ends, never silent for a whole run
             failed = sum(not c.passed for c in found)
-            print(f"validate {k + 1}/{len(steps)}: {robot.name}, {fn.__name__.replace('_', ' ')}: {len(found)} "
-                  f"checks, {failed} failed ({time.perf_counter() - started:.1f} s)", file=sys.stderr, flush=True)
+            print(f"{label}: {len(found)} checks, {failed} failed ({time.perf_counter() - started:.1f} s)",
+                  file=sys.stderr, flush=True)
     return report
