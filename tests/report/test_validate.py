@@ -74,7 +74,7 @@ def test_a_whole_robot_takes_the_whole_body_checks(capsys):
     assert {"whole body: limit violations over the steps", "whole body: false successes (frdm)",
             "whole body: task Jacobians vs differences of Pinocchio's FK",
             "whole body: collision rows: rate against coal's central difference"} <= set(names)
-    assert validate.DEFAULT_ROBOTS[-4:-2] == ("talos", "baxter")
+    assert validate.DEFAULT_ROBOTS[-5:-3] == ("talos", "baxter")
 
 
 def test_a_robot_with_loops_takes_the_loop_checks(capsys):
@@ -86,7 +86,7 @@ def test_a_robot_with_loops_takes_the_loop_checks(capsys):
     assert code == 0 and report["passed"] and all(n.startswith("loops: ") for n in names)
     assert {"loops: closure errors vs Pinocchio's constraint models", "loops: assemblies against the closed form",
             "loops: closure error after every step", "loops: false successes (step)"} <= set(names)
-    assert validate.DEFAULT_ROBOTS[-2:] == ("fourbar", "delta")
+    assert validate.DEFAULT_ROBOTS[-3:] == ("fourbar", "delta", "cassie")
 
 
 def _report_with_one_failure():

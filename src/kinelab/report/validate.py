@@ -50,8 +50,8 @@ from kinelab.studies import paper001_stanford as seed001
 from kinelab.studies import paper003_youbot as yb
 from kinelab.values import is_whole
 
-DEFAULT_ROBOTS = ("stanford", "era", "youbot", "panda", "ur5", "talos", "baxter", "fourbar", "delta")  # whole: the
-# last four, the last two closing loops
+DEFAULT_ROBOTS = ("stanford", "era", "youbot", "panda", "ur5", "talos", "baxter", "fourbar", "delta",
+                  "cassie")  # whole: the last five, the last three closing loops
 DEFAULT_N = 200
 
 
@@ -422,7 +422,7 @@ def heartbeat(label: str | None) -> Iterator[None]:
 def run(robots: list[str] | None = None, n: int | None = None, seed: int = 0, progress: bool = False,
         lines: bool = False) -> Report:
     """Run every check on ``robots`` (default: stanford, era, youbot, panda, ur5, the whole talos and baxter, and
-    fourbar and delta, which close loops: a whole robot takes the whole-body checks,
+    fourbar, delta and cassie, which close loops: a whole robot takes the whole-body checks,
     :mod:`kinelab.report.wholebody_checks`, one with loops :mod:`kinelab.report.closed_checks`)."""
     check_seed(seed)
     names = list(robots or DEFAULT_ROBOTS)
