@@ -369,3 +369,15 @@ def test_a_slow_group_is_heard_from_while_it_runs(monkeypatch):
     with v.heartbeat(None):
         time.sleep(0.2)
     assert quiet.getvalue() == ""
+
+
+def test_the_help_names_every_default_robot():
+    """``kinelab validate --help`` lists the robots the default run checks (it had left out the loops')."""
+    import contextlib
+    import io
+
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.suppress(SystemExit):
+        cli.main(["validate", "--help"])
+    text = " ".join(out.getvalue().split())
+    assert all(name in text for name in validate.DEFAULT_ROBOTS)

@@ -22,7 +22,8 @@ def add(sub: Subcommands) -> None:
     """The ``validate`` subcommand."""
     s = sub.add_parser("validate", help="check every kinelab computation against Pinocchio on the bundled robots")
     s.add_argument("--robots", nargs="+", default=None,
-                   help="robots to check (default: stanford era youbot panda ur5 talos baxter)")
+                   help="robots to check (default: stanford era youbot panda ur5, the whole talos and baxter, and "
+                        "fourbar delta cassie, which close loops)")
     s.add_argument("--n", type=int, default=None, help="random configurations per check (default: each check's own)")
     seed_argument(s)
     s.add_argument("--out", default=None,
