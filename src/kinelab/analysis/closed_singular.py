@@ -95,12 +95,8 @@ def analyze(robot: Robot, q: np.ndarray, output: str) -> ClosedSingularity:
 
 def _maps(robot: Robot, q: np.ndarray, output: str) -> tuple[np.ndarray, np.ndarray]:
     """(J_p, G) at q: the closure Jacobian's passive columns, and the motors' map to the output's position."""
-    J = robot.closure_jacobian(q)
-    va, vp = _actuated(robot)[1], passive_indices(robot, robot.actuated)
-    X = robot.frame_jacobian(q, output, "local_world_aligned")[:3]
-    Jp = J[:, vp]
-    G = X[:, va] - X[:, vp] @ np.linalg.pinv(Jp, rcond=1e-10) @ J[:, va]
-    return Jp, G
+    Jp = robot.closure_jacobian(q)[:, passive_indices(robot, robot.actuated)]
+    return Jp, robot.actuated_jacobian(q, output)[:3]
 
 
 def _actuated(robot: Robot) -> tuple[list[int], list[int]]:

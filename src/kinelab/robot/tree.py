@@ -316,6 +316,26 @@ class Robot:
         assert J is not None
         return J
 
+    def actuated_jacobian(self, q: ArrayLike, frame: str, reference: str = "local_world_aligned") -> np.ndarray:
+        """How ``frame`` moves with the actuated joints when the passive ones follow the loops, at an assembled q:
+        ``G = J_a − J_p J_cp⁺ J_ca`` (6 × the actuated joints, rows [linear; angular] in ``reference``'s axes as
+        :meth:`frame_jacobian`), with J_c the closures' Jacobian split into actuated (a) and passive (p) columns. A
+        free-flyer is held (its columns are neither). Where the motors do not decide the passive motion — J_cp short
+        of rank at a type II singularity, or more passive joints than the loops hold (Cassie's springs) — the
+        pseudo-inverse takes its least-norm part (a choice: how a spring gives is dynamics). Idle spins (a rod on
+        two ball joints) move no frame and change nothing.
+
+        Raises:
+            OptionError: a robot without loops or actuated joints. FrameNotFoundError: an unknown frame (named).
+        """
+        if not self.closures or not self.actuated:
+            raise OptionError("robot", self.name, "a robot with loops and actuated joints declared")
+        J = self.frame_jacobian(q, frame, reference)
+        Jc = self.closure_jacobian(q)
+        va = [self.model.joints[self.model.getJointId(a)].idx_v for a in self.actuated]
+        vp = assembly.passive_indices(self, self.actuated)
+        return J[:, va] - J[:, vp] @ np.linalg.pinv(Jc[:, vp], rcond=1e-10) @ Jc[:, va]
+
     def assemble(self, q: ArrayLike, *, actuated: Sequence[str] | None = None) -> np.ndarray:
         """q with the passive joints moved so that every loop closes to 1e-10 [m, rad], the actuated joints (and a
         free-flyer) held where q has them; usually the assembly nearest q, else one from seeded restarts.
