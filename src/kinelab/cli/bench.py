@@ -78,6 +78,15 @@ def add(sub: Subcommands) -> None:
     s.add_argument("--schedule", choices=("blocked", "interleaved"), default="blocked",
                    help="blocked (default): a solver runs the whole set, then the next; interleaved: every solver "
                         "per problem")
+    _add_also(s)
+    _add_instead(s)
+    s.add_argument("--out", help="write bench.json, bench.md and bench.png here")
+    s.add_argument("--json", action="store_true", help="print the results as JSON instead of tables")
+    s.set_defaults(func=run)
+
+
+def _add_also(s: argparse.ArgumentParser) -> None:
+    """The protocols run besides the arm protocol (``--scaling``, ``--versus``, ``--startup``...)."""
     s.add_argument("--scaling", action="store_true", help="also time FRDM on synthetic chains of 7-100 links")
     s.add_argument("--tracking", action="store_true", help="also time tracking along the ERA passages (FRDM, DLS)")
     s.add_argument("--loops", action="store_true",
@@ -104,6 +113,10 @@ def add(sub: Subcommands) -> None:
     s.add_argument("--startup", action="store_true",
                    help="also how long --help, robots, fk, info and ik take from the shell against python -c "
                         "\"import pinocchio\" (best of --repeats + 4 rounds, interleaved)")
+
+
+def _add_instead(s: argparse.ArgumentParser) -> None:
+    """The protocols run instead of the arm protocol (``--whole-body``, ``--closed``, ``--router``...)."""
     s.add_argument("--whole-body", action="store_true",
                    help="instead of the arm protocol: the whole-body step side by side with pink and mink (--robots "
                         "among panda, baxter, talos, g1; default all four), --repeats rounds, and the converged "
@@ -121,9 +134,6 @@ def add(sub: Subcommands) -> None:
                         "the module functions (--robots; default ur5 panda kinova crx10ia era), --repeats rounds")
     s.add_argument("--budgets", action="store_true",
                    help="also measure how every entry point with a budget keeps 5 ms (p50, p99, max per robot)")
-    s.add_argument("--out", help="write bench.json, bench.md and bench.png here")
-    s.add_argument("--json", action="store_true", help="print the results as JSON instead of tables")
-    s.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
