@@ -114,10 +114,11 @@ class CouplingTask(Task):
         """|joint − ratio · leader − offset|."""
         return abs(self.row(robot, q, 1.0)[1]), 0.0
 
-    def project(self, robot: Robot, q: np.ndarray) -> None:
+    def project(self, robot: Robot, q: np.ndarray) -> bool:
         """The joint set from its leader."""
         (qj, _), (ql, _) = self.indices(robot)
         q[qj] = self.ratio * q[ql] + self.offset
+        return True
 
 
 @dataclass(frozen=True)
@@ -191,16 +192,17 @@ class ClosureTask(Task):
         """The loop's error at q from Pinocchio's placements in ``data``."""
         return self._split(closure_error(robot.model, data, self.closure, self._frames(robot)))
 
-    def project(self, robot: Robot, q: np.ndarray) -> None:
+    def project(self, robot: Robot, q: np.ndarray) -> bool:
         """The passive joints moved to close the loops (Gauss–Newton, the actuated joints held; q changed in place
-        where it closes them). Every loop of the robot at once: the task of its first loop does it, the others'
-        find them closed."""
+        where it closes them, to ASSEMBLY_TOL); whether they are closed. Every loop of the robot at once: the task
+        of its first loop does it and answers for all, the others' leave it to that one."""
         if robot.closures and self.closure in robot.closures[1:]:
-            return
+            return True
         passive = robot.derived("loops' passive joints", lambda r: passive_indices(r, r.actuated))
         closed, residual = newton(robot, q, passive, ASSEMBLY_TOL)
         if residual <= ASSEMBLY_TOL:
             q[:] = closed
+        return residual <= ASSEMBLY_TOL
 
 
 def loops(robot: Robot) -> tuple[Task, ...]:

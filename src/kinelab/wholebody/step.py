@@ -16,7 +16,6 @@ import pinocchio as pin
 
 from kinelab.collision.model import Contact
 from kinelab.errors import OptionError
-from kinelab.robot.closures import ASSEMBLY_TOL
 from kinelab.robot.tree import Robot
 from kinelab.values import is_real
 from kinelab.wholebody import clearance, qp
@@ -205,18 +204,20 @@ def _shortened(robot: Robot, q: np.ndarray, dt: float, found: clearance.StepColl
     return qp.Solution(np.zeros_like(v), solution.status, True, solution.iterations)
 
 
+HALVINGS = 8  # a step the loops' projection cannot close is halved at most this many times
+
+
 def _settled(robot: Robot, q: np.ndarray, dt: float, tasks: tuple[Task, ...], result: StepResult) -> StepResult:
     """The step's q projected onto the equalities the QP holds to first order only (a loop's), v = (q_next ⊖ q)/dt
     again: the drift a step leaves (O(|v dt|²)) removed where it is made, not carried to the next step. A step too
     long for the projection to close the loops from (a passive joint at its stop on the way) is halved until it
-    can (at most 8 times; else the whole step, as the QP gave it)."""
-    q_next, step = _projected(robot, q, result.q, tasks), result.v * dt
-    for _ in range(8 if robot.closures else 0):
-        if np.max(np.abs(robot.closure_error(q_next)), initial=0.0) <= ASSEMBLY_TOL:
-            break
+    can (at most HALVINGS times; else the whole step, as the QP gave it)."""
+    q_next, closed = _projected(robot, result.q, tasks)
+    step = result.v * dt
+    for _ in range(0 if closed else HALVINGS):
         step = 0.5 * step
-        shorter = _projected(robot, q, np.asarray(pin.integrate(robot.model, q, step), dtype=float), tasks)
-        if np.max(np.abs(robot.closure_error(shorter)), initial=0.0) <= ASSEMBLY_TOL:
+        shorter, closed = _projected(robot, np.asarray(pin.integrate(robot.model, q, step), dtype=float), tasks)
+        if closed:
             q_next = shorter
             break
     v = np.asarray(pin.difference(robot.model, q, q_next), dtype=float) / dt
@@ -225,13 +226,14 @@ def _settled(robot: Robot, q: np.ndarray, dt: float, tasks: tuple[Task, ...], re
     return settled
 
 
-def _projected(robot: Robot, q: np.ndarray, q_next: np.ndarray, tasks: tuple[Task, ...]) -> np.ndarray:
-    """q_next with every settled task's projection applied (a copy)."""
+def _projected(robot: Robot, q_next: np.ndarray, tasks: tuple[Task, ...]) -> tuple[np.ndarray, bool]:
+    """q_next with every settled task's projection applied (a copy), and whether every one of them closed."""
     q_next = q_next.copy()
+    closed = True
     for task in tasks:
         if task.settled:
-            task.project(robot, q_next)
-    return q_next
+            closed = task.project(robot, q_next) is not False and closed  # a task of the older protocol says None
+    return q_next, closed
 
 
 def _result(robot: Robot, q: np.ndarray, dt: float, solution: qp.Solution, errors: tuple[TaskError, ...],

@@ -104,9 +104,10 @@ class Task(ABC):
     def judged(self, robot: Robot, data: pin.Data, q: np.ndarray, com: np.ndarray | None) -> tuple[float, float]:
         """(position [m], rotation [rad]) error at q from Pinocchio's placements in ``data`` (and ``com``)."""
 
-    def project(self, robot: Robot, q: np.ndarray) -> None:
-        """Make q meet the task exactly where it can be set outright (a coupling; q changed in place)."""
-        return None  # a task met only by moving toward it: nothing to set
+    def project(self, robot: Robot, q: np.ndarray) -> bool:
+        """Make q meet the task exactly where it can be set outright (a coupling; q changed in place); whether q
+        meets it now as far as setting goes (False: the setting failed and q is unchanged)."""
+        return True  # a task met only by moving toward it: nothing to set
 
     def second(self) -> Task:
         """The task as the converged solve asks for it (a posture: second, so that it never holds a task off)."""
