@@ -25,7 +25,7 @@ from kinelab.robot import xacro
 from kinelab.robot.closures import Closure
 from kinelab.robot.joints import Joint, Mimic
 from kinelab.robot.meshes import c_stderr_captured
-from kinelab.robot.mjcf import equalities, is_mjcf, joint_couplings, read_mjcf
+from kinelab.robot.mjcf import equalities, floats, is_mjcf, joint_couplings, read_mjcf
 from kinelab.robot.srdf import Srdf, read_srdf
 from kinelab.robot.urdf import UrdfTree, read_tree
 
@@ -118,6 +118,7 @@ def whole_model(path: str | Path, *, floating: bool = False, name: str | None = 
     root = pin.JointModelFreeFlyer() if floating else None
     loops: tuple[tuple[Closure, ...], tuple[str, ...]] = ((), ())
     if is_mjcf(urdf_path):
+        root = None if floats(urdf_path) else root  # a file whose root body floats already: no second free-flyer
         model, tree = read_mjcf(urdf_path, root)
         loops = equalities(urdf_path, model, root)
     else:

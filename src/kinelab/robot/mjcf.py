@@ -42,7 +42,6 @@ def read_mjcf(path: Path, root: pin.JointModel | None = None) -> tuple[pin.Model
         URDFError: a file Pinocchio cannot read (the file and Pinocchio's reason named).
     """
     check_mjcf(path)
-    root = None if floats(path) else root
     try:
         model = pin.buildModelFromMJCF(str(path)) if root is None else \
             pin.buildModelAndConstraintsFromMJCF(str(path), root, "root_joint")[0]  # the unambiguous overload
@@ -313,7 +312,7 @@ def equalities(path: Path, model: pin.Model, root: pin.JointModel | None = None)
     if tree.find("equality") is None:
         return (), actuated
     try:
-        built = (pin.buildModelAndConstraintsFromMJCF(str(path)) if root is None or floats(path) else
+        built = (pin.buildModelAndConstraintsFromMJCF(str(path)) if root is None else
                  pin.buildModelAndConstraintsFromMJCF(str(path), root, "root_joint"))
     except Exception as exc:  # noqa: BLE001 - the parser raises RuntimeError, ValueError, IndexError, ...
         warnings.warn(f"{path.name}: Pinocchio cannot read its <equality> constraints ({type(exc).__name__}: {exc}); "
