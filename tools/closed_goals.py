@@ -14,6 +14,7 @@ import pinocchio as pin
 
 import kinelab
 from kinelab import AssemblyError, FrameTask, Limits, WholeBody
+from kinelab.report.bench import closed_step
 from kinelab.report.closed_checks import CLOSED_FORMS, loops_of
 from kinelab.robot.assembly import passive_indices
 
@@ -38,15 +39,11 @@ def assemblies(robot: kinelab.Robot, n: int, seed: int) -> str:
     return f"assemblies: {claimed}/{n} claimed, {wrong} not closed to 1e-10, {disagree} against the closed form"
 
 
-POSES = {"cassie": ("left-foot", "right-foot", "cassie-pelvis")}  # frames held as whole poses (else: a hand's place)
-
-
 def tasks_at(robot: kinelab.Robot, q: np.ndarray) -> list[FrameTask]:
-    """The goal's tasks with their targets where q puts them: Cassie's two feet and pelvis as poses, another
-    robot's first hand as a position."""
-    if robot.name in POSES:
-        return [FrameTask(f, robot.frame_placement(q, f)) for f in POSES[robot.name]]
-    return [FrameTask(robot.hands[0], robot.frame_placement(q, robot.hands[0]).translation, task="position")]
+    """The goal's tasks with their targets where q puts them (the loop bench's: Cassie's two feet and pelvis as
+    poses, another robot's first hand as a position)."""
+    return [FrameTask(f, robot.frame_placement(q, f) if kind == "pose" else robot.frame_placement(q, f).translation,
+                      task=kind) for f, kind in closed_step.frames(robot)]
 
 
 def met(robot: kinelab.Robot, q: np.ndarray, tasks: list[FrameTask]) -> bool:

@@ -29,7 +29,8 @@ HEADER = f"""<?xml version="1.0"?>
   delta.closures.yaml, 15 joints, 9 closure equations, the 3 motors driven, 3 idle spins. The
   platform's position has a closed form (three spheres' intersection, docs/closures.md), the reference of
   tests/robot/test_delta.py. Motors {MOTOR[0]}..{MOTOR[1]} rad (0: arm horizontal, positive: down); passive joints
-  +-2 pi (ball joints have no stop; a stop at +-pi would cut off the assemblies across it). Links 0.05-0.2 kg. Written by tools/make_delta.py.
+  +-2 pi (ball joints have no stop; a stop at +-pi would cut off the assemblies across it). Links 0.05-0.2 kg.
+  Written by tools/make_delta.py.
 -->
 <robot name="delta">
   <link name="base_link">

@@ -168,8 +168,9 @@ def newton(robot: Robot, q: np.ndarray, passive: np.ndarray, tol: float) -> tupl
 
 def _scalar_bounds(model: pin.Model, passive: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The passive joints with one coordinate and finite limits: (their v indices, q indices, lower, upper)."""
+    moving = set(passive.tolist())
     pairs = [(model.joints[j].idx_v, model.joints[j].idx_q) for j in range(1, model.njoints)
-             if model.joints[j].nq == model.joints[j].nv == 1 and model.joints[j].idx_v in set(passive.tolist())
+             if model.joints[j].nq == model.joints[j].nv == 1 and model.joints[j].idx_v in moving
              and np.isfinite(model.lowerPositionLimit[model.joints[j].idx_q])
              and np.isfinite(model.upperPositionLimit[model.joints[j].idx_q])]
     iv = np.array([p[0] for p in pairs], dtype=int)
