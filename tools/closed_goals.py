@@ -16,7 +16,7 @@ import kinelab
 from kinelab import AssemblyError, FrameTask, Limits, WholeBody
 from kinelab.report.bench import closed_step
 from kinelab.report.closed_checks import CLOSED_FORMS, loops_of
-from kinelab.robot.assembly import passive_indices
+from kinelab.robot.assembly import actuated_indices, passive_indices
 
 
 def assemblies(robot: kinelab.Robot, n: int, seed: int) -> str:
@@ -24,7 +24,7 @@ def assemblies(robot: kinelab.Robot, n: int, seed: int) -> str:
     rng = np.random.default_rng(seed)
     data = robot.model.createData()
     home = robot.standing()
-    index = [robot.model.joints[robot.model.getJointId(a)].idx_q for a in robot.actuated]
+    index = actuated_indices(robot)[0]
     claimed = wrong = disagree = 0
     for _ in range(n):
         q = home.copy()
@@ -60,7 +60,7 @@ def met(robot: kinelab.Robot, q: np.ndarray, tasks: list[FrameTask]) -> bool:
 
 def draw(robot: kinelab.Robot, home: np.ndarray, rng: np.random.Generator) -> np.ndarray | None:
     """The motors drawn at random within their limits from ``home`` and assembled; None where none assembles."""
-    index = [robot.model.joints[robot.model.getJointId(a)].idx_q for a in robot.actuated]
+    index = actuated_indices(robot)[0]
     q = home.copy()
     q[index] = robot.random_q(rng)[index]
     try:

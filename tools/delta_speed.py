@@ -14,6 +14,7 @@ import numpy as np
 
 import kinelab
 from kinelab import AssemblyError, FrameTask
+from kinelab.robot.assembly import actuated_indices
 
 R, LA, LB, RP = 0.10, 0.20, 0.45, 0.04  # base radius, upper arm, forearm, platform radius [m] (urdf/delta.urdf)
 PHI = (0.0, 2 * np.pi / 3, 4 * np.pi / 3)
@@ -47,7 +48,7 @@ def main() -> int:
     args = parser.parse_args()
     robot = kinelab.load("delta")
     hand, home = robot.hands[0], robot.standing()
-    index = [robot.model.joints[robot.model.getJointId(a)].idx_q for a in robot.actuated]
+    index = actuated_indices(robot)[0]
     rng = np.random.default_rng(5)
     general, formula, met_general, met_formula = [], [], 0, 0
     while len(general) < args.n:

@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from kinelab.errors import OptionError
-from kinelab.robot.assembly import passive_indices
+from kinelab.robot.assembly import actuated_indices, passive_indices
 
 if TYPE_CHECKING:
     from kinelab.robot.tree import Robot
@@ -62,7 +62,7 @@ def regular_ranks(robot: Robot, output: str) -> tuple[int, int]:
 def _ranks(robot: Robot, output: str) -> tuple[int, int]:
     rng = np.random.default_rng(0)
     home = robot.standing()
-    actuated = _actuated(robot)
+    actuated = actuated_indices(robot)
     ranks = (0, 0)
     for _ in range(RANK_SAMPLES):
         q = home.copy()
@@ -97,12 +97,6 @@ def _maps(robot: Robot, q: np.ndarray, output: str) -> tuple[np.ndarray, np.ndar
     """(J_p, G) at q: the closure Jacobian's passive columns, and the motors' map to the output's position."""
     Jp = robot.closure_jacobian(q)[:, passive_indices(robot, robot.actuated)]
     return Jp, robot.actuated_jacobian(q, output)[:3]
-
-
-def _actuated(robot: Robot) -> tuple[list[int], list[int]]:
-    """The actuated joints' q and v indices."""
-    joints = [robot.model.joints[robot.model.getJointId(a)] for a in robot.actuated]
-    return [j.idx_q for j in joints], [j.idx_v for j in joints]
 
 
 def _rank(M: np.ndarray) -> int:

@@ -78,7 +78,9 @@ def _sweep(robot: Robot, output: str, args: argparse.Namespace) -> int:
     if not (isinstance(args.sweep, int) and args.sweep >= 1):
         raise KinelabError(f"--sweep takes a number of samples ≥ 1, got {args.sweep}")
     rng = np.random.default_rng(args.seed)
-    index = [robot.model.joints[robot.model.getJointId(a)].idx_q for a in robot.actuated]
+    from kinelab.robot.assembly import actuated_indices
+
+    index = actuated_indices(robot)[0]
     home = robot.standing()  # once: every sample starts from it
     rows: list[tuple[float, float, np.ndarray]] = []
     refused = 0

@@ -15,6 +15,7 @@ import pinocchio as pin
 
 from kinelab.errors import AssemblyError
 from kinelab.report.check import SHARE, Check, samples_for
+from kinelab.robot.assembly import actuated_indices
 from kinelab.robot.tree import Robot
 
 FD = 1e-6  # [rad or m] the central difference's step
@@ -78,7 +79,7 @@ def assembly_check(robot: Robot, n: int, seed: int) -> list[Check]:
     rng = np.random.default_rng(seed + 11)
     data = robot.model.createData()
     home = robot.standing()
-    actuated = [robot.model.joints[robot.model.getJointId(a)].idx_q for a in robot.actuated]
+    actuated = actuated_indices(robot)[0]
     reference = CLOSED_FORMS.get(robot.name)
     false = disagree = claimed = 0
     for _ in range(n):
@@ -163,7 +164,7 @@ def held_loops_check(robot: Robot, n: int, seed: int) -> list[Check]:
 
 def _random_assembly(robot: Robot, near: np.ndarray, rng: np.random.Generator) -> np.ndarray:
     """An assembly with the motors at random (retried until one assembles)."""
-    actuated = [robot.model.joints[robot.model.getJointId(a)].idx_q for a in robot.actuated]
+    actuated = actuated_indices(robot)[0]
     for _ in range(100):
         q = near.copy()
         q[actuated] = robot.random_q(rng)[actuated]

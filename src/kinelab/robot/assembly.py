@@ -25,6 +25,7 @@ class Robot(Protocol):
     nv: int
     floating: bool
     closures: tuple[Closure, ...]
+    actuated: tuple[str, ...]
 
     def within_limits(self, q: Any) -> bool:
         """Whether q is within the joint limits."""
@@ -99,6 +100,12 @@ def loop_state(model: pin.Model, data: pin.Data, q: np.ndarray, closures: Sequen
     J = np.vstack([closure_jacobian(model, data, c, f) for c, f in zip(closures, ids, strict=True)] or
                   [np.zeros((0, model.nv))])
     return e, J
+
+
+def actuated_indices(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
+    """The declared actuated joints' q indices and v indices (one each: actuated joints have one coordinate)."""
+    joints = [robot.model.joints[robot.model.getJointId(a)] for a in robot.actuated]
+    return np.array([j.idx_q for j in joints], dtype=int), np.array([j.idx_v for j in joints], dtype=int)
 
 
 def passive_indices(robot: Robot, actuated: Sequence[str]) -> np.ndarray:

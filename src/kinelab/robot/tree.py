@@ -332,7 +332,7 @@ class Robot:
             raise OptionError("robot", self.name, "a robot with loops and actuated joints declared")
         J = self.frame_jacobian(q, frame, reference)
         Jc = self.closure_jacobian(q)
-        va = [self.model.joints[self.model.getJointId(a)].idx_v for a in self.actuated]
+        va = assembly.actuated_indices(self)[1]
         vp = assembly.passive_indices(self, self.actuated)
         return J[:, va] - J[:, vp] @ np.linalg.pinv(Jc[:, vp], rcond=1e-10) @ Jc[:, va]
 

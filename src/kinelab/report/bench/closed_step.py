@@ -26,6 +26,7 @@ import numpy as np
 from kinelab.errors import KinelabError
 from kinelab.report.bench.steppers import Maps, mujoco_spec
 from kinelab.robot import load
+from kinelab.robot.assembly import actuated_indices
 from kinelab.robot.mjcf import is_mjcf
 from kinelab.robot.tree import Robot
 from kinelab.wholebody import FrameTask, Limits, PostureTask, StepOptions, WholeBody
@@ -47,7 +48,7 @@ def targets(robot: Robot, steps: int) -> tuple[np.ndarray, list[list[Any]]]:
     motors swept by sines (0.3 rad, periods of 2-3 s, within their limits) about the start, each sample assembled
     from the one before."""
     home = robot.standing()
-    motors = [robot.model.joints[robot.model.getJointId(a)].idx_q for a in robot.actuated]
+    motors = actuated_indices(robot)[0]
     lower, upper = robot.model.lowerPositionLimit[motors], robot.model.upperPositionLimit[motors]
     periods = 2.0 + np.arange(len(motors)) / max(len(motors) - 1, 1)
     q, out = home.copy(), []
