@@ -157,7 +157,8 @@ def converged(name: str, count: int = 50, seed: int = 0, progress: bool = False)
             res = solve(robot, tasks, q0=start, solver=solver, seed=k, time_budget=2.0)
             rows[solver]["time"].append(time.perf_counter() - t0)
             rows[solver]["ok"].append(float(res.success))
-        ok, seconds = _pink_iterated(robot, frames, placed, tasks, start)
+        com = robot.com(q_true) if scenario.com else None
+        ok, seconds = _pink_iterated(robot, frames, placed, com, start)
         if ok is not None:
             rows["pink iterated"]["ok"].append(float(ok))
             rows["pink iterated"]["time"].append(seconds)
@@ -165,9 +166,10 @@ def converged(name: str, count: int = 50, seed: int = 0, progress: bool = False)
              "median_ms": float(np.median(r["time"]) * 1e3)} for key, r in rows.items() if r["ok"]]
 
 
-def _pink_iterated(robot: Robot, frames: tuple[str, ...], placed: list[pin.SE3], tasks: list[Any],
+def _pink_iterated(robot: Robot, frames: tuple[str, ...], placed: list[pin.SE3], com: np.ndarray | None,
                    start: np.ndarray) -> tuple[bool | None, float]:
-    """pink's step at dt = 1 s, iterated until every frame is within 1e-6 m / 1e-6 rad (200 steps at most)."""
+    """pink's step at dt = 1 s (the frames at ``placed``, the centre of mass at ``com`` [m] unless None), iterated
+    until every frame is within 1e-6 m / 1e-6 rad (200 steps at most)."""
     try:
         import pink
         from pink.limits import ConfigurationLimit
@@ -181,10 +183,9 @@ def _pink_iterated(robot: Robot, frames: tuple[str, ...], placed: list[pin.SE3],
         task = PinkFrame(f, position_cost=1.0, orientation_cost=1.0)
         task.set_target(M)
         pink_tasks.append(task)
-    com = next((t for t in tasks if isinstance(t, ComTask)), None)
     if com is not None:
         task = PinkCom(cost=1.0)
-        task.set_target(com.target)
+        task.set_target(com)
         pink_tasks.append(task)
     limits = [ConfigurationLimit(robot.model)]
     t0 = time.perf_counter()
