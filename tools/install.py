@@ -2,7 +2,7 @@
 
 pip prints nothing while it installs build dependencies, compiles kinelab's core (about a minute on two cores) or
 unpacks the wheels it downloaded; a user or a CI log sees a silent terminal. This runs the same pip command in the
-same Python, passes pip's lines through as they come, and when pip has said nothing for 10 s prints one line saying
+same Python, passes pip's lines through as they come, and when pip has said nothing for 8 s prints one line saying
 what pip is doing and for how long. Standard library only: it runs before kinelab is installed.
 
 Usage (from the repository root, in the virtual environment's Python)::
@@ -21,7 +21,7 @@ import sys
 import threading
 import time
 
-QUIET_S = 10.0
+QUIET_S = 8.0  # [s] under 10 s with a busy machine's delay
 #: pip's line prefixes and what pip does after each, for the heartbeat line.
 PHASES = (
     ("Installing build dependencies", "installing the build's dependencies"),
