@@ -1,5 +1,5 @@
-"""docs/extending.md holds: its example task, defined on the page (not in kinelab), is stepped and solved on TALOS
-and judged here by Pinocchio; the page names every method of the task protocol."""
+"""docs/extending.md holds: its example task and inequality, defined on the page (not in kinelab), are stepped (and
+the task solved) on TALOS and judged here by Pinocchio; the page names every method of both protocols."""
 
 import re
 from pathlib import Path
@@ -7,14 +7,19 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from kinelab.wholebody import Task
+import kinelab
+from kinelab.wholebody import Inequality, Task
 
 PAGE = Path(__file__).resolve().parents[1] / "docs" / "extending.md"
 
 
+def _blocks() -> list[str]:
+    return re.findall(r"```python\n(.*?)```", PAGE.read_text(), re.S)
+
+
 def test_the_pages_toy_task_is_stepped_and_solved_by_its_own_methods(monkeypatch, tmp_path):
     monkeypatch.chdir(tmp_path)
-    block = re.search(r"```python\n(.*?)```", PAGE.read_text(), re.S).group(1)
+    block = _blocks()[0]
     namespace: dict = {}
     exec(compile(block, "extending.md", "exec"), namespace)  # noqa: S102 - the page's own example
     talos, q, solved = namespace["talos"], namespace["q"], namespace["solved"]
@@ -33,9 +38,59 @@ def test_the_pages_toy_task_is_stepped_and_solved_by_its_own_methods(monkeypatch
         assert talos.within_limits(q_end)
 
 
-def test_the_page_names_every_method_of_the_protocol():
+def test_the_page_names_every_method_of_the_protocols():
     page = PAGE.read_text()
     methods = [name for name in vars(Task) if not name.startswith("_") and name not in ("uses_com", "preference",
                                                                                        "second")]
+    methods += [name for name in vars(Inequality) if not name.startswith("_")]
     missing = [m for m in methods if f"`{m}" not in page]
     assert not missing, missing
+
+
+def test_the_pages_inequality_keeps_the_hand_above_its_plane_at_every_step(monkeypatch, tmp_path):
+    """The hand pulled 0.3 m down through a plane 0.1 m below it: by Pinocchio's FK it never goes more than 1e-6 m
+    below the plane, ends on it (within 1 mm), the feet stay (1e-5 m); the same tasks without the inequality take the
+    hand below the plane (so the rows are what holds it)."""
+    monkeypatch.chdir(tmp_path)
+    namespace: dict = {}
+    exec(compile(_blocks()[1], "extending.md", "exec"), namespace)  # noqa: S102 - the page's own example
+    talos, q, table, start = namespace["talos"], namespace["q"], namespace["table"], namespace["start"]
+    assert not namespace["held"].compiled and "inequalities" in namespace["held"].route
+    model, data = talos.model, talos.model.createData()
+    hand = model.getFrameId("gripper_left_base_link")
+    assert min(namespace["heights"]) >= table - 1e-6
+    pin.framesForwardKinematics(model, data, q)
+    assert abs(data.oMf[hand].translation[2] - table) <= 1e-3
+    for foot in ("left_sole_link", "right_sole_link"):
+        after = data.oMf[model.getFrameId(foot)].translation
+        assert np.linalg.norm(after - talos.frame_placement(start, foot).translation) <= 1e-5
+    free = kinelab.WholeBody(talos, namespace["tasks"])
+    q_free = start
+    for _ in range(60):
+        q_free = free.step(q_free, 0.05).q
+    pin.framesForwardKinematics(model, data, q_free)
+    assert data.oMf[hand].translation[2] < table - 0.1
+
+
+def test_the_converged_solve_holds_an_inequality_and_says_when_its_answer_breaks_it():
+    """A solve asked to put the hand below the plane with the plane held: no success, and the answer is not below
+    the plane by more than 1e-6 m (Pinocchio); a target above it: success."""
+    namespace: dict = {}
+    exec(compile(_blocks()[1].split("q, heights")[0], "extending.md", "exec"), namespace)  # noqa: S102
+    talos, table, above = namespace["talos"], namespace["table"], namespace["above"]
+    limits = kinelab.Limits(velocity=None, inequalities=(above,))
+    low = kinelab.solve(talos, namespace["tasks"], q0=namespace["start"], limits=limits, seed=0, max_restarts=0)
+    assert not low.success
+    assert talos.frame_placement(low.q, "gripper_left_base_link").translation[2] >= table - 1e-6
+    hand = namespace["hand"]
+    up = pin.SE3(hand.rotation, hand.translation + np.array([0.05, 0.0, 0.05]))
+    tasks = [*namespace["feet"], kinelab.FrameTask("gripper_left_base_link", up, task="position")]
+    high = kinelab.solve(talos, tasks, q0=namespace["start"], limits=limits, seed=0)
+    assert high.success and talos.frame_placement(high.q, "gripper_left_base_link").translation[2] >= table
+
+
+def test_a_limits_inequality_must_be_one():
+    import pytest
+
+    with pytest.raises(kinelab.OptionError, match="inequalities"):
+        kinelab.Limits(inequalities=("above",))

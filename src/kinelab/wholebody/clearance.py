@@ -21,19 +21,25 @@ a point fixed on an object's joint, ḋ = nᵀ(J₂(p₂) − J₁(p₁)) v, and
 which lets a pair close at most the share ξ of its clearance in one step and, from a start nearer than ``margin``
 (or in contact), asks it apart at the same rate (capped at what the velocity bounds allow: never infeasible by
 itself).
+
+:class:`Clearance` is that, as an inequality of the step (:class:`~kinelab.wholebody.constraints.Inequality`):
+``Limits(collisions=...)`` holds one.
 """
 
 from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 import pinocchio as pin
 
 from kinelab.collision.model import CollisionError, Collisions, Contact, _hulls, paired
 from kinelab.collision.spheres import PLANE
+from kinelab.ik.result import Status
 from kinelab.robot.tree import Robot
+from kinelab.wholebody.constraints import Held, Inequality
 
 WORLD = pin.ReferenceFrame.WORLD
 
@@ -270,11 +276,51 @@ def _rates(found: StepCollisions, data: pin.Data, pairs: np.ndarray, p1: np.ndar
     return out
 
 
-def feasible(A: np.ndarray, b: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
-    """The right-hand sides b of rows A v ≥ b, each at most half of the largest rate its row can reach within the
-    bounds on v: a start nearer than the margin is brought out as fast as the bounds allow, never made infeasible
-    by one row."""
-    with np.errstate(invalid="ignore"):  # 0 · inf where a row does not move an unbounded velocity
-        reach = np.where(A > 0, A * upper, A * lower)
-    reach = np.where(A == 0, 0.0, reach).sum(axis=1)
-    return np.where(b > 0, np.minimum(b, 0.5 * np.maximum(reach, 0.0)), b)
+@dataclass(frozen=True)
+class Clearance(Inequality):
+    """Every monitored pair kept ``margin`` apart (an inequality of the step: a row per near pair).
+
+    Attributes:
+        collisions: the pairs, obstacles, margin, detection distance and gain (:class:`~kinelab.Collisions`).
+    """
+
+    collisions: Collisions
+    broken: ClassVar[Status] = Status.COLLISION
+
+    @property
+    def label(self) -> str:
+        """The inequality in words."""
+        return f"every pair {self.collisions.margin:g} m apart"
+
+    def check(self, robot: Robot) -> None:
+        """Build the robot's step geometry (once per robot and value).
+
+        Raises:
+            CollisionError: the robot has no collision geometry.
+        """
+        step_collisions(robot, self.collisions)
+
+    def rows(self, robot: Robot, q: np.ndarray, dt: float) -> Held:
+        """The velocity damper of every near pair (:func:`rows`)."""
+        found = step_collisions(robot, self.collisions)
+        start = rows(found, robot, dt)
+        return Held(start.A, start.b, start.closest, (found, start))
+
+    def overshoot(self, robot: Robot, held: Held, v: np.ndarray, q_next: np.ndarray, dt: float
+                  ) -> tuple[np.ndarray, np.ndarray] | None:
+        """The pairs the answer brings nearer than it may, carried back as rows (:func:`overshoot`)."""
+        found, start = held.memo
+        return overshoot(found, robot, start, v, q_next, dt)
+
+    def breaks(self, robot: Robot, held: Held, q_next: np.ndarray) -> bool:
+        """Whether a pair ends nearer than it may (:func:`too_near`)."""
+        found, start = held.memo
+        return bool(too_near(found, robot, start, q_next)[1].size)
+
+    def slack(self, robot: Robot, q: np.ndarray) -> float:
+        """The nearest pair's distance less the margin [m] (inf: no pairs)."""
+        return step_collisions(robot, self.collisions).closest(q)[1]
+
+    def nearest(self, robot: Robot, q: np.ndarray) -> Contact | None:
+        """The nearest pair over every monitored pair (coal's distance)."""
+        return step_collisions(robot, self.collisions).closest(q)[0]

@@ -1,15 +1,22 @@
 """Constraints of whole-body kinematics: what the step holds exactly rather than weighs.
 
 Equalities are tasks of the same protocol (:class:`kinelab.wholebody.tasks.Task`) at priority 0: each adds rows
-``a · v = c`` that the QP holds, its error driven to zero (drift corrected every step). Inequalities are the
-step's bounds (:class:`kinelab.wholebody.limits.Limits`).
+``a · v = c`` that the QP holds, its error driven to zero (drift corrected every step). Inequalities are
+:class:`Inequality` objects: each gives rows ``A v ≥ b`` at the step's start, may add rows for what its first order
+missed once the QP has answered, says whether a step's end breaks it (the step is shortened until none does) and
+how far a configuration is inside it (the converged solve's verdict). The joints' position, velocity and
+acceleration limits are the step's bounds on v (:class:`kinelab.wholebody.limits.Limits`, compiled); a
+:class:`Inequality` enters through ``Limits(inequalities=...)``, and collisions (``Limits(collisions=...)``) are one
+(:class:`kinelab.wholebody.clearance.Clearance`).
 
 - :class:`CouplingTask`: one joint a linear function of another (mimic joints, gears), held exactly.
 - :class:`ClosureTask`: a robot's loop held closed (:mod:`kinelab.robot.closures`), one per declared closure.
+- :class:`Inequality`, :class:`Held`: the inequality protocol and its rows.
 """
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -17,6 +24,7 @@ import numpy as np
 import pinocchio as pin
 
 from kinelab.errors import JointNotFoundError, OptionError
+from kinelab.ik.result import Status
 from kinelab.robot.assembly import closure_error, closure_jacobian, newton, passive_indices
 from kinelab.robot.closures import ASSEMBLY_TOL, Closure, check_closures
 from kinelab.values import is_real
@@ -24,6 +32,7 @@ from kinelab.wholebody.evaluate import Packing, StepRows
 from kinelab.wholebody.tasks import Task, TaskError
 
 if TYPE_CHECKING:
+    from kinelab.collision.model import Contact
     from kinelab.robot.tree import Robot
 
 
@@ -210,3 +219,67 @@ def loops(robot: Robot) -> tuple[Task, ...]:
     joints (couplings) and its loops (none: ``()``)."""
     couplings = tuple(CouplingTask(m.name, m.leader, m.multiplier, m.offset) for m in robot.mimics)
     return couplings + tuple(ClosureTask(c) for c in robot.closures)
+
+
+@dataclass(frozen=True)
+class Held:
+    """One inequality's rows at a step's start: ``A v ≥ b`` (A: (m, nv), b: (m,), in the inequality's unit per
+    second), the nearest pair when it has one (collisions), and what the inequality keeps for its later calls."""
+
+    A: np.ndarray
+    b: np.ndarray
+    closest: Contact | None = None
+    memo: Any = None
+
+
+class Inequality(ABC):
+    """What every inequality of the step answers for (see the module's docstring). A subclass is a frozen dataclass
+    (a value: equal ones are the same problem) with a :attr:`label`."""
+
+    broken: ClassVar[Status] = Status.OUTSIDE_LIMITS  # a converged solve's status where its answer breaks it
+
+    @property
+    @abstractmethod
+    def label(self) -> str:
+        """The inequality in words (results and messages)."""
+
+    def check(self, robot: Robot) -> None:
+        """Name what the robot lacks (before any work).
+
+        Raises:
+            KinelabError: a subclass naming it.
+        """
+        return None  # an inequality that names nothing has nothing to check
+
+    @abstractmethod
+    def rows(self, robot: Robot, q: np.ndarray, dt: float) -> Held:
+        """Its rows at q (``robot.data``: Pinocchio's placements and joint Jacobians there) for a step of dt [s]:
+        rows that let it close at most a share of its slack in one step, and ask a start that breaks it back."""
+
+    def overshoot(self, robot: Robot, held: Held, v: np.ndarray, q_next: np.ndarray, dt: float
+                  ) -> tuple[np.ndarray, np.ndarray] | None:
+        """More rows (A, b) where the step's answer v (to ``q_next``) breaks it though its rows held (their first
+        order missed); None: none."""
+        return None  # linear in v: its rows say all
+
+    def breaks(self, robot: Robot, held: Held, q_next: np.ndarray) -> bool:
+        """Whether a step's end breaks it (then the step is made shorter)."""
+        return self.slack(robot, q_next) < 0.0
+
+    @abstractmethod
+    def slack(self, robot: Robot, q: np.ndarray) -> float:
+        """How far q is inside it (≥ 0: it holds; < 0: broken by that much), in its own unit."""
+
+    def nearest(self, robot: Robot, q: np.ndarray) -> Contact | None:
+        """Its nearest pair at q, for a result to name (None: it has no pairs)."""
+        return None
+
+
+def feasible(A: np.ndarray, b: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+    """The right-hand sides b of rows A v ≥ b, each at most half of the largest rate its row can reach within the
+    bounds on v: a start that breaks an inequality is brought back as fast as the bounds allow, never made
+    infeasible by one row."""
+    with np.errstate(invalid="ignore"):  # 0 · inf where a row does not move an unbounded velocity
+        reach = np.where(A > 0, A * upper, A * lower)
+    reach = np.where(A == 0, 0.0, reach).sum(axis=1)
+    return np.where(b > 0, np.minimum(b, 0.5 * np.maximum(reach, 0.0)), b)

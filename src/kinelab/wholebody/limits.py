@@ -16,6 +16,7 @@ import numpy as np
 from kinelab.errors import OptionError
 from kinelab.robot.space import LIMIT_SLACK, Space
 from kinelab.values import is_real, mixes_non_reals
+from kinelab.wholebody.constraints import Inequality
 
 
 @dataclass(frozen=True)
@@ -31,12 +32,15 @@ class Limits:
         collisions: None (none), or what :class:`kinelab.Collisions` takes — ``"self"``, an ``Environment`` or a
             ``Collisions(self_collisions=, environment=, margin=, detection=, gain=)``: every pair nearer than
             margin + detection held apart by one row of the QP (:mod:`kinelab.wholebody.clearance`).
+        inequalities: more inequalities the step holds as rows of its QP and the solve at its answer, any
+            :class:`~kinelab.wholebody.constraints.Inequality` (a tuple; docs/extending.md).
     """
 
     position: bool = True
     velocity: Any = True
     acceleration: Any = None
     collisions: Any = None
+    inequalities: Any = ()
 
     def __post_init__(self) -> None:
         """Check every field.
@@ -54,6 +58,26 @@ class Limits:
             from kinelab.collision.model import as_collisions
 
             object.__setattr__(self, "collisions", as_collisions(self.collisions))
+        _check_inequalities(self.inequalities)
+        object.__setattr__(self, "inequalities", tuple(self.inequalities))
+
+    def held(self) -> tuple[Inequality, ...]:
+        """Every inequality held as rows (the collisions' first), beyond the bounds on v."""
+        if self.collisions is None:
+            return self.inequalities
+        from kinelab.wholebody.clearance import Clearance  # coal's geometry loaded only when asked for
+
+        return (Clearance(self.collisions), *self.inequalities)
+
+
+def _check_inequalities(value: Any) -> None:
+    """A tuple or list of :class:`Inequality` values.
+
+    Raises:
+        OptionError: anything else.
+    """
+    if not isinstance(value, tuple | list) or not all(isinstance(i, Inequality) for i in value):
+        raise OptionError("inequalities", value, "a tuple of kinelab.wholebody.Inequality values (or ())")
 
 
 def _check_rate(name: str, value: Any) -> None:

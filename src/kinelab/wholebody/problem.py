@@ -64,6 +64,8 @@ class WholeBody:
         self.loops = loops(robot)  # the robot's closures, held as equalities of every step
         for task in self._tasks:
             task.check(robot)
+        for inequality in limits.inequalities:
+            inequality.check(robot)
         self._vmax = np.ascontiguousarray(velocity_bounds(limits, robot.space), dtype=float)
         amax = acceleration_bounds(limits, robot.space)
         self._amax = NO_LIMIT if amax is None else np.ascontiguousarray(amax, dtype=float)
@@ -98,13 +100,15 @@ class WholeBody:
     def compiled(self) -> bool:
         """Whether each step is one compiled call (else the readable step answers, alike: :attr:`route` says
         why)."""
-        return self._packed is not None and self.limits.collisions is None
+        return self._packed is not None and not self.limits.held()
 
     @property
     def route(self) -> str:
         """Which step answers, and why, in words."""
         if self.limits.collisions is not None:
             return "readable: collisions are held (the compiled step has no block for the collision rows yet)"
+        if self.limits.inequalities:
+            return "readable: inequalities are held as rows (the compiled step has no block for them)"
         if self._packed is not None:
             return "compiled: the tree certified against Pinocchio, DAQP's C interface linked, every task packed"
         if self.options.solver != "daqp":
@@ -154,7 +158,7 @@ class WholeBody:
         """The step in one compiled call, or None where it does not serve (a q to check and name first, an
         acceleration limit without the velocity before)."""
         packed, robot, arr = self._packed, self.robot, _plain(q, self.robot.nq)
-        if packed is None or arr is None or (self._amax.size and prev is None) or self.limits.collisions is not None:
+        if packed is None or arr is None or (self._amax.size and prev is None) or self.limits.held():
             return None
         q_out, v_out, errors = np.empty(robot.nq), np.empty(robot.nv), np.zeros((len(packed.labels), 2))
         returning = np.empty(robot.nv, dtype=np.uint8)
@@ -324,7 +328,7 @@ def _equal_limits(a: object, b: Limits) -> bool:
     return all(np.array_equal(np.asarray(x, dtype=object), np.asarray(y, dtype=object))
                if isinstance(x, np.ndarray | list | tuple) or isinstance(y, np.ndarray | list | tuple) else x == y
                for x, y in ((a.position, b.position), (a.velocity, b.velocity), (a.acceleration, b.acceleration),
-                            (a.collisions, b.collisions)))
+                            (a.collisions, b.collisions))) and _same_objects(list(a.inequalities), b.inequalities)
 
 
 def _same_objects(held: list[Task], tasks: Any) -> bool:

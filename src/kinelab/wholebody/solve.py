@@ -19,15 +19,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
-from kinelab.collision.model import Collisions, Contact
 from kinelab.errors import OptionError
 from kinelab.ik.result import Status
 from kinelab.robot.chain import Chain
 from kinelab.robot.space import generator
 from kinelab.robot.tree import Robot
 from kinelab.typing import Configuration
-from kinelab.wholebody.clearance import step_collisions
-from kinelab.wholebody.constraints import loops
+from kinelab.wholebody.constraints import Inequality, loops
 from kinelab.wholebody.frdm import frdm_solve
 from kinelab.wholebody.iterate import SolveSettings, iterate, posture_second
 from kinelab.wholebody.limits import Limits
@@ -36,6 +34,8 @@ from kinelab.wholebody.tasks import Task, as_tasks
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
+
+    from kinelab.collision.model import Contact
 
 
 @dataclass(frozen=True)
@@ -146,7 +146,8 @@ def _run(robot: Robot, tasks: tuple[Task, ...], start: np.ndarray, settings: Sol
                 task.project(robot, q)
     _, q, status = best
     result = _result(robot, tasks, q, status, settings, iterations, restarts, time.perf_counter() - t0)
-    return result if limits.collisions is None else _clear(robot, result, limits.collisions)
+    held = limits.held()
+    return _clear(robot, result, held) if held else result
 
 
 def _converge(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, settings: SolveSettings, limits: Limits,
@@ -168,20 +169,19 @@ def _result(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, status: Status
 
 
 def _penetration(robot: Robot, q: np.ndarray, limits: Limits) -> float:
-    """How far the nearest pair at q is inside the margin [m] (0: clear, or no collisions asked)."""
-    if limits.collisions is None:
-        return 0.0
-    return max(0.0, -step_collisions(robot, limits.collisions).closest(q)[1])
+    """How far q breaks the inequalities held (the most of any; 0: it breaks none, or none is asked)."""
+    return max((max(0.0, -i.slack(robot, q)) for i in limits.held()), default=0.0)
 
 
-def _clear(robot: Robot, result: WholeBodyResult, collisions: Collisions) -> WholeBodyResult:
-    """The result with its nearest pair (coal's distance on every monitored pair) and, nearer than the margin, no
-    success (status ``collision``)."""
-    contact, slack = step_collisions(robot, collisions).closest(result.q)
-    if slack >= 0.0:
+def _clear(robot: Robot, result: WholeBodyResult, held: tuple[Inequality, ...]) -> WholeBodyResult:
+    """The result with its nearest pair (coal's distance on every monitored pair, where collisions are held) and,
+    where its q breaks an inequality (a pair nearer than the margin), no success (that inequality's status)."""
+    contact = next((c for i in held if (c := i.nearest(robot, result.q)) is not None), None)
+    broken = [i for i in held if i.slack(robot, result.q) < 0.0]
+    if not broken:
         return replace(result, closest=contact)
     return replace(result, closest=contact, success=False,
-                   status=Status.COLLISION if result.success else result.status)
+                   status=broken[0].broken if result.success else result.status)
 
 
 def _restart(robot: Robot, start: np.ndarray, rng: np.random.Generator, limits: Limits) -> np.ndarray:

@@ -10,16 +10,17 @@ q ⊕ v·dt through ``pin.integrate``.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
 
-from kinelab.collision.model import Contact
 from kinelab.errors import OptionError
 from kinelab.robot.tree import Robot
 from kinelab.values import is_real
-from kinelab.wholebody import clearance, qp
 from kinelab.wholebody import evaluate as ev
+from kinelab.wholebody import qp
+from kinelab.wholebody.constraints import Held, Inequality, feasible
 from kinelab.wholebody.limits import (
     Limits,
     acceleration_bounds,
@@ -27,6 +28,9 @@ from kinelab.wholebody.limits import (
     velocity_bounds,
 )
 from kinelab.wholebody.tasks import Task, TaskError
+
+if TYPE_CHECKING:
+    from kinelab.collision.model import Contact
 
 
 @dataclass(frozen=True)
@@ -103,8 +107,8 @@ DEFAULT_OPTIONS = StepOptions()
 STATUS = {**qp.DAQP_STATUS, -101: qp.NOT_FINITE}  # the compiled step's flags in words
 
 
-SEPARATE = 1e4  # the weight of a pair in collision's separation, where its row cannot be held with the others
-REFINE = 3  # re-solves of a step whose answer brings a pair nearer than the margin (clearance.overshoot)
+SEPARATE = 1e4  # the weight of a broken row's return (a pair in collision), where it cannot be held with the others
+REFINE = 3  # re-solves of a step whose answer breaks an inequality its rows held (Inequality.overshoot)
 
 
 def _step(robot: Robot, q: np.ndarray, tasks: tuple[Task, ...], dt: float, limits: Limits, options: StepOptions,
@@ -119,11 +123,11 @@ def _step(robot: Robot, q: np.ndarray, tasks: tuple[Task, ...], dt: float, limit
                                      acceleration_bounds(limits, robot.space), v_prev)
     A_eq, b_eq = (np.array([a for a, _ in eq]), np.array([c for _, c in eq])) if eq else (None, None)
     problem = _Levels(levels, options, lower, upper, (A_eq, b_eq), dt)
-    if limits.collisions is None:
-        solution = problem.solve(robot, None)
-        closest = None
+    held = limits.held()
+    if held:
+        solution, closest = _apart(robot, q, dt, held, problem)
     else:
-        solution, closest = _apart(robot, q, dt, limits, problem)
+        solution, closest = problem.solve(robot, None), None
     names = tuple(robot.space.names_v[i] for i in np.flatnonzero(returning))
     result = _result(robot, q, dt, solution, tuple(errors), names, solution.iterations)
     result.closest = closest
@@ -160,45 +164,48 @@ class _Levels:
         return qp.Solution(best.v, best.status, True, solution.iterations + second.iterations)
 
 
-def _apart(robot: Robot, q: np.ndarray, dt: float, limits: Limits, problem: _Levels
+def _apart(robot: Robot, q: np.ndarray, dt: float, held: tuple[Inequality, ...], problem: _Levels
            ) -> tuple[qp.Solution, Contact | None]:
-    """The step with the collision rows (:mod:`~kinelab.wholebody.clearance`), solved again with the pairs its
-    answer brought too near held as more rows (up to REFINE times); an answer that still does is shortened."""
-    found = clearance.step_collisions(robot, limits.collisions)
-    start = clearance.rows(found, robot, dt)
-    A, b = start.A, clearance.feasible(start.A, start.b, problem.lower, problem.upper)
+    """The step with every inequality's rows (collisions': :mod:`~kinelab.wholebody.clearance`), solved again with
+    the rows their answer's overshoot asks for (up to REFINE times); an answer that still breaks one is shortened."""
+    starts = [inequality.rows(robot, q, dt) for inequality in held]
+    closest = min((s.closest for s in starts if s.closest is not None), key=lambda c: c.distance, default=None)
+    A = np.vstack([np.zeros((0, robot.nv)), *(s.A for s in starts)])
+    b = feasible(A, np.concatenate([np.zeros(0), *(s.b for s in starts)]), problem.lower, problem.upper)
     solution = problem.solve(robot, qp.Inequalities(A, b) if b.size else None)
-    if not solution.solved and (b > 0).any():  # pairs in collision that cannot all be held apart at once
+    if not solution.solved and (b > 0).any():  # rows broken at the start that cannot all be held at once
         inside = b > 0
         problem = problem.pulled(A[inside], b[inside])
         A, b = A[~inside], b[~inside]
         solution = problem.solve(robot, qp.Inequalities(A, b) if b.size else None)
     if not solution.solved:
-        return solution, start.closest
+        return solution, closest
     for _ in range(REFINE):
-        more = clearance.overshoot(found, robot, start, solution.v, _moved(robot, q, solution.v, dt), dt)
-        if more is None:
-            return solution, start.closest
-        A = np.vstack([A, more[0]])
-        b = np.concatenate([b, clearance.feasible(more[0], more[1], problem.lower, problem.upper)])
+        q_next = _moved(robot, q, solution.v, dt)
+        more = [m for i, s in zip(held, starts, strict=True) if (m := i.overshoot(robot, s, solution.v, q_next, dt))]
+        if not more:
+            return solution, closest
+        A = np.vstack([A, *(m[0] for m in more)])
+        b = np.concatenate([b, *(feasible(m[0], m[1], problem.lower, problem.upper) for m in more)])
         again = problem.solve(robot, qp.Inequalities(A, b))
         if not again.solved:
             break
         solution = again
-    return _shortened(robot, q, dt, found, start, solution), start.closest
+    return _shortened(robot, q, dt, held, starts, solution), closest
 
 
 def _moved(robot: Robot, q: np.ndarray, v: np.ndarray, dt: float) -> np.ndarray:
     return np.asarray(pin.integrate(robot.model, q, v * dt), dtype=float)
 
 
-def _shortened(robot: Robot, q: np.ndarray, dt: float, found: clearance.StepCollisions, start: clearance.Rows,
+def _shortened(robot: Robot, q: np.ndarray, dt: float, held: tuple[Inequality, ...], starts: list[Held],
                solution: qp.Solution) -> qp.Solution:
-    """The answer, halved until no pair ends nearer than it may (none moved at all after 10 halvings): where the
-    rows cannot say how a pair's nearest points move within the step, the step is made shorter."""
+    """The answer, halved until it breaks no inequality (none moved at all after 10 halvings): where the rows
+    cannot say how an inequality changes within the step (a pair's nearest points), the step is made shorter."""
     v = solution.v
     for _ in range(10):
-        if not clearance.too_near(found, robot, start, _moved(robot, q, v, dt))[1].size:
+        q_next = _moved(robot, q, v, dt)
+        if not any(i.breaks(robot, s, q_next) for i, s in zip(held, starts, strict=True)):
             return qp.Solution(v, solution.status, True, solution.iterations)
         v = 0.5 * v
     return qp.Solution(np.zeros_like(v), solution.status, True, solution.iterations)
