@@ -216,10 +216,10 @@ def test_the_limit_check_fails_when_a_bound_is_dropped(monkeypatch, dropped):
 
     from kinelab.report.wholebody_checks import limits_check
 
-    step_module = importlib.import_module("kinelab.wholebody.step")  # the module (the package exports the function)
+    limits_module = importlib.import_module("kinelab.wholebody.limits")  # JointLimits.bounds calls its bounds()
     baxter = kinelab.load("baxter")
     assert limits_check(baxter, 10, 0)[0].value == 0  # as built: none
-    original = step_module.bounds
+    original = limits_module.bounds
 
     def without(space, q, dt, vmax, position, amax, v_prev):
         if dropped == "velocity":
@@ -229,7 +229,7 @@ def test_the_limit_check_fails_when_a_bound_is_dropped(monkeypatch, dropped):
     problem_module = importlib.import_module("kinelab.wholebody.problem")
     monkeypatch.setattr(problem_module.WholeBody, "_compiled_step", lambda *args: None)  # the readable step, whose
     # bounds are patched
-    monkeypatch.setattr(step_module, "bounds", without)
+    monkeypatch.setattr(limits_module, "bounds", without)
     assert limits_check(baxter, 10, 0)[0].value > 0
 
 

@@ -4,7 +4,7 @@ limits held exactly, one differential step (a QP), and the converged solve.
 - :mod:`~kinelab.wholebody.tasks`: the tasks, values that answer for themselves
   (:class:`~kinelab.wholebody.tasks.Task`).
 - :mod:`~kinelab.wholebody.constraints`: what the step holds exactly (couplings, loops; the inequality protocol).
-- :mod:`~kinelab.wholebody.limits`: what the step holds (positions, velocities, accelerations).
+- :mod:`~kinelab.wholebody.limits`: what the step holds (the joints' limits as bounds, and what it holds as rows).
 - :mod:`~kinelab.wholebody.evaluate`: each task's error and rate matrix from one Pinocchio pass.
 - :mod:`~kinelab.wholebody.qp`: the QP (DAQP, or ProxQP).
 - :mod:`~kinelab.wholebody.step`: the step's QP (the readable step, its options and result).
@@ -12,10 +12,10 @@ limits held exactly, one differential step (a QP), and the converged solve.
 """
 
 from kinelab.wholebody.constraints import CouplingTask, Held, Inequality
-from kinelab.wholebody.limits import Limits
+from kinelab.wholebody.limits import JointLimits, Limits
 from kinelab.wholebody.problem import WholeBody, step
 from kinelab.wholebody.step import StepOptions, StepResult
 from kinelab.wholebody.tasks import ComTask, DampingTask, FrameTask, PostureTask, RelativeFrameTask, Task, TaskError
 
-__all__ = ["ComTask", "CouplingTask", "DampingTask", "FrameTask", "Held", "Inequality", "Limits", "PostureTask", "RelativeFrameTask",
-           "StepOptions", "StepResult", "Task", "TaskError", "WholeBody", "step"]
+__all__ = ["ComTask", "CouplingTask", "DampingTask", "FrameTask", "Held", "Inequality", "JointLimits", "Limits",
+           "PostureTask", "RelativeFrameTask", "StepOptions", "StepResult", "Task", "TaskError", "WholeBody", "step"]

@@ -4,10 +4,11 @@ Equalities are tasks of the same protocol (:class:`kinelab.wholebody.tasks.Task`
 ``a · v = c`` that the QP holds, its error driven to zero (drift corrected every step). Inequalities are
 :class:`Inequality` objects: each gives rows ``A v ≥ b`` at the step's start, may add rows for what its first order
 missed once the QP has answered, says whether a step's end breaks it (the step is shortened until none does) and
-how far a configuration is inside it (the converged solve's verdict). The joints' position, velocity and
-acceleration limits are the step's bounds on v (:class:`kinelab.wholebody.limits.Limits`, compiled); a
-:class:`Inequality` enters through ``Limits(inequalities=...)``, and collisions (``Limits(collisions=...)``) are one
-(:class:`kinelab.wholebody.clearance.Clearance`).
+how far a configuration is inside it (the converged solve's verdict); one whose rows are single velocities
+(``bounded``) gives them as bounds on v instead, which the QP holds as its bounds. The joints' position, velocity
+and acceleration limits are one (:class:`kinelab.wholebody.limits.JointLimits`, the only one the compiled step
+packs), collisions another (:class:`kinelab.wholebody.clearance.Clearance`); :class:`kinelab.wholebody.Limits`
+gathers what a step holds, a user's own through ``Limits(inequalities=...)``.
 
 - :class:`CouplingTask`: one joint a linear function of another (mimic joints, gears), held exactly.
 - :class:`ClosureTask`: a robot's loop held closed (:mod:`kinelab.robot.closures`), one per declared closure.
@@ -237,6 +238,8 @@ class Inequality(ABC):
     (a value: equal ones are the same problem) with a :attr:`label`."""
 
     broken: ClassVar[Status] = Status.OUTSIDE_LIMITS  # a converged solve's status where its answer breaks it
+    bounded: ClassVar[bool] = False  # its rows are bounds on single velocities, given by bounds(): the QP's bounds
+    compiled: ClassVar[bool] = False  # the compiled step holds it (the joints' limits only)
 
     @property
     @abstractmethod
@@ -255,6 +258,16 @@ class Inequality(ABC):
     def rows(self, robot: Robot, q: np.ndarray, dt: float) -> Held:
         """Its rows at q (``robot.data``: Pinocchio's placements and joint Jacobians there) for a step of dt [s]:
         rows that let it close at most a share of its slack in one step, and ask a start that breaks it back."""
+
+    def bounds(self, robot: Robot, q: np.ndarray, dt: float, v_prev: np.ndarray | None
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """A ``bounded`` inequality's (lower, upper) on v [nv] (±inf where it bounds nothing) and which velocities
+        it is bringing back (bool [nv]); ``v_prev``: the velocity before the step, or None.
+
+        Raises:
+            OptionError: an inequality that is not ``bounded`` (its rows say all).
+        """
+        raise OptionError("bounds", self.label, "an inequality whose rows are single velocities (bounded = True)")
 
     def overshoot(self, robot: Robot, held: Held, v: np.ndarray, q_next: np.ndarray, dt: float
                   ) -> tuple[np.ndarray, np.ndarray] | None:

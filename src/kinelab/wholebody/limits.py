@@ -1,5 +1,10 @@
 """Limits a whole-body step holds exactly: joint positions, velocities, accelerations — bounds on the step's
-velocity v [nv], so that q ⊕ v·dt stays within every bounded joint's limits and |v| within the velocity limits.
+velocity v [nv], so that q ⊕ v·dt stays within every bounded joint's limits and |v| within the velocity limits —
+and the inequalities it holds as rows (collisions, a user's own).
+
+:class:`JointLimits` is the joints' limits as an inequality of the step's protocol
+(:class:`~kinelab.wholebody.constraints.Inequality`) whose rows are single velocities: the QP holds them as its
+bounds, and the compiled step packs them. :class:`Limits` gathers what one step holds.
 
 A start outside its position limits is brought back at the velocity limit (at once where there is none): the
 bounds of that joint are moved to ask for the return, never made infeasible; the step says which joints
@@ -9,14 +14,81 @@ bounds of that joint are moved to ask for the return, never made infeasible; the
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
 from kinelab.errors import OptionError
 from kinelab.robot.space import LIMIT_SLACK, Space
 from kinelab.values import is_real, mixes_non_reals
-from kinelab.wholebody.constraints import Inequality
+from kinelab.wholebody.constraints import Held, Inequality
+
+if TYPE_CHECKING:
+    from kinelab.robot.tree import Robot
+
+
+@dataclass(frozen=True)
+class JointLimits(Inequality):
+    """The joints' limits as bounds on the step's v (:func:`bounds`): an inequality whose rows are single
+    velocities, held by the QP as its bounds (both steps; the compiled step packs them).
+
+    Attributes:
+        position, velocity, acceleration: as :class:`Limits`' (checked the same way).
+    """
+
+    position: bool = True
+    velocity: Any = True
+    acceleration: Any = None
+    bounded: ClassVar[bool] = True
+    compiled: ClassVar[bool] = True
+
+    def __post_init__(self) -> None:
+        """Check every field.
+
+        Raises:
+            OptionError: a field out of what it accepts (named).
+        """
+        if not isinstance(self.position, bool):
+            raise OptionError("position", self.position, "True or False")
+        _check_rate("velocity", self.velocity)
+        _check_rate("acceleration", self.acceleration)
+        if self.acceleration is True:
+            raise OptionError("acceleration", True, "None, a number > 0 or one per velocity (no file gives them)")
+
+    @property
+    def label(self) -> str:
+        """The inequality in words."""
+        held = [name for name, on in (("positions", self.position), ("velocities", self.velocity not in (None, False)),
+                                      ("accelerations", self.acceleration is not None)) if on]
+        return "joint limits (" + (", ".join(held) or "none") + ")"
+
+    def bounds(self, robot: Robot, q: np.ndarray, dt: float, v_prev: np.ndarray | None
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(lower, upper) on v [nv] and the joints being brought back into their limits (:func:`bounds`)."""
+        return bounds(robot.space, q, dt, velocity_bounds(self, robot.space), self.position,
+                      acceleration_bounds(self, robot.space), v_prev)
+
+    def rows(self, robot: Robot, q: np.ndarray, dt: float) -> Held:
+        """Its bounds as rows, ``v_i ≥ lower_i`` and ``−v_i ≥ −upper_i`` for every finite bound (no velocity before
+        the step: without the acceleration band)."""
+        lower, upper, _ = self.bounds(robot, q, dt, None)
+        eye = np.eye(robot.nv)
+        low, high = np.isfinite(lower), np.isfinite(upper)
+        return Held(np.vstack([eye[low], -eye[high]]), np.concatenate([lower[low], -upper[high]]))
+
+    def breaks(self, robot: Robot, held: Held, q_next: np.ndarray) -> bool:
+        """Never after a step that held its bounds (q ⊕ v·dt is linear in v on every bounded joint)."""
+        return False
+
+    def slack(self, robot: Robot, q: np.ndarray) -> float:
+        """The least distance of a bounded joint inside its position limits [rad or m] (< 0: past one by that
+        much, beyond LIMIT_SLACK; inf without position limits)."""
+        space = robot.space
+        if not self.position or not space.bounded_q.any():
+            return float("inf")
+        qb = q[space.bounded_q]
+        inside = np.minimum(qb - space.lower[space.bounded_q], space.upper[space.bounded_q] - qb) + LIMIT_SLACK
+        return float(np.min(inside))
 
 
 @dataclass(frozen=True)
@@ -32,8 +104,9 @@ class Limits:
         collisions: None (none), or what :class:`kinelab.Collisions` takes — ``"self"``, an ``Environment`` or a
             ``Collisions(self_collisions=, environment=, margin=, detection=, gain=)``: every pair nearer than
             margin + detection held apart by one row of the QP (:mod:`kinelab.wholebody.clearance`).
-        inequalities: more inequalities the step holds as rows of its QP and the solve at its answer, any
-            :class:`~kinelab.wholebody.constraints.Inequality` (a tuple; docs/extending.md).
+        inequalities: more inequalities the step holds (as rows of its QP, or as bounds where they are
+            ``bounded``) and the solve at its answer, any :class:`~kinelab.wholebody.constraints.Inequality` (a
+            tuple; docs/extending.md).
     """
 
     position: bool = True
@@ -43,17 +116,12 @@ class Limits:
     inequalities: Any = ()
 
     def __post_init__(self) -> None:
-        """Check every field.
+        """Check every field (the joints' three through :class:`JointLimits`).
 
         Raises:
             OptionError: a field out of what it accepts (named).
         """
-        if not isinstance(self.position, bool):
-            raise OptionError("position", self.position, "True or False")
-        _check_rate("velocity", self.velocity)
-        _check_rate("acceleration", self.acceleration)
-        if self.acceleration is True:
-            raise OptionError("acceleration", True, "None, a number > 0 or one per velocity (no file gives them)")
+        object.__setattr__(self, "_joints", JointLimits(self.position, self.velocity, self.acceleration))
         if self.collisions is not None:  # the collision module (coal's geometry) loaded only when asked for
             from kinelab.collision.model import as_collisions
 
@@ -61,13 +129,29 @@ class Limits:
         _check_inequalities(self.inequalities)
         object.__setattr__(self, "inequalities", tuple(self.inequalities))
 
+    @property
+    def joints(self) -> JointLimits:
+        """The joints' limits, as an inequality of the step."""
+        joints: JointLimits = self.__dict__["_joints"]
+        return joints
+
+    def boxes(self) -> tuple[Inequality, ...]:
+        """Every inequality held as bounds on v: the joints' limits first, then the bounded ones given."""
+        return (self.joints, *(i for i in self.inequalities if i.bounded))
+
     def held(self) -> tuple[Inequality, ...]:
         """Every inequality held as rows (the collisions' first), beyond the bounds on v."""
+        rowed = tuple(i for i in self.inequalities if not i.bounded)
         if self.collisions is None:
-            return self.inequalities
+            return rowed
         from kinelab.wholebody.clearance import Clearance  # coal's geometry loaded only when asked for
 
-        return (Clearance(self.collisions), *self.inequalities)
+        return (Clearance(self.collisions), *rowed)
+
+    @property
+    def compiled(self) -> bool:
+        """Whether the compiled step holds all of it (the joints' limits only: it has no block for others)."""
+        return self.collisions is None and all(i.compiled for i in self.inequalities)
 
 
 def _check_inequalities(value: Any) -> None:
@@ -99,7 +183,7 @@ def _real(value: Any) -> np.ndarray | None:
     return arr.astype(float) if arr.dtype.kind in "iuf" and not mixes_non_reals(value) else None
 
 
-def velocity_bounds(limits: Limits, space: Space) -> np.ndarray:
+def velocity_bounds(limits: Limits | JointLimits, space: Space) -> np.ndarray:
     """(nv,) the velocity limit of each velocity [rad/s or m/s] (inf where none).
 
     Raises:
@@ -121,7 +205,7 @@ def velocity_bounds(limits: Limits, space: Space) -> np.ndarray:
     return arr
 
 
-def acceleration_bounds(limits: Limits, space: Space) -> np.ndarray | None:
+def acceleration_bounds(limits: Limits | JointLimits, space: Space) -> np.ndarray | None:
     """(nv,) the acceleration limit of each velocity, or None.
 
     Raises:

@@ -100,15 +100,15 @@ class WholeBody:
     def compiled(self) -> bool:
         """Whether each step is one compiled call (else the readable step answers, alike: :attr:`route` says
         why)."""
-        return self._packed is not None and not self.limits.held()
+        return self._packed is not None and self.limits.compiled
 
     @property
     def route(self) -> str:
         """Which step answers, and why, in words."""
         if self.limits.collisions is not None:
             return "readable: collisions are held (the compiled step has no block for the collision rows yet)"
-        if self.limits.inequalities:
-            return "readable: inequalities are held as rows (the compiled step has no block for them)"
+        if not self.limits.compiled:
+            return "readable: inequalities beyond the joints' limits are held (the compiled step has no block for them)"
         if self._packed is not None:
             return "compiled: the tree certified against Pinocchio, DAQP's C interface linked, every task packed"
         if self.options.solver != "daqp":
@@ -158,7 +158,7 @@ class WholeBody:
         """The step in one compiled call, or None where it does not serve (a q to check and name first, an
         acceleration limit without the velocity before)."""
         packed, robot, arr = self._packed, self.robot, _plain(q, self.robot.nq)
-        if packed is None or arr is None or (self._amax.size and prev is None) or self.limits.held():
+        if packed is None or arr is None or (self._amax.size and prev is None) or not self.limits.compiled:
             return None
         q_out, v_out, errors = np.empty(robot.nq), np.empty(robot.nv), np.zeros((len(packed.labels), 2))
         returning = np.empty(robot.nv, dtype=np.uint8)

@@ -21,12 +21,7 @@ from kinelab.values import is_real
 from kinelab.wholebody import evaluate as ev
 from kinelab.wholebody import qp
 from kinelab.wholebody.constraints import Held, Inequality, feasible
-from kinelab.wholebody.limits import (
-    Limits,
-    acceleration_bounds,
-    bounds,
-    velocity_bounds,
-)
+from kinelab.wholebody.limits import Limits
 from kinelab.wholebody.tasks import Task, TaskError
 
 if TYPE_CHECKING:
@@ -118,9 +113,7 @@ def _step(robot: Robot, q: np.ndarray, tasks: tuple[Task, ...], dt: float, limit
     rows = ev.StepRows(robot.nv)
     errors = [task.add_to(rows, robot, q, dt) for task in tasks]
     levels, eq = rows.used(), rows.equalities
-    vmax = velocity_bounds(limits, robot.space)
-    lower, upper, returning = bounds(robot.space, q, dt, vmax, limits.position,
-                                     acceleration_bounds(limits, robot.space), v_prev)
+    lower, upper, returning = _box(robot, q, dt, limits.boxes(), v_prev)
     A_eq, b_eq = (np.array([a for a, _ in eq]), np.array([c for _, c in eq])) if eq else (None, None)
     problem = _Levels(levels, options, lower, upper, (A_eq, b_eq), dt)
     held = limits.held()
@@ -132,6 +125,17 @@ def _step(robot: Robot, q: np.ndarray, tasks: tuple[Task, ...], dt: float, limit
     result = _result(robot, q, dt, solution, tuple(errors), names, solution.iterations)
     result.closest = closest
     return _settled(robot, q, dt, tasks, result) if result.solved and any(t.settled for t in tasks) else result
+
+
+def _box(robot: Robot, q: np.ndarray, dt: float, boxes: tuple[Inequality, ...], v_prev: np.ndarray | None
+         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The bounds on v every bounded inequality asks for, intersected (the joints' limits first), and the velocities
+    any of them is bringing back."""
+    lower, upper, returning = boxes[0].bounds(robot, q, dt, v_prev)
+    for inequality in boxes[1:]:
+        lo, hi, back = inequality.bounds(robot, q, dt, v_prev)
+        lower, upper, returning = np.maximum(lower, lo), np.minimum(upper, hi), returning | back
+    return lower, upper, returning
 
 
 @dataclass(frozen=True)
