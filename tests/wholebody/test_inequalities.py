@@ -125,3 +125,14 @@ def test_joint_limits_check_their_fields():
         JointLimits(velocity=-1.0)
     with pytest.raises(kinelab.OptionError, match="position"):
         Limits(position="yes")
+
+
+def test_the_compiled_steps_outcomes_say_what_the_readable_step_says():
+    """Every flag of the compiled step is an Outcome whose words are the readable step's status for it (DAQP's
+    codes as its Python interface says them, the overflow as the readable step's 'not finite')."""
+    from kinelab.wholebody.compiled import Outcome
+    from kinelab.wholebody.qp import DAQP_STATUS, NOT_FINITE
+
+    for flag, words in DAQP_STATUS.items():
+        assert Outcome(flag).words == words and Outcome(flag).solved == (flag > 0)
+    assert Outcome(-101).words == NOT_FINITE and not Outcome(-100).solved

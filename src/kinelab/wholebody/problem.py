@@ -22,7 +22,7 @@ from kinelab.robot.tree import Robot
 from kinelab.wholebody import compiled as cp
 from kinelab.wholebody.constraints import loops
 from kinelab.wholebody.limits import Limits, acceleration_bounds, checked_v_prev, is_positive_time, velocity_bounds
-from kinelab.wholebody.step import DEFAULT_LIMITS, DEFAULT_OPTIONS, STATUS, StepOptions, StepResult, _step
+from kinelab.wholebody.step import DEFAULT_LIMITS, DEFAULT_OPTIONS, StepOptions, StepResult, _step
 from kinelab.wholebody.subject import as_robot
 from kinelab.wholebody.tasks import Task, as_tasks
 
@@ -35,7 +35,6 @@ if TYPE_CHECKING:
     from kinelab.wholebody.solve import WholeBodyResult
 
 NO_LIMIT = np.empty(0)
-NOT_A_CONFIGURATION = -100  # the compiled step's flag for a q it does not take: the readable step names why
 
 
 class WholeBody:
@@ -165,11 +164,11 @@ class WholeBody:
         flag, iterations = packed.step.step(arr, dt, self._vmax, self.limits.position, self._amax,
                                             NO_LIMIT if prev is None else prev, self.options.damping, q_out, v_out,
                                             errors, returning)
-        if flag == NOT_A_CONFIGURATION:
+        outcome = cp.Outcome(flag)
+        if outcome is cp.Outcome.NOT_A_CONFIGURATION:
             return None
-        return StepResult(v_out, q_out, "solved" if flag in (1, 2) else STATUS.get(flag, str(flag)),
-                          flag in (1, 2), errors, returning.view(bool), iterations, packed.labels,
-                          robot.space.names_v)
+        return StepResult(v_out, q_out, outcome.words, outcome.solved, errors, returning.view(bool), iterations,
+                          packed.labels, robot.space.names_v)
 
     def set_target(self, task: Task | int, target: Any) -> Task:
         """Move one task's target (the task given, or its index in :attr:`tasks`): the task is replaced by

@@ -99,7 +99,6 @@ class StepResult:
 
 DEFAULT_LIMITS = Limits()
 DEFAULT_OPTIONS = StepOptions()
-STATUS = {**qp.DAQP_STATUS, -101: qp.NOT_FINITE}  # the compiled step's flags in words
 
 
 SEPARATE = 1e4  # the weight of a broken row's return (a pair in collision), where it cannot be held with the others
