@@ -299,6 +299,9 @@ def kept(robot: Robot, tasks: Any, limits: Limits, options: StepOptions) -> Whol
     last = table.get(LAST)
     if last is not None and _same_objects(last._tasks, tasks) and last.takes(limits, options):
         return last
+    if last is not None and _alike(last._tasks, tasks) and last.takes(limits, options):
+        last._take(tuple(tasks))  # a new target each step, the way a loop runs: only the targets are written
+        return last
     if not isinstance(limits, Limits):
         raise OptionError("limits", limits, "a kinelab.Limits(...)")
     if not isinstance(options, StepOptions):
@@ -328,6 +331,14 @@ def _equal_limits(a: object, b: Limits) -> bool:
                if isinstance(x, np.ndarray | list | tuple) or isinstance(y, np.ndarray | list | tuple) else x == y
                for x, y in ((a.position, b.position), (a.velocity, b.velocity), (a.acceleration, b.acceleration),
                             (a.collisions, b.collisions))) and _same_objects(list(a.inequalities), b.inequalities)
+
+
+def _alike(held: list[Task], tasks: Any) -> bool:
+    """Whether ``tasks`` is a list or tuple of tasks of the same kinds and shapes as ``held``, one for one (the
+    same objects, or values that differ in their targets only)."""
+    if not isinstance(tasks, list | tuple) or len(tasks) != len(held):
+        return False
+    return all(t is h or (type(t) is type(h) and t.shape() == h.shape()) for h, t in zip(held, tasks, strict=True))
 
 
 def _same_objects(held: list[Task], tasks: Any) -> bool:

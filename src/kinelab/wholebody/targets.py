@@ -9,6 +9,7 @@ overflow).
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -40,6 +41,8 @@ def gain(value: Any) -> float:
     Raises:
         OptionError: anything else.
     """
+    if type(value) is float and 0.0 <= value <= 1.0:  # the usual call, checked at once
+        return value
     if not is_real(value, 0, 1):
         raise OptionError("gain", value, "a number from 0 to 1 (the share of the error a step closes)")
     return float(value)
@@ -145,6 +148,8 @@ def pose(value: Any, what: str) -> FixedPose:
     """
     if isinstance(value, pin.SE3):
         H = value.homogeneous
+        if not pose_defect(H) and math.hypot(*H[:3, 3].tolist()) <= MAX_COORDINATE:
+            return FixedPose(value)  # the usual call: copied from the SE3 at once
     else:
         H = real_array(value, f"{what} must be a pin.SE3 or a 4 × 4 homogeneous matrix")
         try:
