@@ -54,3 +54,23 @@ def test_n_0_skips_the_converged_solves_and_other_protocols_refuse_it(capsys):
     code = cli.main(["bench", "--n", "0"])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and "--whole-body" in err[0]
+
+
+def test_standing_steps_start_where_the_robot_stands_and_say_so(capsys, monkeypatch):
+    """``--standing``: every library's stepper is made at ``robot.standing()`` (TALOS: its SRDF's half-sitting
+    joints), the JSON and the table say the start; without --whole-body it is refused in one line."""
+    import json
+
+    import kinelab
+
+    seen = []
+    made = wb.STEPPERS["kinelab"]
+    monkeypatch.setattr(wb, "STEPPERS", {"kinelab": lambda r, s, q0: seen.append(q0.copy()) or made(r, s, q0)})
+    assert cli.main(["bench", "--whole-body", "--standing", "--robots", "talos", "--repeats", "1", "--n", "0",
+                     "--json"]) == 0
+    found = json.loads(capsys.readouterr().out)["whole_body"]
+    assert found["protocol"]["start"] == "standing" and "standing start" in wb.markdown(found)
+    half = kinelab.load("talos").named_q("half_sitting")
+    assert seen and np.allclose(seen[0][7:], half[7:], atol=1e-12)
+    assert cli.main(["bench", "--standing"]) == 2
+    assert "--whole-body" in capsys.readouterr().err

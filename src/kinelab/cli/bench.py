@@ -121,6 +121,9 @@ def _add_instead(s: argparse.ArgumentParser) -> None:
                    help="instead of the arm protocol: the whole-body step side by side with pink and mink (--robots "
                         "among panda, baxter, talos, g1; default all four), --repeats rounds, and the converged "
                         "solve against pink iterated (--n targets per robot)")
+    s.add_argument("--standing", action="store_true",
+                   help="with --whole-body: every step from where the robot stands (TALOS's half-sitting, G1's "
+                        "keyframe; the arms' neutral) instead of the bent start, velocity bounds active on most steps")
     s.add_argument("--closed", action="store_true",
                    help="instead of the arm protocol: the step on robots that close loops (fourbar, ankle, cassie) "
                         "side by side with mink's EqualityConstraintTask, --repeats rounds of 1,000 steps: time, "
@@ -143,6 +146,8 @@ def run(args: argparse.Namespace) -> int:
     if args.n == 0 and not args.whole_body:
         raise KinelabError("--n 0 skips the converged solves of --whole-body; the other protocols need --n ≥ 1 "
                            "targets per robot")
+    if args.standing and not args.whole_body:
+        raise KinelabError("--standing goes with --whole-body (the step from where the robot stands)")
     if args.closed:
         return _alone(args, "closed", lambda: closed_step.run(args.robots, rounds=args.repeats), closed_step.markdown)
     if args.collisions_step:
@@ -191,7 +196,8 @@ def _router(args: argparse.Namespace) -> int:
 def _whole_body(args: argparse.Namespace) -> int:
     """``--whole-body``: its protocol alone (its tables, JSON or files)."""
     return _alone(args, "whole_body", lambda: wholebody.run(args.robots, rounds=args.repeats, solves=args.n,
-                                                            seed=args.seed, progress=progress_of(args)),
+                                                            seed=args.seed, progress=progress_of(args),
+                                                            standing=args.standing),
                   wholebody.markdown)
 
 

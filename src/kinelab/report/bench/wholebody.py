@@ -43,11 +43,13 @@ from kinelab.wholebody import ComTask, FrameTask, PostureTask
 from kinelab.wholebody.solve import solve
 
 
-def run_steps(name: str, steps: int = 1000, rounds: int = 3, progress: bool = False) -> list[dict[str, Any]]:
+def run_steps(name: str, steps: int = 1000, rounds: int = 3, progress: bool = False, standing: bool = False
+              ) -> list[dict[str, Any]]:
     """The step protocol on one robot: a row per library with its times (median, p95, p99 over every step of every
-    round, and each round's median), its violations and its largest tracking error."""
+    round, and each round's median), its violations and its largest tracking error. ``standing``: from where the
+    robot stands (``robot.standing()``: its SRDF's half-sitting, its file's keyframe) instead of the bent start."""
     scenario, robot = SCENARIOS[name], whole(SCENARIOS[name].robot)
-    q0 = start_of(robot)
+    q0 = robot.standing() if standing else start_of(robot)
     frames = scenario.moving + scenario.held
     start = robot.frame_placements(q0, frames)
     records: dict[str, dict[str, list[float]]] = {k: {"times": [], "medians": [], "violations": [], "errors": []}
@@ -203,8 +205,9 @@ def _pink_iterated(robot: Robot, frames: tuple[str, ...], placed: list[pin.SE3],
 
 
 def run(robots: list[str] | None = None, steps: int = 1000, rounds: int = 3, solves: int = 50, seed: int = 0,
-        progress: bool = False) -> dict[str, Any]:
-    """Both protocols on each robot (default: the four scenarios).
+        progress: bool = False, standing: bool = False) -> dict[str, Any]:
+    """Both protocols on each robot (default: the four scenarios); ``standing``: the steps from where each robot
+    stands (:func:`run_steps`).
 
     Raises:
         KinelabError: a robot without a whole-body scenario (the valid names listed).
@@ -215,16 +218,19 @@ def run(robots: list[str] | None = None, steps: int = 1000, rounds: int = 3, sol
         raise KinelabError(f"no whole-body scenario for {unknown[0]!r}; the scenarios: {', '.join(SCENARIOS)}")
     rows, solved = [], []
     for name in names:
-        rows += run_steps(name, steps, rounds, progress)
+        rows += run_steps(name, steps, rounds, progress, standing)
         if solves:
             solved += converged(name, solves, seed, progress)
     return {"steps": rows, "ratios": ratios(rows), "solves": solved, "not_run": not_installed(),
-            "protocol": {"dt_s": DT, "steps": steps, "rounds": rounds, "radius_m": RADIUS, "period_s": PERIOD}}
+            "protocol": {"dt_s": DT, "steps": steps, "rounds": rounds, "radius_m": RADIUS, "period_s": PERIOD,
+                         "start": "standing" if standing else "bent"}}
 
 
 def markdown(result: dict[str, Any]) -> str:
     """The tables."""
-    lines = ["| robot | library | median | p95 | p99 | violations | largest tracking error |",
+    start = result.get("protocol", {}).get("start", "bent")
+    lines = [f"Steps from the {'standing' if start == 'standing' else 'bent'} start.", "",
+             "| robot | library | median | p95 | p99 | violations | largest tracking error |",
              "|---|---|---:|---:|---:|---:|---:|"]
     for r in result["steps"]:
         lines.append(f"| {r['robot']} | {r['library']} | {r['median_us']:.1f} µs | {r['p95_us']:.1f} µs | "
