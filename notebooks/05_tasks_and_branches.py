@@ -119,7 +119,7 @@ print(f"the multistart: {len(searched)} branches ({'the same set' if same else '
 # %% [markdown]
 # Sorted by distance to `q_ref` (here the configuration the target was made from): the first is that
 # configuration itself. `solve(..., prefer=q_ref)` returns exactly that one, where a plain solve returns
-# whichever branch its start falls towards.
+# whichever branch its route finds first (the closed form's first without a start, FRDM's from its start).
 
 # %%
 plain = kinelab.solve(ur5, oMgoal, seed=1)

@@ -157,7 +157,8 @@ def test_each_round_of_solve_all_and_the_prefer_fallback_get_only_what_is_left(m
     monkeypatch.setattr(prepared, "solve_one", lambda robot, t, q0, req: fallback.append(req.time_budget)
                         or real_one(robot, t, q0, req))
     monkeypatch.setattr(prepared, "time", Clock())  # the branch search took one reading's 7.5 ms of the 50 ms
-    res = kinelab.solve(ur5, target, prefer=np.zeros(6), time_budget=0.05, tol_pos=1e-300, tol_rot=1e-300, seed=0)
+    res = kinelab.solve(ur5, target, solver="frdm", prefer=np.zeros(6), time_budget=0.05, tol_pos=1e-300,
+                        tol_rot=1e-300, seed=0)
     assert not res.success and fallback == [pytest.approx(0.05 - 0.0075, abs=1e-12)]
 
 

@@ -52,7 +52,7 @@ def test_a_named_command_imports_only_its_own_command_module():
 
 
 def test_a_multistart_ik_loads_no_collision_model_closed_form_or_kd_tree():
-    code, modules = _loaded("ik", "ur5", "--target-q", *UR5_Q)
+    code, modules = _loaded("ik", "ur5", "--target-q", *UR5_Q, "--solver", "frdm")
     assert code == 0
     assert not _under(modules, "kinelab.collision"), _under(modules, "kinelab.collision")
     assert not _under(modules, "kinelab.ik.analytic")
@@ -114,7 +114,7 @@ from kinelab.core import _blas
 {patch}
 robot = kinelab.load("ur5")
 q = np.array([0.3, -1.2, 1.4, -0.5, 0.9, 0.2])
-r = kinelab.solve(robot, robot.fk(q), seed=1)
+r = kinelab.solve(robot, robot.fk(q), solver="frdm", seed=1)
 err = float(np.linalg.norm(robot.fk(r.q).translation - robot.fk(q).translation))
 print(_blas.source(), "scipy" in sys.modules, r.success, err < 1e-6)
 """

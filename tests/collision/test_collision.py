@@ -95,10 +95,10 @@ def test_a_colliding_answer_of_an_arm_with_a_closed_form_restarts_at_its_nearest
         if model.colliding_pair(q) is not None:
             continue
         target = ur5.fk(q)
-        plain = kinelab.solve(ur5, target, seed=seed)
+        plain = kinelab.solve(ur5, target, solver="frdm", seed=seed)
         if not plain.success or model.colliding_pair(plain.q) is None:
             continue
-        res = kinelab.solve(ur5, target, seed=seed, collisions=FLOOR_AND_TABLE)
+        res = kinelab.solve(ur5, target, solver="frdm", seed=seed, collisions=FLOOR_AND_TABLE)
         assert res.success and res.diagnostics.clear_after == 1 and model.colliding_pair(res.q) is None
         clear = [b.q for b in kinelab.solve_all(ur5, target) if model.colliding_pair(b.q) is None]
         gaps = [distance(ur5, b, plain.q) for b in clear]  # the distance the branches are sorted by

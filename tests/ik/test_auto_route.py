@@ -85,3 +85,38 @@ def test_the_closed_form_route_checks_its_input_as_the_others_do():
     with pytest.raises(kinelab.ConfigurationError, match="'random', 'table'"):
         kinelab.solve_batch(panda, targets, solver="auto", q0="tables")
     assert kinelab.solve_batch(panda, targets, solver="auto", q0="table").success.all()
+
+
+def test_auto_is_the_default_of_every_one_answer_entry_point():
+    """``solve``, ``solve_batch``, ``solve_all``, ``IK`` and ``kinelab ik`` default to "auto"; a call without a
+    solver takes the route auto names (ur5: the closed form)."""
+    import inspect
+    import typing
+
+    from kinelab.cli.main import build_parser
+    from kinelab.ik import api
+
+    overloads = getattr(typing, "get_overloads", lambda f: [])(kinelab.solve)[:1]  # Python ≥ 3.11 lists them
+    for function in (api.solve, kinelab.solve_batch, kinelab.solve_all, kinelab.IK.__init__, *overloads):
+        assert inspect.signature(function).parameters["solver"].default == "auto", function
+    assert build_parser().parse_args(["ik", "ur5", "--target-q", "0", "0", "0", "0", "0", "0"]).solver == "auto"
+    ur5 = kinelab.load("ur5")
+    target = ur5.fk(ur5.random_q(2))
+    assert kinelab.solve(ur5, target, q0=ur5.random_q(3), seed=0).solver == "analytic"
+    assert kinelab.IK(ur5).solve_batch([target], seed=0).mode.startswith("analytic")
+
+
+def test_the_route_pages_table_is_what_auto_picks():
+    """docs/route.md's table: for every registered arm its row's "auto" column is :func:`kinelab.ik.auto.resolved`'s
+    route for a pose, and every registered arm has a row."""
+    import re
+    from pathlib import Path
+
+    from kinelab.ik import auto
+    from kinelab.robot.catalog import ENTRIES
+
+    page = (Path(__file__).resolve().parents[2] / "docs" / "route.md").read_text()
+    rows = dict(re.findall(r"^\| (\w+) \| \d+ \| (\w+) \|", page, re.M))
+    assert set(rows) == {e.name for e in ENTRIES.values() if not e.whole}
+    for name, route in rows.items():
+        assert auto.resolved(kinelab.load(name), "auto", "pose", None, False) == route, name

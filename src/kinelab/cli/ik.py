@@ -72,10 +72,10 @@ def add(sub: Subcommands) -> None:
     """The ``ik`` subcommand."""
     s = sub.add_parser("ik", help="inverse kinematics to a target pose or configuration")
     s.add_argument("robot", help="registered name or model file (URDF, xacro, MJCF)")
-    s.add_argument("--solver", default="frdm",
-                   help="frdm, biquat, dls (the Pinocchio reference), analytic (the closed form or 1-D search, "
-                        "for the arms `kinelab info` names one for: the branch nearest --start-q) or auto (the "
-                        "fastest of these for the arm, docs/route.md); default frdm")
+    s.add_argument("--solver", default="auto",
+                   help="auto (the default: the fastest certified route for the arm, docs/route.md), frdm, biquat, "
+                        "dls (the Pinocchio reference) or analytic (the closed form or 1-D search, for the arms "
+                        "`kinelab info` names one for: the branch nearest --start-q)")
     target_arguments(s)
     s.add_argument("--task", choices=TASKS, default="pose",
                    help="the components to meet: pose (all, the default), position, axis (point and one tool axis, "

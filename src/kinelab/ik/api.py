@@ -67,7 +67,7 @@ def refuse_positional(function: str, extra: tuple[Any, ...]) -> None:
                     f"{'s' if len(extra) > 1 else ''})")
 
 
-def solve(robot: Chain, target: Target, *positional: object, solver: str = "frdm", q0: Configuration | None = None,
+def solve(robot: Chain, target: Target, *positional: object, solver: str = "auto", q0: Configuration | None = None,
           seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float = 1.0,
           max_restarts: int = 1000, start_outside_limits: str = "project", options: SolverOptions = None,
           task: str = "pose", axis: str = "z", prefer: Configuration | None = None, collisions: CollisionSpec = None,
@@ -78,10 +78,10 @@ def solve(robot: Chain, target: Target, *positional: object, solver: str = "frdm
         robot: the robot (:func:`kinelab.load`).
         target: oMtarget, the wanted tool pose in the base frame (three numbers [m] for task "position").
         positional: nothing: every argument after the target is keyword-only.
-        solver: "frdm", "biquat", "dls" (the Pinocchio reference), "analytic": the closed form's branch nearest
-            ``q0`` (else the first), where the chain has one (docs/analytic.md), refused by name elsewhere; or
-            "auto": the fastest of these with the same guarantees for this robot and task
-            (:mod:`kinelab.ik.auto`; ``result.solver`` and ``result.mode`` name the route taken).
+        solver: "auto" (the default): the fastest of the others with the same guarantees for this robot and
+            task (:mod:`kinelab.ik.auto`, docs/route.md; ``result.solver`` and ``result.mode`` name the route
+            taken); "frdm", "biquat", "dls" (the Pinocchio reference), or "analytic": the closed form's branch
+            nearest ``q0`` (else the first), where the chain has one (docs/analytic.md), refused by name elsewhere.
         q0: first start (one number per joint, rad or m); default a seeded random configuration.
         seed: seed of the random starts, an int ≥ 0 (None: fresh entropy). A solve that does not run out of
             budget returns the same answer for the same seed in any process; one that does depends on speed.
@@ -129,7 +129,7 @@ def solve(robot: Chain, target: Target, *positional: object, solver: str = "frdm
     return prepared(robot, settings, key).solve(target, q0=q0, seed=seed, prefer=prefer)
 
 
-def solve_batch(robot: Chain, targets: Targets, *positional: object, solver: str = "frdm",
+def solve_batch(robot: Chain, targets: Targets, *positional: object, solver: str = "auto",
                 q0: Configuration | None = None,
                 seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6,
                 time_budget: float | None = None, max_restarts: int = 1000, start_outside_limits: str = "refuse",

@@ -23,7 +23,7 @@ from kinelab.ik.registry import SolverOptions
 from kinelab.ik.request import Request, verdict_reserve
 from kinelab.ik.result import Attempt, BypassRecord, IKResult, SingularEvent, Status
 from kinelab.ik.targets import as_target, out_of_reach, reach_bound
-from kinelab.ik.tasks import COMPONENTS, POSE, Task
+from kinelab.ik.tasks import POSE, Task, short_arm_note
 from kinelab.robot import Chain
 from kinelab.robot.chain import _compiled_judge
 from kinelab.typing import Configuration, Target
@@ -298,13 +298,9 @@ def _outside_where(robot: Chain, q: np.ndarray) -> str | None:
 
 def _explained(pb: Call, status: Status, message: str) -> str:
     """The message, with the reason a short arm misses a whole pose and the tasks that fit it."""
-    n = pb.robot.n
-    if status in (Status.CONVERGED, Status.OUTSIDE_LIMITS) or n >= COMPONENTS[pb.task.name]:
+    note = short_arm_note(pb.robot.name, pb.robot.n, pb.task.name)
+    if status in (Status.CONVERGED, Status.OUTSIDE_LIMITS) or note is None:
         return message
-    fits = [t for t in ("axis", "position") if COMPONENTS[t] <= n] or ["position"]
-    note = (f"{pb.robot.name} has {n} joints and can meet at most {n} of the {COMPONENTS[pb.task.name]} "
-            f"components of task {pb.task.name!r}; try task={fits[0]!r}"
-            + (f" or task={fits[1]!r}" if len(fits) > 1 else ""))
     return f"{message}; {note}" if message else note
 
 

@@ -69,11 +69,11 @@ class IK:
     Args:
         robot: the robot.
         positional: nothing: every setting is keyword-only.
-        solver: "frdm", "biquat" or "dls"; "analytic" (the closed form, docs/analytic.md: ``solve`` returns the
-            branch nearest ``q0``, ``solve_all`` every branch; refused here, by name, for a chain without one); or
-            "auto" (``solve_all`` as :func:`kinelab.solve_all`'s default: the closed form where the chain has one,
-            else FRDM's multistart; ``solve`` and ``solve_batch`` run FRDM). ``solve_all`` takes the route
-            :func:`kinelab.solve_all` takes for the same solver and options.
+        solver: "auto" (the default: ``solve`` and ``solve_batch`` take the fastest route with the same guarantees
+            for the arm, :mod:`kinelab.ik.auto`; ``solve_all`` the closed form where the chain has one, else FRDM's
+            multistart); "frdm", "biquat" or "dls"; "analytic" (the closed form, docs/analytic.md: ``solve``
+            returns the branch nearest ``q0``, ``solve_all`` every branch; refused here, by name, for a chain
+            without one). Every method takes the route the module function takes for the same settings.
         tol_pos: position tolerance [m].
         tol_rot: rotation tolerance [rad].
         time_budget: wall-clock budget of each call [s] (None: none).
@@ -92,7 +92,7 @@ class IK:
         SolverNotFoundError, OptionError: a bad setting, named (once, here).
     """
 
-    def __init__(self, robot: Chain, *positional: object, solver: str = "frdm", tol_pos: float = 1e-6,
+    def __init__(self, robot: Chain, *positional: object, solver: str = "auto", tol_pos: float = 1e-6,
                  tol_rot: float = 1e-6, time_budget: float | None = 1.0, max_restarts: int = 1000,
                  start_outside_limits: str = "project", options: SolverOptions = None, task: str = "pose",
                  axis: str = "z", collisions: CollisionSpec = None, **solver_options: object):

@@ -19,8 +19,18 @@ from kinelab.errors import OptionError
 from kinelab.geometry import pose_errors
 from kinelab.ik.words import AXES, TASKS
 
-__all__ = ["AXES", "COMPONENTS", "POSE", "TASKS", "Task"]
+__all__ = ["AXES", "COMPONENTS", "POSE", "TASKS", "Task", "short_arm_note"]
 COMPONENTS = {"pose": 6, "position": 3, "axis": 5, "orientation": 3}
+
+
+def short_arm_note(name: str, joints: int, task: str) -> str | None:
+    """Why an arm of ``joints`` joints misses task ``task`` in general, and the tasks that fit it (None: it has
+    joints enough)."""
+    if joints >= COMPONENTS[task]:
+        return None
+    fits = [t for t in ("axis", "position") if COMPONENTS[t] <= joints] or ["position"]
+    return (f"{name} has {joints} joints and can meet at most {joints} of the {COMPONENTS[task]} components of task "
+            f"{task!r}; try task={fits[0]!r}" + (f" or task={fits[1]!r}" if len(fits) > 1 else ""))
 
 
 @dataclass(frozen=True)

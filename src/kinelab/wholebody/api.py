@@ -43,7 +43,7 @@ def is_tasks(target: object) -> TypeGuard[Task | Sequence[Task]]:
 
 
 @overload
-def solve(robot: Chain, target: Target, *, solver: str = "frdm", q0: Configuration | None = None,
+def solve(robot: Chain, target: Target, *, solver: str = "auto", q0: Configuration | None = None,
           seed: int | None = None, tol_pos: float = 1e-6, tol_rot: float = 1e-6, time_budget: float = 1.0,
           max_restarts: int = 1000, start_outside_limits: str = "project", options: SolverOptions = None,
           task: str = "pose", axis: str = "z", prefer: Configuration | None = None, collisions: CollisionSpec = None,

@@ -29,7 +29,7 @@ from kinelab.ik.analytic.batch import batch_starts
 from kinelab.ik.analytic.branches import arm_of, prepared_form
 from kinelab.ik.analytic.classify import classify, general_class
 from kinelab.ik.analytic.redundancy import SweptArm, has_swept_form, samples, swept_arm
-from kinelab.ik.batch import BatchIKResult, judged_rows, prepare, run_batch
+from kinelab.ik.batch import BatchIKResult, fresh_seed, judged_rows, prepare, run_batch
 from kinelab.ik.frdm.batch import Rows
 from kinelab.ik.request import Request, make_request, verdict_reserve
 from kinelab.ik.result import Diagnostics, IKResult, Status
@@ -192,13 +192,17 @@ def nearest_held(robot: Chain, targets: Targets, q0: Configuration | None, req: 
 
 def _by_frdm(robot: Chain, res: BatchIKResult, H: np.ndarray, starts: np.ndarray | None, rest: np.ndarray,
              req: Request, deadline: float) -> None:
-    """The rows no held value solves, by FRDM's batch from their starts within what is left before ``deadline``,
-    written into ``res``."""
-    left = None if req.time_budget is None else max(deadline - time.perf_counter(), 1e-5)
-    frdm = run_batch(robot, H[rest], None if starts is None else starts[rest], replace(req, time_budget=left))
-    for name in ("q", "success", "status_code", "position_error", "rotation_error", "iterations", "restarts"):
-        getattr(res, name)[rest] = getattr(frdm, name)
-    res.seed = frdm.seed  # the FRDM rows' base seed (their row k used seed + k)
+    """The rows no held value solves, by FRDM from their starts within what is left before ``deadline``, written
+    into ``res``: row b with seed + b, as FRDM's batch runs it, so that a row's answer does not depend on which
+    other rows share its batch (a cluster's chunks give the rows of one batch)."""
+    seed = fresh_seed() if req.seed is None else req.seed
+    for b in rest:
+        left = None if req.time_budget is None else max(deadline - time.perf_counter(), 1e-5)
+        frdm = run_batch(robot, H[b:b + 1], None if starts is None else starts[b:b + 1],
+                         replace(req, seed=seed + int(b), time_budget=left))
+        for name in ("q", "success", "status_code", "position_error", "rotation_error", "iterations", "restarts"):
+            getattr(res, name)[b] = getattr(frdm, name)[0]
+    res.seed = seed  # the FRDM rows' base seed (row b used seed + b)
     res.mode += f"; {rest.size} of {len(H)} rows by FRDM (no branch at any value tried)"
 
 

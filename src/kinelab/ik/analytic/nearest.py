@@ -20,6 +20,7 @@ from kinelab.ik.driver import solve_one
 from kinelab.ik.request import Request
 from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
 from kinelab.ik.targets import beyond_reach
+from kinelab.ik.tasks import short_arm_note
 from kinelab.robot import Chain
 from kinelab.typing import Target
 
@@ -197,8 +198,10 @@ def _no_branch(robot: Chain, target: Any, req: Request, q0: np.ndarray | None, c
                         diagnostics=Diagnostics(path="compiled", branches=count, contact=contact))
     q = np.zeros(robot.n) if q0 is None else np.array(q0, dtype=float)
     dp, dr = robot.tool_error(np.clip(q, robot.lower, robot.upper), target)
+    message = "no branch (closed form or 1-D search) meets the pose within the joint limits: the pose is beyond " \
+              "the arm's reach, or only reached with a joint outside its limits"
+    note = short_arm_note(robot.name, robot.n, "pose")
     return IKResult(q=q, success=False, status=Status.UNREACHABLE, position_error=dp, rotation_error=dr,
                     iterations=0, restarts=0, wall_time=time.perf_counter() - t0, solver="analytic", mode=mode,
-                    message="no branch (closed form or 1-D search) meets the pose within the joint limits: the pose is "
-                            "beyond the arm's reach, or only reached with a joint outside its limits",
-                    task=req.task_label, diagnostics=Diagnostics(path="compiled", branches=0))
+                    message=message if note is None else f"{message}; {note}", task=req.task_label,
+                    diagnostics=Diagnostics(path="compiled", branches=0))

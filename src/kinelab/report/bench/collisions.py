@@ -35,8 +35,9 @@ def arm(robot: Chain, n: int, seed: int, repeats: int) -> dict[str, Any]:
     configurations = [robot.random_q(rng) for _ in range(max(20 * n, 2000))]
     clear = [q for q in configurations if model.colliding_pair(q) is None]
     targets = [robot.fk(q) for q in clear[:n]]
-    calls = {"plain": lambda t, s: solve(robot, t, seed=s, time_budget=0.5),
-             "collisions": lambda t, s: solve(robot, t, seed=s, time_budget=0.5, collisions=FLOOR_AND_TABLE)}
+    calls = {"plain": lambda t, s: solve(robot, t, solver="frdm", seed=s, time_budget=0.5),
+             "collisions": lambda t, s: solve(robot, t, solver="frdm", seed=s, time_budget=0.5,
+                                              collisions=FLOOR_AND_TABLE)}
     medians = warmed_rounds(targets, calls, repeats)
     ratio = [c / p for c, p in zip(medians["collisions"], medians["plain"], strict=True)]
     return {"robot": robot.name, "targets": len(targets), "pairs": len(model.pairs),
@@ -49,8 +50,8 @@ def arm(robot: Chain, n: int, seed: int, repeats: int) -> dict[str, Any]:
 def _answers(robot: Chain, model: Any, targets: list[pin.SE3], seed: int) -> dict[str, float]:
     """How many plain answers collide (``plain_colliding``) and the share of targets solved clear of the floor and
     table (``clear_success``)."""
-    plain = [solve(robot, t, seed=seed + k, time_budget=0.5) for k, t in enumerate(targets)]
-    aware = [solve(robot, t, seed=seed + k, time_budget=0.5, collisions=FLOOR_AND_TABLE)
+    plain = [solve(robot, t, solver="frdm", seed=seed + k, time_budget=0.5) for k, t in enumerate(targets)]
+    aware = [solve(robot, t, solver="frdm", seed=seed + k, time_budget=0.5, collisions=FLOOR_AND_TABLE)
              for k, t in enumerate(targets)]
     return {"plain_colliding": sum(r.success and model.colliding_pair(r.q) is not None for r in plain),
             "clear_success": sum(r.success for r in aware) / len(targets)}

@@ -62,13 +62,13 @@ def throughput(robot: Chain, n: int = 2000, seed: int = 0, start: str = "warm", 
 
     def loop() -> tuple[np.ndarray, float]:
         t0 = time.perf_counter()
-        Q = np.array([solve(robot, t, q0=q, seed=seed + k, time_budget=0.005, max_restarts=RESTARTS).q
+        Q = np.array([solve(robot, t, solver="frdm", q0=q, seed=seed + k, time_budget=0.005, max_restarts=RESTARTS).q
                       for k, (t, q) in enumerate(zip(targets, starts, strict=True))])
         return Q, time.perf_counter() - t0
 
     def batch() -> tuple[np.ndarray, float]:
         t0 = time.perf_counter()
-        res = solve_batch(robot, H, q0=starts, seed=seed, max_restarts=RESTARTS)
+        res = solve_batch(robot, H, solver="frdm", q0=starts, seed=seed, max_restarts=RESTARTS)
         return res.q, time.perf_counter() - t0
 
     runners: dict[str, Runner] = {"frdm solve() loop": loop, "frdm solve_batch": batch}
@@ -202,16 +202,16 @@ def _budget_paths(robot: Chain, budget: float, solvers: tuple[str, ...],
 
     def ik_solve(case: Any, seed: int, tol: float) -> Any:
         if tol not in prepared:  # built inside the call's tolerance context, once per tolerance
-            prepared[tol] = IK(robot, tol_pos=tol, tol_rot=tol, time_budget=budget)
+            prepared[tol] = IK(robot, solver="frdm", tol_pos=tol, tol_rot=tol, time_budget=budget)
         return prepared[tol].solve(case.oMtarget, q0=case.q_start, seed=seed)
 
     paths["frdm IK.solve"] = ik_solve
     paths["frdm batch of 64"] = lambda case, seed, tol: solve_batch(
-        robot, [case.oMtarget] * 64, seed=seed, tol_pos=tol, tol_rot=tol, time_budget=budget)
+        robot, [case.oMtarget] * 64, solver="frdm", seed=seed, tol_pos=tol, tol_rot=tol, time_budget=budget)
     paths["frdm solve_all"] = lambda case, seed, tol: solve_all(robot, case.oMtarget, solver="frdm", seed=seed,
                                                                 tol_pos=tol, tol_rot=tol, time_budget=budget)
-    paths["frdm prefer="] = lambda case, seed, tol: solve(robot, case.oMtarget, seed=seed, tol_pos=tol, tol_rot=tol,
-                                                         time_budget=budget, prefer=case.q_start)
+    paths["frdm prefer="] = lambda case, seed, tol: solve(robot, case.oMtarget, solver="frdm", seed=seed, tol_pos=tol,
+                                                         tol_rot=tol, time_budget=budget, prefer=case.q_start)
     if _has_collision_geometry(robot):
         paths["frdm collisions"] = lambda case, seed, tol: solve(
             robot, case.oMtarget, q0=case.q_start, seed=seed, tol_pos=tol, tol_rot=tol, time_budget=budget,
