@@ -36,6 +36,7 @@ if TYPE_CHECKING:
         throughput,
         versus,
         wholebody,
+        worlds,
     )
     from kinelab.studies import paper000_era
 else:
@@ -54,6 +55,7 @@ else:
     wholebody = lazy.module("kinelab.report.bench.wholebody", globals())
     collision_step = lazy.module("kinelab.report.bench.collision_step", globals())
     closed_step = lazy.module("kinelab.report.bench.closed_step", globals())
+    worlds = lazy.module("kinelab.report.bench.worlds", globals())
 
 
 def add(sub: Subcommands) -> None:
@@ -124,6 +126,9 @@ def _add_instead(s: argparse.ArgumentParser) -> None:
     s.add_argument("--standing", action="store_true",
                    help="with --whole-body: every step from where the robot stands (TALOS's half-sitting, G1's "
                         "keyframe; the arms' neutral) instead of the bent start, velocity bounds active on most steps")
+    s.add_argument("--worlds", action="store_true",
+                   help="instead of the arm protocol: many worlds a step (WholeBody.step_batch): the Panda at 1,024 "
+                        "worlds, G1 at 256 (--robots among panda, g1), --repeats rounds: steps per second")
     s.add_argument("--closed", action="store_true",
                    help="instead of the arm protocol: the step on robots that close loops (fourbar, ankle, cassie) "
                         "side by side with mink's EqualityConstraintTask, --repeats rounds of 1,000 steps: time, "
@@ -148,6 +153,8 @@ def run(args: argparse.Namespace) -> int:
                            "targets per robot")
     if args.standing and not args.whole_body:
         raise KinelabError("--standing goes with --whole-body (the step from where the robot stands)")
+    if args.worlds:
+        return _alone(args, "worlds", lambda: worlds.run(args.robots, rounds=args.repeats), worlds.markdown)
     if args.closed:
         return _alone(args, "closed", lambda: closed_step.run(args.robots, rounds=args.repeats), closed_step.markdown)
     if args.collisions_step:

@@ -29,3 +29,7 @@ class Step:
     def step(self, q: np.ndarray, dt: float, vmax: np.ndarray, position: bool, amax: np.ndarray,
              v_prev: np.ndarray, damping: float, q_out: np.ndarray, v_out: np.ndarray, errors: np.ndarray,
              returning: np.ndarray) -> tuple[int, int]: ...
+    def step_many(self, Q: np.ndarray, dt: float, T: np.ndarray, vmax: np.ndarray, position: bool,
+                  amax: np.ndarray, V_prev: np.ndarray, damping: float, Q_out: np.ndarray, V_out: np.ndarray,
+                  flags: np.ndarray, iters: np.ndarray, warm: np.ndarray, errors: np.ndarray,
+                  returning: np.ndarray) -> None: ...

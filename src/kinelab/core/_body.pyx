@@ -568,34 +568,65 @@ cdef class Step:
         (errors), the joints brought back into their limits (returning). ``amax`` and ``v_prev``: empty, or nv
         numbers each. Returns (DAQP's exit flag: 1 or 2 solved; −100: q is not a configuration, nothing done;
         −101: the answer overflowed, nothing moved; DAQP's iterations)."""
-        cdef int flag, iters = 0, level, nv = self.tree.nv
-        cdef Tree tree = self.tree
+        cdef int flag, iters = 0, nv = self.tree.nv
         cdef const double* a = &amax[0] if amax.shape[0] == nv else NULL
         cdef const double* vp = &v_prev[0] if v_prev.shape[0] == nv else NULL
-        if tree.check(&q[0]):
-            return -100, 0
         with nogil:
-            tree.bounds(&q[0], dt, &vmax[0], position, a, vp, 1e-9, &self.lower[0], &self.upper[0], &returning[0])
-            tree.forward(&q[0])
-            if self._any_com():
-                tree.com(&self.c[0], &self.Jc[0, 0])
-            self._rows(&q[0], dt, &errors[0, 0])
-            self._other_errors(&q[0], &errors[0, 0])
-            flag = self._solve(1, &self.lower[0], &self.upper[0], damping, &q[0], dt, &iters)
-            if (flag == 1 or flag == 2) and self.level2:
-                memcpy(&self.x1[0], &self.x[0], nv * sizeof(double))
-                level = self._solve(2, &self.lower[0], &self.upper[0], damping, &q[0], dt, &iters)
-                if not (level == 1 or level == 2):
-                    memcpy(&self.x[0], &self.x1[0], nv * sizeof(double))
-            if flag == 1 or flag == 2:
-                memcpy(&v_out[0], &self.x[0], nv * sizeof(double))
-                tree.integrate(&q[0], &self.x[0], dt, &q_out[0])
-                if not (_finite(&v_out[0], nv) and _finite(&q_out[0], tree.nq)):
-                    flag = NOT_FINITE
-            if not (flag == 1 or flag == 2):
-                memset(&v_out[0], 0, nv * sizeof(double))
-                memcpy(&q_out[0], &q[0], tree.nq * sizeof(double))
+            flag = self._one(&q[0], dt, &vmax[0], position, a, vp, damping, &q_out[0], &v_out[0], &errors[0, 0],
+                             &returning[0], &iters)
         return flag, iters
+
+    def step_many(self, const double[:, ::1] Q, double dt, const double[:, :, ::1] T, const double[::1] vmax,
+                  bint position, const double[::1] amax, const double[:, ::1] V_prev, double damping,
+                  double[:, ::1] Q_out, double[:, ::1] V_out, int[::1] flags, int[::1] iters, int[:, ::1] warm,
+                  double[:, ::1] errors, unsigned char[::1] returning):
+        """Worlds w = 0..N−1 one after the other, the GIL released throughout: from Q[w] toward the targets T[w]
+        (ntasks × 12, as :meth:`set_target` takes them), with world w's own warm start (warm[w], nv; kept for its
+        next call), into Q_out[w], V_out[w], flags[w] and iters[w] (:meth:`step`'s). ``V_prev``: (N, nv) or empty;
+        ``errors`` (tasks × 2) and ``returning`` (nv): scratch."""
+        cdef Py_ssize_t w, n = Q.shape[0]
+        cdef int nv = self.tree.nv, it
+        cdef const double* a = &amax[0] if amax.shape[0] == nv else NULL
+        cdef bint has_vp = V_prev.shape[0] == n and n > 0
+        with nogil:
+            for w in range(n):
+                if self.ntasks > 0:
+                    memcpy(&self.target[0, 0], &T[w, 0, 0], self.ntasks * 12 * sizeof(double))
+                memcpy(&self.warm[0], &warm[w, 0], nv * sizeof(int))
+                it = 0
+                flags[w] = self._one(&Q[w, 0], dt, &vmax[0], position, a, &V_prev[w, 0] if has_vp else NULL,
+                                     damping, &Q_out[w, 0], &V_out[w, 0], &errors[0, 0], &returning[0], &it)
+                iters[w] = it
+                memcpy(&warm[w, 0], &self.warm[0], nv * sizeof(int))
+
+    cdef int _one(self, const double* q, double dt, const double* vmax, bint position, const double* a,
+                  const double* vp, double damping, double* q_out, double* v_out, double* errors,
+                  unsigned char* returning, int* iters) noexcept nogil:
+        """:meth:`step`'s work on raw buffers (its flag)."""
+        cdef int flag, level, nv = self.tree.nv
+        if self.tree.check(q):
+            return -100
+        self.tree.bounds(q, dt, vmax, position, a, vp, 1e-9, &self.lower[0], &self.upper[0], returning)
+        self.tree.forward(q)
+        if self._any_com():
+            self.tree.com(&self.c[0], &self.Jc[0, 0])
+        self._rows(q, dt, errors)
+        self._other_errors(q, errors)
+        flag = self._solve(1, &self.lower[0], &self.upper[0], damping, q, dt, iters)
+        if (flag == 1 or flag == 2) and self.level2:
+            memcpy(&self.x1[0], &self.x[0], nv * sizeof(double))
+            level = self._solve(2, &self.lower[0], &self.upper[0], damping, q, dt, iters)
+            if not (level == 1 or level == 2):
+                memcpy(&self.x[0], &self.x1[0], nv * sizeof(double))
+        if flag == 1 or flag == 2:
+            memcpy(v_out, &self.x[0], nv * sizeof(double))
+            self.tree.integrate(q, &self.x[0], dt, q_out)
+            if not (_finite(v_out, nv) and _finite(q_out, self.tree.nq)):
+                flag = NOT_FINITE
+        if not (flag == 1 or flag == 2):
+            memset(v_out, 0, nv * sizeof(double))
+            memcpy(q_out, q, self.tree.nq * sizeof(double))
+        return flag
 
     cdef void _other_errors(self, const double* q, double* errors) noexcept nogil:
         """The posture's error (its largest joint gap) and each coupling's, into their slots."""

@@ -111,6 +111,13 @@ def _pose(M: pin.SE3) -> np.ndarray:
 
 def pack_tree(robot: Robot) -> _body.Tree | None:
     """The robot's tree for the compiled step, or None (a joint kind not compiled, or the certificate failed)."""
+    tree = build_tree(robot)
+    return tree if tree is not None and certified(robot, tree) else None
+
+
+def build_tree(robot: Robot) -> _body.Tree | None:
+    """A new compiled tree of the robot (its own buffers), not certified: another copy of a certified one (a
+    thread's), or None (a joint kind not compiled)."""
     model = robot.model
     nj = model.njoints - 1
     parent, kind = np.zeros(nj + 1, dtype=np.intc), np.zeros(nj + 1, dtype=np.intc)
@@ -126,8 +133,7 @@ def pack_tree(robot: Robot) -> _body.Tree | None:
         place[j] = _pose(model.jointPlacements[j])
         mass[j], lever[j] = model.inertias[j].mass, model.inertias[j].lever
     qlo, qhi = np.array(robot.lower, dtype=float), np.array(robot.upper, dtype=float)  # writable copies
-    tree = _body.Tree(parent, kind, iq, iv, ratio, offset, place, axis, mass, lever, model.nq, model.nv, qlo, qhi)
-    return tree if certified(robot, tree) else None
+    return _body.Tree(parent, kind, iq, iv, ratio, offset, place, axis, mass, lever, model.nq, model.nv, qlo, qhi)
 
 
 def certified(robot: Robot, tree: _body.Tree) -> bool:

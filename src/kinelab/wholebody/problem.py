@@ -25,9 +25,10 @@ from kinelab.wholebody.limits import Limits, acceleration_bounds, checked_v_prev
 from kinelab.wholebody.step import DEFAULT_LIMITS, DEFAULT_OPTIONS, StepOptions, StepResult, _step
 from kinelab.wholebody.subject import as_robot
 from kinelab.wholebody.tasks import Task, as_tasks
+from kinelab.wholebody.worlds import BatchStep, Worlds
 
 if TYPE_CHECKING:
-    from collections.abc import Sequence
+    from collections.abc import Mapping, Sequence
 
     from numpy.typing import ArrayLike
 
@@ -69,6 +70,7 @@ class WholeBody:
         amax = acceleration_bounds(limits, robot.space)
         self._amax = NO_LIMIT if amax is None else np.ascontiguousarray(amax, dtype=float)
         self._packed = _packed(robot, tuple(self._tasks) + self.loops, options)
+        self._worlds: Worlds | None = None  # step_batch's threads, made at its first call
         self._refresh_all()
 
     def use(self, limits: Limits) -> None:
@@ -144,6 +146,32 @@ class WholeBody:
             return fast
         return _step(self.robot, self.robot.check_q(q), tuple(self._tasks) + self.loops, dt, self.limits,
                      self.options, prev)
+
+    def step_batch(self, Q: ArrayLike, dt: float,
+                   targets: Mapping[Any, ArrayLike] | Sequence[tuple[Any, ArrayLike]] | None = None,
+                   v_prev: ArrayLike | None = None) -> BatchStep:
+        """N worlds one step each, in one call (:mod:`kinelab.wholebody.worlds`): the compiled step on every core,
+        the GIL released.
+
+        Args:
+            Q: (N, nq) the worlds' configurations (Pinocchio's q, one row per world).
+            dt: the step [s], at least 1e-9.
+            targets: per task (the task or its index in :attr:`tasks`) its target in each world: an (N, 4, 4)
+                array of poses (oM*, world frame; a relative task's in its root frame) or an (N, 3) array of points
+                [m], as a mapping or as (task, array) pairs (a task holding an array, a ComTask, is no dict key);
+                the tasks not named keep their own target in every world.
+            v_prev: (N, nv) each world's velocity before the step, for acceleration limits.
+
+        Returns:
+            A :class:`~kinelab.wholebody.worlds.BatchStep` (q, v, solved, flags, iterations per world).
+
+        Raises:
+            OptionError, TargetError: a bad array, dt or task (named).
+        """
+        dt = is_positive_time(dt)
+        if self._worlds is None:
+            self._worlds = Worlds(self)
+        return self._worlds.step(Q, dt, targets, v_prev)
 
     def _onto_loops(self, q: Any) -> np.ndarray:
         """A copy of q brought onto what the robot itself holds (its loops closed, its folded mimic joints set from
