@@ -13,6 +13,7 @@ bounds of that joint are moved to ask for the return, never made infeasible; the
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -282,6 +283,8 @@ def is_positive_time(dt: object) -> float:
     Raises:
         OptionError: anything else.
     """
+    if type(dt) is float and MIN_DT <= dt < math.inf:  # the usual call, checked at once
+        return dt
     if not is_real(dt, MIN_DT):
         raise OptionError("dt", dt, f"a finite time ≥ {MIN_DT:g} s")
     return float(dt)

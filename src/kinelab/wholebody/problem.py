@@ -35,6 +35,8 @@ if TYPE_CHECKING:
     from kinelab.typing import Configuration
     from kinelab.wholebody.solve import WholeBodyResult
 
+NOT_A_CONFIGURATION, SOLVED, SOLVED_SOFT = (int(o) for o in (cp.Outcome.NOT_A_CONFIGURATION, cp.Outcome.SOLVED,
+                                                             cp.Outcome.SOLVED_SOFT))
 NO_LIMIT = np.empty(0)
 
 
@@ -185,18 +187,20 @@ class WholeBody:
         """The step in one compiled call, or None where it does not serve (a q to check and name first, an
         acceleration limit without the velocity before)."""
         packed, robot, arr = self._packed, self.robot, _plain(q, self.robot.nq)
-        if packed is None or arr is None or (self._amax.size and prev is None) or not self.limits.compiled:
+        limits = self.limits
+        if packed is None or arr is None or (self._amax.size and prev is None) or \
+                not (limits.collisions is None and not limits.inequalities or limits.compiled):
             return None
         q_out, v_out, errors = np.empty(robot.nq), np.empty(robot.nv), np.zeros((len(packed.labels), 2))
         returning = np.empty(robot.nv, dtype=np.uint8)
-        flag, iterations = packed.step.step(arr, dt, self._vmax, self.limits.position, self._amax,
+        flag, iterations = packed.step.step(arr, dt, self._vmax, limits.position, self._amax,
                                             NO_LIMIT if prev is None else prev, self.options.damping, q_out, v_out,
                                             errors, returning)
-        outcome = cp.Outcome(flag)
-        if outcome is cp.Outcome.NOT_A_CONFIGURATION:
+        if flag == NOT_A_CONFIGURATION:
             return None
-        return StepResult(v_out, q_out, outcome.words, outcome.solved, errors, returning.view(bool), iterations,
-                          packed.labels, robot.space.names_v)
+        solved = flag == SOLVED or flag == SOLVED_SOFT  # the usual answer read without making an Outcome
+        return StepResult(v_out, q_out, "solved" if solved else cp.Outcome(flag).words, solved, errors,
+                          returning.view(bool), iterations, packed.labels, robot.space.names_v)
 
     def set_target(self, task: Task | int, target: Any) -> Task:
         """Move one task's target (the task given, or its index in :attr:`tasks`): the task is replaced by
