@@ -58,8 +58,6 @@ def test_the_answers_do_not_depend_on_the_threads(panda):
     Q, H = _draws(panda, 20, 1)
     one, two = Worlds(problem, threads=1), Worlds(problem, threads=2)
     a, b = one.step(Q, 0.01, {0: H}, None), two.step(Q, 0.01, {0: H}, None)
-    one.close()
-    two.close()
     assert np.abs(a.q - b.q).max() <= 1e-12 and (a.flags == b.flags).all()
 
 

@@ -76,7 +76,8 @@ class BatchStep:
 
 
 class Worlds:
-    """A problem's per-thread copies of its compiled step and its worlds' warm starts."""
+    """A problem's per-thread copies of its compiled step and its worlds' warm starts (the threads themselves are
+    the process's, shared by every problem)."""
 
     def __init__(self, problem: WholeBody, threads: int | None = None):
         self.problem = problem
@@ -84,13 +85,8 @@ class Worlds:
         packed = problem._packed
         trees = [cp.build_tree(problem.robot) for _ in range(self.threads)] if packed is not None else []
         self.steps = [cp._body.Step(tree, packed.problem) for tree in trees if tree is not None] if packed else []
-        self.pool = ThreadPoolExecutor(self.threads) if len(self.steps) > 1 else None
+        self.pool = _pool(self.threads) if len(self.steps) > 1 else None
         self.warm = np.zeros((0, problem.robot.nv), dtype=np.intc)
-
-    def close(self) -> None:
-        """Stop the threads."""
-        if self.pool is not None:
-            self.pool.shutdown(wait=False)
 
     def step(self, Q: ArrayLike, dt: float, targets: Targets | None, v_prev: ArrayLike | None) -> BatchStep:
         """Every world one step (see the module's docstring); ``targets``: per task (the task or its index) an
@@ -152,6 +148,16 @@ class Worlds:
                                                   "mass)")
             _place(T, slot, value, n, problem.tasks[i].label)
         return T
+
+
+_POOLS: dict[int, ThreadPoolExecutor] = {}
+
+
+def _pool(threads: int) -> ThreadPoolExecutor:
+    """The process's pool of ``threads`` threads, shared by every problem's worlds (made at its first use)."""
+    if threads not in _POOLS:
+        _POOLS[threads] = ThreadPoolExecutor(threads, thread_name_prefix="kinelab-worlds")
+    return _POOLS[threads]
 
 
 class _Rows:
