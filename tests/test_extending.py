@@ -94,3 +94,26 @@ def test_a_limits_inequality_must_be_one():
 
     with pytest.raises(kinelab.OptionError, match="inequalities"):
         kinelab.Limits(inequalities=("above",))
+
+
+def test_a_start_that_breaks_the_inequality_is_brought_back_not_frozen():
+    """The page's plane 5 cm above the hand at the start (the start breaks it), the hand's task holding it where it
+    is, a posture: the step brings the hand up — every step higher than the one before until it reaches the plane,
+    never below it (1e-9) after, on it within 1e-6 m after 60 steps — instead of halving every step to nothing."""
+    namespace: dict = {}
+    exec(compile(_blocks()[1].split("talos = kinelab.load")[0], "extending.md", "exec"), namespace)  # noqa: S102
+    talos = kinelab.load("talos")
+    start = talos.neutral()
+    hand = talos.frame_placement(start, "gripper_left_base_link")
+    above = namespace["AbovePlane"]("gripper_left_base_link", hand.translation[2] + 0.05)
+    feet = [kinelab.FrameTask(f, talos.frame_placement(start, f)) for f in ("left_sole_link", "right_sole_link")]
+    tasks = [*feet, kinelab.FrameTask("gripper_left_base_link", hand, task="position"),
+             kinelab.PostureTask(start, weight=1e-3)]  # the null space held: the hand moves as its rows say
+    problem = kinelab.WholeBody(talos, tasks, limits=kinelab.Limits(inequalities=(above,)))
+    q, heights = start, [hand.translation[2]]
+    for _ in range(60):
+        q = problem.step(q, 0.05).q
+        heights.append(talos.frame_placement(q, "gripper_left_base_link").translation[2])
+    reached = next(k for k, h in enumerate(heights) if h >= above.height - 1e-9)  # StopIteration: never came up
+    assert all(b >= a - 1e-9 for a, b in zip(heights[:reached], heights[1:reached + 1], strict=True))  # rising
+    assert min(heights[reached:]) >= above.height - 1e-9 and abs(heights[-1] - above.height) <= 1e-6

@@ -304,7 +304,7 @@ class Clearance(Inequality):
         """The velocity damper of every near pair (:func:`rows`)."""
         found = step_collisions(robot, self.collisions)
         start = rows(found, robot, dt)
-        return Held(start.A, start.b, start.closest, (found, start))
+        return Held(start.A, start.b, closest=start.closest, memo=(found, start))
 
     def overshoot(self, robot: Robot, held: Held, v: np.ndarray, q_next: np.ndarray, dt: float
                   ) -> tuple[np.ndarray, np.ndarray] | None:

@@ -225,10 +225,12 @@ def loops(robot: Robot) -> tuple[Task, ...]:
 @dataclass(frozen=True)
 class Held:
     """One inequality's rows at a step's start: ``A v ≥ b`` (A: (m, nv), b: (m,), in the inequality's unit per
-    second), the nearest pair when it has one (collisions), and what the inequality keeps for its later calls."""
+    second), its slack there (:meth:`Inequality.slack`; a start that broke it may end no deeper than it started),
+    the nearest pair when it has one (collisions), and what the inequality keeps for its later calls."""
 
     A: np.ndarray
     b: np.ndarray
+    slack: float = 0.0
     closest: Contact | None = None
     memo: Any = None
 
@@ -276,8 +278,9 @@ class Inequality(ABC):
         return None  # linear in v: its rows say all
 
     def breaks(self, robot: Robot, held: Held, q_next: np.ndarray) -> bool:
-        """Whether a step's end breaks it (then the step is made shorter)."""
-        return self.slack(robot, q_next) < 0.0
+        """Whether a step's end breaks it (then the step is made shorter): inside it less than it allows, or, from
+        a start that broke it (``held.slack`` < 0), deeper than it started."""
+        return self.slack(robot, q_next) < min(0.0, held.slack) - 1e-12
 
     @abstractmethod
     def slack(self, robot: Robot, q: np.ndarray) -> float:
