@@ -145,12 +145,3 @@ def test_the_router_table_calls_met_only_what_every_round_meets():
     table = router.markdown(rows).splitlines()
     verdicts = [line.rsplit("|", 2)[1].strip() for line in table if line.startswith("| ur5")]
     assert verdicts == ["met", "median met", "missed"]
-
-
-def test_a_chain_solve_loads_no_whole_body_step():
-    """``kinelab ik`` of a chain reads the task classes (to tell tasks from a target) but loads no whole-body step,
-    QP, compiled problem or worlds' threads."""
-    code, modules = _loaded("ik", "ur5", "--target-q", *UR5_Q)
-    assert code == 0
-    assert not {"kinelab.wholebody.problem", "kinelab.wholebody.step", "kinelab.wholebody.qp",
-                "kinelab.wholebody.worlds", "kinelab.wholebody.compiled", "concurrent.futures"} & modules

@@ -11,32 +11,11 @@ limits held exactly, one differential step (a QP), and the converged solve.
 - :mod:`~kinelab.wholebody.problem`: :class:`WholeBody`, a problem prepared once, and :func:`step`.
 """
 
-from typing import TYPE_CHECKING
+from kinelab.wholebody.constraints import CouplingTask, Held, Inequality
+from kinelab.wholebody.limits import JointLimits, Limits
+from kinelab.wholebody.problem import WholeBody, step
+from kinelab.wholebody.step import StepOptions, StepResult
+from kinelab.wholebody.tasks import ComTask, DampingTask, FrameTask, PostureTask, RelativeFrameTask, Task, TaskError
 
-from kinelab.lazy import loader
-
-_PUBLIC = {  # name → module: served on first use, so that ``kinelab.wholebody.tasks`` (read by a chain's solve to
-    # tell tasks from a target) loads no step, QP or compiled problem
-    "CouplingTask": "constraints", "Held": "constraints", "Inequality": "constraints",
-    "JointLimits": "limits", "Limits": "limits", "WholeBody": "problem", "step": "problem",
-    "StepOptions": "step", "StepResult": "step", "ComTask": "tasks", "DampingTask": "tasks", "FrameTask": "tasks",
-    "PostureTask": "tasks", "RelativeFrameTask": "tasks", "Task": "tasks", "TaskError": "tasks",
-}
-__getattr__ = loader(__name__, globals(), {name: (f"kinelab.wholebody.{m}", name) for name, m in _PUBLIC.items()})
 __all__ = ["ComTask", "CouplingTask", "DampingTask", "FrameTask", "Held", "Inequality", "JointLimits", "Limits",
            "PostureTask", "RelativeFrameTask", "StepOptions", "StepResult", "Task", "TaskError", "WholeBody", "step"]
-
-if TYPE_CHECKING:  # the names the loader serves, for type checkers and editors
-    from kinelab.wholebody.constraints import CouplingTask, Held, Inequality
-    from kinelab.wholebody.limits import JointLimits, Limits
-    from kinelab.wholebody.problem import WholeBody, step
-    from kinelab.wholebody.step import StepOptions, StepResult
-    from kinelab.wholebody.tasks import (
-        ComTask,
-        DampingTask,
-        FrameTask,
-        PostureTask,
-        RelativeFrameTask,
-        Task,
-        TaskError,
-    )
