@@ -69,6 +69,7 @@ class StepCollisions:
     summary: str
     gdata: pin.GeometryData = field(init=False)
     after: pin.Data = field(init=False)
+    last: tuple[bytes, tuple[Contact | None, float]] | None = field(init=False, default=None)
 
     def __post_init__(self) -> None:
         self.gdata = pin.GeometryData(self.geom)
@@ -102,14 +103,20 @@ class StepCollisions:
 
     def closest(self, q: np.ndarray) -> tuple[Contact | None, float]:
         """The nearest pair at q over every pair, and the least of each pair's distance less its clearance [m]
-        (< 0: a pair nearer than it keeps); (None, inf) without pairs."""
+        (< 0: a pair nearer than it keeps); (None, inf) without pairs. The last q's answer is kept: a solve's
+        verdict asks for the slack and the pair at the same q."""
         if len(self.pairs) == 0:
             return None, float("inf")
+        key = np.asarray(q, dtype=float).tobytes()
+        if self.last is not None and self.last[0] == key:
+            return self.last[1]
         data = self.robot.model.createData()
         pin.forwardKinematics(self.robot.model, data, q)
         d = np.array([r.min_distance for r in self.distances(data, np.arange(len(self.pairs)))])
         k = int(np.argmin(d))
-        return self.contact(k, d[k]), float(d[k] - self.spec.margin)
+        found = self.contact(k, d[k]), float(d[k] - self.spec.margin)
+        self.last = (key, found)
+        return found
 
 
 def step_collisions(robot: Robot, collisions: Collisions) -> StepCollisions:

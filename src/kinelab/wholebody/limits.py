@@ -14,7 +14,7 @@ bounds of that joint are moved to ask for the return, never made infeasible; the
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
@@ -108,6 +108,8 @@ class Limits:
         inequalities: more inequalities the step holds (as rows of its QP, or as bounds where they are
             ``bounded``) and the solve at its answer, any :class:`~kinelab.wholebody.constraints.Inequality` (a
             tuple; docs/extending.md).
+        joints: (derived) the first three as a :class:`JointLimits`; compiled: (derived) whether the compiled step
+            holds all of it (nothing beyond the joints' limits).
     """
 
     position: bool = True
@@ -115,44 +117,40 @@ class Limits:
     acceleration: Any = None
     collisions: Any = None
     inequalities: Any = ()
+    joints: JointLimits = field(init=False, repr=False, compare=False)  # the joints' limits, an inequality of the step
+    compiled: bool = field(init=False, repr=False, compare=False)  # the compiled step holds all of it (joints only)
+    _boxes: tuple[Inequality, ...] = field(init=False, repr=False, compare=False)
+    _rows: tuple[Inequality, ...] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        """Check every field (the joints' three through :class:`JointLimits`).
+        """Check every field (the joints' three through :class:`JointLimits`), and sort the inequalities once into
+        bounds and rows.
 
         Raises:
             OptionError: a field out of what it accepts (named).
         """
-        object.__setattr__(self, "_joints", JointLimits(self.position, self.velocity, self.acceleration))
+        object.__setattr__(self, "joints", JointLimits(self.position, self.velocity, self.acceleration))
+        _check_inequalities(self.inequalities)
+        given = tuple(self.inequalities)
+        object.__setattr__(self, "inequalities", given)
+        rows = tuple(i for i in given if not i.bounded)
         if self.collisions is not None:  # the collision module (coal's geometry) loaded only when asked for
             from kinelab.collision.model import as_collisions
+            from kinelab.wholebody.clearance import Clearance
 
             object.__setattr__(self, "collisions", as_collisions(self.collisions))
-        _check_inequalities(self.inequalities)
-        object.__setattr__(self, "inequalities", tuple(self.inequalities))
-
-    @property
-    def joints(self) -> JointLimits:
-        """The joints' limits, as an inequality of the step."""
-        joints: JointLimits = self.__dict__["_joints"]
-        return joints
+            rows = (Clearance(self.collisions), *rows)
+        object.__setattr__(self, "_boxes", (self.joints, *(i for i in given if i.bounded)))
+        object.__setattr__(self, "_rows", rows)
+        object.__setattr__(self, "compiled", self.collisions is None and all(i.compiled for i in given))
 
     def boxes(self) -> tuple[Inequality, ...]:
         """Every inequality held as bounds on v: the joints' limits first, then the bounded ones given."""
-        return (self.joints, *(i for i in self.inequalities if i.bounded))
+        return self._boxes
 
     def held(self) -> tuple[Inequality, ...]:
         """Every inequality held as rows (the collisions' first), beyond the bounds on v."""
-        rowed = tuple(i for i in self.inequalities if not i.bounded)
-        if self.collisions is None:
-            return rowed
-        from kinelab.wholebody.clearance import Clearance  # coal's geometry loaded only when asked for
-
-        return (Clearance(self.collisions), *rowed)
-
-    @property
-    def compiled(self) -> bool:
-        """Whether the compiled step holds all of it (the joints' limits only: it has no block for others)."""
-        return self.collisions is None and all(i.compiled for i in self.inequalities)
+        return self._rows
 
 
 def _check_inequalities(value: Any) -> None:

@@ -35,8 +35,8 @@ if TYPE_CHECKING:
     from kinelab.typing import Configuration
     from kinelab.wholebody.solve import WholeBodyResult
 
-NOT_A_CONFIGURATION, SOLVED, SOLVED_SOFT = (int(o) for o in (cp.Outcome.NOT_A_CONFIGURATION, cp.Outcome.SOLVED,
-                                                             cp.Outcome.SOLVED_SOFT))
+NOT_A_CONFIGURATION, SOLVED, SOLVED_SOFT = (int(cp.Outcome.NOT_A_CONFIGURATION), int(cp.Outcome.SOLVED),
+                                             int(cp.Outcome.SOLVED_SOFT))  # plain ints: read on every step
 NO_LIMIT = np.empty(0)
 
 
@@ -188,8 +188,7 @@ class WholeBody:
         acceleration limit without the velocity before)."""
         packed, robot, arr = self._packed, self.robot, _plain(q, self.robot.nq)
         limits = self.limits
-        if packed is None or arr is None or (self._amax.size and prev is None) or \
-                not (limits.collisions is None and not limits.inequalities or limits.compiled):
+        if packed is None or arr is None or (self._amax.size and prev is None) or not limits.compiled:
             return None
         q_out, v_out, errors = np.empty(robot.nq), np.empty(robot.nv), np.zeros((len(packed.labels), 2))
         returning = np.empty(robot.nv, dtype=np.uint8)
