@@ -147,3 +147,30 @@ def test_the_worlds_bench_steps_every_world_compiled_and_names_an_unknown_robot(
     assert cli.main(["bench", "--worlds", "--robots", "ur5"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "'ur5'" in err[0] and "g1" in err[0]
+
+
+def test_a_robot_with_folded_mimic_joints_steps_each_world_as_the_single_step_does():
+    """Romeo (22 mimic joints Pinocchio cannot build, held as couplings the compiled step packs): 3 worlds whose
+    rows are off the couplings (the followers moved by 0.1 rad) and whose left hands move by their own targets —
+    each world's q equals the single step's (which starts on the couplings) to 1e-9; the caller's Q is unchanged."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        romeo = kinelab.load("romeo")
+    q0 = romeo.standing()
+    tasks = [FrameTask(f, romeo.frame_placement(q0, f)) for f in romeo.hands + romeo.feet]
+    problem = WholeBody(romeo, [*tasks, PostureTask(q0, weight=1e-3)])
+    assert problem.compiled and len(problem.loops) == 22
+    followers = [romeo.model.joints[romeo.model.getJointId(m.name)].idx_q for m in romeo.mimics]
+    Q = np.repeat(q0[None], 3, axis=0)
+    Q[:, followers] += 0.1
+    given = Q.copy()
+    H = np.repeat(romeo.frame_placement(q0, romeo.hands[0]).homogeneous[None], 3, axis=0)
+    H[:, :3, 3] += np.random.default_rng(6).uniform(-0.02, 0.02, (3, 3))
+    batch = problem.step_batch(Q, 0.01, targets={0: H})
+    assert np.array_equal(Q, given)
+    for w in range(3):
+        single = WholeBody(romeo, [FrameTask(romeo.hands[0], pin.SE3(H[w])), *tasks[1:],
+                                   PostureTask(q0, weight=1e-3)]).step(Q[w], 0.01)
+        assert batch.solved[w] and np.abs(batch.q[w] - single.q).max() <= 1e-9

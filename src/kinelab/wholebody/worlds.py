@@ -87,6 +87,9 @@ class Worlds:
         self.steps = [cp._body.Step(tree, packed.problem) for tree in trees if tree is not None] if packed else []
         self.pool = _pool(self.threads) if len(self.steps) > 1 else None
         self.warm = np.zeros((0, problem.robot.nv), dtype=np.intc)
+        self.labels = packed.labels if packed is not None else ()  # what the compiled step packed, if it did
+        self.slots = packed.slots if packed is not None else ()
+        self.weighted = len(packed.problem.kind) if packed is not None else 0
 
     def step(self, Q: ArrayLike, dt: float, targets: Targets | None, v_prev: ArrayLike | None) -> BatchStep:
         """Every world one step (see the module's docstring); ``targets``: per task (the task or its index) an
@@ -99,6 +102,9 @@ class Worlds:
         problem, robot = self.problem, self.problem.robot
         Q = _worlds(Q, robot.nq, "Q")
         n = Q.shape[0]
+        for q in Q if problem.loops else ():  # onto what the robot itself holds, as the single step starts
+            for task in problem.loops:
+                task.project(robot, q)
         prev = np.zeros((0, robot.nv)) if v_prev is None else _worlds(v_prev, robot.nv, "v_prev", n)
         if problem._amax.size and v_prev is None:
             raise OptionError("v_prev", None, "each world's velocity before the step (N × nv): the limits hold "
@@ -115,7 +121,7 @@ class Worlds:
         jobs = [(step, chunk[0], chunk[-1] + 1) for step, chunk in zip(self.steps, chunks, strict=True) if chunk.size]
         run = lambda job: self._chunk(job, Q, dt, T, prev, out)  # noqa: E731
         list(self.pool.map(run, jobs) if self.pool is not None and len(jobs) > 1 else map(run, jobs))
-        out.solved[:] = (out.flags == 1) | (out.flags == 2)
+        out.solved[:] = np.isin(out.flags, (cp.Outcome.SOLVED, cp.Outcome.SOLVED_SOFT))
         return out
 
     def _chunk(self, job: tuple[Any, int, int], Q: np.ndarray, dt: float, T: np.ndarray, prev: np.ndarray,
@@ -123,26 +129,22 @@ class Worlds:
         """Worlds a..b on one thread's step (the GIL released inside)."""
         step, a, b = job
         problem, nv = self.problem, self.problem.robot.nv
-        labels = problem._packed.labels if problem._packed is not None else ()
-        errors = np.zeros((max(len(labels), 1), 2))
+        errors = np.zeros((max(len(self.labels), 1), 2))
         step.step_many(Q[a:b], dt, T[a:b], problem._vmax, problem.limits.position, problem._amax,
                        prev[a:b] if prev.shape[0] else prev, problem.options.damping, out.q[a:b], out.v[a:b],
                        out.flags[a:b], out.iterations[a:b], self.warm[a:b], errors, np.zeros(nv, dtype=np.uint8))
 
     def _targets(self, n: int, given: list[tuple[Any, ArrayLike]]) -> np.ndarray:
         """(N, weighted tasks, 12): every task's own target in every world, the given ones per world."""
-        problem = self.problem
-        packed = problem._packed
-        slots = len(packed.problem.kind) if packed is not None else 0
-        row = _Rows(slots)
-        if packed is not None:
-            for task, slot in zip(problem.tasks, packed.slots, strict=True):
-                if slot >= 0:
-                    task.refresh(row, problem.robot, slot)
+        problem, slots = self.problem, self.slots
+        row = _Rows(self.weighted)
+        for task, slot in zip(problem.tasks, slots[:len(problem.tasks)], strict=True):  # then the robot's own loops
+            if slot >= 0:
+                task.refresh(row, problem.robot, slot)
         T = np.repeat(row.rows[None], n, axis=0)
         for key, value in given:
             i = problem._index(key)
-            slot = packed.slots[i] if packed is not None else -1
+            slot = slots[i]
             if slot < 0:
                 raise OptionError("targets", key, "a task with a target (a frame, a relative frame or the centre of "
                                                   "mass)")
@@ -211,13 +213,13 @@ def _place(T: np.ndarray, slot: int, value: ArrayLike, n: int, label: str) -> No
 
 
 def _worlds(value: ArrayLike, width: int, name: str, n: int | None = None) -> np.ndarray:
-    """(N, width) finite floats, C-contiguous (N = n when given).
+    """(N, width) finite floats, C-contiguous, a copy (N = n when given).
 
     Raises:
         OptionError: another shape, NaN/inf or not numbers.
     """
     try:
-        arr = np.ascontiguousarray(value, dtype=float)
+        arr = np.array(value, dtype=float, order="C")  # a copy: the caller's rows are not moved onto the loops
     except (TypeError, ValueError):
         arr = np.zeros(0)
     if arr.ndim != 2 or arr.shape[1] != width or (n is not None and arr.shape[0] != n) or arr.shape[0] == 0 \
