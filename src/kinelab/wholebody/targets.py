@@ -146,20 +146,19 @@ def pose(value: Any, what: str) -> FixedPose:
     Raises:
         TargetError: anything else (named).
     """
-    if isinstance(value, pin.SE3):
+    se3 = isinstance(value, pin.SE3)
+    if se3:
         H = value.homogeneous
-        if not pose_defect(H) and math.hypot(*H[:3, 3].tolist()) <= MAX_COORDINATE:
-            return FixedPose(value)  # the usual call: copied from the SE3 at once
     else:
         H = real_array(value, f"{what} must be a pin.SE3 or a 4 × 4 homogeneous matrix")
         try:
             H = H.reshape(4, 4)
         except ValueError:
             raise TargetError(f"{what} must be a pin.SE3 or a 4 × 4 homogeneous matrix, got {value!r}") from None
-    if pose_defect(H) or H[0, 3] * H[0, 3] + H[1, 3] * H[1, 3] + H[2, 3] * H[2, 3] > MAX_COORDINATE * MAX_COORDINATE:
+    if pose_defect(H) or not math.hypot(*H[:3, 3].tolist()) <= MAX_COORDINATE:
         raise TargetError(f"{what} is not a finite pose with a proper rotation (orthonormal within 1e-6, det +1, "
                           f"last row 0, 0, 0, 1) and a position within {MAX_COORDINATE:g} m")
-    return FixedPose(H)
+    return FixedPose(value if se3 else H)  # an SE3 copied as it is (the faster of the two)
 
 
 MAX_COORDINATE = 1e6  # [m] a target farther than this from the world's origin is a mistake (and overflows rates)
