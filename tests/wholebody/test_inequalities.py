@@ -128,11 +128,13 @@ def test_joint_limits_check_their_fields():
 
 
 def test_the_compiled_steps_outcomes_say_what_the_readable_step_says():
-    """Every flag of the compiled step is an Outcome whose words are the readable step's status for it (DAQP's
-    codes as its Python interface says them, the overflow as the readable step's 'not finite')."""
+    """Every flag of the compiled step is an Outcome whose words are the readable step's status for it: DAQP's exit
+    flags as its documentation names them, the overflow as the readable step's 'not finite'."""
     from kinelab.wholebody.compiled import Outcome
     from kinelab.wholebody.qp import DAQP_STATUS, NOT_FINITE
 
-    for flag, words in DAQP_STATUS.items():
-        assert Outcome(flag).words == words and Outcome(flag).solved == (flag > 0)
-    assert Outcome(-101).words == NOT_FINITE and not Outcome(-100).solved
+    daqp = {1: "solved", 2: "solved", -1: "infeasible", -2: "cycling", -3: "unbounded", -4: "iteration limit",
+            -5: "not convex", -6: "initial active set infeasible"}
+    for flag, words in daqp.items():
+        assert Outcome(flag).words == words == DAQP_STATUS[flag] and Outcome(flag).solved == (flag > 0)
+    assert Outcome(-101).words == NOT_FINITE == "not finite" and not Outcome(-100).solved

@@ -11,7 +11,6 @@ installed module (its version checked); another version, or none, leaves the rea
 from __future__ import annotations
 
 from dataclasses import dataclass
-from enum import IntEnum
 from typing import Any
 
 import numpy as np
@@ -19,33 +18,8 @@ import pinocchio as pin
 
 from kinelab.core import _body
 from kinelab.robot.tree import Robot
+from kinelab.wholebody.qp import Outcome as Outcome  # the step's flags, read as cp.Outcome
 from kinelab.wholebody.tasks import Task
-
-
-class Outcome(IntEnum):
-    """What one compiled step did (its flag): solved, a q it does not take, an overflow, or DAQP's failure."""
-
-    SOLVED = 1
-    SOLVED_SOFT = 2  # DAQP: optimal with soft constraints relaxed (none are: as solved)
-    INFEASIBLE = -1
-    CYCLING = -2
-    UNBOUNDED = -3
-    ITERATION_LIMIT = -4
-    NOT_CONVEX = -5
-    INITIAL_ACTIVE_SET_INFEASIBLE = -6
-    NOT_A_CONFIGURATION = -100  # a q the compiled step does not take: the readable step names why
-    NOT_FINITE = -101  # the answer overflowed, nothing moved
-
-    @property
-    def solved(self) -> bool:
-        """Whether v and q are the step's answer."""
-        return self in (Outcome.SOLVED, Outcome.SOLVED_SOFT)
-
-    @property
-    def words(self) -> str:
-        """The status in words, as the readable step says it."""
-        return "solved" if self.solved else self.name.lower().replace("_", " ")
-
 
 CERTIFY_SAMPLES = 20
 CERTIFY_TOL = 1e-10  # [m, rad] compiled against Pinocchio

@@ -13,6 +13,7 @@ import importlib
 import importlib.util
 from ctypes import c_int
 from dataclasses import dataclass
+from enum import IntEnum
 from typing import Any
 
 import numpy as np
@@ -22,8 +23,34 @@ from kinelab.errors import KinelabError
 SOLVERS = ("daqp", "proxsuite")
 BIG = 1e30  # DAQP's infinity: bounds beyond it are none
 EQUALITY, FREE = 5, 0  # DAQP's constraint senses
-DAQP_STATUS = {1: "solved", 2: "solved", -1: "infeasible", -2: "cycling", -3: "unbounded", -4: "iteration limit",
-               -5: "not convex", -6: "initial active set infeasible"}
+
+
+class Outcome(IntEnum):
+    """A QP's or a compiled step's outcome code: DAQP's exit flags, and the compiled step's own two."""
+
+    SOLVED = 1
+    SOLVED_SOFT = 2  # DAQP: optimal with soft constraints relaxed (none are: as solved)
+    INFEASIBLE = -1
+    CYCLING = -2
+    UNBOUNDED = -3
+    ITERATION_LIMIT = -4
+    NOT_CONVEX = -5
+    INITIAL_ACTIVE_SET_INFEASIBLE = -6
+    NOT_A_CONFIGURATION = -100  # the compiled step: a q it does not take (the readable step names why)
+    NOT_FINITE = -101  # the answer overflowed, nothing moved
+
+    @property
+    def solved(self) -> bool:
+        """Whether v and q are the step's answer."""
+        return self in (Outcome.SOLVED, Outcome.SOLVED_SOFT)
+
+    @property
+    def words(self) -> str:
+        """The status in words, as results say it."""
+        return "solved" if self.solved else self.name.lower().replace("_", " ")
+
+
+DAQP_STATUS = {int(o): o.words for o in Outcome if o >= Outcome.INITIAL_ACTIVE_SET_INFEASIBLE}  # DAQP's own flags
 
 
 @dataclass(frozen=True)
@@ -36,10 +63,10 @@ class Solution:
     iterations: int
 
 
-CYCLING = DAQP_STATUS[-2]  # DAQP's active set cycles on many degenerate rows (two grippers pressed together:
+CYCLING = Outcome.CYCLING.words  # DAQP's active set cycles on many degenerate rows (two grippers pressed together:
 # 60 collision rows of rank 12): ProxQP, where installed, answers those
 MAX_ITERATIONS = 10_000  # each solver's iteration bound: the step's QPs take tens, a call never runs unbounded
-NOT_FINITE = "not finite"  # the status of an answer that overflowed (nothing moved)
+NOT_FINITE = Outcome.NOT_FINITE.words  # the status of an answer that overflowed (nothing moved)
 
 
 @dataclass(frozen=True)
