@@ -120,13 +120,15 @@ def test_no_module_imports_itself_back():
 
 
 @pytest.mark.parametrize("script", [
-    "import kinelab; kinelab.load('ur5').fk([0.1] * 6)",
+    "import kinelab; kinelab.load('ur5', prepare=False).fk([0.1] * 6)",
+    "from kinelab.robot import load; load('ur5').fk([0.1] * 6)",
     "from kinelab.cli import main; main(['fk', 'ur5', '0', '0', '0', '0', '0', '0'])",
     "from kinelab.cli import main; main(['robots'])",
 ])
 def test_a_load_fk_robots_or_help_imports_no_solver_and_no_jit(script):
     """Start-up (#32): what a load and an fk need, nothing more: no numba (no solver kernel), no collision model,
-    no closed form, no maps or reports."""
+    no closed form, no maps or reports (``kinelab.load`` readies an arm's solvers since #71: without that, the load
+    alone)."""
     import subprocess
     import sys
 

@@ -29,7 +29,7 @@ from kinelab.lazy import loader
 # the robot (and with it Pinocchio) and the solvers load on first use (kinelab.lazy): ``kinelab --help`` and
 # ``kinelab robots`` need neither
 _LAZY = {
-    "load": ("kinelab.robot.loading", "load"),
+    "load": ("kinelab.wholebody.ready", "load"),  # an arm's solvers readied (kinelab.robot.load: the robot alone)
     "Robot": ("kinelab.robot.tree", "Robot"),
     "Chain": ("kinelab.robot.chain", "Chain"),
     "Joint": ("kinelab.robot.joints", "Joint"),

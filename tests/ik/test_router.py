@@ -1,6 +1,7 @@
 """One router (#58): the module functions are calls on a prepared ``kinelab.IK`` kept per robot and settings, so
 every route — the multistart, the closed form, a 7R arm's held joint, a collision check — is chosen in one place.
-Each case spies on ``IK`` and calls the module function as a user does."""
+Each case spies on ``IK`` and calls the module function as a user does, on a robot loaded with ``prepare=False`` (the
+load's own warm-up would be counted)."""
 
 import numpy as np
 import pinocchio as pin
@@ -45,7 +46,7 @@ def _targets(robot, count, seed=3):
     ("panda", "frdm", {"collisions": "self"}), ("kinova", "biquat", {}), ("crx10ia", "dls", {}),
 ])
 def test_solve_batch_is_the_kept_prepared_solvers_call(spy, name, solver, extra):
-    robot = kinelab.load(name)
+    robot = kinelab.load(name, prepare=False)
     T = _targets(robot, 4)
     first = kinelab.solve_batch(robot, T, solver=solver, seed=5, **extra)
     again = kinelab.solve_batch(robot, T, solver=solver, seed=5, **extra)
@@ -62,7 +63,7 @@ def test_solve_batch_is_the_kept_prepared_solvers_call(spy, name, solver, extra)
 
 
 def test_solve_is_the_kept_prepared_solvers_call(spy):
-    robot = kinelab.load("ur5")
+    robot = kinelab.load("ur5", prepare=False)
     target = robot.fk(np.array([0.3, -1.2, 1.4, -0.5, 0.9, 0.2]))
     results = [kinelab.solve(robot, target, solver="frdm", seed=s) for s in range(3)]
     assert spy["built"] == 1 and spy["solve"] == 1  # later calls: the kept solver's compiled engine directly
@@ -80,7 +81,7 @@ def _path(robot, q, count=30, step=0.01):
 @pytest.mark.parametrize(("name", "extra"), [("panda", {}), ("ur5", {"restrict": ("intervals",)}),
                                              ("kinova", {"collisions": "self"})])
 def test_track_is_the_kept_prepared_solvers_call(spy, name, extra):
-    robot = kinelab.load(name)
+    robot = kinelab.load(name, prepare=False)
     q = robot.display_q()
     targets = _path(robot, q)
     restrict = extra.get("restrict", ())
@@ -102,7 +103,7 @@ def test_track_is_the_kept_prepared_solvers_call(spy, name, extra):
 
 
 def test_track_without_a_start_begins_at_the_first_targets_answer_through_the_router(spy):
-    robot = kinelab.load("ur5")
+    robot = kinelab.load("ur5", prepare=False)
     targets = _path(robot, robot.display_q())
     path = kinelab.track(robot, targets, seed=4)
     assert path.reached.all() and spy["track"] == 1 and spy["solve"] == 1  # the first answer: a kept solver's solve
@@ -115,7 +116,7 @@ def test_track_without_a_start_begins_at_the_first_targets_answer_through_the_ro
     ("ur5", {"collisions": "self", "drop_colliding": True}), ("ur10", {"solver": "analytic"}),
 ])
 def test_solve_all_is_the_kept_prepared_solvers_call(spy, name, extra):
-    robot = kinelab.load(name)
+    robot = kinelab.load(name, prepare=False)
     q = robot.display_q()
     target = robot.fk(q)
     found = [kinelab.solve_all(robot, target, seed=2, **extra) for _ in range(2)]
@@ -132,7 +133,7 @@ def test_solve_all_is_the_kept_prepared_solvers_call(spy, name, extra):
 @pytest.mark.parametrize(("name", "solver"), [("ur5", "frdm"), ("ur5", "analytic"), ("panda", "frdm"),
                                               ("kinova", "auto")])
 def test_solve_preferring_a_branch_is_the_kept_prepared_solvers_call(spy, name, solver):
-    robot = kinelab.load(name)
+    robot = kinelab.load(name, prepare=False)
     q = robot.display_q()
     target = robot.fk(q)
     near = q + 0.05  # the pose's own branch is the one nearest a reference beside it

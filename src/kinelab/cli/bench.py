@@ -28,6 +28,7 @@ if TYPE_CHECKING:
         collision_step,
         collisions,
         completeness,
+        first_call,
         loops,
         router,
         runner,
@@ -56,6 +57,7 @@ else:
     collision_step = lazy.module("kinelab.report.bench.collision_step", globals())
     closed_step = lazy.module("kinelab.report.bench.closed_step", globals())
     worlds = lazy.module("kinelab.report.bench.worlds", globals())
+    first_call = lazy.module("kinelab.report.bench.first_call", globals())
 
 
 def add(sub: Subcommands) -> None:
@@ -129,6 +131,10 @@ def _add_instead(s: argparse.ArgumentParser) -> None:
     s.add_argument("--worlds", action="store_true",
                    help="instead of the arm protocol: many worlds a step (WholeBody.step_batch): the Panda at 1,024 "
                         "worlds, G1 at 256 (--robots among panda, g1), --repeats rounds: steps per second")
+    s.add_argument("--first-call", action="store_true",
+                   help="instead of the arm protocol: a process's first solve, solve_batch and solve_all against its "
+                        "later ones (--robots; default ur5 panda), --repeats rounds of fresh processes, with "
+                        "kinelab.load's preparation and without it")
     s.add_argument("--closed", action="store_true",
                    help="instead of the arm protocol: the step on robots that close loops (fourbar, ankle, cassie) "
                         "side by side with mink's EqualityConstraintTask, --repeats rounds of 1,000 steps: time, "
@@ -155,6 +161,9 @@ def run(args: argparse.Namespace) -> int:
         raise KinelabError("--standing goes with --whole-body (the step from where the robot stands)")
     if args.worlds:
         return _alone(args, "worlds", lambda: worlds.run(args.robots, rounds=args.repeats), worlds.markdown)
+    if args.first_call:
+        return _alone(args, "first_call", lambda: first_call.run(args.robots, rounds=args.repeats),
+                      first_call.markdown)
     if args.closed:
         return _alone(args, "closed", lambda: closed_step.run(args.robots, rounds=args.repeats), closed_step.markdown)
     if args.collisions_step:

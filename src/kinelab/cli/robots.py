@@ -16,10 +16,12 @@ if TYPE_CHECKING:
     from kinelab import collision
     from kinelab.ik.analytic import redundancy
     from kinelab.robot import Chain, Joint
+    from kinelab.wholebody import ready
 else:
     collision = lazy.module("kinelab.collision", globals())
     np = lazy.module("numpy", globals())
     redundancy = lazy.module("kinelab.ik.analytic.redundancy", globals())
+    ready = lazy.module("kinelab.wholebody.ready", globals())
 
 
 def add(sub: Subcommands) -> None:
@@ -81,7 +83,8 @@ def run_info(args: argparse.Namespace) -> int:
             "dof": robot.n, "nq": robot.nq, "nv": robot.nv, "joints": [_joint_row(j) for j in robot.joints],
             "locked": robot.locked, "mimics": {name: m.leader for name, m in robot.mimics.items()},
             "format": robot.source_format, "collisions": _collision_summary(robot) if args.collisions else None,
-            "closed_form": redundancy.closed_form_summary(robot), "judge": str(robot.fk_certificate)}
+            "closed_form": redundancy.closed_form_summary(robot), "judge": str(robot.fk_certificate),
+            "first_call": dict(ready.routes(robot))}
     if args.json:
         print_json(info)
     else:
@@ -104,6 +107,8 @@ def _print_info(robot: Chain, info: dict[str, Any], verbose: bool) -> None:
         print(f"locked: {', '.join(f'{k}={v:g}' for k, v in robot.locked.items())}")
     print(f"branches: {info['closed_form'] if verbose else redundancy.closed_form_words(robot)}")
     print(f"answers judged by: {info['judge']}")
+    print("default routes (readied by kinelab.load in Python; prepare=False leaves them to the first call): "
+          + ", ".join(f"{entry} → {route}" for entry, route in info["first_call"].items()))
     print(f"collisions: {info['collisions'] or 'not built (add --collisions: loads the meshes, counts the pairs)'}")
 
 

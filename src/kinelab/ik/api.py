@@ -19,7 +19,7 @@ from kinelab.errors import OptionError
 from kinelab.ik.auto import single
 from kinelab.ik.batch import BatchIKResult
 from kinelab.ik.branches import UNSEEN
-from kinelab.ik.prepared import kept_solver, prepared
+from kinelab.ik.prepared import IK, kept_solver, prepared
 from kinelab.ik.registry import SolverOptions, capabilities, refuse_options
 from kinelab.ik.request import check_robot
 from kinelab.ik.result import Branches, IKResult, TrackResult
@@ -267,14 +267,27 @@ def solve_all(robot: Chain, target: Target, *positional: object, solver: str = "
     time_budget = _all_budget(time_budget, redundancy)
     if (options is not None or solver_options) and capabilities(solver).closed_form:  # said, not ignored
         refuse_options(options or solver_options)
+    ik = all_solver(robot, solver, tol_pos, tol_rot, time_budget, options, task, axis, collisions, solver_options)
+    return ik.solve_all(target, seed=seed, q_ref=q_ref, max_solutions=max_solutions, stop_below=stop_below,
+                        redundancy=redundancy, drop_colliding=drop_colliding)
+
+
+def all_solver(robot: Chain, solver: str, tol_pos: float, tol_rot: float, time_budget: float | None,
+               options: SolverOptions, task: str, axis: str, collisions: CollisionSpec,
+               solver_options: dict[str, object]) -> IK:
+    """:func:`solve_all`'s prepared solver for these settings, kept on the robot (:mod:`kinelab.wholebody.ready`
+    builds the default one at load).
+
+    Raises:
+        SolverNotFoundError, OptionError: a bad setting, named.
+    """
     key = (solver, tol_pos, tol_rot, time_budget, options, task, axis, collisions) + (
         tuple(solver_options.items()) if solver_options else ())
     ik = kept_solver(robot, key)  # the usual loop: the same settings again, one lookup (no settings dict built)
     if ik is None:
         ik = prepared(robot, dict(solver=solver, tol_pos=tol_pos, tol_rot=tol_rot, time_budget=time_budget,
                                   options=options, task=task, axis=axis, collisions=collisions, **solver_options), key)
-    return ik.solve_all(target, seed=seed, q_ref=q_ref, max_solutions=max_solutions, stop_below=stop_below,
-                        redundancy=redundancy, drop_colliding=drop_colliding)
+    return ik
 
 
 AUTO = "auto"  # solve_all's default time_budget: the route's own (below)

@@ -1,0 +1,136 @@
+"""The one-off work of an arm's first solve, done when it is loaded: :func:`load` is ``kinelab.load``.
+
+A process's first :func:`kinelab.solve` used to pay for everything later calls reuse: importing the solvers'
+modules (about 80 ms), classifying the chain, building the closed form's tables, compiling the engine, certifying
+the compiled FK. :func:`ready` does that work for the calls a user's loop makes with the default settings —
+``solve`` without a start and with one, ``solve_batch``, ``solve_all`` — by building their prepared solvers and
+running each once on the tool pose of the middle of the limits, so the first call of each costs what later ones
+cost (``kinelab bench --first-call``). What was readied, and the route each call takes, is kept on the robot
+(:class:`Ready`, ``robot.derived("ready")``) and said by ``kinelab info``.
+
+Settings other than the defaults build their own prepared solver on their first call, as before. The robot layer's
+own loader (:func:`kinelab.robot.load`, what the command line uses: a command solves once at most) readies nothing.
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from kinelab.errors import KinelabError, OptionError
+from kinelab.robot import loading
+from kinelab.robot.chain import Chain
+
+KEY = "ready"  # where the record lives on the robot (Chain.derived)
+
+
+@dataclass(frozen=True)
+class Ready:
+    """What :func:`ready` prepared on one arm.
+
+    Attributes:
+        routes: (entry point, the route its default call takes), in call order.
+        seconds: wall time of the preparation [s] (the modules' import included when it came first).
+        refused: "" when every call was readied, else the error that stopped it (the first call then meets it).
+    """
+
+    routes: tuple[tuple[str, str], ...]
+    seconds: float
+    refused: str = ""
+
+
+def load(name_or_path: str | Path, *args: Any, prepare: bool = True, **kwargs: Any) -> Any:
+    """``kinelab.load``: a robot as :func:`kinelab.robot.loading.load` builds it (every argument of it), an arm's
+    default calls readied.
+
+    Args:
+        name_or_path: a registered name or a model file, and ``args``/``kwargs``: as
+            :func:`kinelab.robot.loading.load`.
+        args: that function's further positional arguments.
+        prepare: True (the default): an arm's solvers readied here (:func:`ready`): their modules imported, the
+            closed form's tables, the compiled engine and the FK certificate built for the default ``solve``,
+            ``solve_batch`` and ``solve_all``, so that a process's first solve costs what later ones cost (the
+            work moves here: about 0.1 s once per process, 2-30 ms per arm). False: built on the first call instead.
+            A whole robot's step builds on its first call either way.
+        kwargs: that function's keyword arguments.
+
+    Returns:
+        A Chain (readied when ``prepare``), or the whole Robot.
+
+    Raises:
+        OptionError: ``prepare`` not a bool. Otherwise as :func:`kinelab.robot.loading.load`.
+    """
+    if not isinstance(prepare, bool):
+        raise OptionError("prepare", prepare, "True or False")
+    robot = loading.load(name_or_path, *args, **kwargs)
+    if prepare and isinstance(robot, Chain):
+        ready(robot)
+    return robot
+
+
+def routes(robot: Chain) -> tuple[tuple[str, str], ...]:
+    """The route each default call takes on this arm, without taking it: what ``solver="auto"`` picks
+    (docs/route.md) for ``solve`` without and with a start and ``solve_batch`` ("analytic" or "frdm"), and how
+    ``solve_all`` finds every branch ("closed form", "search", "elimination" or "multistart", its ``method``)."""
+    from kinelab.ik import auto
+    from kinelab.ik.analytic import classify, kernel
+
+    def solver(start_given: bool) -> str:
+        return auto.single(robot, auto.AUTO, "pose", None, False, start_given)
+
+    arm = classify.classify(robot).arm
+    if arm is not None and not _held(robot):
+        every = "search" if kernel.SEARCH_6R <= arm.kind < kernel.GENERAL_6R else "closed form"
+    else:
+        every = "elimination" if classify.general_class(robot).arm is not None else "multistart"
+    return (("solve", solver(False)), ("solve with q0", solver(True)),
+            ("solve_batch", auto.resolved(robot, auto.AUTO, "pose", None, False)), ("solve_all", every))
+
+
+def _held(robot: Chain) -> bool:
+    from kinelab.ik.analytic import held
+    return bool(robot.derived("auto: held", held.applies))
+
+
+def ready(robot: Chain) -> Ready:
+    """Prepare ``robot``'s default calls (see the module's docstring) and keep the record on it.
+
+    Returns:
+        The :class:`Ready` record (also ``robot.derived("ready")``).
+    """
+    t0 = time.perf_counter()
+    taken: tuple[tuple[str, str], ...] = ()
+    refused = ""
+    try:
+        taken = _warm(robot)
+    except KinelabError as error:  # the user's own first call meets the same error, named there
+        refused = str(error)
+    found = Ready(taken, time.perf_counter() - t0, refused)
+    robot._derived[KEY] = found  # noqa: SLF001 - the record of work done, not derived on demand
+    return found
+
+
+def _warm(robot: Chain) -> tuple[tuple[str, str], ...]:
+    """Run each default call once on the tool pose at the middle of the limits (seeded: no entropy drawn); the
+    routes they took, in :func:`routes`' words."""
+    from kinelab.ik import api, auto
+    from kinelab.wholebody import api as front  # kinelab.solve's module, imported here rather than on the first call
+
+    lower, upper = robot.sample_bounds
+    q_mid = 0.5 * (lower + upper)
+    target = robot.fk(q_mid)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # a short arm's note on a pose target is for the user's own call
+        alone = front.solve(robot, target, seed=0)
+        started = front.solve(robot, target, q0=q_mid, seed=0)
+        batch = api.solve_batch(robot, [target], seed=0)
+        every = routes(robot)[-1][1]
+        if every == "multistart":  # a round of starts costs 10-100 ms: its solver built, not run
+            api.all_solver(robot, auto.AUTO, 1e-6, 1e-6, api.AUTO_BUDGET, None, "pose", "z", None, {})
+        else:  # microseconds: the default call itself, its one-call form built
+            every = str(api.solve_all(robot, target, seed=0).method.value)
+    return (("solve", alone.solver), ("solve with q0", started.solver),
+            ("solve_batch", batch.mode.split(" ")[0].split("+")[0]), ("solve_all", every))
