@@ -122,7 +122,7 @@ def test_each_round_of_solve_all_and_the_prefer_fallback_get_only_what_is_left(m
     """kinelab 0.1: solve_all ran every round unbounded (a whole round past the budget) and solve(prefer=) then
     started a fresh budget for its fallback (12× at 5 ms). Checked on the budgets handed down, not on a clock."""
 
-    from kinelab.ik import branches, prepared
+    from kinelab.ik import branches, routes
 
     ur5 = kinelab.load("ur5")
     target = ur5.fk(ur5.random_q(5))
@@ -153,10 +153,10 @@ def test_each_round_of_solve_all_and_the_prefer_fallback_get_only_what_is_left(m
     monkeypatch.undo()
 
     fallback: list[float | None] = []
-    real_one = prepared.solve_one  # the fallback's one solve (through solve_clear_of, with no collision check)
-    monkeypatch.setattr(prepared, "solve_one", lambda robot, t, q0, req: fallback.append(req.time_budget)
+    real_one = routes.solve_one  # the fallback's one solve (through solve_clear_of, with no collision check)
+    monkeypatch.setattr(routes, "solve_one", lambda robot, t, q0, req: fallback.append(req.time_budget)
                         or real_one(robot, t, q0, req))
-    monkeypatch.setattr(prepared, "time", Clock())  # the branch search took one reading's 7.5 ms of the 50 ms
+    monkeypatch.setattr(routes, "time", Clock())  # the branch search took one reading's 7.5 ms of the 50 ms
     res = kinelab.solve(ur5, target, solver="frdm", prefer=np.zeros(6), time_budget=0.05, tol_pos=1e-300,
                         tol_rot=1e-300, seed=0)
     assert not res.success and fallback == [pytest.approx(0.05 - 0.0075, abs=1e-12)]

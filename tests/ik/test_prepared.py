@@ -109,7 +109,7 @@ def test_a_start_given_as_a_list_or_another_real_dtype_takes_the_one_call(ur5, m
     """A list, a tuple, a float32 or an integer start holds the same values as its float64 array: the engine takes
     them (no general route: 10× the cost) and answers as the general route does; anything else still gets the
     general route's named error."""
-    from kinelab.ik import prepared
+    from kinelab.ik import routes
 
     ik = kinelab.IK(ur5, solver="frdm", time_budget=None, max_restarts=5)
     rng = np.random.default_rng(6)
@@ -125,7 +125,7 @@ def test_a_start_given_as_a_list_or_another_real_dtype_takes_the_one_call(ur5, m
     for q0 in starts:
         expected = _general(ur5, target, np.asarray(q0, dtype=float), 3, max_restarts=5)
         with monkeypatch.context() as m:
-            m.setattr(prepared, "solve_one", refused)
+            m.setattr(routes, "solve_one", refused)
             one = ik.solve(target, q0=q0, seed=3)
         _same(one, expected)
     for bad, error in ((["a"] * 6, "numbers"), ([True] * 6, "numbers"), ([0.0] * 5, "6 numbers"),

@@ -6,22 +6,24 @@ kernels before it returns; ``ik.solve(target, q0=...)`` then checks only what ch
 the start), so a call pays no argument validation or option building. Its answers are those of
 :func:`kinelab.solve` with the same settings and seed (tested), and every one is judged.
 
-The prepared solver owns its solver's engine (:class:`kinelab.core._engine.Engine`, which the solver's module makes:
-``engine(robot, request)``; FRDM's and the biquaternion preset's). The usual call — a ``pin.SE3`` target, n real
-numbers as the start (a list or any real array; or none), an integer seed or none — on a robot whose compiled FK
-is certified is one compiled call: it checks both (finite, a proper rotation, the start within the limits, the
-target within the reach bound), runs the multistart and judges the answer; the result is built directly, its
-diagnostics only when read. Anything else (a point target, a start outside the limits or not n real numbers, a
-target beyond reach, a robot judged by Pinocchio's FK, options no engine runs) takes the general driver, which
-names the problem, warns or answers UNREACHABLE exactly as :func:`kinelab.solve` does: the engine changes the
-cost, never the answer.
+The routes are objects chosen once, here (:mod:`kinelab.ik.routes`): ``ik.one`` answers ``solve`` and
+``solve_batch`` (the numeric solver, the closed form, a 7R arm's held joint), ``ik.every`` answers ``solve_all``;
+the methods hand the call over without asking which route it is. The prepared solver owns its solver's engine
+(:class:`kinelab.core._engine.Engine`, which the solver's module makes: ``engine(robot, request)``; FRDM's and the
+biquaternion preset's). The usual call — a ``pin.SE3`` target, n real numbers as the start (a list or any real
+array; or none), an integer seed or none — on a robot whose compiled FK is certified is one compiled call: it checks
+both (finite, a proper rotation, the start within the limits, the target within the reach bound), runs the
+multistart and judges the answer; the result is built directly, its diagnostics only when read. Anything else (a
+point target, a start outside the limits or not n real numbers, a target beyond reach, a robot judged by Pinocchio's
+FK, options no engine runs) takes the general driver, which names the problem, warns or answers UNREACHABLE exactly
+as :func:`kinelab.solve` does: the engine changes the cost, never the answer.
 """
 
 from __future__ import annotations
 
 import time
 from dataclasses import replace
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pinocchio as pin
@@ -29,37 +31,26 @@ import pinocchio as pin
 from kinelab import lazy
 from kinelab.core._engine import Engine
 from kinelab.errors import OptionError
-from kinelab.geometry import stack_homogeneous
 from kinelab.ik.auto import resolved
-from kinelab.ik.batch import BatchIKResult, prepare, prepare_robot, run_batch
-from kinelab.ik.branches import UNSEEN, Route, find_all, route_of, usual_entry
+from kinelab.ik.batch import BatchIKResult, prepare_robot
+from kinelab.ik.branches import UNSEEN, route_of
 from kinelab.ik.chain import chain_model
-from kinelab.ik.driver import prepare_solver, solve_one
-from kinelab.ik.options import flag
 from kinelab.ik.registry import SolverOptions, capabilities, refuse_options
 from kinelab.ik.request import Request, check_robot, check_seed, make_request
 from kinelab.ik.result import Branches, IKResult, TrackResult
-from kinelab.ik.targets import TargetArrays, as_target, as_target_arrays
+from kinelab.ik.routes import AllBranches, OneAnswer, collision_check, one_answer
+from kinelab.ik.targets import TargetArrays, as_target_arrays
 from kinelab.robot import Chain
 from kinelab.typing import CollisionSpec, Configuration, Target, Targets
 
 if TYPE_CHECKING:
-    from kinelab.collision import model
     from kinelab.collision.model import CollisionModel
     from kinelab.ik import clear
-    from kinelab.ik.analytic import batch as analytic_batch
-    from kinelab.ik.analytic import branches, held, nearest
-    from kinelab.ik.analytic.nearest import EveryBranch, NearestBranch
     from kinelab.ik.analytic.sew import SEW
     from kinelab.ik.frdm import tracking
     from kinelab.ik.frdm.tracking import PathSettings
 else:
-    analytic_batch = lazy.module("kinelab.ik.analytic.batch", globals())
-    branches = lazy.module("kinelab.ik.analytic.branches", globals())
     clear = lazy.module("kinelab.ik.clear", globals())
-    held = lazy.module("kinelab.ik.analytic.held", globals())
-    model = lazy.module("kinelab.collision.model", globals())
-    nearest = lazy.module("kinelab.ik.analytic.nearest", globals())
     tracking = lazy.module("kinelab.ik.frdm.tracking", globals())
 
 
@@ -102,63 +93,28 @@ class IK:
         check_robot(robot)
         self.robot = robot
         given = options is not None or bool(solver_options)
-        # solve_all's route is the named solver's, as kinelab.solve_all's ("auto" there: the closed form or the 1-D
-        # search, the multistart where they find nothing); the other calls take what "auto" stands for here
-        self.route = route_of(capabilities(solver), given)
-        self._given = (solver, options, dict(solver_options), task, axis)  # what solve_all and a path are made of
-        solver = resolved(robot, solver, task, collisions, given)
-        kind = capabilities(solver)
-        self.analytic = kind.closed_form
-        if self.analytic:
+        self._given = (solver, options, dict(solver_options), task, axis)  # what a path is made of
+        named = capabilities(solver)
+        resolved_solver = resolved(robot, solver, task, collisions, given)
+        kind = capabilities(resolved_solver)
+        if kind.closed_form:
             refuse_options(options or solver_options)
-        self.request: Request = make_request(kind.request_solver(solver), None, tol_pos, tol_rot, time_budget,
-                                             max_restarts, start_outside_limits, options, task, axis, solver_options)
+        self.request: Request = make_request(kind.request_solver(resolved_solver), None, tol_pos, tol_rot,
+                                             time_budget, max_restarts, start_outside_limits, options, task, axis,
+                                             solver_options)
         self._path_request: Request | None = None
-        # solve_all's usual call (no options, collisions or another task): its closed form's key
+        self.collisions = collision_check(robot, collisions)
+        # the routes, chosen once: one answer per target (solve, solve_batch, prefer=), and every branch
+        self.one: OneAnswer = one_answer(robot, self.request, self.collisions, kind.closed_form, named.picks, given)
+        self.engine: Engine | None = self.one.engine  # the usual single call's one compiled call, where there is one
+        # solve_all's route is the named solver's, as kinelab.solve_all's ("auto" there: the closed form or the 1-D
+        # search, the multistart where they find nothing); its usual call (no options, collisions or another task)
+        # is kept in one compiled call
         usual = not given and collisions is None and (task, axis) == ("pose", "z")
         req = self.request
-        self._usual_all = (self._given[0], req.tol_pos, req.tol_rot, req.time_budget) if usual else None
-        self.collisions = collision_check(robot, collisions)
-        self._nearest: NearestBranch | None = None
-        self._every: EveryBranch | None | Literal[False] = False  # solve_all's usual call, once looked up
-        self.held = False  # solver "analytic" on a 7R arm: its six at the held joint's start value (_prepare)
-        self._prepare()
-        # the usual call's one compiled call (kinelab.core._engine), where the solver has one
-        self.engine: Engine | None = None if self.collisions is not None or self.analytic else self._engine()
-        # "auto" on a 7R arm: a single call without a start is FRDM's (kinelab.ik.auto.single), built on its first
-        self._single: IK | None | Literal[False] = None if capabilities(self._given[0]).picks and self.held else False
-
-    def _prepare(self) -> None:
-        """Everything a call would otherwise build first: the closed form's class (a chain without one refused
-        here, by name) and its one-call form, or the solver's model."""
-        robot, req = self.robot, self.request
-        if self.analytic:
-            self.held = held.applies(robot)
-            if self.held:  # a 7R arm: its six in closed form at the held joint's start value
-                if self.collisions is not None:
-                    raise OptionError("collisions", "given", "None with solver='analytic' on a 7R arm "
-                                      "(solver='frdm' takes collisions=)")
-                branches.arm_of(held.held_robot(robot), req)  # the task is "pose" (named otherwise)
-                return
-            held.refuse_7r(robot)
-            branches.arm_of(robot, req)
-            if self.collisions is None:  # the usual call's one compiled call: branches found and judged together
-                form = branches.prepared_form(robot, req)
-                self._nearest = None if form is None else nearest.NearestBranch(robot, req, form)
-            return
-        prepare_solver(req.module, robot, req.options)
-
-    def _engine(self) -> Engine | None:
-        """The solver's one-call engine, where its module offers one (``engine(robot, request)``) for this robot and
-        these settings."""
-        make = getattr(self.request.module, "engine", None)
-        return None if make is None else make(self.robot, self.request)
-
-    def _request(self, seed: int | None) -> Request:
-        if seed is None:
-            return self.request
-        check_seed(seed)
-        return replace(self.request, seed=seed)
+        self.every = AllBranches(robot, req, route_of(named, given),
+                                 (solver, req.tol_pos, req.tol_rot, req.time_budget) if usual else None,
+                                 self.collisions)
 
     def solve(self, target: Target, *, q0: Configuration | None = None, seed: int | None = None,
               prefer: Configuration | None = None) -> IKResult:
@@ -180,53 +136,8 @@ class IK:
         if seed is not None:
             check_seed(seed)  # every route refuses a bad seed, the closed form's too (it draws nothing)
         if prefer is not None:
-            return self._preferring(target, q0, seed, prefer)
-        if self._single is not False and q0 is None:
-            return self._frdm_single().solve(target, seed=seed)
-        if self.engine is not None:  # the usual call, in one compiled call (an int: why it declines)
-            res = self.engine.solve(target, q0, seed)
-            if type(res) is not int:
-                return res
-        elif self.analytic:
-            return self._nearest_branch(target, q0)
-        return solve_clear_of(self.robot, target, q0, self._request(seed), self.collisions)
-
-    def _frdm_single(self) -> IK:
-        """The FRDM solver with these settings, for "auto"'s single calls without a start on a 7R arm."""
-        if not isinstance(self._single, IK):
-            req = self.request
-            self._single = IK(self.robot, solver="frdm", tol_pos=req.tol_pos, tol_rot=req.tol_rot,
-                              time_budget=req.time_budget, max_restarts=req.max_restarts,
-                              start_outside_limits=req.start_outside_limits)
-        return self._single
-
-    def _preferring(self, target: Any, q0: Any, seed: int | None, prefer: Any) -> IKResult:
-        """``solve(prefer=)``: the closed form's branch nearest ``prefer`` for solver "analytic", else the (clear)
-        branch nearest it among those the branch search finds (in closed form where the solver stands in for one
-        and runs without options)."""
-        if self.analytic:
-            if q0 is not None:
-                raise OptionError("prefer", "given with q0", "one reference: q0 or prefer, with solver='analytic'")
-            return self._nearest_branch(target, prefer)
-        if q0 is not None:
-            raise OptionError("q0", "given", "None with prefer= (the branch search draws its own starts)")
-        _, options, solver_options, _, _ = self._given
-        closed = capabilities(self.request.solver).stands_in and options is None and not solver_options
-        return preferred(self.robot, target, self._request(seed), prefer, self.collisions,
-                         Route.EITHER if closed else Route.MULTISTART)
-
-    def _nearest_branch(self, target: Any, q0: Any) -> IKResult:
-        """Solver "analytic": the branch nearest q0 in one compiled call where that serves, else root by root (a q0
-        outside the limits refused or projected, as ``start_outside_limits`` says)."""
-        ref = None if q0 is None else analytic_batch.within_limits(
-            self.robot, self.robot.check_q(q0, what="q0")[None, :], self.request.start_outside_limits)[0]
-        if self.held:
-            return held.nearest_held_one(self.robot, as_target(target, self.request.task.name), ref, self.request)
-        found = None if self._nearest is None else self._nearest.solve(target, ref)
-        if found is not None:  # the usual call: nothing imported on its way (an import costs 8 % of a 13 µs call)
-            return found
-        return nearest.analytic_one(self.robot, as_target(target, self.request.task.name), self.request, ref,
-                                    self.collisions)
+            return self.one.prefer(target, q0, seed, prefer)
+        return self.one.solve(target, q0, seed)
 
     def solve_batch(self, targets: Targets, *, q0: Configuration | None = None,
                     seed: int | None = None) -> BatchIKResult:
@@ -243,12 +154,7 @@ class IK:
         Raises:
             TargetError, ConfigurationError, OptionError: named.
         """
-        req = replace(self._request(seed), start_outside_limits="refuse")
-        if self.held:
-            return held.nearest_held(self.robot, targets, q0, req)
-        if self.analytic:
-            return analytic_batch.nearest_batch(self.robot, targets, q0, req, self.collisions)
-        return batch_clear_of(self.robot, targets, q0, req, self.collisions)
+        return self.one.solve_batch(targets, q0, seed)
 
     def solve_all(self, target: Target, *, seed: int | None = None, q_ref: Configuration | None = None,
                   max_solutions: int | None = None, stop_below: float | None = UNSEEN,
@@ -271,34 +177,7 @@ class IK:
         Raises:
             TargetError, ConfigurationError, OptionError: named.
         """
-        if drop_colliding is not False:
-            flag("drop_colliding", drop_colliding)
-        if self._usual_all is not None and q_ref is None and max_solutions is None and redundancy is None:
-            found = self._usual_solve_all(target, seed, stop_below)
-            if found is not None:
-                return found
-        found = find_all(self.robot, target, replace(self._request(seed), max_restarts=0), q_ref=q_ref,
-                         max_solutions=max_solutions, stop_below=stop_below, method=self.route,
-                         redundancy=redundancy)
-        return clear_of(found, self.collisions, drop=bool(drop_colliding))
-
-    def _usual_solve_all(self, target: Target, seed: int | None, stop_below: float | None) -> Branches | None:
-        """solve_all's usual call: every branch in one compiled call, or None where the general route answers."""
-        entry = self._every_branch(stop_below)
-        if entry is None:
-            return None
-        if seed is not None and not (type(seed) is int and seed >= 0):
-            check_seed(seed)
-        return entry.solve(target)
-
-    def _every_branch(self, stop_below: float | None) -> EveryBranch | None:
-        """solve_all's one-call solver for ``stop_below`` (kept here for the default), or None."""
-        if stop_below is UNSEEN and self._every is not False:
-            return self._every
-        entry = usual_entry(self.robot, (*self._usual_all, stop_below))  # type: ignore[misc]
-        if stop_below is UNSEEN:
-            self._every = entry
-        return entry
+        return self.every.solve_all(target, seed, q_ref, max_solutions, stop_below, redundancy, drop_colliding)
 
     def track(self, targets: Targets, *, q0: Configuration | None = None, seed: int | None = None,
               jump_limit: float | None = 0.2,
@@ -345,21 +224,6 @@ class IK:
         return replace(self._path_request, seed=int(seed))
 
 
-def preferred(robot: Chain, target: Target, req: Request, prefer: Configuration | None, check: CollisionModel | None,
-              method: Route) -> IKResult:
-    """``solve(prefer=)``: the (clear) branch nearest ``prefer`` among every branch found."""
-    prepare(robot, req)  # not the budget's time
-    t0 = time.perf_counter()
-    found = find_all(robot, target, req, q_ref=prefer, method=method)
-    found = clear_of(found, check, drop=True)
-    if found:
-        return replace(found[0], diagnostics=replace(found[0].diagnostics, branches=len(found)))
-    # no (clear) branch met the tolerances: the best single answer, in what is left of the same budget (at
-    # least one attempt's worth, so that there is an answer to return)
-    left = None if req.time_budget is None else max(req.time_budget - (time.perf_counter() - t0), 1e-4)
-    return solve_clear_of(robot, target, None, replace(req, time_budget=left), check)
-
-
 def follow_path(robot: Chain, points: np.ndarray, rotations: np.ndarray, q0: Configuration | None, req: Request,
                 settings: PathSettings, check: CollisionModel | None, t_start: float) -> TrackResult:
     """A path once its settings and targets (points [m], rotations) are checked: the start (the first target's
@@ -384,45 +248,6 @@ def _first_answer(robot: Chain, target: pin.SE3, req: Request, check: CollisionM
                           f"({first.status.value}: {first.message})")
     q: np.ndarray = first.q
     return q
-
-
-def collision_check(robot: Chain, collisions: CollisionSpec) -> CollisionModel | None:
-    """The collision model a ``collisions=`` argument asks for (None, "self", an Environment or a Collisions), or
-    None: the collision package (coal's geometry, the robot's meshes) loads only for a solve that checks."""
-    if collisions is None:
-        return None
-
-    spec = model.as_collisions(collisions)
-    return None if spec is None else model.collision_model(robot, spec)
-
-
-def solve_clear_of(robot: Chain, target: Target, q0: Configuration | None, req: Request,
-                   check: CollisionModel | None) -> IKResult:
-    """One solve through the driver, clear of collisions when ``check`` is given (:mod:`kinelab.ik.clear`, which
-    loads with the first solve that checks)."""
-    if check is None:
-        return solve_one(robot, target, q0, req)
-
-    return clear.solve_clear(robot, target, q0, req, check)
-
-
-def batch_clear_of(robot: Chain, targets: Targets, q0: Configuration | None, req: Request,
-                   check: CollisionModel | None) -> BatchIKResult:
-    """A batch through the FRDM batch, its colliding rows solved again clear of ``check`` when given."""
-    t0 = time.perf_counter()
-    res = run_batch(robot, targets, q0, req)
-    if check is None:
-        return res
-
-    return clear.clear_batch(robot, stack_homogeneous(*as_target_arrays(targets)), res, req, check, t0)
-
-
-def clear_of(found: Branches, check: CollisionModel | None, drop: bool) -> Branches:
-    """The branches with the colliding ones dropped (``drop``) or marked, by ``check`` (None: as found)."""
-    if check is None:
-        return found
-
-    return clear.mark_colliding(found, check, drop=drop)
 
 
 PREPARED_PER_ROBOT = 16  # a caller sweeping settings: the prepared solvers kept stay bounded
