@@ -10,6 +10,7 @@ import pinocchio as pin
 
 import kinelab
 from kinelab import Closure
+from kinelab.report.bench.protocol import cosine_path, joint_line  # noqa: F401 - the tests' paths, the bench's
 
 BUNDLED = ("stanford", "era", "youbot")
 ERD_ARMS = ("panda", "ur5", "kinova", "xarm7")
@@ -175,24 +176,6 @@ def multistart_gaps(robot, seed, poses=4):
         gaps = [min(np.abs(np.arctan2(np.sin(s.q - a.q), np.cos(s.q - a.q))).max() for a in ours) for s in theirs]
         out.append((ours, len(theirs), max(gaps, default=np.inf)))
     return out
-
-
-def cosine_path(robot, rng, samples=2000, share=0.6):
-    """The issue's path: two random configurations pulled to ``share`` of every joint's range about its middle,
-    joined by a cosine blend."""
-    mid = (robot.lower + robot.upper) / 2
-    qa, qb = (mid + share * (rng.uniform(robot.lower, robot.upper) - mid) for _ in range(2))
-    s = (1 - np.cos(np.pi * np.linspace(0, 1, samples))) / 2
-    return qa + s[:, None] * (qb - qa)
-
-
-def joint_line(robot, rng, samples=400, step=0.025):
-    """A straight joint-space line of ``samples`` samples, no joint moving more than ``step`` between two."""
-    mid = (robot.lower + robot.upper) / 2
-    qa, qb = (mid + 0.6 * (rng.uniform(robot.lower, robot.upper) - mid) for _ in range(2))
-    d = qb - qa
-    d *= min(1.0, step * (samples - 1) / np.abs(d).max())
-    return qa + np.linspace(0, 1, samples)[:, None] * d
 
 
 def planar_fourbar(a: float, b: float, c: float, d: float) -> kinelab.Robot:

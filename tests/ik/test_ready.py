@@ -83,3 +83,16 @@ def test_info_says_the_routes_load_readies(capsys):
     assert main(["info", "panda"]) == 0
     line = [x for x in capsys.readouterr().out.splitlines() if x.startswith("default routes")]
     assert line and "solve → frdm, solve with q0 → analytic, solve_batch → analytic, solve_all → multistart" in line[0]
+
+
+def test_a_readying_that_fails_leaves_the_load_whole_and_says_why(monkeypatch):
+    """Readying is a saving: where it fails (a chain a solver refuses, or a fault of ours), the load still returns
+    the robot, the record names the error, and the first call meets it as it would have."""
+    def broken(robot):
+        raise RuntimeError("the engine could not be built")
+
+    monkeypatch.setattr(ready, "_warm", broken)
+    arm = kinelab.load("ur5")
+    record = arm.derived(ready.KEY, lambda _: None)
+    assert record.routes == () and record.refused == "RuntimeError: the engine could not be built"
+    assert kinelab.solve(arm, arm.fk(arm.neutral()), seed=0).success

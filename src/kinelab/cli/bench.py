@@ -30,9 +30,11 @@ if TYPE_CHECKING:
         completeness,
         first_call,
         loops,
+        paths,
         router,
         runner,
         scaling,
+        standing_solve,
         startup,
         throughput,
         versus,
@@ -58,6 +60,8 @@ else:
     closed_step = lazy.module("kinelab.report.bench.closed_step", globals())
     worlds = lazy.module("kinelab.report.bench.worlds", globals())
     first_call = lazy.module("kinelab.report.bench.first_call", globals())
+    paths = lazy.module("kinelab.report.bench.paths", globals())
+    standing_solve = lazy.module("kinelab.report.bench.standing_solve", globals())
 
 
 def add(sub: Subcommands) -> None:
@@ -135,6 +139,14 @@ def _add_instead(s: argparse.ArgumentParser) -> None:
                    help="instead of the arm protocol: a process's first solve, solve_batch and solve_all against its "
                         "later ones (--robots; default ur5 panda), --repeats rounds of fresh processes, with "
                         "kinelab.load's preparation and without it")
+    s.add_argument("--paths", action="store_true",
+                   help="instead of the arm protocol: the default path follower and the step follower on 50 "
+                        "joint-space lines and cosine blends per arm (panda, xarm7, era, baxter_left, kinova; "
+                        "--robots among them): paths met without a jump or a drift, µs per sample")
+    s.add_argument("--standing-solve", action="store_true",
+                   help="instead of the arm protocol: the converged whole-body solve from where each humanoid "
+                        "stands (talos, g1, icub; --robots among them), --n targets each: met, met without a "
+                        "restart, median time")
     s.add_argument("--closed", action="store_true",
                    help="instead of the arm protocol: the step on robots that close loops (fourbar, ankle, cassie) "
                         "side by side with mink's EqualityConstraintTask, --repeats rounds of 1,000 steps: time, "
@@ -164,6 +176,11 @@ def run(args: argparse.Namespace) -> int:
     if args.first_call:
         return _alone(args, "first_call", lambda: first_call.run(args.robots, rounds=args.repeats),
                       first_call.markdown)
+    if args.paths:
+        return _alone(args, "paths", lambda: paths.run(args.robots, progress=progress_of(args)), paths.markdown)
+    if args.standing_solve:
+        return _alone(args, "standing_solve", lambda: standing_solve.run(
+            args.robots, count=args.n, seed=args.seed, progress=progress_of(args)), standing_solve.markdown)
     if args.closed:
         return _alone(args, "closed", lambda: closed_step.run(args.robots, rounds=args.repeats), closed_step.markdown)
     if args.collisions_step:

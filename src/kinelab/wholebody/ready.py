@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from kinelab.errors import KinelabError, OptionError
+from kinelab.errors import OptionError
 from kinelab.robot import loading
 from kinelab.robot.chain import Chain
 
@@ -106,8 +106,8 @@ def ready(robot: Chain) -> Ready:
     refused = ""
     try:
         taken = _warm(robot)
-    except KinelabError as error:  # the user's own first call meets the same error, named there
-        refused = str(error)
+    except Exception as error:  # noqa: BLE001 - readying is a saving, never a failure of the load: the user's
+        refused = f"{type(error).__name__}: {error}"  # own first call meets the same error, named there
     found = Ready(taken, time.perf_counter() - t0, refused)
     robot._derived[KEY] = found  # noqa: SLF001 - the record of work done, not derived on demand
     return found
