@@ -52,7 +52,7 @@ def test_every_registered_arms_routes_are_those_its_warm_up_took():
     assert len(arms) >= 20
     for name in arms:
         arm = kinelab.load(name)
-        record = arm.derived(ready.KEY, lambda _: None)
+        record = ready.readied(arm)
         assert record is not None and record.refused == "", name
         assert record.routes == ready.routes(arm), name
         assert dict(record.routes)["solve_all"] in {"closed form", "search", "elimination", "multistart"}
@@ -60,7 +60,7 @@ def test_every_registered_arms_routes_are_those_its_warm_up_took():
 
 def test_prepare_false_builds_nothing_and_answers_alike():
     lazy = kinelab.load("panda", prepare=False)
-    assert lazy.derived(ready.KEY, lambda _: None) is None
+    assert ready.readied(lazy) is None
     assert lazy.derived("prepared solvers", lambda _: {}) == {}
     eager = kinelab.load("panda")
     target = eager.fk(eager.random_q(np.random.default_rng(4)))
@@ -93,6 +93,6 @@ def test_a_readying_that_fails_leaves_the_load_whole_and_says_why(monkeypatch):
 
     monkeypatch.setattr(ready, "_warm", broken)
     arm = kinelab.load("ur5")
-    record = arm.derived(ready.KEY, lambda _: None)
+    record = ready.readied(arm)
     assert record.routes == () and record.refused == "RuntimeError: the engine could not be built"
     assert kinelab.solve(arm, arm.fk(arm.neutral()), seed=0).success

@@ -6,7 +6,7 @@ the compiled FK. :func:`ready` does that work for the calls a user's loop makes 
 ``solve`` without a start and with one, ``solve_batch``, ``solve_all`` — by building their prepared solvers and
 running each once on the tool pose of the middle of the limits, so the first call of each costs what later ones
 cost (``kinelab bench --first-call``). What was readied, and the route each call takes, is kept on the robot
-(:class:`Ready`, ``robot.derived("ready")``) and said by ``kinelab info``.
+(:class:`Ready`, read by :func:`readied`) and said by ``kinelab info``.
 
 Settings other than the defaults build their own prepared solver on their first call, as before. The robot layer's
 own loader (:func:`kinelab.robot.load`, what the command line uses: a command solves once at most) readies nothing.
@@ -99,7 +99,7 @@ def ready(robot: Chain) -> Ready:
     """Prepare ``robot``'s default calls (see the module's docstring) and keep the record on it.
 
     Returns:
-        The :class:`Ready` record (also ``robot.derived("ready")``).
+        The :class:`Ready` record (also :func:`readied` afterwards).
     """
     t0 = time.perf_counter()
     taken: tuple[tuple[str, str], ...] = ()
@@ -111,6 +111,17 @@ def ready(robot: Chain) -> Ready:
     found = Ready(taken, time.perf_counter() - t0, refused)
     robot._derived[KEY] = found  # noqa: SLF001 - the record of work done, not derived on demand
     return found
+
+
+def readied(robot: Chain) -> Ready | None:
+    """What the load readied on ``robot`` (:class:`Ready`), or None where nothing was (``prepare=False``, the robot
+    layer's own loader)."""
+    found: Ready | None = robot.derived(KEY, _nothing)
+    return found
+
+
+def _nothing(_: Chain) -> None:
+    return None
 
 
 def _warm(robot: Chain) -> tuple[tuple[str, str], ...]:
