@@ -7,8 +7,9 @@ the start), so a call pays no argument validation or option building. Its answer
 :func:`kinelab.solve` with the same settings and seed (tested), and every one is judged.
 
 The routes are objects chosen once, here (:mod:`kinelab.ik.routes`): ``ik.one`` answers ``solve`` and
-``solve_batch`` (the numeric solver, the closed form, a 7R arm's held joint), ``ik.every`` answers ``solve_all``;
-the methods hand the call over without asking which route it is. The prepared solver owns its solver's engine
+``solve_batch`` (the numeric solver, the closed form, a 7R arm's held joint), ``ik.every`` answers ``solve_all``,
+``ik.path`` (:class:`PathFollower`) answers ``track``; the methods hand the call over without asking which route it
+is. The prepared solver owns its solver's engine
 (:class:`kinelab.core._engine.Engine`, which the solver's module makes: ``engine(robot, request)``; FRDM's and the
 biquaternion preset's). The usual call — a ``pin.SE3`` target, n real numbers as the start (a list or any real
 array; or none), an integer seed or none — on a robot whose compiled FK is certified is one compiled call: it checks
@@ -93,7 +94,7 @@ class IK:
         check_robot(robot)
         self.robot = robot
         given = options is not None or bool(solver_options)
-        self._given = (solver, options, dict(solver_options), task, axis)  # what a path is made of
+        given_settings = (solver, options, dict(solver_options), task, axis)  # what a path is made of
         named = capabilities(solver)
         resolved_solver = resolved(robot, solver, task, collisions, given)
         kind = capabilities(resolved_solver)
@@ -102,7 +103,6 @@ class IK:
         self.request: Request = make_request(kind.request_solver(resolved_solver), None, tol_pos, tol_rot,
                                              time_budget, max_restarts, start_outside_limits, options, task, axis,
                                              solver_options)
-        self._path_request: Request | None = None
         self.collisions = collision_check(robot, collisions)
         # the routes, chosen once: one answer per target (solve, solve_batch, prefer=), and every branch
         self.one: OneAnswer = one_answer(robot, self.request, self.collisions, kind.closed_form, named.picks, given)
@@ -115,6 +115,7 @@ class IK:
         self.every = AllBranches(robot, req, route_of(named, given),
                                  (solver, req.tol_pos, req.tol_rot, req.time_budget) if usual else None,
                                  self.collisions)
+        self.path = PathFollower(robot, req, given_settings, self.collisions)
 
     def solve(self, target: Target, *, q0: Configuration | None = None, seed: int | None = None,
               prefer: Configuration | None = None) -> IKResult:
@@ -200,28 +201,47 @@ class IK:
         Raises:
             OptionError, ConfigurationError, JointLimitError, TargetError: named.
         """
+        return self.path.track(targets, q0, seed, tracking.PathSettings(jump_limit, restrict, hold, rest_weight))
+
+
+class PathFollower:
+    """``track``'s route: FRDM's follower (the compiled one, or the monitored loop for a bypass, a policy or a
+    restriction), refused by name for a solver that does not follow paths.
+
+    Args:
+        robot: the robot.
+        request: the prepared solver's request (its tolerances and budget).
+        given: (solver, options, solver_options, task, axis) as the prepared solver was given them.
+        check: the collision model every sample must clear, or None.
+    """
+
+    def __init__(self, robot: Chain, request: Request, given: tuple[Any, ...], check: CollisionModel | None):
+        self.robot, self.request, self.given, self.check = robot, request, given, check
+        self._request: Request | None = None
+
+    def track(self, targets: Targets, q0: Configuration | None, seed: int | None,
+              settings: PathSettings) -> TrackResult:
+        """The path (see :meth:`IK.track`)."""
         chain_model(self.robot)  # the follower's chain and the judge are built once per robot, on no budget's clock
         prepare_robot(self.robot)
         t_start = time.perf_counter()  # the budget counts from here, the checks of the call included
         req = self._path(seed)
-
         points, rotations = as_target_arrays(targets)
-        settings = tracking.PathSettings(jump_limit, restrict, hold, rest_weight)
-        return follow_path(self.robot, points, rotations, q0, req, settings, self.collisions, t_start)
+        return follow_path(self.robot, points, rotations, q0, req, settings, self.check, t_start)
 
     def _path(self, seed: int | None) -> Request:
         """The request of a path: the path's option defaults under the options given, no restarts, starts refused."""
-        solver, options, solver_options, task, axis = self._given
+        solver, options, solver_options, task, axis = self.given
         if not capabilities(self.request.solver).follows_paths:
             raise OptionError("solver", solver, "'frdm' (track follows a path with FRDM's warm-started sweeps)")
-        if self._path_request is None:
+        if self._request is None:
             req = self.request
-            self._path_request = make_request(req.solver, None, req.tol_pos, req.tol_rot, req.time_budget, 0, "refuse",
-                                              options, task, axis, tracking.path_options(options, solver_options))
+            self._request = make_request(req.solver, None, req.tol_pos, req.tol_rot, req.time_budget, 0, "refuse",
+                                         options, task, axis, tracking.path_options(options, solver_options))
         if seed is None:
-            return self._path_request
+            return self._request
         check_seed(seed)
-        return replace(self._path_request, seed=int(seed))
+        return replace(self._request, seed=int(seed))
 
 
 def follow_path(robot: Chain, points: np.ndarray, rotations: np.ndarray, q0: Configuration | None, req: Request,
