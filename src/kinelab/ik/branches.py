@@ -20,6 +20,7 @@ from kinelab import lazy
 from kinelab.errors import OptionError
 from kinelab.ik.batch import fresh_seed, prepare, run_batch
 from kinelab.ik.limits import distance as distance  # exported: the branch distance users sort by
+from kinelab.ik.limits import distances
 from kinelab.ik.registry import Capabilities, capabilities
 from kinelab.ik.request import Request, count_ok, make_request
 from kinelab.ik.result import Branches, Diagnostics, IKResult, Status
@@ -255,9 +256,14 @@ def _wanting(found: list[tuple[np.ndarray, float, float, int]], rounds: int, max
 
 def _merge(robot: Chain, found: list[tuple[np.ndarray, float, float, int]], q: np.ndarray, dp: float,
            dr: float) -> None:
-    """Count q towards the solution it equals (joint by joint, revolute joints modulo 2π), or add it."""
-    for k, (other, odp, odr, count) in enumerate(found):
-        if distance(robot, q, other) <= SAME:
+    """Count q towards the first solution it equals (joint by joint, revolute joints modulo 2π), or add it; the
+    distances to every solution found in one pass (a 7R arm's multistart finds ~90: one by one, the merging took
+    ten times the search)."""
+    if found:
+        same = np.flatnonzero(distances(robot, q, np.array([f[0] for f in found])) <= SAME)
+        if same.size:
+            k = int(same[0])
+            other, odp, odr, count = found[k]
             found[k] = (other, odp, odr, count + 1)
             return
     found.append((np.array(q, dtype=float), float(dp), float(dr), 1))

@@ -75,7 +75,13 @@ def turned_verdict(robot: Chain, H_target: np.ndarray, q: np.ndarray,
 
 def distance(robot: Chain, q: np.ndarray, ref: np.ndarray) -> float:
     """max |q_i − ref_i| over the joints [rad or m], revolute and continuous joints modulo 2π."""
-    d = np.asarray(q, dtype=float) - np.asarray(ref, dtype=float)
+    return float(distances(robot, q, np.asarray(ref, dtype=float)[None, :])[0])
+
+
+def distances(robot: Chain, q: np.ndarray, refs: np.ndarray) -> np.ndarray:
+    """:func:`distance` from q to each row of ``refs`` (k × n), in one pass [rad or m]."""
+    d = np.asarray(q, dtype=float)[None, :] - np.asarray(refs, dtype=float)
     revolute = np.array([k != "prismatic" for k in robot.joint_kinds])
-    d[revolute] = wrap_to_pi(d[revolute])
-    return float(np.max(np.abs(d)))
+    d[:, revolute] = wrap_to_pi(d[:, revolute])
+    found: np.ndarray = np.max(np.abs(d), axis=1)
+    return found
