@@ -104,13 +104,13 @@ if TYPE_CHECKING:  # the names the lazy table serves, for type checkers and edit
     from kinelab.robot.chain import Chain
     from kinelab.robot.closures import Closure
     from kinelab.robot.joints import Joint
-    from kinelab.robot.loading import load
     from kinelab.robot.standing import standing
     from kinelab.robot.tree import Robot
     from kinelab.wholebody.api import solve, track
     from kinelab.wholebody.constraints import CouplingTask
     from kinelab.wholebody.limits import Limits
     from kinelab.wholebody.problem import WholeBody, step
+    from kinelab.wholebody.ready import load
     from kinelab.wholebody.solve import WholeBodyResult
     from kinelab.wholebody.step import StepOptions, StepResult
     from kinelab.wholebody.tasks import ComTask, DampingTask, FrameTask, PostureTask, RelativeFrameTask

@@ -96,3 +96,18 @@ def test_a_readying_that_fails_leaves_the_load_whole_and_says_why(monkeypatch):
     record = ready.readied(arm)
     assert record.routes == () and record.refused == "RuntimeError: the engine could not be built"
     assert kinelab.solve(arm, arm.fk(arm.neutral()), seed=0).success
+
+
+def test_kinelab_load_takes_every_argument_of_the_robot_layers_load_and_prepare():
+    """``kinelab.load`` spells out the robot layer's loader's arguments (for editors and type checkers) plus
+    ``prepare``: the two lists must not drift apart."""
+    import inspect
+
+    from kinelab.robot import loading
+
+    ours = inspect.signature(kinelab.load).parameters
+    theirs = inspect.signature(loading.load).parameters
+    assert list(ours) == [*theirs, "prepare"]
+    for name, p in theirs.items():
+        assert (ours[name].kind, ours[name].default) == (p.kind, p.default), name
+    assert ours["prepare"].default is True and ours["prepare"].kind is inspect.Parameter.KEYWORD_ONLY

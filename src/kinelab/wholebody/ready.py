@@ -16,13 +16,17 @@ from __future__ import annotations
 
 import time
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from kinelab.errors import OptionError
 from kinelab.robot import loading
 from kinelab.robot.chain import Chain
+
+if TYPE_CHECKING:
+    from kinelab.robot.closures import Closure
 
 KEY = "ready"  # where the record lives on the robot (Chain.derived)
 
@@ -42,20 +46,34 @@ class Ready:
     refused: str = ""
 
 
-def load(name_or_path: str | Path, *args: Any, prepare: bool = True, **kwargs: Any) -> Any:
-    """``kinelab.load``: a robot as :func:`kinelab.robot.loading.load` builds it (every argument of it), an arm's
-    default calls readied.
+def load(name_or_path: str | Path, tool: str | None = None, locked: dict[str, float] | None = None,
+         base: str | None = None, package_dirs: list[str] | None = None, srdf: str | Path | None = None,
+         group: str | None = None, xacro_args: dict[str, str] | None = None, *,
+         trust_xacro: bool = False, whole: bool | None = None, floating: bool | None = None,
+         closures: Sequence[Closure] | str | Path | None = None, actuated: Sequence[str] | None = None,
+         prepare: bool = True) -> Any:
+    """``kinelab.load``: a robot as :func:`kinelab.robot.loading.load` builds it, an arm's default calls readied.
 
     Args:
-        name_or_path: a registered name or a model file, and ``args``/``kwargs``: as
-            :func:`kinelab.robot.loading.load`.
-        args: that function's further positional arguments.
+        name_or_path: a registered name, a URDF, xacro or MJCF file, or "rd:NAME" (as
+            :func:`kinelab.robot.loading.load`, whose arguments these all are).
+        tool: the chain's tool frame.
+        locked: joints held fixed, name → value [rad or m].
+        base: the frame the chain starts from.
+        package_dirs: where ``package://`` mesh URIs resolve.
+        srdf: an SRDF file.
+        group: an SRDF group giving base and tool.
+        xacro_args: a ``.xacro`` source's arguments.
+        trust_xacro: let a ``.xacro`` source run what xacro runs.
+        whole: the whole robot (no chain cut); None: a registered robot's own choice.
+        floating: the whole robot with a free-flyer at its root; None: the robot's own choice.
+        closures: the loops the robot closes (a list of Closure or a declarations file).
+        actuated: the joints a controller drives, with closures.
         prepare: True (the default): an arm's solvers readied here (:func:`ready`): their modules imported, the
             closed form's tables, the compiled engine and the FK certificate built for the default ``solve``,
             ``solve_batch`` and ``solve_all``, so that a process's first solve costs what later ones cost (the
             work moves here: about 0.1 s once per process, 2-30 ms per arm). False: built on the first call instead.
             A whole robot's step builds on its first call either way.
-        kwargs: that function's keyword arguments.
 
     Returns:
         A Chain (readied when ``prepare``), or the whole Robot.
@@ -65,7 +83,9 @@ def load(name_or_path: str | Path, *args: Any, prepare: bool = True, **kwargs: A
     """
     if not isinstance(prepare, bool):
         raise OptionError("prepare", prepare, "True or False")
-    robot = loading.load(name_or_path, *args, **kwargs)
+    robot = loading.load(name_or_path, tool, locked, base, package_dirs, srdf, group, xacro_args,
+                         trust_xacro=trust_xacro, whole=whole, floating=floating, closures=closures,
+                         actuated=actuated)
     if prepare and isinstance(robot, Chain):
         ready(robot)
     return robot
