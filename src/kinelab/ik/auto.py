@@ -49,9 +49,14 @@ def single(robot: Chain, solver: str, task: str, collisions: CollisionSpec, has_
     route = resolved(robot, solver, task, collisions, has_options)
     kind = registry.capabilities(solver)
     if kind.picks and registry.capabilities(route).closed_form and not start_given \
-            and robot.derived("auto: held", held.applies):
+            and holds_a_joint(robot):
         return kind.request_solver(solver)  # what the picking solver runs: FRDM
     return route
+
+
+def holds_a_joint(robot: Chain) -> bool:
+    """True for a 7R arm whose six are in closed form with an end joint held (kept on the robot)."""
+    return bool(robot.derived("auto: held", held.applies))
 
 
 def closed_form_serves(robot: Chain) -> bool:

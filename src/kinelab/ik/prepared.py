@@ -9,15 +9,15 @@ the start), so a call pays no argument validation or option building. Its answer
 The routes are objects chosen once, here (:mod:`kinelab.ik.routes`): ``ik.one`` answers ``solve`` and
 ``solve_batch`` (the numeric solver, the closed form, a 7R arm's held joint), ``ik.every`` answers ``solve_all``,
 ``ik.path`` (:class:`PathFollower`) answers ``track``; the methods hand the call over without asking which route it
-is. The prepared solver owns its solver's engine
-(:class:`kinelab.core._engine.Engine`, which the solver's module makes: ``engine(robot, request)``; FRDM's and the
-biquaternion preset's). The usual call — a ``pin.SE3`` target, n real numbers as the start (a list or any real
-array; or none), an integer seed or none — on a robot whose compiled FK is certified is one compiled call: it checks
-both (finite, a proper rotation, the start within the limits, the target within the reach bound), runs the
-multistart and judges the answer; the result is built directly, its diagnostics only when read. Anything else (a
-point target, a start outside the limits or not n real numbers, a target beyond reach, a robot judged by Pinocchio's
-FK, options no engine runs) takes the general driver, which names the problem, warns or answers UNREACHABLE exactly
-as :func:`kinelab.solve` does: the engine changes the cost, never the answer.
+is. The prepared solver owns its solver's engine (:class:`kinelab.core._engine.Engine`, which the solver's module
+makes: ``engine(robot, request)``; FRDM's and the biquaternion preset's). The usual call — a ``pin.SE3`` target, n
+real numbers as the start (a list or any real array; or none), an integer seed or none — on a robot whose compiled
+FK is certified is one compiled call: it checks both (finite, a proper rotation, the start within the limits, the
+target within the reach bound), runs the multistart and judges the answer; the result is built directly, its
+diagnostics only when read. Anything else (a point target, a start outside the limits or not n real numbers, a
+target beyond reach, a robot judged by Pinocchio's FK, options no engine runs) takes the general driver, which names
+the problem, warns or answers UNREACHABLE exactly as :func:`kinelab.solve` does: the engine changes the cost, never
+the answer.
 """
 
 from __future__ import annotations

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import replace
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any, Literal, Protocol
 
 from kinelab import lazy
 from kinelab.core._engine import Engine
@@ -180,8 +180,9 @@ class HeldJoint(_Analytic):
     Args:
         robot: a 7R arm whose six are in a closed-form class.
         request: the validated request.
-        alone: the route of a single call without a start (``solver="auto"``: FRDM's), built on its first use; None:
-            this route answers it too.
+        check: the collision model: must be None here.
+        alone: True (``solver="auto"``): a single call without a start is FRDM's, its route built on first use;
+            False: this route answers it too.
 
     Raises:
         OptionError: a collision check (FRDM takes it) or a task other than "pose", named.
@@ -193,19 +194,20 @@ class HeldJoint(_Analytic):
                               "(solver='frdm' takes collisions=)")
         self.robot, self.request = robot, request
         branches.arm_of(held.held_robot(robot), request)
-        self._alone: Numeric | None | bool = alone
+        self._picks = alone
+        self._alone: Numeric | None = None
 
     def solve(self, target: Target, q0: Configuration | None, seed: int | None) -> IKResult:
         """The six at the held joint's start value (else at one of its samples); without a start, FRDM's answer
         where ``alone``."""
-        if q0 is None and self._alone is not False:
+        if q0 is None and self._picks:
             return self.alone().solve(target, None, seed)
         return held.nearest_held_one(self.robot, as_target(target, self.request.task.name), self._reference(q0),
                                      self.request)
 
     def alone(self) -> Numeric:
         """FRDM with these tolerances, budget and restarts: ``solver="auto"``'s single call without a start."""
-        if not isinstance(self._alone, Numeric):
+        if self._alone is None:
             req = self.request
             frdm = make_request("frdm", None, req.tol_pos, req.tol_rot, req.time_budget, req.max_restarts,
                                 req.start_outside_limits, None, "pose", "z", {})
@@ -256,7 +258,7 @@ class AllBranches:
     def __init__(self, robot: Chain, request: Request, method: Route, usual: tuple[Any, ...] | None,
                  check: CollisionModel | None):
         self.robot, self.request, self.method, self.usual, self.check = robot, request, method, usual, check
-        self._every: EveryBranch | None | bool = False  # the usual call's, once looked up
+        self._every: EveryBranch | None | Literal[False] = False  # the usual call's, once looked up
 
     def solve_all(self, target: Target, seed: int | None, q_ref: Configuration | None, max_solutions: int | None,
                   stop_below: float | None, redundancy: int | dict[str, float] | SEW | None,
@@ -280,7 +282,7 @@ class AllBranches:
     def _every_branch(self, stop_below: float | None) -> EveryBranch | None:
         """The one-call solver of every branch for ``stop_below`` (kept here for the default), or None."""
         if stop_below is UNSEEN and self._every is not False:
-            return self._every  # type: ignore[return-value]
+            return self._every
         entry = usual_entry(self.robot, (*self.usual, stop_below))  # type: ignore[misc]
         if stop_below is UNSEEN:
             self._every = entry

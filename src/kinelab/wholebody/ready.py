@@ -102,17 +102,12 @@ def routes(robot: Chain) -> tuple[tuple[str, str], ...]:
         return auto.single(robot, auto.AUTO, "pose", None, False, start_given)
 
     arm = classify.classify(robot).arm
-    if arm is not None and not _held(robot):
+    if arm is not None and not auto.holds_a_joint(robot):
         every = "search" if kernel.SEARCH_6R <= arm.kind < kernel.GENERAL_6R else "closed form"
     else:
         every = "elimination" if classify.general_class(robot).arm is not None else "multistart"
     return (("solve", solver(False)), ("solve with q0", solver(True)),
             ("solve_batch", auto.resolved(robot, auto.AUTO, "pose", None, False)), ("solve_all", every))
-
-
-def _held(robot: Chain) -> bool:
-    from kinelab.ik.analytic import held
-    return bool(robot.derived("auto: held", held.applies))
 
 
 def ready(robot: Chain) -> Ready:

@@ -128,11 +128,17 @@ def path_set(robot: Chain, seed: int, count: int, samples: int = 200) -> list[np
     return [(blend_path if k % 2 == 0 else smooth_path)(robot, seed + k, samples) for k in range(count)]
 
 
+def _pulled_pair(robot: Chain, rng: np.random.Generator, share: float) -> tuple[np.ndarray, np.ndarray]:
+    """Two configurations drawn uniform in the limits, each pulled to ``share`` of the way from mid-range."""
+    mid = (robot.lower + robot.upper) / 2
+    qa, qb = (mid + share * (rng.uniform(robot.lower, robot.upper) - mid) for _ in range(2))
+    return qa, qb
+
+
 def cosine_path(robot: Chain, rng: np.random.Generator, samples: int = 2000, share: float = 0.6) -> np.ndarray:
     """Two random configurations pulled to ``share`` of every joint's range about its middle, joined by a cosine
     blend (samples × n) [rad or m]: inside the limits, feasible by construction (the trust issues' path)."""
-    mid = (robot.lower + robot.upper) / 2
-    qa, qb = (mid + share * (rng.uniform(robot.lower, robot.upper) - mid) for _ in range(2))
+    qa, qb = _pulled_pair(robot, rng, share)
     s = (1 - np.cos(np.pi * np.linspace(0, 1, samples))) / 2
     return qa + s[:, None] * (qb - qa)
 
@@ -140,8 +146,7 @@ def cosine_path(robot: Chain, rng: np.random.Generator, samples: int = 2000, sha
 def joint_line(robot: Chain, rng: np.random.Generator, samples: int = 400, step: float = 0.025) -> np.ndarray:
     """A straight joint-space line of ``samples`` samples between two configurations drawn as :func:`cosine_path`
     draws them, no joint moving more than ``step`` [rad or m] between two."""
-    mid = (robot.lower + robot.upper) / 2
-    qa, qb = (mid + 0.6 * (rng.uniform(robot.lower, robot.upper) - mid) for _ in range(2))
+    qa, qb = _pulled_pair(robot, rng, 0.6)
     d = qb - qa
     d *= min(1.0, step * (samples - 1) / np.abs(d).max())
     return qa + np.linspace(0, 1, samples)[:, None] * d
