@@ -1,6 +1,6 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False
 """The compiled path follower: every sample of a path solved in one call, warm-started from the sample before
-(FRDM's direct-control use, Danilov 2019; docs/methods.md §1.7).
+(FRDM's direct-control use, Danilov 2019; docs/methods.md §1.9).
 
 Each sample runs in two phases. The first minimises E plus a rest term pulling towards the previous sample's
 answer (``w_rest`` Σ 2(1 − cos Δq)): among the configurations that reach the target it prefers the nearest one,
@@ -16,7 +16,7 @@ sample starts from the last reached configuration. With ``finish="none"`` (the p
 plain one: no recovery. The linear algebra is BLAS and LAPACK's, called as NumPy calls them.
 """
 
-from libc.math cimport fabs, sqrt, INFINITY, NAN
+from libc.math cimport exp, fabs, sqrt, INFINITY, NAN
 from libc.stdlib cimport calloc, free, malloc
 
 from kinelab.core._blas cimport ddot, dgemm, dgemv, dgesv, ready
@@ -31,12 +31,15 @@ from kinelab.core._geometry cimport rotm
 cdef double TRUST_FLOOR = 0.02
 cdef double TRUST_FACTOR = 2.0
 cdef int SWEEPS_PER_LOOK = 32  # a phase's sweeps between two looks at the clock
-# a redundant arm's pull towards mid-range moves no joint by more than PULL_FLOOR + PULL_SHARE × the largest joint
+# a redundant arm's push away from its limits moves no joint by more than PUSH_FLOOR + PUSH_SHARE × the largest joint
 # step the task itself asks of the sample [rad or m]: the self-motion it steers stays as smooth as the path (uncapped,
 # a path starting at rest moved joints 18 times faster than the path itself did; capped by the last sample's whole
-# step, the pull fed on itself)
-cdef double PULL_FLOOR = 1e-5
-cdef double PULL_SHARE = 0.5
+# step, the push fed on itself)
+cdef double PUSH_FLOOR = 1e-5
+cdef double PUSH_SHARE = 0.5
+# [1/rad or 1/m] the push's soft minimum of the margins: a joint whose margin is within about 1/MARGIN_SOFTNESS of the
+# least one shares the push
+cdef double MARGIN_SOFTNESS = 10.0
 
 
 cdef struct Follow:
@@ -92,6 +95,28 @@ cdef void _pull_towards_centre(const double* q, int n, const Objective* pb, cons
         z[i] = _limit_pull(q[i], pb.lower[i], pb.upper[i], pull) * (centre[i] - q[i]) if pb.free[i] else 0.0
 
 
+cdef void _push_from_limits(const double* q, int n, const Objective* pb, double* z) noexcept nogil:
+    """z ← the ascent direction of a soft minimum of the joints' margins min(q − lower, upper − q), its entries summing
+    to 1 in size: the joint nearest its limit, and those about as near, move away from it. A margin is measured in
+    rad (or m), not as a share of the range, because a joint's distance to its limit is what a path keeps. Joints
+    frozen or without a finite range: 0."""
+    cdef int i
+    cdef double least = INFINITY, total = 0.0, margin, w
+    for i in range(n):
+        z[i] = 0.0
+        if pb.free[i] and pb.upper[i] - pb.lower[i] < INFINITY:
+            least = _min(least, _min(q[i] - pb.lower[i], pb.upper[i] - q[i]))
+    for i in range(n):
+        if pb.free[i] and pb.upper[i] - pb.lower[i] < INFINITY:
+            margin = _min(q[i] - pb.lower[i], pb.upper[i] - q[i])
+            w = exp(-MARGIN_SOFTNESS * (margin - least))
+            z[i] = w if q[i] - pb.lower[i] < pb.upper[i] - q[i] else -w
+            total += w
+    if total > 0.0:
+        for i in range(n):
+            z[i] /= total
+
+
 cdef void _solve6(const double* A, const double* b, double* x, double* F, int* pivots) noexcept nogil:
     """x = A⁻¹ b for the 6 × 6 row-major A, by LAPACK as NumPy's solve calls it (A copied to Fortran order)."""
     cdef int six = 6, one = 1, info = 0, i, j
@@ -103,13 +128,13 @@ cdef void _solve6(const double* A, const double* b, double* x, double* F, int* p
 
 
 cdef int redundant_newton(double* q, const Chain* ch, const Objective* pb, int iterations, double max_step,
-                          const double* centre, double pull, int* spent) noexcept nogil:
+                          int* spent) noexcept nogil:
     """Damped Gauss–Newton steps in their minimum-norm form, dq = Jᵀ(JJᵀ + λI)⁻¹ err, the first plus the projection
-    onto the task's null space of a pull towards mid-range: a redundant arm's self-motion turns away from its
-    limits instead of drifting into one. Steps capped at ``max_step`` [rad or m]. Returns CONVERGED or −1, the
-    steps in ``spent``; q is updated in place."""
+    onto the task's null space of a push away from the limits (:func:`_push_from_limits`): a redundant arm's
+    self-motion turns away from its limits instead of drifting into one. Steps capped at ``max_step`` [rad or m].
+    Returns CONVERGED or −1, the steps in ``spent``; q is updated in place."""
     cdef int n = ch.n, it, i, six = 6, one_i = 1
-    cdef double one = 1.0, zero = 0.0, damping, largest, task, pulled, scale
+    cdef double one = 1.0, zero = 0.0, damping, largest, task, pushed, scale
     cdef char t = b't', nt = b'n'
     cdef double p[3]
     cdef double R[9]
@@ -145,8 +170,8 @@ cdef int redundant_newton(double* q, const Chain* ch, const Objective* pb, int i
         damping = 1e-9 + 1e-3 * ddot(&six, err, &one_i, err, &one_i)
         for i in range(6):
             A[7 * i] += damping
-        if it == 0:  # the pull acts on the first step only: the later ones converge as Gauss–Newton does
-            _pull_towards_centre(q, n, pb, centre, pull, z)
+        if it == 0:  # the push acts on the first step only: the later ones converge as Gauss–Newton does
+            _push_from_limits(q, n, pb, z)
         else:
             for i in range(n):
                 z[i] = 0.0
@@ -155,11 +180,11 @@ cdef int redundant_newton(double* q, const Chain* ch, const Objective* pb, int i
         dgemv(&t, &n, &six, &one, J, &n, z, &one_i, &zero, Jz, &one_i)
         _solve6(A, Jz, s2, F, pivots)
         dgemv(&nt, &n, &six, &one, J, &n, s2, &one_i, &zero, b, &one_i)
-        task = pulled = 0.0
+        task = pushed = 0.0
         for i in range(n):
-            b[i] = z[i] - b[i]  # the pull's share in the task's null space
-            task, pulled = _max(task, fabs(a[i])), _max(pulled, fabs(b[i]))
-        scale = 1.0 if pulled <= PULL_FLOOR + PULL_SHARE * task else (PULL_FLOOR + PULL_SHARE * task) / pulled
+            b[i] = z[i] - b[i]  # the push's share in the task's null space
+            task, pushed = _max(task, fabs(a[i])), _max(pushed, fabs(b[i]))
+        scale = 1.0 if pushed <= PUSH_FLOOR + PUSH_SHARE * task else (PUSH_FLOOR + PUSH_SHARE * task) / pushed
         largest = 0.0
         for i in range(n):
             a[i] += scale * b[i]
@@ -264,7 +289,7 @@ cdef int _predicted(double* q, const double* q_good, const double* velocity, con
     for i in range(ch.n):
         q[i] = _min(_max(q_good[i] + carry * velocity[i], pb.lower[i]), pb.upper[i])
     if fw.w_rest > 0.0:
-        return redundant_newton(q, ch, &aim, 2 * fw.st.finish_steps, trust, fw.centre, fw.pull, spent)
+        return redundant_newton(q, ch, &aim, 2 * fw.st.finish_steps, trust, spent)
     return lm_polish(q, ch, &aim, 2 * fw.st.finish_steps, trust, spent)
 
 
