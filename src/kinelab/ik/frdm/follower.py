@@ -29,7 +29,8 @@ CENTRE_PULL = 0.01  # share of the way from the previous answer to mid-range tak
 
 def follow(robot: Chain, targets: TargetArrays, q0: np.ndarray, tol_pos: float, tol_rot: float, max_sweeps: int,
            rest_weight: float | None, opts: FRDMOptions, task: Task = POSE, seed: int | None = None,
-           time_budget: float | None = None, t_start: float | None = None) -> TrackResult:
+           time_budget: float | None = None, t_start: float | None = None,
+           toward: np.ndarray | None = None) -> TrackResult:
     """Solve every sample of a path in the compiled follower; each answer judged by Pinocchio.
 
     Args:
@@ -46,13 +47,14 @@ def follow(robot: Chain, targets: TargetArrays, q0: np.ndarray, tol_pos: float, 
         time_budget: wall-clock budget [s] of the whole path (None: none); the samples not started when it runs
             out are left unsolved (NaN, status ``time_budget``).
         t_start: the ``time.perf_counter()`` value the budget counts from (None: now).
+        toward: (N, n) per sample, the configuration [rad or m] a redundant arm's self-motion is drawn towards in
+            place of the push from its limits (None, or a NaN row: the push); :mod:`kinelab.ik.frdm.rejoin`.
 
     Returns:
         A :class:`~kinelab.ik.frdm.tracking.TrackResult` with mode "frdm (compiled follower)". Continuous
         joints are not wrapped: the rows are a continuous path, as a controller wants them.
     """
-    if rest_weight is None:
-        rest_weight = REST_WEIGHT if robot.n > 6 else 0.0
+    rest_weight = effective_rest_weight(robot, rest_weight)
     points, rotations = targets
     cm = chain_model(robot)
     count = points.shape[0]
@@ -63,11 +65,20 @@ def follow(robot: Chain, targets: TargetArrays, q0: np.ndarray, tol_pos: float, 
     _follow.follow(Q, np.array(q0, dtype=float), cm.chain, _objective(cm, opts, tol_pos, tol_rot),
                    np.ascontiguousarray(points, dtype=float), np.ascontiguousarray(rotations, dtype=float),
                    opts.settings(), order, int(max_sweeps), float(rest_weight), REST_SWEEPS, _centre(cm, q0),
-                   CENTRE_PULL, LM_ITERATIONS if opts.polish else 0, seed_state(seed), deadline, codes, sweeps)
+                   CENTRE_PULL, LM_ITERATIONS if opts.polish else 0, seed_state(seed), deadline, codes, sweeps,
+                   None if toward is None else np.ascontiguousarray(toward, dtype=float))
     dp, dr, ok = judged_path(robot, Q, points, rotations, task, tol_pos, tol_rot)
     per_sample = (time.perf_counter() - t0) / count  # the kernel and Pinocchio's check of every answer
     return TrackResult(Q, dp, dr, _statuses(ok, codes), sweeps, np.full(count, per_sample), _stall_events(codes), [],
                        mode=opts.label + ("+lm" if opts.polish else "") + " (compiled follower)")
+
+
+def effective_rest_weight(robot: Chain, rest_weight: float | None) -> float:
+    """The rest term's weight on this robot: the one given, or :data:`REST_WEIGHT` beyond six joints (else 0). A
+    weight above 0 is what makes the follower treat the arm as redundant (its null-space term, the rejoin)."""
+    if rest_weight is None:
+        return REST_WEIGHT if robot.n > 6 else 0.0
+    return float(rest_weight)
 
 
 def _deadline(time_budget: float | None, t_start: float, count: int) -> float:

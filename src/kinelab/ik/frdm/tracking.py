@@ -28,8 +28,9 @@ from kinelab.core._chain import rotation_steps, running_events
 from kinelab.errors import OptionError
 from kinelab.ik import options as opt
 from kinelab.ik.frdm import solver
-from kinelab.ik.frdm.follower import follow
+from kinelab.ik.frdm.follower import effective_rest_weight, follow
 from kinelab.ik.frdm.options import FRDMOptions
+from kinelab.ik.frdm.rejoin import rejoined
 from kinelab.ik.limits import wrap_q
 from kinelab.ik.registry import SolverOptions
 from kinelab.ik.request import Request
@@ -99,8 +100,7 @@ def run_track(robot: Chain, targets: TargetArrays, q0: np.ndarray, req: Request,
     _check_restrict(settings.restrict, opts.intervals, opts.freeze)
     points, rotations = targets
     if _followable(opts) and not settings.restrict:
-        followed = follow(robot, targets, q0, req.tol_pos, req.tol_rot, opts.sweep_cap, settings.rest_weight, opts,
-                          req.task, req.seed, req.time_budget, t_start)
+        followed = _compiled(robot, targets, q0, req, settings, t_start)
         followed.events += jump_events(followed.q, q0, settings.jump_limit)
     else:
         policy = opts.policy or ()
@@ -112,6 +112,21 @@ def run_track(robot: Chain, targets: TargetArrays, q0: np.ndarray, req: Request,
         followed = path.result()
     mark_jumps(followed, q0, settings.jump_limit)
     followed.add_events_later(self_motion_check(robot, followed.q, q0, points, rotations, req.task))
+    return followed
+
+
+def _compiled(robot: Chain, targets: TargetArrays, q0: np.ndarray, req: Request, settings: PathSettings,
+              t_start: float | None) -> TrackResult:
+    """The compiled follower's path; on a redundant arm each jump undone where :mod:`kinelab.ik.frdm.rejoin` can."""
+    opts: FRDMOptions = req.options
+
+    def run(path: TargetArrays, start: np.ndarray, toward: np.ndarray | None) -> TrackResult:
+        return follow(robot, path, start, req.tol_pos, req.tol_rot, opts.sweep_cap, settings.rest_weight, opts,
+                      req.task, req.seed, req.time_budget, t_start, toward)
+
+    followed = run(targets, q0, None)
+    if effective_rest_weight(robot, settings.rest_weight) > 0.0:
+        followed = rejoined(targets, q0, followed, settings.jump_limit, run)
     return followed
 
 
