@@ -108,3 +108,30 @@ def test_a_rejoin_that_meets_fewer_samples_is_not_kept():
     first = _result(jumped)
     assert rejoin.rejoined(targets, np.zeros(2), first, 0.2, run) is first
     assert rejoin.rejoined(targets, np.zeros(2), first, None, run) is first  # no jump limit: no jumps to undo
+
+
+def _run_at(robot):
+    chain_model(robot)
+
+    def run(targets, start, toward):
+        return follow(robot, targets, start, 1e-6, 1e-6, 200, None, FRDMOptions(), seed=0, toward=toward)
+    return run
+
+
+def test_a_paths_pace_is_its_typical_joint_step():
+    """A straight joint-space line moves its joints by the same step every sample: the pilot pass (one sample in ten)
+    measures that step within a factor of two (the follower's own self-motion is not the line's)."""
+    from helpers import joint_line
+
+    from kinelab.ik.frdm.follower import path_pace
+
+    for name, seed in (("panda", 0), ("xarm7", 1), ("baxter_left", 2)):
+        robot = kinelab.load(name)
+        path = joint_line(robot, np.random.default_rng(seed))
+        own = np.abs(np.diff(path, axis=0)).max()
+        targets = robot.fk_batch(path)
+        arrays = TargetArrays(np.ascontiguousarray(targets[:, :3, 3]), np.ascontiguousarray(targets[:, :3, :3]))
+        pace = path_pace(arrays, path[0], _run_at(robot))
+        assert 0.5 * own <= pace <= 2.0 * own, (name, pace, own)
+        short = TargetArrays(arrays.points[:19], arrays.rotations[:19])
+        assert path_pace(short, path[0], _run_at(robot)) == 0.0  # too short to measure: no pace

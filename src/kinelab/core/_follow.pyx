@@ -31,10 +31,11 @@ from kinelab.core._geometry cimport rotm
 cdef double TRUST_FLOOR = 0.02
 cdef double TRUST_FACTOR = 2.0
 cdef int SWEEPS_PER_LOOK = 32  # a phase's sweeps between two looks at the clock
-# a redundant arm's push away from its limits moves no joint by more than PUSH_FLOOR + PUSH_SHARE × the largest joint
-# step the task itself asks of the sample [rad or m]: the self-motion it steers stays as smooth as the path (uncapped,
-# a path starting at rest moved joints 18 times faster than the path itself did; capped by the last sample's whole
-# step, the push fed on itself)
+# a redundant arm's push away from its limits moves no joint by more than PUSH_FLOOR + the larger of PUSH_SHARE × the
+# largest joint step the task itself asks of the sample and the path's pace (its typical joint step) [rad or m]: the
+# self-motion it steers stays as smooth as the path (uncapped, a path starting at rest moved joints 18 times faster
+# than the path itself did; capped by the last sample's whole step, the push fed on itself), and where the path slows
+# down (the ends of a blend) the arm can still turn away from a limit at the path's usual pace
 cdef double PUSH_FLOOR = 1e-5
 cdef double PUSH_SHARE = 0.5
 # [1/rad or 1/m] the push's soft minimum of the margins: a joint whose margin is within about 1/MARGIN_SOFTNESS of the
@@ -54,6 +55,7 @@ cdef struct Follow:
     int lm_iterations
     double deadline  # [s] on time.perf_counter()'s clock (inf: none)
     const double* toward  # (N, n) per sample, the configuration the null-space term draws towards (NULL: the push)
+    double pace  # [rad or m] the path's typical joint step: the null-space term may always move a joint this far
 
 
 cdef inline double _max(double a, double b) noexcept nogil:
@@ -129,15 +131,16 @@ cdef void _solve6(const double* A, const double* b, double* x, double* F, int* p
 
 
 cdef int redundant_newton(double* q, const Chain* ch, const Objective* pb, int iterations, double max_step,
-                          const double* toward, int* spent) noexcept nogil:
+                          const double* toward, double pace, int* spent) noexcept nogil:
     """Damped Gauss–Newton steps in their minimum-norm form, dq = Jᵀ(JJᵀ + λI)⁻¹ err, the first plus the projection
     onto the task's null space of a push away from the limits (:func:`_push_from_limits`): a redundant arm's
     self-motion turns away from its limits instead of drifting into one; with ``toward`` (not NULL) a draw towards
     that configuration instead (z = toward − q), which brings the self-motion to a path followed from elsewhere.
+    The null-space share moves no joint by more than PUSH_FLOOR + max(PUSH_SHARE × the task's share, ``pace``).
     Steps capped at ``max_step`` [rad or m]. Returns CONVERGED or −1, the steps in ``spent``; q is updated in
     place."""
     cdef int n = ch.n, it, i, six = 6, one_i = 1
-    cdef double one = 1.0, zero = 0.0, damping, largest, task, pushed, scale
+    cdef double one = 1.0, zero = 0.0, damping, largest, task, pushed, cap, scale
     cdef char t = b't', nt = b'n'
     cdef double p[3]
     cdef double R[9]
@@ -191,7 +194,8 @@ cdef int redundant_newton(double* q, const Chain* ch, const Objective* pb, int i
         for i in range(n):
             b[i] = z[i] - b[i]  # the push's share in the task's null space
             task, pushed = _max(task, fabs(a[i])), _max(pushed, fabs(b[i]))
-        scale = 1.0 if pushed <= PUSH_FLOOR + PUSH_SHARE * task else (PUSH_FLOOR + PUSH_SHARE * task) / pushed
+        cap = PUSH_FLOOR + _max(PUSH_SHARE * task, pace)
+        scale = 1.0 if pushed <= cap else cap / pushed
         largest = 0.0
         for i in range(n):
             a[i] += scale * b[i]
@@ -297,7 +301,7 @@ cdef int _predicted(double* q, const double* q_good, const double* velocity, con
     for i in range(ch.n):
         q[i] = _min(_max(q_good[i] + carry * velocity[i], pb.lower[i]), pb.upper[i])
     if fw.w_rest > 0.0:
-        return redundant_newton(q, ch, &aim, 2 * fw.st.finish_steps, trust, toward, spent)
+        return redundant_newton(q, ch, &aim, 2 * fw.st.finish_steps, trust, toward, fw.pace, spent)
     return lm_polish(q, ch, &aim, 2 * fw.st.finish_steps, trust, spent)
 
 
@@ -430,7 +434,8 @@ cdef void _follow(double* Q, int count, const double* q0, const Chain* ch, const
 def follow(double[:, ::1] Q, const double[::1] q0, chain, objective, const double[:, ::1] pstars,
            const double[:, :, ::1] Rstars, settings, int order, int max_sweeps, double w_rest, int rest_sweeps,
            const double[::1] centre, double pull, int lm_iterations, unsigned long long[::1] rng_state,
-           double deadline, long long[::1] codes, long long[::1] sweeps, const double[:, ::1] toward=None):
+           double deadline, long long[::1] codes, long long[::1] sweeps, const double[:, ::1] toward=None,
+           double pace=0.0):
     """Solve sample k of the path (pstars[k], Rstars[k]) from the last reached configuration (q0 at first).
 
     Args:
@@ -449,6 +454,8 @@ def follow(double[:, ::1] Q, const double[::1] q0, chain, objective, const doubl
         codes, sweeps: (N,) out: run() code (NOT_STARTED −2 past the deadline) and sweeps spent per sample.
         toward: (N, n) per sample, the configuration a redundant arm's null-space term draws towards in place of
             the push from the limits (None, or a NaN row: the push).
+        pace: the path's typical joint step [rad or m]: a redundant arm's null-space term may always move a joint
+            this far a sample (0: only its share of the task's own step).
     """
     cdef Packed packed = Packed(chain, objective, settings)
     cdef int n = packed.n, count = Q.shape[0], rows = packed.st.accel_m + 1
@@ -463,6 +470,7 @@ def follow(double[:, ::1] Q, const double[::1] q0, chain, objective, const doubl
     fw.st, fw.order, fw.max_sweeps, fw.w_rest, fw.rest_sweeps = &packed.st, order, max_sweeps, w_rest, rest_sweeps
     fw.centre, fw.pull, fw.lm_iterations, fw.deadline = &centre[0], pull, lm_iterations, deadline
     fw.toward = NULL if toward is None or count == 0 else &toward[0, 0]
+    fw.pace = pace if pace > 0.0 else 0.0
     cdef double* work = <double*> calloc(12 * n + 12 + 2 * rows * n + STATE_SIZE + 3 * (2 * n + 4), sizeof(double))
     if work == NULL:
         raise MemoryError("the path follower's work arrays")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -30,7 +31,7 @@ CENTRE_PULL = 0.01  # share of the way from the previous answer to mid-range tak
 def follow(robot: Chain, targets: TargetArrays, q0: np.ndarray, tol_pos: float, tol_rot: float, max_sweeps: int,
            rest_weight: float | None, opts: FRDMOptions, task: Task = POSE, seed: int | None = None,
            time_budget: float | None = None, t_start: float | None = None,
-           toward: np.ndarray | None = None) -> TrackResult:
+           toward: np.ndarray | None = None, pace: float = 0.0) -> TrackResult:
     """Solve every sample of a path in the compiled follower; each answer judged by Pinocchio.
 
     Args:
@@ -49,6 +50,8 @@ def follow(robot: Chain, targets: TargetArrays, q0: np.ndarray, tol_pos: float, 
         t_start: the ``time.perf_counter()`` value the budget counts from (None: now).
         toward: (N, n) per sample, the configuration [rad or m] a redundant arm's self-motion is drawn towards in
             place of the push from its limits (None, or a NaN row: the push); :mod:`kinelab.ik.frdm.rejoin`.
+        pace: the path's typical joint step [rad or m]: a redundant arm's null-space term may always move a joint
+            this far a sample (0: only half the task's own step); :func:`path_pace`.
 
     Returns:
         A :class:`~kinelab.ik.frdm.tracking.TrackResult` with mode "frdm (compiled follower)". Continuous
@@ -66,11 +69,30 @@ def follow(robot: Chain, targets: TargetArrays, q0: np.ndarray, tol_pos: float, 
                    np.ascontiguousarray(points, dtype=float), np.ascontiguousarray(rotations, dtype=float),
                    opts.settings(), order, int(max_sweeps), float(rest_weight), REST_SWEEPS, _centre(cm, q0),
                    CENTRE_PULL, LM_ITERATIONS if opts.polish else 0, seed_state(seed), deadline, codes, sweeps,
-                   None if toward is None else np.ascontiguousarray(toward, dtype=float))
+                   None if toward is None else np.ascontiguousarray(toward, dtype=float), float(pace))
     dp, dr, ok = judged_path(robot, Q, points, rotations, task, tol_pos, tol_rot)
     per_sample = (time.perf_counter() - t0) / count  # the kernel and Pinocchio's check of every answer
     return TrackResult(Q, dp, dr, _statuses(ok, codes), sweeps, np.full(count, per_sample), _stall_events(codes), [],
                        mode=opts.label + ("+lm" if opts.polish else "") + " (compiled follower)")
+
+
+PILOT_STRIDE = 10  # the pilot pass that measures a path's pace solves one sample in this many
+
+
+def path_pace(targets: TargetArrays, q0: np.ndarray,
+              run: Callable[[TargetArrays, np.ndarray, np.ndarray | None], TrackResult]) -> float:
+    """A path's typical joint step [rad or m]: the median joint step of a pilot pass of the follower (``run``: targets,
+    start, toward → its path) over one sample in :data:`PILOT_STRIDE`, divided by the stride; 0 for a path too short
+    to measure or a pilot that meets no sample. A redundant arm's self-motion may turn this far a sample wherever the
+    path itself slows down (:func:`follow`'s ``pace``)."""
+    points, rotations = targets
+    if points.shape[0] < 2 * PILOT_STRIDE:
+        return 0.0
+    pilot = TargetArrays(np.ascontiguousarray(points[::PILOT_STRIDE]), np.ascontiguousarray(rotations[::PILOT_STRIDE]))
+    path = run(pilot, q0, None)
+    steps = np.abs(np.diff(np.vstack([q0[None, :], path.q]), axis=0)).max(axis=1)
+    met = steps[path.status_code == Status.CONVERGED.code]
+    return float(np.median(met)) / PILOT_STRIDE if met.size else 0.0
 
 
 def effective_rest_weight(robot: Chain, rest_weight: float | None) -> float:

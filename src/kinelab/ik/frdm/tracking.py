@@ -28,7 +28,7 @@ from kinelab.core._chain import rotation_steps, running_events
 from kinelab.errors import OptionError
 from kinelab.ik import options as opt
 from kinelab.ik.frdm import solver
-from kinelab.ik.frdm.follower import effective_rest_weight, follow
+from kinelab.ik.frdm.follower import effective_rest_weight, follow, path_pace
 from kinelab.ik.frdm.options import FRDMOptions
 from kinelab.ik.frdm.rejoin import rejoined
 from kinelab.ik.limits import wrap_q
@@ -115,19 +115,43 @@ def run_track(robot: Chain, targets: TargetArrays, q0: np.ndarray, req: Request,
     return followed
 
 
+# a paced path whose largest joint step is above FAST × its pace is followed again without the pace, and the smoother
+# of the two kept: near a singular configuration the paced push can hold the arm where the task's own step is large
+FAST = 6.0
+
+
 def _compiled(robot: Chain, targets: TargetArrays, q0: np.ndarray, req: Request, settings: PathSettings,
               t_start: float | None) -> TrackResult:
-    """The compiled follower's path; on a redundant arm each jump undone where :mod:`kinelab.ik.frdm.rejoin` can."""
+    """The compiled follower's path. On a redundant arm the path's pace is measured first (a pilot pass,
+    :func:`~kinelab.ik.frdm.follower.path_pace`) and given to the push; each jump is undone where
+    :mod:`kinelab.ik.frdm.rejoin` can; a path that then turns a joint faster than :data:`FAST` × its pace is
+    followed again without the pace, and the one with the smaller largest step kept (if it meets as many samples)."""
     opts: FRDMOptions = req.options
 
-    def run(path: TargetArrays, start: np.ndarray, toward: np.ndarray | None) -> TrackResult:
-        return follow(robot, path, start, req.tol_pos, req.tol_rot, opts.sweep_cap, settings.rest_weight, opts,
-                      req.task, req.seed, req.time_budget, t_start, toward)
+    def at(pace: float) -> Callable[[TargetArrays, np.ndarray, np.ndarray | None], TrackResult]:
+        def run(path: TargetArrays, start: np.ndarray, toward: np.ndarray | None) -> TrackResult:
+            return follow(robot, path, start, req.tol_pos, req.tol_rot, opts.sweep_cap, settings.rest_weight, opts,
+                          req.task, req.seed, req.time_budget, t_start, toward, pace)
+        return run
 
-    followed = run(targets, q0, None)
-    if effective_rest_weight(robot, settings.rest_weight) > 0.0:
-        followed = rejoined(targets, q0, followed, settings.jump_limit, run)
-    return followed
+    if effective_rest_weight(robot, settings.rest_weight) <= 0.0:
+        return at(0.0)(targets, q0, None)
+    pace = path_pace(targets, q0, at(0.0))
+    paced = rejoined(targets, q0, at(pace)(targets, q0, None), settings.jump_limit, at(pace))
+    if not pace > 0.0 or _largest_step(paced, q0) <= FAST * pace:
+        return paced
+    plain = rejoined(targets, q0, at(0.0)(targets, q0, None), settings.jump_limit, at(0.0))
+    met = Status.CONVERGED.code
+    if np.sum(plain.status_code == met) >= np.sum(paced.status_code == met) \
+            and _largest_step(plain, q0) < _largest_step(paced, q0):
+        return plain
+    return paced
+
+
+def _largest_step(path: TrackResult, q0: np.ndarray) -> float:
+    """The largest joint step [rad or m] between two samples of the path (q0 before the first), NaN rows skipped."""
+    steps = np.abs(np.diff(np.vstack([q0[None, :], path.q]), axis=0)).max(axis=1)
+    return float(np.nanmax(steps)) if np.isfinite(steps).any() else 0.0
 
 
 def mark_jumps(path: TrackResult, q0: np.ndarray, jump_limit: float | None) -> None:
