@@ -28,6 +28,10 @@ LM_ITERATIONS = 20  # Levenberg–Marquardt steps of the polish (mode "frdm+lm")
 CENTRE_PULL = 0.01  # share of the way from the previous answer to mid-range taken as the rest configuration
 
 
+Run = Callable[[TargetArrays, np.ndarray, "np.ndarray | None"], TrackResult]
+"""The follower with a path's settings fixed: (targets, start, toward) → its path (:func:`follow`'s ``toward``)."""
+
+
 def follow(robot: Chain, targets: TargetArrays, q0: np.ndarray, tol_pos: float, tol_rot: float, max_sweeps: int,
            rest_weight: float | None, opts: FRDMOptions, task: Task = POSE, seed: int | None = None,
            time_budget: float | None = None, t_start: float | None = None,
@@ -79,8 +83,7 @@ def follow(robot: Chain, targets: TargetArrays, q0: np.ndarray, tol_pos: float, 
 PILOT_STRIDE = 10  # the pilot pass that measures a path's pace solves one sample in this many
 
 
-def path_pace(targets: TargetArrays, q0: np.ndarray,
-              run: Callable[[TargetArrays, np.ndarray, np.ndarray | None], TrackResult]) -> float:
+def path_pace(targets: TargetArrays, q0: np.ndarray, run: Run) -> float:
     """A path's typical joint step [rad or m]: the median joint step of a pilot pass of the follower (``run``: targets,
     start, toward → its path) over one sample in :data:`PILOT_STRIDE`, divided by the stride; 0 for a path too short
     to measure or a pilot that meets no sample. A redundant arm's self-motion may turn this far a sample wherever the
@@ -90,9 +93,14 @@ def path_pace(targets: TargetArrays, q0: np.ndarray,
         return 0.0
     pilot = TargetArrays(np.ascontiguousarray(points[::PILOT_STRIDE]), np.ascontiguousarray(rotations[::PILOT_STRIDE]))
     path = run(pilot, q0, None)
-    steps = np.abs(np.diff(np.vstack([q0[None, :], path.q]), axis=0)).max(axis=1)
-    met = steps[path.status_code == Status.CONVERGED.code]
+    met = steps_from(q0, path.q)[path.status_code == Status.CONVERGED.code]
     return float(np.median(met)) / PILOT_STRIDE if met.size else 0.0
+
+
+def steps_from(q0: np.ndarray, Q: np.ndarray) -> np.ndarray:
+    """(K,) each row's largest joint step [rad or m] from the row before (q0 before the first); NaN rows give NaN."""
+    steps: np.ndarray = np.abs(np.diff(np.vstack([np.asarray(q0, dtype=float)[None, :], Q]), axis=0)).max(axis=1)
+    return steps
 
 
 def effective_rest_weight(robot: Chain, rest_weight: float | None) -> float:

@@ -13,16 +13,13 @@ the first and jumps fewer times.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import numpy as np
 
+from kinelab.ik.frdm.follower import Run
 from kinelab.ik.result import Status, TrackResult
 from kinelab.ik.targets import TargetArrays
 
 MAX_REJOINS = 4  # jumps undone on one path, each a backward and a forward pass of the compiled follower
-
-Run = Callable[[TargetArrays, np.ndarray, "np.ndarray | None"], TrackResult]
 
 
 def rejoined(targets: TargetArrays, q0: np.ndarray, followed: TrackResult, jump_limit: float | None,
@@ -56,11 +53,13 @@ def rejoined(targets: TargetArrays, q0: np.ndarray, followed: TrackResult, jump_
 def first_jump(path: TrackResult, q0: np.ndarray, jump_limit: float) -> int | None:
     """The first met sample reached by a joint step above ``jump_limit`` [rad or m] from the last met sample before
     it (q0 before the first), or None."""
-    jumps = _jumps(path, q0, jump_limit)
+    jumps = jumped(path, q0, jump_limit)
     return int(jumps[0]) if jumps.size else None
 
 
-def _jumps(path: TrackResult, q0: np.ndarray, jump_limit: float) -> np.ndarray:
+def jumped(path: TrackResult, q0: np.ndarray, jump_limit: float) -> np.ndarray:
+    """The met samples reached by a joint step above ``jump_limit`` [rad or m] from the last met sample before each
+    (q0 before the first): a missed sample is skipped, as a controller holds where it was."""
     met = np.flatnonzero(path.status_code == Status.CONVERGED.code)
     if met.size == 0:
         return met
@@ -75,7 +74,7 @@ def _rejoin(targets: TargetArrays, q0: np.ndarray, followed: TrackResult, k: int
     points, rotations = targets
     back_targets = TargetArrays(np.ascontiguousarray(points[k::-1]), np.ascontiguousarray(rotations[k::-1]))
     back = run(back_targets, followed.q[k], None)
-    if not np.all(back.status_code == Status.CONVERGED.code) or _jumps(back, followed.q[k], jump_limit).size:
+    if not np.all(back.status_code == Status.CONVERGED.code) or jumped(back, followed.q[k], jump_limit).size:
         return None
     toward = np.full_like(followed.q, np.nan)
     toward[: k + 1] = back.q[::-1]
@@ -85,4 +84,4 @@ def _rejoin(targets: TargetArrays, q0: np.ndarray, followed: TrackResult, k: int
 def _better(again: TrackResult, followed: TrackResult, q0: np.ndarray, jump_limit: float) -> bool:
     met = Status.CONVERGED.code
     return bool(np.sum(again.status_code == met) >= np.sum(followed.status_code == met)
-                and _jumps(again, q0, jump_limit).size < _jumps(followed, q0, jump_limit).size)
+                and jumped(again, q0, jump_limit).size < jumped(followed, q0, jump_limit).size)

@@ -28,9 +28,9 @@ from kinelab.core._chain import rotation_steps, running_events
 from kinelab.errors import OptionError
 from kinelab.ik import options as opt
 from kinelab.ik.frdm import solver
-from kinelab.ik.frdm.follower import effective_rest_weight, follow, path_pace
+from kinelab.ik.frdm.follower import Run, effective_rest_weight, follow, path_pace, steps_from
 from kinelab.ik.frdm.options import FRDMOptions
-from kinelab.ik.frdm.rejoin import rejoined
+from kinelab.ik.frdm.rejoin import jumped, rejoined
 from kinelab.ik.limits import wrap_q
 from kinelab.ik.registry import SolverOptions
 from kinelab.ik.request import Request
@@ -128,7 +128,7 @@ def _compiled(robot: Chain, targets: TargetArrays, q0: np.ndarray, req: Request,
     followed again without the pace, and the one with the smaller largest step kept (if it meets as many samples)."""
     opts: FRDMOptions = req.options
 
-    def at(pace: float) -> Callable[[TargetArrays, np.ndarray, np.ndarray | None], TrackResult]:
+    def at(pace: float) -> Run:
         def run(path: TargetArrays, start: np.ndarray, toward: np.ndarray | None) -> TrackResult:
             return follow(robot, path, start, req.tol_pos, req.tol_rot, opts.sweep_cap, settings.rest_weight, opts,
                           req.task, req.seed, req.time_budget, t_start, toward, pace)
@@ -138,19 +138,19 @@ def _compiled(robot: Chain, targets: TargetArrays, q0: np.ndarray, req: Request,
         return at(0.0)(targets, q0, None)
     pace = path_pace(targets, q0, at(0.0))
     paced = rejoined(targets, q0, at(pace)(targets, q0, None), settings.jump_limit, at(pace))
-    if not pace > 0.0 or _largest_step(paced, q0) <= FAST * pace:
+    largest = _largest_step(paced, q0)
+    if not pace > 0.0 or largest <= FAST * pace:
         return paced
     plain = rejoined(targets, q0, at(0.0)(targets, q0, None), settings.jump_limit, at(0.0))
     met = Status.CONVERGED.code
-    if np.sum(plain.status_code == met) >= np.sum(paced.status_code == met) \
-            and _largest_step(plain, q0) < _largest_step(paced, q0):
+    if np.sum(plain.status_code == met) >= np.sum(paced.status_code == met) and _largest_step(plain, q0) < largest:
         return plain
     return paced
 
 
 def _largest_step(path: TrackResult, q0: np.ndarray) -> float:
     """The largest joint step [rad or m] between two samples of the path (q0 before the first), NaN rows skipped."""
-    steps = np.abs(np.diff(np.vstack([q0[None, :], path.q]), axis=0)).max(axis=1)
+    steps = steps_from(q0, path.q)
     return float(np.nanmax(steps)) if np.isfinite(steps).any() else 0.0
 
 
@@ -161,10 +161,7 @@ def mark_jumps(path: TrackResult, q0: np.ndarray, jump_limit: float | None) -> N
     where it jumped to."""
     if jump_limit is None or path.q.shape[0] == 0:
         return
-    met = np.flatnonzero(path.status_code == Status.CONVERGED.code)
-    before = np.vstack([np.asarray(q0, dtype=float)[None, :], path.q[met[:-1]]])  # each met sample's last met one
-    steps = np.abs(path.q[met] - before).max(axis=1) if met.size else np.empty(0)
-    path.status_code[met[steps > jump_limit]] = Status.JUMP.code
+    path.status_code[jumped(path, np.asarray(q0, dtype=float), jump_limit)] = Status.JUMP.code
 
 
 SELF_MOTION = 5.0  # a self-motion event: the joints' drift along the task's null space beyond 5 × the path's step
@@ -237,7 +234,7 @@ def jump_events(Q: np.ndarray, q0: np.ndarray, jump_limit: float | None) -> list
     ``jump_limit`` [rad or m] (None: none); samples left unsolved (NaN) are skipped."""
     if jump_limit is None or Q.shape[0] == 0:
         return []
-    steps = np.abs(np.diff(np.vstack([q0, Q]), axis=0)).max(axis=1)
+    steps = steps_from(q0, Q)
     return [SingularEvent("jump", sample=int(k), max_joint_step=float(steps[k]))
             for k in np.flatnonzero(np.nan_to_num(steps, nan=0.0) > jump_limit)]
 
