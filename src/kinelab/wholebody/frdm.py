@@ -114,7 +114,7 @@ def sweep(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, joints: list[Tre
         pin.framesForwardKinematics(robot.model, data, q)
         has_com = any(t.uses_com for t in tasks)
         com = pin.centerOfMass(robot.model, data, q) if has_com else None
-        _move_base(robot, q, task_points(robot, tasks, data, com))
+        move_base(robot, q, task_points(robot, tasks, data, com))
     _couple(robot, tasks, q)
 
 
@@ -235,7 +235,7 @@ def _axis(robot: Robot, joint: TreeJoint) -> np.ndarray:
     return robot._derived[key]
 
 
-def _move_base(robot: Robot, q: np.ndarray, points: Points) -> None:
+def move_base(robot: Robot, q: np.ndarray, points: Points) -> None:
     """The free-flyer's optimal rigid motion for every task point (weighted Procrustes), applied to q[:7]."""
     if not len(points.w):
         return

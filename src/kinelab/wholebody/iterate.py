@@ -51,10 +51,11 @@ class SolveSettings:
         opt.positive("damping", self.damping, zero=True)
 
 
-def posture_second(tasks: tuple[Task, ...]) -> tuple[Task, ...]:
+def posture_second(tasks: tuple[Task, ...], pull: bool = True) -> tuple[Task, ...]:
     """The tasks as a converged solve asks for them (:meth:`~kinelab.wholebody.tasks.Task.second`: every posture
-    second, priority 2), so that it meets the others exactly."""
-    return tuple(t.second() for t in tasks)
+    second, priority 2), so that it meets the others exactly; without ``pull``, every posture holds the joints where
+    they are (the converged solve's first phase)."""
+    return tuple(t.second(pull) for t in tasks)
 
 
 def iterate(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, settings: SolveSettings, limits: Limits,
@@ -88,6 +89,35 @@ def iterate(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, settings: Solv
         accepted, share = (q, result.q, merit), 1.0
         q = result.q
     return q, settings.max_iterations, Status.MAX_ITERATIONS
+
+
+def lean(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, settings: SolveSettings, limits: Limits,
+         deadline: float) -> tuple[np.ndarray, int]:
+    """From a q that meets the tasks, towards the postures they leave room for: LEAN_STEPS times, one step with the
+    postures pulling (the tasks held to first order), then the tasks met again with the postures holding still.
+
+    Returns:
+        (the last q that met every task — q itself when the first lean does not come back —, steps taken).
+    """
+    if not any(t.preference for t in tasks):
+        return q, 0
+    pulled, held = posture_second(tasks), posture_second(tasks, pull=False)
+    options = StepOptions(damping=settings.damping)
+    limits = replace(limits, velocity=settings.max_step) if limits.velocity is None else limits
+    used = 0
+    for _ in range(LEAN_STEPS):
+        moved = _step(robot, q, pulled, 1.0, limits, options, None)
+        if not moved.solved:
+            break
+        again, steps, status = iterate(robot, held, moved.q, settings, limits, deadline)
+        used += steps + 1
+        if status is not Status.CONVERGED:
+            break
+        q = again
+    return q, used
+
+
+LEAN_STEPS = 2
 
 
 def _toward(robot: Robot, q: np.ndarray, q_full: np.ndarray, share: float) -> np.ndarray:

@@ -25,9 +25,10 @@ from kinelab.robot.chain import Chain
 from kinelab.robot.space import generator
 from kinelab.robot.tree import Robot
 from kinelab.typing import Configuration
+from kinelab.wholebody.approach import approached
 from kinelab.wholebody.constraints import Inequality, loops
 from kinelab.wholebody.frdm import frdm_solve
-from kinelab.wholebody.iterate import SolveSettings, iterate, posture_second
+from kinelab.wholebody.iterate import SolveSettings, iterate, lean, posture_second
 from kinelab.wholebody.limits import Limits
 from kinelab.wholebody.subject import as_robot
 from kinelab.wholebody.tasks import Task, as_tasks
@@ -125,13 +126,11 @@ def _run(robot: Robot, tasks: tuple[Task, ...], start: np.ndarray, settings: Sol
     t0 = time.perf_counter()
     deadline = math.inf if settings.time_budget is None else t0 + settings.time_budget
     rng = generator(seed)
-    ordered = posture_second(tasks)
     best: tuple[tuple[float, float], np.ndarray, Status] | None = None
     iterations, restarts = 0, 0
-    q = start
+    q = approached(robot, tasks, start, deadline)
     while True:
-        q, used, status = _converge(robot, tasks if settings.solver == "frdm" else ordered, q, settings, limits,
-                                    deadline)
+        q, used, status = _converge(robot, tasks, q, settings, limits, deadline)
         iterations += used
         verdicts = judge(robot, tasks, q, settings.tol_pos, settings.tol_rot)
         score = (_penetration(robot, q, limits), _score(verdicts))  # a clear answer before any in collision
@@ -144,6 +143,7 @@ def _run(robot: Robot, tasks: tuple[Task, ...], start: np.ndarray, settings: Sol
         for task in tasks:
             if task.settled:  # a restart starts on the robot's loops, as the mechanism would
                 task.project(robot, q)
+        q = approached(robot, tasks, q, deadline)
     _, q, status = best
     result = _result(robot, tasks, q, status, settings, iterations, restarts, time.perf_counter() - t0)
     held = limits.held()
@@ -155,7 +155,11 @@ def _converge(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, settings: So
     """One start run to convergence by the chosen solver: (q, iterations, status)."""
     if settings.solver == "frdm":
         return frdm_solve(robot, tasks, q, settings, deadline)
-    return iterate(robot, tasks, q, settings, limits, deadline)
+    q, used, status = iterate(robot, posture_second(tasks, pull=False), q, settings, limits, deadline)
+    if status is not Status.CONVERGED:
+        return q, used, status
+    q, more = lean(robot, tasks, q, settings, limits, deadline)
+    return q, used + more, status
 
 
 def _result(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, status: Status, settings: SolveSettings,

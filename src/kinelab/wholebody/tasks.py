@@ -47,6 +47,17 @@ T_RELATIVE, T_COM = 4, 5
 
 
 @dataclass(frozen=True)
+class Placement:
+    """A frame a task places outright in the world: its name, its target oM* and which part of it the task asks for
+    (``kind``: "pose", "position", "axis" or "orientation"; ``axis``: the frame axis of kind "axis")."""
+
+    frame: str
+    target: pin.SE3
+    kind: str
+    axis: str
+
+
+@dataclass(frozen=True)
 class TaskError:
     """One task's error at a configuration: position [m] and rotation [rad] (0 where the task has none; a posture's
     and a coupling's in ``position``, their largest joint gap [rad or m])."""
@@ -104,13 +115,19 @@ class Task(ABC):
     def judged(self, robot: Robot, data: pin.Data, q: np.ndarray, com: np.ndarray | None) -> tuple[float, float]:
         """(position [m], rotation [rad]) error at q from Pinocchio's placements in ``data`` (and ``com``)."""
 
+    def placement(self) -> Placement | None:
+        """The frame this task places outright in the world, for the converged solve's first move
+        (:mod:`~kinelab.wholebody.approach`); None: it places none (the default)."""
+        return None
+
     def project(self, robot: Robot, q: np.ndarray) -> bool:
         """Make q meet the task exactly where it can be set outright (a coupling; q changed in place); whether q
         meets it now as far as setting goes (False: the setting failed and q is unchanged)."""
         return True  # a task met only by moving toward it: nothing to set
 
-    def second(self) -> Task:
-        """The task as the converged solve asks for it (a posture: second, so that it never holds a task off)."""
+    def second(self, pull: bool = True) -> Task:
+        """The task as the converged solve asks for it (a posture: second, so that it never holds a task off; with
+        ``pull`` False, holding the joints where they are instead of pulling them to its reference)."""
         return self
 
     def moved(self, target: Any) -> Task:
@@ -290,6 +307,10 @@ class FrameTask(_Frame):
     def points(self, robot: Robot, data: pin.Data, com: np.ndarray | None) -> list[PointRow]:
         """The origin (unless only the orientation is asked for) and the axes the task constrains."""
         return frame_points(robot, self, data, self.target, -1, self.task, self.axis)
+
+    def placement(self) -> Placement:
+        """The frame, its target and the part of it asked for."""
+        return Placement(self.frame, self.target, self.task, self.axis)
 
     def judged(self, robot: Robot, data: pin.Data, q: np.ndarray, com: np.ndarray | None) -> tuple[float, float]:
         """The frame's errors by Pinocchio's placement."""
@@ -621,9 +642,9 @@ class PostureTask(Task):
         """The largest gap it pulls (never a verdict: a posture is a preference)."""
         return float(np.abs(self.error_at(robot, q)[self.mask(robot)]).max(initial=0.0)), 0.0
 
-    def second(self) -> PostureTask:
-        """Asked for second, in what the other tasks leave free."""
-        return replace(self, priority=2)
+    def second(self, pull: bool = True) -> PostureTask:
+        """Asked for second, in what the other tasks leave free (gain 0 without ``pull``: held where it is)."""
+        return replace(self, priority=2) if pull else replace(self, priority=2, gain=0.0)
 
 
 def _per_velocity(robot: Robot, weight: float | np.ndarray) -> np.ndarray:
