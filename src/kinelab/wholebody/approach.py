@@ -5,14 +5,15 @@ its joint limits.
 From the start it is given: (1) the base takes the rigid motion that best fits every task point (FRDM's weighted
 Procrustes on the free-flyer, :mod:`kinelab.wholebody.frdm`); (2) each limb whose end a task places outright
 (:meth:`~kinelab.wholebody.tasks.Task.placement`) is solved alone, as an arm from the link it hangs from, by
-kinelab's single-chain IK from the limb's own joints (no random start: the answer nearest where the limb is);
+FRDM from the limb's own joints (one start, no random one: the limb goes where its joints lead from where it is;
+the held joint's closed form, ``auto``'s route on a 7R arm, met as many targets at twice the time);
 (3) the base is shifted by what the centre of mass still misses and the limbs are solved again. A limb is the run of
 joints from the root to its task frame that no other placed frame's run shares (a humanoid's legs from the pelvis,
 its arms from the torso); joints shared by several limbs (a torso) are left to the iterations, and so is every
 task that places no frame outright (a centre of mass, a posture, a frame in another frame).
 
 Robots with loops or folded mimic joints are left as they are: a limb solved alone would break what they hold.
-docs/methods.md §3.4.
+docs/wholebody.md, "The converged solve".
 """
 
 from __future__ import annotations
@@ -125,7 +126,7 @@ def _solve_limbs(robot: Robot, placed: list[tuple[Placement, Limb]], q: np.ndarr
         lo, hi = limb.chain.model.lowerPositionLimit, limb.chain.model.upperPositionLimit
         start = np.clip(limb.chain.from_pin_q(q[limb.index]), lo, hi)
         try:
-            found = solve(limb.chain, oMbase.actInv(placement.target), q0=start, seed=0, max_restarts=0,
+            found = solve(limb.chain, oMbase.actInv(placement.target), q0=start, seed=0, max_restarts=0, solver="frdm",
                           time_budget=min(LIMB_BUDGET, left), task=placement.kind, axis=placement.axis)
         except KinelabError:
             continue  # a limb its solver refuses (a target it cannot take) is left to the iterations

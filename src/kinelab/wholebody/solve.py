@@ -2,8 +2,11 @@
 
 Two solvers. "step": the differential step iterated at dt = 1 s with full gain (a Gauss–Newton step of every task
 at once, within the position limits), the posture asked for second (in the null space of the rest, so that it
-never holds a task off its target). "frdm": FRDM carried to the tree (:mod:`kinelab.wholebody.frdm`). Either
-restarts from random configurations (the base left where the start has it) when it stalls, within the budget.
+never holds a task off its target): held still while the tasks converge, leaned towards once they are met
+(:func:`~kinelab.wholebody.iterate.lean`). "frdm": FRDM carried to the tree (:mod:`kinelab.wholebody.frdm`).
+On a free-flyer robot either starts with the first move (:mod:`kinelab.wholebody.approach`: the base and the
+limbs brought to the tasks), and restarts from random configurations (the base left where the start has it, then
+the same move) when it stalls, within the budget.
 
 A task is met when its error is within ``tol_pos`` [m] and ``tol_rot`` [rad] (a posture is a preference: never
 judged; a coupling within ``tol_pos``); the answer is a success when every task is met within the limits.
