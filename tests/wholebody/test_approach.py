@@ -91,3 +91,30 @@ def test_a_fixed_base_robot_is_left_where_it_starts():
     q = baxter.random_q(1)
     goal = baxter.frame_placements(baxter.random_q(2), ["left_gripper"])[0]
     assert np.array_equal(approached(baxter, (FrameTask("left_gripper", goal),), q), q)
+
+
+def test_the_solves_compiled_step_answers_as_the_readable_one_for_its_own_targets():
+    """Two steppers of one task structure (one compiled problem kept on the robot) with different targets, called in
+    turn: each answers as the readable step does for its own targets — the same errors at the start (1e-9: its own
+    targets, never the other's), the task frames where the readable step puts them (1e-6 m; the joints only the
+    damping decides may differ by as much, as tests/wholebody/test_whole_body_step.py allows)."""
+    from kinelab.wholebody.iterate import stepper
+    from kinelab.wholebody.step import StepOptions, _step
+
+    talos = kinelab.load("talos")
+    start, rng = talos.standing(), np.random.default_rng(5)
+    limits, options = Limits(velocity=1.0), StepOptions(damping=1e-6)
+    task_sets = [posture_second(tasks_at(talos, talos.random_q(rng), start), pull=False) for _ in range(2)]
+    steps = [stepper(talos, tasks, limits, options) for tasks in task_sets]
+    q = start.copy()
+    for k in range(6):
+        tasks, step = task_sets[k % 2], steps[k % 2]
+        fast, readable = step(q), _step(talos, q, tasks, 1.0, limits, options, None)
+        assert fast.solved and readable.solved
+        assert all(abs(a.position - b.position) <= 1e-9 and abs(a.rotation - b.rotation) <= 1e-9
+                   for a, b in zip(fast.errors, readable.errors, strict=True))
+        frames = FRAMES["talos"]
+        for A, B in zip(talos.frame_placements(fast.q, frames), talos.frame_placements(readable.q, frames),
+                        strict=True):
+            assert np.linalg.norm(A.translation - B.translation) <= 1e-6
+        q = fast.q

@@ -9,13 +9,25 @@ limits held exactly, one differential step (a QP), and the converged solve.
 - :mod:`~kinelab.wholebody.qp`: the QP (DAQP, or ProxQP).
 - :mod:`~kinelab.wholebody.step`: the step's QP (the readable step, its options and result).
 - :mod:`~kinelab.wholebody.problem`: :class:`WholeBody`, a problem prepared once, and :func:`step`.
+- :mod:`~kinelab.wholebody.approach`: the converged solve's first move (the base and the limbs to the tasks).
+- :mod:`~kinelab.wholebody.solve`: the converged solve.
 """
 
 from kinelab.wholebody.constraints import CouplingTask, Held, Inequality
 from kinelab.wholebody.limits import JointLimits, Limits
 from kinelab.wholebody.problem import WholeBody, step
 from kinelab.wholebody.step import StepOptions, StepResult
-from kinelab.wholebody.tasks import ComTask, DampingTask, FrameTask, PostureTask, RelativeFrameTask, Task, TaskError
+from kinelab.wholebody.tasks import (
+    ComTask,
+    DampingTask,
+    FrameTask,
+    Placement,
+    PostureTask,
+    RelativeFrameTask,
+    Task,
+    TaskError,
+)
 
 __all__ = ["ComTask", "CouplingTask", "DampingTask", "FrameTask", "Held", "Inequality", "JointLimits", "Limits",
-           "PostureTask", "RelativeFrameTask", "StepOptions", "StepResult", "Task", "TaskError", "WholeBody", "step"]
+           "Placement", "PostureTask", "RelativeFrameTask", "StepOptions", "StepResult", "Task", "TaskError",
+           "WholeBody", "step"]

@@ -19,6 +19,7 @@ import pinocchio as pin
 from kinelab.core import _body
 from kinelab.robot.tree import Robot
 from kinelab.wholebody.qp import Outcome as Outcome  # the step's flags, read as cp.Outcome
+from kinelab.wholebody.step import StepResult
 from kinelab.wholebody.tasks import Task
 
 CERTIFY_SAMPLES = 20
@@ -281,3 +282,43 @@ def set_targets(robot: Robot, packed: Packed, tasks: tuple[Task, ...]) -> None:
     """Each task's target (and the posture's reference) written into the packed problem."""
     for task, slot in zip(tasks, packed.slots, strict=True):
         task.refresh(packed, robot, slot)
+
+
+NOT_A_CONFIGURATION, SOLVED, SOLVED_SOFT = (int(Outcome.NOT_A_CONFIGURATION), int(Outcome.SOLVED),
+                                             int(Outcome.SOLVED_SOFT))  # plain ints: read on every step
+NO_LIMIT = np.empty(0)
+
+
+def packed_for(robot: Robot, tasks: tuple[Task, ...], solver: str) -> Packed | None:
+    """The compiled problem of the tasks, or None where the compiled step does not serve (a QP solver other than
+    DAQP, DAQP not linked, a tree or a task it has no code for)."""
+    if solver != "daqp" or not daqp_linked():
+        return None
+    tree = robot.derived("compiled tree", pack_tree)
+    return None if tree is None else pack(robot, tree, tasks)
+
+
+def run(packed: Packed, robot: Robot, q: np.ndarray, dt: float, bounds: tuple[np.ndarray, bool, np.ndarray],
+        prev: np.ndarray | None, damping: float) -> StepResult | None:
+    """One compiled step from q (nq contiguous float64 numbers) with the targets packed: the readable step's answer,
+    or None for a q it leaves the readable step to check and name.
+
+    Args:
+        packed: the problem (:func:`packed_for`, its targets set).
+        robot: its robot.
+        q: the start (Pinocchio's q).
+        dt: the step [s].
+        bounds: (the velocity bounds (nv), whether positions are held, the acceleration bounds (nv, or empty)).
+        prev: the velocity before the step (nv), or None.
+        damping: the QP's damping.
+    """
+    vmax, position, amax = bounds
+    q_out, v_out, errors = np.empty(robot.nq), np.empty(robot.nv), np.zeros((len(packed.labels), 2))
+    returning = np.empty(robot.nv, dtype=np.uint8)
+    flag, iterations = packed.step.step(q, dt, vmax, position, amax, NO_LIMIT if prev is None else prev, damping,
+                                        q_out, v_out, errors, returning)
+    if flag == NOT_A_CONFIGURATION:
+        return None
+    solved = flag == SOLVED or flag == SOLVED_SOFT  # the usual answer read without making an Outcome
+    return StepResult(v_out, q_out, "solved" if solved else Outcome(flag).words, solved, errors,
+                      returning.view(bool), iterations, packed.labels, robot.space.names_v)

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -15,8 +16,9 @@ import pinocchio as pin
 from kinelab.ik import options as opt
 from kinelab.ik.result import Status
 from kinelab.robot.tree import Robot
-from kinelab.wholebody.limits import Limits
-from kinelab.wholebody.step import StepOptions, _step
+from kinelab.wholebody import compiled as cp
+from kinelab.wholebody.limits import Limits, acceleration_bounds, velocity_bounds
+from kinelab.wholebody.step import StepOptions, StepResult, _step
 from kinelab.wholebody.tasks import Task, TaskError
 
 SOLVERS = ("step", "frdm")
@@ -65,12 +67,13 @@ def iterate(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, settings: Solv
     the same direction from where it started: full Gauss–Newton steps circle a solution near a singularity."""
     options = StepOptions(damping=settings.damping)
     limits = replace(limits, velocity=settings.max_step) if limits.velocity is None else limits
+    step = stepper(robot, tasks, limits, options)
     accepted: tuple[np.ndarray, np.ndarray, float] | None = None  # (q, its full step's q, merit)
     share, still, best = 1.0, 0, math.inf
     for k in range(settings.max_iterations):
         if time.perf_counter() > deadline:
             return q, k, Status.TIME_BUDGET
-        result = _step(robot, q, tasks, 1.0, limits, options, None)
+        result = step(q)
         size, merit = _size(result.errors, tasks, settings)
         if size <= 1.0:
             return q, k, Status.CONVERGED
@@ -106,7 +109,7 @@ def lean(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, settings: SolveSe
     limits = replace(limits, velocity=settings.max_step) if limits.velocity is None else limits
     used = 0
     for _ in range(LEAN_STEPS):
-        moved = _step(robot, q, pulled, 1.0, limits, options, None)
+        moved = stepper(robot, pulled, limits, options)(q)
         if not moved.solved:
             break
         again, steps, status = iterate(robot, held, moved.q, settings, limits, deadline)
@@ -118,6 +121,40 @@ def lean(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, settings: SolveSe
 
 
 LEAN_STEPS = 2
+
+
+def stepper(robot: Robot, tasks: tuple[Task, ...], limits: Limits, options: StepOptions
+            ) -> Callable[[np.ndarray], StepResult]:
+    """The step at dt = 1 s for these tasks, as a function of q: the compiled one (the readable one's answers, in one
+    call; its problem packed once per task structure and kept on the robot, the targets written at each call) where
+    it serves, else the readable one (:mod:`kinelab.wholebody.step`)."""
+    packed = _kept_packed(robot, tasks, options) if limits.compiled and not (robot.closures or robot.mimics) \
+        else None
+    if packed is None or acceleration_bounds(limits, robot.space) is not None:
+        return lambda q: _step(robot, q, tasks, 1.0, limits, options, None)
+    bounds = (np.ascontiguousarray(velocity_bounds(limits, robot.space), dtype=float), limits.position, cp.NO_LIMIT)
+
+    def step(q: np.ndarray) -> StepResult:
+        cp.set_targets(robot, packed, tasks)  # another solve of the same structure may have written its own
+        found = cp.run(packed, robot, np.ascontiguousarray(q, dtype=float), 1.0, bounds, None, options.damping)
+        return _step(robot, q, tasks, 1.0, limits, options, None) if found is None else found
+
+    return step
+
+
+def _kept_packed(robot: Robot, tasks: tuple[Task, ...], options: StepOptions) -> cp.Packed | None:
+    """The compiled problem of this task structure (None: the compiled step does not serve it), packed once."""
+    table: dict[tuple[object, ...], cp.Packed | None] = robot.derived("converged solve's compiled problems",
+                                                                       lambda _: {})
+    key = (cp.structure(tasks), options.solver)
+    if key not in table:
+        if len(table) >= KEPT:
+            table.clear()
+        table[key] = cp.packed_for(robot, tasks, options.solver)
+    return table[key]
+
+
+KEPT = 32  # task structures kept per robot (a caller sweeping weights: the memory stays bounded)
 
 
 def _toward(robot: Robot, q: np.ndarray, q_full: np.ndarray, share: float) -> np.ndarray:

@@ -35,9 +35,7 @@ if TYPE_CHECKING:
     from kinelab.typing import Configuration
     from kinelab.wholebody.solve import WholeBodyResult
 
-NOT_A_CONFIGURATION, SOLVED, SOLVED_SOFT = (int(cp.Outcome.NOT_A_CONFIGURATION), int(cp.Outcome.SOLVED),
-                                             int(cp.Outcome.SOLVED_SOFT))  # plain ints: read on every step
-NO_LIMIT = np.empty(0)
+NO_LIMIT = cp.NO_LIMIT
 
 
 class WholeBody:
@@ -186,20 +184,11 @@ class WholeBody:
     def _compiled_step(self, q: Any, dt: float, prev: np.ndarray | None) -> StepResult | None:
         """The step in one compiled call, or None where it does not serve (a q to check and name first, an
         acceleration limit without the velocity before)."""
-        packed, robot, arr = self._packed, self.robot, _plain(q, self.robot.nq)
-        limits = self.limits
+        packed, arr, limits = self._packed, _plain(q, self.robot.nq), self.limits
         if packed is None or arr is None or (self._amax.size and prev is None) or not limits.compiled:
             return None
-        q_out, v_out, errors = np.empty(robot.nq), np.empty(robot.nv), np.zeros((len(packed.labels), 2))
-        returning = np.empty(robot.nv, dtype=np.uint8)
-        flag, iterations = packed.step.step(arr, dt, self._vmax, limits.position, self._amax,
-                                            NO_LIMIT if prev is None else prev, self.options.damping, q_out, v_out,
-                                            errors, returning)
-        if flag == NOT_A_CONFIGURATION:
-            return None
-        solved = flag == SOLVED or flag == SOLVED_SOFT  # the usual answer read without making an Outcome
-        return StepResult(v_out, q_out, "solved" if solved else cp.Outcome(flag).words, solved, errors,
-                          returning.view(bool), iterations, packed.labels, robot.space.names_v)
+        return cp.run(packed, self.robot, arr, dt, (self._vmax, limits.position, self._amax), prev,
+                      self.options.damping)
 
     def set_target(self, task: Task | int, target: Any) -> Task:
         """Move one task's target (the task given, or its index in :attr:`tasks`): the task is replaced by
@@ -284,12 +273,8 @@ def _plain(q: Any, nq: int) -> np.ndarray | None:
 
 
 def _packed(robot: Robot, tasks: tuple[Task, ...], options: StepOptions) -> cp.Packed | None:
-    """The compiled problem of the tasks, or None where the compiled step does not serve (another QP solver, DAQP
-    not linked, a tree or a task it has no code for)."""
-    if options.solver != "daqp" or not cp.daqp_linked():
-        return None
-    tree = robot.derived("compiled tree", cp.pack_tree)
-    return None if tree is None else cp.pack(robot, tree, tasks)
+    """The compiled problem of the tasks (:func:`~kinelab.wholebody.compiled.packed_for`)."""
+    return cp.packed_for(robot, tasks, options.solver)
 
 
 def step(robot: Robot | Chain, q: Configuration, tasks: Task | Sequence[Task], dt: float, *,

@@ -131,7 +131,7 @@ def _run(robot: Robot, tasks: tuple[Task, ...], start: np.ndarray, settings: Sol
     rng = generator(seed)
     best: tuple[tuple[float, float], np.ndarray, Status] | None = None
     iterations, restarts = 0, 0
-    q = approached(robot, tasks, start, deadline)
+    q = _approached(robot, tasks, start, limits, deadline)
     while True:
         q, used, status = _converge(robot, tasks, q, settings, limits, deadline)
         iterations += used
@@ -146,7 +146,7 @@ def _run(robot: Robot, tasks: tuple[Task, ...], start: np.ndarray, settings: Sol
         for task in tasks:
             if task.settled:  # a restart starts on the robot's loops, as the mechanism would
                 task.project(robot, q)
-        q = approached(robot, tasks, q, deadline)
+        q = _approached(robot, tasks, q, limits, deadline)
     _, q, status = best
     result = _result(robot, tasks, q, status, settings, iterations, restarts, time.perf_counter() - t0)
     held = limits.held()
@@ -173,6 +173,16 @@ def _result(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, status: Status
     within = robot.within_limits(q)
     final = Status.CONVERGED if met and within else Status.OUTSIDE_LIMITS if met else status
     return WholeBodyResult(q, met and within, final, verdicts, iterations, restarts, seconds, settings.solver)
+
+
+def _approached(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, limits: Limits, deadline: float
+                ) -> np.ndarray:
+    """The first move from q (:mod:`~kinelab.wholebody.approach`), kept only where it breaks the inequalities held
+    (a plane, a collision pair) no deeper than q does: the limbs are solved alone, blind to them."""
+    moved = approached(robot, tasks, q, deadline)
+    if moved is q or not limits.held():
+        return moved
+    return moved if _penetration(robot, moved, limits) <= _penetration(robot, q, limits) else q
 
 
 def _penetration(robot: Robot, q: np.ndarray, limits: Limits) -> float:
