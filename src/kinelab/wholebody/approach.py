@@ -96,7 +96,6 @@ def _spread(p: np.ndarray) -> bool:
     if len(p) < 3:
         return False
     return bool(np.linalg.svd(p - p.mean(axis=0), compute_uv=False)[1] > 1e-3)
-    return True
 
 
 def _shift_to_com(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, data: pin.Data) -> bool:
