@@ -5,8 +5,7 @@ its joint limits.
 From the start it is given: (1) the base takes the rigid motion that best fits every task point (FRDM's weighted
 Procrustes on the free-flyer, :mod:`kinelab.wholebody.frdm`); (2) each limb whose end a task places outright
 (:meth:`~kinelab.wholebody.tasks.Task.placement`) is solved alone, as an arm from the link it hangs from, by
-FRDM from the limb's own joints (one start, no random one: the limb goes where its joints lead from where it is;
-the held joint's closed form, ``auto``'s route on a 7R arm, met as many targets at twice the time);
+FRDM from the limb's own joints (one start, no random one: the limb goes where its joints lead from where it is);
 (3) the base is shifted by what the centre of mass still misses and the limbs are solved again. A limb is the run of
 joints from the root to its task frame that no other placed frame's run shares (a humanoid's legs from the pelvis,
 its arms from the torso); joints shared by several limbs (a torso) are left to the iterations, and so is every
