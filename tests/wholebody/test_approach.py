@@ -15,7 +15,8 @@ from kinelab.wholebody.limits import Limits
 
 FRAMES = {"talos": ("left_sole_link", "right_sole_link", "gripper_left_base_link", "gripper_right_base_link"),
           "g1": ("left_ankle_roll_link", "right_ankle_roll_link", "left_wrist_yaw_link", "right_wrist_yaw_link"),
-          "icub": ("l_sole", "r_sole", "l_hand", "r_hand")}
+          "icub": ("l_sole", "r_sole", "l_hand", "r_hand"),
+          "romeo": ("l_sole", "r_sole", "LWristYawLink", "RWristYawLink")}
 
 
 def tasks_at(robot, q, posture):
@@ -93,18 +94,21 @@ def test_a_fixed_base_robot_is_left_where_it_starts():
     assert np.array_equal(approached(baxter, (FrameTask("left_gripper", goal),), q), q)
 
 
-def test_the_solves_compiled_step_answers_as_the_readable_one_for_its_own_targets():
+@pytest.mark.parametrize("name", ["talos", "romeo"])  # Romeo's fingers: 22 folded mimic joints (the readable step)
+def test_the_solves_compiled_step_answers_as_the_readable_one_for_its_own_targets(name):
     """Two steppers of one task structure (one compiled problem kept on the robot) with different targets, called in
     turn: each answers as the readable step does for its own targets — the same errors at the start (1e-9: its own
     targets, never the other's), the task frames where the readable step puts them (1e-6 m; the joints only the
     damping decides may differ by as much, as tests/wholebody/test_whole_body_step.py allows)."""
+    from kinelab.wholebody.constraints import loops
     from kinelab.wholebody.iterate import stepper
     from kinelab.wholebody.step import StepOptions, _step
 
-    talos = kinelab.load("talos")
+    talos = kinelab.load(name)
     start, rng = talos.standing(), np.random.default_rng(5)
     limits, options = Limits(velocity=1.0), StepOptions(damping=1e-6)
-    task_sets = [posture_second(tasks_at(talos, talos.random_q(rng), start), pull=False) for _ in range(2)]
+    task_sets = [posture_second(tasks_at(talos, talos.random_q(rng), start), pull=False) + loops(talos)
+                 for _ in range(2)]
     steps = [stepper(talos, tasks, limits, options) for tasks in task_sets]
     q = start.copy()
     for k in range(6):
@@ -113,7 +117,7 @@ def test_the_solves_compiled_step_answers_as_the_readable_one_for_its_own_target
         assert fast.solved and readable.solved
         assert all(abs(a.position - b.position) <= 1e-9 and abs(a.rotation - b.rotation) <= 1e-9
                    for a, b in zip(fast.errors, readable.errors, strict=True))
-        frames = FRAMES["talos"]
+        frames = FRAMES[name]
         for A, B in zip(talos.frame_placements(fast.q, frames), talos.frame_placements(readable.q, frames),
                         strict=True):
             assert np.linalg.norm(A.translation - B.translation) <= 1e-6

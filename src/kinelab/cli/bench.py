@@ -145,7 +145,7 @@ def _add_instead(s: argparse.ArgumentParser) -> None:
                         "--robots among them): paths met without a jump or a drift, µs per sample")
     s.add_argument("--standing-solve", action="store_true",
                    help="instead of the arm protocol: the converged whole-body solve from where each humanoid "
-                        "stands (talos, g1, icub; --robots among them), --n targets each: met, met without a "
+                        "stands (talos, g1, icub, romeo; --robots among them), --n targets each: met, met without a "
                         "restart, median time")
     s.add_argument("--closed", action="store_true",
                    help="instead of the arm protocol: the step on robots that close loops (fourbar, ankle, cassie) "

@@ -11,7 +11,8 @@ joints from the root to its task frame that no other placed frame's run shares (
 its arms from the torso); joints shared by several limbs (a torso) are left to the iterations, and so is every
 task that places no frame outright (a centre of mass, a posture, a frame in another frame).
 
-Robots with loops or folded mimic joints are left as they are: a limb solved alone would break what they hold.
+Robots with loops are left as they are, and so is a limb with a folded mimic joint (a follower or a leader): a
+limb solved alone would break what they hold.
 docs/wholebody.md, "The converged solve".
 """
 
@@ -45,7 +46,7 @@ class Limb:
 
 def approached(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, deadline: float = math.inf) -> np.ndarray:
     """q with its base and limbs brought to the tasks (see the module's docstring); q itself where there is nothing to
-    bring (a fixed base, a robot with loops or mimic joints, no task with points).
+    bring (a fixed base, a robot with loops, no task with points).
 
     Args:
         robot: the whole robot.
@@ -56,7 +57,7 @@ def approached(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, deadline: f
     Returns:
         A new configuration within the joint limits the limbs' solves hold (the base and shared joints as moved).
     """
-    if not robot.floating or robot.mimics or robot.closures:
+    if not robot.floating or robot.closures:
         return q
     q = np.array(q, dtype=float)
     data = robot.model.createData()
@@ -150,8 +151,9 @@ def _build_limb(robot: Robot, frame: str, frames: tuple[str, ...]) -> Limb | Non
                 if j > 0 and model.joints[j].nq == model.joints[j].nv == 1}
 
     own = sorted(path(frame) - set().union(set(), *(path(f) for f in frames if f != frame)))
-    if not own or any(model.parents[own[k]] != own[k - 1] for k in range(1, len(own))):
-        return None  # a limb's joints run one after the other
+    coupled = {model.getJointId(n) for m in robot.mimics for n in (m.name, m.leader) if model.existJointName(n)}
+    if not own or coupled & set(own) or any(model.parents[own[k]] != own[k - 1] for k in range(1, len(own))):
+        return None  # a limb's joints run one after the other, none held to another by a mimic
     parent = model.parents[own[0]]
     base = next((f.name for f in model.frames if f.parentJoint == parent and f.type == pin.FrameType.BODY
                  and f.placement.isIdentity()), None)

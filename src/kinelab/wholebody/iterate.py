@@ -129,7 +129,7 @@ def stepper(robot: Robot, tasks: tuple[Task, ...], limits: Limits, options: Step
     call; its problem packed once per task structure and kept on the robot, the targets written at each call) where
     it serves, else the readable one (:mod:`kinelab.wholebody.step`)."""
     packed = _kept_packed(robot, tasks, options) if limits.compiled and not (robot.closures or robot.mimics) \
-        else None
+        else None  # a robot's couplings: its compiled step is WholeBody's, which brings q onto them first
     if packed is None or acceleration_bounds(limits, robot.space) is not None:
         return lambda q: _step(robot, q, tasks, 1.0, limits, options, None)
     bounds = (np.ascontiguousarray(velocity_bounds(limits, robot.space), dtype=float), limits.position, cp.NO_LIMIT)

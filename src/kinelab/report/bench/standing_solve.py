@@ -1,9 +1,10 @@
 """``kinelab bench --standing-solve``: the converged whole-body solve from where a humanoid stands.
 
-Per humanoid — TALOS from its SRDF's half-sitting, G1 from its file's keyframe, iCub (not used in tuning) from
-``robot.standing()`` — ``--n`` targets, each the hands' and feet's placements and the centre of mass of a seeded
-random configuration (its base where :meth:`random_q` puts it, not the start's), solved by :func:`kinelab.solve`
-from the standing pose with a posture at weight 1e-6 and a 1 s budget, judged by Pinocchio (1e-6 m, 1e-6 rad).
+Per humanoid — TALOS from its SRDF's half-sitting, G1 from its file's keyframe, iCub and Romeo (Romeo used in no
+tuning; its fingers are 22 folded mimic joints) from ``robot.standing()`` — ``--n`` targets, each the hands' and
+feet's placements and the centre of mass of a seeded random configuration (its base where :meth:`random_q` puts
+it, not the start's), solved by :func:`kinelab.solve` from the standing pose with a posture at weight 1e-6 and a
+1 s budget, judged by Pinocchio (1e-6 m, 1e-6 rad).
 Per robot: the share met, the share met without a random restart (the answer continuous with the start), the
 median and 95th-percentile time, and how the misses ended.
 """
@@ -22,7 +23,8 @@ from kinelab.wholebody.api import solve
 from kinelab.wholebody.tasks import ComTask, FrameTask, PostureTask, Task
 
 HUMANOIDS = {"talos": SCENARIOS["talos"], "g1": SCENARIOS["g1"],
-             "icub": Scenario("icub", ("l_hand", "r_hand"), ("l_sole", "r_sole"), True)}
+             "icub": Scenario("icub", ("l_hand", "r_hand"), ("l_sole", "r_sole"), True),
+             "romeo": Scenario("romeo", ("LWristYawLink", "RWristYawLink"), ("l_sole", "r_sole"), True)}
 BUDGET = 1.0  # [s] per target
 
 
