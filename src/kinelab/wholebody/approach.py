@@ -28,6 +28,7 @@ import pinocchio as pin
 from kinelab.errors import KinelabError
 from kinelab.robot.chain import Chain
 from kinelab.robot.tree import Robot
+from kinelab.wholebody.evaluate import kept_data
 from kinelab.wholebody.frdm import move_base, task_points
 from kinelab.wholebody.tasks import Placement, Task
 
@@ -60,7 +61,7 @@ def approached(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, deadline: f
     if not robot.floating or robot.closures:
         return q
     q = np.array(q, dtype=float)
-    data = robot.model.createData()
+    data = kept_data(robot, "the first move")
     if not _fit_base(robot, tasks, q, data):
         return q
     placements = _placements(tasks)
@@ -117,11 +118,11 @@ def _solve_limbs(robot: Robot, placed: list[tuple[Placement, Limb]], q: np.ndarr
     placement in that link's frame, the single-chain solve's answer (met or not) written back."""
     from kinelab.ik.api import solve  # the single-chain solvers: imported when a whole-body solve first needs them
 
-    for placement, limb in placed:
+    bases = robot.frame_placements(q, [limb.base for _, limb in placed])  # no limb moves another's base link
+    for (placement, limb), oMbase in zip(placed, bases, strict=True):
         left = deadline - time.perf_counter()
         if left <= 0.0:
             return
-        oMbase = robot.frame_placements(q, [limb.base])[0]
         lo, hi = limb.chain.model.lowerPositionLimit, limb.chain.model.upperPositionLimit
         start = np.clip(limb.chain.from_pin_q(q[limb.index]), lo, hi)
         try:
@@ -150,7 +151,7 @@ def _build_limb(robot: Robot, frame: str, frames: tuple[str, ...]) -> Limb | Non
         return {j for j in model.supports[model.frames[robot.frame_id(name)].parentJoint]
                 if j > 0 and model.joints[j].nq == model.joints[j].nv == 1}
 
-    own = sorted(path(frame) - set().union(set(), *(path(f) for f in frames if f != frame)))
+    own = sorted(path(frame) - set().union(*(path(f) for f in frames if f != frame)))
     coupled = {model.getJointId(n) for m in robot.mimics for n in (m.name, m.leader) if model.existJointName(n)}
     if not own or coupled & set(own) or any(model.parents[own[k]] != own[k - 1] for k in range(1, len(own))):
         return None  # a limb's joints run one after the other, none held to another by a mimic

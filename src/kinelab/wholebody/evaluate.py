@@ -99,6 +99,13 @@ def skew(a: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
 
 
+def kept_data(robot: Robot, purpose: str) -> pin.Data:
+    """A Pinocchio Data of the robot's model kept on the robot for one ``purpose`` (its user computes what it reads
+    first): making one costs milliseconds on a humanoid, too much to pay on every solve."""
+    found: pin.Data = robot.derived(f"data for {purpose}", lambda r: r.model.createData())
+    return found
+
+
 def forward(robot: Robot, q: np.ndarray, com: bool) -> None:
     """Pinocchio's pass at q: joint placements and Jacobians, frame placements, and with ``com`` the centre of mass
     and its Jacobian (in ``robot.data``)."""

@@ -65,8 +65,7 @@ def iterate(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, settings: Solv
     """The step at dt = 1 s, full gain, until the tasks are met, it stalls, or the iterations or time run out. A step
     that does not lower the merit (Σ of every error squared, each in units of its tolerance) is cut in half along
     the same direction from where it started: full Gauss–Newton steps circle a solution near a singularity."""
-    options = StepOptions(damping=settings.damping)
-    limits = replace(limits, velocity=settings.max_step) if limits.velocity is None else limits
+    options, limits = _setup(settings, limits)
     step = stepper(robot, tasks, limits, options)
     accepted: tuple[np.ndarray, np.ndarray, float] | None = None  # (q, its full step's q, merit)
     share, still, best = 1.0, 0, math.inf
@@ -104,12 +103,12 @@ def lean(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, settings: SolveSe
     """
     if not any(t.preference for t in tasks):
         return q, 0
-    pulled, held = posture_second(tasks), posture_second(tasks, pull=False)
-    options = StepOptions(damping=settings.damping)
-    limits = replace(limits, velocity=settings.max_step) if limits.velocity is None else limits
+    held = posture_second(tasks, pull=False)
+    options, limits = _setup(settings, limits)
+    pull = stepper(robot, posture_second(tasks), limits, options)
     used = 0
     for _ in range(LEAN_STEPS):
-        moved = stepper(robot, pulled, limits, options)(q)
+        moved = pull(q)
         if not moved.solved:
             break
         again, steps, status = iterate(robot, held, moved.q, settings, limits, deadline)
@@ -123,13 +122,20 @@ def lean(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, settings: SolveSe
 LEAN_STEPS = 2
 
 
+def _setup(settings: SolveSettings, limits: Limits) -> tuple[StepOptions, Limits]:
+    """The step's options and limits at dt = 1 s: the settings' damping, and the settings' cap on each joint's change
+    an iteration where the limits set no velocity (velocities mean nothing at dt = 1 s)."""
+    return StepOptions(damping=settings.damping), (replace(limits, velocity=settings.max_step)
+                                                   if limits.velocity is None else limits)
+
+
 def stepper(robot: Robot, tasks: tuple[Task, ...], limits: Limits, options: StepOptions
             ) -> Callable[[np.ndarray], StepResult]:
     """The step at dt = 1 s for these tasks, as a function of q: the compiled one (the readable one's answers, in one
     call; its problem packed once per task structure and kept on the robot, the targets written at each call) where
     it serves, else the readable one (:mod:`kinelab.wholebody.step`)."""
     packed = _kept_packed(robot, tasks, options) if limits.compiled and not (robot.closures or robot.mimics) \
-        else None  # a robot's couplings: its compiled step is WholeBody's, which brings q onto them first
+        else None  # a robot's couplings as tasks: the readable step (docs/bench/standing-approach-2026-12-07.md)
     if packed is None or acceleration_bounds(limits, robot.space) is not None:
         return lambda q: _step(robot, q, tasks, 1.0, limits, options, None)
     bounds = (np.ascontiguousarray(velocity_bounds(limits, robot.space), dtype=float), limits.position, cp.NO_LIMIT)

@@ -30,6 +30,7 @@ from kinelab.robot.tree import Robot
 from kinelab.typing import Configuration
 from kinelab.wholebody.approach import approached
 from kinelab.wholebody.constraints import Inequality, loops
+from kinelab.wholebody.evaluate import kept_data
 from kinelab.wholebody.frdm import frdm_solve
 from kinelab.wholebody.iterate import SolveSettings, iterate, lean, posture_second
 from kinelab.wholebody.limits import Limits
@@ -224,7 +225,7 @@ def judge(robot: Robot, tasks: tuple[Task, ...], q: np.ndarray, tol_pos: float, 
           ) -> tuple[TaskVerdict, ...]:
     """Each task's errors at q by Pinocchio's own FK (``framesForwardKinematics``) and centre of mass
     (``centerOfMass``), and whether they are within tolerance (a preference — a posture — is never judged: met)."""
-    model, data = robot.model, robot.model.createData()
+    model, data = robot.model, kept_data(robot, "the solve's verdict")
     pin.framesForwardKinematics(model, data, q)
     com = pin.centerOfMass(model, data, q) if any(t.uses_com for t in tasks) else None
     out = []
